@@ -1,0 +1,2 @@
+"""`make demo`: placeholder until the reaching demo lands."""
+print("demo: not yet available")
