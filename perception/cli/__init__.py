@@ -19,7 +19,7 @@ import sys
 from minvar import __version__
 
 #: Subcommand modules, in the order ``--help`` lists them.
-COMMANDS: tuple[str, ...] = ()
+COMMANDS = ("reach",)
 
 
 class _Parser(argparse.ArgumentParser):

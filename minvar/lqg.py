@@ -1,0 +1,508 @@
+"""Todorov's (2005) LQG with signal-dependent noise.
+
+The model (Todorov 2005, Neural Computation 17:1084; thesis eqs. 3.8-3.17)::
+
+    x[t+1]    = A x[t] + B (u[t] + sum_i eps_i C_i u[t]) + C0 xi[t]
+    y[t]      = H x[t] + sum_j eta_j D_j x[t] + D0 w[t]
+    xhat[t+1] = A xhat[t] + B u[t] + K[t] (y[t] - H xhat[t]) + E0 v[t]
+    u[t]      = -L[t] xhat[t]
+    cost      = E[ sum_{t<T} (x' Q[t] x + u' R u) + x[T]' Q[T] x[T] ]
+
+with ``eps_i, eta_j`` scalar and ``xi, w, v`` vector standard normal noise, and
+``x[0] ~ N(X1, S1)``, ``xhat[0] = X1``. ``C_i`` are m x m (the thesis's C is
+``B C_i``). The filter ``K`` and controller ``L`` are found by alternating a
+forward pass (``K`` optimal for the current ``L``; the first pass uses
+``L = 0``) and a backward pass (``L`` optimal for the current ``K``) until the
+expected cost stops changing.
+
+This is a line-by-line port of Todorov's ``kalman_lqg.m``; it reproduces that
+code's ``K``, ``L``, expected trajectory and cost per iteration (see
+``tests/test_lqg.py`` and ``shared/reference``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.linalg.lapack import dposv as _dposv
+
+__all__ = ["LQGProblem", "LQGSolution", "solve", "expected_cost", "state_moments"]
+
+
+def _as_matrix(name: str, value, shape: tuple[int | None, ...]) -> np.ndarray:
+    """Convert ``value`` to a finite float array of ``shape`` (None = any size)."""
+    arr = np.array(value, dtype=float)
+    if arr.ndim != len(shape) or any(s is not None and s != a for s, a in zip(shape, arr.shape)):
+        want = "(" + ", ".join("*" if s is None else str(s) for s in shape) + ")"
+        raise ValueError(f"LQGProblem.{name}: expected shape {want}, got {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"LQGProblem.{name}: contains non-finite values (NaN or inf)")
+    arr.setflags(write=False)
+    return arr
+
+
+def _as_stack(name: str, value, shape: tuple[int, int], what: str) -> np.ndarray:
+    """A sequence of matrices of one ``shape`` as a read-only (count, *shape) array."""
+    mats = [np.asarray(v, dtype=float) for v in value] if value is not None else []
+    for i, m in enumerate(mats):
+        if m.shape != shape:
+            raise ValueError(
+                f"LQGProblem.{name}[{i}]: expected shape {shape} ({what}), got {m.shape}"
+            )
+    arr = np.stack(mats) if mats else np.zeros((0, *shape))
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"LQGProblem.{name}: contains non-finite values (NaN or inf)")
+    arr.setflags(write=False)
+    return arr
+
+
+@dataclass(frozen=True, eq=False)
+class LQGProblem:
+    """A finite-horizon LQG problem with signal-dependent noise.
+
+    Shapes use n states, m controls, k observations, T steps.
+
+    Parameters
+    ----------
+    A : (n, n) array
+        State dynamics.
+    B : (n, m) array
+        Control input.
+    C : sequence of (m, m) arrays
+        Control-dependent noise: ``B C_i u`` scaled by a standard normal scalar.
+    C0 : (n, p) array
+        Additive process noise.
+    H : (k, n) array
+        Observation matrix.
+    D : sequence of (k, n) arrays
+        State-dependent observation noise: ``D_j x`` scaled by a standard normal scalar.
+    D0 : (k, q) array
+        Additive observation noise.
+    E0 : (n, e) array
+        Internal (estimation) noise added to the estimate.
+    Q : (T+1, n, n) array
+        State cost for x[0] .. x[T].
+    R : (m, m) array
+        Control cost per step.
+    X1 : (n,) array
+        Mean initial state (also the initial estimate).
+    S1 : (n, n) array
+        Covariance of the initial state.
+    """
+
+    A: np.ndarray
+    B: np.ndarray
+    C: np.ndarray
+    C0: np.ndarray
+    H: np.ndarray
+    D: np.ndarray
+    D0: np.ndarray
+    E0: np.ndarray
+    Q: np.ndarray
+    R: np.ndarray
+    X1: np.ndarray
+    S1: np.ndarray
+
+    def __post_init__(self):
+        A = _as_matrix("A", self.A, (None, None))
+        n = A.shape[0]
+        if A.shape != (n, n):
+            raise ValueError(f"LQGProblem.A: expected a square (n, n) matrix, got {A.shape}")
+        B = np.array(self.B, dtype=float)
+        if B.ndim != 2 or B.shape[0] != n:
+            raise ValueError(
+                f"LQGProblem.B: expected shape ({n}, m) to match A {A.shape}, got {B.shape}"
+            )
+        m = B.shape[1]
+        B = _as_matrix("B", B, (n, m))
+        H = np.array(self.H, dtype=float)
+        if H.ndim != 2 or H.shape[1] != n:
+            raise ValueError(
+                f"LQGProblem.H: expected shape (k, {n}) to match A {A.shape}, got {H.shape}"
+            )
+        k = H.shape[0]
+        H = _as_matrix("H", H, (k, n))
+        Q = np.array(self.Q, dtype=float)
+        if Q.ndim != 3 or Q.shape[1:] != (n, n) or Q.shape[0] < 2:
+            raise ValueError(
+                f"LQGProblem.Q: expected shape (T+1, {n}, {n}) with T >= 1, got {Q.shape}"
+            )
+        values = {
+            "A": A,
+            "B": B,
+            "C": _as_stack("C", self.C, (m, m), "m x m"),
+            "C0": _as_matrix("C0", self.C0, (n, None)),
+            "H": H,
+            "D": _as_stack("D", self.D, (k, n), "k x n"),
+            "D0": _as_matrix("D0", self.D0, (k, None)),
+            "E0": _as_matrix("E0", self.E0, (n, None)),
+            "Q": _as_matrix("Q", Q, Q.shape),
+            "R": _as_matrix("R", self.R, (m, m)),
+            "X1": _as_matrix("X1", np.ravel(self.X1), (n,)),
+            "S1": _as_matrix("S1", self.S1, (n, n)),
+        }
+        for key, val in values.items():
+            object.__setattr__(self, key, val)
+
+    @property
+    def n_states(self) -> int:
+        """Number of states n."""
+        return self.A.shape[0]
+
+    @property
+    def n_controls(self) -> int:
+        """Number of controls m."""
+        return self.B.shape[1]
+
+    @property
+    def n_outputs(self) -> int:
+        """Number of observations k."""
+        return self.H.shape[0]
+
+    @property
+    def horizon(self) -> int:
+        """Number of control steps T (states x[0] .. x[T])."""
+        return self.Q.shape[0] - 1
+
+
+@dataclass(frozen=True, eq=False)
+class LQGSolution:
+    """Filter and controller gains of an :class:`LQGProblem`.
+
+    Attributes
+    ----------
+    K : (T, n, k) array
+        Filter gains.
+    L : (T, m, n) array
+        Control gains, ``u[t] = -L[t] xhat[t]``.
+    cost : float
+        Expected cost of the returned ``K`` and ``L``.
+    cost_history : (iterations,) array
+        Expected cost after each iteration.
+    iterations : int
+        Forward/backward iterations run.
+    converged : bool
+        Whether the cost change fell below the tolerance before ``max_iter``.
+    mean_states : (T+1, n) array
+        Expected state trajectory with no noise (``xhat = x``).
+    """
+
+    K: np.ndarray
+    L: np.ndarray
+    cost: float
+    cost_history: np.ndarray
+    iterations: int
+    converged: bool
+    mean_states: np.ndarray = field(repr=False)
+
+
+def _is_positive_definite(M: np.ndarray) -> bool:
+    """True if ``M`` is safely invertible as a symmetric positive definite matrix."""
+    if M.size == 0:
+        return False
+    w = np.linalg.eigvalsh(0.5 * (M + M.T))
+    return bool(w[0] > 1e-12 * max(w[-1], np.finfo(float).tiny))
+
+
+class _Solver:
+    """Gain recursions for one problem; precomputes the constant terms once.
+
+    Linear systems are solved by Cholesky when the matrix is bounded below by a
+    positive definite constant (``D0 D0'`` for the filter, ``R`` for the
+    controller) and with the pseudo-inverse, as in Todorov's code, when it may
+    be singular.
+    """
+
+    def __init__(self, p: LQGProblem):
+        self.p = p
+        A, B = p.A, p.B
+        self.At = np.ascontiguousarray(A.T)
+        self.Bt = np.ascontiguousarray(B.T)
+        self.Ht = np.ascontiguousarray(p.H.T)
+        self.BC = np.einsum("ij,cjk->cik", B, p.C)  # (c, n, m): thesis C_i
+        n, m = p.n_states, p.n_controls
+        # sum_i X_i M X_i' as one product on vec(M) (row-major: vec(X M Y) = (X kron Y') vec(M))
+        self.noise_fwd = sum((np.kron(BCi, BCi) for BCi in self.BC), np.zeros((n * n, m * m)))
+        self.noise_bwd = sum((np.kron(Ci.T, Ci.T) for Ci in p.C), np.zeros((m * m, m * m)))
+        self.DD0 = p.D0 @ p.D0.T
+        self.CC0 = p.C0 @ p.C0.T
+        self.EE0 = p.E0 @ p.E0.T
+        self.Dt = np.ascontiguousarray(np.transpose(p.D, (0, 2, 1)))
+        self.has_C = bool(np.any(p.C))
+        self.has_D = bool(np.any(p.D))
+        self.has_E0 = bool(np.any(self.EE0))
+        self.has_C0 = bool(np.any(self.CC0))
+        # additive noise terms of the cost (zero for the thesis problems)
+        self.has_noise_cost = self.has_C0 or self.has_E0 or bool(np.any(self.DD0))
+        self.filter_pd = _is_positive_definite(self.DD0)
+        self.control_pd = _is_positive_definite(p.R)
+        self.XX1 = np.outer(p.X1, p.X1)
+
+    @staticmethod
+    def _solve(M: np.ndarray, Y: np.ndarray, pd: bool) -> np.ndarray:
+        """``M^-1 Y`` for symmetric ``M``: Cholesky when ``M`` is positive definite,
+        else the pseudo-inverse, as Todorov's code does for every step."""
+        if pd:
+            _, X, info = _dposv(M, Y)
+            if info == 0:
+                return X
+        return np.linalg.pinv(M).dot(Y)
+
+    # The two passes are the hot path of every planning call (hundreds of steps
+    # times a few iterations, on matrices of ~14 x 14): they use ndarray.dot and
+    # LAPACK directly because numpy's per-call overhead, not arithmetic, is the
+    # cost at this size.
+    def forward(self, L: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Filter gains ``K`` optimal for control gains ``L``; also ``A - K H`` per step."""
+        p = self.p
+        A, B, H, At, Ht = p.A, p.B, p.H, self.At, self.Ht
+        T, n, k = p.horizon, p.n_states, p.n_outputs
+        K = np.empty((T, n, k))
+        AKH = np.empty((T, n, n))
+        SiE = p.S1.copy()
+        SiX = self.XX1.copy()
+        SiXE = np.zeros((n, n))
+        track_xe = self.has_E0  # SiXE stays exactly zero without internal noise
+        for t in range(T):
+            Lt = L[t]
+            SiEHt = SiE.dot(Ht)
+            M = H.dot(SiEHt) + self.DD0
+            if self.has_D:
+                temp = SiE + SiX + SiXE + SiXE.T
+                M += (p.D @ temp @ self.Dt).sum(axis=0)
+            ASH = A.dot(SiEHt)  # A SiE H'
+            Kt = self._solve(M, ASH.T, self.filter_pd).T  # A SiE H' M^-1
+            K[t] = Kt
+            akh = AKH[t]
+            np.subtract(A, Kt.dot(H), out=akh)
+            newE = akh.dot(SiE).dot(At)
+            if self.has_C:
+                LSiL = Lt.dot(SiX).dot(Lt.T)
+                newE += self.noise_fwd.dot(LSiL.ravel()).reshape(n, n)
+            if self.has_C0 or self.has_E0:
+                newE += self.EE0 + self.CC0
+            abl = A - B.dot(Lt)
+            SiX = Kt.dot(ASH.T) + abl.dot(SiX).dot(abl.T)
+            if track_xe:
+                cross = abl.dot(SiXE).dot(Ht).dot(Kt.T)
+                SiX += self.EE0 + cross + cross.T
+                SiXE = abl.dot(SiXE).dot(akh.T) - self.EE0
+            SiE = newE
+        return K, AKH
+
+    def backward(self, K: np.ndarray, AKH: np.ndarray) -> tuple[np.ndarray, float]:
+        """Control gains ``L`` optimal for filter gains ``K``, and the expected cost."""
+        p = self.p
+        A, B, At, Bt = p.A, p.B, self.At, self.Bt
+        T, n, m = p.horizon, p.n_states, p.n_controls
+        L = np.empty((T, m, n))
+        Sx = p.Q[T].copy()
+        Se = np.zeros((n, n))
+        cost = 0.0
+        for t in range(T - 1, -1, -1):
+            Kt = K[t]
+            if self.has_noise_cost:
+                cost += np.trace(Sx.dot(self.CC0)) + np.trace(
+                    Se.dot(Kt.dot(self.DD0).dot(Kt.T) + self.EE0 + self.CC0)
+                )
+            SxB = Sx.dot(B)
+            BSxB = Bt.dot(SxB)
+            temp = p.R + BSxB
+            if self.has_C:
+                BSxeB = BSxB + Bt.dot(Se).dot(B)
+                temp += self.noise_bwd.dot(BSxeB.ravel()).reshape(m, m)
+            AtSx = At.dot(Sx)
+            AtSxB = AtSx.dot(B)
+            Lt = self._solve(temp, AtSxB.T, self.control_pd)  # B' Sx A = (A' Sx B)'
+            L[t] = Lt
+            akh = AKH[t]
+            ASBL = AtSxB.dot(Lt)
+            newSe = ASBL + akh.T.dot(Se).dot(akh)
+            SxNew = p.Q[t] + AtSx.dot(A) - ASBL
+            if self.has_D:
+                KSeK = Kt.T.dot(Se).dot(Kt)
+                SxNew += (self.Dt @ KSeK @ p.D).sum(axis=0)
+            Sx, Se = SxNew, newSe
+        X1 = p.X1
+        cost += float(X1.dot(Sx).dot(X1)) + float(np.trace((Se + Sx).dot(p.S1)))
+        return L, cost
+
+    def mean_states(self, L: np.ndarray) -> np.ndarray:
+        """Noise-free trajectory under ``u = -L x`` from ``X1``."""
+        p = self.p
+        X = np.empty((p.horizon + 1, p.n_states))
+        X[0] = p.X1
+        closed = p.A[None] - p.B[None] @ L  # (T, n, n)
+        for t in range(p.horizon):
+            X[t + 1] = closed[t] @ X[t]
+        return X
+
+
+def solve(
+    problem: LQGProblem,
+    *,
+    tol: float = 1e-12,
+    atol: float = 1e-15,
+    max_iter: int = 500,
+) -> LQGSolution:
+    """Find the filter ``K`` and controller ``L`` that are optimal for each other.
+
+    Parameters
+    ----------
+    problem : LQGProblem
+        The problem to solve.
+    tol : float, optional
+        Stop when the expected cost changes by less than ``tol`` times its value
+        between iterations ...
+    atol : float, optional
+        ... or by less than ``atol`` (the floor for problems of near-zero cost;
+        Todorov's code uses only this absolute test, with 1e-15).
+    max_iter : int, optional
+        Maximum number of forward/backward iterations; ``max_iter=2`` runs
+        exactly two (Todorov's ``Niter=2``).
+
+    Returns
+    -------
+    LQGSolution
+        Gains, expected cost, cost per iteration and the noise-free mean states.
+
+    Raises
+    ------
+    ValueError
+        If ``tol``, ``atol`` or ``max_iter`` are out of range.
+    """
+    if not isinstance(problem, LQGProblem):
+        raise ValueError(f"solve: expected an LQGProblem, got {type(problem).__name__}")
+    if not (tol >= 0 and atol >= 0):
+        raise ValueError(f"solve: tol and atol must be >= 0, got tol={tol}, atol={atol}")
+    if int(max_iter) < 1:
+        raise ValueError(f"solve: max_iter must be >= 1, got {max_iter}")
+    solver = _Solver(problem)
+    T, m, n = problem.horizon, problem.n_controls, problem.n_states
+    L = np.zeros((T, m, n))
+    history: list[float] = []
+    converged = False
+    K = None
+    for _ in range(int(max_iter)):
+        K, AKH = solver.forward(L)
+        L, cost = solver.backward(K, AKH)
+        history.append(cost)
+        if len(history) > 1:
+            change = abs(history[-2] - history[-1])
+            if change < atol or change < tol * abs(history[-1]):
+                converged = True
+                break
+    for arr in (K, L):
+        arr.setflags(write=False)
+    return LQGSolution(
+        K=K,
+        L=L,
+        cost=history[-1],
+        cost_history=np.array(history),
+        iterations=len(history),
+        converged=converged,
+        mean_states=solver.mean_states(L),
+    )
+
+
+def _joint_moments(problem: LQGProblem, K: np.ndarray, L: np.ndarray):
+    """Yield ``(t, mean z, second moment of z)`` of ``z = [x; xhat]`` for t = 0..T."""
+    p = problem
+    T, n, m, k = p.horizon, p.n_states, p.n_controls, p.n_outputs
+    K = np.asarray(K, dtype=float)
+    L = np.asarray(L, dtype=float)
+    if K.shape != (T, n, k):
+        raise ValueError(f"K must have shape {(T, n, k)}, got {K.shape}")
+    if L.shape != (T, m, n):
+        raise ValueError(f"L must have shape {(T, m, n)}, got {L.shape}")
+    A, B, H = p.A, p.B, p.H
+    X1 = p.X1
+    mean = np.concatenate([X1, X1])
+    S = np.outer(mean, mean)
+    S[:n, :n] += p.S1
+    CC0, DD0, EE0 = p.C0 @ p.C0.T, p.D0 @ p.D0.T, p.E0 @ p.E0.T
+    G = np.zeros((2 * n, 2 * n))
+    for t in range(T):
+        yield t, mean, S
+        Kt, Lt = K[t], L[t]
+        F = np.block([[A, -B @ Lt], [Kt @ H, A - B @ Lt - Kt @ H]])
+        S_next = F @ S @ F.T
+        for Ci in p.C:  # control-dependent noise acts through xhat
+            G[:] = 0
+            G[:n, n:] = -B @ Ci @ Lt
+            S_next += G @ S @ G.T
+        for Dj in p.D:  # state-dependent sensory noise enters the estimate
+            G[:] = 0
+            G[n:, :n] = Kt @ Dj
+            S_next += G @ S @ G.T
+        S_next[:n, :n] += CC0
+        S_next[n:, n:] += Kt @ DD0 @ Kt.T + EE0
+        mean, S = F @ mean, S_next
+    yield T, mean, S
+
+
+def state_moments(
+    problem: LQGProblem, K: np.ndarray, L: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Exact mean and covariance of the true state under gains ``K``, ``L``.
+
+    The distribution the Monte Carlo of :func:`minvar.simulate.simulate`
+    samples from, without sampling error (e.g. the exact end-point SD).
+
+    Parameters
+    ----------
+    problem : LQGProblem
+        The problem (its noise model is the one propagated).
+    K : (T, n, k) array
+        Filter gains.
+    L : (T, m, n) array
+        Control gains.
+
+    Returns
+    -------
+    mean : (T+1, n) array
+        ``E[x[t]]``.
+    cov : (T+1, n, n) array
+        ``Cov[x[t]]``.
+    """
+    n = problem.n_states
+    means, covs = [], []
+    for _, mean, S in _joint_moments(problem, K, L):
+        mx = mean[:n]
+        means.append(mx)
+        covs.append(S[:n, :n] - np.outer(mx, mx))
+    return np.array(means), np.array(covs)
+
+
+def expected_cost(problem: LQGProblem, K: np.ndarray, L: np.ndarray) -> float:
+    """Exact expected cost of arbitrary gains ``K``, ``L`` by moment propagation.
+
+    Propagates the second moment of the joint vector ``z = [x; xhat]`` through
+    the full noise model, so it needs no optimality of either gain. It is the
+    independent check on the cost that :func:`solve` reports, and the way to
+    score a perturbed or hand-made controller.
+
+    Parameters
+    ----------
+    problem : LQGProblem
+        The problem.
+    K : (T, n, k) array
+        Filter gains.
+    L : (T, m, n) array
+        Control gains.
+
+    Returns
+    -------
+    float
+        ``E[sum_t x'Q[t]x + u'Ru]`` including the final state cost.
+    """
+    p = problem
+    n, T = p.n_states, p.horizon
+    cost = 0.0
+    for t, _, S in _joint_moments(p, K, L):
+        cost += np.trace(p.Q[t] @ S[:n, :n])
+        if t < T:
+            Lt = np.asarray(L[t], dtype=float)
+            cost += np.trace(Lt.T @ p.R @ Lt @ S[n:, n:])
+    return float(cost)

@@ -1,0 +1,203 @@
+"""Reaching tasks with via-points, and their LQG cost (thesis eqs. 3.20-3.25).
+
+For P positional targets (via-points in the order given, then the goal) the
+task error is scaled by ``1/(P+2)``; each via-point costs only position, at its
+own step; the goal adds ``(w_v v)^2 + (w_f f)^2`` at the final step. Effort is
+``R = r dt / T I``, T the number of steps: the effort term as a time integral
+(DESIGN.md). The target coordinates live in ``Q`` against a pair of constant
+1s appended to the state per target (thesis 3.2.3).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .lqg import LQGProblem
+from .plant import FORCE, N_BASE, POSITION, VELOCITY, PointMassPlant
+
+__all__ = ["ViaPoint", "ReachTask", "reach_problem"]
+
+
+def _point(owner: str, name: str, value) -> tuple[float, float]:
+    arr = np.asarray(value, dtype=float)
+    if arr.shape != (2,) or not np.all(np.isfinite(arr)):
+        raise ValueError(f"{owner}.{name}: expected 2 finite coordinates, got {value!r}")
+    return float(arr[0]), float(arr[1])
+
+
+@dataclass(frozen=True)
+class ViaPoint:
+    """A position the movement should pass through at a given time.
+
+    Give the time either as ``fraction`` of the movement (0 < fraction < 1) or
+    in ``seconds`` from the start; exactly one of the two.
+
+    Parameters
+    ----------
+    position : (2,) array_like
+        Via-point position (m, or rad in joint space).
+    fraction : float, optional
+        Time as a fraction of the movement duration.
+    seconds : float, optional
+        Time in seconds from the start of the movement.
+    """
+
+    position: tuple[float, float]
+    fraction: float | None = None
+    seconds: float | None = None
+
+    def __post_init__(self):
+        object.__setattr__(self, "position", _point("ViaPoint", "position", self.position))
+        if (self.fraction is None) == (self.seconds is None):
+            raise ValueError("ViaPoint: give the time as exactly one of fraction= or seconds=")
+        t = self.fraction if self.fraction is not None else self.seconds
+        if not np.isfinite(t):
+            raise ValueError(f"ViaPoint: time must be finite, got {t}")
+
+    def time_s(self, duration: float) -> float:
+        """The via-point time in seconds for a movement of ``duration`` s."""
+        return self.seconds if self.seconds is not None else self.fraction * duration
+
+    def step(self, duration: float, dt: float) -> int:
+        """The step index at which the via-point is costed.
+
+        Raises
+        ------
+        ValueError
+            If the time does not fall strictly inside the movement.
+        """
+        steps = int(round(duration / dt))
+        n = int(round(self.time_s(duration) / dt))
+        if not 0 < n < steps:
+            if self.fraction is not None:
+                when = f"fraction={self.fraction}"
+            else:
+                when = f"seconds={self.seconds}"
+            raise ValueError(
+                f"ViaPoint at {self.position}: time {when} falls outside the movement "
+                f"(must be strictly between 0 and {duration} s, i.e. steps 1..{steps - 1})"
+            )
+        return n
+
+
+@dataclass(frozen=True)
+class ReachTask:
+    """A point-to-point movement, optionally through via-points.
+
+    Parameters
+    ----------
+    start, goal : (2,) array_like
+        Start and goal positions (m; rad for joint-space tasks).
+    duration : float
+        Movement time, s. Must span at least 2 plant steps.
+    via_points : sequence of ViaPoint
+        Intermediate positional targets.
+    r : float
+        Effort weight; ``R = r dt / T I``.
+    w_v, w_f : float
+        Weights of the final velocity and force in the goal cost.
+    """
+
+    start: tuple[float, float]
+    goal: tuple[float, float]
+    duration: float
+    via_points: tuple[ViaPoint, ...] = field(default_factory=tuple)
+    r: float = 2e-4
+    w_v: float = 0.2
+    w_f: float = 0.01
+
+    def __post_init__(self):
+        object.__setattr__(self, "start", _point("ReachTask", "start", self.start))
+        object.__setattr__(self, "goal", _point("ReachTask", "goal", self.goal))
+        vias = tuple(self.via_points)
+        for i, v in enumerate(vias):
+            if not isinstance(v, ViaPoint):
+                raise ValueError(f"ReachTask.via_points[{i}]: expected a ViaPoint, got {v!r}")
+        object.__setattr__(self, "via_points", vias)
+        if not (np.isfinite(self.duration) and self.duration > 0):
+            raise ValueError(
+                f"ReachTask.duration: expected a positive time in s, got {self.duration}"
+            )
+        for name in ("r", "w_v", "w_f"):
+            value = getattr(self, name)
+            if not (np.isfinite(value) and value >= 0):
+                raise ValueError(f"ReachTask.{name}: expected a finite weight >= 0, got {value}")
+
+    def steps(self, dt: float) -> int:
+        """Number of control steps T for time step ``dt``.
+
+        Raises
+        ------
+        ValueError
+            If the movement is shorter than 2 steps.
+        """
+        T = int(round(self.duration / dt))
+        if T < 2:
+            raise ValueError(
+                f"ReachTask.duration: {self.duration} s is shorter than 2 steps of {dt} s"
+            )
+        return T
+
+    @property
+    def targets(self) -> list[tuple[float, float]]:
+        """Positional targets in state order: via-points as given, then the goal."""
+        return [v.position for v in self.via_points] + [self.goal]
+
+
+def reach_problem(task: ReachTask, plant: PointMassPlant | None = None) -> LQGProblem:
+    """Build the :class:`~minvar.lqg.LQGProblem` of a reaching task.
+
+    Parameters
+    ----------
+    task : ReachTask
+        Start, goal, duration, via-points and cost weights.
+    plant : PointMassPlant, optional
+        The plant (default: DESIGN.md parameters).
+
+    Returns
+    -------
+    LQGProblem
+        ``T = task.steps(plant.dt)`` steps; ``n = 8 + 2 P`` states.
+    """
+    plant = PointMassPlant() if plant is None else plant
+    T = task.steps(plant.dt)
+    targets = task.targets
+    P = len(targets)
+    n = plant.n_states(P)
+    A, B = plant.dynamics(P)
+    H, D0 = plant.observation(P)
+    # Divide by (P + 2) rather than multiply by its reciprocal: the same
+    # rounding as Todorov's code, so the reference inputs match bit for bit.
+    weight = P + 2.0
+    Q = np.zeros((T + 1, n, n))
+    steps = [v.step(task.duration, plant.dt) for v in task.via_points] + [T]
+    for k, (target, step) in enumerate(zip(targets, steps)):
+        for axis in range(2):
+            p, one, g = POSITION.start + axis, N_BASE + 2 * k + axis, target[axis]
+            Q[step, p, p] += 1.0 / weight
+            Q[step, p, one] -= g / weight
+            Q[step, one, p] -= g / weight
+            Q[step, one, one] += g * g / weight
+    for axis in range(2):
+        v, f = VELOCITY.start + axis, FORCE.start + axis
+        Q[T, v, v] += task.w_v * task.w_v / weight
+        Q[T, f, f] += task.w_f * task.w_f / weight
+    X1 = np.zeros(n)
+    X1[POSITION] = task.start
+    X1[N_BASE:] = 1.0
+    return LQGProblem(
+        A=A,
+        B=B,
+        C=list(plant.control_noise()),
+        C0=np.zeros((n, 1)),
+        H=H,
+        D=[np.zeros((H.shape[0], n))],
+        D0=D0,
+        E0=np.zeros((n, 1)),
+        Q=Q,
+        R=task.r * plant.dt / T * np.eye(2),
+        X1=X1,
+        S1=np.zeros((n, n)),
+    )

@@ -1,0 +1,127 @@
+"""``hammer-mv reach``: simulate reaching movements (thesis chapter 3)."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+from pathlib import Path
+
+import numpy as np
+
+from minvar.analysis import (
+    THESIS_DURATIONS,
+    closest_approach,
+    count_speed_peaks,
+    endpoint_stats,
+    path_deviation,
+    peak_to_mean_speed,
+    speed_accuracy,
+)
+from minvar.plant import PointMassPlant
+from minvar.reach import simulate_reach
+from minvar.task import ReachTask, ViaPoint
+
+from ..atomic import save_figure, write_csv, write_json
+
+log = logging.getLogger(__name__)
+
+
+def register(sub) -> None:
+    """Add the ``reach`` subcommand to ``sub`` (an argparse subparsers action)."""
+    p = sub.add_parser(
+        "reach",
+        help="simulate noisy repetitions of a reach (figures + CSV)",
+        description="Plan a reach with the minimum variance model, execute noisy repetitions "
+        "and write figures (PNG) and trajectories (CSV). With --sweep, the speed-accuracy "
+        "trade-off over several movement times (thesis Figs. 3.5, 3.7).",
+    )
+    p.add_argument("--start", nargs=2, type=float, metavar=("X", "Y"), default=(0.2, 0.2),
+                   help="start position, m (default: 0.2 0.2, thesis Fig. 3.4)")
+    p.add_argument("--goal", nargs=2, type=float, metavar=("X", "Y"), default=(0.4, 0.5),
+                   help="goal position, m (default: 0.4 0.5)")
+    p.add_argument("--duration", type=float, default=0.5, metavar="S",
+                   help="movement time, s (default: 0.5)")
+    p.add_argument("--via", nargs=3, type=float, action="append", default=[],
+                   metavar=("X", "Y", "FRACTION"),
+                   help="via-point at (X, Y) m, at FRACTION (0-1) of the movement; repeatable")
+    p.add_argument("--trials", type=int, default=None, metavar="N",
+                   help="repetitions (default: 100; 200 per duration with --sweep)")
+    p.add_argument("--seed", type=int, default=0, metavar="N", help="random seed (default: 0)")
+    p.add_argument("--sweep", action="store_true",
+                   help="speed-accuracy sweep over --durations instead of one movement")
+    p.add_argument("--durations", nargs="+", type=float, default=list(THESIS_DURATIONS),
+                   metavar="S", help="movement times for --sweep, s (default: 0.5 ... 1.2)")
+    p.add_argument("--r", type=float, default=ReachTask.r, help="effort weight r (default: 2e-4)")
+    p.add_argument("--w-v", type=float, default=ReachTask.w_v, help="final velocity weight")
+    p.add_argument("--w-f", type=float, default=ReachTask.w_f, help="final force weight")
+    p.add_argument("--sigma-u", type=float, default=PointMassPlant.sigma_u,
+                   help="control-dependent noise scale (default: 0.4)")
+    p.add_argument("--sigma-s", type=float, default=PointMassPlant.sigma_s,
+                   help="sensory noise scale (default: 0.4)")
+    p.add_argument("-o", "--output", required=True, type=Path, metavar="DIR",
+                   help="folder for the figures and tables")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Execute ``hammer-mv reach`` with parsed ``args``; return the exit status."""
+    from minvar.figures import reach_figure, speed_accuracy_figure
+
+    plant = PointMassPlant(sigma_u=args.sigma_u, sigma_s=args.sigma_s)
+    vias = tuple(ViaPoint((x, y), fraction=f) for x, y, f in args.via)
+    task = ReachTask(tuple(args.start), tuple(args.goal), args.duration, vias,
+                     r=args.r, w_v=args.w_v, w_f=args.w_f)
+    for v in vias:
+        v.step(task.duration, plant.dt)  # reject bad via-point times before any work
+    task.steps(plant.dt)
+    out: Path = args.output
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"{out}: output exists and is not a folder")
+    if args.sweep:
+        trials = 200 if args.trials is None else args.trials
+        if trials < 2:
+            raise ValueError(f"--trials: need at least 2 repetitions for a sweep, got {trials}")
+        for d in args.durations:
+            ReachTask(task.start, task.goal, d, vias).steps(plant.dt)
+            for v in vias:
+                v.step(d, plant.dt)
+        sweep = speed_accuracy(task, args.durations, trials, seed=args.seed, plant=plant)
+        write_csv(out / "speed_accuracy.csv", sweep.summary)
+        write_csv(out / "speed_accuracy_trials.csv", sweep.trials)
+        save_figure(out / "speed_accuracy.png", speed_accuracy_figure(sweep))
+        print(f"wrote {out / 'speed_accuracy.png'} and speed_accuracy.csv "
+              f"({len(args.durations)} durations x {trials} repetitions)")
+        return 0
+
+    trials = 100 if args.trials is None else args.trials
+    if trials < 2:
+        raise ValueError(f"--trials: need at least 2 repetitions, got {trials}")
+    result = simulate_reach(task, trials, seed=args.seed, plant=plant)
+    stats = endpoint_stats(result.endpoint, task.goal)
+    summary = {
+        "start": task.start,
+        "goal": task.goal,
+        "duration_s": task.duration,
+        "via_points": [{"position": v.position, "fraction": v.fraction} for v in vias],
+        "trials": trials,
+        "seed": args.seed,
+        "solver": {"iterations": result.solution.iterations,
+                   "converged": result.solution.converged,
+                   "expected_cost": result.solution.cost},
+        "endpoint_mean_m": stats.mean,
+        "endpoint_sd_m": stats.sd,
+        "endpoint_distance_mean_m": stats.distance_mean,
+        "peak_to_mean_speed": peak_to_mean_speed(result.mean_speed, result.time),
+        "speed_peaks": count_speed_peaks(result.mean_speed),
+        "max_deviation_of_mean_path_m": float(np.max(np.abs(
+            path_deviation(result.mean_position, task.start, task.goal)))),
+        "via_point_closest_approach_m": [closest_approach(result.mean_position, v.position)
+                                         for v in vias],
+    }
+    write_csv(out / "trajectories.csv", result.to_pandas())
+    write_json(out / "summary.json", summary)
+    save_figure(out / "reach.png", reach_figure(result))
+    print(f"wrote {out / 'reach.png'}, trajectories.csv and summary.json "
+          f"({trials} repetitions; end-point SD {stats.sd_total * 1000:.2f} mm)")
+    return 0
+

@@ -1,0 +1,72 @@
+"""The plant and task builders against DESIGN.md and the reference inputs."""
+
+import numpy as np
+import pytest
+
+from minvar import PointMassPlant, ReachTask, ViaPoint, reach_problem
+
+S_TASK = ReachTask(
+    (-0.2, 0.5), (-0.4, 0.2), 1.0,
+    (ViaPoint((-0.4, 0.4), fraction=0.25), ViaPoint((-0.2, 0.3), fraction=0.75)),
+)
+
+
+def test_builder_reproduces_reference_inputs_exactly(todorov):
+    task = ReachTask((0.2, 0.2), (0.4, 0.5), 0.5, r=0.002, w_v=0.1, w_f=0.01)
+    p = reach_problem(task)
+    for name, value in todorov["inputs"].items():
+        ref = np.array(value, dtype=float)
+        ours = getattr(p, name)
+        assert ours.shape == ref.reshape(ours.shape).shape, name
+        assert np.array_equal(ours, ref.reshape(ours.shape)), name
+
+
+def test_state_layout_and_cost_of_via_points():
+    p = reach_problem(S_TASK)
+    assert p.n_states == 14 and p.horizon == 100
+    x = np.zeros(14)
+    x[8:] = 1.0
+    x[:2] = (-0.38, 0.43)  # 2 cm / 3 cm off the first via-point at step 25
+    assert x @ p.Q[25] @ x == pytest.approx((0.02**2 + 0.03**2) / 5)
+    x[:2] = (-0.2, 0.3)
+    assert x @ p.Q[75] @ x == pytest.approx(0.0, abs=1e-15)
+    assert np.count_nonzero([np.any(q) for q in p.Q]) == 3  # steps 25, 75, 100
+    np.testing.assert_allclose(p.R, 2e-4 * 0.01 / 100 * np.eye(2))
+
+
+def test_seconds_and_fraction_agree():
+    a = reach_problem(ReachTask((0, 0), (0.1, 0), 0.8, (ViaPoint((0.05, 0.02), fraction=0.5),)))
+    b = reach_problem(ReachTask((0, 0), (0.1, 0), 0.8, (ViaPoint((0.05, 0.02), seconds=0.4),)))
+    assert np.array_equal(a.Q, b.Q)
+
+
+def test_plant_discretisation():
+    A, B = PointMassPlant(mass=2.0).dynamics(1)
+    x = np.zeros(10)
+    x[4] = 1.0  # 1 N of force on x
+    assert (A @ x)[2] == pytest.approx(0.01 / 2.0)  # dv = dt f / m
+    assert B[6, 0] == pytest.approx(0.25) and B[:6].sum() == 0
+
+
+@pytest.mark.parametrize(
+    "make, message",
+    [
+        (lambda: ReachTask((0, 0), (0.1, 0), 0.01).steps(0.01), "shorter than 2 steps"),
+        (lambda: ReachTask((0, 0), (0.1, 0), -1.0), "duration"),
+        (lambda: ReachTask((0, np.nan), (0.1, 0), 1.0), "start"),
+        (lambda: ReachTask((0, 0), (0.1, 0, 3), 1.0), "goal"),
+        (lambda: ViaPoint((0, 0)), "exactly one"),
+        (lambda: ViaPoint((0, 0), fraction=0.5, seconds=0.2), "exactly one"),
+        (lambda: reach_problem(ReachTask((0, 0), (1, 0), 1.0, (ViaPoint((0, 0), fraction=1.0),))),
+         "outside the movement"),
+        (lambda: reach_problem(ReachTask((0, 0), (1, 0), 1.0, (ViaPoint((0, 0), seconds=2.0),))),
+         "outside the movement"),
+        (lambda: PointMassPlant(sigma_u=-0.1), "sigma_u"),
+        (lambda: PointMassPlant(sigma_s=np.inf), "sigma_s"),
+        (lambda: PointMassPlant(dt=0.1), "dt"),
+        (lambda: ReachTask((0, 0), (0.1, 0), 1.0, r=-1), "ReachTask.r"),
+    ],
+)
+def test_bad_input_is_a_value_error_naming_the_argument(make, message):
+    with pytest.raises(ValueError, match=message):
+        make()

@@ -1,0 +1,173 @@
+"""hammer-mv benchmarks: prints figures against targets and same-run baselines.
+
+Run ``make bench`` or ``python tools/bench.py [--only SECTION ...]``. Nothing
+here asserts; the figures go in closing notes and pull requests. Each section
+is a function printing one table; sections living in ``tools/bench_*.py``
+modules are picked up by name.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import statistics
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "tools"))
+
+from minvar import (  # noqa: E402
+    LQGProblem,
+    ReachTask,
+    ViaPoint,
+    reach_problem,
+    simulate,
+    solve,
+)
+
+
+def timeit(fn: Callable[[], object], *, repeat: int = 7, min_time: float = 0.2) -> float:
+    """Median wall time of ``fn`` in seconds over ``repeat`` batches."""
+    fn()  # warm caches
+    n = 1
+    while True:
+        t0 = time.perf_counter()
+        for _ in range(n):
+            fn()
+        if time.perf_counter() - t0 > min_time / repeat or n > 1000:
+            break
+        n *= 2
+    runs = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        for _ in range(n):
+            fn()
+        runs.append((time.perf_counter() - t0) / n)
+    return statistics.median(runs)
+
+
+def table(title: str, rows: list[tuple[str, str, str, str]]) -> None:
+    """Print rows of (what, measured, baseline/target, verdict)."""
+    print(f"\n## {title}")
+    w = [max(len(r[i]) for r in rows + [("what", "measured", "target / baseline", "")])
+         for i in range(4)]
+    print(f"{'what':<{w[0]}}  {'measured':>{w[1]}}  {'target / baseline':<{w[2]}}  ")
+    for r in rows:
+        print(f"{r[0]:<{w[0]}}  {r[1]:>{w[1]}}  {r[2]:<{w[2]}}  {r[3]}")
+
+
+def _literal_kalman_lqg(p: LQGProblem, tol: float = 1e-12, max_iter: int = 500):
+    """Baseline: kalman_lqg.m transcribed call for call (pinv, @, explicit loops)."""
+    T, n, m = p.horizon, p.n_states, p.n_controls
+    L = np.zeros((T, m, n))
+    K = np.zeros((T, n, p.n_outputs))
+    costs = []
+    for _ in range(max_iter):
+        SiE, SiX, SiXE = p.S1.copy(), np.outer(p.X1, p.X1), np.zeros((n, n))
+        for k in range(T):
+            temp = SiE + SiX + SiXE + SiXE.T
+            DSiD = sum((D @ temp @ D.T for D in p.D), np.zeros((p.n_outputs,) * 2))
+            K[k] = p.A @ SiE @ p.H.T @ np.linalg.pinv(p.H @ SiE @ p.H.T + p.D0 @ p.D0.T + DSiD)
+            newE = p.E0 @ p.E0.T + p.C0 @ p.C0.T + (p.A - K[k] @ p.H) @ SiE @ p.A.T
+            LSiL = L[k] @ SiX @ L[k].T
+            for C in p.C:
+                newE = newE + p.B @ C @ LSiL @ C.T @ p.B.T
+            ABL = p.A - p.B @ L[k]
+            SiX = (p.E0 @ p.E0.T + K[k] @ p.H @ SiE @ p.A.T + ABL @ SiX @ ABL.T
+                   + ABL @ SiXE @ p.H.T @ K[k].T + K[k] @ p.H @ SiXE.T @ ABL.T)
+            SiE = newE
+            SiXE = ABL @ SiXE @ (p.A - K[k] @ p.H).T - p.E0 @ p.E0.T
+        Sx, Se, cost = p.Q[T].copy(), np.zeros((n, n)), 0.0
+        for k in range(T - 1, -1, -1):
+            cost += np.trace(Sx @ p.C0 @ p.C0.T) + np.trace(
+                Se @ (K[k] @ p.D0 @ p.D0.T @ K[k].T + p.E0 @ p.E0.T + p.C0 @ p.C0.T))
+            temp = p.R + p.B.T @ Sx @ p.B
+            BSxeB = p.B.T @ (Sx + Se) @ p.B
+            for C in p.C:
+                temp = temp + C.T @ BSxeB @ C
+            L[k] = np.linalg.pinv(temp) @ p.B.T @ Sx @ p.A
+            newE = p.A.T @ Sx @ p.B @ L[k] + (p.A - K[k] @ p.H).T @ Se @ (p.A - K[k] @ p.H)
+            Sx = p.Q[k] + p.A.T @ Sx @ (p.A - p.B @ L[k])
+            for D in p.D:
+                Sx = Sx + D.T @ K[k].T @ Se @ K[k] @ D
+            Se = newE
+        costs.append(cost + p.X1 @ Sx @ p.X1 + np.trace((Se + Sx) @ p.S1))
+        if len(costs) > 1 and abs(costs[-2] - costs[-1]) < tol * abs(costs[-1]):
+            break
+    return K, L, costs
+
+
+S_TASK = ReachTask(
+    (-0.2, 0.5), (-0.4, 0.2), 1.0,
+    (ViaPoint((-0.4, 0.4), fraction=0.25), ViaPoint((-0.2, 0.3), fraction=0.75)),
+)
+
+
+def section_solver() -> None:
+    """LQG solve times: thesis 's' problem and the reference reach."""
+    ref = json.loads((ROOT / "tests" / "data" / "todorov_reach.json").read_text())
+    octave_ms = ref["info"]["time_per_call_median_s"] * 1000
+    rows = []
+    for label, problem in [
+        ("solve 's' (T=100, n=14, 2 via-points)", reach_problem(S_TASK)),
+        ("solve reference reach (T=50, n=10)",
+         LQGProblem(**{k: np.array(v, float) for k, v in ref["inputs"].items()})),
+    ]:
+        ours = timeit(lambda p=problem: solve(p))
+        literal = timeit(lambda p=problem: _literal_kalman_lqg(p), repeat=3)
+        sol = solve(problem)
+        rows.append((f"{label}, {sol.iterations} it", f"{ours * 1e3:.1f} ms",
+                     f"literal numpy port {literal * 1e3:.1f} ms", f"{literal / ours:.1f}x faster"))
+    rows[0] = (*rows[0][:3], rows[0][3] + "; target <= 10 ms; Octave ~300 ms")
+    rows[1] = (*rows[1][:3], rows[1][3] + f"; Octave {octave_ms:.0f} ms (reference file)")
+    table("minvar: LQG solver", rows)
+
+
+def section_execution() -> None:
+    """Monte Carlo execution: 500 repetitions x 100 steps."""
+    problem = reach_problem(S_TASK)
+    sol = solve(problem)
+    vec = timeit(lambda: simulate(problem, sol, 500, seed=0))
+    loop = timeit(lambda: [simulate(problem, sol, 1, seed=i) for i in range(500)], repeat=3)
+    table("minvar: Monte Carlo execution", [
+        ("500 repetitions x 100 steps (vectorised)", f"{vec * 1e3:.1f} ms",
+         f"target <= 50 ms; per-trial loop {loop * 1e3:.0f} ms", f"{loop / vec:.0f}x faster"),
+    ])
+
+
+SECTIONS: dict[str, Callable[[], None]] = {
+    "solver": section_solver,
+    "execution": section_execution,
+}
+
+
+def _discover() -> dict[str, Callable[[], None]]:
+    """Built-in sections plus ``main`` of each ``tools/bench_<name>.py``."""
+    found = dict(SECTIONS)
+    for path in sorted((ROOT / "tools").glob("bench_*.py")):
+        mod = importlib.import_module(path.stem)
+        found[path.stem.removeprefix("bench_")] = mod.main
+    return found
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the benchmark sections named in ``argv`` (default: all)."""
+    sections = _discover()
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--only", nargs="+", choices=sorted(sections), help="sections to run")
+    args = parser.parse_args(argv)
+    print(f"hammer-mv benchmarks  (python {sys.version.split()[0]}, numpy {np.__version__})")
+    for name in args.only or list(sections):
+        sections[name]()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
