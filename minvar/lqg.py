@@ -27,7 +27,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.linalg.lapack import dposv as _dposv
 
-__all__ = ["LQGProblem", "LQGSolution", "solve", "expected_cost", "state_moments"]
+__all__ = ["LQGProblem", "LQGSolution", "solve", "expected_cost", "state_moments",
+           "estimation_error_covariance"]
 
 
 def _as_matrix(name: str, value, shape: tuple[int | None, ...]) -> np.ndarray:
@@ -473,6 +474,34 @@ def state_moments(
         means.append(mx)
         covs.append(S[:n, :n] - np.outer(mx, mx))
     return np.array(means), np.array(covs)
+
+
+def estimation_error_covariance(problem: LQGProblem, K: np.ndarray, L: np.ndarray) -> np.ndarray:
+    """Exact covariance of the filter's error ``x[t] - xhat[t]`` under gains ``K``, ``L``.
+
+    ``xhat[t]`` uses observations up to ``t - 1``, so this is the spread of the
+    true state about the one-step prediction: the model's own predictive
+    uncertainty, used to score observed movements by likelihood.
+
+    Parameters
+    ----------
+    problem : LQGProblem
+        The problem (its noise model is the one propagated).
+    K : (T, n, k) array
+        Filter gains.
+    L : (T, m, n) array
+        Control gains.
+
+    Returns
+    -------
+    (T+1, n, n) array
+        ``Cov[x[t] - xhat[t]]`` for t = 0..T.
+    """
+    n = problem.n_states
+    out = []
+    for _, _, S in _joint_moments(problem, K, L):
+        out.append(S[:n, :n] - S[:n, n:] - S[n:, :n] + S[n:, n:])
+    return np.array(out)
 
 
 def expected_cost(problem: LQGProblem, K: np.ndarray, L: np.ndarray) -> float:

@@ -149,3 +149,19 @@ def test_bad_solver_options(reference_problem):
     with pytest.raises(ValueError, match="trials"):
         simulate(reference_problem, solve(reference_problem, max_iter=1), 0)
     assert isinstance(reference_problem, LQGProblem)
+
+
+def test_estimation_error_covariance_matches_monte_carlo(noisy):
+    from minvar.lqg import estimation_error_covariance
+
+    p, s = noisy
+    P = estimation_error_covariance(p, s.K, s.L)
+    tr = simulate(p, s, 20000, seed=13)
+    err = tr.states - tr.estimates
+    assert np.allclose(P[0], p.S1)
+    for t in (10, 30, 50):
+        exact = P[t, :4, :4]
+        # standard error of each sample covariance element of a Gaussian
+        d = np.diag(exact)
+        se = np.sqrt((np.outer(d, d) + exact**2) / err.shape[0])
+        assert np.all(np.abs(np.cov(err[:, t, :4].T) - exact) < 4 * se)
