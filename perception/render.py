@@ -575,7 +575,22 @@ def render_frames(
 
 
 def visibility(style: RenderStyle, names: tuple[str, ...], n_frames: int) -> np.ndarray:
-    """(T, M) bool: False where an :class:`Occlusion` hides the marker."""
+    """Which markers are drawn in which frame.
+
+    Parameters
+    ----------
+    style : RenderStyle
+        Its ``occlusions`` hide markers.
+    names : tuple of str
+        Marker names, M of them.
+    n_frames : int
+        T.
+
+    Returns
+    -------
+    (T, M) bool
+        False where an :class:`Occlusion` hides the marker.
+    """
     vis = np.ones((n_frames, len(names)), dtype=bool)
     for occ in style.occlusions:
         vis[max(occ.start, 0) : max(occ.stop, 0), names.index(occ.marker)] = False

@@ -427,7 +427,16 @@ def write_video(
 ) -> int:
     """Write an iterable of BGR frames to ``path`` atomically; return the frame count.
 
-    The frame size is taken from the first frame.
+    Parameters
+    ----------
+    frames : iterable of (H, W, 3) uint8
+        BGR frames; the size is taken from the first.
+    path : str or os.PathLike
+        Output video (see :class:`VideoWriter` for extensions and codecs).
+    fps : float
+        Frame rate, frames/s.
+    codec : str, optional
+        FourCC overriding the extension's default.
     """
     it = iter(frames)
     try:

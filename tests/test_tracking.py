@@ -32,7 +32,7 @@ def test_accuracy_on_hard_clip(tmp_path, angle, seed):
 
 @pytest.mark.parametrize(
     "fps, size, ext",
-    [(25.0, (640, 480), ".mp4"), (60.0, (640, 480), ".avi"), (30.0, (1280, 720), ".mkv")],
+    [(25.0, (640, 480), ".avi"), (60.0, (640, 480), ".mkv"), (30.0, (1280, 720), ".mp4")],
 )
 def test_frame_rates_resolutions_and_codecs(tmp_path, fps, size, ext):
     clip, _ = render(
@@ -177,3 +177,12 @@ def test_tracker_processes_regions_not_whole_frames(monkeypatch):
         tracker.update(f)
     assert len(sizes) == 4 * 10  # one region per marker and frame
     assert max(sizes) < 0.04 * 640 * 480
+
+
+def test_progress_bar_goes_to_stderr_only_when_asked(tmp_path, capsys):
+    clip, _ = render(tmp_path, n=6, width=160, height=120)
+    track_video(clip.video, tmp_path / "a.h5")
+    assert capsys.readouterr().err == ""
+    track_video(clip.video, tmp_path / "b.h5", progress=True)
+    captured = capsys.readouterr()
+    assert "/6 [" in captured.err and "frame/s" in captured.err and captured.out == ""
