@@ -414,13 +414,10 @@ def _rect(centre: np.ndarray, half: tuple[float, float]) -> np.ndarray:
     return centre + np.array([[-hx, -hy], [hx, -hy], [hx, hy], [-hx, hy]])
 
 
-_UNIT_CIRCLE = np.stack(
-    [
-        np.cos(np.linspace(0, 2 * np.pi, 32, endpoint=False)),
-        np.sin(np.linspace(0, 2 * np.pi, 32, endpoint=False)),
-    ],
-    axis=1,
-)
+def _unit_circle(n: int = 32) -> np.ndarray:
+    """(n, 2) points on the unit circle (a polygon for ellipses drawn in world units)."""
+    a = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    return np.stack([np.cos(a), np.sin(a)], axis=1)
 
 
 def _draw_hand(img, camera: Camera, wrist, finger, thumb) -> None:
@@ -430,7 +427,7 @@ def _draw_hand(img, camera: Camera, wrist, finger, thumb) -> None:
     # The hand frame is translated, never rotated (DESIGN.md): fingers point +y.
     forearm = np.array([[-0.033, 0.0], [0.033, 0.0], [0.03, -0.32], [-0.03, -0.32]]) + wrist
     _poly(img, to_px(forearm), SKIN_BGR)
-    palm = wrist + np.array([0.0, 0.022]) + _UNIT_CIRCLE * np.array([0.038, 0.03])
+    palm = wrist + np.array([0.0, 0.022]) + _unit_circle() * np.array([0.038, 0.03])
     _poly(img, to_px(palm), SKIN_BGR)
     width = max(1, int(round(0.016 * k)))
     for base, tip in ((wrist + (0.022, 0.04), finger), (wrist + (-0.03, 0.015), thumb)):

@@ -21,9 +21,10 @@ import math
 import os
 import queue
 import threading
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import asdict, dataclass
 from pathlib import Path
+from types import MappingProxyType
 from typing import Any
 
 import cv2
@@ -35,7 +36,7 @@ from perception.errors import InputError
 logger = logging.getLogger(__name__)
 
 #: Output extension -> FourCC the writer uses for it.
-CODECS: dict[str, str] = {".mp4": "mp4v", ".avi": "MJPG", ".mkv": "FFV1"}
+CODECS: Mapping[str, str] = MappingProxyType({".mp4": "mp4v", ".avi": "MJPG", ".mkv": "FFV1"})
 
 #: Values of :attr:`FrameSource.time_source`.
 TIME_SOURCES = ("container", "index/fps", "mixed")
