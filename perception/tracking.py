@@ -698,8 +698,8 @@ def _ref_side(ref: float) -> int:
 
 
 def _clamp_window(win: tuple[int, int], min_side: int, ref: float) -> tuple[int, int]:
-    # Never below the minimum, never much larger than the marker itself:
-    # a window that grows over a same-coloured neighbour stays captured.
+    # Never below the minimum, never much larger than the marker itself: a
+    # window allowed to grow over a same-coloured neighbour would stay on it.
     cap = max(3 * _ref_side(ref), min_side) if ref > 0 else 10**6
     return (min(max(int(win[0]), min_side), cap), min(max(int(win[1]), min_side), cap))
 
