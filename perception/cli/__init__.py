@@ -14,12 +14,13 @@ from __future__ import annotations
 import argparse
 import importlib
 import logging
+import os
 import sys
 
 from minvar import __version__
 
 #: Subcommand modules, in the order ``--help`` lists them.
-COMMANDS = ("reach",)
+COMMANDS = ("reach", "track", "tracks")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -42,6 +43,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     """Run ``hammer-mv`` with ``argv`` (default ``sys.argv[1:]``); return the exit status."""
+    # FFmpeg and OpenCV print their own warnings about broken files on stderr;
+    # we report those files in one line ourselves. Set before any video opens.
+    os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "-8")
+    os.environ.setdefault("OPENCV_LOG_LEVEL", "ERROR")
     parser = build_parser()
     args = parser.parse_args(argv)
     logging.basicConfig(

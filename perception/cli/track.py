@@ -1,0 +1,100 @@
+"""``hammer-mv track VIDEO``: track the colour markers of a video into a tracks file."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``track`` subcommand to ``subparsers`` (an argparse subparsers action)."""
+    p = subparsers.add_parser(
+        "track",
+        help="track the thumb, finger, wrist and object markers of a video",
+        description=(
+            "Track the colour markers of VIDEO with CamShift and write their pixel "
+            "positions, likelihoods and status per frame to an HDF5 tracks file."
+        ),
+    )
+    p.add_argument("video", type=Path, metavar="VIDEO", help="video file (mp4, avi, mkv, ...)")
+    p.add_argument(
+        "-o",
+        "--output",
+        type=Path,
+        metavar="OUT.h5",
+        help="tracks file (default: <video stem>.tracks.h5 beside the video)",
+    )
+    p.add_argument(
+        "--colours",
+        type=Path,
+        metavar="FILE",
+        help="JSON or TOML file overriding marker colour models",
+    )
+    p.add_argument(
+        "--roi",
+        nargs=5,
+        action="append",
+        default=[],
+        metavar=("MARKER", "X", "Y", "W", "H"),
+        help="look for MARKER only inside this first-frame rectangle (px); repeatable",
+    )
+    p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
+    p.set_defaults(func=run)
+
+
+def parse_rois(specs: list[list[str]], names: tuple[str, ...]) -> dict[str, tuple[int, ...]]:
+    """``[[MARKER, X, Y, W, H], ...]`` -> ``{marker: (x, y, w, h)}``, validated.
+
+    Parameters
+    ----------
+    specs : list of list of str
+        The ``--roi`` arguments as given.
+    names : tuple of str
+        Known marker names.
+
+    Raises
+    ------
+    InputError
+        Unknown or repeated marker, non-integer or non-positive sizes.
+    """
+    from perception.errors import InputError
+
+    rois: dict[str, tuple[int, ...]] = {}
+    for spec in specs:
+        name, *numbers = spec
+        shown = " ".join(spec)
+        if name not in names:
+            raise InputError(
+                f"--roi {shown}: unknown marker {name!r} (expected {', '.join(names)})"
+            )
+        if name in rois:
+            raise InputError(f"--roi {shown}: a second ROI for {name}")
+        try:
+            x, y, w, h = (int(v) for v in numbers)
+        except ValueError:
+            raise InputError(f"--roi {shown}: expected integer pixels X Y W H") from None
+        if x < 0 or y < 0 or w <= 0 or h <= 0:
+            raise InputError(f"--roi {shown}: expected X, Y >= 0 and W, H > 0")
+        rois[name] = (x, y, w, h)
+    return rois
+
+
+def run(args: argparse.Namespace) -> int:
+    """Track ``args.video``; print a one-line summary unless ``--quiet``."""
+    from perception.markers import default_markers, load_markers
+    from perception.tracking import track_video
+    from perception.tracks import Tracks
+
+    markers = load_markers(args.colours) if args.colours else default_markers()
+    rois = parse_rois(args.roi, markers.names)
+    progress = not args.quiet and sys.stderr.isatty()
+    out = track_video(args.video, args.output, markers=markers, rois=rois, progress=progress)
+    if not args.quiet:
+        tracks = Tracks.load(out)
+        found = ", ".join(
+            f"{name} {100 * tracks.valid[:, j].mean():.0f} %"
+            for j, name in enumerate(tracks.markers)
+        )
+        print(f"{out}: {tracks.n_frames} frames; found {found}")
+    return 0

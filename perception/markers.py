@@ -1,0 +1,325 @@
+"""Colour models of the markers, shared by the renderer and the tracker.
+
+One :class:`MarkerColour` per marker says how the renderer paints it (``bgr``)
+and which pixels the tracker counts as that marker: hue inside one of the
+``hue`` ranges, saturation >= ``sat_min`` and value >= ``val_min``. Hue is in
+OpenCV units, 0..179 (degrees / 2); a range with ``lo > hi`` wraps through 0,
+which red needs.
+
+The defaults are the thesis set: thumb red, index finger green, wrist band
+blue, object yellow, always in that order in files (:data:`MARKER_NAMES`).
+Users override any field from a JSON or TOML file (``--colours FILE``)::
+
+    [thumb]              # one table per marker to change; omitted ones keep defaults
+    bgr = [30, 30, 210]  # or rgb = [...]; render colour
+    hue = [[172, 6]]     # inclusive ranges; [172, 6] wraps through 0
+    sat_min = 140
+    val_min = 60
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tomllib
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, field, fields, replace
+from functools import cached_property
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+
+from perception.errors import InputError
+
+#: Marker names in file order (``/tracks/markers``).
+MARKER_NAMES: tuple[str, ...] = ("thumb", "finger", "wrist", "object")
+
+_FIELDS = ("bgr", "rgb", "hue", "sat_min", "val_min")
+
+
+@dataclass(frozen=True)
+class MarkerColour:
+    """How one marker looks: its render colour and the tracker's colour gate.
+
+    Parameters
+    ----------
+    name : str
+        Marker name (one of :data:`MARKER_NAMES` in the default set).
+    bgr : tuple of 3 int
+        Render colour, 0..255 each, OpenCV channel order.
+    hue : tuple of (lo, hi) int pairs
+        Accepted hue ranges, inclusive, OpenCV units 0..179; ``lo > hi`` wraps
+        through 0 (e.g. ``(172, 6)`` for red).
+    sat_min, val_min : int
+        Minimum saturation and value (0..255) of an accepted pixel; they keep
+        greyish, dark and skin-coloured pixels out of the back-projection.
+    """
+
+    name: str
+    bgr: tuple[int, int, int]
+    hue: tuple[tuple[int, int], ...]
+    sat_min: int = 100
+    val_min: int = 50
+
+    def __post_init__(self) -> None:
+        where = f"marker {self.name!r}"
+        bgr = tuple(int(c) for c in np.asarray(self.bgr).ravel())
+        if len(bgr) != 3 or not all(0 <= c <= 255 for c in bgr):
+            raise ValueError(f"{where}: bgr: expected 3 integers 0..255, got {self.bgr!r}")
+        object.__setattr__(self, "bgr", bgr)
+        hue = _normalise_hue(self.hue, where)
+        object.__setattr__(self, "hue", hue)
+        for name in ("sat_min", "val_min"):
+            value = getattr(self, name)
+            if (
+                isinstance(value, bool)
+                or not isinstance(value, (int, np.integer))
+                or not (0 <= value <= 255)
+            ):
+                raise ValueError(f"{where}: {name}: expected an integer 0..255, got {value!r}")
+            object.__setattr__(self, name, int(value))
+
+    @property
+    def hsv(self) -> tuple[int, int, int]:
+        """Render colour in OpenCV HSV (hue 0..179, saturation and value 0..255)."""
+        px = np.array([[self.bgr]], dtype=np.uint8)
+        return tuple(int(c) for c in cv2.cvtColor(px, cv2.COLOR_BGR2HSV)[0, 0])
+
+    @cached_property
+    def _bounds(self) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
+        # cv2.inRange takes one box per call: split wrapping ranges in two.
+        boxes = []
+        for lo, hi in self.hue:
+            spans = [(lo, hi)] if lo <= hi else [(lo, 179), (0, hi)]
+            for a, b in spans:
+                boxes.append(
+                    (
+                        np.array([a, self.sat_min, self.val_min], dtype=np.uint8),
+                        np.array([b, 255, 255], dtype=np.uint8),
+                    )
+                )
+        return tuple(boxes)
+
+    def backproject(self, hsv: np.ndarray) -> np.ndarray:
+        """Back-project the colour model onto an HSV image.
+
+        Parameters
+        ----------
+        hsv : (H, W, 3) uint8
+            Image in OpenCV HSV.
+
+        Returns
+        -------
+        (H, W) uint8
+            255 where the pixel matches the model, 0 elsewhere.
+        """
+        boxes = self._bounds
+        mask = cv2.inRange(hsv, *boxes[0])
+        for lo, hi in boxes[1:]:
+            mask = cv2.bitwise_or(mask, cv2.inRange(hsv, lo, hi))
+        return mask
+
+    def matches(self, bgr: tuple[int, int, int]) -> bool:
+        """Whether a single BGR colour passes this marker's colour gate."""
+        hsv = cv2.cvtColor(np.array([[bgr]], dtype=np.uint8), cv2.COLOR_BGR2HSV)
+        return bool(self.backproject(hsv)[0, 0])
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-data form (JSON-ready), the same fields a colours file uses."""
+        return {
+            "bgr": list(self.bgr),
+            "hue": [list(r) for r in self.hue],
+            "sat_min": self.sat_min,
+            "val_min": self.val_min,
+        }
+
+
+def _normalise_hue(hue: Any, where: str) -> tuple[tuple[int, int], ...]:
+    """Accept ``[lo, hi]`` or ``[[lo, hi], ...]``; return a tuple of int pairs."""
+    bad = ValueError(
+        f"{where}: hue: expected [lo, hi] or a list of [lo, hi] ranges with "
+        f"integers 0..179 (lo > hi wraps through 0), got {hue!r}"
+    )
+    try:
+        arr = np.asarray(hue)
+    except (TypeError, ValueError):
+        raise bad from None
+    if arr.ndim == 1:
+        arr = arr[None, :]
+    if arr.ndim != 2 or arr.shape[1] != 2 or arr.shape[0] == 0:
+        raise bad
+    if arr.dtype.kind not in "iu" and not (
+        arr.dtype.kind == "f" and np.all(np.isfinite(arr)) and np.all(arr == np.round(arr))
+    ):
+        raise bad
+    if np.any(arr < 0) or np.any(arr > 179):
+        raise bad
+    return tuple((int(lo), int(hi)) for lo, hi in arr)
+
+
+@dataclass(frozen=True)
+class MarkerSet:
+    """The colour models of every marker, in file order.
+
+    Parameters
+    ----------
+    markers : tuple of MarkerColour
+        One per marker; names must be unique.
+    """
+
+    markers: tuple[MarkerColour, ...] = field(default_factory=lambda: DEFAULT_MARKERS.markers)
+
+    def __post_init__(self) -> None:
+        markers = tuple(self.markers)
+        names = [m.name for m in markers]
+        if not markers or len(set(names)) != len(names):
+            raise ValueError(f"MarkerSet: expected unique marker names, got {names}")
+        object.__setattr__(self, "markers", markers)
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """Marker names in order."""
+        return tuple(m.name for m in self.markers)
+
+    def __getitem__(self, name: str) -> MarkerColour:
+        for m in self.markers:
+            if m.name == name:
+                return m
+        raise KeyError(f"no marker {name!r} (markers: {', '.join(self.names)})")
+
+    def __iter__(self) -> Iterator[MarkerColour]:
+        return iter(self.markers)
+
+    def __len__(self) -> int:
+        return len(self.markers)
+
+    def to_dict(self) -> dict[str, dict[str, Any]]:
+        """``{name: fields}`` in marker order, the shape of a colours file."""
+        return {m.name: m.to_dict() for m in self.markers}
+
+    def to_json(self) -> str:
+        """JSON of :meth:`to_dict` (stored in ``/tracker`` attrs)."""
+        return json.dumps(self.to_dict())
+
+    def with_overrides(self, overrides: Mapping[str, Any], source: str = "colours") -> MarkerSet:
+        """Return a copy with fields replaced from ``{marker: {field: value}}``.
+
+        Parameters
+        ----------
+        overrides : mapping
+            Marker name -> mapping of :class:`MarkerColour` fields (``bgr`` or
+            ``rgb``, ``hue``, ``sat_min``, ``val_min``).
+        source : str
+            Where the overrides come from, for error messages.
+
+        Raises
+        ------
+        ValueError
+            Unknown marker or field, or an invalid value; the message names
+            ``marker.field``.
+        """
+        if not isinstance(overrides, Mapping):
+            raise ValueError(
+                f"{source}: expected a table of markers, got {type(overrides).__name__}"
+            )
+        by_name = {m.name: m for m in self.markers}
+        for name, table in overrides.items():
+            if name not in by_name:
+                raise ValueError(
+                    f"{source}: unknown marker {name!r} (expected one of {', '.join(self.names)})"
+                )
+            if not isinstance(table, Mapping):
+                raise ValueError(f"{source}: {name}: expected a table of fields, got {table!r}")
+            unknown = sorted(set(table) - set(_FIELDS))
+            if unknown:
+                raise ValueError(
+                    f"{source}: {name}.{unknown[0]}: unknown field (expected {', '.join(_FIELDS)})"
+                )
+            if "bgr" in table and "rgb" in table:
+                raise ValueError(f"{source}: {name}: give bgr or rgb, not both")
+            changes = {k: v for k, v in table.items() if k != "rgb"}
+            if "rgb" in table:
+                rgb = table["rgb"]
+                changes["bgr"] = list(rgb)[::-1] if isinstance(rgb, (list, tuple)) else rgb
+            try:
+                by_name[name] = replace(by_name[name], **changes)
+            except (ValueError, TypeError) as exc:
+                # Re-point the message at the file's field name.
+                raise ValueError(f"{source}: {name}.{_field_in(str(exc))}") from None
+        return MarkerSet(tuple(by_name[n] for n in self.names))
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any], source: str = "colours") -> MarkerSet:
+        """Build from a full ``{name: fields}`` mapping (as :meth:`to_dict` writes)."""
+        markers = []
+        for name, table in data.items():
+            kwargs = {
+                k: v for k, v in dict(table).items() if k in {f.name for f in fields(MarkerColour)}
+            }
+            try:
+                markers.append(MarkerColour(name=name, **kwargs))
+            except (ValueError, TypeError) as exc:
+                raise ValueError(f"{source}: {name}.{_field_in(str(exc))}") from None
+        return cls(tuple(markers))
+
+
+def _field_in(message: str) -> str:
+    """``"marker 'thumb': hue: expected ..."`` -> ``"hue: expected ..."``."""
+    return message.split(": ", 1)[1] if message.startswith("marker ") else message
+
+
+def default_markers() -> MarkerSet:
+    """The default colour models: thumb red, finger green, wrist blue, object yellow."""
+    return DEFAULT_MARKERS
+
+
+def load_markers(path: str | os.PathLike, base: MarkerSet | None = None) -> MarkerSet:
+    """Read colour overrides from a JSON (``.json``) or TOML (other) file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The colours file; its top-level keys are marker names.
+    base : MarkerSet, optional
+        Models to override (default :func:`default_markers`).
+
+    Raises
+    ------
+    InputError
+        Missing or unparsable file, unknown marker or field, invalid value;
+        the message names the file and ``marker.field``.
+    """
+    p = Path(path)
+    base = default_markers() if base is None else base
+    try:
+        raw = p.read_bytes()
+    except FileNotFoundError:
+        raise InputError("colours file not found", p) from None
+    except OSError as exc:
+        raise InputError(f"cannot read colours file ({exc.strerror})", p) from None
+    try:
+        if p.suffix.lower() == ".json":
+            data = json.loads(raw.decode("utf-8"))
+        else:
+            data = tomllib.loads(raw.decode("utf-8"))
+    except (UnicodeDecodeError, json.JSONDecodeError, tomllib.TOMLDecodeError) as exc:
+        kind = "JSON" if p.suffix.lower() == ".json" else "TOML"
+        raise InputError(f"not valid {kind}: {exc}", p) from None
+    try:
+        return base.with_overrides(data, source="colours")
+    except ValueError as exc:
+        raise InputError(str(exc).removeprefix("colours: "), p) from None
+
+
+# Saturations sit well above skin's (~110) so a skin-coloured hand never
+# passes the red gate even though its hue is only ~10 units away.
+DEFAULT_MARKERS = MarkerSet(
+    (
+        MarkerColour("thumb", bgr=(30, 30, 210), hue=((172, 6),), sat_min=140, val_min=50),
+        MarkerColour("finger", bgr=(50, 170, 40), hue=((48, 78),), sat_min=100, val_min=50),
+        MarkerColour("wrist", bgr=(190, 80, 30), hue=((98, 124),), sat_min=110, val_min=40),
+        MarkerColour("object", bgr=(30, 200, 220), hue=((20, 34),), sat_min=120, val_min=60),
+    )
+)

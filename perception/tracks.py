@@ -1,0 +1,668 @@
+"""Marker tracks: the :class:`Tracks` object and its HDF5 file (``<clip>.tracks.h5``).
+
+Schema (DESIGN.md), written with h5py::
+
+    /            attrs: schema="hammer-mv/tracks", schema_version, software_version
+    /video       attrs: path, sha256, fps_nominal, n_frames, width, height, fourcc
+    /tracks/frame      int64   (T,)      decoded frame index
+    /tracks/time       float64 (T,)      s, from the container's timestamps
+    /tracks/markers    str     (M,)      thumb, finger, wrist, object
+    /tracks/position   float64 (T,M,2)   px; NaN where lost (never 0)
+    /tracks/likelihood float32 (T,M)     0..1; 0 where lost
+    /tracks/status     int8    (T,M)     0 tracked, 1 reacquired, 2 lost, 3 interpolated
+    /tracker     attrs: colour models, termination criteria, parameters
+
+The datasets are chunked and resizable; :class:`TracksWriter` appends to them
+a chunk at a time while tracking, so memory does not grow with the video.
+Extra groups (e.g. ``/truth`` in rendered ground truth) are allowed and
+ignored by :meth:`Tracks.load`.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import enum
+import json
+import os
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
+
+import h5py
+import numpy as np
+import pandas as pd
+
+from minvar import __version__
+from perception.atomic import atomic_path
+from perception.errors import InputError
+
+SCHEMA = "hammer-mv/tracks"
+SCHEMA_VERSION = 1
+
+#: Export formats of :meth:`Tracks.export`.
+EXPORT_FORMATS = ("dlc", "trackpy", "csv")
+
+
+class Status(enum.IntEnum):
+    """Per-frame, per-marker status codes (``/tracks/status``)."""
+
+    TRACKED = 0
+    REACQUIRED = 1
+    LOST = 2
+    INTERPOLATED = 3
+
+
+def _attr_value(value: Any) -> Any:
+    """Make a value storable as an HDF5 attribute (JSON for anything structured)."""
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, (int, float, str, np.integer, np.floating)):
+        return value
+    if isinstance(value, Path):
+        return os.fspath(value)
+    if (
+        isinstance(value, (list, tuple))
+        and value
+        and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
+    ):
+        return np.asarray(value)
+    return json.dumps(value)
+
+
+def _read_attrs(attrs: h5py.AttributeManager) -> dict[str, Any]:
+    out = {}
+    for key, value in attrs.items():
+        if isinstance(value, bytes):
+            value = value.decode("utf-8")
+        elif isinstance(value, np.generic):
+            value = value.item()
+        out[key] = value
+    return out
+
+
+def _write_attrs(attrs: h5py.AttributeManager, values: Mapping[str, Any]) -> None:
+    for key, value in values.items():
+        attrs[key] = _attr_value(value)
+
+
+@dataclass(frozen=True, eq=False)
+class Tracks:
+    """Marker positions over time, as tracked (or as rendered ground truth).
+
+    Attributes
+    ----------
+    frame : (T,) int64
+        Decoded frame index of each row.
+    time : (T,) float64
+        Frame time, s (container timestamps).
+    markers : tuple of str
+        Marker names, M of them, in column order.
+    position : (T, M, 2) float64
+        Image position (x right, y down), px; NaN where lost.
+    likelihood : (T, M) float32
+        0..1; 0 where lost.
+    status : (T, M) int8
+        :class:`Status` codes.
+    video : mapping
+        ``/video`` attributes.
+    tracker : mapping
+        ``/tracker`` attributes.
+    attrs : mapping
+        Root attributes beyond the schema's own (e.g. a rendered clip's label).
+    path : Path or None
+        File the tracks were loaded from.
+    """
+
+    frame: np.ndarray
+    time: np.ndarray
+    markers: tuple[str, ...]
+    position: np.ndarray
+    likelihood: np.ndarray
+    status: np.ndarray
+    video: Mapping[str, Any] = field(default_factory=dict)
+    tracker: Mapping[str, Any] = field(default_factory=dict)
+    attrs: Mapping[str, Any] = field(default_factory=dict)
+    path: Path | None = None
+
+    def __post_init__(self) -> None:
+        markers = tuple(str(m) for m in self.markers)
+        frame = np.asarray(self.frame, dtype=np.int64)
+        time = np.asarray(self.time, dtype=np.float64)
+        position = np.asarray(self.position, dtype=np.float64)
+        likelihood = np.asarray(self.likelihood, dtype=np.float32)
+        status = np.asarray(self.status, dtype=np.int8)
+        t, m = frame.shape[0] if frame.ndim == 1 else -1, len(markers)
+        checks = [
+            ("frame", frame, (t,)),
+            ("time", time, (t,)),
+            ("position", position, (t, m, 2)),
+            ("likelihood", likelihood, (t, m)),
+            ("status", status, (t, m)),
+        ]
+        for name, arr, shape in checks:
+            if arr.shape != shape:
+                raise ValueError(
+                    f"Tracks.{name}: expected shape {shape} (T, M={m}), got {arr.shape}"
+                )
+        object.__setattr__(self, "markers", markers)
+        object.__setattr__(self, "frame", frame)
+        object.__setattr__(self, "time", time)
+        object.__setattr__(self, "position", position)
+        object.__setattr__(self, "likelihood", likelihood)
+        object.__setattr__(self, "status", status)
+        for name in ("video", "tracker", "attrs"):
+            object.__setattr__(self, name, MappingProxyType(dict(getattr(self, name))))
+
+    # -- basic views --------------------------------------------------------
+    @property
+    def n_frames(self) -> int:
+        """T, the number of rows."""
+        return int(self.frame.shape[0])
+
+    def __len__(self) -> int:
+        return self.n_frames
+
+    def index(self, name: str) -> int:
+        """Column of marker ``name``."""
+        try:
+            return self.markers.index(name)
+        except ValueError:
+            raise KeyError(f"no marker {name!r} (markers: {', '.join(self.markers)})") from None
+
+    def marker(self, name: str) -> np.ndarray:
+        """(T, 2) px positions of one marker (a view; NaN where lost)."""
+        return self.position[:, self.index(name)]
+
+    @property
+    def valid(self) -> np.ndarray:
+        """(T, M) bool, True where the position is known (not lost)."""
+        return np.isfinite(self.position).all(axis=-1)
+
+    def replace(self, **changes: Any) -> Tracks:
+        """Copy with some attributes replaced."""
+        kwargs = {
+            name: getattr(self, name)
+            for name in (
+                "frame",
+                "time",
+                "markers",
+                "position",
+                "likelihood",
+                "status",
+                "video",
+                "tracker",
+                "attrs",
+                "path",
+            )
+        }
+        kwargs.update(changes)
+        return Tracks(**kwargs)
+
+    # -- processing ---------------------------------------------------------
+    def interpolate(self, max_gap: int = 5) -> Tracks:
+        """Fill short gaps linearly in time; filled samples get status 3.
+
+        A gap is a run of lost frames with a known position on both sides;
+        runs at the start or end, and runs longer than ``max_gap`` frames, stay
+        NaN. A filled sample's likelihood is the lower of the two bounding
+        likelihoods: the bridge is no more certain than its weaker end.
+
+        Parameters
+        ----------
+        max_gap : int
+            Longest gap filled, frames (0 fills nothing).
+
+        Returns
+        -------
+        Tracks
+            A new object; this one is unchanged.
+        """
+        if max_gap < 0:
+            raise ValueError(f"interpolate: max_gap: expected >= 0 frames, got {max_gap}")
+        position = self.position.copy()
+        likelihood = self.likelihood.copy()
+        status = self.status.copy()
+        valid = self.valid
+        for j in range(len(self.markers)):
+            ok = np.flatnonzero(valid[:, j])
+            if ok.size < 2:
+                continue
+            gaps = np.flatnonzero(np.diff(ok) > 1)
+            for g in gaps:
+                a, b = ok[g], ok[g + 1]
+                if b - a - 1 > max_gap:
+                    continue
+                inner = slice(a + 1, b)
+                w = (self.time[inner] - self.time[a]) / (self.time[b] - self.time[a])
+                position[inner, j] = position[a, j] + w[:, None] * (position[b, j] - position[a, j])
+                likelihood[inner, j] = min(likelihood[a, j], likelihood[b, j])
+                status[inner, j] = Status.INTERPOLATED
+        return self.replace(position=position, likelihood=likelihood, status=status)
+
+    def speed(self, markers: Sequence[str] | None = None, smooth: int = 5) -> np.ndarray:
+        """Fastest marker speed per frame, px/s, NaN-tolerant.
+
+        Parameters
+        ----------
+        markers : sequence of str, optional
+            Markers considered (default: every marker but ``object``).
+        smooth : int
+            Width of the running median over frames that suppresses tracking
+            jitter before differencing (odd; 1 = none).
+
+        Returns
+        -------
+        (T,) float64
+            Speed of the fastest listed marker at each frame (0 where no
+            listed marker has two consecutive known positions).
+        """
+        names = [m for m in self.markers if m != "object"] if markers is None else list(markers)
+        cols = [self.index(n) for n in names]
+        t = self.n_frames
+        if t < 2 or not cols:
+            return np.zeros(t)
+        pos = self.position[:, cols]
+        if smooth > 1:
+            pos = (
+                pd.DataFrame(pos.reshape(t, -1))
+                .rolling(smooth, center=True, min_periods=1)
+                .median()
+                .to_numpy()
+                .reshape(pos.shape)
+            )
+        dt = np.diff(self.time)
+        step = np.linalg.norm(np.diff(pos, axis=0), axis=-1) / dt[:, None]
+        fastest = np.max(np.where(np.isfinite(step), step, -np.inf), axis=1)
+        fastest = np.where(np.isfinite(fastest), fastest, 0.0)
+        # Speed at frame i is the step (i-1 -> i); frame 0 copies frame 1.
+        return np.concatenate([fastest[:1], fastest])
+
+    def active_span(
+        self,
+        *,
+        threshold: float = 0.05,
+        min_speed: float = 20.0,
+        pad: int = 3,
+        markers: Sequence[str] | None = None,
+    ) -> tuple[int, int]:
+        """Rows ``[start, stop)`` between the first and last active frame.
+
+        A frame is *active* when the fastest hand marker moves faster than
+        ``max(threshold * peak speed, min_speed)`` (a fraction of the peak, as
+        movement onsets are usually defined, with a floor so tracking jitter in
+        a still clip never counts as movement). See :meth:`speed` for the
+        markers and smoothing.
+
+        Parameters
+        ----------
+        threshold : float
+            Fraction of the clip's peak speed.
+        min_speed : float
+            Floor of the activity threshold, px/s.
+        pad : int
+            Frames kept on either side of the active period.
+        markers : sequence of str, optional
+            Markers whose motion counts (default: all but ``object``).
+
+        Returns
+        -------
+        (int, int)
+            ``(start, stop)`` rows; ``start == stop`` if nothing moves.
+        """
+        speed = self.speed(markers)
+        if speed.size == 0:
+            return 0, 0
+        level = max(threshold * float(speed.max()), min_speed)
+        active = np.flatnonzero(speed > level)
+        if active.size == 0:
+            return 0, 0
+        return max(int(active[0]) - pad, 0), min(int(active[-1]) + 1 + pad, self.n_frames)
+
+    def trim(self, **kwargs: Any) -> Tracks:
+        """The active period as a view: rows of :meth:`active_span` (same keywords).
+
+        The arrays are views of this object's; ``frame`` keeps the original
+        frame indices, and ``attrs["trimmed_rows"]`` records ``[start, stop)``.
+        The tracks file itself always keeps every frame.
+        """
+        start, stop = self.active_span(**kwargs)
+        s = slice(start, stop)
+        attrs = dict(self.attrs)
+        attrs["trimmed_rows"] = (start, stop)
+        return self.replace(
+            frame=self.frame[s],
+            time=self.time[s],
+            position=self.position[s],
+            likelihood=self.likelihood[s],
+            status=self.status[s],
+            attrs=attrs,
+        )
+
+    # -- tables -----------------------------------------------------------
+    def to_dlc(self, scorer: str = "hammer-mv") -> pd.DataFrame:
+        """DeepLabCut-style wide table.
+
+        Index: frame. Columns: MultiIndex ``(scorer, bodyparts, coords)`` with
+        coords ``x, y, likelihood`` per marker. NaN where lost.
+        """
+        cols = pd.MultiIndex.from_product(
+            [[scorer], list(self.markers), ["x", "y", "likelihood"]],
+            names=["scorer", "bodyparts", "coords"],
+        )
+        data = np.concatenate(
+            [self.position, self.likelihood[..., None].astype(np.float64)], axis=-1
+        ).reshape(self.n_frames, -1)
+        return pd.DataFrame(data, index=pd.Index(self.frame, name="frame"), columns=cols)
+
+    def to_trackpy(self) -> pd.DataFrame:
+        """trackpy-style long table, one row per frame and marker.
+
+        Columns: ``frame, time, particle`` (marker column index), ``marker,
+        x, y, likelihood, status``. Lost rows are kept with NaN ``x, y``;
+        drop them with ``df.dropna(subset=["x", "y"])`` where trackpy needs.
+        """
+        t, m = self.n_frames, len(self.markers)
+        return pd.DataFrame(
+            {
+                "frame": np.repeat(self.frame, m),
+                "time": np.repeat(self.time, m),
+                "particle": np.tile(np.arange(m), t),
+                "marker": pd.Categorical(
+                    np.tile(np.array(self.markers, dtype=object), t), categories=list(self.markers)
+                ),
+                "x": self.position[..., 0].ravel(),
+                "y": self.position[..., 1].ravel(),
+                "likelihood": self.likelihood.ravel(),
+                "status": self.status.ravel(),
+            }
+        )
+
+    def to_pandas(self) -> pd.DataFrame:
+        """Plain wide table: ``frame, time`` then ``<marker>_x, _y, _likelihood, _status``."""
+        data: dict[str, Any] = {"frame": self.frame, "time": self.time}
+        for j, name in enumerate(self.markers):
+            data[f"{name}_x"] = self.position[:, j, 0]
+            data[f"{name}_y"] = self.position[:, j, 1]
+            data[f"{name}_likelihood"] = self.likelihood[:, j]
+            data[f"{name}_status"] = self.status[:, j]
+        return pd.DataFrame(data)
+
+    def export(self, path: str | os.PathLike, format: str = "csv") -> Path:
+        """Write a table as CSV, atomically.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            Output file.
+        format : {"dlc", "trackpy", "csv"}
+            :meth:`to_dlc` (three header rows, as DeepLabCut writes),
+            :meth:`to_trackpy` or :meth:`to_pandas`.
+        """
+        if format == "dlc":
+            # DeepLabCut's files have the three header rows and no index-name row.
+            table, index = self.to_dlc().rename_axis(None), True
+        elif format == "trackpy":
+            table, index = self.to_trackpy(), False
+        elif format == "csv":
+            table, index = self.to_pandas(), False
+        else:
+            raise ValueError(
+                f"export: format: expected one of {', '.join(EXPORT_FORMATS)}, got {format!r}"
+            )
+        with atomic_path(path) as tmp:
+            table.to_csv(tmp, index=index, na_rep="NaN")
+        return Path(path)
+
+    # -- files ----------------------------------------------------------------
+    def save(self, path: str | os.PathLike) -> Path:
+        """Write this object as a tracks file (atomically); return the path."""
+        with TracksWriter(
+            path, self.markers, video=self.video, tracker=self.tracker, attrs=self.attrs
+        ) as w:
+            w.extend(self.frame, self.time, self.position, self.likelihood, self.status)
+        return Path(path)
+
+    @classmethod
+    def load(cls, path: str | os.PathLike) -> Tracks:
+        """Read a tracks file, checking its schema and version.
+
+        Raises
+        ------
+        InputError
+            Missing file, not HDF5, another schema or version, or a missing or
+            misshapen dataset; the message names the file.
+        """
+        p = Path(path)
+        if not p.exists():
+            raise InputError("no such file", p)
+        try:
+            fh = h5py.File(p, "r")
+        except OSError:
+            raise InputError("not an HDF5 file (or unreadable)", p) from None
+        with fh:
+            root = _read_attrs(fh.attrs)
+            schema = root.pop("schema", None)
+            version = root.pop("schema_version", None)
+            if schema != SCHEMA:
+                raise InputError(
+                    f"not a hammer-mv tracks file (schema {schema!r}, expected {SCHEMA!r})", p
+                )
+            if version != SCHEMA_VERSION:
+                raise InputError(
+                    f"tracks schema_version {version!r} is not supported "
+                    f"(this hammer-mv reads version {SCHEMA_VERSION})",
+                    p,
+                )
+            root.pop("software_version", None)
+            data = {}
+            for name in ("frame", "time", "markers", "position", "likelihood", "status"):
+                key = f"tracks/{name}"
+                if key not in fh or not isinstance(fh[key], h5py.Dataset):
+                    raise InputError(f"missing dataset /{key}", p)
+                data[name] = fh[key][()]
+            markers = tuple(
+                m.decode("utf-8") if isinstance(m, bytes) else str(m) for m in data.pop("markers")
+            )
+            video = _read_attrs(fh["video"].attrs) if "video" in fh else {}
+            tracker = _read_attrs(fh["tracker"].attrs) if "tracker" in fh else {}
+        try:
+            return cls(markers=markers, video=video, tracker=tracker, attrs=root, path=p, **data)
+        except ValueError as exc:
+            raise InputError(f"inconsistent datasets: {exc}", p) from None
+
+
+class TracksWriter:
+    """Stream tracks into a new HDF5 file, a chunk of frames at a time.
+
+    Rows are buffered in memory ``chunk_frames`` at a time and appended to
+    chunked, resizable datasets, so memory stays flat however long the video.
+    The file is written under a temporary name and renamed when the block
+    exits cleanly; if it raises, nothing is left behind.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Output file.
+    markers : sequence of str
+        Marker names, M of them.
+    video, tracker, attrs : mapping, optional
+        ``/video``, ``/tracker`` and extra root attributes; may be updated
+        with :meth:`update` before the block ends.
+    chunk_frames : int
+        Rows per HDF5 chunk and per write.
+
+    Examples
+    --------
+    >>> with TracksWriter("clip.tracks.h5", ["thumb"]) as w:  # doctest: +SKIP
+    ...     w.append(0, 0.0, [[10.0, 20.0]], [1.0], [0])
+    """
+
+    def __init__(
+        self,
+        path: str | os.PathLike,
+        markers: Sequence[str],
+        *,
+        video: Mapping[str, Any] | None = None,
+        tracker: Mapping[str, Any] | None = None,
+        attrs: Mapping[str, Any] | None = None,
+        chunk_frames: int = 512,
+    ):
+        self.path = Path(path)
+        self.markers = tuple(markers)
+        if not self.markers:
+            raise ValueError("TracksWriter.markers: expected at least one marker")
+        if chunk_frames < 1:
+            raise ValueError(f"TracksWriter.chunk_frames: expected >= 1, got {chunk_frames}")
+        self.meta = {
+            "video": dict(video or {}),
+            "tracker": dict(tracker or {}),
+            "attrs": dict(attrs or {}),
+        }
+        self.chunk = int(chunk_frames)
+        m = len(self.markers)
+        self._buf = {
+            "frame": np.empty(self.chunk, np.int64),
+            "time": np.empty(self.chunk, np.float64),
+            "position": np.empty((self.chunk, m, 2), np.float64),
+            "likelihood": np.empty((self.chunk, m), np.float32),
+            "status": np.empty((self.chunk, m), np.int8),
+        }
+        self._n_buf = 0
+        self.n_written = 0
+        self._stack: contextlib.ExitStack | None = None
+        self._fh: h5py.File | None = None
+
+    def update(self, *, video=None, tracker=None, attrs=None) -> None:
+        """Add or replace ``/video``, ``/tracker`` or root attributes (written at close)."""
+        for key, values in (("video", video), ("tracker", tracker), ("attrs", attrs)):
+            if values:
+                self.meta[key].update(values)
+
+    def __enter__(self) -> TracksWriter:
+        stack = contextlib.ExitStack()
+        try:
+            tmp = stack.enter_context(atomic_path(self.path))
+            fh = stack.enter_context(h5py.File(tmp, "w"))
+            g = fh.create_group("tracks")
+            c = self.chunk
+            g.create_dataset(
+                "markers", data=np.array(self.markers, dtype=object), dtype=h5py.string_dtype()
+            )
+            for name, buf in self._buf.items():
+                g.create_dataset(
+                    name,
+                    shape=(0, *buf.shape[1:]),
+                    maxshape=(None, *buf.shape[1:]),
+                    chunks=(c, *buf.shape[1:]),
+                    dtype=buf.dtype,
+                    fillvalue=np.nan if name == "position" else 0,
+                )
+        except BaseException:
+            stack.close()
+            raise
+        self._stack, self._fh = stack, fh
+        return self
+
+    def append(self, frame: int, time: float, position, likelihood, status) -> None:
+        """Append one frame's row.
+
+        Parameters
+        ----------
+        frame : int
+            Frame index.
+        time : float
+            Frame time, s.
+        position : (M, 2) array_like
+            px; NaN where lost.
+        likelihood : (M,) array_like
+            0..1.
+        status : (M,) array_like of int
+            :class:`Status` codes.
+        """
+        i = self._n_buf
+        b = self._buf
+        b["frame"][i] = frame
+        b["time"][i] = time
+        b["position"][i] = position
+        b["likelihood"][i] = likelihood
+        b["status"][i] = status
+        self._n_buf = i + 1
+        if self._n_buf == self.chunk:
+            self.flush()
+
+    def extend(self, frame, time, position, likelihood, status) -> None:
+        """Append many rows at once (arrays with a leading T axis)."""
+        self.flush()
+        m = len(self.markers)
+        arrays = {
+            "frame": np.asarray(frame, np.int64),
+            "time": np.asarray(time, np.float64),
+            "position": np.asarray(position, np.float64),
+            "likelihood": np.asarray(likelihood, np.float32),
+            "status": np.asarray(status, np.int8),
+        }
+        t = arrays["frame"].shape[0]
+        expected = {
+            "frame": (t,),
+            "time": (t,),
+            "position": (t, m, 2),
+            "likelihood": (t, m),
+            "status": (t, m),
+        }
+        for name, arr in arrays.items():
+            if arr.shape != expected[name]:
+                raise ValueError(
+                    f"TracksWriter.extend: {name}: expected shape {expected[name]}, got {arr.shape}"
+                )
+        self._write(arrays, t)
+
+    def flush(self) -> None:
+        """Write buffered rows to the file."""
+        if self._n_buf:
+            n = self._n_buf
+            self._write({k: v[:n] for k, v in self._buf.items()}, n)
+            self._n_buf = 0
+
+    def _write(self, arrays: Mapping[str, np.ndarray], n: int) -> None:
+        if n == 0:
+            return
+        g = self._fh["tracks"]
+        start = self.n_written
+        for name, arr in arrays.items():
+            ds = g[name]
+            ds.resize(start + n, axis=0)
+            ds[start : start + n] = arr
+        self.n_written = start + n
+
+    def __exit__(self, exc_type, exc, tb) -> bool:
+        assert self._stack is not None and self._fh is not None
+        if exc_type is None:
+            try:
+                self.flush()
+                fh = self._fh
+                fh.attrs["schema"] = SCHEMA
+                fh.attrs["schema_version"] = SCHEMA_VERSION
+                fh.attrs["software_version"] = __version__
+                _write_attrs(fh.attrs, self.meta["attrs"])
+                _write_attrs(fh.require_group("video").attrs, self.meta["video"])
+                _write_attrs(fh.require_group("tracker").attrs, self.meta["tracker"])
+            except BaseException:
+                import sys
+
+                self._stack.__exit__(*sys.exc_info())
+                raise
+        return bool(self._stack.__exit__(exc_type, exc, tb))
+
+    @property
+    def file(self) -> h5py.File:
+        """The open (temporary) HDF5 file, for writers adding their own groups."""
+        assert self._fh is not None, "TracksWriter: use inside a with block"
+        return self._fh
+
+
+def tracks_path_for(video: str | os.PathLike) -> Path:
+    """Default tracks file of a video: ``<stem>.tracks.h5`` beside it."""
+    v = Path(video)
+    return v.with_name(f"{v.stem}.tracks.h5")

@@ -1,0 +1,460 @@
+"""Video files: lazy sequential frames with real timestamps, and clip writing.
+
+:class:`FrameSource` reads a file front to back (pims/trackpy style) and
+yields ``(index, time_s, frame)``. Times come from the container
+(``CAP_PROP_POS_MSEC`` after each read); only a frame the container gives no
+usable time for gets ``previous + 1/fps``, and :attr:`FrameSource.time_source`
+records whether that happened. The file is checked when opened (exists,
+non-empty, decodable, at least one frame), and a stream that ends before the
+frame count its header claims is kept with a warning and the true count.
+
+:class:`VideoWriter` writes a clip atomically: mp4v ``.mp4`` (default), MJPG
+``.avi`` or FFV1 ``.mkv`` (lossless).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import logging
+import math
+import os
+import queue
+import threading
+from collections.abc import Iterable, Iterator, Mapping
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
+
+import cv2
+import numpy as np
+
+from perception.atomic import atomic_path
+from perception.errors import InputError
+
+logger = logging.getLogger(__name__)
+
+#: Output extension -> FourCC the writer uses for it.
+CODECS: Mapping[str, str] = MappingProxyType({".mp4": "mp4v", ".avi": "MJPG", ".mkv": "FFV1"})
+
+#: Values of :attr:`FrameSource.time_source`.
+TIME_SOURCES = ("container", "index/fps", "mixed")
+
+
+def sha256_file(path: str | os.PathLike, chunk: int = 1 << 20) -> str:
+    """Hex SHA-256 of the file at ``path``, read in ``chunk``-byte pieces (memory stays flat)."""
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        while block := fh.read(chunk):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _fourcc_str(code: float) -> str:
+    n = int(code)
+    text = "".join(chr((n >> (8 * i)) & 0xFF) for i in range(4))
+    return text if text.isprintable() and n else ""
+
+
+@dataclass(frozen=True)
+class VideoInfo:
+    """What the container says about a video.
+
+    Attributes
+    ----------
+    path : str
+        The file as given.
+    sha256 : str
+        Hex digest of the file's bytes.
+    fps_nominal : float
+        Frame rate from the header, frames/s (0 if the container has none).
+    n_frames_header : int
+        Frame count the header claims (may be an estimate; 0 if unknown).
+    width, height : int
+        Frame size, px.
+    fourcc : str
+        Codec FourCC, e.g. ``"FMP4"``, ``"MJPG"``, ``"FFV1"``.
+    """
+
+    path: str
+    sha256: str
+    fps_nominal: float
+    n_frames_header: int
+    width: int
+    height: int
+    fourcc: str
+
+
+class TimeResolver:
+    """Turn per-frame container timestamps into a strictly increasing time axis.
+
+    A container time is used when it is finite, non-negative and later than the
+    previous frame's; otherwise the frame gets ``previous + 1/fps`` (``0`` for
+    the first frame), and the fallback is counted.
+
+    Parameters
+    ----------
+    fps : float
+        Nominal frame rate, frames/s, for the fallback.
+    """
+
+    def __init__(self, fps: float):
+        self.fps = fps
+        self.previous: float | None = None
+        self.n_container = 0
+        self.n_fallback = 0
+
+    def __call__(self, pos_msec: float) -> float:
+        """Return the time (s) of the next frame given its ``CAP_PROP_POS_MSEC``."""
+        t = pos_msec / 1000.0
+        if math.isfinite(t) and t >= 0 and (self.previous is None or t > self.previous):
+            self.n_container += 1
+        else:
+            if not (self.fps > 0 and math.isfinite(self.fps)):
+                raise InputError("the container gives neither frame timestamps nor a frame rate")
+            t = 0.0 if self.previous is None else self.previous + 1.0 / self.fps
+            self.n_fallback += 1
+        self.previous = t
+        return t
+
+    @property
+    def source(self) -> str:
+        """``"container"``, ``"index/fps"`` (no frame had a usable time) or ``"mixed"``."""
+        if self.n_fallback == 0:
+            return "container"
+        # A lone first frame at t=0 says nothing about the container.
+        return "index/fps" if self.n_container <= 1 else "mixed"
+
+
+class FrameSource:
+    """Lazy, sequential frames of one video file.
+
+    Opening checks the file and decodes the first frame; iterating yields
+    ``(index, time_s, frame)`` once, front to back. Decoding runs in a
+    background thread a few frames ahead (OpenCV releases the GIL while
+    decoding), so work done on each frame overlaps the next frame's decoding;
+    at most ``prefetch`` frames are held.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Video file.
+    prefetch : int
+        Frames decoded ahead (0: decode in the caller's thread).
+    hash : bool
+        Compute the file's SHA-256 (one extra sequential read of the file).
+
+    Raises
+    ------
+    InputError
+        Missing, zero-byte, unreadable or non-video file, or no decodable frame.
+
+    Attributes
+    ----------
+    info : VideoInfo
+        Header metadata.
+    n_decoded : int
+        Frames yielded so far; the true frame count once iteration has ended.
+    complete : bool
+        True once the stream has been read to its end.
+    """
+
+    def __init__(self, path: str | os.PathLike, *, prefetch: int = 8, hash: bool = True):
+        self.path = Path(path)
+        self.prefetch = int(prefetch)
+        if not self.path.exists():
+            raise InputError("no such file", self.path)
+        if not self.path.is_file():
+            raise InputError("not a regular file", self.path)
+        if self.path.stat().st_size == 0:
+            raise InputError("empty file (0 bytes)", self.path)
+        cap = cv2.VideoCapture(os.fspath(self.path), cv2.CAP_FFMPEG)
+        if not cap.isOpened():
+            cap.release()
+            raise InputError("not a readable video (FFmpeg could not open it)", self.path)
+        ok, first = cap.read()
+        if not ok or first is None:
+            cap.release()
+            raise InputError("no decodable frames (empty, truncated or corrupt video)", self.path)
+        self._cap = cap
+        self._first = first
+        self._first_msec = cap.get(cv2.CAP_PROP_POS_MSEC)
+        height, width = first.shape[:2]
+        n_header = cap.get(cv2.CAP_PROP_FRAME_COUNT)
+        fps = cap.get(cv2.CAP_PROP_FPS)
+        self.info = VideoInfo(
+            path=os.fspath(path),
+            sha256=sha256_file(self.path) if hash else "",
+            fps_nominal=float(fps) if math.isfinite(fps) and fps > 0 else 0.0,
+            n_frames_header=int(n_header) if math.isfinite(n_header) and n_header > 0 else 0,
+            width=int(width),
+            height=int(height),
+            fourcc=_fourcc_str(cap.get(cv2.CAP_PROP_FOURCC)),
+        )
+        self._times = TimeResolver(self.info.fps_nominal)
+        self.n_decoded = 0
+        self.complete = False
+        self._started = False
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+
+    # -- iteration ---------------------------------------------------------
+    def __iter__(self) -> Iterator[tuple[int, float, np.ndarray]]:
+        if self._started:
+            raise RuntimeError(f"{self.path}: a FrameSource can be iterated only once")
+        self._started = True
+        return self._frames()
+
+    def _frames(self) -> Iterator[tuple[int, float, np.ndarray]]:
+        try:
+            yield 0, self._times(self._first_msec), self._first
+            self._first = None
+            self.n_decoded = 1
+            reader = self._threaded() if self.prefetch > 0 else self._direct()
+            for frame, msec in reader:
+                index = self.n_decoded
+                t = self._times(msec)
+                self.n_decoded += 1
+                yield index, t, frame
+            self.complete = True
+            self._check_count()
+        finally:
+            self.close()
+
+    def _direct(self) -> Iterator[tuple[np.ndarray, float]]:
+        cap = self._cap
+        while True:
+            ok, frame = cap.read()
+            if not ok or frame is None:
+                return
+            yield frame, cap.get(cv2.CAP_PROP_POS_MSEC)
+
+    def _threaded(self) -> Iterator[tuple[np.ndarray, float]]:
+        q: queue.Queue = queue.Queue(maxsize=self.prefetch)
+        done = object()
+
+        def put(item: Any) -> bool:
+            while not self._stop.is_set():
+                try:
+                    q.put(item, timeout=0.1)
+                    return True
+                except queue.Full:
+                    continue
+            return False
+
+        def run() -> None:
+            try:
+                for item in self._direct():
+                    if not put(item):
+                        return
+                put(done)
+            except BaseException as exc:  # surfaced in the consumer thread
+                put(exc)
+
+        self._thread = threading.Thread(target=run, name=f"decode:{self.path.name}", daemon=True)
+        self._thread.start()
+        while True:
+            item = q.get()
+            if item is done:
+                return
+            if isinstance(item, BaseException):
+                raise item
+            yield item
+
+    def _check_count(self) -> None:
+        claimed = self.info.n_frames_header
+        if claimed and self.n_decoded < claimed:
+            logger.warning(
+                "%s: decoded %d of the %d frames the header claims (truncated or corrupt?); "
+                "keeping the %d decoded",
+                self.path,
+                self.n_decoded,
+                claimed,
+                self.n_decoded,
+            )
+        if self._times.n_fallback:
+            logger.warning(
+                "%s: %d of %d frames had no usable container timestamp; used previous + 1/fps",
+                self.path,
+                self._times.n_fallback,
+                self.n_decoded,
+            )
+
+    @property
+    def time_source(self) -> str:
+        """Where frame times came from so far: see :class:`TimeResolver`."""
+        return self._times.source
+
+    def attrs(self) -> dict[str, Any]:
+        """The ``/video`` attributes of a tracks file.
+
+        ``n_frames`` is the true decoded count once iteration has ended, the
+        header's claim before; ``n_frames_header`` and ``time_source`` are
+        recorded beside it.
+        """
+        info = asdict(self.info)
+        info["n_frames"] = self.n_decoded if self.complete else info["n_frames_header"]
+        info["time_source"] = self.time_source
+        return info
+
+    # -- lifetime ------------------------------------------------------------
+    def close(self) -> None:
+        """Stop the decoding thread and release the file."""
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join()
+            self._thread = None
+        if self._cap is not None:
+            self._cap.release()
+            self._cap = None
+
+    def __enter__(self) -> FrameSource:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def __del__(self) -> None:
+        with contextlib.suppress(Exception):
+            self.close()
+
+
+def open_video(path: str | os.PathLike, **kwargs: Any) -> FrameSource:
+    """Open the video at ``path`` for sequential reading; see :class:`FrameSource`.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The video file.
+    **kwargs
+        Passed to :class:`FrameSource` (``prefetch``, ``hash``).
+    """
+    return FrameSource(path, **kwargs)
+
+
+def codec_for(path: str | os.PathLike, codec: str | None = None) -> str:
+    """FourCC to write ``path`` with: ``codec`` if given, else from the extension.
+
+    Raises
+    ------
+    InputError
+        Unknown extension with no codec, or a codec that is not 4 characters.
+    """
+    if codec is None:
+        ext = Path(path).suffix.lower()
+        if ext not in CODECS:
+            raise InputError(
+                f"unknown video extension {ext!r} (expected one of {', '.join(CODECS)})", path
+            )
+        return CODECS[ext]
+    if len(codec) != 4:
+        raise InputError(f"codec: expected a 4-character FourCC, got {codec!r}", path)
+    return codec
+
+
+class VideoWriter:
+    """Write a clip frame by frame; the file appears only when complete.
+
+    Use as a context manager; frames go to a temporary file beside ``path``,
+    renamed on a clean exit and removed if the block raises.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Output file (``.mp4`` -> mp4v, ``.avi`` -> MJPG, ``.mkv`` -> FFV1).
+    fps : float
+        Frame rate, frames/s.
+    size : (int, int)
+        ``(width, height)``, px.
+    codec : str, optional
+        FourCC overriding the extension's default.
+    """
+
+    def __init__(
+        self,
+        path: str | os.PathLike,
+        fps: float,
+        size: tuple[int, int],
+        codec: str | None = None,
+    ):
+        self.path = Path(path)
+        self.codec = codec_for(self.path, codec)
+        if not (math.isfinite(fps) and fps > 0):
+            raise ValueError(f"VideoWriter.fps: expected a positive frame rate, got {fps!r}")
+        width, height = (int(s) for s in size)
+        if width <= 0 or height <= 0:
+            raise ValueError(f"VideoWriter.size: expected positive (width, height), got {size!r}")
+        self.fps = float(fps)
+        self.size = (width, height)
+        self.n_written = 0
+        self._stack: contextlib.ExitStack | None = None
+        self._vw: cv2.VideoWriter | None = None
+        self.tmp_path: Path | None = None
+
+    def __enter__(self) -> VideoWriter:
+        stack = contextlib.ExitStack()
+        try:
+            self.tmp_path = stack.enter_context(atomic_path(self.path))
+            vw = cv2.VideoWriter(
+                os.fspath(self.tmp_path), cv2.VideoWriter_fourcc(*self.codec), self.fps, self.size
+            )
+            if not vw.isOpened():
+                raise OSError(f"{self.path}: OpenCV cannot write {self.codec!r} video here")
+        except BaseException:
+            stack.close()
+            raise
+        self._stack, self._vw = stack, vw
+        return self
+
+    def write(self, frame: np.ndarray) -> None:
+        """Append one frame: ``(height, width, 3)`` uint8, BGR."""
+        w, h = self.size
+        if frame.shape != (h, w, 3) or frame.dtype != np.uint8:
+            raise ValueError(
+                f"VideoWriter.write: expected a ({h}, {w}, 3) uint8 frame, "
+                f"got {frame.shape} {frame.dtype}"
+            )
+        self._vw.write(frame)
+        self.n_written += 1
+
+    def __exit__(self, exc_type, exc, tb) -> bool:
+        assert self._stack is not None and self._vw is not None
+        self._vw.release()
+        if exc_type is None and self.n_written == 0:
+            err = ValueError(f"{self.path}: no frames written")
+            self._stack.__exit__(ValueError, err, None)  # removes the temporary file
+            raise err
+        return bool(self._stack.__exit__(exc_type, exc, tb))
+
+
+def write_video(
+    frames: Iterable[np.ndarray],
+    path: str | os.PathLike,
+    fps: float,
+    codec: str | None = None,
+) -> int:
+    """Write an iterable of BGR frames to ``path`` atomically; return the frame count.
+
+    Parameters
+    ----------
+    frames : iterable of (H, W, 3) uint8
+        BGR frames; the size is taken from the first.
+    path : str or os.PathLike
+        Output video (see :class:`VideoWriter` for extensions and codecs).
+    fps : float
+        Frame rate, frames/s.
+    codec : str, optional
+        FourCC overriding the extension's default.
+    """
+    it = iter(frames)
+    try:
+        first = next(it)
+    except StopIteration:
+        raise ValueError(f"{path}: no frames to write") from None
+    h, w = first.shape[:2]
+    with VideoWriter(path, fps, (w, h), codec) as vw:
+        vw.write(first)
+        for frame in it:
+            vw.write(frame)
+    return vw.n_written

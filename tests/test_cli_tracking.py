@@ -1,0 +1,244 @@
+import shutil
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+import pandas as pd
+import pytest
+from _clips import HARD, errors, render
+
+from perception.render import Occlusion
+from perception.tracks import Tracks
+
+
+def hammer(*args, cwd=None):
+    return subprocess.run(
+        [sys.executable, "-m", "perception.cli", *map(str, args)],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        timeout=120,
+    )
+
+
+@pytest.fixture(scope="module")
+def clips(tmp_path_factory):
+    d = tmp_path_factory.mktemp("clips")
+    good, _ = render(d, "good.mp4", n=24, width=320, height=240, **HARD)
+    no_thumb, _ = render(
+        d, "nothumb.mp4", n=8, width=320, height=240, occlusions=(Occlusion("thumb", 0, 8),)
+    )
+    good_avi, _ = render(d, "good.avi", n=24, width=320, height=240, **HARD)
+    return {"good": good, "nothumb": no_thumb, "avi": good_avi}
+
+
+def _copy(clip, tmp_path, name=None):
+    dst = tmp_path / (name or clip.video.name)
+    shutil.copy(clip.video, dst)
+    return dst
+
+
+def test_track_writes_default_output_beside_video(clips, tmp_path):
+    video = _copy(clips["good"], tmp_path)
+    proc = hammer("track", video)
+    assert proc.returncode == 0, proc.stderr
+    out = tmp_path / "good.tracks.h5"
+    assert out.exists()
+    assert proc.stderr == ""  # no progress bar when stderr is not a terminal
+    assert "24 frames" in proc.stdout and "thumb 100 %" in proc.stdout
+    tracks, truth = Tracks.load(out), Tracks.load(clips["good"].truth)
+    assert np.median(errors(tracks, truth)) < 1.0
+    assert tracks.video["n_frames"] == 24 and tracks.video["path"] == str(video)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["good.mp4", "good.tracks.h5"]
+
+
+def test_track_output_option_and_quiet(clips, tmp_path):
+    video = _copy(clips["good"], tmp_path)
+    out = tmp_path / "sub" / "t.h5"
+    proc = hammer("track", video, "-o", out, "--quiet")
+    assert proc.returncode == 0 and proc.stdout == "" and proc.stderr == ""
+    assert Tracks.load(out).n_frames == 24
+
+
+def test_track_roi_and_colours_options(clips, tmp_path):
+    video = _copy(clips["good"], tmp_path)
+    truth = Tracks.load(clips["good"].truth)
+    x, y = truth.position[0, 0]
+    colours = tmp_path / "colours.toml"
+    colours.write_text("[thumb]\nhue = [[170, 8]]\n")
+    proc = hammer(
+        "track",
+        video,
+        "--roi",
+        "thumb",
+        int(x) - 8,
+        int(y) - 8,
+        16,
+        16,
+        "--colours",
+        colours,
+        "--quiet",
+    )
+    assert proc.returncode == 0, proc.stderr
+    tracks = Tracks.load(tmp_path / "good.tracks.h5")
+    assert "170, 8" in tracks.tracker["colour_models"]
+    assert "thumb" in tracks.tracker["rois"]
+    assert np.median(errors(tracks, truth)[:, 0]) < 1.0
+
+
+def test_truncated_avi_is_tracked_with_a_warning_and_true_count(clips, tmp_path):
+    data = clips["avi"].video.read_bytes()
+    video = tmp_path / "cut.avi"
+    video.write_bytes(data[: len(data) * 2 // 3])
+    proc = hammer("track", video, "--quiet")
+    assert proc.returncode == 0, proc.stderr
+    assert "header claims" in proc.stderr
+    tracks = Tracks.load(tmp_path / "cut.tracks.h5")
+    assert 0 < tracks.n_frames < 24
+    assert tracks.video["n_frames"] == tracks.n_frames and tracks.video["n_frames_header"] == 24
+
+
+def test_tracks_info(clips, tmp_path):
+    video = _copy(clips["good"], tmp_path)
+    hammer("track", video, "--quiet")
+    proc = hammer("tracks", "info", tmp_path / "good.tracks.h5")
+    assert proc.returncode == 0, proc.stderr
+    assert "24 frames" in proc.stdout
+    for name in ("thumb", "finger", "wrist", "object"):
+        assert name in proc.stdout
+    assert "times from container" in proc.stdout
+
+
+@pytest.mark.parametrize("fmt", ["dlc", "trackpy", "csv"])
+def test_tracks_export(clips, tmp_path, fmt):
+    video = _copy(clips["good"], tmp_path)
+    hammer("track", video, "--quiet")
+    tracks = Tracks.load(tmp_path / "good.tracks.h5")
+    out = tmp_path / f"out.{fmt}.csv"
+    proc = hammer("tracks", "export", tmp_path / "good.tracks.h5", "--format", fmt, "-o", out)
+    assert proc.returncode == 0, proc.stderr
+    if fmt == "dlc":
+        df = pd.read_csv(out, header=[0, 1, 2], index_col=0)
+        np.testing.assert_allclose(df[("hammer-mv", "wrist", "x")], tracks.marker("wrist")[:, 0])
+    elif fmt == "trackpy":
+        df = pd.read_csv(out)
+        assert len(df) == 4 * 24
+        wrist = df[df.marker == "wrist"].sort_values("frame")
+        np.testing.assert_allclose(wrist.y, tracks.marker("wrist")[:, 1])
+    else:
+        df = pd.read_csv(out)
+        np.testing.assert_allclose(df.thumb_x, tracks.marker("thumb")[:, 0])
+
+
+def test_tracks_export_trim_and_interpolate(clips, tmp_path):
+    video = _copy(clips["good"], tmp_path)
+    hammer("track", video, "--quiet")
+    out = tmp_path / "t.csv"
+    proc = hammer(
+        "tracks",
+        "export",
+        tmp_path / "good.tracks.h5",
+        "--format",
+        "csv",
+        "-o",
+        out,
+        "--trim",
+        "--max-gap",
+        "3",
+    )
+    assert proc.returncode == 0, proc.stderr
+    df = pd.read_csv(out)
+    assert 0 < len(df) < 24
+
+
+def _wrong_schema(tmp_path):
+    path = tmp_path / "other.h5"
+    with h5py.File(path, "w") as fh:
+        fh.attrs["schema"] = "someone-else/poses"
+        fh.create_dataset("x", data=[1, 2, 3])
+    return path
+
+
+def _wrong_version(tmp_path, clips):
+    path = tmp_path / "v9.tracks.h5"
+    shutil.copy(clips["good"].truth, path)
+    with h5py.File(path, "a") as fh:
+        fh.attrs["schema_version"] = 9
+    return path
+
+
+def _truncated_mp4(tmp_path, clips):
+    data = clips["good"].video.read_bytes()
+    path = tmp_path / "cut.mp4"
+    path.write_bytes(data[: len(data) // 2])
+    return path
+
+
+def _bad_case(case, t, clips):
+    """Arguments for one bad input; the names and problem its error line must mention."""
+    if case == "missing":
+        return ["track", t / "none.mp4"], "none.mp4", "no such file"
+    if case == "zero-byte":
+        (t / "empty.mp4").touch()
+        return ["track", t / "empty.mp4"], "empty.mp4", "empty file"
+    if case == "not-video":
+        (t / "notes.mp4").write_text("hello\n" * 50)
+        return ["track", t / "notes.mp4"], "notes.mp4", "not a readable video"
+    if case == "truncated":
+        return ["track", _truncated_mp4(t, clips)], "cut.mp4", "video"
+    if case == "never-found":
+        return ["track", _copy(clips["nothumb"], t)], "nothumb.mp4", "thumb never found"
+    if case == "colours":
+        (t / "c.toml").write_text("[thumb]\nhue = 5\n")
+        return ["track", _copy(clips["good"], t), "--colours", t / "c.toml"], "c.toml", "thumb.hue"
+    if case.startswith("roi-"):
+        roi, names, problem = {
+            "roi-marker": (["nose", 1, 2, 3, 4], "--roi nose", "unknown marker"),
+            "roi-number": (["thumb", 1, 2, "x", 4], "--roi thumb", "integer"),
+            "roi-size": (["thumb", 1, 2, 0, 4], "--roi thumb", "W, H > 0"),
+            "roi-outside": (["thumb", 300, 200, 50, 50], "good.mp4", "extends past"),
+            "roi-empty": (["thumb", 0, 0, 10, 10], "good.mp4", "nothing of its colour"),
+        }[case]
+        return ["track", _copy(clips["good"], t), "--roi", *roi], names, problem
+    if case == "info-schema":
+        return ["tracks", "info", _wrong_schema(t)], "other.h5", "not a hammer-mv tracks file"
+    if case == "export-version":
+        args = ["tracks", "export", _wrong_version(t, clips), "--format", "dlc", "-o", t / "x.csv"]
+        return args, "v9.tracks.h5", "schema_version 9"
+    if case == "export-not-hdf5":
+        (t / "x.h5").write_text("x")
+        args = ["tracks", "export", t / "x.h5", "--format", "csv", "-o", t / "x.csv"]
+        return args, "x.h5", "not an HDF5 file"
+    raise AssertionError(case)
+
+
+BAD = [
+    "missing",
+    "zero-byte",
+    "not-video",
+    "truncated",
+    "never-found",
+    "colours",
+    "roi-marker",
+    "roi-number",
+    "roi-size",
+    "roi-outside",
+    "roi-empty",
+    "info-schema",
+    "export-version",
+    "export-not-hdf5",
+]
+
+
+@pytest.mark.parametrize("case", BAD)
+def test_bad_input_exits_2_with_one_line_and_no_output(clips, tmp_path, case):
+    args, names, problem = _bad_case(case, tmp_path, clips)
+    before = {p.name for p in tmp_path.rglob("*")}
+    proc = hammer(*args, cwd=tmp_path)
+    assert proc.returncode == 2, (proc.stdout, proc.stderr)
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1, proc.stderr
+    assert "Traceback" not in proc.stderr
+    assert names in lines[0] and problem in lines[0], lines[0]
+    assert {p.name for p in tmp_path.rglob("*")} == before  # no output, no temporary file

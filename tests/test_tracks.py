@@ -1,0 +1,207 @@
+import h5py
+import numpy as np
+import pandas as pd
+import pytest
+
+from perception.errors import InputError
+from perception.tracks import SCHEMA, SCHEMA_VERSION, Status, Tracks, TracksWriter
+
+MARKERS = ("thumb", "finger", "wrist", "object")
+
+
+def _tracks(t=50, fps=30.0, lost=()):
+    """Known tracks: markers move right at 3 px/frame between frames 10 and 40."""
+    time = np.arange(t) / fps
+    x = np.clip(np.arange(t) - 10, 0, 30) * 3.0
+    pos = np.zeros((t, 4, 2))
+    for j in range(4):
+        pos[:, j, 0] = 100 + 20 * j + (x if j < 3 else 0)
+        pos[:, j, 1] = 50 + 10 * j
+    lik = np.ones((t, 4), np.float32)
+    status = np.zeros((t, 4), np.int8)
+    for j, frames in lost:
+        pos[frames, j] = np.nan
+        lik[frames, j] = 0
+        status[frames, j] = Status.LOST
+    return Tracks(
+        np.arange(t),
+        time,
+        MARKERS,
+        pos,
+        lik,
+        status,
+        video={
+            "path": "clip.mp4",
+            "fps_nominal": fps,
+            "n_frames": t,
+            "width": 640,
+            "height": 480,
+            "fourcc": "FMP4",
+            "sha256": "ab" * 32,
+        },
+        tracker={"method": "test", "lost_ratio": 0.3},
+    )
+
+
+def test_schema_round_trip(tmp_path):
+    tr = _tracks(lost=[(0, slice(5, 8))])
+    path = tr.save(tmp_path / "c.tracks.h5")
+    with h5py.File(path) as fh:
+        assert fh.attrs["schema"] == SCHEMA
+        assert fh.attrs["schema_version"] == SCHEMA_VERSION
+        assert "software_version" in fh.attrs
+        assert fh["tracks/position"].dtype == np.float64
+        assert fh["tracks/likelihood"].dtype == np.float32
+        assert fh["tracks/status"].dtype == np.int8
+        assert fh["tracks/frame"].dtype == np.int64
+        assert fh["tracks/position"].chunks is not None
+        assert fh["tracks/position"].maxshape[0] is None
+        assert [m.decode() for m in fh["tracks/markers"][()]] == list(MARKERS)
+        for key in ("path", "sha256", "fps_nominal", "n_frames", "width", "height", "fourcc"):
+            assert key in fh["video"].attrs
+    back = Tracks.load(path)
+    assert back.markers == MARKERS
+    np.testing.assert_array_equal(back.position, tr.position)  # NaN in the same places
+    np.testing.assert_array_equal(back.status, tr.status)
+    np.testing.assert_array_equal(back.time, tr.time)
+    assert back.video["fourcc"] == "FMP4" and back.tracker["lost_ratio"] == 0.3
+    assert np.isnan(back.marker("thumb")[5:8]).all()
+    assert not np.any(back.position == 0)
+
+
+def test_streaming_writer_appends_in_chunks(tmp_path):
+    path = tmp_path / "s.tracks.h5"
+    with TracksWriter(path, ["a", "b"], chunk_frames=7) as w:
+        for i in range(23):  # three full chunks and a partial one
+            w.append(i, i / 25, [[i, -i], [np.nan, np.nan]], [1.0, 0.0], [0, 2])
+        assert w.n_written == 21  # flushed chunk by chunk, not held to the end
+        assert not path.exists()  # appears only when complete
+        w.update(video={"n_frames": 23})
+    tr = Tracks.load(path)
+    assert tr.n_frames == 23 and tr.video["n_frames"] == 23
+    np.testing.assert_array_equal(tr.position[:, 0, 0], np.arange(23))
+    assert np.isnan(tr.marker("b")).all() and (tr.status[:, 1] == 2).all()
+
+
+def test_writer_leaves_nothing_on_failure(tmp_path):
+    path = tmp_path / "s.tracks.h5"
+    with pytest.raises(RuntimeError), TracksWriter(path, ["a"]) as w:
+        w.append(0, 0.0, [[1.0, 2.0]], [1.0], [0])
+        raise RuntimeError("tracker crashed")
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    "schema, version, message",
+    [
+        ("other/format", SCHEMA_VERSION, "not a hammer-mv tracks file"),
+        (SCHEMA, SCHEMA_VERSION + 1, "schema_version 2 is not supported"),
+    ],
+)
+def test_wrong_schema_or_version_is_rejected_naming_the_file(tmp_path, schema, version, message):
+    path = _tracks().save(tmp_path / "c.tracks.h5")
+    with h5py.File(path, "a") as fh:
+        fh.attrs["schema"] = schema
+        fh.attrs["schema_version"] = version
+    with pytest.raises(InputError, match=message) as err:
+        Tracks.load(path)
+    assert str(err.value).startswith(str(path))
+
+
+def test_not_hdf5_and_missing_dataset(tmp_path):
+    bad = tmp_path / "x.h5"
+    bad.write_text("hello")
+    with pytest.raises(InputError, match="not an HDF5 file"):
+        Tracks.load(bad)
+    path = _tracks().save(tmp_path / "c.tracks.h5")
+    with h5py.File(path, "a") as fh:
+        del fh["tracks/status"]
+    with pytest.raises(InputError, match="missing dataset /tracks/status"):
+        Tracks.load(path)
+    with pytest.raises(InputError, match="no such file"):
+        Tracks.load(tmp_path / "none.h5")
+
+
+def test_shapes_are_validated():
+    tr = _tracks()
+    with pytest.raises(ValueError, match="Tracks.position: expected shape"):
+        tr.replace(position=tr.position[:, :2])
+
+
+def test_interpolation_fills_short_gaps_only():
+    tr = _tracks(
+        lost=[(0, slice(20, 23)), (1, slice(20, 30)), (2, slice(0, 3)), (2, slice(47, 50))]
+    )
+    filled = tr.interpolate(max_gap=5)
+    truth = _tracks()
+    # 3-frame gap in linear motion: filled exactly, status 3.
+    np.testing.assert_allclose(filled.position[20:23, 0], truth.position[20:23, 0])
+    assert (filled.status[20:23, 0] == Status.INTERPOLATED).all()
+    assert (filled.likelihood[20:23, 0] == 1).all()
+    # 10-frame gap: longer than max_gap, stays lost.
+    assert np.isnan(filled.position[20:30, 1]).all()
+    assert (filled.status[20:30, 1] == Status.LOST).all()
+    # Leading and trailing gaps are not extrapolated.
+    assert np.isnan(filled.position[:3, 2]).all() and np.isnan(filled.position[47:, 2]).all()
+    # The original is untouched; max_gap=0 fills nothing.
+    assert np.isnan(tr.position[20:23, 0]).all()
+    assert np.isnan(tr.interpolate(0).position[20:23, 0]).all()
+    with pytest.raises(ValueError, match="max_gap"):
+        tr.interpolate(-1)
+
+
+def test_trim_is_a_view_of_the_active_period():
+    rng = np.random.default_rng(0)
+    tr = _tracks()
+    jitter = tr.replace(position=tr.position + rng.normal(0, 0.3, tr.position.shape))
+    start, stop = jitter.active_span(pad=0)
+    # Motion runs from frame 10 (first step into 11) to frame 40.
+    assert 10 <= start <= 12 and 39 <= stop <= 42
+    trimmed = jitter.trim(pad=0)
+    assert trimmed.frame[0] == start and trimmed.n_frames == stop - start
+    assert np.shares_memory(trimmed.position, jitter.position)
+    assert trimmed.attrs["trimmed_rows"] == (start, stop)
+    assert jitter.n_frames == 50  # the full tracks are kept
+    # A still clip has no active period.
+    still = _tracks().replace(position=np.broadcast_to(tr.position[:1], tr.position.shape))
+    assert still.active_span() == (0, 0)
+
+
+def test_dlc_export(tmp_path):
+    tr = _tracks(lost=[(1, slice(3, 5))])
+    df = tr.to_dlc()
+    assert df.columns.names == ["scorer", "bodyparts", "coords"]
+    assert list(df.columns.get_level_values("bodyparts").unique()) == list(MARKERS)
+    assert list(df.columns.get_level_values("coords")[:3]) == ["x", "y", "likelihood"]
+    assert np.isnan(df[("hammer-mv", "finger", "x")].iloc[3])
+    assert df[("hammer-mv", "finger", "likelihood")].iloc[3] == 0
+    assert df[("hammer-mv", "wrist", "x")].iloc[20] == pytest.approx(tr.position[20, 2, 0])
+    path = tr.export(tmp_path / "c.csv", "dlc")
+    back = pd.read_csv(path, header=[0, 1, 2], index_col=0)
+    np.testing.assert_allclose(back.to_numpy(), df.to_numpy(), equal_nan=True)
+
+
+def test_trackpy_and_plain_exports(tmp_path):
+    tr = _tracks(lost=[(0, slice(3, 4))])
+    long = tr.to_trackpy()
+    assert len(long) == tr.n_frames * 4
+    assert {"frame", "time", "particle", "marker", "x", "y", "likelihood", "status"} <= set(long)
+    row = long[(long.frame == 3) & (long.marker == "thumb")].iloc[0]
+    assert np.isnan(row.x) and row.status == Status.LOST and row.likelihood == 0
+    row = long[(long.frame == 20) & (long.marker == "wrist")].iloc[0]
+    assert (row.x, row.y) == pytest.approx(tuple(tr.position[20, 2]))
+    back = pd.read_csv(tr.export(tmp_path / "t.csv", "trackpy"))
+    assert len(back) == len(long) and back.x.isna().sum() == 1
+    plain = pd.read_csv(tr.export(tmp_path / "p.csv", "csv"))
+    assert list(plain.columns[:6]) == [
+        "frame",
+        "time",
+        "thumb_x",
+        "thumb_y",
+        "thumb_likelihood",
+        "thumb_status",
+    ]
+    assert np.isnan(plain.thumb_x[3]) and plain.wrist_x[20] == pytest.approx(tr.position[20, 2, 0])
+    with pytest.raises(ValueError, match="format"):
+        tr.export(tmp_path / "x.csv", "excel")
+    assert not (tmp_path / "x.csv").exists()

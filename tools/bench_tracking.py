@@ -1,0 +1,151 @@
+"""Benchmark the tracker: throughput against pure decoding, and memory on long clips.
+
+Renders a 640x480 30 fps mp4v clip with a skin-coloured hand, camera noise
+and a lighting gradient, then in the same run times
+
+* pure decoding (an OpenCV read loop over every frame), and
+* ``hammer-mv track`` on the same file (in-process ``track_video``: open,
+  hash, decode, track, write HDF5),
+
+alternating the two so both see the same machine load, and reports the
+median of the repeats. Peak memory (``ru_maxrss``) of ``track`` is measured
+in fresh subprocesses on a short and a 10x longer clip. Prints a table of
+targets (issue 4) and measured figures; asserts nothing.
+
+Run: ``.venv/bin/python tools/bench_tracking.py [--frames 300] [--long 3000]``
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from perception.render import Camera, RenderStyle, Scene, render_clip
+from perception.tracking import track_video
+from perception.tracks import Tracks
+
+_CHILD = """
+import resource, sys
+from perception.tracking import track_video
+track_video(sys.argv[1], sys.argv[2])
+print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)
+"""
+
+
+def render(path: Path, n_frames: int, seed: int = 0):
+    """The benchmark clip: a reach-to-grasp repeated every 2.5 s."""
+    fps = 30.0
+    cycle = int(2.5 * fps)
+    one = Scene.reach_to_grasp(cycle, fps, onset=0.4, duration=1.2)
+    reps = -(-n_frames // cycle)
+    scene = Scene(
+        *(np.tile(getattr(one, k), (reps, 1))[:n_frames] for k in ("wrist", "finger", "thumb"))
+    )
+    style = RenderStyle(fps=fps, hand=True, noise_sd=5.0, lighting=0.4)
+    return render_clip(scene, Camera.for_frame(640, 480, angle_deg=15), style, path, seed=seed)
+
+
+def decode_fps(path: Path) -> float:
+    cap = cv2.VideoCapture(str(path))
+    t0 = time.perf_counter()
+    n = 0
+    while cap.read()[0]:
+        n += 1
+    dt = time.perf_counter() - t0
+    cap.release()
+    return n / dt
+
+
+def track_fps(path: Path, out: Path, n_frames: int) -> float:
+    t0 = time.perf_counter()
+    track_video(path, out)
+    return n_frames / (time.perf_counter() - t0)
+
+
+def peak_rss_mib(video: Path, out: Path) -> float:
+    proc = subprocess.run(
+        [sys.executable, "-c", _CHILD, str(video), str(out)],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    return int(proc.stdout.split()[-1]) / 1024
+
+
+def accuracy(out: Path, truth: Path) -> dict[str, tuple[float, float]]:
+    tr, gt = Tracks.load(out), Tracks.load(truth)
+    err = np.linalg.norm(tr.position - gt.position, axis=-1)
+    return {
+        m: (float(np.nanmedian(err[:, j])), float(np.nanpercentile(err[:, j], 95)))
+        for j, m in enumerate(tr.markers)
+    }
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the benchmark and print its table."""
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--frames", type=int, default=300, help="throughput clip length")
+    ap.add_argument("--long", type=int, default=3000, help="long clip length for memory")
+    ap.add_argument("--repeats", type=int, default=5, help="alternating timing repeats")
+    args = ap.parse_args(argv)
+
+    with tempfile.TemporaryDirectory(prefix="bench_tracking_") as tmp:
+        d = Path(tmp)
+        t0 = time.perf_counter()
+        short = render(d / "short.mp4", args.frames)
+        t_render = time.perf_counter() - t0
+        out = d / "short.tracks.h5"
+        decode_fps(short.video)  # warm the page cache and the codec
+        track_fps(short.video, out, args.frames)
+        dec, trk = [], []
+        for _ in range(args.repeats):
+            dec.append(decode_fps(short.video))
+            trk.append(track_fps(short.video, out, args.frames))
+        dec_fps, trk_fps = statistics.median(dec), statistics.median(trk)
+        acc = accuracy(out, short.truth)
+
+        long = render(d / "long.mp4", args.long, seed=1)
+        rss_short = peak_rss_mib(short.video, d / "s.h5")
+        rss_long = peak_rss_mib(long.video, d / "l.h5")
+
+    ratio = trk_fps / dec_fps
+    mem = rss_long / rss_short
+    rows = [
+        ("render short clip", "-", f"{args.frames / t_render:,.0f} frames/s"),
+        ("decode (cv2 read loop)", "-", f"{dec_fps:,.0f} frames/s"),
+        (
+            "track (hammer-mv track)",
+            "-",
+            f"{trk_fps:,.0f} frames/s = {trk_fps / 30:.0f}x real time",
+        ),
+        ("track / decode", ">= 0.75", f"{ratio:.2f}  {'ok' if ratio >= 0.75 else 'MISSED'}"),
+        (f"peak RSS, {args.frames} frames", "-", f"{rss_short:.0f} MiB"),
+        (f"peak RSS, {args.long} frames", "-", f"{rss_long:.0f} MiB"),
+        ("peak RSS long / short", "<= 1.2", f"{mem:.2f}  {'ok' if mem <= 1.2 else 'MISSED'}"),
+    ]
+    rows += [
+        (f"error {m} (median / 95th)", "<= 1 / 3 px", f"{a:.2f} / {b:.2f} px")
+        for m, (a, b) in acc.items()
+    ]
+    print(
+        f"hammer-mv tracking benchmark: {args.frames}-frame 640x480 30 fps mp4v clip "
+        f"(hand, noise, lighting gradient); median of {args.repeats} alternating runs"
+    )
+    w0 = max(len(r[0]) for r in rows)
+    w1 = max(len(r[1]) for r in rows + [("", "target")])
+    print(f"{'measure':<{w0}}  {'target':<{w1}}  measured")
+    for name, target, measured in rows:
+        print(f"{name:<{w0}}  {target:<{w1}}  {measured}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
