@@ -19,7 +19,7 @@ import sys
 from minvar import __version__
 
 #: Subcommand modules, in the order ``--help`` lists them.
-COMMANDS = ("reach",)
+COMMANDS = ("reach", "grasp")
 
 
 class _Parser(argparse.ArgumentParser):
