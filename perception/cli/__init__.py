@@ -20,7 +20,7 @@ import sys
 from minvar import __version__
 
 #: Subcommand modules, in the order ``--help`` lists them.
-COMMANDS = ("reach", "track", "tracks")
+COMMANDS = ("reach", "grasp", "track", "tracks")
 
 
 class _Parser(argparse.ArgumentParser):

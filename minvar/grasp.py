@@ -1,0 +1,747 @@
+"""Reach-to-grasp with the minimum variance model (thesis chapter 4).
+
+Geometry (DESIGN.md, "Grasping"). World frame: origin at the object centre,
++y from the wrist's start toward the object, metres. The object is a disk of
+diameter ``object_size``.
+
+* **Arm**: a 2-link planar chain (links 0.30 m). Its shoulder sits at
+  ``shoulder_offset`` from the wrist's start position ``(0, -distance)`` —
+  by default 0.15 m to the right of and 0.25 m behind it, a right arm whose
+  elbow bends outward (to +x of the shoulder-wrist line), 122 deg at the
+  start. The wrist target is ``wrist_offset`` (6 cm) short of the object
+  centre along the approach: ``(0, -wrist_offset)``.
+* **Gripper**: two 2-link digits (links 0.10 m), the finger and the thumb,
+  both based at the wrist. The hand frame is the world frame translated (not
+  rotated) to the wrist. At the start the digit tips touch at
+  ``(0, tip_start)`` in the hand frame, on the approach axis (by default 6 cm
+  ahead of the wrist: the grip line once the wrist is on its target, so
+  grasping is opening and closing). The finger's middle joint bends outward
+  to +x, the thumb's to -x (the elbow branches are fixed for each chain, so
+  the joint angles stay continuous).
+* **Targets**: the digit tips end on the object surface on the line through
+  its centre perpendicular to the approach, the finger at ``(+size/2, 0)``
+  and the thumb at ``(-size/2, 0)`` (world frame; hand frame
+  ``(+-size/2, wrist_offset)``). A digit via-point lies ``viapoint_offset``
+  outside the surface along that line, ``viapoint_height`` above it, at
+  ``viapoint_time`` of the movement; :class:`GripVia` schedules replace it.
+
+Planning: transport and grip are planned separately, one joint-space LQG per
+2-joint chain (a :class:`~minvar.plant.PointMassPlant` in joint coordinates:
+rad, unit inertia), targets from inverse kinematics of the Cartesian targets
+(the digits' in the hand frame at the wrist target). Execution: the three
+plans run together; each joint's command gets signal-dependent noise with
+``execution_cv`` (1 %) coefficient of variation, independently per joint
+(``C = cv diag(1, 0), cv diag(0, 1)``), instead of the planning noise
+(``sigma_u = 0.4``). The thesis says nothing of sensory noise at execution:
+by default there is none (``execution_sigma_s = 0``; the Kalman filter then
+sees the exact joint positions, velocities and torques), so the variability
+is the signal-dependent noise alone. Wrist and tip paths follow by forward
+kinematics, the digit bases moving with the simulated wrist.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from .kinematics import TwoLinkChain
+from .lqg import LQGProblem, LQGSolution, solve
+from .plant import POSITION, VELOCITY, PointMassPlant
+from .simulate import simulate
+from .task import ReachTask, ViaPoint, reach_problem
+
+__all__ = [
+    "GripVia",
+    "GraspTask",
+    "ChainPlan",
+    "GraspPlan",
+    "GraspResult",
+    "plan_grasp",
+    "simulate_grasp",
+    "CHAINS",
+]
+
+#: Names of the three chains, in the order they are planned and simulated.
+CHAINS = ("arm", "finger", "thumb")
+
+
+def _finite(owner: str, name: str, value, *, low: float | None = None, strict: bool = False):
+    """``value`` as a float, checked finite and above ``low``; raise naming ``owner.name``."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{owner}.{name}: expected a number, got {value!r}") from None
+    if not np.isfinite(v):
+        raise ValueError(f"{owner}.{name}: expected a finite number, got {value!r}")
+    if low is not None and (v <= low if strict else v < low):
+        op = ">" if strict else ">="
+        raise ValueError(f"{owner}.{name}: expected a value {op} {low}, got {value!r}")
+    return v
+
+
+def _pair(owner: str, name: str, value, *, positive: bool = False) -> tuple[float, float]:
+    arr = np.asarray(value, dtype=float)
+    if arr.shape != (2,) or not np.all(np.isfinite(arr)) or (positive and np.any(arr <= 0)):
+        what = "2 positive lengths" if positive else "2 finite coordinates"
+        raise ValueError(f"{owner}.{name}: expected {what}, got {value!r}")
+    return float(arr[0]), float(arr[1])
+
+
+@dataclass(frozen=True)
+class GripVia:
+    """A via-point of the grip channel, shared by both digits (mirrored).
+
+    Parameters
+    ----------
+    half_aperture : float
+        Lateral distance of each tip from the approach axis, m (>= 0): the
+        finger passes ``+half_aperture``, the thumb ``-half_aperture``; the
+        aperture there is twice this.
+    height : float
+        Height relative to the line through the digit targets, m (positive:
+        further along the approach, beyond the object's centre line).
+    fraction : float
+        Time as a fraction of the movement, strictly between 0 and 1.
+    """
+
+    half_aperture: float
+    height: float
+    fraction: float
+
+    def __post_init__(self):
+        object.__setattr__(
+            self, "half_aperture", _finite("GripVia", "half_aperture", self.half_aperture, low=0.0)
+        )
+        object.__setattr__(self, "height", _finite("GripVia", "height", self.height))
+        f = _finite("GripVia", "fraction", self.fraction)
+        if not 0.0 < f < 1.0:
+            raise ValueError(f"GripVia.fraction: expected a time fraction in (0, 1), got {f}")
+        object.__setattr__(self, "fraction", f)
+
+
+@dataclass(frozen=True)
+class GraspTask:
+    """One reach-to-grasp movement (thesis 4.1.1; geometry in the module docstring).
+
+    All lengths in m, times in s unless stated.
+
+    Parameters
+    ----------
+    object_size : float
+        Diameter of the disk to grasp (>= 0; thesis 0-8 cm).
+    distance : float
+        Distance from the wrist's start to the object centre (thesis 8-24 cm).
+    duration : float
+        Movement time (> 0; thesis 0.6-1.2 s). Must span at least 2 plant steps.
+    viapoint_offset : float
+        Distance of the default digit via-point outside the object surface,
+        along the grip axis (>= 0).
+    viapoint_height : float
+        Height of the default via-point relative to the line through the
+        digit targets (positive: further along the approach).
+    viapoint_time : float
+        Time of the default via-point, a fraction of the movement in (0, 1).
+    grip_via : tuple of GripVia, optional
+        Explicit grip via-points replacing the default one (in increasing
+        time; ``()`` for none). Used to derive abnormal grasps, e.g. delayed
+        opening or open-close-open.
+    reach_only : bool
+        Transport only: the digits' goal is their closed start posture and
+        they have no via-points.
+    plant : PointMassPlant
+        Plant of every chain, in joint coordinates; its ``dt`` sets the step
+        and its noise (``sigma_u``, ``sigma_s``) the planning noise model.
+    execution_cv : float
+        Coefficient of variation of the signal-dependent noise on each joint
+        command at execution (>= 0; thesis: 1 %).
+    execution_sigma_s : float
+        Scale of the sensory noise at execution, multiplying
+        ``plant.sensory_sd`` (>= 0; default 0: none, see the module docstring).
+    wrist_offset : float
+        Wrist target distance short of the object centre along the approach
+        (> 0; thesis 6 cm).
+    tip_start : float
+        Where the touching digit tips start, ahead of the wrist along the
+        approach axis (hand frame).
+    shoulder_offset : (2,) tuple
+        Shoulder position relative to the wrist's start position (world axes).
+    arm_links : (2,) tuple
+        Upper-arm and forearm lengths (thesis 0.30 m each).
+    digit_links : (2,) tuple
+        Lengths of the two links of each digit (thesis 0.10 m each).
+    r : float
+        Effort weight of every chain's cost (``R = r dt / T I``).
+    w_v, w_f : float
+        Final velocity and force weights of every chain's goal cost.
+    """
+
+    object_size: float = 0.04
+    distance: float = 0.20
+    duration: float = 1.0
+    viapoint_offset: float = 0.01
+    viapoint_height: float = 0.0
+    viapoint_time: float = 0.7
+    grip_via: tuple[GripVia, ...] | None = None
+    reach_only: bool = False
+    plant: PointMassPlant = field(default_factory=PointMassPlant)
+    execution_cv: float = 0.01
+    execution_sigma_s: float = 0.0
+    wrist_offset: float = 0.06
+    tip_start: float = 0.06
+    shoulder_offset: tuple[float, float] = (0.15, -0.25)
+    arm_links: tuple[float, float] = (0.30, 0.30)
+    digit_links: tuple[float, float] = (0.10, 0.10)
+    r: float = 2e-4
+    w_v: float = 0.2
+    w_f: float = 0.01
+
+    def __post_init__(self):
+        own = "GraspTask"
+        setv = object.__setattr__
+        setv(self, "object_size", _finite(own, "object_size", self.object_size, low=0.0))
+        setv(self, "distance", _finite(own, "distance", self.distance, low=0.0, strict=True))
+        setv(self, "duration", _finite(own, "duration", self.duration, low=0.0, strict=True))
+        setv(self, "viapoint_offset",
+             _finite(own, "viapoint_offset", self.viapoint_offset, low=0.0))
+        setv(self, "viapoint_height", _finite(own, "viapoint_height", self.viapoint_height))
+        vt = _finite(own, "viapoint_time", self.viapoint_time)
+        if not 0.0 < vt < 1.0:
+            raise ValueError(
+                f"{own}.viapoint_time: expected a fraction of the movement in (0, 1), got {vt}"
+            )
+        setv(self, "viapoint_time", vt)
+        for name in ("execution_cv", "execution_sigma_s", "r", "w_v", "w_f"):
+            setv(self, name, _finite(own, name, getattr(self, name), low=0.0))
+        setv(self, "wrist_offset",
+             _finite(own, "wrist_offset", self.wrist_offset, low=0.0, strict=True))
+        setv(self, "tip_start", _finite(own, "tip_start", self.tip_start))
+        setv(self, "shoulder_offset", _pair(own, "shoulder_offset", self.shoulder_offset))
+        setv(self, "arm_links", _pair(own, "arm_links", self.arm_links, positive=True))
+        setv(self, "digit_links", _pair(own, "digit_links", self.digit_links, positive=True))
+        if not isinstance(self.plant, PointMassPlant):
+            raise ValueError(f"{own}.plant: expected a PointMassPlant, got {self.plant!r}")
+        setv(self, "reach_only", bool(self.reach_only))
+        if self.grip_via is not None:
+            vias = tuple(self.grip_via)
+            for i, v in enumerate(vias):
+                if not isinstance(v, GripVia):
+                    raise ValueError(f"{own}.grip_via[{i}]: expected a GripVia, got {v!r}")
+            fr = [v.fraction for v in vias]
+            if any(b <= a for a, b in zip(fr, fr[1:])):
+                raise ValueError(f"{own}.grip_via: fractions must increase, got {fr}")
+            setv(self, "grip_via", vias)
+        self._check_timing()
+        self._check_reach()
+
+    def _check_timing(self) -> None:
+        dt = self.plant.dt
+        T = int(round(self.duration / dt))
+        if T < 2:
+            raise ValueError(
+                f"GraspTask.duration: {self.duration} s is shorter than 2 steps of {dt} s"
+            )
+        used = self.via_schedule
+        name = "viapoint_time" if self.grip_via is None else "grip_via"
+        steps = [int(round(v.fraction * self.duration / dt)) for v in used]
+        for v, n in zip(used, steps):
+            if not 0 < n < T:
+                raise ValueError(
+                    f"GraspTask.{name}: via-point at {v.fraction:g} of {self.duration} s falls "
+                    f"on step {n}, outside the movement's steps 1..{T - 1}"
+                )
+        if len(set(steps)) != len(steps):
+            raise ValueError(f"GraspTask.grip_via: two via-points fall on the same step {steps}")
+
+    def _check_reach(self) -> None:
+        lo, hi = abs(self.arm_links[0] - self.arm_links[1]), sum(self.arm_links)
+        d_start = float(np.hypot(*self.shoulder_offset))
+        if not lo <= d_start <= hi:
+            raise ValueError(
+                f"GraspTask.shoulder_offset: the wrist's start is {d_start:.3f} m from the "
+                f"shoulder, outside the arm's reach [{lo:.3f}, {hi:.3f}] m"
+            )
+        d_goal = float(np.linalg.norm(np.subtract(self.wrist_target, self.shoulder)))
+        if not lo <= d_goal <= hi:
+            raise ValueError(
+                f"GraspTask.distance: an object {self.distance} m away puts the wrist target "
+                f"{d_goal:.3f} m from the shoulder, outside the arm's reach "
+                f"[{lo:.3f}, {hi:.3f}] m"
+            )
+        lo, hi = abs(self.digit_links[0] - self.digit_links[1]), sum(self.digit_links)
+
+        def check(point, name, what):
+            d = float(np.hypot(*point))
+            if not lo <= d <= hi:
+                raise ValueError(
+                    f"GraspTask.{name}: {what} {d:.3f} m from the wrist, outside the "
+                    f"digits' reach [{lo:.3f}, {hi:.3f}] m"
+                )
+
+        check((0.0, self.tip_start), "tip_start", "the closed digit tips lie")
+        if self.reach_only:
+            return
+        check(self.finger_goal_hand, "object_size",
+              f"an object of {self.object_size} m puts the digit targets")
+        name = "grip_via" if self.grip_via is not None else "viapoint_offset"
+        for v in self.via_schedule:
+            check((v.half_aperture, self.wrist_offset + v.height), name, "a digit via-point lies")
+
+    # --- geometry (world frame unless stated) ---------------------------------
+    @property
+    def wrist_start(self) -> tuple[float, float]:
+        """Wrist position at the start, m."""
+        return (0.0, -self.distance)
+
+    @property
+    def wrist_target(self) -> tuple[float, float]:
+        """Wrist target, ``wrist_offset`` short of the object centre, m."""
+        return (0.0, -self.wrist_offset)
+
+    @property
+    def shoulder(self) -> tuple[float, float]:
+        """Shoulder (arm base) position, m."""
+        return (self.shoulder_offset[0], self.shoulder_offset[1] - self.distance)
+
+    @property
+    def finger_target(self) -> tuple[float, float]:
+        """Finger-tip target on the object surface, m."""
+        return (0.0, 0.0) if self.reach_only else (self.object_size / 2, 0.0)
+
+    @property
+    def thumb_target(self) -> tuple[float, float]:
+        """Thumb-tip target on the object surface, m."""
+        return (0.0, 0.0) if self.reach_only else (-self.object_size / 2, 0.0)
+
+    @property
+    def finger_goal_hand(self) -> tuple[float, float]:
+        """Finger-tip goal in the hand frame (relative to the wrist target), m."""
+        if self.reach_only:
+            return (0.0, self.tip_start)
+        return (self.object_size / 2, self.wrist_offset)
+
+    @property
+    def via_schedule(self) -> tuple[GripVia, ...]:
+        """The grip via-points in use: ``grip_via``, or the default one; none if reach_only."""
+        if self.reach_only:
+            return ()
+        if self.grip_via is not None:
+            return self.grip_via
+        return (
+            GripVia(
+                self.object_size / 2 + self.viapoint_offset,
+                self.viapoint_height,
+                self.viapoint_time,
+            ),
+        )
+
+    @property
+    def steps(self) -> int:
+        """Number of control steps T (``duration / plant.dt``, rounded)."""
+        return int(round(self.duration / self.plant.dt))
+
+    @property
+    def time(self) -> np.ndarray:
+        """(T+1,) time of each state, s."""
+        return np.arange(self.steps + 1) * self.plant.dt
+
+    def chains(self) -> dict[str, TwoLinkChain]:
+        """The arm (world frame) and the two digits (hand frame) as :class:`TwoLinkChain`."""
+        return {
+            "arm": TwoLinkChain(*self.arm_links, base=self.shoulder),
+            "finger": TwoLinkChain(*self.digit_links, base=(0.0, 0.0)),
+            "thumb": TwoLinkChain(*self.digit_links, base=(0.0, 0.0)),
+        }
+
+
+@dataclass(frozen=True, eq=False)
+class ChainPlan:
+    """The movement plan of one 2-joint chain: a joint-space LQG and its gains.
+
+    This is a HAMMER inverse model (``solution.L``, ``solution.K``) with its
+    forward model (``problem.A``, ``problem.B``).
+
+    Attributes
+    ----------
+    name : str
+        ``"arm"``, ``"finger"`` or ``"thumb"``.
+    chain : TwoLinkChain
+        Kinematics (arm: world frame; digits: hand frame, base at the wrist).
+    elbow : int
+        The inverse-kinematics branch used (sign of the second joint angle).
+    task : ReachTask
+        The joint-space task (start, goal, via-points in rad).
+    problem : LQGProblem
+        Planning problem (plant noise model).
+    execution : LQGProblem
+        The same problem with the execution noise model.
+    solution : LQGSolution
+        Filter and control gains.
+    q_start, q_goal : (2,) arrays
+        Joint angles at the start and the goal, rad.
+    q_via : (V, 2) array
+        Joint angles of the via-points, rad.
+    via_fractions : (V,) array
+        Their times as fractions of the movement.
+    """
+
+    name: str
+    chain: TwoLinkChain
+    elbow: int
+    task: ReachTask
+    problem: LQGProblem = field(repr=False)
+    execution: LQGProblem = field(repr=False)
+    solution: LQGSolution = field(repr=False)
+    q_start: np.ndarray = field(repr=False)
+    q_goal: np.ndarray = field(repr=False)
+    q_via: np.ndarray = field(repr=False)
+    via_fractions: np.ndarray = field(repr=False)
+
+    @property
+    def nominal_q(self) -> np.ndarray:
+        """(T+1, 2) noise-free joint angles of the plan, rad."""
+        return self.solution.mean_states[:, POSITION]
+
+    @property
+    def nominal_qd(self) -> np.ndarray:
+        """(T+1, 2) noise-free joint velocities of the plan, rad/s."""
+        return self.solution.mean_states[:, VELOCITY]
+
+
+@dataclass(frozen=True, eq=False)
+class GraspPlan:
+    """The three chain plans of a grasp and its Cartesian targets.
+
+    Attributes
+    ----------
+    task : GraspTask
+        The planned task.
+    arm, finger, thumb : ChainPlan
+        Transport and grip plans.
+    wrist_start, wrist_target : (2,) arrays
+        World frame, m.
+    finger_target, thumb_target : (2,) arrays
+        Digit targets on the object surface, world frame, m.
+    finger_via, thumb_via : (V, 2) arrays
+        Digit via-points in the hand frame (relative to the wrist), m.
+    via_fractions : (V,) array
+        Via-point times as fractions of the movement.
+    """
+
+    task: GraspTask
+    arm: ChainPlan
+    finger: ChainPlan
+    thumb: ChainPlan
+    wrist_start: np.ndarray
+    wrist_target: np.ndarray
+    finger_target: np.ndarray
+    thumb_target: np.ndarray
+    finger_via: np.ndarray
+    thumb_via: np.ndarray
+    via_fractions: np.ndarray
+
+    @property
+    def chains(self) -> dict[str, ChainPlan]:
+        """The three chain plans by name (``CHAINS`` order)."""
+        return {"arm": self.arm, "finger": self.finger, "thumb": self.thumb}
+
+    @property
+    def time(self) -> np.ndarray:
+        """(T+1,) time of each state, s."""
+        return self.task.time
+
+    def nominal(self) -> GraspResult:
+        """The noise-free movement (the plan's mean states) as a one-trial result."""
+        q = {k: c.nominal_q[None] for k, c in self.chains.items()}
+        qd = {k: c.nominal_qd[None] for k, c in self.chains.items()}
+        return _result(self, q, qd)
+
+
+def _ik(chain: TwoLinkChain, point, elbow: int, ref: np.ndarray | None = None) -> np.ndarray:
+    """Joint angles on branch ``elbow``, first angle within pi of ``ref[0]`` (continuity)."""
+    q = chain.inverse(np.asarray(point, dtype=float), elbow)
+    if ref is not None:
+        q[..., 0] += 2 * np.pi * np.round((ref[0] - q[..., 0]) / (2 * np.pi))
+    return q
+
+
+def _chain_plan(name, chain, elbow, p_start, p_goal, vias, fractions, task: GraspTask):
+    q0 = _ik(chain, p_start, elbow)
+    qg = _ik(chain, p_goal, elbow, q0)
+    qv = np.array([_ik(chain, p, elbow, q0) for p in vias]).reshape(-1, 2)
+    jtask = ReachTask(
+        tuple(q0),
+        tuple(qg),
+        task.duration,
+        tuple(ViaPoint(tuple(q), fraction=f) for q, f in zip(qv, fractions)),
+        r=task.r,
+        w_v=task.w_v,
+        w_f=task.w_f,
+    )
+    problem = reach_problem(jtask, task.plant)
+    cv = task.execution_cv
+    # each joint's command gets its own noise: u_i (1 + cv eps_i)
+    noise = [cv * np.diag([1.0, 0.0]), cv * np.diag([0.0, 1.0])]
+    execution = dataclasses.replace(
+        problem, C=noise, D0=task.execution_sigma_s * np.diag(task.plant.sensory_sd)
+    )
+    return ChainPlan(
+        name=name,
+        chain=chain,
+        elbow=elbow,
+        task=jtask,
+        problem=problem,
+        execution=execution,
+        solution=solve(problem),
+        q_start=q0,
+        q_goal=qg,
+        q_via=qv,
+        via_fractions=np.asarray(fractions, dtype=float),
+    )
+
+
+def plan_grasp(task: GraspTask) -> GraspPlan:
+    """Plan transport and grip of a grasp: one joint-space LQG per chain.
+
+    Parameters
+    ----------
+    task : GraspTask
+        The grasp.
+
+    Returns
+    -------
+    GraspPlan
+        Chains, joint-space problems, gains and targets.
+    """
+    if not isinstance(task, GraspTask):
+        raise ValueError(f"plan_grasp: task: expected a GraspTask, got {type(task).__name__}")
+    chains = task.chains()
+    # Right arm (shoulder at +x of the wrist): the elbow bends outward, to the
+    # right of the shoulder-to-wrist line, which is the q2 > 0 branch.
+    arm_elbow = 1 if task.shoulder_offset[0] >= 0 else -1
+    arm = _chain_plan(
+        "arm", chains["arm"], arm_elbow, task.wrist_start, task.wrist_target, [], [], task
+    )
+    vias = task.via_schedule
+    fractions = [v.fraction for v in vias]
+    finger_via = np.array([(v.half_aperture, task.wrist_offset + v.height) for v in vias])
+    finger_via = finger_via.reshape(-1, 2)
+    thumb_via = finger_via * np.array([-1.0, 1.0])
+    start = (0.0, task.tip_start)
+    finger_goal = np.asarray(task.finger_goal_hand)
+    thumb_goal = finger_goal * np.array([-1.0, 1.0])
+    # The finger's middle joint lies to +x of the tip (right of the wrist-tip
+    # line: q2 > 0), the thumb's to -x (q2 < 0): each bends out on its own side.
+    finger = _chain_plan(
+        "finger", chains["finger"], 1, start, finger_goal, finger_via, fractions, task
+    )
+    thumb = _chain_plan(
+        "thumb", chains["thumb"], -1, start, thumb_goal, thumb_via, fractions, task
+    )
+    return GraspPlan(
+        task=task,
+        arm=arm,
+        finger=finger,
+        thumb=thumb,
+        wrist_start=np.asarray(task.wrist_start),
+        wrist_target=np.asarray(task.wrist_target),
+        finger_target=np.asarray(task.finger_target),
+        thumb_target=np.asarray(task.thumb_target),
+        finger_via=finger_via,
+        thumb_via=thumb_via,
+        via_fractions=np.asarray(fractions, dtype=float),
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class GraspResult:
+    """Noisy repetitions of one grasp, in the world frame.
+
+    Attributes
+    ----------
+    task : GraspTask
+        The grasp.
+    plan : GraspPlan
+        The plans that were executed.
+    time : (S+1,) array
+        Time of each state, s (S = ``task.steps``).
+    wrist, finger, thumb : (trials, S+1, 2) arrays
+        Wrist and digit-tip positions, m.
+    wrist_velocity, finger_velocity, thumb_velocity : (trials, S+1, 2) arrays
+        Their velocities, m/s.
+    q_arm, q_finger, q_thumb : (trials, S+1, 2) arrays
+        Joint angles of each chain, rad.
+    """
+
+    task: GraspTask
+    plan: GraspPlan = field(repr=False)
+    time: np.ndarray = field(repr=False)
+    wrist: np.ndarray = field(repr=False)
+    finger: np.ndarray = field(repr=False)
+    thumb: np.ndarray = field(repr=False)
+    wrist_velocity: np.ndarray = field(repr=False)
+    finger_velocity: np.ndarray = field(repr=False)
+    thumb_velocity: np.ndarray = field(repr=False)
+    q_arm: np.ndarray = field(repr=False)
+    q_finger: np.ndarray = field(repr=False)
+    q_thumb: np.ndarray = field(repr=False)
+
+    @property
+    def trials(self) -> int:
+        """Number of repetitions."""
+        return self.wrist.shape[0]
+
+    @property
+    def relative_time(self) -> np.ndarray:
+        """(S+1,) time as a fraction of the movement."""
+        return self.time / self.task.duration
+
+    @property
+    def aperture(self) -> np.ndarray:
+        """(trials, S+1) grip aperture ``|finger - thumb|``, m."""
+        d = self.finger - self.thumb
+        return np.hypot(d[..., 0], d[..., 1])
+
+    @property
+    def wrist_speed(self) -> np.ndarray:
+        """(trials, S+1) wrist speed, m/s."""
+        return np.hypot(self.wrist_velocity[..., 0], self.wrist_velocity[..., 1])
+
+    @property
+    def finger_speed(self) -> np.ndarray:
+        """(trials, S+1) finger-tip speed (world frame), m/s."""
+        return np.hypot(self.finger_velocity[..., 0], self.finger_velocity[..., 1])
+
+    @property
+    def thumb_speed(self) -> np.ndarray:
+        """(trials, S+1) thumb-tip speed (world frame), m/s."""
+        return np.hypot(self.thumb_velocity[..., 0], self.thumb_velocity[..., 1])
+
+    @property
+    def mga(self) -> np.ndarray:
+        """(trials,) maximum grip aperture of each repetition, m."""
+        return self.aperture.max(axis=1)
+
+    @property
+    def mga_time(self) -> np.ndarray:
+        """(trials,) time of each repetition's maximum aperture, fraction of the movement."""
+        return self.relative_time[np.argmax(self.aperture, axis=1)]
+
+    @property
+    def wrist_sd(self) -> np.ndarray:
+        """(S+1,) SD of the wrist position across repetitions, ``sqrt(var x + var y)``, m."""
+        return np.sqrt(self.wrist.var(axis=0, ddof=1).sum(axis=-1))
+
+    @property
+    def aperture_sd(self) -> np.ndarray:
+        """(S+1,) SD of the grip aperture across repetitions, m."""
+        return self.aperture.std(axis=0, ddof=1)
+
+    @property
+    def finger_end(self) -> np.ndarray:
+        """(trials, 2) final finger-tip positions, m."""
+        return self.finger[:, -1]
+
+    @property
+    def thumb_end(self) -> np.ndarray:
+        """(trials, 2) final thumb-tip positions, m."""
+        return self.thumb[:, -1]
+
+    def to_pandas(self) -> pd.DataFrame:
+        """One tidy row per repetition and time step.
+
+        Columns: trial, step, time (s), wrist_x, wrist_y, finger_x, finger_y,
+        thumb_x, thumb_y, aperture (m), arm_q1, arm_q2, finger_q1, finger_q2,
+        thumb_q1, thumb_q2 (rad).
+        """
+        trials, steps = self.wrist.shape[:2]
+        cols = {
+            "trial": np.repeat(np.arange(trials), steps),
+            "step": np.tile(np.arange(steps), trials),
+            "time": np.tile(self.time, trials),
+        }
+        for name in ("wrist", "finger", "thumb"):
+            arr = getattr(self, name)
+            cols[f"{name}_x"] = arr[..., 0].ravel()
+            cols[f"{name}_y"] = arr[..., 1].ravel()
+        cols["aperture"] = self.aperture.ravel()
+        for name in CHAINS:
+            q = getattr(self, f"q_{name}")
+            cols[f"{name}_q1"] = q[..., 0].ravel()
+            cols[f"{name}_q2"] = q[..., 1].ravel()
+        return pd.DataFrame(cols)
+
+
+def _result(plan: GraspPlan, q: dict, qd: dict) -> GraspResult:
+    """Cartesian paths by forward kinematics of joint angles ``q`` and velocities ``qd``."""
+    arm, finger, thumb = plan.arm.chain, plan.finger.chain, plan.thumb.chain
+    wrist = arm.forward(q["arm"])
+    wrist_v = np.einsum("...ij,...j->...i", arm.jacobian(q["arm"]), qd["arm"])
+    f_v = np.einsum("...ij,...j->...i", finger.jacobian(q["finger"]), qd["finger"])
+    t_v = np.einsum("...ij,...j->...i", thumb.jacobian(q["thumb"]), qd["thumb"])
+    return GraspResult(
+        task=plan.task,
+        plan=plan,
+        time=plan.time,
+        wrist=wrist,
+        finger=wrist + finger.forward(q["finger"]),
+        thumb=wrist + thumb.forward(q["thumb"]),
+        wrist_velocity=wrist_v,
+        finger_velocity=wrist_v + f_v,
+        thumb_velocity=wrist_v + t_v,
+        q_arm=q["arm"],
+        q_finger=q["finger"],
+        q_thumb=q["thumb"],
+    )
+
+
+def _seeds(seed) -> list[np.random.Generator]:
+    """One generator per chain from an int, SeedSequence or Generator."""
+    if isinstance(seed, np.random.Generator):
+        return seed.spawn(len(CHAINS))
+    ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
+    return [np.random.default_rng(s) for s in ss.spawn(len(CHAINS))]
+
+
+def simulate_grasp(
+    task: GraspTask,
+    trials: int = 500,
+    seed: int | np.random.SeedSequence | np.random.Generator | None = 0,
+    plan: GraspPlan | None = None,
+) -> GraspResult:
+    """Plan a grasp (unless given) and execute ``trials`` noisy repetitions.
+
+    Each chain runs all repetitions in one vectorised pass with the execution
+    noise model; the three chains are independent, and each draws from its own
+    child of ``seed``.
+
+    Parameters
+    ----------
+    task : GraspTask
+        The grasp.
+    trials : int
+        Number of repetitions (>= 1; thesis 500).
+    seed : int, numpy.random.SeedSequence or numpy.random.Generator, optional
+        Randomness; the same seed gives the same result.
+    plan : GraspPlan, optional
+        A plan of this very task from :func:`plan_grasp` (skips planning).
+
+    Returns
+    -------
+    GraspResult
+    """
+    if not isinstance(task, GraspTask):
+        raise ValueError(f"simulate_grasp: task: expected a GraspTask, got {type(task).__name__}")
+    if isinstance(trials, bool) or not isinstance(trials, int | np.integer) or trials < 1:
+        raise ValueError(f"simulate_grasp: trials: expected an integer >= 1, got {trials!r}")
+    if plan is None:
+        plan = plan_grasp(task)
+    elif not isinstance(plan, GraspPlan) or plan.task != task:
+        raise ValueError("simulate_grasp: plan: expected a GraspPlan made for this task")
+    q, qd = {}, {}
+    for (name, cp), rng in zip(plan.chains.items(), _seeds(seed)):
+        X = simulate(cp.problem, cp.solution, int(trials), seed=rng, execution=cp.execution).states
+        q[name], qd[name] = X[..., POSITION], X[..., VELOCITY]
+    return _result(plan, q, qd)

@@ -1,0 +1,342 @@
+"""Statistics of grasps (thesis chapter 4): grip aperture, variability, end-points.
+
+Functions take arrays, so they serve simulated and observed grasps alike;
+:func:`summarize_grasp` collects them for one :class:`~minvar.grasp.GraspResult`.
+:func:`grasp_moments` gives the same variabilities without sampling error,
+from the exact joint-space moments of each chain's plan
+(:func:`minvar.lqg.state_moments`) mapped through the kinematics to first
+order — exact up to terms of order (noise SD / link length)^2, i.e. to a
+part in 10^4 at the thesis's 1 % execution noise.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .analysis import endpoint_stats
+from .grasp import GraspPlan, GraspResult
+from .lqg import state_moments
+from .plant import POSITION
+
+__all__ = [
+    "GraspMoments",
+    "GraspSummary",
+    "grasp_moments",
+    "max_grip_aperture",
+    "path_sd",
+    "peak",
+    "peak_deviation",
+    "summarize_grasp",
+]
+
+
+def max_grip_aperture(aperture: np.ndarray, relative_time: np.ndarray):
+    """Maximum grip aperture (MGA) of each repetition and when it occurs.
+
+    Parameters
+    ----------
+    aperture : (trials, S+1) array
+        Grip aperture over time, m.
+    relative_time : (S+1,) array
+        Time of each sample as a fraction of the movement.
+
+    Returns
+    -------
+    mga : (trials,) array
+        Maximum aperture, m.
+    time : (trials,) array
+        Its time, fraction of the movement.
+    """
+    aperture = np.atleast_2d(np.asarray(aperture, dtype=float))
+    i = np.argmax(aperture, axis=1)
+    return aperture[np.arange(len(i)), i], np.asarray(relative_time, dtype=float)[i]
+
+
+def path_sd(paths: np.ndarray) -> np.ndarray:
+    """Standard deviation across repetitions at each time step.
+
+    Parameters
+    ----------
+    paths : (trials, S+1) or (trials, S+1, 2) array
+        A scalar (e.g. aperture, m) or a 2-D position (m) over time. For
+        positions the SD is ``sqrt(var x + var y)``.
+
+    Returns
+    -------
+    (S+1,) array
+        SD, in the unit of ``paths``.
+    """
+    paths = np.asarray(paths, dtype=float)
+    var = paths.var(axis=0, ddof=1)
+    return np.sqrt(var.sum(axis=-1)) if paths.ndim == 3 else np.sqrt(var)
+
+
+def peak(curve: np.ndarray, relative_time: np.ndarray) -> tuple[float, float]:
+    """Largest value of a curve and its time.
+
+    Parameters
+    ----------
+    curve : (S+1,) array
+        E.g. an SD over time.
+    relative_time : (S+1,) array
+        Time of each sample (any unit; fractions of the movement here).
+    """
+    i = int(np.argmax(curve))
+    return float(curve[i]), float(np.asarray(relative_time)[i])
+
+
+def peak_deviation(paths: np.ndarray, relative_time: np.ndarray):
+    """Each repetition's largest deviation from the mean path, and its time.
+
+    The per-repetition measure of variability that one-way ANOVA compares
+    across settings (the SD over time is its across-trial root mean square at
+    each step): a setting with more variable movements has larger peak
+    deviations on average.
+
+    Parameters
+    ----------
+    paths : (trials, S+1) or (trials, S+1, 2) array
+        Scalar or 2-D positions over time, m.
+    relative_time : (S+1,) array
+        Time of each sample as a fraction of the movement.
+
+    Returns
+    -------
+    deviation : (trials,) array
+        ``max_t |path(t) - mean path(t)|``, m.
+    time : (trials,) array
+        When it occurs, fraction of the movement.
+    """
+    paths = np.asarray(paths, dtype=float)
+    dev = paths - paths.mean(axis=0)
+    dist = np.sqrt((dev**2).sum(axis=-1)) if paths.ndim == 3 else np.abs(dev)
+    i = np.argmax(dist, axis=1)
+    return dist[np.arange(len(i)), i], np.asarray(relative_time, dtype=float)[i]
+
+
+@dataclass(frozen=True, eq=False)
+class GraspMoments:
+    """Exact (first-order) means and covariances of a planned grasp's execution.
+
+    Attributes
+    ----------
+    relative_time : (S+1,) array
+        Time as a fraction of the movement.
+    wrist_mean, finger_mean, thumb_mean : (S+1, 2) arrays
+        Positions of the mean joint angles, world frame, m.
+    wrist_cov, finger_cov, thumb_cov : (S+1, 2, 2) arrays
+        Position covariances, m^2.
+    aperture_mean, aperture_sd : (S+1,) arrays
+        Grip aperture and its SD, m (first order; poor where the aperture is
+        within a few SDs of zero, e.g. with the digits closed).
+    """
+
+    relative_time: np.ndarray = field(repr=False)
+    wrist_mean: np.ndarray = field(repr=False)
+    finger_mean: np.ndarray = field(repr=False)
+    thumb_mean: np.ndarray = field(repr=False)
+    wrist_cov: np.ndarray = field(repr=False)
+    finger_cov: np.ndarray = field(repr=False)
+    thumb_cov: np.ndarray = field(repr=False)
+    aperture_mean: np.ndarray = field(repr=False)
+    aperture_sd: np.ndarray = field(repr=False)
+
+    @property
+    def wrist_sd(self) -> np.ndarray:
+        """(S+1,) wrist SD, ``sqrt(var x + var y)``, m."""
+        return np.sqrt(np.trace(self.wrist_cov, axis1=1, axis2=2))
+
+    @property
+    def finger_end_sd(self) -> np.ndarray:
+        """(2,) SD of the final finger-tip position in x and y, m."""
+        return np.sqrt(np.diag(self.finger_cov[-1]))
+
+    @property
+    def thumb_end_sd(self) -> np.ndarray:
+        """(2,) SD of the final thumb-tip position in x and y, m."""
+        return np.sqrt(np.diag(self.thumb_cov[-1]))
+
+
+def grasp_moments(plan: GraspPlan) -> GraspMoments:
+    """Means and covariances of wrist, tips and aperture without sampling error.
+
+    Propagates each chain's exact joint-space moments under its execution
+    noise model, then maps them through the forward kinematics to first order
+    (the chains are independent; the digit bases move with the wrist).
+
+    Parameters
+    ----------
+    plan : GraspPlan
+        The grasp, from :func:`minvar.grasp.plan_grasp`.
+
+    Returns
+    -------
+    GraspMoments
+    """
+    mq, cq = {}, {}
+    for name, cp in plan.chains.items():
+        mean, cov = state_moments(cp.execution, cp.solution.K, cp.solution.L)
+        mq[name], cq[name] = mean[:, POSITION], cov[:, POSITION, POSITION]
+
+    def mapped(cp, name):
+        J = cp.chain.jacobian(mq[name])
+        return cp.chain.forward(mq[name]), J, J @ cq[name] @ np.swapaxes(J, 1, 2)
+
+    wrist, _, w_cov = mapped(plan.arm, "arm")
+    f_pos, _, f_cov = mapped(plan.finger, "finger")
+    t_pos, _, t_cov = mapped(plan.thumb, "thumb")
+    d = f_pos - t_pos
+    a = np.hypot(d[:, 0], d[:, 1])
+    # direction of the aperture; undefined with the tips together, where any
+    # unit vector gives the (then meaningless) first-order value
+    u = np.where(a[:, None] > 1e-12, d / np.maximum(a, 1e-12)[:, None], [1.0, 0.0])
+    a_var = np.einsum("ti,tij,tj->t", u, f_cov + t_cov, u)
+    return GraspMoments(
+        relative_time=plan.time / plan.task.duration,
+        wrist_mean=wrist,
+        finger_mean=wrist + f_pos,
+        thumb_mean=wrist + t_pos,
+        wrist_cov=w_cov,
+        finger_cov=w_cov + f_cov,
+        thumb_cov=w_cov + t_cov,
+        aperture_mean=a,
+        aperture_sd=np.sqrt(np.maximum(a_var, 0.0)),
+    )
+
+
+@dataclass(frozen=True)
+class GraspSummary:
+    """The chapter-4 measures of one grasp setting.
+
+    Lengths in m, times as fractions of the movement. ``*_exact`` values come
+    from :func:`grasp_moments` (no sampling error); the others from the
+    repetitions.
+
+    Attributes
+    ----------
+    trials : int
+        Number of repetitions.
+    mga_mean, mga_sd : float
+        Maximum grip aperture: mean and SD across repetitions.
+    mga_time_mean, mga_time_sd : float
+        Relative time of the MGA: mean and SD.
+    wrist_sd_peak, wrist_sd_peak_time : float
+        Largest wrist-position SD over the movement, and when.
+    aperture_sd_peak, aperture_sd_peak_time : float
+        Largest aperture SD, and when.
+    finger_distance_mean, finger_distance_sd : float
+        Distance of the final finger tip from its target: mean and SD.
+    finger_sd_x, finger_sd_y : float
+        SD of the final finger-tip position in x and y.
+    thumb_distance_mean, thumb_distance_sd, thumb_sd_x, thumb_sd_y : float
+        The same for the thumb.
+    wrist_sd_peak_exact, wrist_sd_peak_time_exact : float
+        Peak wrist SD and its time, exact.
+    aperture_sd_peak_exact, aperture_sd_peak_time_exact : float
+        Peak aperture SD and its time, exact.
+    finger_sd_x_exact, finger_sd_y_exact, thumb_sd_x_exact, thumb_sd_y_exact : float
+        End-point SDs, exact.
+    """
+
+    trials: int
+    mga_mean: float
+    mga_sd: float
+    mga_time_mean: float
+    mga_time_sd: float
+    wrist_sd_peak: float
+    wrist_sd_peak_time: float
+    aperture_sd_peak: float
+    aperture_sd_peak_time: float
+    finger_distance_mean: float
+    finger_distance_sd: float
+    finger_sd_x: float
+    finger_sd_y: float
+    thumb_distance_mean: float
+    thumb_distance_sd: float
+    thumb_sd_x: float
+    thumb_sd_y: float
+    wrist_sd_peak_exact: float = float("nan")
+    wrist_sd_peak_time_exact: float = float("nan")
+    aperture_sd_peak_exact: float = float("nan")
+    aperture_sd_peak_time_exact: float = float("nan")
+    finger_sd_x_exact: float = float("nan")
+    finger_sd_y_exact: float = float("nan")
+    thumb_sd_x_exact: float = float("nan")
+    thumb_sd_y_exact: float = float("nan")
+
+    @property
+    def finger_sd(self) -> float:
+        """Total final finger-tip SD, ``sqrt(sd_x^2 + sd_y^2)``, m."""
+        return float(np.hypot(self.finger_sd_x, self.finger_sd_y))
+
+    @property
+    def thumb_sd(self) -> float:
+        """Total final thumb-tip SD, m."""
+        return float(np.hypot(self.thumb_sd_x, self.thumb_sd_y))
+
+    def as_dict(self) -> dict[str, float]:
+        """All fields as a flat dict (one table row)."""
+        from dataclasses import asdict
+
+        return asdict(self)
+
+
+def summarize_grasp(result: GraspResult, moments: GraspMoments | None = None) -> GraspSummary:
+    """The chapter-4 measures of a simulated grasp.
+
+    Parameters
+    ----------
+    result : GraspResult
+        Repetitions of one grasp (at least 2).
+    moments : GraspMoments, optional
+        Exact moments of the same plan, for the ``*_exact`` fields (left NaN
+        without them).
+
+    Returns
+    -------
+    GraspSummary
+    """
+    if result.trials < 2:
+        raise ValueError(f"summarize_grasp: result: need >= 2 repetitions, got {result.trials}")
+    rt = result.relative_time
+    mga, mga_t = max_grip_aperture(result.aperture, rt)
+    w_peak = peak(path_sd(result.wrist), rt)
+    a_peak = peak(path_sd(result.aperture), rt)
+    fs = endpoint_stats(result.finger_end, result.task.finger_target)
+    ts = endpoint_stats(result.thumb_end, result.task.thumb_target)
+    exact = {}
+    if moments is not None:
+        mw = peak(moments.wrist_sd, moments.relative_time)
+        ma = peak(moments.aperture_sd, moments.relative_time)
+        exact = dict(
+            wrist_sd_peak_exact=mw[0],
+            wrist_sd_peak_time_exact=mw[1],
+            aperture_sd_peak_exact=ma[0],
+            aperture_sd_peak_time_exact=ma[1],
+            finger_sd_x_exact=float(moments.finger_end_sd[0]),
+            finger_sd_y_exact=float(moments.finger_end_sd[1]),
+            thumb_sd_x_exact=float(moments.thumb_end_sd[0]),
+            thumb_sd_y_exact=float(moments.thumb_end_sd[1]),
+        )
+    return GraspSummary(
+        trials=result.trials,
+        mga_mean=float(mga.mean()),
+        mga_sd=float(mga.std(ddof=1)),
+        mga_time_mean=float(mga_t.mean()),
+        mga_time_sd=float(mga_t.std(ddof=1)),
+        wrist_sd_peak=w_peak[0],
+        wrist_sd_peak_time=w_peak[1],
+        aperture_sd_peak=a_peak[0],
+        aperture_sd_peak_time=a_peak[1],
+        finger_distance_mean=fs.distance_mean,
+        finger_distance_sd=fs.distance_sd,
+        finger_sd_x=float(fs.sd[0]),
+        finger_sd_y=float(fs.sd[1]),
+        thumb_distance_mean=ts.distance_mean,
+        thumb_distance_sd=ts.distance_sd,
+        thumb_sd_x=float(ts.sd[0]),
+        thumb_sd_y=float(ts.sd[1]),
+        **exact,
+    )

@@ -1,0 +1,195 @@
+"""``hammer-mv grasp``: simulate reach-to-grasp movements (thesis chapter 4).
+
+``grasp simulate`` runs one grasp setting (figures + tidy CSV + summary);
+``grasp experiment NAME`` runs one of the chapter's sweeps (or ``all``) and
+writes its tables (CSV), statistics (JSON) and figures (PNG, named after the
+thesis's figures).
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import time
+from pathlib import Path
+
+from minvar.grasp import GraspTask
+from minvar.plant import PointMassPlant
+
+from ..atomic import save_figure, write_csv, write_json
+
+log = logging.getLogger(__name__)
+
+_EXPERIMENT_NAMES = (
+    "viapoint-height", "viapoint-time", "viapoint-distance", "object-size",
+    "movement-time", "variability-size", "variability-distance",
+)
+
+
+def register(sub) -> None:
+    """Add the ``grasp`` subcommand to ``sub`` (an argparse subparsers action)."""
+    p = sub.add_parser(
+        "grasp",
+        help="simulate reach-to-grasp movements and the thesis's chapter 4 experiments",
+        description="Reach-to-grasp with the minimum variance model: an arm and a two-digit "
+        "gripper, transport and grip planned separately and executed together "
+        "(thesis chapter 4). World frame: origin at the object centre, +y toward the object, m.",
+    )
+    p.set_defaults(func=lambda args: _usage(p))
+    gsub = p.add_subparsers(dest="grasp_command", metavar="{simulate,experiment}")
+
+    s = gsub.add_parser(
+        "simulate",
+        help="noisy repetitions of one grasp (figures + CSV)",
+        description="Plan one grasp, execute noisy repetitions and write trajectories.csv "
+        "(one row per repetition and step), summary.json (MGA, variability, end-points), "
+        "grasp.png and setup.png.",
+    )
+    d = GraspTask()
+    s.add_argument("--object-size", type=float, default=d.object_size, metavar="M",
+                   help=f"object diameter, m (default {d.object_size})")
+    s.add_argument("--distance", type=float, default=d.distance, metavar="M",
+                   help=f"wrist start to object centre, m (default {d.distance})")
+    s.add_argument("--duration", type=float, default=d.duration, metavar="S",
+                   help=f"movement time, s (default {d.duration})")
+    s.add_argument("--viapoint-offset", type=float, default=d.viapoint_offset, metavar="M",
+                   help=f"digit via-point distance outside the object, m "
+                        f"(default {d.viapoint_offset})")
+    s.add_argument("--viapoint-height", type=float, default=d.viapoint_height, metavar="M",
+                   help="digit via-point height above the target line, m (default 0)")
+    s.add_argument("--viapoint-time", type=float, default=d.viapoint_time, metavar="F",
+                   help=f"digit via-point time, fraction of the movement "
+                        f"(default {d.viapoint_time})")
+    s.add_argument("--reach-only", action="store_true",
+                   help="transport only: the digits stay closed")
+    s.add_argument("--execution-cv", type=float, default=d.execution_cv, metavar="CV",
+                   help=f"coefficient of variation of the execution noise "
+                        f"(default {d.execution_cv})")
+    s.add_argument("--dt", type=float, default=d.plant.dt, metavar="S",
+                   help=f"time step, s (default {d.plant.dt})")
+    s.add_argument("--trials", type=int, default=500, metavar="N",
+                   help="repetitions (default 500)")
+    s.add_argument("--seed", type=int, default=0, metavar="N", help="random seed (default 0)")
+    s.add_argument("-o", "--output", required=True, type=Path, metavar="DIR",
+                   help="folder for the figures and tables")
+    s.set_defaults(func=run_simulate)
+
+    e = gsub.add_parser(
+        "experiment",
+        help="one of the thesis's chapter 4 experiments, or all",
+        description="Run a chapter 4 sweep (500 repetitions per setting by default) and write "
+        "NAME.csv (one row per setting), NAME_trials.csv, NAME_curves.csv, NAME_stats.json "
+        "and the figures as PNG, named after the thesis's (e.g. fig4_10_object_size_mga.png).",
+    )
+    e.add_argument("name", choices=(*_EXPERIMENT_NAMES, "all"), metavar="NAME",
+                   help=f"one of {', '.join(_EXPERIMENT_NAMES)}, all")
+    e.add_argument("--trials", type=int, default=500, metavar="N",
+                   help="repetitions per setting (default 500, as in the thesis)")
+    e.add_argument("--seed", type=int, default=0, metavar="N", help="random seed (default 0)")
+    e.add_argument("-o", "--output", required=True, type=Path, metavar="DIR",
+                   help="folder for the tables and figures")
+    e.set_defaults(func=run_experiment)
+
+
+def _usage(parser: argparse.ArgumentParser) -> int:
+    parser.print_help()
+    return 2
+
+
+def _check_output(out: Path) -> None:
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"{out}: output exists and is not a folder")
+
+
+def _check_trials(trials: int) -> None:
+    if trials < 2:
+        raise ValueError(f"--trials: need at least 2 repetitions, got {trials}")
+
+
+def run_simulate(args: argparse.Namespace) -> int:
+    """Execute ``hammer-mv grasp simulate`` with parsed ``args``; return the exit status."""
+    from minvar.grasp import plan_grasp, simulate_grasp
+    from minvar.grasp_figures import grasp_figure, setup_figure
+    from minvar.grasp_stats import grasp_moments, summarize_grasp
+
+    _check_trials(args.trials)
+    _check_output(args.output)
+    task = GraspTask(
+        object_size=args.object_size, distance=args.distance, duration=args.duration,
+        viapoint_offset=args.viapoint_offset, viapoint_height=args.viapoint_height,
+        viapoint_time=args.viapoint_time, reach_only=args.reach_only,
+        execution_cv=args.execution_cv, plant=PointMassPlant(dt=args.dt),
+    )
+    plan = plan_grasp(task)
+    result = simulate_grasp(task, args.trials, seed=args.seed, plan=plan)
+    summary = summarize_grasp(result, grasp_moments(plan))
+    out: Path = args.output
+    info = {
+        "task": {k: getattr(task, k) for k in (
+            "object_size", "distance", "duration", "viapoint_offset", "viapoint_height",
+            "viapoint_time", "reach_only", "execution_cv", "execution_sigma_s",
+            "wrist_offset", "tip_start", "shoulder_offset", "arm_links", "digit_links")},
+        "dt_s": task.plant.dt,
+        "trials": args.trials,
+        "seed": args.seed,
+        "units": "m; times as fractions of the movement",
+        "wrist_target": task.wrist_target,
+        "finger_target": task.finger_target,
+        "thumb_target": task.thumb_target,
+        "solver": {name: {"iterations": cp.solution.iterations,
+                          "converged": cp.solution.converged,
+                          "expected_cost": cp.solution.cost}
+                   for name, cp in plan.chains.items()},
+        "summary": summary.as_dict(),
+    }
+    write_csv(out / "trajectories.csv", result.to_pandas())
+    write_json(out / "summary.json", info)
+    save_figure(out / "grasp.png", grasp_figure(result))
+    save_figure(out / "setup.png", setup_figure(plan=plan))
+    print(f"wrote {out / 'grasp.png'}, setup.png, trajectories.csv and summary.json "
+          f"({args.trials} repetitions; MGA {summary.mga_mean * 100:.2f} cm at "
+          f"{summary.mga_time_mean * 100:.0f} % of the movement)")
+    return 0
+
+
+def run_experiment(args: argparse.Namespace) -> int:
+    """Execute ``hammer-mv grasp experiment`` with parsed ``args``; return the exit status."""
+    from minvar.grasp_experiments import EXPERIMENTS
+
+    _check_trials(args.trials)
+    _check_output(args.output)
+    names = list(EXPERIMENTS) if args.name == "all" else [args.name]
+    out: Path = args.output
+    for name in names:
+        t0 = time.perf_counter()
+        exp = EXPERIMENTS[name](trials=args.trials, seed=args.seed)
+        write_experiment(exp, out)
+        print(f"{name}: {len(exp.summary)} settings x {args.trials} repetitions in "
+              f"{time.perf_counter() - t0:.1f} s -> {out / (name + '.csv')}, "
+              + ", ".join(f"{stem}.png" for stem in exp.figures))
+    return 0
+
+
+def write_experiment(exp, out: Path) -> list[Path]:
+    """Write an experiment's tables, statistics and figures into ``out``.
+
+    Parameters
+    ----------
+    exp : minvar.grasp_experiments.GraspExperiment
+        The experiment.
+    out : pathlib.Path
+        Output folder (created if missing).
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written.
+    """
+    written = [
+        write_csv(out / f"{exp.name}.csv", exp.summary),
+        write_csv(out / f"{exp.name}_trials.csv", exp.trials),
+        write_csv(out / f"{exp.name}_curves.csv", exp.curves),
+        write_json(out / f"{exp.name}_stats.json", exp.stats),
+    ]
+    written += [save_figure(out / f"{stem}.png", fig) for stem, fig in exp.figures.items()]
+    return written
