@@ -33,6 +33,7 @@ for _p in (ROOT, ROOT / "tools"):
     if str(_p) not in sys.path:
         sys.path.insert(0, str(_p))
 
+import pandas as pd  # noqa: E402
 from reproduce_common import CLAIM_KEYS  # noqa: E402
 from tqdm import tqdm  # noqa: E402
 
@@ -196,8 +197,6 @@ def main(argv: list[str] | None = None) -> int:
         "Each claim names how agreement was judged; where ours differs the note says why. "
         "Figures and CSV tables are beside this file.",
     ]
-    import pandas as pd
-
     write_csv(out / "numbers.csv", pd.DataFrame(claims, columns=list(CLAIM_KEYS)))
     write_text(out / "numbers.md", numbers_markdown(claims, notes, header))
     figures = sorted(p.name for p in out.glob("fig*.png"))
