@@ -140,6 +140,7 @@ def run(
                     raise ModuleNotFoundError(f"tools/{module}.py is missing")
                 notes.append(f"{title}: tools/{module}.py is missing, so its figures and "
                              "claims are not in this run.")
+                start = None
                 continue
             if module == "reproduce_ch4":  # another engineer's interface: (out, *, trials, seed)
                 got = reproduce(out, trials=CH4_TRIALS if trials is None else trials, seed=seed)
@@ -153,7 +154,8 @@ def run(
             log.exception("%s failed", title)
             notes.append(f"{title} FAILED: {type(exc).__name__}: {exc}")
         finally:
-            timings.append(f"{title}: {time.perf_counter() - start:.1f} s")
+            if start is not None:
+                timings.append(f"{title}: {time.perf_counter() - start:.1f} s")
     return claims, notes, timings, ok
 
 
