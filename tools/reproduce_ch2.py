@@ -1,0 +1,162 @@
+"""Thesis chapter 2 (section 2.2): the minimum jerk family, Figs. 2.5-2.8.
+
+``reproduce(out, *, trials, seed)`` writes the figures and returns the claims
+(see ``reproduce_common``). The models are noiseless, so ``trials`` is unused;
+``seed`` places the ten movements of Figs. 2.5 and 2.7.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from reproduce_common import Progress, claim, no_progress, rng_for, save
+
+from minvar.analysis import count_speed_peaks, path_deviation, peak_to_mean_speed
+from minvar.baselines import (
+    minimum_angle_jerk,
+    minimum_derivative,
+    minimum_jerk,
+    peak_to_mean_ratio,
+)
+from minvar.thesis_figures import (
+    angle_jerk_hand_figure,
+    angle_jerk_joint_figure,
+    derivative_order_figure,
+    minimum_jerk_figure,
+)
+
+#: The movement of Figs. 2.5, 2.7, 2.8 (m, s): a lateral reach in front of the
+#: shoulder of a two-link arm with 0.30 m links (the thesis gives no coordinates).
+START, GOAL, DURATION = np.array([-0.15, 0.30]), np.array([0.15, 0.40]), 1.0
+#: "Similar points in one area of the workspace": start and goal jittered by up to this, m.
+JITTER = 0.02
+ORDERS = (2, 3, 4, 5, 6)
+
+
+def _movements(seed: int, count: int = 10) -> list[tuple[np.ndarray, np.ndarray]]:
+    rng = rng_for(seed, "fig2_5")
+    jitter = rng.uniform(-JITTER, JITTER, size=(count, 2, 2))
+    return [(START + j[0], GOAL + j[1]) for j in jitter]
+
+
+def reproduce(
+    out: Path, *, trials: int | None = None, seed: int = 0, progress: Progress = no_progress
+) -> list[dict]:
+    """Figs. 2.5-2.8 into ``out``; the chapter's claims.
+
+    Parameters
+    ----------
+    out : Path
+        Output folder.
+    trials : int, optional
+        Unused (the models are noiseless); accepted for a uniform interface.
+    seed : int
+        Places the ten jittered movements.
+    progress : callable
+        Called with the name of each figure as it starts.
+    """
+    out = Path(out)
+    claims = []
+    pairs = _movements(seed)
+
+    progress("fig2_5")
+    jerk = [minimum_jerk(s, g, DURATION, dt=0.001) for s, g in pairs]
+    rows = [
+        {
+            "movement": k,
+            "start_x": s[0], "start_y": s[1], "goal_x": g[0], "goal_y": g[1],
+            "max_deviation_m": np.abs(path_deviation(m.position, s, g)).max(),
+            "peak_to_mean": peak_to_mean_speed(m.speed, m.time),
+            "speed_peaks": count_speed_peaks(m.speed),
+        }
+        for k, ((s, g), m) in enumerate(zip(pairs, jerk))
+    ]
+    table = pd.DataFrame(rows)
+    save(out, "fig2_5_minimum_jerk", minimum_jerk_figure(jerk), table)
+    dev = table["max_deviation_m"].max()
+    claims.append(claim(
+        "2.2.2, Fig. 2.5", "Minimum jerk hand paths are straight", "straight",
+        f"max deviation {dev * 1000:.1e} mm over {len(jerk)} movements", dev < 1e-9,
+    ))
+    bells = int((table["speed_peaks"] == 1).sum())
+    claims.append(claim(
+        "2.2.2, Fig. 2.5", "Minimum jerk speed profiles are smooth single bells",
+        "bell-shaped", f"{bells}/{len(jerk)} profiles with one peak", bells == len(jerk),
+    ))
+
+    progress("fig2_6")
+    ratios = {n: peak_to_mean_ratio(n) for n in ORDERS}
+    sampled = {}
+    for n in ORDERS:
+        m = minimum_derivative(n, (0.0, 0.0), (0.20, 0.0), 1.0, dt=0.001)
+        sampled[n] = peak_to_mean_speed(m.speed, m.time)
+    table = pd.DataFrame(
+        {"order": list(ORDERS), "ratio_closed_form": [ratios[n] for n in ORDERS],
+         "ratio_sampled_1ms": [sampled[n] for n in ORDERS]}
+    )
+    save(out, "fig2_6_derivative_order", derivative_order_figure(ORDERS), table)
+    claims.append(claim(
+        "2.2.3, Fig. 2.6(c)", "Peak/mean velocity ratio r of minimum jerk (n = 3)",
+        "1.875", f"{sampled[3]:.4f} (profile sampled at 1 ms); closed form 15/8 = {ratios[3]:.4f}",
+        abs(sampled[3] - 1.875) < 1e-3,
+        "Closed form r(n) = 1 / (4^(n-1) B(n, n)); the thesis quotes 1.875 as the human value.",
+    ))
+    values = [ratios[n] for n in ORDERS]
+    claims.append(claim(
+        "2.2.3, Fig. 2.6(c)", "r increases with the derivative order n",
+        "increases with n",
+        "n = 2..6: " + ", ".join(f"{r:.3f}" for r in values),
+        bool(np.all(np.diff(values) > 0)),
+    ))
+    nearest = min(ORDERS, key=lambda n: abs(ratios[n] - 1.875))
+    claims.append(claim(
+        "2.2.3, Fig. 2.6(c)", "Humans (r ≈ 1.875) are closest to minimum jerk",
+        "n = 3", f"n = {nearest}", nearest == 3,
+    ))
+
+    progress("fig2_7")
+    arm = [minimum_angle_jerk(s, g, DURATION, dt=0.005) for s, g in pairs]
+    save(out, "fig2_7_angle_jerk_joints", angle_jerk_joint_figure(arm))
+    joint_dev = max(
+        np.abs(path_deviation(m.joints.position, m.joints.position[0], m.joints.position[-1])).max()
+        for m in arm
+    )
+    claims.append(claim(
+        "2.2.4, Fig. 2.7", "Minimum angle jerk: joint paths are straight in joint space",
+        "straight joint paths", f"max deviation {joint_dev:.1e} rad over {len(arm)} movements",
+        joint_dev < 1e-9,
+    ))
+
+    progress("fig2_8")
+    hand_dev = np.array([
+        np.abs(path_deviation(m.hand.position, s, g)).max() for (s, g), m in zip(pairs, arm)
+    ])
+    lengths = np.array([np.linalg.norm(g - s) for s, g in pairs])
+    rel = hand_dev / lengths
+    main = minimum_angle_jerk(START, GOAL, DURATION, dt=0.005)
+    straight = minimum_jerk(START, GOAL, DURATION, dt=0.005)
+    table = pd.DataFrame({
+        "movement": np.arange(len(arm)), "length_m": lengths, "hand_max_deviation_m": hand_dev,
+        "hand_speed_peaks": [count_speed_peaks(m.hand.speed) for m in arm],
+        "hand_peak_to_mean": [peak_to_mean_speed(m.hand.speed, m.time) for m in arm],
+    })
+    save(out, "fig2_8_angle_jerk_hand", angle_jerk_hand_figure(main, straight), table)
+    claims.append(claim(
+        "2.2.4, Fig. 2.8", "Minimum angle jerk: hand path roughly straight, slightly curved",
+        "slight curvature",
+        f"max deviation {hand_dev.min() * 1000:.0f}-{hand_dev.max() * 1000:.0f} mm "
+        f"({rel.min():.0%}-{rel.max():.0%} of the movement length)",
+        bool(np.all((rel > 0.01) & (rel < 0.15))),
+        "Judged 'slight' as 1-15 % of the movement length. Arm: two 0.30 m links, shoulder at "
+        "the origin, elbow angle positive; movements of about 32 cm across the front.",
+    ))
+    peaks = table["hand_speed_peaks"]
+    claims.append(claim(
+        "2.2.4, Fig. 2.8(b)", "Minimum angle jerk hand speed is bell-shaped", "bell-shaped",
+        f"{int((peaks == 1).sum())}/{len(arm)} with one peak; peak/mean "
+        f"{table['hand_peak_to_mean'].min():.2f}-{table['hand_peak_to_mean'].max():.2f}",
+        bool((peaks == 1).all()),
+    ))
+    return claims
