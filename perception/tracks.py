@@ -171,6 +171,35 @@ class Tracks:
         except ValueError:
             raise KeyError(f"no marker {name!r} (markers: {', '.join(self.markers)})") from None
 
+    def object_diameter_px(self, name: str = "object") -> float | None:
+        """Apparent diameter of the round object in pixels, if the tracks can tell.
+
+        Tracker output: from the object's reference blob area (found while it
+        was fully visible, before the hand reaches it), as the diameter of a
+        disc of that area. Rendered ground truth: the true diameter times the
+        camera scale.
+
+        Parameters
+        ----------
+        name : str
+            The object's marker name.
+        """
+        if name not in self.markers:
+            return None
+        camera = self.attrs.get("camera")
+        if camera and "object_diameter" in self.attrs:
+            scale = json.loads(camera).get("px_per_m") if isinstance(camera, str) else None
+            if scale:
+                return float(self.attrs["object_diameter"]) * float(scale)
+        mass = self.tracker.get("reference_mass_px")
+        if mass is None:
+            return None
+        mass = np.atleast_1d(np.asarray(mass, dtype=float))
+        if len(mass) != len(self.markers):
+            return None
+        area = mass[self.markers.index(name)]
+        return float(2 * np.sqrt(area / np.pi)) if np.isfinite(area) and area > 0 else None
+
     def marker(self, name: str) -> np.ndarray:
         """(T, 2) px positions of one marker (a view; NaN where lost)."""
         return self.position[:, self.index(name)]

@@ -20,7 +20,7 @@ import sys
 from minvar import __version__
 
 #: Subcommand modules, in the order ``--help`` lists them.
-COMMANDS = ("reach", "grasp", "track", "tracks")
+COMMANDS = ("reach", "grasp", "synth", "track", "tracks", "repertoire", "recognize", "batch")
 
 
 class _Parser(argparse.ArgumentParser):

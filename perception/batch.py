@@ -1,0 +1,354 @@
+"""Batch recognition: many clips, in parallel, resumable, failures recorded.
+
+A batch input is a folder of videos and/or tracks files, or a synth
+``manifest.csv`` (which also gives each clip's condition). Each clip is
+tracked (videos), observed, scored against the repertoire and reported on
+its own (:func:`process_clip`); a failure is recorded with its message and
+the batch goes on. Rerunning skips clips whose report is complete and
+current: the report records a fingerprint of its input and settings.
+
+Clips run in local processes (``jobs``) or on a dask.distributed cluster
+(``scheduler``); each clip's result does not depend on where it ran.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import logging
+import multiprocessing
+import os
+import sys
+from collections.abc import Iterable
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pandas as pd
+
+from .atomic import write_json
+from .errors import InputError
+from .hammer import HammerParams, recognize
+from .observe import ObserveParams, observe
+from .repertoire import Repertoire
+from .report import ClipSummary, clip_outputs, write_batch_report, write_clip_report
+
+__all__ = ["BatchItem", "BatchSettings", "clip_name", "discover", "process_clip", "run_batch",
+           "VIDEO_SUFFIXES"]
+
+log = logging.getLogger(__name__)
+
+VIDEO_SUFFIXES = (".mp4", ".avi", ".mkv", ".mov", ".m4v")
+TRACKS_SUFFIX = ".tracks.h5"
+#: Files that sit beside clips and are not inputs.
+COMPANION_SUFFIXES = (".truth.h5",)
+COMPANION_NAMES = ("manifest.csv", "README.md", "recipe.toml")
+
+
+@dataclass(frozen=True)
+class BatchItem:
+    """One clip of a batch.
+
+    Attributes
+    ----------
+    clip : str
+        Clip name (file stem).
+    path : Path
+        Video or tracks file.
+    kind : str
+        ``video``, ``tracks`` or ``unknown`` (recorded as a failure).
+    condition : str or None
+        Stimulus condition, when a manifest gives it.
+    """
+
+    clip: str
+    path: Path
+    kind: str
+    condition: str | None = None
+
+
+@dataclass(frozen=True)
+class BatchSettings:
+    """Everything that decides a clip's result (part of its fingerprint).
+
+    Parameters
+    ----------
+    observe : ObserveParams
+        Tracks -> observation settings.
+    hammer : HammerParams
+        Rule and weights.
+    quiet : bool
+        No progress bars.
+    """
+
+    observe: ObserveParams = field(default_factory=ObserveParams)
+    hammer: HammerParams = field(default_factory=HammerParams)
+    quiet: bool = False
+
+    def fingerprint(self) -> dict:
+        """JSON-able settings that change results."""
+        return {"observe": dataclasses.asdict(self.observe),
+                "hammer": dataclasses.asdict(self.hammer)}
+
+
+def clip_name(path: Path) -> tuple[str, str]:
+    """Clip name and input kind (``video``, ``tracks`` or ``unknown``) of a file.
+
+    Parameters
+    ----------
+    path : Path
+        The file.
+    """
+    name = path.name
+    if name.endswith(TRACKS_SUFFIX):
+        return name[: -len(TRACKS_SUFFIX)], "tracks"
+    if path.suffix.lower() in VIDEO_SUFFIXES:
+        return path.stem, "video"
+    return path.stem, "unknown"
+
+
+def discover(source: str | os.PathLike) -> list[BatchItem]:
+    """List the clips of a batch input.
+
+    Parameters
+    ----------
+    source : str or os.PathLike
+        A folder, or a ``manifest.csv`` with columns ``clip``, ``condition`` and
+        ``video`` (path relative to the manifest) as written by ``hammer-mv synth``.
+
+    Returns
+    -------
+    list of BatchItem
+        Sorted by clip name. A clip with both a video and a tracks file uses the
+        tracks file. Other files become ``unknown`` items (reported as failed).
+
+    Raises
+    ------
+    InputError
+        If the source does not exist, or a manifest is unreadable.
+    """
+    source = Path(source)
+    if not source.exists():
+        raise InputError("batch input not found", source)
+    if source.is_file():
+        if source.suffix.lower() != ".csv":
+            raise InputError("batch input must be a folder or a manifest.csv", source)
+        try:
+            man = pd.read_csv(source)
+        except (OSError, ValueError, pd.errors.ParserError) as exc:
+            raise InputError(f"unreadable manifest: {exc}", source) from None
+        if "clip" not in man.columns or "video" not in man.columns:
+            raise InputError("manifest needs columns clip and video", source)
+        items = []
+        for row in man.itertuples(index=False):
+            path = (source.parent / str(row.video)).resolve()
+            cond = getattr(row, "condition", None)
+            cond = None if cond is None or pd.isna(cond) else str(cond)
+            items.append(BatchItem(str(row.clip), path, clip_name(path)[1], cond))
+        return sorted(items, key=lambda i: i.clip)
+    found: dict[str, BatchItem] = {}
+    conditions = {}
+    manifest = source / "manifest.csv"
+    if manifest.is_file():
+        conditions = {i.clip: i.condition for i in discover(manifest)}
+    for path in sorted(source.iterdir()):
+        if path.name.startswith(".") or path.is_dir() or path.name in COMPANION_NAMES:
+            continue
+        if path.name.endswith(COMPANION_SUFFIXES):
+            continue
+        clip, kind = clip_name(path)
+        item = BatchItem(clip, path, kind, conditions.get(clip))
+        prev = found.get(clip)
+        if prev is None or (kind == "tracks") or prev.kind == "unknown":
+            if kind == "unknown" and prev is not None:
+                continue
+            found[clip] = item
+    return sorted(found.values(), key=lambda i: i.clip)
+
+
+def _input_fingerprint(path: Path) -> dict:
+    st = path.stat()
+    return {"path": str(path.resolve()), "size": st.st_size, "mtime_ns": st.st_mtime_ns}
+
+
+def _fingerprint(item: BatchItem, settings: BatchSettings, repertoire_id: str) -> str:
+    payload = json.dumps({"input": _input_fingerprint(item.path), "settings":
+                          settings.fingerprint(), "repertoire": repertoire_id}, sort_keys=True)
+    return hashlib.sha256(payload.encode()).hexdigest()[:16]
+
+
+def _current_report(item: BatchItem, out: Path, fingerprint: str) -> dict | None:
+    """The clip's finished report if it was made from this input and these settings."""
+    p = clip_outputs(out, item.clip)
+    if not all(path.exists() for path in p.values()):
+        return None
+    try:
+        data = json.loads(p["json"].read_text())
+    except (OSError, ValueError):
+        return None
+    return data if data.get("fingerprint") == fingerprint else None
+
+
+def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
+                 settings: BatchSettings, repertoire_id: str = "") -> dict:
+    """Track (if a video), observe, recognise and report one clip.
+
+    Parameters
+    ----------
+    item : BatchItem
+        The clip.
+    out : Path
+        Report folder; tracks of videos go to ``out/tracks/``.
+    repertoire : Repertoire
+        Models to score against.
+    settings : BatchSettings
+        Observation and engine settings.
+    repertoire_id : str
+        Identity of the repertoire, part of the report's fingerprint.
+
+    Returns
+    -------
+    dict
+        A summary row: clip, condition, status (``ok``, ``skipped`` — report
+        already current — or ``failed``), error, winner, rule, and the report JSON
+        under ``report`` (absent on failure).
+    """
+    row = {"clip": item.clip, "condition": item.condition, "status": "failed",
+           "error": "", "winner": None, "rule": settings.hammer.rule}
+    try:
+        fp = _fingerprint(item, settings, repertoire_id)
+        done = _current_report(item, out, fp)
+        if done is not None:
+            return {**row, "status": "skipped", "winner": done["winner"], "report": done}
+        if item.kind == "unknown":
+            raise InputError("not a video or tracks file", item.path)
+        from .tracks import Tracks
+
+        if item.kind == "video":
+            from .tracking import track_video
+
+            tracks_file = track_video(item.path, out / "tracks" / f"{item.clip}{TRACKS_SUFFIX}",
+                                      progress=not settings.quiet and sys.stderr.isatty())
+        else:
+            tracks_file = item.path
+        tracks = Tracks.load(tracks_file)
+        obs = observe(tracks, settings.observe, clip=item.clip)
+        rec = recognize(obs, repertoire, settings.hammer)
+        write_clip_report(rec, out, extra={"fingerprint": fp, "condition": item.condition,
+                                           "input": str(item.path)})
+        report = json.loads(clip_outputs(out, item.clip)["json"].read_text())
+        return {**row, "status": "ok", "winner": rec.winner, "report": report}
+    except (InputError, ValueError, OSError) as exc:
+        msg = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        if isinstance(exc, OSError) and not isinstance(exc, InputError):
+            msg = f"{item.path}: {msg}"
+        log.info("%s failed: %s", item.clip, msg)
+        return {**row, "error": msg}
+
+
+def _limit_threads() -> None:
+    """One thread per worker process: parallelism comes from the processes."""
+    try:
+        import cv2
+
+        cv2.setNumThreads(1)
+    except ImportError:  # pragma: no cover
+        pass
+
+
+def run_batch(
+    items: Iterable[BatchItem],
+    out: str | os.PathLike,
+    repertoire: Repertoire,
+    settings: BatchSettings | None = None,
+    *,
+    jobs: int = 1,
+    scheduler: str | None = None,
+    repertoire_id: str = "",
+) -> pd.DataFrame:
+    """Process every clip and write the batch report.
+
+    Parameters
+    ----------
+    items : iterable of BatchItem
+        Clips (see :func:`discover`).
+    out : str or os.PathLike
+        Report folder.
+    repertoire : Repertoire
+        Models to score against.
+    settings : BatchSettings, optional
+        Observation and engine settings.
+    jobs : int
+        Local worker processes (ignored with ``scheduler``).
+    scheduler : str, optional
+        Address of a dask.distributed scheduler (``tcp://host:8786``) to run on.
+    repertoire_id : str
+        Identity of the repertoire for the resume fingerprints.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The summary: clip, condition, winner, conf_<model> per model, status, error.
+    """
+    from tqdm import tqdm
+
+    settings = BatchSettings() if settings is None else settings
+    items = list(items)
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    if jobs < 1:
+        raise ValueError(f"--jobs: expected at least 1, got {jobs}")
+    bar = tqdm(total=len(items), unit="clip", file=sys.stderr, desc="batch",
+               disable=settings.quiet or not sys.stderr.isatty())
+    rows: list[dict] = []
+    if scheduler:
+        from dask.distributed import Client
+        from dask.distributed import as_completed as dask_completed
+
+        with Client(scheduler) as client:
+            rep = client.scatter(repertoire, broadcast=True)
+            futures = [client.submit(process_clip, it, out, rep, settings, repertoire_id,
+                                     pure=False) for it in items]
+            for fut in dask_completed(futures):
+                rows.append(fut.result())
+                bar.update()
+    elif jobs == 1 or len(items) <= 1:
+        for it in items:
+            rows.append(process_clip(it, out, repertoire, settings, repertoire_id))
+            bar.update()
+    else:
+        # spawn, not fork: a parent that has already rendered or planned holds
+        # OpenCV/BLAS thread pools, and forking those deadlocks the workers
+        ctx = multiprocessing.get_context("spawn")
+        with ProcessPoolExecutor(max_workers=jobs, initializer=_limit_threads,
+                                 mp_context=ctx) as pool:
+            futures = [pool.submit(process_clip, it, out, repertoire, settings, repertoire_id)
+                       for it in items]
+            for fut in as_completed(futures):
+                rows.append(fut.result())
+                bar.update()
+    bar.close()
+    rows.sort(key=lambda r: r["clip"])
+    summaries = {r["clip"]: ClipSummary.from_dict(r["report"]) for r in rows if "report" in r}
+    names = next((s.names for s in summaries.values()), [])
+    table = []
+    for r in rows:
+        rec = summaries.get(r["clip"])
+        entry = {"clip": r["clip"], "condition": r["condition"], "winner": r["winner"],
+                 "rule": r["rule"]}
+        for n in names:
+            entry[f"conf_{n}"] = (float(rec.confidence[rec.names.index(n), -1])
+                                  if rec is not None and n in rec.names else float("nan"))
+        entry["status"] = "ok" if r["status"] in ("ok", "skipped") else "failed"
+        entry["reused"] = r["status"] == "skipped"
+        entry["error"] = r["error"]
+        table.append(entry)
+    summary = pd.DataFrame(table)
+    write_batch_report(summary, summaries, out)
+    write_json(out / "batch.json", {"clips": len(rows),
+                                    "ok": int((summary["status"] == "ok").sum()),
+                                    "failed": int((summary["status"] != "ok").sum()),
+                                    "settings": settings.fingerprint(),
+                                    "repertoire": repertoire_id})
+    return summary

@@ -1,0 +1,48 @@
+"""``hammer-mv batch``: recognise many clips in parallel and write a report."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from ..batch import BatchSettings, discover, run_batch
+from .options import add_recognition_options, hammer_params, load_repertoire, observe_params
+
+
+def register(sub) -> None:
+    """Add the ``batch`` subcommand to ``sub`` (an argparse subparsers action)."""
+    p = sub.add_parser("batch", help="recognise a folder of clips (or a synth manifest)",
+                       description="Track and recognise every clip of INPUT (a folder of "
+                       "videos / .tracks.h5 files, or a manifest.csv from hammer-mv synth) in "
+                       "parallel; write REPORT_DIR/report.html, summary.csv, statistics and "
+                       "per-clip reports. Rerunning skips clips whose report is current. "
+                       "Exits 1 if any clip failed (each failure is in the report).")
+    p.add_argument("input", type=Path, metavar="INPUT")
+    p.add_argument("-o", "--output", type=Path, required=True, metavar="REPORT_DIR")
+    p.add_argument("--jobs", type=int, default=1, metavar="N", help="local worker processes")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="run on a dask.distributed scheduler, e.g. tcp://host:8786")
+    add_recognition_options(p)
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Execute ``hammer-mv batch`` with parsed ``args``; return the exit status."""
+    if args.jobs < 1:
+        raise ValueError(f"--jobs: expected at least 1, got {args.jobs}")
+    items = discover(args.input)
+    if not items:
+        raise ValueError(f"{args.input}: no clips found")
+    settings = BatchSettings(observe=observe_params(args), hammer=hammer_params(args),
+                             quiet=args.quiet)
+    rep, rep_id = load_repertoire(args)
+    summary = run_batch(items, args.output, rep, settings, jobs=args.jobs,
+                        scheduler=args.scheduler, repertoire_id=rep_id)
+    failed = int((summary["status"] != "ok").sum())
+    print(f"{len(summary) - failed}/{len(summary)} clips recognised -> "
+          f"{args.output / 'report.html'}")
+    if failed:
+        print(f"hammer-mv batch: {failed} clip(s) failed; see the report", file=sys.stderr)
+        return 1
+    return 0

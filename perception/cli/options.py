@@ -1,0 +1,60 @@
+"""Options shared by the recognition commands (``recognize``, ``batch``)."""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+from pathlib import Path
+
+from ..hammer import RULES, HammerParams
+from ..observe import ObserveParams
+from ..repertoire import Repertoire
+
+
+def add_recognition_options(p: argparse.ArgumentParser) -> None:
+    """Add repertoire, scale and rule options to parser ``p``."""
+    g = p.add_argument_group("recognition")
+    g.add_argument("--repertoire", type=Path, metavar="REP.h5",
+                   help="models to score against (default: build the default repertoire)")
+    g.add_argument("--rule", choices=RULES, default="likelihood",
+                   help="rule that picks the winner (default: likelihood); the thesis "
+                        "rule's confidence is reported either way")
+    g.add_argument("--w-r", type=float, default=1.0, help="transport weight of the thesis rule")
+    g.add_argument("--w-g", type=float, default=2.0, help="grip weight of the thesis rule")
+    g.add_argument("--filter-gain", type=float, default=0.3, metavar="G",
+                   help="how strongly observed positions correct each model's estimate of "
+                        "velocity and force (0: the plan alone; 1: the plan's Kalman gains; "
+                        "default 0.3)")
+    g.add_argument("--object-diameter", type=float, default=0.10, metavar="M",
+                   help="real diameter of the object, m (default: 0.10, the thesis's ball)")
+    g.add_argument("--px-per-m", type=float, default=None, metavar="X",
+                   help="image scale (default: from the object's apparent size)")
+    g.add_argument("--mirror", action="store_true",
+                   help="mirror the image so the finger lies on the model's +x side")
+    p.add_argument("--quiet", action="store_true", help="no progress bars")
+
+
+def observe_params(args: argparse.Namespace) -> ObserveParams:
+    """:class:`ObserveParams` from parsed ``args``."""
+    return ObserveParams(object_diameter=args.object_diameter, px_per_m=args.px_per_m,
+                         mirror=args.mirror)
+
+
+def hammer_params(args: argparse.Namespace) -> HammerParams:
+    """:class:`HammerParams` from parsed ``args``."""
+    return HammerParams(rule=args.rule, w_r=args.w_r, w_g=args.w_g, filter_gain=args.filter_gain)
+
+
+def load_repertoire(args: argparse.Namespace) -> tuple[Repertoire, str]:
+    """The repertoire named by ``args`` (or the default one) and an identity string.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments with ``repertoire``.
+    """
+    if args.repertoire is None:
+        return Repertoire.build(), "default"
+    rep = Repertoire.load(args.repertoire)
+    digest = hashlib.sha256(Path(args.repertoire).read_bytes()).hexdigest()[:16]
+    return rep, f"{Path(args.repertoire).name}:{digest}"

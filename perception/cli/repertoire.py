@@ -1,0 +1,60 @@
+"""``hammer-mv repertoire``: build and inspect HAMMER-MV model repertoires."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ..repertoire import DEFAULT_DURATIONS, Repertoire, SceneSpec, default_specs
+
+
+def register(sub) -> None:
+    """Add the ``repertoire`` subcommand to ``sub`` (an argparse subparsers action)."""
+    p = sub.add_parser("repertoire", help="build or inspect a model repertoire",
+                       description="Inverse/forward model pairs planned with the minimum "
+                       "variance grasp model, stored in HDF5 so they are built once.")
+    verbs = p.add_subparsers(dest="verb", metavar="VERB", required=True)
+    b = verbs.add_parser("build", help="plan the models and save them",
+                         description="Without CONFIG: grasp and reach-only models at each "
+                         "of --durations. CONFIG is TOML with a [scene] table (distance, "
+                         "object_size, frame_period) and [[model]] entries (name, kind, "
+                         "and GraspTask fields such as duration or grip_via).")
+    b.add_argument("config", nargs="?", type=Path, help="TOML configuration")
+    b.add_argument("-o", "--output", type=Path, required=True, metavar="REP.h5")
+    b.add_argument("--durations", nargs="+", type=float, default=list(DEFAULT_DURATIONS),
+                   metavar="S", help="movement times without CONFIG (default: 0.8 ... 1.2)")
+    b.add_argument("--distance", type=float, default=SceneSpec.distance,
+                   help="wrist start to object centre, m (without CONFIG)")
+    b.add_argument("--object-size", type=float, default=SceneSpec.object_size,
+                   help="object diameter, m (without CONFIG)")
+    b.add_argument("--fps", type=float, default=30.0, help="video frame rate (without CONFIG)")
+    b.set_defaults(func=run_build)
+    i = verbs.add_parser("info", help="list the models of a repertoire file")
+    i.add_argument("file", type=Path)
+    i.set_defaults(func=run_info)
+
+
+def run_build(args: argparse.Namespace) -> int:
+    """Execute ``repertoire build`` with parsed ``args``; return the exit status."""
+    if args.config is not None:
+        rep = Repertoire.from_config(args.config)
+    else:
+        if not args.fps > 0:
+            raise ValueError(f"--fps: expected a positive frame rate, got {args.fps}")
+        scene = SceneSpec(distance=args.distance, object_size=args.object_size,
+                          frame_period=1.0 / args.fps)
+        rep = Repertoire.build(default_specs(args.durations), scene)
+    rep.save(args.output)
+    print(f"wrote {args.output}: {len(rep)} models ({', '.join(rep.names)})")
+    return 0
+
+
+def run_info(args: argparse.Namespace) -> int:
+    """Execute ``repertoire info`` with parsed ``args``; return the exit status."""
+    rep = Repertoire.load(args.file)
+    print(f"{args.file}: {len(rep)} models")
+    for m in rep:
+        s = m.scene
+        print(f"  {m.name:<14} {m.kind:<6} {m.duration:.2f} s  dt {m.dt * 1000:.2f} ms "
+              f"({m.substeps}/frame)  distance {s.distance:.3f} m  object {s.object_size:.3f} m")
+    return 0

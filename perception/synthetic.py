@@ -1,0 +1,327 @@
+"""Synthetic grasp clips rendered from the minimum variance model.
+
+The three stimuli of Gangitano et al. 2004 (thesis 5.4.1) are all derived
+from the grasp model, differing only in the grip channel's via-points:
+
+``normal``
+    The thesis's grasp: one via-point per digit 1 cm outside the object,
+    level with the targets, at 70 % of the movement.
+``delayed``
+    The digits stay nearly closed through the first half and open late: the
+    maximal aperture comes markedly late (about 85-90 % of the movement).
+``open-close-open``
+    The digits open, close unexpectedly near the expected maximal aperture,
+    and re-open before closing on the object.
+``reach``
+    Not a Gangitano stimulus: the transport alone, digits kept closed (for
+    checking that reach-only movements are told from grasps).
+
+A *recipe* (TOML, see ``datasets/README.md``) says how many clips of each
+condition to render, the scene, the demonstrator's variability and the
+camera/rendering style. Every clip gets its ground truth beside it
+(``<clip>.truth.h5``) with its condition and parameters, and the set gets a
+``manifest.csv``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import logging
+import os
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from minvar import GraspTask, GripVia, simulate_grasp
+
+from .atomic import write_csv
+from .errors import InputError
+from .render import Camera, Distractor, Occlusion, RenderStyle, Scene, render_clip
+
+__all__ = [
+    "CONDITIONS",
+    "StimulusParams",
+    "stimulus_task",
+    "stimulus_paths",
+    "Recipe",
+    "load_recipe",
+    "render_style",
+    "synthesize",
+]
+
+log = logging.getLogger(__name__)
+
+CONDITIONS = ("normal", "delayed", "open-close-open", "reach")
+
+
+@dataclass(frozen=True)
+class StimulusParams:
+    """One demonstration's movement.
+
+    Parameters
+    ----------
+    condition : str
+        ``normal``, ``delayed``, ``open-close-open`` or ``reach``.
+    object_size : float
+        Object diameter, m (thesis chapter 5: a 100 mm ball).
+    distance : float
+        Wrist start to object centre, m.
+    duration : float
+        Movement time, s.
+    execution_cv : float
+        Coefficient of variation of the demonstrator's motor noise.
+    rest_before, rest_after : float
+        Still periods around the movement, s (trimmed before recognition).
+    marker_offset : float
+        How far each digit's marker sits outside its tip, across the grip, m:
+        the model's tips touch at the start, real markers sit side by side.
+    """
+
+    condition: str = "normal"
+    object_size: float = 0.10
+    distance: float = 0.25
+    duration: float = 1.0
+    execution_cv: float = 0.03
+    rest_before: float = 0.3
+    rest_after: float = 0.3
+    marker_offset: float = 0.0065
+
+    def __post_init__(self):
+        if self.condition not in CONDITIONS:
+            raise ValueError(f"condition: expected one of {CONDITIONS}, got {self.condition!r}")
+        for name in ("rest_before", "rest_after"):
+            if not getattr(self, name) >= 0:
+                raise ValueError(f"{name}: expected a time >= 0 s, got {getattr(self, name)}")
+
+
+def stimulus_task(p: StimulusParams) -> GraspTask:
+    """The :class:`minvar.GraspTask` that produces stimulus ``p``.
+
+    Parameters
+    ----------
+    p : StimulusParams
+        The demonstration.
+    """
+    radius = p.object_size / 2
+    common = dict(object_size=p.object_size, distance=p.distance, duration=p.duration,
+                  execution_cv=p.execution_cv)
+    if p.condition == "normal":
+        return GraspTask(**common)
+    if p.condition == "reach":
+        return GraspTask(reach_only=True, **common)
+    if p.condition == "delayed":
+        # two closed via-points: one soft via-point alone lets the tips drift open early
+        vias = (GripVia(0.003, 0.0, 0.30), GripVia(0.003, 0.0, 0.55),
+                GripVia(radius + 0.02, 0.0, 0.88))
+    else:  # open-close-open
+        vias = (GripVia(radius + 0.012, 0.0, 0.40), GripVia(0.3 * radius, 0.0, 0.60),
+                GripVia(radius + 0.015, 0.0, 0.82))
+    return GraspTask(grip_via=vias, **common)
+
+
+def stimulus_paths(p: StimulusParams, fps: float, *, seed) -> tuple[np.ndarray, dict]:
+    """World-frame marker paths of one noisy demonstration, sampled at frame times.
+
+    Parameters
+    ----------
+    p : StimulusParams
+        The demonstration.
+    fps : float
+        Frame rate, frames/s.
+    seed : int or numpy.random.Generator
+        Motor noise of this repetition.
+
+    Returns
+    -------
+    time : (F,) array
+        Frame times, s.
+    paths : dict of (F, 2) arrays
+        ``wrist``, ``finger``, ``thumb`` marker positions, m (object centre at
+        the origin); the digit markers sit ``p.marker_offset`` outside the tips.
+    """
+    res = simulate_grasp(stimulus_task(p), trials=1, seed=seed)
+    t_model = res.time
+    n = int(round((p.rest_before + p.duration + p.rest_after) * fps)) + 1
+    t = np.arange(n) / fps
+    # the model's time runs from the onset; before it the hand rests, after it it holds
+    tm = np.clip(t - p.rest_before, 0.0, t_model[-1])
+    paths = {}
+    for name in ("wrist", "finger", "thumb"):
+        xy = getattr(res, name)[0]
+        paths[name] = np.stack([np.interp(tm, t_model, xy[:, 0]),
+                                np.interp(tm, t_model, xy[:, 1])], axis=1)
+    # the hand frame is not rotated: across the grip is the world x axis
+    paths["finger"][:, 0] += p.marker_offset
+    paths["thumb"][:, 0] -= p.marker_offset
+    return t, paths
+
+
+@dataclass(frozen=True)
+class Recipe:
+    """How to render a set of clips (parsed from a TOML recipe).
+
+    Parameters
+    ----------
+    name : str
+        Recipe name (file stem).
+    counts : dict
+        Clips per condition.
+    stimulus : StimulusParams
+        The nominal movement (its condition is replaced per clip).
+    duration_sd, distance_sd : float
+        Demonstrator variability between clips (SD, s and m).
+    camera_angle_deg : (float, float)
+        Range of camera rotations, degrees, drawn uniformly per clip.
+    style : dict
+        :class:`perception.render.RenderStyle` fields (fps, width, height, codec,
+        hand, noise_sd, blur_sigma, lighting, ...).
+    """
+
+    name: str
+    counts: dict
+    stimulus: StimulusParams = field(default_factory=StimulusParams)
+    duration_sd: float = 0.0
+    distance_sd: float = 0.0
+    camera_angle_deg: tuple[float, float] = (0.0, 0.0)
+    style: dict = field(default_factory=dict)
+
+    @property
+    def n_clips(self) -> int:
+        """Total number of clips."""
+        return int(sum(self.counts.values()))
+
+
+def load_recipe(path: str | os.PathLike) -> Recipe:
+    """Read a recipe TOML file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The recipe.
+
+    Raises
+    ------
+    InputError
+        If the file is missing, not TOML, or has unknown or bad fields.
+    """
+    path = Path(path)
+    try:
+        cfg = tomllib.loads(path.read_text())
+    except FileNotFoundError:
+        raise InputError("recipe not found", path) from None
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+        raise InputError(f"not a readable TOML recipe: {exc}", path) from None
+    try:
+        counts = {str(k): int(v) for k, v in cfg.get("conditions", {}).items()}
+        bad = set(counts) - set(CONDITIONS)
+        if bad:
+            raise ValueError(f"[conditions]: unknown {sorted(bad)} (expected {CONDITIONS})")
+        if not counts or any(v < 0 for v in counts.values()) or sum(counts.values()) == 0:
+            raise ValueError("[conditions]: give a non-negative clip count per condition")
+        stim = StimulusParams(**cfg.get("scene", {}))
+        var = dict(cfg.get("variation", {}))
+        angle = tuple(float(a) for a in var.pop("camera_angle_deg", (0.0, 0.0)))
+        if len(angle) != 2:
+            raise ValueError("[variation] camera_angle_deg: expected [low, high]")
+        recipe = Recipe(name=path.stem, counts=counts, stimulus=stim,
+                        duration_sd=float(var.pop("duration_sd", 0.0)),
+                        distance_sd=float(var.pop("distance_sd", 0.0)),
+                        camera_angle_deg=angle, style=dict(cfg.get("render", {})))
+        if var:
+            raise ValueError(f"[variation]: unknown fields {sorted(var)}")
+        render_style(recipe.style)  # validate now, not after rendering half the set
+    except (TypeError, ValueError, KeyError) as exc:
+        raise InputError(f"bad recipe: {exc}", path) from None
+    return recipe
+
+
+def render_style(table: dict) -> RenderStyle:
+    """A :class:`~perception.render.RenderStyle` from a recipe's ``[render]`` table.
+
+    Parameters
+    ----------
+    table : dict
+        RenderStyle fields; ``distractors`` and ``occlusions`` as lists of tables
+        (``{colour, start, end, diameter, frames}``, ``{marker, start, stop}``).
+    """
+    fields = dict(table)
+
+    def tup(v):
+        return None if v is None else tuple(v)
+
+    if "distractors" in fields:
+        fields["distractors"] = tuple(
+            Distractor(colour=d["colour"] if isinstance(d["colour"], str) else tuple(d["colour"]),
+                       start=tuple(d["start"]), end=tup(d.get("end")),
+                       diameter=float(d.get("diameter", 0.02)), frames=tup(d.get("frames")))
+            for d in fields["distractors"])
+    if "occlusions" in fields:
+        fields["occlusions"] = tuple(Occlusion(**o) for o in fields["occlusions"])
+    if "band_size" in fields:
+        fields["band_size"] = tuple(fields["band_size"])
+    return RenderStyle(**fields)
+
+
+def synthesize(recipe: Recipe, out: str | os.PathLike, *, seed: int = 0,
+               progress: bool = False) -> pd.DataFrame:
+    """Render every clip of a recipe into ``out`` and write ``manifest.csv``.
+
+    Parameters
+    ----------
+    recipe : Recipe
+        What to render.
+    out : str or os.PathLike
+        Output folder.
+    seed : int
+        Master seed; clip i draws from child i of it, so a clip does not
+        change when others are added after it.
+    progress : bool
+        Show a progress bar.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The manifest: clip, condition, seed, video, truth, parameters (JSON).
+    """
+    from tqdm import tqdm
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    style = render_style(recipe.style)
+    plan = [(cond, i) for cond in CONDITIONS for i in range(recipe.counts.get(cond, 0))]
+    children = np.random.SeedSequence(seed).spawn(len(plan))
+    rows = []
+    for (cond, i), child in tqdm(list(zip(plan, children)), desc=f"synth {recipe.name}",
+                                 unit="clip", disable=not progress):
+        rng = np.random.default_rng(child)
+        base = recipe.stimulus
+        params = dataclasses.replace(
+            base, condition=cond,
+            duration=float(base.duration + recipe.duration_sd * rng.standard_normal()),
+            distance=float(base.distance + recipe.distance_sd * rng.standard_normal()))
+        angle = float(rng.uniform(*recipe.camera_angle_deg))
+        clip = f"{cond}-{i + 1:02d}"
+        t, paths = stimulus_paths(params, style.fps, seed=rng)
+        scene = Scene(wrist=paths["wrist"], finger=paths["finger"], thumb=paths["thumb"],
+                      object_diameter=params.object_size)
+        camera = Camera.for_frame(style.width, style.height, angle_deg=angle)
+        clip_seed = int(rng.integers(2**31))
+        meta = {**dataclasses.asdict(params), "camera_angle_deg": angle, "recipe": recipe.name}
+        result = render_clip(scene, camera, style, out / f"{clip}{_suffix(style)}",
+                             seed=clip_seed, label=cond, params=meta)
+        rows.append({"clip": clip, "condition": cond, "seed": clip_seed,
+                     "video": result.video.name, "truth": result.truth.name,
+                     "parameters": json.dumps(meta)})
+        log.info("rendered %s (%d frames)", clip, result.n_frames)
+    manifest = pd.DataFrame(rows)
+    write_csv(out / "manifest.csv", manifest)
+    return manifest
+
+
+def _suffix(style: RenderStyle) -> str:
+    codec = (style.codec or "mp4v").lower()
+    return {"mp4v": ".mp4", "mjpg": ".avi", "ffv1": ".mkv"}.get(codec, ".mp4")

@@ -1,0 +1,144 @@
+"""The whole pipeline on rendered video: recognize, batch, resume, failures, dask."""
+
+import json
+import shutil
+import subprocess
+import sys
+
+import pandas as pd
+import pytest
+from _demos import default_repertoire
+
+from perception.batch import BatchSettings, discover, run_batch
+from perception.cli import main
+from perception.synthetic import Recipe, StimulusParams, synthesize
+
+pytestmark = pytest.mark.slow
+
+
+@pytest.fixture(scope="module")
+def clips(tmp_path_factory):
+    out = tmp_path_factory.mktemp("clips")
+    recipe = Recipe(name="t", counts={"normal": 2, "delayed": 1, "open-close-open": 1,
+                                      "reach": 1},
+                    stimulus=StimulusParams(rest_before=0.3, rest_after=0.2),
+                    camera_angle_deg=(-15, 15),
+                    style={"hand": True, "marker_diameter": 0.012, "noise_sd": 3.0,
+                           "lighting": 0.25, "blur_sigma": 0.6})
+    synthesize(recipe, out, seed=2)
+    return out
+
+
+@pytest.fixture(scope="module")
+def repfile(tmp_path_factory):
+    return default_repertoire().save(tmp_path_factory.mktemp("rep") / "rep.h5")
+
+
+def _batch(src, out, repfile, *extra):
+    return subprocess.run([sys.executable, "-m", "perception.cli", "batch", str(src), "-o",
+                           str(out), "--repertoire", str(repfile), "--quiet", *extra],
+                          capture_output=True, text=True)
+
+
+def test_batch_jobs_1_and_2_agree_and_resume(clips, repfile, tmp_path):
+    one, two = tmp_path / "one", tmp_path / "two"
+    assert _batch(clips / "manifest.csv", one, repfile).returncode == 0
+    assert _batch(clips, two, repfile, "--jobs", "2").returncode == 0
+    s1, s2 = pd.read_csv(one / "summary.csv"), pd.read_csv(two / "summary.csv")
+    assert list(s1.columns[:4]) == ["clip", "condition", "winner", "rule"]
+    assert {"status", "error"} <= set(s1.columns)
+    assert (s1["status"] == "ok").all()
+    pd.testing.assert_frame_equal(s1, s2)
+    for clip in s1["clip"]:
+        a = json.loads((one / f"{clip}.recognition.json").read_text())
+        b = json.loads((two / f"{clip}.recognition.json").read_text())
+        assert a["confidence"] == b["confidence"] and a["winner"] == b["winner"]
+    # what the thesis reports, end to end from video
+    final = s1.set_index("clip")["conf_grasp-1.0s"]
+    for normal in ("normal-01", "normal-02"):
+        assert final[normal] > final["delayed-01"] and final[normal] > final["open-close-open-01"]
+    kinds = s1.set_index("clip")["winner"].str.split("-").str[0]
+    assert kinds["reach-01"] == "reach" and (kinds[["normal-01", "normal-02"]] == "grasp").all()
+    for name in ("report.html", "statistics.csv", "condition_profiles.png"):
+        assert (one / name).exists(), name
+    # rerun: complete, current clips are skipped
+    again = _batch(clips / "manifest.csv", one, repfile)
+    assert again.returncode == 0
+    assert pd.read_csv(one / "summary.csv")["reused"].all()
+
+
+def test_batch_goes_on_past_bad_files(clips, repfile, tmp_path):
+    src = tmp_path / "src"
+    src.mkdir()
+    for name in ("normal-01.mp4", "manifest.csv"):
+        shutil.copy(clips / name, src / name)
+    (src / "notes.txt").write_text("not a video")
+    (src / "empty.mp4").write_bytes(b"")
+    proc = _batch(src, tmp_path / "out", repfile)
+    assert proc.returncode == 1 and "2 clip(s) failed" in proc.stderr
+    s = pd.read_csv(tmp_path / "out" / "summary.csv").set_index("clip")
+    assert s.loc["normal-01", "status"] == "ok"
+    assert s.loc["notes", "status"] == "failed" and "not a video" in s.loc["notes", "error"]
+    assert s.loc["empty", "status"] == "failed" and "empty.mp4" in s.loc["empty", "error"]
+    assert not list((tmp_path / "out").glob("empty.*")) and not list(
+        (tmp_path / "out").glob(".*part*"))
+
+
+def test_dask_scheduler_gives_the_same_results(clips, tmp_path):
+    from dask.distributed import LocalCluster
+
+    items = [i for i in discover(clips) if i.clip in ("normal-01", "reach-01")]
+    rep = default_repertoire()
+    local = run_batch(items, tmp_path / "local", rep, BatchSettings(quiet=True))
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                      dashboard_address=None) as cluster:
+        remote = run_batch(items, tmp_path / "dask", rep, BatchSettings(quiet=True),
+                           scheduler=cluster.scheduler_address)
+    pd.testing.assert_frame_equal(local, remote)
+
+
+def test_recognize_writes_the_contract(clips, repfile, tmp_path):
+    out = tmp_path / "r"
+    assert main(["recognize", str(clips / "open-close-open-01.mp4"), "-o", str(out),
+                 "--repertoire", str(repfile), "--quiet"]) == 0
+    d = json.loads((out / "open-close-open-01.recognition.json").read_text())
+    assert d["clip"] == "open-close-open-01" and d["rule"] == "likelihood"
+    assert {"name", "kind", "final_confidence"} <= set(d["models"][0])
+    assert d["winner"] in [m["name"] for m in d["models"]]
+    assert all(len(v) == len(d["time"]) for v in d["confidence"].values())
+    csv = pd.read_csv(out / "open-close-open-01.confidence.csv")
+    assert {"time", "model", "C", "dC_r", "dC_g"} <= set(csv.columns)
+    for suffix in ("confidence.png", "paths.png"):
+        assert (out / f"open-close-open-01.{suffix}").stat().st_size > 5000
+    # a tracks file is accepted as input too
+    tracks = out / "tracks" / "open-close-open-01.tracks.h5"
+    assert tracks.exists()
+    assert main(["recognize", str(tracks), "-o", str(tmp_path / "r2"),
+                 "--repertoire", str(repfile), "--quiet"]) == 0
+
+
+@pytest.mark.parametrize("make, message", [
+    (lambda d: d / "missing.mp4", "not found"),
+    (lambda d: (d / "x.txt").write_text("hi") and d / "x.txt", "not a video"),
+    (lambda d: (d / "z.mp4").write_bytes(b"") or d / "z.mp4", "z.mp4"),
+])
+def test_recognize_bad_input_exit_2(tmp_path, repfile, make, message):
+    path = make(tmp_path)
+    proc = subprocess.run([sys.executable, "-m", "perception.cli", "recognize", str(path),
+                           "-o", str(tmp_path / "o"), "--repertoire", str(repfile)],
+                          capture_output=True, text=True)
+    assert proc.returncode == 2, proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1 and message in proc.stderr
+    assert not (tmp_path / "o").exists() or not any(
+        p.suffix == ".json" for p in (tmp_path / "o").iterdir())
+
+
+def test_parallel_batch_after_work_in_the_same_process(clips, tmp_path):
+    # rendering and planning first leaves thread pools behind: workers must still run
+    from perception.synthetic import StimulusParams, stimulus_paths
+
+    stimulus_paths(StimulusParams(), 30, seed=0)
+    items = [i for i in discover(clips) if i.clip in ("normal-01", "delayed-01")]
+    summary = run_batch(items, tmp_path / "out", default_repertoire(), BatchSettings(quiet=True),
+                        jobs=2)
+    assert (summary["status"] == "ok").all()

@@ -1,0 +1,128 @@
+"""HAMMER-MV on demonstrations derived from the model (thesis chapter 5 behaviour)."""
+
+import numpy as np
+import pytest
+from _demos import default_repertoire, demo_tracks
+from scipy import stats
+
+from perception.hammer import HammerParams, recognize
+from perception.observe import observe
+
+MODEL = "grasp-1.0s"  # the normal grasp of the demonstrations' movement time
+SEEDS = range(5)
+
+
+@pytest.fixture(scope="module")
+def rep():
+    return default_repertoire()
+
+
+@pytest.fixture(scope="module")
+def scored(rep):
+    out = {}
+    for cond in ("normal", "delayed", "open-close-open"):
+        out[cond] = [recognize(observe(demo_tracks(cond, s)[0]), rep) for s in SEEDS]
+    return out
+
+
+def _conf(rec, model=MODEL):
+    return rec.confidence[rec.names.index(model)]
+
+
+def test_normal_beats_abnormal_in_90_percent_of_pairs(scored):
+    normal = np.array([_conf(r)[-1] for r in scored["normal"]])
+    for cond in ("delayed", "open-close-open"):
+        other = np.array([_conf(r)[-1] for r in scored[cond]])
+        assert np.mean(normal[:, None] > other[None, :]) >= 0.9, cond
+
+
+def _first_half(rec, model=MODEL):
+    """Transport and grip terms summed over the first half of the movement (0.5 s)."""
+    i, h = rec.names.index(model), np.searchsorted(rec.time, 0.5)
+    return rec.dC_r[i, :h].sum(), rec.dC_g[i, :h].sum()
+
+
+def test_delayed_opening_rises_clearly_less_over_the_first_half(scored):
+    normal = np.array([_first_half(r) for r in scored["normal"]])
+    delayed = np.array([_first_half(r) for r in scored["delayed"]])
+    # the whole grasp model: significantly less (its transport child, which
+    # sees a normal transport in both stimuli, keeps rising in both)
+    assert delayed.sum(1).mean() < 0.7 * normal.sum(1).mean()
+    assert stats.ttest_ind(delayed.sum(1), normal.sum(1), equal_var=False).pvalue < 0.01
+    # the grip child: hardly any rise while the digits stay closed
+    assert delayed[:, 1].mean() < 0.35 * normal[:, 1].mean()
+
+
+def test_open_close_open_falls_after_the_unexpected_closing(scored):
+    for rec in scored["open-close-open"]:
+        c, g, t = _conf(rec), rec.observation.g, rec.time
+        closing = np.flatnonzero((np.diff(g) < -0.003) & (t[1:] > 0.2))[0] + 1  # closes fast
+        peak = np.argmax(c[: closing + 1])
+        after = c[peak: closing + 8]
+        assert after.min() < c[peak] - 0.03 * c[peak]  # the whole model's confidence drops
+        grip = np.cumsum(rec.dC_g[rec.names.index(MODEL)])
+        assert grip[closing + 4] < grip[closing] - 0.01  # and its grip child's clearly
+
+
+def test_kinds_are_told_apart_by_the_likelihood_rule(rep):
+    for s in range(3):
+        grasp = recognize(observe(demo_tracks("normal", s)[0]), rep)
+        reach = recognize(observe(demo_tracks("reach", s)[0]), rep)
+        assert grasp.kinds[grasp.names.index(grasp.winner)] == "grasp"
+        assert reach.kinds[reach.names.index(reach.winner)] == "reach"
+        assert grasp.rule == "likelihood"
+
+
+def test_movement_time_is_recognised_within_one_variant(rep):
+    for duration in (0.8, 1.2):
+        rec = recognize(observe(demo_tracks("normal", 0, duration=duration)[0]), rep)
+        assert rec.winner in {f"grasp-{d:.1f}s" for d in (duration - 0.1, duration, duration + 0.1)}
+
+
+def test_predictions_follow_a_normal_grasp(scored):
+    rec = scored["normal"][0]
+    i = rec.names.index(MODEL)
+    err = np.abs(rec.predicted_g[i][1:] - rec.observation.g[1:])
+    assert np.nanmedian(err) < 0.003  # mm-level one-step prediction of the aperture
+
+
+def test_results_are_deterministic(rep):
+    tracks = demo_tracks("open-close-open", 3)[0]
+    a, b = recognize(observe(tracks), rep), recognize(observe(tracks), rep)
+    assert a.confidence.tobytes() == b.confidence.tobytes()
+    assert a.log_likelihood.tobytes() == b.log_likelihood.tobytes()
+
+
+def test_lost_markers_do_not_update_confidence(rep):
+    tracks = demo_tracks("normal", 0, lost={"finger": slice(20, 24)})[0]
+    rec = recognize(observe(tracks), rep)
+    gap = np.flatnonzero(np.isin(rec.frame, np.arange(20, 25)))
+    assert len(gap) == 5
+    assert np.all(rec.dC_g[:, gap] == 0) and np.all(rec.dC_r[:, gap] == 0)
+    assert np.all(np.isfinite(rec.confidence)) and np.all(np.isfinite(rec.log_likelihood))
+    full = recognize(observe(demo_tracks("normal", 0)[0]), rep)
+    assert full.winner == rec.winner
+
+
+def test_other_scene_is_replanned(rep):
+    tracks = demo_tracks("normal", 0, distance=0.20, fps=25)[0]
+    rec = recognize(observe(tracks), rep)
+    assert rec.kinds[rec.names.index(rec.winner)] == "grasp"
+    assert _conf(rec)[-1] > 0.3
+
+
+def test_thesis_rule_can_pick_the_winner(rep):
+    rec = recognize(observe(demo_tracks("normal", 0)[0]), rep, HammerParams(rule="thesis"))
+    assert rec.rule == "thesis"
+    assert rec.winner == rec.names[int(np.argmax(rec.confidence[:, -1]))]
+    d = rec.to_dict()
+    assert set(d) >= {"clip", "models", "winner", "rule", "time", "confidence"}
+    assert {m["kind"] for m in d["models"]} == {"grasp", "reach"}
+    assert len(d["time"]) == len(d["confidence"][MODEL])
+
+
+def test_bad_params():
+    with pytest.raises(ValueError, match="rule"):
+        HammerParams(rule="vote")
+    with pytest.raises(ValueError, match="filter_gain"):
+        HammerParams(filter_gain=2)

@@ -1,0 +1,86 @@
+"""Tracks -> model frame: transform, filter, onset, bad input."""
+
+import numpy as np
+import pytest
+from _demos import demo_tracks
+
+from perception.errors import InputError
+from perception.observe import ObserveParams, PixelTransform, alpha_beta, observe
+
+
+def test_pixel_transform_round_trip():
+    tr = PixelTransform(np.array([300.0, 200.0]), 750.0, 1.1, mirror=True)
+    pts = np.random.default_rng(0).uniform(-0.3, 0.3, (20, 2))
+    np.testing.assert_allclose(tr.to_model(tr.to_pixels(pts)), pts, atol=1e-12)
+
+
+@pytest.mark.parametrize("angle", [0.0, 35.0, -120.0])
+def test_observation_recovers_world_frame(angle):
+    tracks, truth = demo_tracks("normal", 1, angle_deg=angle, noise_px=0.0)
+    obs = observe(tracks)
+    frames = obs.frame
+    for name in ("wrist", "finger", "thumb"):
+        np.testing.assert_allclose(obs.raw[name], truth["world"][name][frames], atol=1e-9)
+    assert obs.start_distance == pytest.approx(0.25, abs=1e-3)
+    # onset within one frame of the true start of the movement
+    assert abs(obs.onset_frame - truth["onset_frame"]) <= 1
+    assert 0 <= obs.time[0] < obs.dt and obs.dt == pytest.approx(1 / 30)
+    # the observation ends after the grasp, not at the end of the clip's rest
+    assert obs.n_frames < len(tracks.time) - 5
+
+
+def test_alpha_beta_keeps_signs_of_small_changes_and_coasts_over_gaps():
+    # slow changes (about 0.5 mm a frame) seen with 0.7 mm of noise, as in
+    # DESIGN.md's finding on the signs of small aperture changes
+    t = np.arange(90) / 30
+    truth = np.stack([0.015 * t, 0.004 * np.sin(2 * t)], axis=1)
+    noisy = truth + 0.0007 * np.random.default_rng(1).standard_normal(truth.shape)
+    out = alpha_beta(noisy, 1 / 30, 0.5, 0.15)
+    true_sign = np.sign(np.diff(truth, axis=0))
+    agree_raw = np.mean(np.sign(np.diff(noisy, axis=0)) == true_sign)
+    agree_filt = np.mean(np.sign(np.diff(out, axis=0)) == true_sign)
+    assert agree_filt > agree_raw + 0.15
+    gappy = noisy.copy()
+    gappy[30:35] = np.nan
+    out = alpha_beta(gappy, 1 / 30, 0.5, 0.15)
+    assert np.all(np.isnan(out[30:35]))  # a gap is not filled
+    assert np.all(np.isfinite(out[35:]))  # and the filter picks up after it
+
+
+def test_default_onset_latency_is_the_models():
+    from minvar import GraspTask, plan_grasp
+
+    params = ObserveParams()
+    for duration in (0.8, 1.0, 1.2):
+        nom = plan_grasp(GraspTask(object_size=0.1, distance=0.25, duration=duration)).nominal()
+        disp = np.linalg.norm(nom.wrist[0] - nom.wrist[0, 0], axis=1)
+        latency = nom.time[np.argmax(disp > params.onset_displacement)]
+        assert latency == pytest.approx(params.onset_latency, abs=0.0201)
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda pos: pos.__setitem__((slice(None), 2), np.nan), "marker 'wrist' is never seen"),
+    (lambda pos: pos.__setitem__((slice(None), 3), np.nan), "object is never seen"),
+])
+def test_bad_tracks(change, message):
+    tracks, _ = demo_tracks("normal", 0)
+    pos = tracks.position.copy()
+    change(pos)
+    with pytest.raises(InputError, match=message):
+        observe(tracks.replace(position=pos))
+
+
+def test_too_short_and_no_scale_and_no_movement():
+    tracks, _ = demo_tracks("normal", 0)
+    short = tracks.replace(frame=tracks.frame[:5], time=tracks.time[:5],
+                           position=tracks.position[:5], likelihood=tracks.likelihood[:5],
+                           status=tracks.status[:5])
+    with pytest.raises(InputError, match="too short"):
+        observe(short)
+    with pytest.raises(InputError, match="px-per-m"):
+        observe(tracks.replace(attrs={}))
+    assert observe(tracks.replace(attrs={}), ObserveParams(px_per_m=800.0)).n_frames > 20
+    still = tracks.position.copy()
+    still[:] = still[:1]
+    with pytest.raises(InputError, match="no movement"):
+        observe(tracks.replace(position=still))
