@@ -235,7 +235,10 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
         else:
             tracks_file = item.path
         tracks = Tracks.load(tracks_file)
-        obs = observe(tracks, settings.observe, clip=item.clip)
+        try:
+            obs = observe(tracks, settings.observe, clip=item.clip)
+        except InputError as exc:  # name the file the user gave, not the clip
+            raise InputError(exc.problem, item.path) from None
         rec = recognize(obs, repertoire, settings.hammer)
         write_clip_report(rec, out, extra={"fingerprint": fp, "condition": item.condition,
                                            "input": str(item.path)})

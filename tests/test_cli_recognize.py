@@ -1,0 +1,70 @@
+"""`hammer-mv recognize` on tracks files: bad inputs are one line and exit 2."""
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from _demos import default_repertoire, demo_tracks
+
+
+@pytest.fixture(scope="module")
+def repfile(tmp_path_factory):
+    return default_repertoire().save(tmp_path_factory.mktemp("rep") / "rep.h5")
+
+
+def _recognize(path, out, repfile, *extra):
+    return subprocess.run([sys.executable, "-m", "perception.cli", "recognize", str(path), "-o",
+                           str(out), "--repertoire", str(repfile), *extra],
+                          capture_output=True, text=True)
+
+
+def _save(tracks, path):
+    tracks.save(path)
+    return path
+
+
+def test_tracks_file_is_recognised(tmp_path, repfile):
+    path = _save(demo_tracks("normal", 0)[0], tmp_path / "n.tracks.h5")
+    proc = _recognize(path, tmp_path / "out", repfile)
+    assert proc.returncode == 0, proc.stderr
+    assert "winner grasp-" in proc.stdout
+    assert (tmp_path / "out" / "n.recognition.json").exists()
+
+
+@pytest.mark.parametrize("marker, message", [("finger", "marker 'finger' is never seen"),
+                                             ("object", "object is never seen")])
+def test_marker_missing_for_the_whole_clip(tmp_path, repfile, marker, message):
+    tracks = demo_tracks("normal", 0)[0]
+    pos = tracks.position.copy()
+    pos[:, tracks.markers.index(marker)] = np.nan
+    path = _save(tracks.replace(position=pos), tmp_path / "m.tracks.h5")
+    proc = _recognize(path, tmp_path / "out", repfile)
+    assert proc.returncode == 2
+    assert proc.stderr.count("\n") == 1 and message in proc.stderr and "m.tracks.h5" in proc.stderr
+    assert not (tmp_path / "out" / "m.recognition.json").exists()
+
+
+def test_clip_too_short(tmp_path, repfile):
+    t = demo_tracks("normal", 0)[0]
+    short = t.replace(frame=t.frame[:6], time=t.time[:6], position=t.position[:6],
+                      likelihood=t.likelihood[:6], status=t.status[:6])
+    proc = _recognize(_save(short, tmp_path / "s.tracks.h5"), tmp_path / "out", repfile)
+    assert proc.returncode == 2 and "too short" in proc.stderr
+
+
+def test_corrupt_repertoire(tmp_path):
+    path = _save(demo_tracks("normal", 0)[0], tmp_path / "n.tracks.h5")
+    bad = tmp_path / "rep.h5"
+    bad.write_bytes(b"\x89HDF\r\n\x1a\n" + b"\0" * 100)
+    proc = _recognize(path, tmp_path / "out", bad)
+    assert proc.returncode == 2 and proc.stderr.count("\n") == 1 and "rep.h5" in proc.stderr
+
+
+@pytest.mark.parametrize("extra, message", [(["--rule", "vote"], "invalid choice"),
+                                            (["--filter-gain", "3"], "filter_gain"),
+                                            (["--object-diameter", "-1"], "object_diameter")])
+def test_bad_options(tmp_path, repfile, extra, message):
+    path = _save(demo_tracks("normal", 0)[0], tmp_path / "n.tracks.h5")
+    proc = _recognize(path, tmp_path / "out", repfile, *extra)
+    assert proc.returncode == 2 and proc.stderr.count("\n") == 1 and message in proc.stderr
