@@ -36,6 +36,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from minvar.kinematics import TwoLinkChain
+
 from .observe import Observation
 from .repertoire import ChainModel, MotorModel, Repertoire, SceneSpec
 
@@ -207,23 +209,22 @@ def _clamp_reach(p: np.ndarray, l1: float, l2: float) -> np.ndarray:
 def _ik(p: np.ndarray, c: ChainModel) -> np.ndarray:
     """Joint angles (..., 2) for tip positions relative to the chain base; NaN stays NaN."""
     p = _clamp_reach(p, c.l1, c.l2)
-    d2 = np.sum(p**2, axis=-1)
-    c2 = np.clip((d2 - c.l1**2 - c.l2**2) / (2 * c.l1 * c.l2), -1, 1)
-    q2 = c.elbow * np.arccos(c2)
-    q1 = np.arctan2(p[..., 1], p[..., 0]) - np.arctan2(c.l2 * np.sin(q2), c.l1 + c.l2 * np.cos(q2))
-    return np.stack([q1, q2], axis=-1)
+    ok = np.isfinite(p).all(axis=-1)
+    q = np.full(p.shape, np.nan)
+    q[ok] = TwoLinkChain(c.l1, c.l2).inverse(p[ok], elbow=c.elbow)
+    return q
 
 
 def _fk(q: np.ndarray, l1: np.ndarray, l2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Tip positions (..., 2) and Jacobians (..., 2, 2) of chains (l1, l2 broadcast)."""
-    a1, a12 = q[..., 0], q[..., 0] + q[..., 1]
-    s1, c1, s12, c12 = np.sin(a1), np.cos(a1), np.sin(a12), np.cos(a12)
-    tip = np.stack([l1 * c1 + l2 * c12, l1 * s1 + l2 * s12], axis=-1)
-    J = np.empty(q.shape[:-1] + (2, 2))
-    J[..., 0, 0] = -l1 * s1 - l2 * s12
-    J[..., 0, 1] = -l2 * s12
-    J[..., 1, 0] = l1 * c1 + l2 * c12
-    J[..., 1, 1] = l2 * c12
+    """Tip positions (N, L, 2) and Jacobians (N, L, 2, 2) of leaves with link lengths (L,)."""
+    tip = np.empty(q.shape)
+    J = np.empty(q.shape + (2,))
+    geometry = np.stack([l1, l2], axis=1)
+    for g in np.unique(geometry, axis=0):  # one chain per distinct geometry (a few at most)
+        cols = np.flatnonzero((geometry == g).all(axis=1))
+        chain = TwoLinkChain(*g)
+        tip[:, cols] = chain.forward(q[:, cols])
+        J[:, cols] = chain.jacobian(q[:, cols])
     return tip, J
 
 
