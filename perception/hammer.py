@@ -382,9 +382,12 @@ def recognize(
     grasp = np.array([m.kind == "grasp" for m in models])[:, None]
     dC_r = _sgn(dr_obs) * _sgn(dr_pred) * np.abs(dr_pred) * params.w_r
     dC_g = _sgn(dg_obs) * _sgn(dg_pred) * np.abs(dg_pred) * params.w_g * grasp
-    # sgn(NaN) is not NaN, so validity comes from the inputs, not the products
-    valid = (np.isfinite(dr_obs) & np.isfinite(dg_obs))[None] & np.isfinite(dr_pred) & \
-        np.isfinite(dg_pred)
+    # A step counts only if the state it predicts from was observed (all three
+    # markers at n-1: the wrist anchors every chain) and the outcome is (the
+    # digits at n). sgn(NaN) is not NaN, so this comes from the inputs.
+    seen = np.isfinite(np.stack([w, f, t], axis=1)).all(axis=(1, 2))
+    valid = (np.concatenate([[False], seen[:-1]]) & np.isfinite(r_obs) & np.isfinite(g_obs))
+    valid = valid[None] & np.isfinite(dr_pred) & np.isfinite(dg_pred)
     dC_r = np.where(valid, dC_r, 0.0)
     dC_g = np.where(valid, dC_g, 0.0)
     confidence = np.cumsum(dC_r + dC_g, axis=1)
@@ -413,8 +416,7 @@ def recognize(
     er, eg = r_obs[None] - r_pred, g_obs[None] - g_pred
     maha = (var_g * er**2 - 2 * cov_rg * er * eg + var_r * eg**2) / det
     dll = -0.5 * (np.log(det) + maha) - np.log(2 * np.pi)
-    ok = np.isfinite(dll) & np.isfinite(r_obs)[None] & np.isfinite(g_obs)[None]
-    dll = np.where(ok, dll, 0.0)
+    dll = np.where(valid & np.isfinite(dll), dll, 0.0)
     log_likelihood = np.cumsum(dll, axis=1)
 
     return Recognition(

@@ -55,13 +55,17 @@ class ObserveParams:
     rest_frames : int
         Frames at the start used to fix the scene (object position, rest posture).
     onset_displacement : float
-        Wrist displacement from rest that marks a movement, m (raised to four
-        times the rest jitter on noisy tracks).
-    onset_latency : float
-        Time from a movement's command onset to that displacement, s: the
-        muscle filter delays visible motion. 0.11 s is what the minimum
-        variance plans take to move the wrist 2 mm (0.10-0.13 s for 0.8-1.2 s
-        movements; ``tests/test_observe.py`` checks it against the model).
+        Wrist displacement from rest that marks a movement, m (raised above
+        the tracking noise on noisy tracks).
+    onset_profile : tuple of (float, float)
+        ``(displacement m, time s)`` pairs: how long after a movement's
+        command onset the wrist has moved that far. Visible motion lags the
+        command (the muscle filter), so the onset is the crossing time less
+        this latency. The default is the 1 s minimum variance grasp's
+        (``tests/test_observe.py`` checks it against the model).
+    max_rest_noise : float
+        Largest position noise at rest, m, for a clip to be scored: a clip must
+        start with the hand still and visible.
     alpha, beta : float
         Gains of the causal alpha-beta filter applied to every marker.
     min_frames : int
@@ -73,7 +77,10 @@ class ObserveParams:
     mirror: bool = False
     rest_frames: int = 5
     onset_displacement: float = 0.002
-    onset_latency: float = 0.11
+    onset_profile: tuple[tuple[float, float], ...] = (
+        (0.001, 0.091), (0.002, 0.110), (0.003, 0.123), (0.004, 0.133),
+        (0.006, 0.151), (0.008, 0.166), (0.012, 0.190))
+    max_rest_noise: float = 0.003
     alpha: float = 0.5
     beta: float = 0.15
     min_frames: int = 8
@@ -88,8 +95,16 @@ class ObserveParams:
         if not (0 < self.alpha <= 1 and 0 <= self.beta < 2):
             raise ValueError(f"alpha/beta: expected 0 < alpha <= 1, 0 <= beta < 2, "
                              f"got {self.alpha}, {self.beta}")
-        if not (self.onset_displacement > 0 and self.onset_latency >= 0):
-            raise ValueError("onset_displacement must be > 0 and onset_latency >= 0")
+        prof = np.asarray(self.onset_profile, dtype=float)
+        if not (self.onset_displacement > 0 and prof.ndim == 2 and prof.shape[1] == 2
+                and np.all(np.diff(prof, axis=0) > 0)):
+            raise ValueError("onset_displacement must be > 0 and onset_profile increasing "
+                             "(displacement m, time s) pairs")
+
+    def onset_latency(self, displacement: float) -> float:
+        """Time after the command onset at which the wrist has moved ``displacement`` m."""
+        d, t = np.asarray(self.onset_profile, dtype=float).T
+        return float(np.interp(displacement, d, t))
         if self.rest_frames < 1 or self.min_frames < 3:
             raise ValueError("rest_frames must be >= 1 and min_frames >= 3")
 
@@ -151,24 +166,34 @@ def alpha_beta(z: np.ndarray, dt: np.ndarray | float, alpha: float, beta: float)
     Returns
     -------
     (N, ..., 2) array
-        Filtered positions; NaN where the input is missing (a gap is not filled).
+        Filtered positions; NaN where the input is missing (a gap is not filled;
+        the filter restarts from the first measurement after it).
     """
     z = np.asarray(z, dtype=float)
     dt = np.broadcast_to(np.asarray(dt, dtype=float), (z.shape[0],))
     out = np.full_like(z, np.nan)
     x = np.full(z.shape[1:], np.nan)
     v = np.zeros(z.shape[1:])
+    shape = z.shape[1:-1] + (1,)
+    missing_before = np.ones(shape, dtype=bool)
+    second = np.zeros(shape, dtype=bool)  # first measurement after a (re)start
     for i in range(z.shape[0]):
         zi = z[i]
         have = np.isfinite(zi).all(axis=-1, keepdims=True)
-        fresh = have & ~np.isfinite(x).all(axis=-1, keepdims=True)
         pred = x + v * dt[i]
         resid = zi - pred
-        x = np.where(have, pred + alpha * resid, pred)
-        v = np.where(have, v + beta / max(dt[i], 1e-9) * resid, v)
-        # (re)start from the measurement with zero velocity
-        x = np.where(fresh, zi, x)
-        v = np.where(fresh, 0.0, v)
+        x_new = np.where(have, pred + alpha * resid, pred)
+        v_new = np.where(have, v + beta / max(dt[i], 1e-9) * resid, v)
+        # After a gap, start again from the measurement (coasting on an old
+        # velocity lands far from the marker), and take the velocity from the
+        # first two measurements back (two-point initiation).
+        fresh = have & missing_before
+        two = have & second & ~fresh
+        v_new = np.where(two, (zi - x) / max(dt[i], 1e-9), np.where(fresh, 0.0, v_new))
+        x_new = np.where(fresh | two, zi, x_new)
+        second = fresh | (second & ~have)
+        missing_before = ~have
+        x, v = x_new, v_new
         out[i] = np.where(have, x, np.nan)
     return out
 
@@ -204,6 +229,8 @@ class Observation:
         Grip midpoint relative to the wrist at rest, m (the hand's size and posture).
     marker_separation : float
         Distance between the digit markers at rest, m (removed from finger and thumb).
+    noise : float
+        Tracking noise of the positions at rest (robust SD), m.
     object_diameter : float
         Object diameter, m.
     """
@@ -223,6 +250,7 @@ class Observation:
     hand_offset: np.ndarray = field(default_factory=lambda: np.zeros(2), repr=False)
     object_diameter: float = 0.10
     marker_separation: float = 0.0
+    noise: float = 0.0
 
     @property
     def n_frames(self) -> int:
@@ -243,13 +271,6 @@ class Observation:
     def g(self) -> np.ndarray:
         """(N,) grip aperture |finger - thumb|, m (thesis eq. 5.5)."""
         return np.linalg.norm(self.finger - self.thumb, axis=-1)
-
-
-def _median_rest(p: np.ndarray, frames: int) -> np.ndarray:
-    """Median of the first ``frames`` valid positions of a (T, 2) track (NaN if none)."""
-    ok = np.isfinite(p).all(axis=1)
-    idx = np.flatnonzero(ok)[:frames]
-    return np.median(p[idx], axis=0) if len(idx) else np.full(2, np.nan)
 
 
 def _object_diameter_px(tracks) -> float | None:
@@ -304,11 +325,29 @@ def observe(tracks, params: ObserveParams | None = None, *, clip: str | None = N
                          f"(need at least {params.min_frames})", name)
     px = {m: pos[:, markers.index(m)] for m in (*DIGIT_MARKERS, "object")}
 
-    # The scene, from the first frames only.
-    origin = _median_rest(px["object"], params.rest_frames * 2)
-    wrist_rest_px = _median_rest(px["wrist"], params.rest_frames)
-    if not np.all(np.isfinite(wrist_rest_px)):
-        raise InputError("the wrist is never seen at rest", name)
+    time_ok = np.isfinite(time)
+    if not time_ok.all():
+        raise InputError(f"{int((~time_ok).sum())} time stamps are not finite", name)
+    dts = np.diff(time)
+    if np.any(dts <= 0):
+        raise InputError("time stamps do not increase", name)
+    dt_med = float(np.median(dts))
+    if not 0.001 <= dt_med <= 0.5:
+        raise InputError(f"implausible frame period {dt_med:g} s (time stamps must be in "
+                         "seconds, 2-1000 frames/s)", name)
+    for m in (*DIGIT_MARKERS, "object"):
+        bad = ~np.isfinite(px[m]).all(axis=1) & np.isinf(px[m]).any(axis=1)
+        if bad.any():
+            raise InputError(f"marker '{m}' has infinite positions", name)
+
+    # The scene, from the first frames only: the hand must be still and seen.
+    rest = slice(0, params.rest_frames)
+    for m in (*DIGIT_MARKERS, "object"):
+        if not np.isfinite(px[m][rest]).all():
+            what = "object" if m == "object" else f"marker '{m}'"
+            raise InputError(f"the clip must start with the hand at rest and visible: the "
+                             f"{what} is lost in its first {params.rest_frames} frames", name)
+    origin = np.median(px["object"][: 2 * params.rest_frames], axis=0)
     scale = params.px_per_m
     if scale is None:
         dpx = _object_diameter_px(tracks)
@@ -316,58 +355,64 @@ def observe(tracks, params: ObserveParams | None = None, *, clip: str | None = N
             raise InputError("image scale unknown: the tracks carry no object size; "
                              "give px_per_m (--px-per-m)", name)
         scale = dpx / params.object_diameter
+    wrist_rest_px = np.median(px["wrist"][rest], axis=0)
     d = wrist_rest_px - origin
     approach = np.array([-d[0], d[1]])  # from wrist toward object, in y-up image coordinates
     if np.linalg.norm(approach) < 1e-6:
         raise InputError("impossible geometry: the wrist starts on the object", name)
     scene = PixelTransform(origin_px=origin, px_per_m=float(scale),
-                  rotation=float(np.arctan2(approach[1], approach[0])), mirror=params.mirror)
+                           rotation=float(np.arctan2(approach[1], approach[0])),
+                           mirror=params.mirror)
 
     model = {m: scene.to_model(px[m]) for m in DIGIT_MARKERS}
-    dts = np.diff(time)
-    if np.any(dts <= 0):
-        raise InputError("time stamps do not increase", name)
-    dt_med = float(np.median(dts))
+    raw = np.stack([model[m] for m in DIGIT_MARKERS], axis=1)  # (T, 3, 2)
+    # Tracking noise, robustly, from the frame-to-frame changes at rest.
+    steps = np.diff(raw[rest], axis=0).ravel()
+    noise = 1.4826 * np.median(np.abs(steps - np.median(steps))) / np.sqrt(2)
+    rest_mean = raw[rest].mean(axis=0)
+    drift = np.linalg.norm(raw[rest] - rest_mean, axis=-1).max()
+    if noise > params.max_rest_noise or drift > max(3 * params.onset_displacement, 6 * noise):
+        raise InputError(f"the clip must start with the hand at rest: its markers move "
+                         f"{drift * 1000:.1f} mm (noise {noise * 1000:.1f} mm) over the first "
+                         f"{params.rest_frames} frames", name)
     dt_series = np.concatenate([[dt_med], dts])
-    stacked = np.stack([model[m] for m in DIGIT_MARKERS], axis=1)  # (T, 3, 2)
-    filt = alpha_beta(stacked, dt_series, params.alpha, params.beta)
+    filt = alpha_beta(raw, dt_series, params.alpha, params.beta)
 
     # Onset: when the wrist's displacement from rest crosses a threshold
-    # (interpolated between frames), less the latency of visible motion.
+    # (interpolated between frames, and held for three frames), less the
+    # time the model's own movements take to get that far.
     w = filt[:, 0]
-    rest = _median_rest(w, params.rest_frames)
-    disp = np.linalg.norm(w - rest, axis=1)
-    jitter = np.nanstd(disp[: max(params.rest_frames, 2)])
-    threshold = max(params.onset_displacement, 4 * jitter)
-    if threshold > params.onset_displacement:
-        log.warning("%s: rest jitter %.2f mm raises the onset threshold to %.1f mm",
-                    name, jitter * 1000, threshold * 1000)
-    moving = np.flatnonzero(disp > threshold)
-    if len(moving) == 0:
+    disp = np.linalg.norm(w - np.median(w[rest], axis=0), axis=1)
+    threshold = max(params.onset_displacement, 4 * noise)
+    above = np.nan_to_num(disp, nan=0.0) > threshold
+    held = above & np.roll(above, -1) & np.roll(above, -2)
+    held[-2:] = False
+    if not held.any():
         raise InputError("no movement found: the wrist never leaves its rest position", name)
-    i = int(moving[0])
+    i = int(np.argmax(held))
     if i > 0 and np.isfinite(disp[i - 1]):
         frac = (threshold - disp[i - 1]) / (disp[i] - disp[i - 1])
         crossing = time[i - 1] + frac * (time[i] - time[i - 1])
     else:
         crossing = time[i]
-    onset_time = crossing - params.onset_latency
+    onset_time = crossing - params.onset_latency(threshold)
     onset = int(np.searchsorted(time, onset_time))
-    # End: the last frame any digit marker still moves.
+    # End: the last frame any hand marker still moves faster than its noise allows.
     speed = np.linalg.norm(np.diff(filt, axis=0), axis=-1) / dts[:, None]
-    active = np.flatnonzero(np.nanmax(np.where(np.isfinite(speed), speed, 0), axis=1) > 0.02)
+    speed_floor = max(0.02, 6 * noise / dt_med)
+    active = np.flatnonzero(np.nanmax(np.where(np.isfinite(speed), speed, 0), axis=1)
+                            > speed_floor)
     end = int(min(len(time) - 1, active[-1] + 2)) if len(active) else len(time) - 1
     if end - onset + 1 < params.min_frames:
         raise InputError(f"movement too short to score: {end - onset + 1} frames "
                          f"(need at least {params.min_frames})", name)
     sl = slice(onset, end + 1)
-    start = _median_rest(model["wrist"], params.rest_frames)
-    finger0 = _median_rest(model["finger"], params.rest_frames)
-    thumb0 = _median_rest(model["thumb"], params.rest_frames)
+    start = rest_mean[0]
+    finger0, thumb0 = rest_mean[1], rest_mean[2]
     mid0 = 0.5 * (finger0 + thumb0)
     # The digits touch at rest (as in the model), so the markers' separation
     # then is where they sit on the digits, outside the tips: take it off.
-    half = 0.5 * (finger0 - thumb0) if np.all(np.isfinite(finger0 - thumb0)) else np.zeros(2)
+    half = 0.5 * (finger0 - thumb0)
     filt[:, 1] -= half
     filt[:, 2] += half
     log.info("%s: onset at frame %d, %d frames scored, start distance %.3f m",
@@ -380,6 +425,7 @@ def observe(tracks, params: ObserveParams | None = None, *, clip: str | None = N
         finger=filt[sl, 1],
         thumb=filt[sl, 2],
         raw={m: model[m][sl] for m in DIGIT_MARKERS},
+        noise=float(noise),
         scene=scene,
         dt=dt_med,
         onset_frame=int(frames[onset]),

@@ -126,3 +126,21 @@ def test_bad_params():
         HammerParams(rule="vote")
     with pytest.raises(ValueError, match="filter_gain"):
         HammerParams(filter_gain=2)
+
+
+@pytest.mark.parametrize("marker", ["wrist", "finger", "thumb"])
+def test_a_gap_in_any_marker_is_not_scored_and_leaves_no_outliers(rep, marker):
+    for s in range(3):
+        full = recognize(observe(demo_tracks("delayed", s)[0]), rep)
+        tracks = demo_tracks("delayed", s, lost={marker: slice(20, 28)})[0]
+        rec = recognize(observe(tracks), rep)
+        # a step predicts frame n from n-1 (all markers) and compares r, g at n (digits)
+        first = 20 if marker != "wrist" else 21
+        gap = np.isin(rec.frame, np.arange(first, 29))
+        assert np.all(rec.dC_r[:, gap] == 0) and np.all(rec.dC_g[:, gap] == 0)
+        step_ll = np.diff(rec.log_likelihood, axis=1, prepend=0)
+        assert np.all(step_ll[:, gap] == 0)
+        # no frame after the gap scores wildly off the clip's usual steps
+        typical = np.median(np.abs(step_ll[:, ~gap]))
+        assert np.abs(step_ll).max() < 20 * typical + 50
+        assert rec.kinds[rec.names.index(rec.winner)] == full.kinds[full.names.index(full.winner)]

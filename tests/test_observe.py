@@ -47,15 +47,16 @@ def test_alpha_beta_keeps_signs_of_small_changes_and_coasts_over_gaps():
     assert np.all(np.isfinite(out[35:]))  # and the filter picks up after it
 
 
-def test_default_onset_latency_is_the_models():
+def test_default_onset_profile_is_the_models():
     from minvar import GraspTask, plan_grasp
 
     params = ObserveParams()
-    for duration in (0.8, 1.0, 1.2):
+    for duration, tol in ((1.0, 0.005), (0.8, 0.03), (1.2, 0.03)):
         nom = plan_grasp(GraspTask(object_size=0.1, distance=0.25, duration=duration)).nominal()
         disp = np.linalg.norm(nom.wrist[0] - nom.wrist[0, 0], axis=1)
-        latency = nom.time[np.argmax(disp > params.onset_displacement)]
-        assert latency == pytest.approx(params.onset_latency, abs=0.0201)
+        for d, _ in params.onset_profile:
+            latency = np.interp(d, disp[:60], nom.time[:60])
+            assert params.onset_latency(d) == pytest.approx(latency, abs=tol)
 
 
 @pytest.mark.parametrize("change, message", [
