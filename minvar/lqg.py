@@ -22,10 +22,13 @@ code's ``K``, ``L``, expected trajectory and cost per iteration (see
 
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.linalg.lapack import dposv as _dposv
+
+log = logging.getLogger(__name__)
 
 __all__ = ["LQGProblem", "LQGSolution", "solve", "expected_cost", "state_moments",
            "estimation_error_covariance"]
@@ -56,6 +59,17 @@ def _as_stack(name: str, value, shape: tuple[int, int], what: str) -> np.ndarray
         raise ValueError(f"LQGProblem.{name}: contains non-finite values (NaN or inf)")
     arr.setflags(write=False)
     return arr
+
+
+def _check_psd(name: str, M: np.ndarray) -> None:
+    """Raise unless ``M`` (or each of a stack) is symmetric positive semi-definite."""
+    scale = max(float(np.abs(M).max()), np.finfo(float).tiny)
+    if not np.allclose(M, np.swapaxes(M, -1, -2), rtol=0, atol=1e-10 * scale):
+        raise ValueError(f"LQGProblem.{name}: expected a symmetric matrix")
+    lowest = np.linalg.eigvalsh(0.5 * (M + np.swapaxes(M, -1, -2))).min()
+    if lowest < -1e-10 * scale:
+        raise ValueError(f"LQGProblem.{name}: expected a positive semi-definite matrix "
+                         f"(an eigenvalue is {lowest:.3g})")
 
 
 @dataclass(frozen=True, eq=False)
@@ -143,6 +157,8 @@ class LQGProblem:
             "X1": _as_matrix("X1", np.ravel(self.X1), (n,)),
             "S1": _as_matrix("S1", self.S1, (n, n)),
         }
+        for key in ("Q", "R", "S1"):
+            _check_psd(key, values[key])
         for key, val in values.items():
             object.__setattr__(self, key, val)
 
@@ -394,6 +410,10 @@ def solve(
             if change < atol or change < tol * abs(history[-1]):
                 converged = True
                 break
+    if not converged:
+        log.warning("solve: the cost did not converge in %d iterations (last change %.3g, "
+                    "cost %.6g)", len(history), abs(history[-2] - history[-1])
+                    if len(history) > 1 else float("nan"), history[-1])
     for arr in (K, L):
         arr.setflags(write=False)
     return LQGSolution(

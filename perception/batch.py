@@ -14,7 +14,6 @@ Clips run in local processes (``jobs``) or on a dask.distributed cluster
 from __future__ import annotations
 
 import dataclasses
-import functools
 import hashlib
 import json
 import logging
@@ -29,6 +28,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from . import __version__
 from .atomic import write_json
 from .errors import InputError
 from .hammer import HammerParams, recognize
@@ -43,9 +43,13 @@ log = logging.getLogger(__name__)
 
 VIDEO_SUFFIXES = (".mp4", ".avi", ".mkv", ".mov", ".m4v")
 TRACKS_SUFFIX = ".tracks.h5"
-#: Files that sit beside clips and are not inputs.
-COMPANION_SUFFIXES = (".truth.h5",)
-COMPANION_NAMES = ("manifest.csv", "README.md", "recipe.toml")
+#: Files that sit beside clips and are not inputs: ground truth, the synth
+#: manifest, and what a batch writes (so a report folder can be its own input).
+COMPANION_SUFFIXES = (".truth.h5", ".recognition.json", ".confidence.csv", ".confidence.png",
+                      ".paths.png")
+COMPANION_NAMES = ("manifest.csv", "README.md", "recipe.toml", "summary.csv", "statistics.csv",
+                   "condition_profiles.csv", "condition_profiles.png", "report.html",
+                   "batch.json", "repertoire.h5")
 
 
 @dataclass(frozen=True)
@@ -176,7 +180,8 @@ def _input_fingerprint(path: Path) -> dict:
 
 def _fingerprint(item: BatchItem, settings: BatchSettings, repertoire_id: str) -> str:
     payload = json.dumps({"input": _input_fingerprint(item.path), "settings":
-                          settings.fingerprint(), "repertoire": repertoire_id}, sort_keys=True)
+                          settings.fingerprint(), "repertoire": repertoire_id,
+                          "software": __version__}, sort_keys=True)
     return hashlib.sha256(payload.encode()).hexdigest()[:16]
 
 
@@ -239,7 +244,12 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
             obs = observe(tracks, settings.observe, clip=item.clip)
         except InputError as exc:  # name the file the user gave, not the clip
             raise InputError(exc.problem, item.path) from None
-        rec = recognize(obs, repertoire, settings.hammer)
+        try:
+            rec = recognize(obs, repertoire, settings.hammer)
+        except ValueError as exc:  # the scene the first frames describe cannot be planned
+            raise InputError(f"cannot plan the models for this clip's scene (distance "
+                             f"{obs.start_distance:.3f} m; check the scale: --px-per-m, "
+                             f"--object-diameter): {exc}", item.path) from None
         write_clip_report(rec, out, extra={"fingerprint": fp, "condition": item.condition,
                                            "input": str(item.path)})
         report = json.loads(clip_outputs(out, item.clip)["json"].read_text())
@@ -249,7 +259,31 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
         if isinstance(exc, OSError) and not isinstance(exc, InputError):
             msg = f"{item.path}: {msg}"
         log.info("%s failed: %s", item.clip, msg)
+        _remove_outputs(item, out)
         return {**row, "error": msg}
+
+
+def _remove_outputs(item: BatchItem, out: Path) -> None:
+    """A clip that fails now must not keep a report from an earlier run."""
+    for path in clip_outputs(out, item.clip).values():
+        path.unlink(missing_ok=True)
+
+
+def _guarded(item: BatchItem, out: Path, **kwargs) -> dict:
+    """:func:`process_clip` that records an unexpected error instead of raising it.
+
+    A batch goes on past any clip; the error (a bug, not bad input) is logged
+    with its traceback and reported with its type.
+    """
+    try:
+        return process_clip(item, out, **kwargs)
+    except Exception as exc:  # noqa: BLE001 - one clip must not end the batch
+        log.exception("%s: unexpected error", item.clip)
+        _remove_outputs(item, out)
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
+        return {"clip": item.clip, "condition": item.condition, "status": "failed",
+                "error": f"{item.path}: unexpected {type(exc).__name__}: {first}",
+                "winner": None, "rule": kwargs["settings"].hammer.rule}
 
 
 def _limit_threads() -> None:
@@ -262,32 +296,56 @@ def _limit_threads() -> None:
         pass
 
 
-def _run_local(items: list[BatchItem], work, jobs: int) -> Iterator[dict]:
-    """``work(item)`` for every item in this process and ``jobs - 1`` worker processes.
+def _init_worker(repertoire: Repertoire) -> None:
+    """Worker setup: one thread, and the repertoire received once per process."""
+    _limit_threads()
+    _WORKER["repertoire"] = repertoire
+
+
+def _work_in_worker(item: BatchItem, out: Path, settings: BatchSettings,
+                    repertoire_id: str) -> dict:
+    # the worker's own repertoire keeps its re-planned models between clips
+    return _guarded(item, out, repertoire=_WORKER["repertoire"], settings=settings,
+                    repertoire_id=repertoire_id)
+
+
+#: State of a worker process (set by its initializer; empty in the main process).
+_WORKER: dict = {}
+
+
+def _run_local(items: list[BatchItem], out: Path, repertoire: Repertoire,
+               settings: BatchSettings, repertoire_id: str, jobs: int) -> Iterator[dict]:
+    """Every item in this process and ``jobs - 1`` worker processes.
 
     The calling process takes items from the same queue as its workers: it is
     warm (modules imported) while a worker spends about a second starting, so
     a short batch gains from the second process too.
     """
     pending = deque(items)
+
+    def here(item):
+        return _guarded(item, out, repertoire=repertoire, settings=settings,
+                        repertoire_id=repertoire_id)
+
     if jobs == 1 or len(items) <= 1:
         while pending:
-            yield work(pending.popleft())
+            yield here(pending.popleft())
         return
     # spawn, not fork: a parent that has already rendered or planned holds
     # OpenCV/BLAS thread pools, and forking those deadlocks the workers
     ctx = multiprocessing.get_context("spawn")
-    with ProcessPoolExecutor(max_workers=jobs - 1, initializer=_limit_threads,
-                             mp_context=ctx) as pool:
+    with ProcessPoolExecutor(max_workers=jobs - 1, initializer=_init_worker,
+                             initargs=(repertoire,), mp_context=ctx) as pool:
         running: set = set()
 
         def feed():
             while pending and len(running) < 2 * (jobs - 1):  # a little queued per worker
-                running.add(pool.submit(work, pending.popleft()))
+                running.add(pool.submit(_work_in_worker, pending.popleft(), out, settings,
+                                        repertoire_id))
 
         feed()
         while pending:
-            yield work(pending.popleft())
+            yield here(pending.popleft())
             done = {f for f in running if f.done()}
             running -= done
             for f in done:
@@ -336,11 +394,11 @@ def run_batch(
     from tqdm import tqdm
 
     settings = BatchSettings() if settings is None else settings
+    if jobs < 1:
+        raise ValueError(f"--jobs: expected at least 1, got {jobs}")
     items = list(items)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    if jobs < 1:
-        raise ValueError(f"--jobs: expected at least 1, got {jobs}")
     bar = tqdm(total=len(items), unit="clip", file=sys.stderr, desc="batch",
                disable=settings.quiet or not sys.stderr.isatty())
     rows: list[dict] = []
@@ -350,15 +408,13 @@ def run_batch(
 
         with Client(scheduler) as client:
             rep = client.scatter(repertoire, broadcast=True)
-            futures = [client.submit(process_clip, it, out, rep, settings, repertoire_id,
-                                     pure=False) for it in items]
+            futures = [client.submit(_guarded, it, out, repertoire=rep, settings=settings,
+                                     repertoire_id=repertoire_id, pure=False) for it in items]
             for fut in dask_completed(futures):
                 rows.append(fut.result())
                 bar.update()
     else:
-        work = functools.partial(process_clip, out=out, repertoire=repertoire,
-                                 settings=settings, repertoire_id=repertoire_id)
-        for row in _run_local(items, work, jobs):
+        for row in _run_local(items, out, repertoire, settings, repertoire_id, jobs):
             rows.append(row)
             bar.update()
     bar.close()

@@ -80,8 +80,10 @@ class HammerParams:
     def __post_init__(self):
         if self.rule not in RULES:
             raise ValueError(f"rule: expected one of {RULES}, got {self.rule!r}")
-        if not (self.w_r >= 0 and self.w_g >= 0):
-            raise ValueError("w_r and w_g must be >= 0")
+        if not (np.isfinite(self.w_r) and np.isfinite(self.w_g) and self.w_r >= 0
+                and self.w_g >= 0):
+            raise ValueError(f"w_r, w_g: expected finite weights >= 0, got {self.w_r}, "
+                             f"{self.w_g}")
         if not 0 <= self.filter_gain <= 1:
             raise ValueError(f"filter_gain: expected a value in [0, 1], got {self.filter_gain}")
         if not (np.isfinite(self.obs_sd) and self.obs_sd > 0):
@@ -135,7 +137,7 @@ class Recognition:
         return self.log_likelihood if rule == "likelihood" else self.confidence
 
     def winner_at(self, n: int, rule: str | None = None) -> str:
-        """Name of the best model after frame ``n`` under ``rule``."""
+        """Name of the best model after sample ``n`` (index into :attr:`time`) under ``rule``."""
         return self.names[int(np.argmax(self.score(rule)[:, n]))]
 
     @property
@@ -293,7 +295,7 @@ def recognize(
     obs = observation
     if isinstance(repertoire, Repertoire):
         scene = SceneSpec(distance=obs.start_distance, object_size=obs.object_diameter,
-                          frame_period=obs.dt)
+                          frame_period=obs.dt, tip_start=float(obs.hand_offset[1]))
         models = repertoire.for_scene(scene)
     else:
         models = list(repertoire)

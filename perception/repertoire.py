@@ -25,6 +25,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import logging
+import re
 import tomllib
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
@@ -60,6 +61,9 @@ KINDS = ("grasp", "reach")
 DEFAULT_DURATIONS = (0.8, 0.9, 1.0, 1.1, 1.2)
 #: Model time step the plans aim for, s (the thesis's 10 ms).
 TARGET_DT = 0.01
+#: GraspTask fields a repertoire entry may not set: the scene and the kind supply them.
+SCENE_FIELDS = frozenset({"object_size", "distance", "tip_start", "reach_only", "plant"})
+GRIP_VIA_KEYS = frozenset({"half_aperture", "height", "fraction"})
 
 
 def model_substeps(frame_period: float) -> int:
@@ -134,19 +138,39 @@ class SceneSpec:
         Object diameter, m.
     frame_period : float
         Video frame period, s (the plan steps a sub-multiple of it).
+    tip_start : float
+        How far ahead of the wrist the touching digit tips rest, m: the
+        demonstrator's hand size, from the first frames.
     """
 
     distance: float = 0.25
     object_size: float = 0.10
     frame_period: float = 1 / 30
+    tip_start: float = 0.06
+
+    def __post_init__(self):
+        for name in ("distance", "object_size", "frame_period", "tip_start"):
+            value = getattr(self, name)
+            if not (isinstance(value, int | float) and np.isfinite(value) and value > 0):
+                raise ValueError(f"scene {name}: expected a positive number, got {value!r}")
 
     def matches(self, other: SceneSpec, *, tol_m: float = 0.01, tol_rel_dt: float = 0.02) -> bool:
         """Whether plans for ``other`` may be reused here (within ``tol_m``, ``tol_rel_dt``)."""
         return (
             abs(self.distance - other.distance) <= tol_m
             and abs(self.object_size - other.object_size) <= tol_m / 2
+            and abs(self.tip_start - other.tip_start) <= tol_m / 2
             and abs(self.frame_period - other.frame_period) <= tol_rel_dt * self.frame_period
         )
+
+    def quantized(self) -> SceneSpec:
+        """This scene rounded to a 5 mm grid (frame period kept), so that
+        re-planned models are shared by clips of nearly the same scene."""
+        def q(v):
+            return max(0.005, round(v / 0.005) * 0.005)
+
+        return SceneSpec(distance=q(self.distance), object_size=q(self.object_size),
+                         frame_period=self.frame_period, tip_start=q(self.tip_start))
 
 
 @dataclass(frozen=True)
@@ -169,13 +193,27 @@ class ModelSpec:
     task: dict = field(default_factory=dict)
 
     def __post_init__(self):
+        if not (isinstance(self.name, str) and re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._+-]*",
+                                                             self.name)):
+            raise ValueError(f"model name {self.name!r}: use letters, digits and . _ + - only")
         if self.kind not in KINDS:
             raise ValueError(f"model '{self.name}': kind must be one of {KINDS}, got {self.kind!r}")
-        known = {f.name for f in dataclasses.fields(GraspTask)}
-        bad = set(self.task) - known - {"grip_via"}
+        known = {f.name for f in dataclasses.fields(GraspTask)} - SCENE_FIELDS
+        bad = set(self.task) - known
         if bad:
             raise ValueError(f"model '{self.name}': unknown task fields {sorted(bad)} "
-                             f"(GraspTask has {sorted(known)})")
+                             f"(the scene sets {sorted(SCENE_FIELDS)}; a model may set "
+                             f"{sorted(known)})")
+        vias = self.task.get("grip_via")
+        if vias is not None:
+            if not isinstance(vias, list | tuple):
+                raise ValueError(f"model '{self.name}': grip_via must be a list of "
+                                 "{half_aperture, height, fraction} tables")
+            for i, v in enumerate(vias):
+                if not (isinstance(v, dict) and set(v) == GRIP_VIA_KEYS):
+                    raise ValueError(f"model '{self.name}': grip_via[{i}] must have exactly "
+                                     f"the keys {sorted(GRIP_VIA_KEYS)}, got {v!r}")
+        self.grasp_task(SceneSpec())  # every other check of the task, before any planning
 
     def grasp_task(self, scene: SceneSpec) -> GraspTask:
         """The :class:`minvar.GraspTask` of this model in ``scene``."""
@@ -188,7 +226,8 @@ class ModelSpec:
             params["grip_via"] = tuple(GripVia(**g) if isinstance(g, dict) else g
                                        for g in params["grip_via"])
         return GraspTask(object_size=scene.object_size, distance=scene.distance,
-                         reach_only=self.kind == "reach", plant=plant, **params)
+                         tip_start=scene.tip_start, reach_only=self.kind == "reach",
+                         plant=plant, **params)
 
 
 @dataclass(frozen=True, eq=False)
@@ -236,6 +275,21 @@ class MotorModel:
     def chains(self) -> tuple[ChainModel, ChainModel, ChainModel]:
         """The leaves (arm, finger, thumb)."""
         return self.arm, self.finger, self.thumb
+
+
+def _check_chain_arrays(where: str, a: dict) -> None:
+    """Raise ValueError unless a stored chain's arrays fit together."""
+    n = a["A"].shape[0] if a["A"].ndim == 2 else -1
+    T = a["L"].shape[0] if a["L"].ndim == 3 else -1
+    m = a["B"].shape[1] if a["B"].ndim == 2 else -1
+    k = a["H"].shape[0] if a["H"].ndim == 2 else -1
+    want = {"A": (n, n), "B": (n, m), "H": (k, n), "K": (T, n, k), "L": (T, m, n),
+            "P": (T + 1, 2, 2), "x0": (n,)}
+    for key, shape in want.items():
+        if a[key].shape != shape or min(shape) < 1:
+            raise ValueError(f"{where}: {key} has shape {a[key].shape}, expected {shape}")
+        if not np.all(np.isfinite(a[key])):
+            raise ValueError(f"{where}: {key} has non-finite values")
 
 
 def _chain_model(role: str, chain_plan) -> ChainModel:
@@ -372,11 +426,11 @@ class Repertoire:
                          for e in entries]
             else:
                 specs = default_specs(cfg.get("durations", DEFAULT_DURATIONS))
+            return cls.build(specs, scene)
         except (TypeError, KeyError) as exc:
             raise InputError(f"bad repertoire config: {exc}", path) from None
         except ValueError as exc:
             raise InputError(str(exc), path) from None
-        return cls.build(specs, scene)
 
     def for_scene(self, scene: SceneSpec) -> list[MotorModel]:
         """The models, re-planned for ``scene`` where their stored scene differs.
@@ -387,16 +441,17 @@ class Repertoire:
             The scene of the clip being scored.
         """
         out = []
+        grid = scene.quantized()
         for m in self.models:
             if m.scene.matches(scene):
                 out.append(m)
                 continue
-            key = (m.name, round(scene.distance, 3), round(scene.object_size, 3),
-                   round(scene.frame_period, 5))
+            key = (m.name, grid)
             if key not in self._replanned:
-                log.info("re-planning %s for distance %.3f m, object %.3f m, %.1f frames/s",
-                         m.name, scene.distance, scene.object_size, 1 / scene.frame_period)
-                self._replanned[key] = build_model(m.spec, scene)
+                log.info("re-planning %s for distance %.3f m, object %.3f m, hand %.3f m, "
+                         "%.1f frames/s", m.name, grid.distance, grid.object_size,
+                         grid.tip_start, 1 / grid.frame_period)
+                self._replanned[key] = build_model(m.spec, grid)
             out.append(self._replanned[key])
         return out
 
@@ -465,11 +520,13 @@ class Repertoire:
                     chains = {}
                     for role in ROLES:
                         cg = mg[role]
+                        arrays = {k: np.asarray(cg[k][()], dtype=float)
+                                  for k in ("A", "B", "H", "K", "L", "P", "x0")}
+                        _check_chain_arrays(f"model '{name}' {role}", arrays)
                         chains[role] = ChainModel(
                             role=role, l1=float(cg.attrs["l1"]), l2=float(cg.attrs["l2"]),
                             base=np.asarray(cg.attrs["base"], dtype=float),
-                            elbow=int(cg.attrs["elbow"]),
-                            **{k: cg[k][()] for k in ("A", "B", "H", "K", "L", "P", "x0")},
+                            elbow=int(cg.attrs["elbow"]), **arrays,
                         )
                     models.append(MotorModel(
                         spec=spec, scene=SceneSpec(**json.loads(mg.attrs["scene"])),

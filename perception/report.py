@@ -292,7 +292,7 @@ def condition_statistics(summary: pd.DataFrame, model: str) -> pd.DataFrame:
     Returns
     -------
     pandas.DataFrame
-        Columns: test, groups, n, statistic, p_value, mean_difference.
+        Columns: model, test, groups, n, statistic, p_value, mean_difference.
     """
     col = f"conf_{model}"
     ok = summary[(summary["status"] == "ok") & summary["condition"].notna()]
@@ -313,7 +313,8 @@ def condition_statistics(summary: pd.DataFrame, model: str) -> pd.DataFrame:
                          "p_value": float(p),
                          "mean_difference": float(testable[a].mean() - testable[b].mean())})
     return pd.DataFrame(rows, columns=["test", "groups", "n", "statistic", "p_value",
-                                       "mean_difference"])
+                                       "mean_difference"]).assign(model=model)[
+        ["model", "test", "groups", "n", "statistic", "p_value", "mean_difference"]]
 
 
 @dataclass(frozen=True)

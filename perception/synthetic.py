@@ -50,6 +50,7 @@ __all__ = [
     "Recipe",
     "load_recipe",
     "render_style",
+    "clip_plans",
     "synthesize",
 ]
 
@@ -93,9 +94,14 @@ class StimulusParams:
     def __post_init__(self):
         if self.condition not in CONDITIONS:
             raise ValueError(f"condition: expected one of {CONDITIONS}, got {self.condition!r}")
-        for name in ("rest_before", "rest_after"):
-            if not getattr(self, name) >= 0:
-                raise ValueError(f"{name}: expected a time >= 0 s, got {getattr(self, name)}")
+        for name, positive in (("object_size", True), ("distance", True), ("duration", True),
+                               ("execution_cv", False), ("rest_before", False),
+                               ("rest_after", False), ("marker_offset", False)):
+            value = getattr(self, name)
+            if not (isinstance(value, int | float) and np.isfinite(value)
+                    and (value > 0 if positive else value >= 0)):
+                raise ValueError(f"[scene] {name}: expected a finite value "
+                                 f"{'> 0' if positive else '>= 0'}, got {value!r}")
 
 
 def stimulus_task(p: StimulusParams) -> GraspTask:
@@ -216,12 +222,17 @@ def load_recipe(path: str | os.PathLike) -> Recipe:
     except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
         raise InputError(f"not a readable TOML recipe: {exc}", path) from None
     try:
-        counts = {str(k): int(v) for k, v in cfg.get("conditions", {}).items()}
-        bad = set(counts) - set(CONDITIONS)
+        table = cfg.get("conditions", {})
+        if not isinstance(table, dict):
+            raise ValueError("[conditions] must be a table of clip counts, e.g. normal = 2")
+        bad = set(table) - set(CONDITIONS)
         if bad:
             raise ValueError(f"[conditions]: unknown {sorted(bad)} (expected {CONDITIONS})")
-        if not counts or any(v < 0 for v in counts.values()) or sum(counts.values()) == 0:
-            raise ValueError("[conditions]: give a non-negative clip count per condition")
+        if not all(isinstance(v, int) and not isinstance(v, bool) and v >= 0
+                   for v in table.values()) or sum(table.values()) == 0:
+            raise ValueError("[conditions]: give a whole, non-negative clip count per "
+                             "condition, and at least one clip")
+        counts = {str(k): int(v) for k, v in table.items()}
         stim = StimulusParams(**cfg.get("scene", {}))
         var = dict(cfg.get("variation", {}))
         angle = tuple(float(a) for a in var.pop("camera_angle_deg", (0.0, 0.0)))
@@ -233,7 +244,10 @@ def load_recipe(path: str | os.PathLike) -> Recipe:
                         camera_angle_deg=angle, style=dict(cfg.get("render", {})))
         if var:
             raise ValueError(f"[variation]: unknown fields {sorted(var)}")
+        if not (recipe.duration_sd >= 0 and recipe.distance_sd >= 0):
+            raise ValueError("[variation]: duration_sd and distance_sd must be >= 0")
         render_style(recipe.style)  # validate now, not after rendering half the set
+        clip_plans(recipe, seed=0)  # every clip's movement must be plannable
     except (TypeError, ValueError, KeyError) as exc:
         raise InputError(f"bad recipe: {exc}", path) from None
     return recipe
@@ -266,6 +280,42 @@ def render_style(table: dict) -> RenderStyle:
     return RenderStyle(**fields)
 
 
+def clip_plans(recipe: Recipe, seed: int) -> list[tuple]:
+    """Each clip's name, condition, movement, camera angle and random generator.
+
+    Clip *i* of a condition draws from its own stream, keyed by (seed,
+    condition, i): adding clips, or clips of other conditions, leaves it as it is.
+
+    Parameters
+    ----------
+    recipe : Recipe
+        What to render.
+    seed : int
+        Master seed.
+
+    Raises
+    ------
+    ValueError
+        If a clip's drawn movement is impossible (e.g. a negative duration).
+    """
+    plans = []
+    base = recipe.stimulus
+    for c, cond in enumerate(CONDITIONS):
+        for i in range(recipe.counts.get(cond, 0)):
+            rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(c, i)))
+            clip = f"{cond}-{i + 1:02d}"
+            try:
+                params = dataclasses.replace(
+                    base, condition=cond,
+                    duration=float(base.duration + recipe.duration_sd * rng.standard_normal()),
+                    distance=float(base.distance + recipe.distance_sd * rng.standard_normal()))
+                stimulus_task(params)
+            except ValueError as exc:
+                raise ValueError(f"clip {clip} (seed {seed}): {exc}") from None
+            plans.append((clip, cond, params, float(rng.uniform(*recipe.camera_angle_deg)), rng))
+    return plans
+
+
 def synthesize(recipe: Recipe, out: str | os.PathLike, *, seed: int = 0,
                progress: bool = False) -> pd.DataFrame:
     """Render every clip of a recipe into ``out`` and write ``manifest.csv``.
@@ -277,8 +327,8 @@ def synthesize(recipe: Recipe, out: str | os.PathLike, *, seed: int = 0,
     out : str or os.PathLike
         Output folder.
     seed : int
-        Master seed; clip i draws from child i of it, so a clip does not
-        change when others are added after it.
+        Master seed; each clip draws from its own stream (:func:`clip_plans`),
+        so a clip does not change when other clips are added.
     progress : bool
         Show a progress bar.
 
@@ -289,22 +339,13 @@ def synthesize(recipe: Recipe, out: str | os.PathLike, *, seed: int = 0,
     """
     from tqdm import tqdm
 
+    style = render_style(recipe.style)
+    plans = clip_plans(recipe, seed)  # all of them first: a bad draw renders nothing
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    style = render_style(recipe.style)
-    plan = [(cond, i) for cond in CONDITIONS for i in range(recipe.counts.get(cond, 0))]
-    children = np.random.SeedSequence(seed).spawn(len(plan))
     rows = []
-    for (cond, i), child in tqdm(list(zip(plan, children)), desc=f"synth {recipe.name}",
-                                 unit="clip", disable=not progress):
-        rng = np.random.default_rng(child)
-        base = recipe.stimulus
-        params = dataclasses.replace(
-            base, condition=cond,
-            duration=float(base.duration + recipe.duration_sd * rng.standard_normal()),
-            distance=float(base.distance + recipe.distance_sd * rng.standard_normal()))
-        angle = float(rng.uniform(*recipe.camera_angle_deg))
-        clip = f"{cond}-{i + 1:02d}"
+    for clip, cond, params, angle, rng in tqdm(plans, desc=f"synth {recipe.name}",
+                                               unit="clip", disable=not progress):
         t, paths = stimulus_paths(params, style.fps, seed=rng)
         scene = Scene(wrist=paths["wrist"], finger=paths["finger"], thumb=paths["thumb"],
                       object_diameter=params.object_size)

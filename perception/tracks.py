@@ -62,6 +62,8 @@ def _attr_value(value: Any) -> Any:
         return value
     if isinstance(value, Path):
         return os.fspath(value)
+    if isinstance(value, np.ndarray) and value.dtype.kind in "biuf":
+        return value  # numeric arrays as read back from a file: store them as they are
     if (
         isinstance(value, (list, tuple))
         and value

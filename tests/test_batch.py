@@ -142,3 +142,58 @@ def test_parallel_batch_after_work_in_the_same_process(clips, tmp_path):
     summary = run_batch(items, tmp_path / "out", default_repertoire(), BatchSettings(quiet=True),
                         jobs=2)
     assert (summary["status"] == "ok").all()
+
+
+def test_changed_settings_or_input_are_rerun(clips, repfile, tmp_path):
+    src = tmp_path / "src"
+    src.mkdir()
+    shutil.copy(clips / "normal-01.mp4", src / "normal-01.mp4")
+    out = tmp_path / "out"
+    assert _batch(src, out, repfile).returncode == 0
+    assert _batch(src, out, repfile).returncode == 0
+    assert pd.read_csv(out / "summary.csv")["reused"].all()
+    assert _batch(src, out, repfile, "--rule", "thesis").returncode == 0
+    assert not pd.read_csv(out / "summary.csv")["reused"].any()
+    (src / "normal-01.mp4").touch()
+    assert _batch(src, out, repfile, "--rule", "thesis").returncode == 0
+    assert not pd.read_csv(out / "summary.csv")["reused"].any()
+
+
+def test_report_folder_can_be_its_own_input(clips, repfile, tmp_path):
+    src = tmp_path / "both"
+    src.mkdir()
+    for name in ("normal-01.mp4", "reach-01.mp4"):
+        shutil.copy(clips / name, src / name)
+    for _ in range(2):
+        proc = _batch(src, src, repfile)
+        assert proc.returncode == 0, proc.stderr
+    s = pd.read_csv(src / "summary.csv")
+    assert list(s["clip"]) == ["normal-01", "reach-01"] and s["reused"].all()
+
+
+def test_an_unexpected_error_is_recorded_and_the_batch_goes_on(clips, tmp_path):
+    import dataclasses
+
+    rep = default_repertoire()
+    broken = dataclasses.replace(rep.models[0], finger=dataclasses.replace(
+        rep.models[0].finger, K=rep.models[0].finger.K[:3]))
+    from perception.repertoire import Repertoire
+
+    bad_rep = Repertoire([broken, *rep.models[1:]])
+    items = [i for i in discover(clips) if i.clip in ("normal-01", "reach-01")]
+    summary = run_batch(items, tmp_path / "out", bad_rep, BatchSettings(quiet=True))
+    assert (summary["status"] == "failed").all()
+    assert summary["error"].str.contains("unexpected IndexError").all()
+    assert (tmp_path / "out" / "summary.csv").exists()
+    assert (tmp_path / "out" / "report.html").exists()
+
+
+def test_object_scale_from_tracking_is_within_five_percent(clips, tmp_path):
+    from perception.tracking import track_video
+    from perception.tracks import Tracks
+
+    for clip in ("normal-01", "delayed-01"):
+        tracked = Tracks.load(track_video(clips / f"{clip}.mp4", tmp_path / f"{clip}.tracks.h5"))
+        truth = Tracks.load(clips / f"{clip}.truth.h5")
+        ratio = tracked.object_diameter_px() / truth.object_diameter_px()
+        assert 1.0 <= ratio < 1.05  # the blob's blurred rim makes it slightly large

@@ -165,3 +165,18 @@ def test_estimation_error_covariance_matches_monte_carlo(noisy):
         d = np.diag(exact)
         se = np.sqrt((np.outer(d, d) + exact**2) / err.shape[0])
         assert np.all(np.abs(np.cov(err[:, t, :4].T) - exact) < 4 * se)
+
+
+@pytest.mark.parametrize("field, value, message", [
+    ("R", np.array([[1e-6, 1e-6], [0.0, 1e-6]]), "symmetric"),
+    ("R", -1e-6 * np.eye(2), "positive semi-definite"),
+    ("S1", np.diag([-1e-4] + [0.0] * 9), "positive semi-definite"),
+])
+def test_costs_and_initial_covariance_must_be_psd(reference_problem, field, value, message):
+    with pytest.raises(ValueError, match=rf"LQGProblem\.{field}: .*{message}"):
+        dataclasses.replace(reference_problem, **{field: value})
+
+
+def test_unconverged_solve_is_reported(reference_problem, caplog):
+    solve(reference_problem, max_iter=2)
+    assert "did not converge" in caplog.text

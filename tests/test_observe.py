@@ -85,3 +85,37 @@ def test_too_short_and_no_scale_and_no_movement():
     still[:] = still[:1]
     with pytest.raises(InputError, match="no movement"):
         observe(tracks.replace(position=still))
+
+
+def test_onset_and_end_hold_at_one_pixel_of_noise():
+    for seed in range(3):
+        tracks, truth = demo_tracks("normal", seed, noise_px=1.0)
+        obs = observe(tracks)
+        assert abs(obs.onset_frame - truth["onset_frame"]) <= 1
+        assert obs.end_frame < len(tracks.time) - 3  # the rest after the grasp is not scored
+        assert obs.noise == pytest.approx(1.0 / 800, rel=0.35)
+
+
+def test_a_clip_must_start_at_rest_and_visible():
+    tracks, _ = demo_tracks("normal", 0)
+    late = tracks.replace(frame=tracks.frame[14:], time=tracks.time[14:],
+                          position=tracks.position[14:], likelihood=tracks.likelihood[14:],
+                          status=tracks.status[14:])
+    with pytest.raises(InputError, match="start with the hand at rest"):
+        observe(late)
+    pos = tracks.position.copy()
+    pos[:3, tracks.markers.index("wrist")] = np.nan
+    with pytest.raises(InputError, match="marker 'wrist' is lost in its first"):
+        observe(tracks.replace(position=pos))
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda t: t.__setitem__(3, np.nan), "not finite"),
+    (lambda t: t.__imul__(1000.0), "implausible frame period"),
+])
+def test_bad_time_stamps(change, message):
+    tracks, _ = demo_tracks("normal", 0)
+    time = tracks.time.copy()
+    change(time)
+    with pytest.raises(InputError, match=message):
+        observe(tracks.replace(time=time))

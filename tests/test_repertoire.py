@@ -103,3 +103,29 @@ def test_cli_build_and_info(tmp_path, capsys):
     proc = subprocess.run([sys.executable, "-m", "perception.cli", "repertoire", "info",
                            str(tmp_path / "nope.h5")], capture_output=True, text=True)
     assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("entry, message", [
+    ('name = "x"\ndistance = 0.3', "the scene sets"),
+    ('name = "x"\nreach_only = true', "the scene sets"),
+    ('name = "x"\ngrip_via = [{half = 0.01}]', "grip_via\\[0\\] must have exactly"),
+    ('name = "x"\ngrip_via = 3', "grip_via must be a list"),
+    ('name = "a/b"', "use letters, digits"),
+    ('name = "x"\nduration = -1', "duration"),
+])
+def test_bad_model_entries_are_one_line(tmp_path, entry, message):
+    cfg = tmp_path / "rep.toml"
+    cfg.write_text(f"[[model]]\n{entry}\n")
+    with pytest.raises(InputError, match=message) as exc:
+        Repertoire.from_config(cfg)
+    assert str(cfg) in str(exc.value)
+
+
+def test_truncated_gains_are_refused(tmp_path):
+    path = Repertoire.build([ModelSpec("g", "grasp", {"duration": 0.9})]).save(tmp_path / "r.h5")
+    with h5py.File(path, "a") as f:
+        K = f["models/g/finger/K"][()]
+        del f["models/g/finger/K"]
+        f["models/g/finger/K"] = K[:5]
+    with pytest.raises(InputError, match="finger: K has shape"):
+        Repertoire.load(path)

@@ -65,3 +65,29 @@ def test_synth_cli_is_reproducible_and_labels_truth(tmp_path):
     again = Tracks.load(tmp_path / "b" / "delayed-01.truth.h5")
     assert np.array_equal(truth.position, again.position)
     assert (tmp_path / "a" / "normal-01.mp4").stat().st_size > 1000
+
+
+@pytest.mark.parametrize("text, message", [
+    ("conditions = 3\n", "must be a table"),
+    ("[conditions]\nnormal = 1.7\n", "whole, non-negative"),
+    ("[conditions]\nnormal = 1\n[scene]\nmarker_offset = -0.5\n", "marker_offset"),
+    ("[conditions]\nnormal = 1\n[variation]\nduration_sd = -0.1\n", "duration_sd"),
+    ("[conditions]\nnormal = 3\n[scene]\nduration = 0.15\n[variation]\nduration_sd = 0.3\n",
+     "clip normal-0"),
+])
+def test_recipe_problems_are_found_before_rendering(tmp_path, text, message):
+    path = tmp_path / "r.toml"
+    path.write_text(text)
+    with pytest.raises(InputError, match=message):
+        load_recipe(path)
+
+
+def test_a_clip_does_not_depend_on_other_conditions_counts():
+    from perception.synthetic import Recipe, clip_plans
+
+    one = {p[0]: p[2] for p in clip_plans(Recipe("r", {"normal": 1, "delayed": 1},
+                                                 duration_sd=0.05), seed=3)}
+    two = {p[0]: p[2] for p in clip_plans(Recipe("r", {"normal": 4, "delayed": 2},
+                                                 duration_sd=0.05), seed=3)}
+    assert one["delayed-01"] == two["delayed-01"] and one["normal-01"] == two["normal-01"]
+    assert two["normal-01"] != two["normal-02"]

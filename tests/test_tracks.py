@@ -205,3 +205,19 @@ def test_trackpy_and_plain_exports(tmp_path):
     with pytest.raises(ValueError, match="format"):
         tr.export(tmp_path / "x.csv", "excel")
     assert not (tmp_path / "x.csv").exists()
+
+
+def test_loaded_tracks_save_again(tmp_path):
+    from _demos import demo_tracks
+
+    from perception.tracks import Tracks
+
+    t = demo_tracks("normal", 0)[0].replace(tracker={"reference_mass_px": [10.0, 12.0, 80.0, 5e3],
+                                                     "method": "camshift"})
+    t.save(tmp_path / "a.tracks.h5")
+    back = Tracks.load(tmp_path / "a.tracks.h5")
+    back.interpolate(3).save(tmp_path / "b.tracks.h5")  # load -> process -> save
+    again = Tracks.load(tmp_path / "b.tracks.h5")
+    assert np.array_equal(np.asarray(again.tracker["reference_mass_px"]),
+                          np.asarray(t.tracker["reference_mass_px"]))
+    assert np.array_equal(again.position, back.interpolate(3).position, equal_nan=True)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import hashlib
+import json
 from pathlib import Path
 
 from ..hammer import RULES, HammerParams
@@ -54,7 +55,9 @@ def load_repertoire(args: argparse.Namespace) -> tuple[Repertoire, str]:
         Parsed arguments with ``repertoire``.
     """
     if args.repertoire is None:
-        return Repertoire.build(), "default"
+        rep = Repertoire.build()
+        config = json.dumps(rep.config, sort_keys=True).encode()
+        return rep, f"default:{hashlib.sha256(config).hexdigest()[:16]}"
     rep = Repertoire.load(args.repertoire)
     digest = hashlib.sha256(Path(args.repertoire).read_bytes()).hexdigest()[:16]
     return rep, f"{Path(args.repertoire).name}:{digest}"
