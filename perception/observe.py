@@ -66,6 +66,9 @@ class ObserveParams:
     max_rest_noise : float
         Largest position noise at rest, m, for a clip to be scored: a clip must
         start with the hand still and visible.
+    max_rest_aperture : float
+        Largest distance between the finger and thumb markers at rest, m: the
+        digits touch at the start (as in the model).
     alpha, beta : float
         Gains of the causal alpha-beta filter applied to every marker.
     min_frames : int
@@ -81,6 +84,7 @@ class ObserveParams:
         (0.001, 0.091), (0.002, 0.110), (0.003, 0.123), (0.004, 0.133),
         (0.006, 0.151), (0.008, 0.166), (0.012, 0.190))
     max_rest_noise: float = 0.003
+    max_rest_aperture: float = 0.04
     alpha: float = 0.5
     beta: float = 0.15
     min_frames: int = 8
@@ -410,6 +414,14 @@ def observe(tracks, params: ObserveParams | None = None, *, clip: str | None = N
     start = rest_mean[0]
     finger0, thumb0 = rest_mean[1], rest_mean[2]
     mid0 = 0.5 * (finger0 + thumb0)
+    # The rest posture must look like a hand: digits touching, in front of the wrist.
+    apart = float(np.linalg.norm(finger0 - thumb0))
+    reach = float(np.linalg.norm(mid0 - start))
+    if apart > params.max_rest_aperture or not 0.01 <= reach <= 0.25:
+        raise InputError(f"the hand at rest does not look like a hand: finger and thumb "
+                         f"markers {apart * 100:.1f} cm apart, {reach * 100:.1f} cm from the "
+                         "wrist (a same-coloured object taken for a marker? give --roi when "
+                         "tracking, or check --px-per-m)", name)
     # The digits touch at rest (as in the model), so the markers' separation
     # then is where they sit on the digits, outside the tips: take it off.
     half = 0.5 * (finger0 - thumb0)

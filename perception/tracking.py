@@ -40,6 +40,7 @@ hidden or merged with similar colour.
 
 from __future__ import annotations
 
+import itertools
 import json
 import logging
 import math
@@ -59,6 +60,8 @@ from perception.tracks import Status, TracksWriter, tracks_path_for
 from perception.video import FrameSource
 
 logger = logging.getLogger(__name__)
+#: Blobs of each colour considered when a hand marker is first found (largest first).
+_INIT_CANDIDATES = 6
 
 #: A region of interest: ``(x, y, width, height)``, px.
 ROI = tuple[int, int, int, int]
@@ -566,31 +569,35 @@ class Tracker:
     def _initialise(self, frame: np.ndarray, todo: list[int]) -> dict[int, Any]:
         """Find markers for the first time.
 
-        Each marker takes the largest blob of its colour; when several blobs
-        of comparable size (at least half the largest) compete, a hand
-        marker takes the one nearest the other hand markers, which sit within
-        a hand's width of each other while a same-coloured object need not.
+        The hand's markers sit within a hand's width of each other, while
+        same-coloured things on the table need not: of the few largest blobs
+        of each hand marker's colour, the combination whose markers lie
+        closest together (with any hand marker already tracked) wins, however
+        large a distant blob is. A still marker (the object), or a marker
+        without rivals, takes its largest blob.
         """
-        cands = {j: self._candidates(self._tracks[j], frame) for j in todo}
+        cands = {j: self._candidates(self._tracks[j], frame)[:_INIT_CANDIDATES] for j in todo}
+        free = [j for j in todo if cands[j] and not self._tracks[j].still
+                and self._tracks[j].roi is None]
+        anchors = [t.x for t in self._tracks if t.found and not t.lost and not t.still] + [
+            cands[j][0][0] for j in todo if cands[j] and not self._tracks[j].still
+            and self._tracks[j].roi is not None]
+        chosen: dict[int, tuple] = {}
+        if free and len(free) + len(anchors) >= 2:
+
+            def spread(combo):
+                pts = [cands[j][k][0] for j, k in zip(free, combo)] + anchors
+                return sum(float(np.hypot(*(p - q))) for i, p in enumerate(pts)
+                           for q in pts[i + 1:])
+
+            best = min(itertools.product(*(range(len(cands[j])) for j in free)), key=spread)
+            chosen = {j: cands[j][k] for j, k in zip(free, best)}
         results: dict[int, Any] = {}
         for j in todo:
-            tr = self._tracks[j]
-            found = cands[j]
-            if not found:
+            if not cands[j]:
                 results[j] = None
                 continue
-            pick = found[0]
-            comparable = [c for c in found if c[1] >= 0.5 * found[0][1]]
-            if not tr.still and tr.roi is None and len(comparable) > 1:
-                anchors = [t.x for t in self._tracks if t.found and not t.lost and not t.still] + [
-                    cands[k][0][0]
-                    for k in todo
-                    if k != j and cands[k] and not self._tracks[k].still
-                ]
-                if anchors:
-                    hub = np.mean(anchors, axis=0)
-                    pick = min(comparable, key=lambda c: float(np.hypot(*(c[0] - hub))))
-            results[j] = self._start(tr, frame, pick)
+            results[j] = self._start(self._tracks[j], frame, chosen.get(j, cands[j][0]))
         return results
 
     def _start(self, tr: _Track, frame: np.ndarray, blob: tuple[np.ndarray, float, tuple]):

@@ -119,3 +119,11 @@ def test_bad_time_stamps(change, message):
     change(time)
     with pytest.raises(InputError, match=message):
         observe(tracks.replace(time=time))
+
+
+def test_a_marker_on_the_wrong_object_is_caught_at_rest():
+    tracks, _ = demo_tracks("normal", 0)
+    pos = tracks.position.copy()
+    pos[:, tracks.markers.index("thumb")] = (200.0, 150.0)  # a red mug, still, on the table
+    with pytest.raises(InputError, match="does not look like a hand"):
+        observe(tracks.replace(position=pos))
