@@ -24,7 +24,12 @@ def clips(tmp_path_factory):
                     stimulus=StimulusParams(rest_before=0.3, rest_after=0.2),
                     camera_angle_deg=(-15, 15),
                     style={"hand": True, "marker_diameter": 0.012, "noise_sd": 3.0,
-                           "lighting": 0.25, "blur_sigma": 0.6})
+                           "lighting": 0.25, "blur_sigma": 0.6,
+                           # same-coloured things on the table, as in datasets/gangitano.toml
+                           "distractors": [{"colour": [20, 40, 200], "start": [-0.16, -0.05],
+                                            "diameter": 0.05},
+                                           {"colour": "finger", "start": [0.17, -0.2],
+                                            "diameter": 0.015}]})
     synthesize(recipe, out, seed=2)
     return out
 
