@@ -30,6 +30,9 @@ from scipy.linalg.lapack import dposv as _dposv
 
 log = logging.getLogger(__name__)
 
+#: Largest relative bounce of a cost at its rounding floor that still counts as converged.
+_FLOOR_RTOL = 1e-6
+
 __all__ = ["LQGProblem", "LQGSolution", "solve", "expected_cost", "state_moments",
            "estimation_error_covariance"]
 
@@ -374,7 +377,10 @@ def solve(
         between iterations ...
     atol : float, optional
         ... or by less than ``atol`` (the floor for problems of near-zero cost;
-        Todorov's code uses only this absolute test, with 1e-15).
+        Todorov's code uses this absolute test, with 1e-15). As in his code,
+        iteration also stops when the cost rises more than 3 times in the last
+        10 iterations: it is then bouncing on its rounding floor, and counts
+        as converged if those changes are below 1e-6 of the cost.
     max_iter : int, optional
         Maximum number of forward/backward iterations; ``max_iter=2`` runs
         exactly two (Todorov's ``Niter=2``).
@@ -409,6 +415,14 @@ def solve(
             change = abs(history[-2] - history[-1])
             if change < atol or change < tol * abs(history[-1]):
                 converged = True
+                break
+        if len(history) > 20:
+            # kalman_lqg.m's third test: a cost that rises more than 3 times in
+            # 10 iterations is bouncing on its rounding floor (large target
+            # coordinates make it a small difference of large terms)
+            recent = np.diff(history[-11:])
+            if np.sum(recent > 0) > 3:
+                converged = bool(np.abs(recent).max() <= _FLOOR_RTOL * abs(history[-1]))
                 break
     if not converged:
         log.warning("solve: the cost did not converge in %d iterations (last change %.3g, "

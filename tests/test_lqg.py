@@ -180,3 +180,15 @@ def test_costs_and_initial_covariance_must_be_psd(reference_problem, field, valu
 def test_unconverged_solve_is_reported(reference_problem, caplog):
     solve(reference_problem, max_iter=2)
     assert "did not converge" in caplog.text
+
+
+def test_a_cost_bouncing_on_its_rounding_floor_stops_the_iteration():
+    from minvar import GraspTask, GripVia, plan_grasp
+
+    # an open-close-open grip schedule; the thumb's targets near pi rad make its
+    # cost a small difference of large terms
+    vias = (GripVia(0.062, 0.0, 0.40), GripVia(0.015, 0.0, 0.60), GripVia(0.065, 0.0, 0.82))
+    plan = plan_grasp(GraspTask(object_size=0.10, distance=0.25, duration=0.98, grip_via=vias))
+    sol = plan.thumb.solution
+    assert sol.converged and sol.iterations < 100
+    np.testing.assert_allclose(sol.cost, plan.finger.solution.cost, rtol=1e-8)  # its mirror
