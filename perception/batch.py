@@ -13,6 +13,7 @@ Clips run in local processes (``jobs``) or on a dask.distributed cluster
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import hashlib
 import json
@@ -20,6 +21,7 @@ import logging
 import multiprocessing
 import os
 import sys
+import tempfile
 from collections import deque
 from collections.abc import Iterable, Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -296,10 +298,29 @@ def _limit_threads() -> None:
         pass
 
 
-def _init_worker(repertoire: Repertoire) -> None:
-    """Worker setup: one thread, and the repertoire received once per process."""
+@contextlib.contextmanager
+def _one_thread():
+    """OpenCV single-threaded in this process while it works beside its workers:
+    its thread pool would otherwise take the cores the workers run on."""
+    import cv2
+
+    before = cv2.getNumThreads()
+    cv2.setNumThreads(1)
+    try:
+        yield
+    finally:
+        cv2.setNumThreads(before)
+
+
+def _init_worker(repertoire_file: str) -> None:
+    """Worker setup: one thread, and the repertoire read once per process.
+
+    The repertoire comes as a file, not pickled in the start-up arguments: a
+    spawning parent blocks writing those into the worker's pipe until the
+    worker has started and imported everything (about a second).
+    """
     _limit_threads()
-    _WORKER["repertoire"] = repertoire
+    _WORKER["repertoire"] = Repertoire.load(repertoire_file)
 
 
 def _work_in_worker(item: BatchItem, out: Path, settings: BatchSettings,
@@ -334,24 +355,40 @@ def _run_local(items: list[BatchItem], out: Path, repertoire: Repertoire,
     # spawn, not fork: a parent that has already rendered or planned holds
     # OpenCV/BLAS thread pools, and forking those deadlocks the workers
     ctx = multiprocessing.get_context("spawn")
+    with tempfile.TemporaryDirectory(prefix=".repertoire-", dir=out) as tmp, _one_thread():
+        rep_file = repertoire.save(Path(tmp) / "repertoire.h5")
+        yield from _parallel(pending, here, jobs, ctx, rep_file, out, settings, repertoire_id)
+
+
+def _parallel(pending, here, jobs, ctx, rep_file, out, settings, repertoire_id):
+    """The caller's share of the clips and the workers', until all are done."""
     with ProcessPoolExecutor(max_workers=jobs - 1, initializer=_init_worker,
-                             initargs=(repertoire,), mp_context=ctx) as pool:
-        running: set = set()
+                             initargs=(str(rep_file),), mp_context=ctx) as pool:
+        running: dict = {}
 
         def feed():
-            while pending and len(running) < 2 * (jobs - 1):  # a little queued per worker
-                running.add(pool.submit(_work_in_worker, pending.popleft(), out, settings,
-                                        repertoire_id))
+            # a few clips queued per worker, so it never waits for this process
+            while pending and len(running) < 4 * (jobs - 1):
+                item = pending.popleft()
+                running[pool.submit(_work_in_worker, item, out, settings, repertoire_id)] = item
+
+        def collect():
+            for f in [f for f in running if f.done()]:
+                del running[f]
+                yield f.result()
 
         feed()
         while pending:
             yield here(pending.popleft())
-            done = {f for f in running if f.done()}
-            running -= done
-            for f in done:
-                yield f.result()
+            yield from collect()
             feed()
-        for f in as_completed(running):
+        # The queue is empty: take back clips no worker has started, rather than
+        # wait for them.
+        for f in list(running):
+            if f.cancel():
+                yield here(running.pop(f))
+            yield from collect()
+        for f in as_completed(list(running)):
             yield f.result()
 
 

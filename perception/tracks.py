@@ -176,10 +176,11 @@ class Tracks:
     def object_diameter_px(self, name: str = "object") -> float | None:
         """Apparent diameter of the round object in pixels, if the tracks can tell.
 
-        Tracker output: from the object's reference blob area (found while it
-        was fully visible, before the hand reaches it), as the diameter of a
-        disc of that area. Rendered ground truth: the true diameter times the
-        camera scale.
+        Tracker output: the diameter the tracker measured when it found the
+        object (fully visible, before the hand reaches it) from its
+        colour-unmixed area; for older files, the diameter of a disc of the
+        object's reference blob area (about 3 % large on blurred footage).
+        Rendered ground truth: the true diameter times the camera scale.
 
         Parameters
         ----------
@@ -193,6 +194,13 @@ class Tracks:
             scale = json.loads(camera).get("px_per_m") if isinstance(camera, str) else None
             if scale:
                 return float(self.attrs["object_diameter"]) * float(scale)
+        measured = self.tracker.get("diameter_px")
+        if measured is not None:
+            measured = np.atleast_1d(np.asarray(measured, dtype=float))
+            if len(measured) == len(self.markers):
+                d = measured[self.markers.index(name)]
+                if np.isfinite(d) and d > 0:
+                    return float(d)
         mass = self.tracker.get("reference_mass_px")
         if mass is None:
             return None

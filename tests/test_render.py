@@ -191,3 +191,18 @@ def test_reach_to_grasp_stand_in_ends_on_the_object():
     assert s.finger[-1, 0] > 0 > s.thumb[-1, 0]  # right hand seen from above
     aperture = np.linalg.norm(s.finger - s.thumb, axis=1)
     assert aperture.max() == pytest.approx(0.14) and aperture.argmax() < 89
+
+
+def test_discs_are_drawn_at_their_nominal_size():
+    import cv2
+
+    from perception.render import _disc
+
+    # object-sized discs to a tenth of a pixel; small ones (markers) within half a
+    # pixel: OpenCV's anti-aliased rasteriser is irregular around 8-10 px
+    for r, tol in ((5.0, 0.5), (10.0, 0.5), (20.0, 0.1), (40.0, 0.1), (60.0, 0.1)):
+        for centre in (100.0, 100.3):
+            img = np.zeros((200, 200), np.uint8)
+            _disc(img, np.array([centre, 100.0]), r, 255)
+            assert 2 * np.sqrt((img / 255.0).sum() / np.pi) == pytest.approx(2 * r, abs=tol)
+    assert cv2 is not None
