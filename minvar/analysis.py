@@ -10,7 +10,6 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 import pandas as pd
-from scipy.signal import find_peaks
 
 from .lqg import solve
 from .plant import PointMassPlant
@@ -60,6 +59,10 @@ def count_speed_peaks(speed: np.ndarray, prominence: float = 0.05) -> int:
         Minimum peak prominence as a fraction of the profile's maximum; smaller
         ripples are not counted.
     """
+    # imported here: scipy.signal takes half a second to import, and every
+    # command and batch worker imports this module
+    from scipy.signal import find_peaks
+
     speed = np.asarray(speed, dtype=float)
     padded = np.concatenate([[0.0], speed, [0.0]])  # a peak at either end still counts
     peaks, _ = find_peaks(padded, prominence=prominence * speed.max())

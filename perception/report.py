@@ -15,7 +15,6 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
-from scipy import stats
 
 from minvar.figures import new_figure
 
@@ -294,6 +293,8 @@ def condition_statistics(summary: pd.DataFrame, model: str) -> pd.DataFrame:
     pandas.DataFrame
         Columns: model, test, groups, n, statistic, p_value, mean_difference.
     """
+    from scipy import stats  # slow to import; only the batch report needs it
+
     col = f"conf_{model}"
     ok = summary[(summary["status"] == "ok") & summary["condition"].notna()]
     groups = {c: g[col].to_numpy(float) for c, g in ok.groupby("condition", sort=False)}
