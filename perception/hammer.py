@@ -283,7 +283,7 @@ def recognize(
         The demonstration in the model frame (from :func:`perception.observe.observe`).
     repertoire : Repertoire or list of MotorModel
         The models; a :class:`Repertoire` re-plans models whose stored scene
-        differs from the clip's (distance, object size, frame rate).
+        differs from the clip's (distance, object size, hand size, frame rate).
     params : HammerParams, optional
         Rule and weights.
 
@@ -327,8 +327,7 @@ def recognize(
             cache[key] = _ik(rel, c)
         q_obs[:, i] = cache[key]
 
-    # Batched filtering: x (Lc, n). The frame's observation enters at the
-    # first model step of each frame; the other steps are pure prediction.
+    # Every leaf of every model at once: states x (Lc, n).
     A, B = leaves.A, leaves.B
     gain = params.filter_gain
 

@@ -309,7 +309,9 @@ def observe(tracks, params: ObserveParams | None = None, *, clip: str | None = N
     ------
     InputError
         If a needed marker is missing or never seen, the object is never seen,
-        the scale is unknown, or the movement is too short to score.
+        the scale is unknown, the time stamps are not finite seconds, the clip
+        does not start with a still, visible hand that looks like a hand, no
+        movement is found, or the movement is too short to score.
     """
     params = ObserveParams() if params is None else params
     name = clip or getattr(tracks, "name", None) or "clip"
