@@ -49,6 +49,8 @@ TRACKS_SUFFIX = ".tracks.h5"
 #: manifest, and what a batch writes (so a report folder can be its own input).
 COMPANION_SUFFIXES = (".truth.h5", ".recognition.json", ".confidence.csv", ".confidence.png",
                       ".paths.png")
+#: Which file stands for a clip found more than once (a tracks file spares tracking).
+_PREFERENCE = {"tracks": 2, "video": 1, "unknown": 0}
 COMPANION_NAMES = ("manifest.csv", "README.md", "recipe.toml", "summary.csv", "statistics.csv",
                    "condition_profiles.csv", "condition_profiles.png", "report.html",
                    "batch.json", "repertoire.h5")
@@ -166,12 +168,9 @@ def discover(source: str | os.PathLike) -> list[BatchItem]:
         if path.name.endswith(COMPANION_SUFFIXES):
             continue
         clip, kind = clip_name(path)
-        item = BatchItem(clip, path, kind, conditions.get(clip))
         prev = found.get(clip)
-        if prev is None or (kind == "tracks") or prev.kind == "unknown":
-            if kind == "unknown" and prev is not None:
-                continue
-            found[clip] = item
+        if prev is None or _PREFERENCE[kind] > _PREFERENCE[prev.kind]:
+            found[clip] = BatchItem(clip, path, kind, conditions.get(clip))
     return sorted(found.values(), key=lambda i: i.clip)
 
 
@@ -254,6 +253,8 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
                              f"--object-diameter): {exc}", item.path) from None
         write_clip_report(rec, out, extra={"fingerprint": fp, "condition": item.condition,
                                            "input": str(item.path)})
+        # the summary is built from the written report, as for a resumed clip,
+        # so fresh and reused clips go through the same JSON
         report = json.loads(clip_outputs(out, item.clip)["json"].read_text())
         return {**row, "status": "ok", "winner": rec.winner, "report": report}
     except (InputError, ValueError, OSError) as exc:
@@ -290,12 +291,9 @@ def _guarded(item: BatchItem, out: Path, **kwargs) -> dict:
 
 def _limit_threads() -> None:
     """One thread per worker process: parallelism comes from the processes."""
-    try:
-        import cv2
+    import cv2
 
-        cv2.setNumThreads(1)
-    except ImportError:  # pragma: no cover
-        pass
+    cv2.setNumThreads(1)
 
 
 @contextlib.contextmanager

@@ -67,7 +67,7 @@ class HammerParams:
         keep each model's own timing. Measured on the synthetic stimuli
         (README): the normal grasp's confidence and one-step prediction error
         do not change with it, while delayed and open-close-open grasps earn
-        less for motion the plan did not expect (final confidence 84 % and
+        less for motion the plan did not expect (final confidence 86 % and
         64 % of normal at 1, 63 % and 46 % at the default 0.3).
     """
 

@@ -277,16 +277,6 @@ class Observation:
         return np.linalg.norm(self.finger - self.thumb, axis=-1)
 
 
-def _object_diameter_px(tracks) -> float | None:
-    """The object's apparent diameter in pixels, if the tracks carry it."""
-    size = getattr(tracks, "object_diameter_px", None)
-    if callable(size):
-        size = size()
-    if size is not None and np.isfinite(size) and size > 0:
-        return float(size)
-    return None
-
-
 def observe(tracks, params: ObserveParams | None = None, *, clip: str | None = None) -> Observation:
     """Turn marker tracks into an :class:`Observation` in the model frame.
 
@@ -294,8 +284,9 @@ def observe(tracks, params: ObserveParams | None = None, *, clip: str | None = N
     ----------
     tracks : Tracks
         Tracks with ``time`` (T,) s, ``frame`` (T,), ``markers`` (names),
-        ``position`` (T, M, 2) px with NaN where lost; the markers ``wrist``,
-        ``finger``, ``thumb`` and ``object`` are needed.
+        ``position`` (T, M, 2) px with NaN where lost, and the object's apparent
+        size (``object_diameter_px()``); the markers ``wrist``, ``finger``,
+        ``thumb`` and ``object`` are needed.
     params : ObserveParams, optional
         Scale, filter and onset settings.
     clip : str, optional
@@ -356,7 +347,7 @@ def observe(tracks, params: ObserveParams | None = None, *, clip: str | None = N
     origin = np.median(px["object"][: 2 * params.rest_frames], axis=0)
     scale = params.px_per_m
     if scale is None:
-        dpx = _object_diameter_px(tracks)
+        dpx = tracks.object_diameter_px()
         if dpx is None:
             raise InputError("image scale unknown: the tracks carry no object size; "
                              "give px_per_m (--px-per-m)", name)

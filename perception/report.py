@@ -368,14 +368,14 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
     sections = []
     ok = summary[summary["status"] == "ok"]
     recs = [recognitions[c] for c in ok["clip"] if c in recognitions]
+    condition_of = ok.set_index("clip")["condition"]
     if recs and profile_model is None:
-        conds = ok.set_index("clip")["condition"]
-        normal = [r for r in recs if conds.get(r.clip) == "normal"]
+        normal = [r for r in recs if condition_of.get(r.clip) == "normal"]
         profile_model = _default_profile_model(normal or recs)
     stats_df = pd.DataFrame()
     if recs and profile_model:
-        conds = [str(c) if isinstance(c, str) else "unlabelled"
-                 for c in ok.set_index("clip").loc[[r.clip for r in recs], "condition"]]
+        conds = [c if isinstance(c, str) else "unlabelled"
+                 for c in condition_of.loc[[r.clip for r in recs]]]
         prof = condition_profiles(recs, conds, profile_model)
         write_csv(out / "condition_profiles.csv", prof)
         save_figure(out / "condition_profiles.png", condition_figure(prof, profile_model))

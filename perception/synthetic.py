@@ -41,6 +41,7 @@ from minvar import GraspTask, GripVia, simulate_grasp
 from .atomic import write_csv
 from .errors import InputError
 from .render import Camera, Distractor, Occlusion, RenderStyle, Scene, render_clip
+from .video import CODECS
 
 __all__ = [
     "CONDITIONS",
@@ -364,5 +365,6 @@ def synthesize(recipe: Recipe, out: str | os.PathLike, *, seed: int = 0,
 
 
 def _suffix(style: RenderStyle) -> str:
-    codec = (style.codec or "mp4v").lower()
-    return {"mp4v": ".mp4", "mjpg": ".avi", "ffv1": ".mkv"}.get(codec, ".mp4")
+    """File extension for the style's codec (the inverse of :data:`video.CODECS`)."""
+    by_codec = {codec.lower(): ext for ext, codec in CODECS.items()}
+    return by_codec.get((style.codec or CODECS[".mp4"]).lower(), ".mp4")

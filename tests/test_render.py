@@ -194,8 +194,6 @@ def test_reach_to_grasp_stand_in_ends_on_the_object():
 
 
 def test_discs_are_drawn_at_their_nominal_size():
-    import cv2
-
     from perception.render import _disc
 
     # object-sized discs to a tenth of a pixel; small ones (markers) within half a
@@ -205,4 +203,3 @@ def test_discs_are_drawn_at_their_nominal_size():
             img = np.zeros((200, 200), np.uint8)
             _disc(img, np.array([centre, 100.0]), r, 255)
             assert 2 * np.sqrt((img / 255.0).sum() / np.pi) == pytest.approx(2 * r, abs=tol)
-    assert cv2 is not None

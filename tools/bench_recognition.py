@@ -7,6 +7,7 @@ to 2 processes >= 1.7x.
 
 from __future__ import annotations
 
+import dataclasses
 import shutil
 import sys
 import tempfile
@@ -48,8 +49,8 @@ def main() -> None:
     work = Path(tempfile.mkdtemp(prefix="hammer-bench-"))
     try:
         recipe = load_recipe(ROOT / "datasets" / "smoke.toml")
-        recipe = type(recipe)(**{**recipe.__dict__, "counts": {"normal": 14, "delayed": 13,
-                                                                "open-close-open": 13}})
+        recipe = dataclasses.replace(recipe, counts={"normal": 14, "delayed": 13,
+                                                     "open-close-open": 13})
         synthesize(recipe, work / "clips", seed=0)
         items = discover(work / "clips")
         times = {}
