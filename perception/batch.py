@@ -30,13 +30,13 @@ from pathlib import Path
 
 import pandas as pd
 
-from . import __version__
-from .atomic import write_json
-from .errors import InputError
-from .hammer import HammerParams, recognize
-from .observe import ObserveParams, observe
-from .repertoire import Repertoire
-from .report import ClipSummary, clip_outputs, write_batch_report, write_clip_report
+from perception import __version__
+from perception.io.atomic import write_json
+from perception.errors import InputError
+from perception.recognition.engine import HammerParams, recognize
+from perception.observe import ObserveParams, observe
+from perception.recognition.repertoire import Repertoire
+from perception.report import ClipSummary, clip_outputs, write_batch_report, write_clip_report
 
 __all__ = ["BatchItem", "BatchSettings", "clip_name", "discover", "process_clip", "run_batch",
            "VIDEO_SUFFIXES"]
@@ -231,10 +231,10 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
             return {**row, "status": "skipped", "winner": done["winner"], "report": done}
         if item.kind == "unknown":
             raise InputError("not a video or tracks file", item.path)
-        from .tracks import Tracks
+        from perception.io.tracks import Tracks
 
         if item.kind == "video":
-            from .tracking import track_video
+            from perception.tracking.tracker import track_video
 
             tracks_file = track_video(item.path, out / "tracks" / f"{item.clip}{TRACKS_SUFFIX}",
                                       progress=not settings.quiet and sys.stderr.isatty())

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .errors import InputError
+from perception.errors import InputError
 
 __all__ = [
     "ObserveParams",

@@ -18,8 +18,8 @@ from matplotlib.figure import Figure
 
 from minvar.figures import new_figure
 
-from .atomic import save_figure, write_csv, write_json, write_text
-from .hammer import Recognition
+from perception.io.atomic import save_figure, write_csv, write_json, write_text
+from perception.recognition.engine import Recognition
 
 __all__ = [
     "ClipSummary",
@@ -96,7 +96,7 @@ class ClipSummary:
 
     @classmethod
     def from_recognition(cls, rec: Recognition) -> ClipSummary:
-        """From a :class:`~perception.hammer.Recognition`.
+        """From a :class:`~perception.recognition.engine.Recognition`.
 
         Parameters
         ----------

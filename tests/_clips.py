@@ -5,9 +5,9 @@ from __future__ import annotations
 import h5py
 import numpy as np
 
-from perception.render import Camera, RenderStyle, Scene, render_clip
-from perception.tracking import track_video
-from perception.tracks import Tracks
+from perception.synthetic.render import Camera, RenderStyle, Scene, render_clip
+from perception.tracking.tracker import track_video
+from perception.io.tracks import Tracks
 
 #: The issue's hard case: noise, skin-coloured hand, lighting gradient (plus
 #: blur and a camera not aligned with the approach).

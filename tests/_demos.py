@@ -7,10 +7,10 @@ import json
 
 import numpy as np
 
-from perception.render import Camera
-from perception.repertoire import Repertoire, SceneSpec
-from perception.synthetic import StimulusParams, stimulus_paths
-from perception.tracks import Tracks
+from perception.synthetic.render import Camera
+from perception.recognition.repertoire import Repertoire, SceneSpec
+from perception.synthetic.recipes import StimulusParams, stimulus_paths
+from perception.io.tracks import Tracks
 
 MARKERS = ("thumb", "finger", "wrist", "object")
 CAMERA = Camera(px_per_m=800.0, origin_px=(320.0, 144.0), angle_deg=0.0)

@@ -10,8 +10,8 @@ import pytest
 from _demos import default_repertoire
 
 from perception.batch import BatchSettings, discover, run_batch
-from perception.cli import main
-from perception.synthetic import Recipe, StimulusParams, synthesize
+from hammer_mv.cli import main
+from perception.synthetic.recipes import Recipe, StimulusParams, synthesize
 
 pytestmark = pytest.mark.slow
 
@@ -40,7 +40,7 @@ def repfile(tmp_path_factory):
 
 
 def _batch(src, out, repfile, *extra):
-    return subprocess.run([sys.executable, "-m", "perception.cli", "batch", str(src), "-o",
+    return subprocess.run([sys.executable, "-m", "hammer_mv", "batch", str(src), "-o",
                            str(out), "--repertoire", str(repfile), "--quiet", *extra],
                           capture_output=True, text=True)
 
@@ -129,7 +129,7 @@ def test_recognize_writes_the_contract(clips, repfile, tmp_path):
 ])
 def test_recognize_bad_input_exit_2(tmp_path, repfile, make, message):
     path = make(tmp_path)
-    proc = subprocess.run([sys.executable, "-m", "perception.cli", "recognize", str(path),
+    proc = subprocess.run([sys.executable, "-m", "hammer_mv", "recognize", str(path),
                            "-o", str(tmp_path / "o"), "--repertoire", str(repfile)],
                           capture_output=True, text=True)
     assert proc.returncode == 2, proc.stderr
@@ -140,7 +140,7 @@ def test_recognize_bad_input_exit_2(tmp_path, repfile, make, message):
 
 def test_parallel_batch_after_work_in_the_same_process(clips, tmp_path):
     # rendering and planning first leaves thread pools behind: workers must still run
-    from perception.synthetic import StimulusParams, stimulus_paths
+    from perception.synthetic.recipes import StimulusParams, stimulus_paths
 
     stimulus_paths(StimulusParams(), 30, seed=0)
     items = [i for i in discover(clips) if i.clip in ("normal-01", "delayed-01")]
@@ -182,7 +182,7 @@ def test_an_unexpected_error_is_recorded_and_the_batch_goes_on(clips, tmp_path):
     rep = default_repertoire()
     broken = dataclasses.replace(rep.models[0], finger=dataclasses.replace(
         rep.models[0].finger, K=rep.models[0].finger.K[:3]))
-    from perception.repertoire import Repertoire
+    from perception.recognition.repertoire import Repertoire
 
     bad_rep = Repertoire([broken, *rep.models[1:]])
     items = [i for i in discover(clips) if i.clip in ("normal-01", "reach-01")]
@@ -194,8 +194,8 @@ def test_an_unexpected_error_is_recorded_and_the_batch_goes_on(clips, tmp_path):
 
 
 def test_object_scale_from_tracking_is_within_one_percent(clips, tmp_path):
-    from perception.tracking import track_video
-    from perception.tracks import Tracks
+    from perception.tracking.tracker import track_video
+    from perception.io.tracks import Tracks
 
     for clip in ("normal-01", "delayed-01"):
         tracked = Tracks.load(track_video(clips / f"{clip}.mp4", tmp_path / f"{clip}.tracks.h5"))

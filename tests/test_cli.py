@@ -1,7 +1,7 @@
 import subprocess
 import sys
 
-from perception.cli import main
+from hammer_mv.cli import main
 
 
 def test_version(capsys):
@@ -14,7 +14,7 @@ def test_version(capsys):
 
 def test_bad_option_is_one_line_exit_2():
     proc = subprocess.run(
-        [sys.executable, "-m", "perception.cli", "--no-such-option"],
+        [sys.executable, "-m", "hammer_mv", "--no-such-option"],
         capture_output=True, text=True,
     )
     assert proc.returncode == 2

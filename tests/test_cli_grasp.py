@@ -5,7 +5,7 @@ import sys
 import pandas as pd
 import pytest
 
-from perception.cli import main
+from hammer_mv.cli import main
 
 
 def test_grasp_simulate_writes_figures_and_table(tmp_path):
@@ -60,7 +60,7 @@ def test_grasp_bad_input_one_line_exit_2(tmp_path, capsys, argv):
 
 def test_grasp_bad_input_in_a_fresh_process(tmp_path):
     for bad in (["experiment", "nonsense"], ["simulate", "--object-size", "-1"]):
-        proc = subprocess.run([sys.executable, "-m", "perception.cli", "grasp", *bad,
+        proc = subprocess.run([sys.executable, "-m", "hammer_mv", "grasp", *bad,
                                "-o", str(tmp_path / "x")], capture_output=True, text=True)
         assert proc.returncode == 2, bad
         assert len(proc.stderr.strip().splitlines()) == 1, proc.stderr

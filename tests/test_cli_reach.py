@@ -4,7 +4,7 @@ import sys
 
 import pandas as pd
 
-from perception.cli import main
+from hammer_mv.cli import main
 
 
 def test_reach_writes_figures_and_table(tmp_path):
@@ -32,7 +32,7 @@ def test_reach_sweep(tmp_path):
 def test_reach_bad_input_one_line_exit_2(tmp_path):
     for bad in (["--via", "0.3", "0.4", "1.5"], ["--duration", "0.01"], ["--trials", "0"],
                 ["--sigma-u", "-1"], ["--start", "nan", "0"]):
-        proc = subprocess.run([sys.executable, "-m", "perception.cli", "reach", *bad,
+        proc = subprocess.run([sys.executable, "-m", "hammer_mv", "reach", *bad,
                                "-o", str(tmp_path / "x")], capture_output=True, text=True)
         assert proc.returncode == 2, bad
         assert len(proc.stderr.strip().splitlines()) == 1, proc.stderr

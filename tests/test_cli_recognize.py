@@ -14,7 +14,7 @@ def repfile(tmp_path_factory):
 
 
 def _recognize(path, out, repfile, *extra):
-    return subprocess.run([sys.executable, "-m", "perception.cli", "recognize", str(path), "-o",
+    return subprocess.run([sys.executable, "-m", "hammer_mv", "recognize", str(path), "-o",
                            str(out), "--repertoire", str(repfile), *extra],
                           capture_output=True, text=True)
 

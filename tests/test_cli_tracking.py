@@ -8,13 +8,13 @@ import pandas as pd
 import pytest
 from _clips import HARD, errors, render
 
-from perception.render import Occlusion
-from perception.tracks import Tracks
+from perception.synthetic.render import Occlusion
+from perception.io.tracks import Tracks
 
 
 def hammer(*args, cwd=None):
     return subprocess.run(
-        [sys.executable, "-m", "perception.cli", *map(str, args)],
+        [sys.executable, "-m", "hammer_mv", *map(str, args)],
         capture_output=True,
         text=True,
         cwd=cwd,

@@ -5,7 +5,7 @@ import pytest
 from _demos import default_repertoire, demo_tracks
 from scipy import stats
 
-from perception.hammer import HammerParams, recognize
+from perception.recognition.engine import HammerParams, recognize
 from perception.observe import observe
 
 MODEL = "grasp-1.0s"  # the normal grasp of the demonstrations' movement time

@@ -5,7 +5,7 @@ import inspect
 
 import pytest
 
-MODULES = ["markers", "video", "tracks", "render", "tracking"]
+MODULES = ["tracking.markers", "io.video", "io.tracks", "synthetic.render", "tracking.tracker"]
 
 
 def _public(module):

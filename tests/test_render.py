@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from _clips import render
 
-from perception.markers import default_markers
-from perception.render import (
+from perception.tracking.markers import default_markers
+from perception.synthetic.render import (
     Camera,
     Distractor,
     Occlusion,
@@ -19,8 +19,8 @@ from perception.render import (
     render_frames,
     world_to_pixel,
 )
-from perception.tracks import Tracks
-from perception.video import FrameSource
+from perception.io.tracks import Tracks
+from perception.io.video import FrameSource
 
 
 def test_camera_maps_world_to_pixels_as_documented():
@@ -169,7 +169,7 @@ def test_failed_render_leaves_no_files(tmp_path, monkeypatch):
     def broken(path):
         raise OSError("disk full")
 
-    monkeypatch.setattr("perception.render.sha256_file", broken)
+    monkeypatch.setattr("perception.synthetic.render.sha256_file", broken)
     with pytest.raises(OSError, match="disk full"):
         render_clip(scene, Camera.for_frame(160, 120), style, tmp_path / "y.mp4")
     assert list(tmp_path.iterdir()) == []
@@ -194,7 +194,7 @@ def test_reach_to_grasp_stand_in_ends_on_the_object():
 
 
 def test_discs_are_drawn_at_their_nominal_size():
-    from perception.render import _disc
+    from perception.synthetic.render import _disc
 
     # object-sized discs to a tenth of a pixel; small ones (markers) within half a
     # pixel: OpenCV's anti-aliased rasteriser is irregular around 8-10 px

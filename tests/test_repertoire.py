@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from _demos import default_repertoire
 
-from perception.cli import main
+from hammer_mv.cli import main
 from perception.errors import InputError
-from perception.repertoire import ModelSpec, Repertoire, SceneSpec, build_model, model_substeps
+from perception.recognition.repertoire import ModelSpec, Repertoire, SceneSpec, build_model, model_substeps
 
 
 def test_default_repertoire_has_both_kinds_and_ten_models():
@@ -100,7 +100,7 @@ def test_cli_build_and_info(tmp_path, capsys):
     assert main(["repertoire", "info", str(out)]) == 0
     text = capsys.readouterr().out
     assert "grasp-0.9s" in text and "reach-1.1s" in text
-    proc = subprocess.run([sys.executable, "-m", "perception.cli", "repertoire", "info",
+    proc = subprocess.run([sys.executable, "-m", "hammer_mv", "repertoire", "info",
                            str(tmp_path / "nope.h5")], capture_output=True, text=True)
     assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1
 

@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from perception.cli import main
+from hammer_mv.cli import main
 from perception.errors import InputError
-from perception.synthetic import StimulusParams, load_recipe, stimulus_paths
-from perception.tracks import Tracks
+from perception.synthetic.recipes import StimulusParams, load_recipe, stimulus_paths
+from perception.io.tracks import Tracks
 
 
 def _aperture(cond, seed=0):
@@ -83,7 +83,7 @@ def test_recipe_problems_are_found_before_rendering(tmp_path, text, message):
 
 
 def test_a_clip_does_not_depend_on_other_conditions_counts():
-    from perception.synthetic import Recipe, clip_plans
+    from perception.synthetic.recipes import Recipe, clip_plans
 
     one = {p[0]: p[2] for p in clip_plans(Recipe("r", {"normal": 1, "delayed": 1},
                                                  duration_sd=0.05), seed=3)}

@@ -3,10 +3,10 @@ import pytest
 from _clips import HARD, errors, render, track
 
 from perception.errors import InputError
-from perception.markers import default_markers
-from perception.render import Distractor, Occlusion, Scene
-from perception.tracking import Tracker, TrackerParams, track_video
-from perception.tracks import Status, Tracks
+from perception.tracking.markers import default_markers
+from perception.synthetic.render import Distractor, Occlusion, Scene
+from perception.tracking.tracker import Tracker, TrackerParams, track_video
+from perception.io.tracks import Status, Tracks
 
 
 def _check_accuracy(tracks, truth, visible, median=1.0, p95=3.0):
@@ -165,7 +165,7 @@ def test_tracker_processes_regions_not_whole_frames(monkeypatch):
     """Once markers are found, HSV conversion touches only small regions."""
     import cv2
 
-    from perception import render as r
+    from perception.synthetic import render as r
 
     scene = Scene.reach_to_grasp(12, 30)
     cam = r.Camera.for_frame(640, 480)

@@ -4,7 +4,7 @@ import pandas as pd
 import pytest
 
 from perception.errors import InputError
-from perception.tracks import SCHEMA, SCHEMA_VERSION, Status, Tracks, TracksWriter
+from perception.io.tracks import SCHEMA, SCHEMA_VERSION, Status, Tracks, TracksWriter
 
 MARKERS = ("thumb", "finger", "wrist", "object")
 
@@ -210,7 +210,7 @@ def test_trackpy_and_plain_exports(tmp_path):
 def test_loaded_tracks_save_again(tmp_path):
     from _demos import demo_tracks
 
-    from perception.tracks import Tracks
+    from perception.io.tracks import Tracks
 
     t = demo_tracks("normal", 0)[0].replace(tracker={"reference_mass_px": [10.0, 12.0, 80.0, 5e3],
                                                      "method": "camshift"})

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from perception.errors import InputError
-from perception.video import FrameSource, TimeResolver, VideoWriter, write_video
+from perception.io.video import FrameSource, TimeResolver, VideoWriter, write_video
 
 
 def _frames(n, w=96, h=64):
@@ -116,7 +116,7 @@ def test_truncated_avi_keeps_decoded_frames_warns_and_records_true_count(tmp_pat
     cut.write_bytes(path.read_bytes()[: path.stat().st_size // 2])
     src = FrameSource(cut)
     assert src.info.n_frames_header == 30
-    with caplog.at_level(logging.WARNING, logger="perception.video"):
+    with caplog.at_level(logging.WARNING, logger="perception.io.video"):
         n = sum(1 for _ in src)
     assert 0 < n < 30
     assert src.attrs()["n_frames"] == n

@@ -26,10 +26,10 @@ def main() -> None:
     from _demos import demo_tracks
 
     from perception.batch import BatchSettings, discover, run_batch
-    from perception.hammer import recognize
+    from perception.recognition.engine import recognize
     from perception.observe import observe
-    from perception.repertoire import Repertoire, SceneSpec
-    from perception.synthetic import load_recipe, synthesize
+    from perception.recognition.repertoire import Repertoire, SceneSpec
+    from perception.synthetic.recipes import load_recipe, synthesize
 
     t0 = time.perf_counter()
     rep = Repertoire.build(scene=SceneSpec())

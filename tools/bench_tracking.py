@@ -28,13 +28,13 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from perception.render import Camera, RenderStyle, Scene, render_clip
-from perception.tracking import track_video
-from perception.tracks import Tracks
+from perception.synthetic.render import Camera, RenderStyle, Scene, render_clip
+from perception.tracking.tracker import track_video
+from perception.io.tracks import Tracks
 
 _CHILD = """
 import resource, sys
-from perception.tracking import track_video
+from perception.tracking.tracker import track_video
 track_video(sys.argv[1], sys.argv[2])
 print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)
 """

@@ -17,7 +17,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from perception.cli import main  # noqa: E402
+from hammer_mv.cli import main  # noqa: E402
 
 
 def run() -> int:

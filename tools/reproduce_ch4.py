@@ -37,8 +37,8 @@ if str(ROOT) not in sys.path:
 from minvar.grasp import GraspTask, plan_grasp, simulate_grasp  # noqa: E402
 from minvar.grasp_experiments import EXPERIMENTS, GraspExperiment  # noqa: E402
 from minvar.grasp_figures import grasp_figure, setup_figure  # noqa: E402
-from perception.atomic import save_figure, write_csv  # noqa: E402
-from perception.cli.grasp import write_experiment  # noqa: E402
+from perception.io.atomic import save_figure, write_csv  # noqa: E402
+from hammer_mv.cli.grasp import write_experiment  # noqa: E402
 
 log = logging.getLogger("reproduce_ch4")
 

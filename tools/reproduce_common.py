@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from perception.atomic import save_figure, write_csv
+from perception.io.atomic import save_figure, write_csv
 
 #: Keys of a claim, in the column order of numbers.md.
 CLAIM_KEYS = ("section", "claim", "thesis", "ours", "agrees", "note")

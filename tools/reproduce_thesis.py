@@ -37,7 +37,7 @@ import pandas as pd  # noqa: E402
 from reproduce_common import CLAIM_KEYS  # noqa: E402
 from tqdm import tqdm  # noqa: E402
 
-from perception.atomic import write_csv, write_text  # noqa: E402
+from perception.io.atomic import write_csv, write_text  # noqa: E402
 
 log = logging.getLogger("reproduce_thesis")
 

@@ -1,6 +1,6 @@
 """CamShift colour-marker tracker that survives real footage.
 
-Each marker has a colour model (:mod:`perception.markers`) and its own
+Each marker has a colour model (:mod:`perception.tracking.markers`) and its own
 search window. Per frame and marker:
 
 1. **Prediction.** An alpha-beta filter predicts the marker's position; the
@@ -55,9 +55,9 @@ import cv2
 import numpy as np
 
 from perception.errors import InputError
-from perception.markers import MarkerColour, MarkerSet, default_markers
-from perception.tracks import Status, TracksWriter, tracks_path_for
-from perception.video import FrameSource
+from perception.tracking.markers import MarkerColour, MarkerSet, default_markers
+from perception.io.tracks import Status, TracksWriter, tracks_path_for
+from perception.io.video import FrameSource
 
 logger = logging.getLogger(__name__)
 #: Blobs of each colour considered when a hand marker is first found (largest first).
@@ -199,7 +199,7 @@ class Tracker:
     Parameters
     ----------
     markers : MarkerSet, optional
-        Colour models (default :func:`perception.markers.default_markers`).
+        Colour models (default :func:`perception.tracking.markers.default_markers`).
     params : TrackerParams, optional
         Tuning (defaults suit 25-60 fps clips of 2 cm markers at 500-1500 px/m).
     rois : mapping of str to (x, y, w, h), optional
@@ -280,7 +280,7 @@ class Tracker:
         likelihood : (M,) float32
             0..1; 0 where lost.
         status : (M,) int8
-            :class:`~perception.tracks.Status` codes.
+            :class:`~perception.io.tracks.Status` codes.
         """
         if frame.ndim != 3 or frame.shape[2] != 3 or frame.dtype != np.uint8:
             raise ValueError(
@@ -785,7 +785,7 @@ def track_frames(
     Parameters
     ----------
     frames : iterable of (int, float, (H, W, 3) uint8)
-        ``(index, time_s, frame)``, as :class:`~perception.video.FrameSource` yields.
+        ``(index, time_s, frame)``, as :class:`~perception.io.video.FrameSource` yields.
     writer : TracksWriter
         Open writer whose markers are the tracker's.
     tracker : Tracker
@@ -839,7 +839,7 @@ def track_video(
     Raises
     ------
     InputError
-        Bad video (see :class:`~perception.video.FrameSource`), a bad ROI, or a
+        Bad video (see :class:`~perception.io.video.FrameSource`), a bad ROI, or a
         marker never found; no output file is left behind.
     """
     markers = default_markers() if markers is None else markers

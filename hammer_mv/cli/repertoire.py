@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..repertoire import DEFAULT_DURATIONS, Repertoire, SceneSpec, default_specs
+from perception.recognition.repertoire import DEFAULT_DURATIONS, Repertoire, SceneSpec, default_specs
 
 
 def register(sub) -> None:

@@ -67,5 +67,5 @@ def main(argv: list[str] | None = None) -> int:
         return 130
 
 
-if __name__ == "__main__":  # python -m perception.cli
+if __name__ == "__main__":  # python -m hammer_mv.cli
     sys.exit(main())

@@ -38,8 +38,8 @@ import pandas as pd
 
 from minvar.kinematics import TwoLinkChain
 
-from .observe import Observation
-from .repertoire import ChainModel, MotorModel, Repertoire, SceneSpec
+from perception.observe import Observation
+from perception.recognition.repertoire import ChainModel, MotorModel, Repertoire, SceneSpec
 
 __all__ = ["HammerParams", "Recognition", "recognize", "RULES"]
 

@@ -35,7 +35,7 @@ import numpy as np
 import pandas as pd
 
 from minvar import __version__
-from perception.atomic import atomic_path
+from perception.io.atomic import atomic_path
 from perception.errors import InputError
 
 SCHEMA = "hammer-mv/tracks"

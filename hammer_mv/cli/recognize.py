@@ -6,9 +6,9 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..batch import BatchItem, BatchSettings, clip_name, process_clip
-from ..errors import InputError
-from .options import add_recognition_options, hammer_params, load_repertoire, observe_params
+from perception.batch import BatchItem, BatchSettings, clip_name, process_clip
+from perception.errors import InputError
+from hammer_mv.cli.options import add_recognition_options, hammer_params, load_repertoire, observe_params
 
 
 def register(sub) -> None:

@@ -36,9 +36,9 @@ import numpy as np
 from minvar import GraspTask, PointMassPlant, plan_grasp
 from minvar.lqg import estimation_error_covariance
 
-from . import __version__
-from .atomic import atomic_path
-from .errors import InputError
+from perception import __version__
+from perception.io.atomic import atomic_path
+from perception.errors import InputError
 
 __all__ = [
     "ChainModel",

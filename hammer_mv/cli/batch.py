@@ -6,8 +6,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..batch import BatchSettings, discover, run_batch
-from .options import add_recognition_options, hammer_params, load_repertoire, observe_params
+from perception.batch import BatchSettings, discover, run_batch
+from hammer_mv.cli.options import add_recognition_options, hammer_params, load_repertoire, observe_params
 
 
 def register(sub) -> None:

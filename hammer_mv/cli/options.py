@@ -7,9 +7,9 @@ import hashlib
 import json
 from pathlib import Path
 
-from ..hammer import RULES, HammerParams
-from ..observe import ObserveParams
-from ..repertoire import Repertoire
+from perception.recognition.engine import RULES, HammerParams
+from perception.observe import ObserveParams
+from perception.recognition.repertoire import Repertoire
 
 
 def add_recognition_options(p: argparse.ArgumentParser) -> None:

@@ -43,7 +43,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run_info(args: argparse.Namespace) -> int:
     """Print a summary of ``args.file``."""
-    from perception.tracks import Status, Tracks
+    from perception.io.tracks import Status, Tracks
 
     t = Tracks.load(args.file)
     v = t.video
@@ -81,7 +81,7 @@ def run_info(args: argparse.Namespace) -> int:
 def run_export(args: argparse.Namespace) -> int:
     """Write ``args.file`` as a table in ``args.format`` to ``args.output``."""
     from perception.errors import InputError
-    from perception.tracks import Tracks
+    from perception.io.tracks import Tracks
 
     if args.max_gap < 0:
         raise InputError(f"--max-gap: expected >= 0 frames, got {args.max_gap}")

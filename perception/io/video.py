@@ -30,7 +30,7 @@ from typing import Any
 import cv2
 import numpy as np
 
-from perception.atomic import atomic_path
+from perception.io.atomic import atomic_path
 from perception.errors import InputError
 
 logger = logging.getLogger(__name__)

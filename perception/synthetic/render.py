@@ -34,9 +34,9 @@ from typing import Any, NamedTuple
 import cv2
 import numpy as np
 
-from perception.markers import MarkerSet, default_markers
-from perception.tracks import TracksWriter
-from perception.video import VideoWriter, codec_for, sha256_file
+from perception.tracking.markers import MarkerSet, default_markers
+from perception.io.tracks import TracksWriter
+from perception.io.video import VideoWriter, codec_for, sha256_file
 
 #: BGR of the hand and forearm. Hue ~10 (OpenCV units), saturation ~110:
 #: beside the red thumb marker's hue, below its saturation gate.
@@ -538,7 +538,7 @@ def render_frames(
     seed : int
         Seed of every random draw (texture, noise); same seed, same frames.
     markers : MarkerSet, optional
-        Colour models (default :func:`perception.markers.default_markers`);
+        Colour models (default :func:`perception.tracking.markers.default_markers`);
         must contain thumb, finger, wrist and object.
 
     Yields

@@ -21,7 +21,7 @@ from minvar.plant import PointMassPlant
 from minvar.reach import simulate_reach
 from minvar.task import ReachTask, ViaPoint
 
-from ..atomic import save_figure, write_csv, write_json
+from perception.io.atomic import save_figure, write_csv, write_json
 
 log = logging.getLogger(__name__)
 

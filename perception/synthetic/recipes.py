@@ -38,10 +38,10 @@ import pandas as pd
 
 from minvar import GraspTask, GripVia, simulate_grasp
 
-from .atomic import write_csv
-from .errors import InputError
-from .render import Camera, Distractor, Occlusion, RenderStyle, Scene, render_clip
-from .video import CODECS
+from perception.io.atomic import write_csv
+from perception.errors import InputError
+from perception.synthetic.render import Camera, Distractor, Occlusion, RenderStyle, Scene, render_clip
+from perception.io.video import CODECS
 
 __all__ = [
     "CONDITIONS",
@@ -184,7 +184,7 @@ class Recipe:
     camera_angle_deg : (float, float)
         Range of camera rotations, degrees, drawn uniformly per clip.
     style : dict
-        :class:`perception.render.RenderStyle` fields (fps, width, height, codec,
+        :class:`perception.synthetic.render.RenderStyle` fields (fps, width, height, codec,
         hand, noise_sd, blur_sigma, lighting, ...).
     """
 
@@ -255,7 +255,7 @@ def load_recipe(path: str | os.PathLike) -> Recipe:
 
 
 def render_style(table: dict) -> RenderStyle:
-    """A :class:`~perception.render.RenderStyle` from a recipe's ``[render]`` table.
+    """A :class:`~perception.synthetic.render.RenderStyle` from a recipe's ``[render]`` table.
 
     Parameters
     ----------

@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..synthetic import load_recipe, synthesize
+from perception.synthetic.recipes import load_recipe, synthesize
 
 
 def register(sub) -> None:

@@ -1,5 +1,0 @@
-import sys
-
-from perception.cli import main
-
-sys.exit(main())
