@@ -1,4 +1,4 @@
-"""hammer-mv, the application: the ``hammer-mv`` command line over :mod:`minvar` and :mod:`perception`.
+"""hammer-mv, the application: the ``hammer-mv`` command over :mod:`minvar` and :mod:`perception`.
 
 The libraries never import this package.
 """

@@ -14,8 +14,6 @@ Clips run in local processes (``jobs``) or on a dask.distributed cluster
 from __future__ import annotations
 
 import contextlib
-import dataclasses
-import hashlib
 import json
 import logging
 import multiprocessing
@@ -25,26 +23,28 @@ import tempfile
 from collections import deque
 from collections.abc import Iterable, Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
 
-from perception import __version__
-from perception.io.atomic import write_json
 from perception.errors import InputError
-from perception.recognition.engine import HammerParams, recognize
-from perception.observe import ObserveParams, observe
+from perception.io.atomic import write_json
+from perception.pipeline import (
+    TRACKS_SUFFIX,
+    RecognitionSettings,
+    clip_fingerprint,
+    clip_name,
+    recognize_clip,
+)
 from perception.recognition.repertoire import Repertoire
-from perception.report import ClipSummary, clip_outputs, write_batch_report, write_clip_report
+from perception.report.batch import write_batch_report
+from perception.report.clip import ClipSummary, clip_outputs, write_clip_report
 
-__all__ = ["BatchItem", "BatchSettings", "clip_name", "discover", "process_clip", "run_batch",
-           "VIDEO_SUFFIXES"]
+__all__ = ["BatchItem", "ClipResult", "discover", "process_clip", "run_batch", "summary_table"]
 
 log = logging.getLogger(__name__)
 
-VIDEO_SUFFIXES = (".mp4", ".avi", ".mkv", ".mov", ".m4v")
-TRACKS_SUFFIX = ".tracks.h5"
 #: Files that sit beside clips and are not inputs: ground truth, the synth
 #: manifest, and what a batch writes (so a report folder can be its own input).
 COMPANION_SUFFIXES = (".truth.h5", ".recognition.json", ".confidence.csv", ".confidence.png",
@@ -76,46 +76,6 @@ class BatchItem:
     path: Path
     kind: str
     condition: str | None = None
-
-
-@dataclass(frozen=True)
-class BatchSettings:
-    """Everything that decides a clip's result (part of its fingerprint).
-
-    Parameters
-    ----------
-    observe : ObserveParams
-        Tracks -> observation settings.
-    hammer : HammerParams
-        Rule and weights.
-    quiet : bool
-        No progress bars.
-    """
-
-    observe: ObserveParams = field(default_factory=ObserveParams)
-    hammer: HammerParams = field(default_factory=HammerParams)
-    quiet: bool = False
-
-    def fingerprint(self) -> dict:
-        """JSON-able settings that change results."""
-        return {"observe": dataclasses.asdict(self.observe),
-                "hammer": dataclasses.asdict(self.hammer)}
-
-
-def clip_name(path: Path) -> tuple[str, str]:
-    """Clip name and input kind (``video``, ``tracks`` or ``unknown``) of a file.
-
-    Parameters
-    ----------
-    path : Path
-        The file.
-    """
-    name = path.name
-    if name.endswith(TRACKS_SUFFIX):
-        return name[: -len(TRACKS_SUFFIX)], "tracks"
-    if path.suffix.lower() in VIDEO_SUFFIXES:
-        return path.stem, "video"
-    return path.stem, "unknown"
 
 
 def discover(source: str | os.PathLike) -> list[BatchItem]:
@@ -174,18 +134,6 @@ def discover(source: str | os.PathLike) -> list[BatchItem]:
     return sorted(found.values(), key=lambda i: i.clip)
 
 
-def _input_fingerprint(path: Path) -> dict:
-    st = path.stat()
-    return {"path": str(path.resolve()), "size": st.st_size, "mtime_ns": st.st_mtime_ns}
-
-
-def _fingerprint(item: BatchItem, settings: BatchSettings, repertoire_id: str) -> str:
-    payload = json.dumps({"input": _input_fingerprint(item.path), "settings":
-                          settings.fingerprint(), "repertoire": repertoire_id,
-                          "software": __version__}, sort_keys=True)
-    return hashlib.sha256(payload.encode()).hexdigest()[:16]
-
-
 def _current_report(item: BatchItem, out: Path, fingerprint: str) -> dict | None:
     """The clip's finished report if it was made from this input and these settings."""
     p = clip_outputs(out, item.clip)
@@ -198,9 +146,43 @@ def _current_report(item: BatchItem, out: Path, fingerprint: str) -> dict | None
     return data if data.get("fingerprint") == fingerprint else None
 
 
+@dataclass(frozen=True)
+class ClipResult:
+    """How one clip of a batch went.
+
+    Attributes
+    ----------
+    clip : str
+        Clip name.
+    condition : str or None
+        Its stimulus condition, if known.
+    status : str
+        ``ok``, ``reused`` (its report was already current) or ``failed``.
+    error : str
+        One line saying why it failed (empty otherwise).
+    rule : str
+        Rule that picks the winner.
+    summary : ClipSummary or None
+        The scored clip (None if it failed).
+    """
+
+    clip: str
+    condition: str | None
+    status: str
+    error: str = ""
+    rule: str = "likelihood"
+    summary: ClipSummary | None = None
+
+    @property
+    def winner(self) -> str | None:
+        """The winning model, if the clip was scored."""
+        return None if self.summary is None else self.summary.winner
+
+
 def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
-                 settings: BatchSettings, repertoire_id: str = "") -> dict:
-    """Track (if a video), observe, recognise and report one clip.
+                 settings: RecognitionSettings, repertoire_id: str = "", *,
+                 progress: bool = False) -> ClipResult:
+    """Recognise one clip through :func:`~perception.pipeline.recognize_clip` and report it.
 
     Parameters
     ----------
@@ -210,60 +192,39 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
         Report folder; tracks of videos go to ``out/tracks/``.
     repertoire : Repertoire
         Models to score against.
-    settings : BatchSettings
+    settings : RecognitionSettings
         Observation and engine settings.
     repertoire_id : str
         Identity of the repertoire, part of the report's fingerprint.
+    progress : bool
+        Show a progress bar while tracking a video.
 
     Returns
     -------
-    dict
-        A summary row: clip, condition, status (``ok``, ``skipped`` — report
-        already current — or ``failed``), error, winner, rule, and the report JSON
-        under ``report`` (absent on failure).
+    ClipResult
+        ``reused`` with the summary of the existing report when it is current
+        for this input, settings and repertoire; ``failed`` with the error of
+        a bad clip (its stale outputs removed).
     """
-    row = {"clip": item.clip, "condition": item.condition, "status": "failed",
-           "error": "", "winner": None, "rule": settings.hammer.rule}
+    base = dict(clip=item.clip, condition=item.condition, rule=settings.hammer.rule)
     try:
-        fp = _fingerprint(item, settings, repertoire_id)
+        fp = clip_fingerprint(item.path, settings, repertoire_id)
         done = _current_report(item, out, fp)
         if done is not None:
-            return {**row, "status": "skipped", "winner": done["winner"], "report": done}
-        if item.kind == "unknown":
-            raise InputError("not a video or tracks file", item.path)
-        from perception.io.tracks import Tracks
-
-        if item.kind == "video":
-            from perception.tracking.tracker import track_video
-
-            tracks_file = track_video(item.path, out / "tracks" / f"{item.clip}{TRACKS_SUFFIX}",
-                                      progress=not settings.quiet and sys.stderr.isatty())
-        else:
-            tracks_file = item.path
-        tracks = Tracks.load(tracks_file)
-        try:
-            obs = observe(tracks, settings.observe, clip=item.clip)
-        except InputError as exc:  # name the file the user gave, not the clip
-            raise InputError(exc.problem, item.path) from None
-        try:
-            rec = recognize(obs, repertoire, settings.hammer)
-        except ValueError as exc:  # the scene the first frames describe cannot be planned
-            raise InputError(f"cannot plan the models for this clip's scene (distance "
-                             f"{obs.start_distance:.3f} m; check the scale: --px-per-m, "
-                             f"--object-diameter): {exc}", item.path) from None
+            return ClipResult(**base, status="reused", summary=ClipSummary.from_dict(done))
+        rec = recognize_clip(item.path, repertoire, settings, clip=item.clip,
+                             tracks_out=out / "tracks" / f"{item.clip}{TRACKS_SUFFIX}",
+                             progress=progress)
         write_clip_report(rec, out, extra={"fingerprint": fp, "condition": item.condition,
                                            "input": str(item.path)})
-        # the summary is built from the written report, as for a resumed clip,
-        # so fresh and reused clips go through the same JSON
-        report = json.loads(clip_outputs(out, item.clip)["json"].read_text())
-        return {**row, "status": "ok", "winner": rec.winner, "report": report}
+        return ClipResult(**base, status="ok", summary=ClipSummary.from_recognition(rec))
     except (InputError, ValueError, OSError) as exc:
         msg = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         if isinstance(exc, OSError) and not isinstance(exc, InputError):
             msg = f"{item.path}: {msg}"
         log.info("%s failed: %s", item.clip, msg)
         _remove_outputs(item, out)
-        return {**row, "error": msg}
+        return ClipResult(**base, status="failed", error=msg)
 
 
 def _remove_outputs(item: BatchItem, out: Path) -> None:
@@ -272,7 +233,7 @@ def _remove_outputs(item: BatchItem, out: Path) -> None:
         path.unlink(missing_ok=True)
 
 
-def _guarded(item: BatchItem, out: Path, **kwargs) -> dict:
+def _guarded(item: BatchItem, out: Path, **kwargs) -> ClipResult:
     """:func:`process_clip` that records an unexpected error instead of raising it.
 
     A batch goes on past any clip; the error (a bug, not bad input) is logged
@@ -284,9 +245,9 @@ def _guarded(item: BatchItem, out: Path, **kwargs) -> dict:
         log.exception("%s: unexpected error", item.clip)
         _remove_outputs(item, out)
         first = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
-        return {"clip": item.clip, "condition": item.condition, "status": "failed",
-                "error": f"{item.path}: unexpected {type(exc).__name__}: {first}",
-                "winner": None, "rule": kwargs["settings"].hammer.rule}
+        return ClipResult(item.clip, item.condition, "failed",
+                          f"{item.path}: unexpected {type(exc).__name__}: {first}",
+                          kwargs["settings"].hammer.rule)
 
 
 def _limit_threads() -> None:
@@ -321,19 +282,30 @@ def _init_worker(repertoire_file: str) -> None:
     _WORKER["repertoire"] = Repertoire.load(repertoire_file)
 
 
-def _work_in_worker(item: BatchItem, out: Path, settings: BatchSettings,
-                    repertoire_id: str) -> dict:
+@dataclass(frozen=True)
+class _Job:
+    """What every clip of one batch shares (sent to each worker with its clip)."""
+
+    out: Path
+    settings: RecognitionSettings
+    repertoire_id: str
+
+    def run(self, item: BatchItem, repertoire: Repertoire) -> ClipResult:
+        return _guarded(item, self.out, repertoire=repertoire, settings=self.settings,
+                        repertoire_id=self.repertoire_id)
+
+
+def _work_in_worker(item: BatchItem, job: _Job) -> ClipResult:
     # the worker's own repertoire keeps its re-planned models between clips
-    return _guarded(item, out, repertoire=_WORKER["repertoire"], settings=settings,
-                    repertoire_id=repertoire_id)
+    return job.run(item, _WORKER["repertoire"])
 
 
 #: State of a worker process (set by its initializer; empty in the main process).
 _WORKER: dict = {}
 
 
-def _run_local(items: list[BatchItem], out: Path, repertoire: Repertoire,
-               settings: BatchSettings, repertoire_id: str, jobs: int) -> Iterator[dict]:
+def _run_local(items: list[BatchItem], repertoire: Repertoire, job: _Job,
+               jobs: int) -> Iterator[ClipResult]:
     """Every item in this process and ``jobs - 1`` worker processes.
 
     The calling process takes items from the same queue as its workers: it is
@@ -342,9 +314,8 @@ def _run_local(items: list[BatchItem], out: Path, repertoire: Repertoire,
     """
     pending = deque(items)
 
-    def here(item):
-        return _guarded(item, out, repertoire=repertoire, settings=settings,
-                        repertoire_id=repertoire_id)
+    def here(item: BatchItem) -> ClipResult:
+        return job.run(item, repertoire)
 
     if jobs == 1 or len(items) <= 1:
         while pending:
@@ -353,52 +324,95 @@ def _run_local(items: list[BatchItem], out: Path, repertoire: Repertoire,
     # spawn, not fork: a parent that has already rendered or planned holds
     # OpenCV/BLAS thread pools, and forking those deadlocks the workers
     ctx = multiprocessing.get_context("spawn")
-    with tempfile.TemporaryDirectory(prefix=".repertoire-", dir=out) as tmp, _one_thread():
+    with tempfile.TemporaryDirectory(prefix=".repertoire-", dir=job.out) as tmp, _one_thread():
         rep_file = repertoire.save(Path(tmp) / "repertoire.h5")
-        yield from _parallel(pending, here, jobs, ctx, rep_file, out, settings, repertoire_id)
+        with ProcessPoolExecutor(max_workers=jobs - 1, initializer=_init_worker,
+                                 initargs=(str(rep_file),), mp_context=ctx) as pool:
+            yield from _share(pending, here, pool, job, jobs - 1)
 
 
-def _parallel(pending, here, jobs, ctx, rep_file, out, settings, repertoire_id):
+def _share(pending: deque, here, pool: ProcessPoolExecutor, job: _Job,
+           workers: int) -> Iterator[ClipResult]:
     """The caller's share of the clips and the workers', until all are done."""
-    with ProcessPoolExecutor(max_workers=jobs - 1, initializer=_init_worker,
-                             initargs=(str(rep_file),), mp_context=ctx) as pool:
-        running: dict = {}
+    running: dict = {}
 
-        def feed():
-            # a few clips queued per worker, so it never waits for this process
-            while pending and len(running) < 4 * (jobs - 1):
-                item = pending.popleft()
-                running[pool.submit(_work_in_worker, item, out, settings, repertoire_id)] = item
+    def feed():
+        # a few clips queued per worker, so it never waits for this process
+        while pending and len(running) < 4 * workers:
+            item = pending.popleft()
+            running[pool.submit(_work_in_worker, item, job)] = item
 
-        def collect():
-            for f in [f for f in running if f.done()]:
-                del running[f]
-                yield f.result()
-
-        feed()
-        while pending:
-            yield here(pending.popleft())
-            yield from collect()
-            feed()
-        # The queue is empty: take back clips no worker has started, rather than
-        # wait for them.
-        for f in list(running):
-            if f.cancel():
-                yield here(running.pop(f))
-            yield from collect()
-        for f in as_completed(list(running)):
+    def collect():
+        for f in [f for f in running if f.done()]:
+            del running[f]
             yield f.result()
+
+    feed()
+    while pending:
+        yield here(pending.popleft())
+        yield from collect()
+        feed()
+    # The queue is empty: take back clips no worker has started, rather than
+    # wait for them.
+    for f in list(running):
+        if f.cancel():
+            yield here(running.pop(f))
+        yield from collect()
+    for f in as_completed(list(running)):
+        yield f.result()
+
+
+def _run_dask(items: list[BatchItem], repertoire: Repertoire, job: _Job,
+              scheduler: str) -> Iterator[ClipResult]:
+    """Every item on a dask.distributed cluster."""
+    from dask.distributed import Client
+    from dask.distributed import as_completed as dask_completed
+
+    with Client(scheduler) as client:
+        rep = client.scatter(repertoire, broadcast=True)
+        futures = [client.submit(job.run, it, rep, pure=False) for it in items]
+        for fut in dask_completed(futures):
+            yield fut.result()
+
+
+def summary_table(results: list[ClipResult]) -> pd.DataFrame:
+    """The batch summary, one row per clip (``summary.csv``).
+
+    Columns: ``clip, condition, winner, rule``, ``conf_<model>`` (final
+    thesis-rule confidence of each model of the first scored clip), ``status``
+    (``ok`` or ``failed``), ``reused`` (the report was already current),
+    ``error``.
+
+    Parameters
+    ----------
+    results : list of ClipResult
+        The clips, in table order.
+    """
+    names = next((r.summary.names for r in results if r.summary is not None), [])
+    table = []
+    for r in results:
+        entry = {"clip": r.clip, "condition": r.condition, "winner": r.winner, "rule": r.rule}
+        s = r.summary
+        for n in names:
+            entry[f"conf_{n}"] = (float(s.confidence[s.names.index(n), -1])
+                                  if s is not None and n in s.names else float("nan"))
+        entry["status"] = "failed" if r.status == "failed" else "ok"
+        entry["reused"] = r.status == "reused"
+        entry["error"] = r.error
+        table.append(entry)
+    return pd.DataFrame(table)
 
 
 def run_batch(
     items: Iterable[BatchItem],
     out: str | os.PathLike,
     repertoire: Repertoire,
-    settings: BatchSettings | None = None,
+    settings: RecognitionSettings | None = None,
     *,
     jobs: int = 1,
     scheduler: str | None = None,
     repertoire_id: str = "",
+    quiet: bool = False,
 ) -> pd.DataFrame:
     """Process every clip and write the batch report.
 
@@ -410,7 +424,7 @@ def run_batch(
         Report folder.
     repertoire : Repertoire
         Models to score against.
-    settings : BatchSettings, optional
+    settings : RecognitionSettings, optional
         Observation and engine settings.
     jobs : int
         Local processes working on clips: this one and ``jobs - 1`` spawned
@@ -420,57 +434,35 @@ def run_batch(
         Address of a dask.distributed scheduler (``tcp://host:8786``) to run on.
     repertoire_id : str
         Identity of the repertoire for the resume fingerprints.
+    quiet : bool
+        No progress bar (there is none anyway when stderr is not a terminal).
 
     Returns
     -------
     pandas.DataFrame
-        The summary: clip, condition, winner, conf_<model> per model, status, error.
+        The summary (see :func:`summary_table`).
     """
     from tqdm import tqdm
 
-    settings = BatchSettings() if settings is None else settings
+    settings = RecognitionSettings() if settings is None else settings
     if jobs < 1:
         raise ValueError(f"--jobs: expected at least 1, got {jobs}")
     items = list(items)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    bar = tqdm(total=len(items), unit="clip", file=sys.stderr, desc="batch",
-               disable=settings.quiet or not sys.stderr.isatty())
-    rows: list[dict] = []
-    if scheduler:
-        from dask.distributed import Client
-        from dask.distributed import as_completed as dask_completed
-
-        with Client(scheduler) as client:
-            rep = client.scatter(repertoire, broadcast=True)
-            futures = [client.submit(_guarded, it, out, repertoire=rep, settings=settings,
-                                     repertoire_id=repertoire_id, pure=False) for it in items]
-            for fut in dask_completed(futures):
-                rows.append(fut.result())
-                bar.update()
-    else:
-        for row in _run_local(items, out, repertoire, settings, repertoire_id, jobs):
-            rows.append(row)
+    job = _Job(out, settings, repertoire_id)
+    results = (_run_dask(items, repertoire, job, scheduler) if scheduler
+               else _run_local(items, repertoire, job, jobs))
+    done: list[ClipResult] = []
+    with tqdm(total=len(items), unit="clip", file=sys.stderr, desc="batch",
+              disable=quiet or not sys.stderr.isatty()) as bar:
+        for result in results:
+            done.append(result)
             bar.update()
-    bar.close()
-    rows.sort(key=lambda r: r["clip"])
-    summaries = {r["clip"]: ClipSummary.from_dict(r["report"]) for r in rows if "report" in r}
-    names = next((s.names for s in summaries.values()), [])
-    table = []
-    for r in rows:
-        rec = summaries.get(r["clip"])
-        entry = {"clip": r["clip"], "condition": r["condition"], "winner": r["winner"],
-                 "rule": r["rule"]}
-        for n in names:
-            entry[f"conf_{n}"] = (float(rec.confidence[rec.names.index(n), -1])
-                                  if rec is not None and n in rec.names else float("nan"))
-        entry["status"] = "ok" if r["status"] in ("ok", "skipped") else "failed"
-        entry["reused"] = r["status"] == "skipped"
-        entry["error"] = r["error"]
-        table.append(entry)
-    summary = pd.DataFrame(table)
-    write_batch_report(summary, summaries, out)
-    write_json(out / "batch.json", {"clips": len(rows),
+    done.sort(key=lambda r: r.clip)
+    summary = summary_table(done)
+    write_batch_report(summary, {r.clip: r.summary for r in done if r.summary is not None}, out)
+    write_json(out / "batch.json", {"clips": len(done),
                                     "ok": int((summary["status"] == "ok").sum()),
                                     "failed": int((summary["status"] != "ok").sum()),
                                     "settings": settings.fingerprint(),

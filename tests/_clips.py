@@ -5,34 +5,14 @@ from __future__ import annotations
 import h5py
 import numpy as np
 
-from perception.synthetic.render import Camera, RenderStyle, Scene, render_clip
-from perception.tracking.tracker import track_video
 from perception.io.tracks import Tracks
+from perception.synthetic.demos import HARD, render_demo_clip
+from perception.tracking.tracker import track_video
 
-#: The issue's hard case: noise, skin-coloured hand, lighting gradient (plus
-#: blur and a camera not aligned with the approach).
-HARD = dict(hand=True, noise_sd=6.0, lighting=0.45, blur_sigma=0.8)
+__all__ = ["HARD", "render", "track", "errors"]
 
-
-def render(
-    tmp_path,
-    name="clip.mp4",
-    *,
-    n=60,
-    fps=30.0,
-    width=640,
-    height=480,
-    angle=20.0,
-    scene=None,
-    seed=0,
-    **style,
-):
-    """Render a reach-to-grasp clip; return (RenderResult, Camera)."""
-    camera = Camera.for_frame(width, height, angle_deg=angle)
-    if scene is None:
-        scene = Scene.reach_to_grasp(n, fps, onset=0.2, duration=n / fps - 0.6)
-    style = RenderStyle(fps=fps, width=width, height=height, **style)
-    return render_clip(scene, camera, style, tmp_path / name, seed=seed, label="test"), camera
+#: Render a test clip: ``render(tmp_path, name, n=..., **style) -> (RenderResult, Camera)``.
+render = render_demo_clip
 
 
 def track(clip, **kwargs):

@@ -8,8 +8,8 @@ import pandas as pd
 import pytest
 from _clips import HARD, errors, render
 
-from perception.synthetic.render import Occlusion
 from perception.io.tracks import Tracks
+from perception.synthetic.scene import Occlusion
 
 
 def hammer(*args, cwd=None):
@@ -131,25 +131,43 @@ def test_tracks_export(clips, tmp_path, fmt):
         np.testing.assert_allclose(df.thumb_x, tracks.marker("thumb")[:, 0])
 
 
-def test_tracks_export_trim_and_interpolate(clips, tmp_path):
-    video = _copy(clips["good"], tmp_path)
-    hammer("track", video, "--quiet")
+def test_trim_keeps_exactly_the_frames_recognition_scores(tmp_path):
+    """``tracks export --trim`` and ``recognize`` use the one movement span."""
+    from perception.synthetic.scene import Scene
+
+    scene = Scene.reach_to_grasp(60, 30.0, start=(0.0, -0.30), onset=0.4, duration=1.0)
+    clip, _ = render(tmp_path, "reach.mp4", n=60, width=320, height=240, scene=scene, angle=0)
+    assert hammer("track", clip.video, "--quiet").returncode == 0
+    tracks_file = tmp_path / "reach.tracks.h5"
     out = tmp_path / "t.csv"
-    proc = hammer(
-        "tracks",
-        "export",
-        tmp_path / "good.tracks.h5",
-        "--format",
-        "csv",
-        "-o",
-        out,
-        "--trim",
-        "--max-gap",
-        "3",
-    )
+    proc = hammer("tracks", "export", tracks_file, "--format", "csv", "-o", out, "--trim",
+                  "--max-gap", "3")
     assert proc.returncode == 0, proc.stderr
-    df = pd.read_csv(out)
-    assert 0 < len(df) < 24
+    trimmed = pd.read_csv(out)["frame"].to_numpy()
+    proc = hammer("recognize", tracks_file, "-o", tmp_path / "rec", "--quiet")
+    assert proc.returncode == 0, proc.stderr
+    scored = np.unique(pd.read_csv(tmp_path / "rec" / "reach.confidence.csv")["frame"])
+    np.testing.assert_array_equal(trimmed, scored)
+    # the movement: from just before the onset (frame 12) to a little after the end
+    assert 8 <= trimmed[0] <= 13 and 40 <= trimmed[-1] < 59
+    info = hammer("tracks", "info", tracks_file)
+    assert f"active: frames {trimmed[0]} .. {trimmed[-1]}" in info.stdout
+
+
+def test_trim_of_tracks_without_a_movement_is_refused_in_one_line(tmp_path):
+    from perception.synthetic.demos import demo_tracks
+
+    tracks, _ = demo_tracks("normal", 0)
+    still = tracks.replace(position=np.broadcast_to(tracks.position[:1], tracks.position.shape))
+    still.save(tmp_path / "still.tracks.h5")
+    out = tmp_path / "t.csv"
+    proc = hammer("tracks", "export", tmp_path / "still.tracks.h5", "--format", "csv",
+                  "-o", out, "--trim")
+    assert proc.returncode == 2
+    assert proc.stderr.count("\n") == 1 and "--trim: no movement found" in proc.stderr
+    assert not out.exists()
+    info = hammer("tracks", "info", tmp_path / "still.tracks.h5")
+    assert "active: none (no movement found" in info.stdout
 
 
 def _wrong_schema(tmp_path):

@@ -5,8 +5,14 @@ import pytest
 from _demos import default_repertoire, demo_tracks
 from scipy import stats
 
-from perception.recognition.engine import HammerParams, recognize
-from perception.observe import observe
+from perception.observation import observe
+from perception.pipeline import RecognitionSettings, recognize_clip
+from perception.recognition import HammerParams, SceneSpec, recognize
+
+
+def _score(tracks, rep, params=None):
+    """The pipeline's recognition of in-memory tracks (models planned for their scene)."""
+    return recognize_clip(tracks, rep, RecognitionSettings(hammer=params or HammerParams()))
 
 MODEL = "grasp-1.0s"  # the normal grasp of the demonstrations' movement time
 SEEDS = range(5)
@@ -21,7 +27,7 @@ def rep():
 def scored(rep):
     out = {}
     for cond in ("normal", "delayed", "open-close-open"):
-        out[cond] = [recognize(observe(demo_tracks(cond, s)[0]), rep) for s in SEEDS]
+        out[cond] = [_score(demo_tracks(cond, s)[0], rep) for s in SEEDS]
     return out
 
 
@@ -66,8 +72,8 @@ def test_open_close_open_falls_after_the_unexpected_closing(scored):
 
 def test_kinds_are_told_apart_by_the_likelihood_rule(rep):
     for s in range(3):
-        grasp = recognize(observe(demo_tracks("normal", s)[0]), rep)
-        reach = recognize(observe(demo_tracks("reach", s)[0]), rep)
+        grasp = _score(demo_tracks("normal", s)[0], rep)
+        reach = _score(demo_tracks("reach", s)[0], rep)
         assert grasp.kinds[grasp.names.index(grasp.winner)] == "grasp"
         assert reach.kinds[reach.names.index(reach.winner)] == "reach"
         assert grasp.rule == "likelihood"
@@ -75,7 +81,7 @@ def test_kinds_are_told_apart_by_the_likelihood_rule(rep):
 
 def test_movement_time_is_recognised_within_one_variant(rep):
     for duration in (0.8, 1.2):
-        rec = recognize(observe(demo_tracks("normal", 0, duration=duration)[0]), rep)
+        rec = _score(demo_tracks("normal", 0, duration=duration)[0], rep)
         assert rec.winner in {f"grasp-{d:.1f}s" for d in (duration - 0.1, duration, duration + 0.1)}
 
 
@@ -88,31 +94,37 @@ def test_predictions_follow_a_normal_grasp(scored):
 
 def test_results_are_deterministic(rep):
     tracks = demo_tracks("open-close-open", 3)[0]
-    a, b = recognize(observe(tracks), rep), recognize(observe(tracks), rep)
+    a, b = _score(tracks, rep), _score(tracks, rep)
     assert a.confidence.tobytes() == b.confidence.tobytes()
     assert a.log_likelihood.tobytes() == b.log_likelihood.tobytes()
 
 
 def test_lost_markers_do_not_update_confidence(rep):
     tracks = demo_tracks("normal", 0, lost={"finger": slice(20, 24)})[0]
-    rec = recognize(observe(tracks), rep)
+    rec = _score(tracks, rep)
     gap = np.flatnonzero(np.isin(rec.frame, np.arange(20, 25)))
     assert len(gap) == 5
     assert np.all(rec.dC_g[:, gap] == 0) and np.all(rec.dC_r[:, gap] == 0)
     assert np.all(np.isfinite(rec.confidence)) and np.all(np.isfinite(rec.log_likelihood))
-    full = recognize(observe(demo_tracks("normal", 0)[0]), rep)
+    full = _score(demo_tracks("normal", 0)[0], rep)
     assert full.winner == rec.winner
 
 
 def test_other_scene_is_replanned(rep):
     tracks = demo_tracks("normal", 0, distance=0.20, fps=25)[0]
-    rec = recognize(observe(tracks), rep)
+    rec = _score(tracks, rep)
     assert rec.kinds[rec.names.index(rec.winner)] == "grasp"
     assert _conf(rec)[-1] > 0.3
+    # the pipeline plans for the clip's first frames; the engine scores what it is given
+    obs = observe(tracks)
+    models = rep.for_scene(SceneSpec.of(obs))
+    assert all(m.scene.distance == pytest.approx(0.20, abs=0.005) for m in models)
+    assert all(m.substeps == 4 for m in models)  # 40 ms frames in ~10 ms steps
+    np.testing.assert_array_equal(recognize(obs, models).log_likelihood, rec.log_likelihood)
 
 
 def test_thesis_rule_can_pick_the_winner(rep):
-    rec = recognize(observe(demo_tracks("normal", 0)[0]), rep, HammerParams(rule="thesis"))
+    rec = _score(demo_tracks("normal", 0)[0], rep, HammerParams(rule="thesis"))
     assert rec.rule == "thesis"
     assert rec.winner == rec.names[int(np.argmax(rec.confidence[:, -1]))]
     d = rec.to_dict()
@@ -131,9 +143,9 @@ def test_bad_params():
 @pytest.mark.parametrize("marker", ["wrist", "finger", "thumb"])
 def test_a_gap_in_any_marker_is_not_scored_and_leaves_no_outliers(rep, marker):
     for s in range(3):
-        full = recognize(observe(demo_tracks("delayed", s)[0]), rep)
+        full = _score(demo_tracks("delayed", s)[0], rep)
         tracks = demo_tracks("delayed", s, lost={marker: slice(20, 28)})[0]
-        rec = recognize(observe(tracks), rep)
+        rec = _score(tracks, rep)
         # a step predicts frame n from n-1 (all markers) and compares r, g at n (digits)
         first = 20 if marker != "wrist" else 21
         gap = np.isin(rec.frame, np.arange(first, 29))

@@ -5,13 +5,31 @@ import pytest
 from _demos import demo_tracks
 
 from perception.errors import InputError
-from perception.observe import ObserveParams, PixelTransform, alpha_beta, observe
+from perception.geometry import SimilarityTransform
+from perception.observation import ObserveParams, alpha_beta, movement_span, observe
 
 
 def test_pixel_transform_round_trip():
-    tr = PixelTransform(np.array([300.0, 200.0]), 750.0, 1.1, mirror=True)
+    tr = SimilarityTransform(np.array([300.0, 200.0]), 750.0, 1.1, mirror=True)
     pts = np.random.default_rng(0).uniform(-0.3, 0.3, (20, 2))
     np.testing.assert_allclose(tr.to_model(tr.to_pixels(pts)), pts, atol=1e-12)
+    # the affine matrix is the same map
+    m = tr.matrix
+    np.testing.assert_allclose(tr.to_pixels(pts), pts @ m[:, :2].T + m[:, 2], atol=1e-9)
+    # a similarity: distances scale by px_per_m
+    d_m = np.linalg.norm(pts[1] - pts[0])
+    d_px = np.linalg.norm(tr.to_pixels(pts[1]) - tr.to_pixels(pts[0]))
+    assert d_px == pytest.approx(750.0 * d_m)
+
+
+@pytest.mark.parametrize("field, value", [
+    ("rest_frames", 0), ("rest_frames", 1), ("min_frames", 2), ("onset_hold_frames", 0),
+    ("object_diameter", -0.1), ("hand_size_range", (0.3, 0.1)), ("alpha", 0.0),
+    ("max_rest_noise", float("nan")), ("frame_period_range", (0.0, 0.5)),
+])
+def test_observe_params_refuse_bad_values_naming_the_field(field, value):
+    with pytest.raises(ValueError, match=field):
+        ObserveParams(**{field: value})
 
 
 @pytest.mark.parametrize("angle", [0.0, 35.0, -120.0])
@@ -31,7 +49,7 @@ def test_observation_recovers_world_frame(angle):
 
 def test_alpha_beta_keeps_signs_of_small_changes_and_coasts_over_gaps():
     # slow changes (about 0.5 mm a frame) seen with 0.7 mm of noise, as in
-    # DESIGN.md's finding on the signs of small aperture changes
+    # docs/recognition.md's finding on the signs of small aperture changes
     t = np.arange(90) / 30
     truth = np.stack([0.015 * t, 0.004 * np.sin(2 * t)], axis=1)
     noisy = truth + 0.0007 * np.random.default_rng(1).standard_normal(truth.shape)
@@ -79,8 +97,8 @@ def test_too_short_and_no_scale_and_no_movement():
     with pytest.raises(InputError, match="too short"):
         observe(short)
     with pytest.raises(InputError, match="px-per-m"):
-        observe(tracks.replace(attrs={}))
-    assert observe(tracks.replace(attrs={}), ObserveParams(px_per_m=800.0)).n_frames > 20
+        observe(tracks.replace(tracker={}))
+    assert observe(tracks.replace(tracker={}), ObserveParams(px_per_m=800.0)).n_frames > 20
     still = tracks.position.copy()
     still[:] = still[:1]
     with pytest.raises(InputError, match="no movement"):
@@ -127,3 +145,14 @@ def test_a_marker_on_the_wrong_object_is_caught_at_rest():
     pos[:, tracks.markers.index("thumb")] = (200.0, 150.0)  # a red mug, still, on the table
     with pytest.raises(InputError, match="does not look like a hand"):
         observe(tracks.replace(position=pos))
+
+
+def test_movement_span_is_what_observe_scores():
+    for condition, seed in (("normal", 0), ("delayed", 1), ("reach", 2)):
+        tracks, truth = demo_tracks(condition, seed)
+        obs = observe(tracks)
+        span = movement_span(tracks)
+        assert (span.onset_frame, span.end_frame) == (obs.onset_frame, obs.end_frame)
+        np.testing.assert_array_equal(tracks.frame[span.rows], obs.frame)
+        assert span.n_frames == obs.n_frames
+        assert abs(span.onset_frame - truth["onset_frame"]) <= 1

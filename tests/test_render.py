@@ -8,26 +8,18 @@ import numpy as np
 import pytest
 from _clips import render
 
-from perception.tracking.markers import default_markers
-from perception.synthetic.render import (
-    Camera,
-    Distractor,
-    Occlusion,
-    RenderStyle,
-    Scene,
-    render_clip,
-    render_frames,
-    world_to_pixel,
-)
 from perception.io.tracks import Tracks
 from perception.io.video import FrameSource
+from perception.synthetic.render import render_clip, render_frames
+from perception.synthetic.scene import Camera, Distractor, Occlusion, RenderStyle, Scene
+from perception.tracking.markers import default_markers
 
 
 def test_camera_maps_world_to_pixels_as_documented():
     cam = Camera(px_per_m=500.0, origin_px=(100.0, 200.0))
-    np.testing.assert_allclose(world_to_pixel(cam, [0.0, 0.0]), [100, 200])
-    np.testing.assert_allclose(world_to_pixel(cam, [0.1, 0.0]), [150, 200])  # +x right
-    np.testing.assert_allclose(world_to_pixel(cam, [0.0, 0.1]), [100, 150])  # +y up the image
+    np.testing.assert_allclose(cam.world_to_pixel([0.0, 0.0]), [100, 200])
+    np.testing.assert_allclose(cam.world_to_pixel([0.1, 0.0]), [150, 200])  # +x right
+    np.testing.assert_allclose(cam.world_to_pixel([0.0, 0.1]), [100, 150])  # +y up the image
     rot = Camera(px_per_m=500.0, origin_px=(100.0, 200.0), angle_deg=90.0)
     np.testing.assert_allclose(rot.world_to_pixel([0.1, 0.0]), [100, 150], atol=1e-9)
     pts = np.random.default_rng(0).normal(size=(7, 2))

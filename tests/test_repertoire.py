@@ -10,7 +10,8 @@ from _demos import default_repertoire
 
 from hammer_mv.cli import main
 from perception.errors import InputError
-from perception.recognition.repertoire import ModelSpec, Repertoire, SceneSpec, build_model, model_substeps
+from perception.recognition import ModelSpec, Repertoire, SceneSpec, build_model
+from perception.recognition.models import model_substeps
 
 
 def test_default_repertoire_has_both_kinds_and_ten_models():

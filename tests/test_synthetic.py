@@ -5,8 +5,8 @@ import pytest
 
 from hammer_mv.cli import main
 from perception.errors import InputError
-from perception.synthetic.recipes import StimulusParams, load_recipe, stimulus_paths
 from perception.io.tracks import Tracks
+from perception.synthetic.recipes import StimulusParams, load_recipe, stimulus_paths
 
 
 def _aperture(cond, seed=0):

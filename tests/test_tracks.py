@@ -1,3 +1,5 @@
+import json
+
 import h5py
 import numpy as np
 import pandas as pd
@@ -150,21 +152,27 @@ def test_interpolation_fills_short_gaps_only():
         tr.interpolate(-1)
 
 
-def test_trim_is_a_view_of_the_active_period():
-    rng = np.random.default_rng(0)
+def test_rows_are_a_view():
     tr = _tracks()
-    jitter = tr.replace(position=tr.position + rng.normal(0, 0.3, tr.position.shape))
-    start, stop = jitter.active_span(pad=0)
-    # Motion runs from frame 10 (first step into 11) to frame 40.
-    assert 10 <= start <= 12 and 39 <= stop <= 42
-    trimmed = jitter.trim(pad=0)
-    assert trimmed.frame[0] == start and trimmed.n_frames == stop - start
-    assert np.shares_memory(trimmed.position, jitter.position)
-    assert trimmed.attrs["trimmed_rows"] == (start, stop)
-    assert jitter.n_frames == 50  # the full tracks are kept
-    # A still clip has no active period.
-    still = _tracks().replace(position=np.broadcast_to(tr.position[:1], tr.position.shape))
-    assert still.active_span() == (0, 0)
+    part = tr.rows(10, 40)
+    assert part.frame[0] == 10 and part.n_frames == 30
+    assert np.shares_memory(part.position, tr.position)
+    assert part.attrs["trimmed_rows"] == (10, 40)
+    assert tr.n_frames == 50  # the full tracks are kept
+
+
+def test_object_diameter_comes_from_what_the_tracker_recorded():
+    tr = _tracks()
+    names = tr.markers
+    measured = [np.nan if m != "object" else 81.5 for m in names]
+    assert tr.replace(tracker={"diameter_px": measured}).object_diameter_px() == 81.5
+    # files written before diameter_px: a disc of the reference mass
+    area = [np.nan if m != "object" else np.pi * 40.0**2 for m in names]
+    assert tr.replace(tracker={"reference_mass_px": area}).object_diameter_px() == \
+        pytest.approx(80.0)
+    # a rendered clip's camera attributes are no shortcut: only the tracker's record counts
+    camera = {"camera": json.dumps({"px_per_m": 800.0}), "object_diameter": 0.1}
+    assert tr.replace(tracker={}, attrs=camera).object_diameter_px() is None
 
 
 def test_dlc_export(tmp_path):

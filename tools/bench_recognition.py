@@ -25,9 +25,9 @@ def main() -> None:
     """Print the recognition and batch figures."""
     from _demos import demo_tracks
 
-    from perception.batch import BatchSettings, discover, run_batch
+    from perception.batch import discover, run_batch
     from perception.recognition.engine import recognize
-    from perception.observe import observe
+    from perception.observation import observe
     from perception.recognition.repertoire import Repertoire, SceneSpec
     from perception.synthetic.recipes import load_recipe, synthesize
 
@@ -56,7 +56,7 @@ def main() -> None:
         times = {}
         for jobs in (1, 2):
             t0 = time.perf_counter()
-            run_batch(items, work / f"out{jobs}", rep, BatchSettings(quiet=True), jobs=jobs)
+            run_batch(items, work / f"out{jobs}", rep, quiet=True, jobs=jobs)
             times[jobs] = time.perf_counter() - t0
         speedup = times[1] / times[2]
         rows.append((f"batch: track + recognise + report {len(items)} clips, 2 processes",

@@ -28,7 +28,8 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from perception.synthetic.render import Camera, RenderStyle, Scene, render_clip
+from perception.synthetic.render import render_clip
+from perception.synthetic.scene import Camera, RenderStyle, Scene
 from perception.tracking.tracker import track_video
 from perception.io.tracks import Tracks
 

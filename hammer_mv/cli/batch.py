@@ -6,12 +6,18 @@ import argparse
 import sys
 from pathlib import Path
 
-from perception.batch import BatchSettings, discover, run_batch
-from hammer_mv.cli.options import add_recognition_options, hammer_params, load_repertoire, observe_params
+from hammer_mv.cli.options import add_recognition_options, load_repertoire, recognition_settings
+from perception.batch import discover, run_batch
 
 
 def register(sub) -> None:
-    """Add the ``batch`` subcommand to ``sub`` (an argparse subparsers action)."""
+    """Add the ``batch`` subcommand to ``sub`` (an argparse subparsers action).
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The top-level parser's subparsers.
+    """
     p = sub.add_parser("batch", help="recognise a folder of clips (or a synth manifest)",
                        description="Track and recognise every clip of INPUT (a folder of "
                        "videos / .tracks.h5 files, or a manifest.csv from hammer-mv synth) in "
@@ -28,17 +34,21 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Execute ``hammer-mv batch`` with parsed ``args``; return the exit status."""
+    """Execute ``hammer-mv batch`` with parsed ``args``; return the exit status.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments.
+    """
     if args.jobs < 1:
         raise ValueError(f"--jobs: expected at least 1, got {args.jobs}")
     items = discover(args.input)
     if not items:
         raise ValueError(f"{args.input}: no clips found")
-    settings = BatchSettings(observe=observe_params(args), hammer=hammer_params(args),
-                             quiet=args.quiet)
     rep, rep_id = load_repertoire(args)
-    summary = run_batch(items, args.output, rep, settings, jobs=args.jobs,
-                        scheduler=args.scheduler, repertoire_id=rep_id)
+    summary = run_batch(items, args.output, rep, recognition_settings(args), jobs=args.jobs,
+                        scheduler=args.scheduler, repertoire_id=rep_id, quiet=args.quiet)
     failed = int((summary["status"] != "ok").sum())
     print(f"{len(summary) - failed}/{len(summary)} clips recognised -> "
           f"{args.output / 'report.html'}")

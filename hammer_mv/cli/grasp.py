@@ -15,7 +15,6 @@ from pathlib import Path
 
 from minvar.grasp import GraspTask
 from minvar.plant import PointMassPlant
-
 from perception.io.atomic import save_figure, write_csv, write_json
 
 log = logging.getLogger(__name__)

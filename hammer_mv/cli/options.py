@@ -1,4 +1,8 @@
-"""Options shared by the recognition commands (``recognize``, ``batch``)."""
+"""Options shared by the recognition commands (``recognize``, ``batch``).
+
+Defaults are read from the parameter dataclasses, so the help text and the
+library agree by construction.
+"""
 
 from __future__ import annotations
 
@@ -7,27 +11,40 @@ import hashlib
 import json
 from pathlib import Path
 
+from perception.observation import ObserveParams
+from perception.pipeline import RecognitionSettings
 from perception.recognition.engine import RULES, HammerParams
-from perception.observe import ObserveParams
 from perception.recognition.repertoire import Repertoire
+
+_OBSERVE = ObserveParams()
+_HAMMER = HammerParams()
 
 
 def add_recognition_options(p: argparse.ArgumentParser) -> None:
-    """Add repertoire, scale and rule options to parser ``p``."""
+    """Add repertoire, scale and rule options to parser ``p``.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser.
+    """
     g = p.add_argument_group("recognition")
     g.add_argument("--repertoire", type=Path, metavar="REP.h5",
                    help="models to score against (default: build the default repertoire)")
-    g.add_argument("--rule", choices=RULES, default="likelihood",
-                   help="rule that picks the winner (default: likelihood); the thesis "
+    g.add_argument("--rule", choices=RULES, default=_HAMMER.rule,
+                   help=f"rule that picks the winner (default: {_HAMMER.rule}); the thesis "
                         "rule's confidence is reported either way")
-    g.add_argument("--w-r", type=float, default=1.0, help="transport weight of the thesis rule")
-    g.add_argument("--w-g", type=float, default=2.0, help="grip weight of the thesis rule")
-    g.add_argument("--filter-gain", type=float, default=0.3, metavar="G",
+    g.add_argument("--w-r", type=float, default=_HAMMER.w_r,
+                   help=f"transport weight of the thesis rule (default: {_HAMMER.w_r:g})")
+    g.add_argument("--w-g", type=float, default=_HAMMER.w_g,
+                   help=f"grip weight of the thesis rule (default: {_HAMMER.w_g:g})")
+    g.add_argument("--filter-gain", type=float, default=_HAMMER.filter_gain, metavar="G",
                    help="how strongly observed positions correct each model's estimate of "
                         "velocity and force (0: the plan alone; 1: the plan's Kalman gains; "
-                        "default 0.3)")
-    g.add_argument("--object-diameter", type=float, default=0.10, metavar="M",
-                   help="real diameter of the object, m (default: 0.10, the thesis's ball)")
+                        f"default {_HAMMER.filter_gain:g})")
+    g.add_argument("--object-diameter", type=float, default=_OBSERVE.object_diameter,
+                   metavar="M", help="real diameter of the object, m (default: "
+                   f"{_OBSERVE.object_diameter:g}, the thesis's ball)")
     g.add_argument("--px-per-m", type=float, default=None, metavar="X",
                    help="image scale (default: from the object's apparent size)")
     g.add_argument("--mirror", action="store_true",
@@ -35,15 +52,19 @@ def add_recognition_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--quiet", action="store_true", help="no progress bars")
 
 
-def observe_params(args: argparse.Namespace) -> ObserveParams:
-    """:class:`ObserveParams` from parsed ``args``."""
-    return ObserveParams(object_diameter=args.object_diameter, px_per_m=args.px_per_m,
-                         mirror=args.mirror)
+def recognition_settings(args: argparse.Namespace) -> RecognitionSettings:
+    """:class:`~perception.pipeline.RecognitionSettings` from parsed ``args``.
 
-
-def hammer_params(args: argparse.Namespace) -> HammerParams:
-    """:class:`HammerParams` from parsed ``args``."""
-    return HammerParams(rule=args.rule, w_r=args.w_r, w_g=args.w_g, filter_gain=args.filter_gain)
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments of :func:`add_recognition_options`.
+    """
+    observe = ObserveParams(object_diameter=args.object_diameter, px_per_m=args.px_per_m,
+                            mirror=args.mirror)
+    hammer = HammerParams(rule=args.rule, w_r=args.w_r, w_g=args.w_g,
+                          filter_gain=args.filter_gain)
+    return RecognitionSettings(observe=observe, hammer=hammer)
 
 
 def load_repertoire(args: argparse.Namespace) -> tuple[Repertoire, str]:

@@ -20,7 +20,6 @@ from minvar.analysis import (
 from minvar.plant import PointMassPlant
 from minvar.reach import simulate_reach
 from minvar.task import ReachTask, ViaPoint
-
 from perception.io.atomic import save_figure, write_csv, write_json
 
 log = logging.getLogger(__name__)

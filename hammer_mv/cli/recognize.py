@@ -6,13 +6,20 @@ import argparse
 import sys
 from pathlib import Path
 
-from perception.batch import BatchItem, BatchSettings, clip_name, process_clip
+from hammer_mv.cli.options import add_recognition_options, load_repertoire, recognition_settings
 from perception.errors import InputError
-from hammer_mv.cli.options import add_recognition_options, hammer_params, load_repertoire, observe_params
+from perception.pipeline import TRACKS_SUFFIX, clip_fingerprint, clip_name, recognize_clip
+from perception.report.clip import write_clip_report
 
 
 def register(sub) -> None:
-    """Add the ``recognize`` subcommand to ``sub`` (an argparse subparsers action)."""
+    """Add the ``recognize`` subcommand to ``sub`` (an argparse subparsers action).
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The top-level parser's subparsers.
+    """
     p = sub.add_parser("recognize", help="recognise the grasp in one video or tracks file",
                        description="Track INPUT (a video) or load it (a .tracks.h5), score it "
                        "against every model with HAMMER-MV and write DIR/<clip>.recognition.json, "
@@ -24,7 +31,13 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Execute ``hammer-mv recognize`` with parsed ``args``; return the exit status."""
+    """Execute ``hammer-mv recognize`` with parsed ``args``; return the exit status.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments.
+    """
     path: Path = args.input
     if not path.exists():
         raise InputError("input not found", path)
@@ -34,14 +47,13 @@ def run(args: argparse.Namespace) -> int:
     clip, kind = clip_name(path)
     if kind == "unknown":
         raise InputError("not a video or .tracks.h5 file", path)
-    settings = BatchSettings(observe=observe_params(args), hammer=hammer_params(args),
-                             quiet=args.quiet)
+    settings = recognition_settings(args)
     rep, rep_id = load_repertoire(args)
-    row = process_clip(BatchItem(clip, path, kind), args.output, rep, settings, rep_id)
-    if row["status"] == "failed":
-        print(f"hammer-mv recognize: error: {row['error']}", file=sys.stderr)
-        return 2
-    print(f"{clip}: winner {row['winner']} ({row['rule']} rule) -> "
-          f"{args.output / (clip + '.recognition.json')}")
+    rec = recognize_clip(path, rep, settings, clip=clip,
+                         tracks_out=args.output / "tracks" / f"{clip}{TRACKS_SUFFIX}",
+                         progress=not args.quiet and sys.stderr.isatty())
+    extra = {"fingerprint": clip_fingerprint(path, settings, rep_id), "condition": None,
+             "input": str(path)}
+    paths = write_clip_report(rec, args.output, extra=extra)
+    print(f"{clip}: winner {rec.winner} ({rec.rule} rule) -> {paths['json']}")
     return 0
-

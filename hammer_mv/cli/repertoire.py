@@ -5,7 +5,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from perception.recognition.repertoire import DEFAULT_DURATIONS, Repertoire, SceneSpec, default_specs
+from perception.recognition.models import SceneSpec
+from perception.recognition.planning import DEFAULT_DURATIONS, default_specs
+from perception.recognition.repertoire import Repertoire
 
 
 def register(sub) -> None:

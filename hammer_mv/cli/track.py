@@ -82,9 +82,9 @@ def parse_rois(specs: list[list[str]], names: tuple[str, ...]) -> dict[str, tupl
 
 def run(args: argparse.Namespace) -> int:
     """Track ``args.video``; print a one-line summary unless ``--quiet``."""
+    from perception.io.tracks import Tracks
     from perception.tracking.markers import default_markers, load_markers
     from perception.tracking.tracker import track_video
-    from perception.io.tracks import Tracks
 
     markers = load_markers(args.colours) if args.colours else default_markers()
     rois = parse_rois(args.roi, markers.names)

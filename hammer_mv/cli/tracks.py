@@ -36,13 +36,20 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     export.add_argument(
         "--trim",
         action="store_true",
-        help="export only the active period (inactive start and end dropped)",
+        help="export only the movement recognition scores (onset to end of activity; "
+        "needs the object and a hand at rest in the first frames)",
     )
     export.set_defaults(func=run_export)
 
 
 def run_info(args: argparse.Namespace) -> int:
-    """Print a summary of ``args.file``."""
+    """Print a summary of ``args.file``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments.
+    """
     from perception.io.tracks import Status, Tracks
 
     t = Tracks.load(args.file)
@@ -58,14 +65,7 @@ def run_info(args: argparse.Namespace) -> int:
         )
     if t.n_frames:
         print(f"time: {t.time[0]:.3f} .. {t.time[-1]:.3f} s")
-        start, stop = t.active_span()
-        if stop > start:
-            print(
-                f"active: frames {t.frame[start]} .. {t.frame[stop - 1]} "
-                f"({t.time[start]:.3f} .. {t.time[stop - 1]:.3f} s)"
-            )
-        else:
-            print("active: no movement detected")
+        print(_movement_line(t))
     header = (
         f"{'marker':<8} {'tracked':>8} {'reacq.':>7} {'lost':>7} {'interp.':>8} {'mean lik.':>9}"
     )
@@ -78,17 +78,45 @@ def run_info(args: argparse.Namespace) -> int:
     return 0
 
 
+def _movement_line(t) -> str:
+    """The movement recognition would score, or why none can be found."""
+    from perception.errors import InputError
+    from perception.observation import movement_span
+
+    try:
+        span = movement_span(t)
+    except InputError as exc:
+        return f"active: none ({exc.problem})"
+    last = span.stop - 1
+    return (f"active: frames {span.onset_frame} .. {span.end_frame} "
+            f"({t.time[span.start]:.3f} .. {t.time[last]:.3f} s, the movement recognition "
+            "scores)")
+
+
 def run_export(args: argparse.Namespace) -> int:
-    """Write ``args.file`` as a table in ``args.format`` to ``args.output``."""
+    """Write ``args.file`` as a table in ``args.format`` to ``args.output``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments.
+    """
     from perception.errors import InputError
     from perception.io.tracks import Tracks
+    from perception.observation import movement_span
 
     if args.max_gap < 0:
         raise InputError(f"--max-gap: expected >= 0 frames, got {args.max_gap}")
     t = Tracks.load(args.file)
+    span = None
+    if args.trim:  # on the tracks as recorded, as recognition sees them
+        try:
+            span = movement_span(t)
+        except InputError as exc:
+            raise InputError(f"--trim: {exc.problem}", args.file) from None
     if args.max_gap:
         t = t.interpolate(args.max_gap)
-    if args.trim:
-        t = t.trim()
+    if span is not None:
+        t = t.rows(span.start, span.stop)
     t.export(args.output, args.format)
     return 0

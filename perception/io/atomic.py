@@ -51,18 +51,38 @@ def write_text(path: str | os.PathLike, text: str) -> Path:
     return Path(path)
 
 
-def write_json(path: str | os.PathLike, obj) -> Path:
-    """Write ``obj`` as indented JSON to ``path`` atomically (NaN written as null)."""
-    import json
+def jsonable(value):
+    """``json.dumps(default=...)`` hook: numpy arrays and scalars, paths and sets as JSON.
 
+    Parameters
+    ----------
+    value : object
+        Something :mod:`json` cannot encode by itself.
+    """
     import numpy as np
 
-    def default(o):
-        if isinstance(o, np.ndarray):
-            return o.tolist()
-        if isinstance(o, np.generic):
-            return o.item()
-        raise TypeError(f"not JSON serialisable: {type(o).__name__}")
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, os.PathLike):
+        return os.fspath(value)
+    if isinstance(value, set | frozenset):
+        return sorted(value)
+    raise TypeError(f"not JSON serialisable: {type(value).__name__}")
+
+
+def write_json(path: str | os.PathLike, obj) -> Path:
+    """Write ``obj`` as indented JSON to ``path`` atomically (NaN written as null).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Output file.
+    obj : object
+        JSON-able data; numpy values are converted (see :func:`jsonable`).
+    """
+    import json
 
     def clean(o):
         if isinstance(o, float) and o != o:
@@ -73,7 +93,7 @@ def write_json(path: str | os.PathLike, obj) -> Path:
             return [clean(v) for v in o]
         return o
 
-    text = json.dumps(clean(json.loads(json.dumps(obj, default=default))), indent=2)
+    text = json.dumps(clean(json.loads(json.dumps(obj, default=jsonable))), indent=2)
     return write_text(path, text + "\n")
 
 

@@ -1,6 +1,6 @@
 """Marker tracks: the :class:`Tracks` object and its HDF5 file (``<clip>.tracks.h5``).
 
-Schema (DESIGN.md), written with h5py::
+Schema (docs/tracks-format.md), written with h5py::
 
     /            attrs: schema="hammer-mv/tracks", schema_version, software_version
     /video       attrs: path, sha256, fps_nominal, n_frames, width, height, fourcc
@@ -35,8 +35,8 @@ import numpy as np
 import pandas as pd
 
 from minvar import __version__
-from perception.io.atomic import atomic_path
 from perception.errors import InputError
+from perception.io.atomic import atomic_path
 
 SCHEMA = "hammer-mv/tracks"
 SCHEMA_VERSION = 1
@@ -176,11 +176,12 @@ class Tracks:
     def object_diameter_px(self, name: str = "object") -> float | None:
         """Apparent diameter of the round object in pixels, if the tracks can tell.
 
-        Tracker output: the diameter the tracker measured when it found the
-        object (fully visible, before the hand reaches it) from its
-        colour-unmixed area; for older files, the diameter of a disc of the
-        object's reference blob area (about 3 % large on blurred footage).
-        Rendered ground truth: the true diameter times the camera scale.
+        The ``/tracker`` attribute ``diameter_px``: what the tracker measured
+        when it first found the object (fully visible, before the hand
+        reaches it) from its colour-unmixed area, or, in a rendered clip's
+        ground truth, the true apparent diameter. Files written before that
+        attribute existed give the diameter of a disc of the object's
+        reference blob area (about 3 % large on blurred footage).
 
         Parameters
         ----------
@@ -189,26 +190,16 @@ class Tracks:
         """
         if name not in self.markers:
             return None
-        camera = self.attrs.get("camera")
-        if camera and "object_diameter" in self.attrs:
-            scale = json.loads(camera).get("px_per_m") if isinstance(camera, str) else None
-            if scale:
-                return float(self.attrs["object_diameter"]) * float(scale)
-        measured = self.tracker.get("diameter_px")
-        if measured is not None:
-            measured = np.atleast_1d(np.asarray(measured, dtype=float))
-            if len(measured) == len(self.markers):
-                d = measured[self.markers.index(name)]
-                if np.isfinite(d) and d > 0:
-                    return float(d)
-        mass = self.tracker.get("reference_mass_px")
-        if mass is None:
-            return None
-        mass = np.atleast_1d(np.asarray(mass, dtype=float))
-        if len(mass) != len(self.markers):
-            return None
-        area = mass[self.markers.index(name)]
-        return float(2 * np.sqrt(area / np.pi)) if np.isfinite(area) and area > 0 else None
+        j = self.markers.index(name)
+        for key, to_diameter in (("diameter_px", float),
+                                 ("reference_mass_px", lambda a: 2 * np.sqrt(a / np.pi))):
+            values = self.tracker.get(key)
+            if values is None:
+                continue
+            values = np.atleast_1d(np.asarray(values, dtype=float))
+            if len(values) == len(self.markers) and np.isfinite(values[j]) and values[j] > 0:
+                return float(to_diameter(values[j]))
+        return None
 
     def marker(self, name: str) -> np.ndarray:
         """(T, 2) px positions of one marker (a view; NaN where lost)."""
@@ -280,103 +271,25 @@ class Tracks:
                 status[inner, j] = Status.INTERPOLATED
         return self.replace(position=position, likelihood=likelihood, status=status)
 
-    def speed(self, markers: Sequence[str] | None = None, smooth: int = 5) -> np.ndarray:
-        """Fastest marker speed per frame, px/s, NaN-tolerant.
+    def rows(self, start: int, stop: int) -> Tracks:
+        """Rows ``[start, stop)`` as a view (``frame`` keeps the original frame indices).
+
+        ``attrs["trimmed_rows"]`` records ``(start, stop)``; the tracks file
+        itself always keeps every frame.
 
         Parameters
         ----------
-        markers : sequence of str, optional
-            Markers considered (default: every marker but ``object``).
-        smooth : int
-            Width of the running median over frames that suppresses tracking
-            jitter before differencing (odd; 1 = none).
-
-        Returns
-        -------
-        (T,) float64
-            Speed of the fastest listed marker at each frame (0 where no
-            listed marker has two consecutive known positions).
+        start, stop : int
+            Row range, as in a slice.
         """
-        names = [m for m in self.markers if m != "object"] if markers is None else list(markers)
-        cols = [self.index(n) for n in names]
-        t = self.n_frames
-        if t < 2 or not cols:
-            return np.zeros(t)
-        pos = self.position[:, cols]
-        if smooth > 1:
-            pos = (
-                pd.DataFrame(pos.reshape(t, -1))
-                .rolling(smooth, center=True, min_periods=1)
-                .median()
-                .to_numpy()
-                .reshape(pos.shape)
-            )
-        dt = np.diff(self.time)
-        step = np.linalg.norm(np.diff(pos, axis=0), axis=-1) / dt[:, None]
-        fastest = np.max(np.where(np.isfinite(step), step, -np.inf), axis=1)
-        fastest = np.where(np.isfinite(fastest), fastest, 0.0)
-        # Speed at frame i is the step (i-1 -> i); frame 0 copies frame 1.
-        return np.concatenate([fastest[:1], fastest])
-
-    def active_span(
-        self,
-        *,
-        threshold: float = 0.05,
-        min_speed: float = 20.0,
-        pad: int = 3,
-        markers: Sequence[str] | None = None,
-    ) -> tuple[int, int]:
-        """Rows ``[start, stop)`` between the first and last active frame.
-
-        A frame is *active* when the fastest hand marker moves faster than
-        ``max(threshold * peak speed, min_speed)`` (a fraction of the peak, as
-        movement onsets are usually defined, with a floor so tracking jitter in
-        a still clip never counts as movement). See :meth:`speed` for the
-        markers and smoothing.
-
-        Parameters
-        ----------
-        threshold : float
-            Fraction of the clip's peak speed.
-        min_speed : float
-            Floor of the activity threshold, px/s.
-        pad : int
-            Frames kept on either side of the active period.
-        markers : sequence of str, optional
-            Markers whose motion counts (default: all but ``object``).
-
-        Returns
-        -------
-        (int, int)
-            ``(start, stop)`` rows; ``start == stop`` if nothing moves.
-        """
-        speed = self.speed(markers)
-        if speed.size == 0:
-            return 0, 0
-        level = max(threshold * float(speed.max()), min_speed)
-        active = np.flatnonzero(speed > level)
-        if active.size == 0:
-            return 0, 0
-        return max(int(active[0]) - pad, 0), min(int(active[-1]) + 1 + pad, self.n_frames)
-
-    def trim(self, **kwargs: Any) -> Tracks:
-        """The active period as a view: rows of :meth:`active_span` (same keywords).
-
-        The arrays are views of this object's; ``frame`` keeps the original
-        frame indices, and ``attrs["trimmed_rows"]`` records ``[start, stop)``.
-        The tracks file itself always keeps every frame.
-        """
-        start, stop = self.active_span(**kwargs)
         s = slice(start, stop)
-        attrs = dict(self.attrs)
-        attrs["trimmed_rows"] = (start, stop)
         return self.replace(
             frame=self.frame[s],
             time=self.time[s],
             position=self.position[s],
             likelihood=self.likelihood[s],
             status=self.status[s],
-            attrs=attrs,
+            attrs={**self.attrs, "trimmed_rows": (start, stop)},
         )
 
     # -- tables -----------------------------------------------------------

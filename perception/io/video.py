@@ -30,8 +30,8 @@ from typing import Any
 import cv2
 import numpy as np
 
-from perception.io.atomic import atomic_path
 from perception.errors import InputError
+from perception.io.atomic import atomic_path
 
 logger = logging.getLogger(__name__)
 

@@ -55,9 +55,9 @@ import cv2
 import numpy as np
 
 from perception.errors import InputError
-from perception.tracking.markers import MarkerColour, MarkerSet, default_markers
 from perception.io.tracks import Status, TracksWriter, tracks_path_for
 from perception.io.video import FrameSource
+from perception.tracking.markers import MarkerColour, MarkerSet, default_markers
 
 logger = logging.getLogger(__name__)
 #: Blobs of each colour considered when a hand marker is first found (largest first).

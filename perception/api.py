@@ -1,0 +1,85 @@
+"""The public face of :mod:`perception`: what a user calls, in one flat namespace.
+
+::
+
+    import perception as pc
+
+    tracks_file = pc.track_video("clip.mp4")              # video -> <clip>.tracks.h5
+    tracks = pc.Tracks.load(tracks_file)                    # positions, likelihood, status
+    obs = pc.observe(tracks)                                # model frame, movement span
+    rep = pc.Repertoire.build()                             # or pc.Repertoire.load("rep.h5")
+    rec = pc.recognize_clip("clip.mp4", rep)                # the whole chain in one call
+    rec.winner, rec.to_pandas()
+    pc.run_batch(pc.discover("clips/"), "report/", rep)    # many clips -> report.html
+
+Everything here is importable from ``perception`` directly; the topic
+modules hold the rest.
+"""
+
+from perception.batch import BatchItem, discover, run_batch
+from perception.errors import InputError
+from perception.geometry import DEFAULT_OBJECT_DIAMETER, SimilarityTransform
+from perception.io.tracks import Status, Tracks, TracksWriter
+from perception.io.video import FrameSource, open_video, write_video
+from perception.observation import MovementSpan, Observation, ObserveParams, movement_span, observe
+from perception.pipeline import RecognitionSettings, load_clip, recognize_clip
+from perception.recognition import (
+    HammerParams,
+    ModelSpec,
+    MotorModel,
+    Recognition,
+    Repertoire,
+    SceneSpec,
+    recognize,
+)
+from perception.report import write_batch_report, write_clip_report
+from perception.synthetic.demos import demo_tracks
+from perception.synthetic.recipes import load_recipe, synthesize
+from perception.synthetic.render import render_clip
+from perception.synthetic.scene import Camera, RenderStyle, Scene
+from perception.tracking.markers import MarkerSet, default_markers
+from perception.tracking.tracker import Tracker, TrackerParams, track_video
+
+__all__ = [
+    "BatchItem",
+    "Camera",
+    "DEFAULT_OBJECT_DIAMETER",
+    "FrameSource",
+    "HammerParams",
+    "InputError",
+    "MarkerSet",
+    "ModelSpec",
+    "MotorModel",
+    "MovementSpan",
+    "Observation",
+    "ObserveParams",
+    "Recognition",
+    "RecognitionSettings",
+    "RenderStyle",
+    "Repertoire",
+    "Scene",
+    "SceneSpec",
+    "SimilarityTransform",
+    "Status",
+    "Tracker",
+    "TrackerParams",
+    "Tracks",
+    "TracksWriter",
+    "default_markers",
+    "demo_tracks",
+    "discover",
+    "load_clip",
+    "load_recipe",
+    "movement_span",
+    "observe",
+    "open_video",
+    "recognize",
+    "recognize_clip",
+    "render_clip",
+    "run_batch",
+    "synthesize",
+    "track_video",
+    "write_batch_report",
+    "write_clip_report",
+    "write_video",
+]

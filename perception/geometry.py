@@ -1,0 +1,101 @@
+"""The one similarity transform between image pixels and the model frame.
+
+Image: pixels, x right, y down, origin at the top-left corner. Model (world)
+frame: metres, origin at the object's centre, +y from the demonstrator's
+start toward the object (docs/coordinates.md). The two differ by a
+similarity: a translation (where the object is in the image), a scale
+(pixels per metre), a rotation (which way the approach points in the image)
+and possibly a reflection (a view in which the finger lies on the model's
+-x side). The renderer's camera and the observation of tracked clips both use
+:class:`SimilarityTransform`, so a rendered clip and its recognition agree by
+construction.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["DEFAULT_OBJECT_DIAMETER", "SimilarityTransform"]
+
+#: Diameter of the thesis's ball, m: the default object, which sets the
+#: metric scale of a clip (its apparent size in pixels over this).
+DEFAULT_OBJECT_DIAMETER = 0.10
+
+
+@dataclass(frozen=True)
+class SimilarityTransform:
+    """Pixels (x right, y down) <-> model frame (m).
+
+    ``pixel = origin_px + px_per_m * flip(R(rotation) @ S @ model)`` where ``S``
+    mirrors the model's x axis when ``mirror`` is set, ``R`` turns the model's
+    axes into the image's "up" coordinates (x right, y up) and ``flip`` turns
+    y up into y down.
+
+    Parameters
+    ----------
+    origin_px : (2,) array_like
+        Image position of the model origin (the object centre), px.
+    px_per_m : float
+        Scale, px/m.
+    rotation : float
+        Direction of the model's +y axis in the image, rad, counter-clockwise
+        from image right with image y pointing up (pi/2: the approach points
+        up the image).
+    mirror : bool
+        Mirror the model's x axis (the finger on the model's -x side).
+    """
+
+    origin_px: np.ndarray
+    px_per_m: float
+    rotation: float = math.pi / 2
+    mirror: bool = False
+
+    def __post_init__(self) -> None:
+        origin = np.asarray(self.origin_px, dtype=np.float64).reshape(-1)
+        if origin.shape != (2,) or not np.all(np.isfinite(origin)):
+            raise ValueError(
+                f"SimilarityTransform.origin_px: expected finite (x, y) px, got {self.origin_px!r}"
+            )
+        if not (math.isfinite(self.px_per_m) and self.px_per_m > 0):
+            raise ValueError(
+                f"SimilarityTransform.px_per_m: expected a positive scale, got {self.px_per_m!r}"
+            )
+        if not math.isfinite(self.rotation):
+            raise ValueError(
+                f"SimilarityTransform.rotation: expected a finite angle, got {self.rotation!r}"
+            )
+        object.__setattr__(self, "origin_px", origin)
+        object.__setattr__(self, "px_per_m", float(self.px_per_m))
+        object.__setattr__(self, "rotation", float(self.rotation))
+        object.__setattr__(self, "mirror", bool(self.mirror))
+
+    @property
+    def basis(self) -> np.ndarray:
+        """(2, 2): columns are the model's x and y axes in image "up" coordinates."""
+        c, s = math.cos(self.rotation), math.sin(self.rotation)
+        ey = np.array([c, s])
+        ex = np.array([s, -c])
+        if self.mirror:
+            ex = -ex
+        return np.stack([ex, ey], axis=1)
+
+    @property
+    def matrix(self) -> np.ndarray:
+        """(2, 3) affine matrix: ``pixel = M[:, :2] @ model + M[:, 2]``."""
+        linear = self.basis * self.px_per_m
+        linear[1] *= -1.0  # image y points down
+        return np.column_stack([linear, self.origin_px])
+
+    def to_model(self, px: np.ndarray) -> np.ndarray:
+        """Pixels ``(..., 2)`` -> model frame ``(..., 2)``, m (NaN stays NaN)."""
+        rel = np.asarray(px, dtype=np.float64) - self.origin_px
+        up = np.stack([rel[..., 0], -rel[..., 1]], axis=-1) / self.px_per_m
+        return up @ self.basis
+
+    def to_pixels(self, xy: np.ndarray) -> np.ndarray:
+        """Model frame ``(..., 2)``, m -> pixels ``(..., 2)`` (NaN stays NaN)."""
+        up = np.asarray(xy, dtype=np.float64) @ self.basis.T * self.px_per_m
+        return np.stack([up[..., 0], -up[..., 1]], axis=-1) + self.origin_px

@@ -1,0 +1,597 @@
+"""Tracks -> observations in the model frame.
+
+The model frame (docs/coordinates.md): origin at the object centre, +y from
+the demonstrator's start toward the object, metres. Pixels map to metres by
+the similarity transform of :mod:`perception.geometry`, fixed from the first
+frames of the clip (the scene): the object's position, its known diameter
+(or a given pixel scale), and the direction from the wrist's rest position
+to the object.
+
+The movement is scored over its :class:`MovementSpan`: from its onset (found
+from the wrist's displacement from rest, less the model's own latency) to
+the end of activity. :func:`movement_span` is the one detector of it: the
+recognition and ``hammer-mv tracks export --trim`` both use it. The trimmed
+frames stay in the tracks file. Marker positions are smoothed by a causal
+alpha-beta filter before their changes are compared with predictions: with
+raw tracks half a pixel of noise randomises the sign of the small per-frame
+changes the thesis's confidence rule counts (docs/recognition.md).
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+from typing import NamedTuple
+
+import numpy as np
+
+from perception.errors import InputError
+from perception.geometry import DEFAULT_OBJECT_DIAMETER, SimilarityTransform
+
+__all__ = [
+    "DIGIT_MARKERS",
+    "MovementSpan",
+    "ObserveParams",
+    "Observation",
+    "alpha_beta",
+    "movement_span",
+    "observe",
+]
+
+log = logging.getLogger(__name__)
+
+#: Markers the recognition needs, in the order of the model's effectors.
+DIGIT_MARKERS = ("wrist", "finger", "thumb")
+#: Every marker an observation needs.
+NEEDED_MARKERS = (*DIGIT_MARKERS, "object")
+#: Median absolute deviation -> standard deviation, for normally distributed noise.
+MAD_TO_SD = 1.4826
+
+
+def _positive(value) -> bool:
+    return isinstance(value, int | float) and bool(np.isfinite(value)) and value > 0
+
+
+def _range(value) -> bool:
+    return (isinstance(value, tuple) and len(value) == 2 and all(_positive(v) for v in value)
+            and value[0] < value[1])
+
+
+@dataclass(frozen=True)
+class ObserveParams:
+    """How tracks become observations.
+
+    Parameters
+    ----------
+    object_diameter : float
+        Real diameter of the object, m (default: the thesis's 0.10 m ball).
+    px_per_m : float, optional
+        Image scale; default: the object's apparent diameter in pixels
+        (from the tracks) divided by ``object_diameter``.
+    mirror : bool
+        Mirror the image x axis, for views in which the finger lies on the
+        model's -x side (the model puts the finger at +x).
+    rest_frames : int
+        Frames at the start used to fix the scene (object position, rest posture).
+    max_rest_noise : float
+        Largest position noise at rest, m, for a clip to be scored: a clip must
+        start with the hand still and visible.
+    max_rest_drift : float
+        Largest excursion of a marker from its mean over the rest frames, m
+        (or ``rest_noise_factor`` x the noise, if larger).
+    rest_noise_factor : float
+        Noise SDs a marker may wander at rest before the hand counts as moving.
+    max_rest_aperture : float
+        Largest distance between the finger and thumb markers at rest, m: the
+        digits touch at the start (as in the model).
+    hand_size_range : (float, float)
+        Plausible distance from the wrist band to the touching digit tips at
+        rest, m; outside it the "hand" is not one (a marker on a
+        same-coloured object, or a wrong scale).
+    frame_period_range : (float, float)
+        Plausible median frame period, s (1000 down to 2 frames/s): time
+        stamps outside it are not in seconds.
+    onset_displacement : float
+        Wrist displacement from rest that marks a movement, m (raised to
+        ``onset_noise_factor`` x the noise on noisy tracks).
+    onset_noise_factor : float
+        Noise SDs the onset threshold stays above.
+    onset_hold_frames : int
+        Frames the wrist must stay beyond the threshold for a movement to count.
+    onset_profile : tuple of (float, float)
+        ``(displacement m, time s)`` pairs: how long after a movement's
+        command onset the wrist has moved that far. Visible motion lags the
+        command (the muscle filter), so the onset is the crossing time less
+        this latency. The default is the 1 s minimum variance grasp's
+        (``tests/test_observe.py`` checks it against the model).
+    end_speed : float
+        A hand marker faster than this, m/s (or ``end_noise_factor`` noise SDs
+        per frame, if larger), is still moving: the movement ends after the
+        last such frame.
+    end_noise_factor : float
+        Noise SDs per frame a marker must move to count as moving.
+    end_pad_frames : int
+        Frames kept after the last moving frame (the finite difference and
+        the filter lag the motion by about that much).
+    alpha, beta : float
+        Gains of the causal alpha-beta filter applied to every marker.
+    min_frames : int
+        Fewest frames of movement that can be scored.
+    """
+
+    object_diameter: float = DEFAULT_OBJECT_DIAMETER
+    px_per_m: float | None = None
+    mirror: bool = False
+    rest_frames: int = 5
+    max_rest_noise: float = 0.003
+    max_rest_drift: float = 0.006
+    rest_noise_factor: float = 6.0
+    max_rest_aperture: float = 0.04
+    hand_size_range: tuple[float, float] = (0.01, 0.25)
+    frame_period_range: tuple[float, float] = (0.001, 0.5)
+    onset_displacement: float = 0.002
+    onset_noise_factor: float = 4.0
+    onset_hold_frames: int = 3
+    onset_profile: tuple[tuple[float, float], ...] = (
+        (0.001, 0.091), (0.002, 0.110), (0.003, 0.123), (0.004, 0.133),
+        (0.006, 0.151), (0.008, 0.166), (0.012, 0.190))
+    end_speed: float = 0.02
+    end_noise_factor: float = 6.0
+    end_pad_frames: int = 2
+    alpha: float = 0.5
+    beta: float = 0.15
+    min_frames: int = 8
+
+    def __post_init__(self):
+        object.__setattr__(self, "hand_size_range", tuple(self.hand_size_range))
+        object.__setattr__(self, "frame_period_range", tuple(self.frame_period_range))
+        object.__setattr__(self, "onset_profile",
+                           tuple(tuple(float(v) for v in row) for row in self.onset_profile))
+        for name in ("object_diameter", "max_rest_noise", "max_rest_drift", "rest_noise_factor",
+                     "max_rest_aperture", "onset_displacement", "onset_noise_factor",
+                     "end_speed", "end_noise_factor"):
+            if not _positive(getattr(self, name)):
+                raise ValueError(f"ObserveParams.{name}: expected a positive number, "
+                                 f"got {getattr(self, name)!r}")
+        if self.px_per_m is not None and not _positive(self.px_per_m):
+            raise ValueError(f"ObserveParams.px_per_m: expected a positive scale, "
+                             f"got {self.px_per_m!r}")
+        for name in ("hand_size_range", "frame_period_range"):
+            if not _range(getattr(self, name)):
+                raise ValueError(f"ObserveParams.{name}: expected (low, high) with "
+                                 f"0 < low < high, got {getattr(self, name)!r}")
+        for name, least in (("rest_frames", 2), ("onset_hold_frames", 1),
+                            ("end_pad_frames", 0), ("min_frames", 3)):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < least:
+                raise ValueError(f"ObserveParams.{name}: expected a whole number of frames "
+                                 f">= {least}, got {value!r}")
+        if not (0 < self.alpha <= 1 and 0 <= self.beta < 2):
+            raise ValueError(f"ObserveParams.alpha/beta: expected 0 < alpha <= 1, "
+                             f"0 <= beta < 2, got {self.alpha}, {self.beta}")
+        prof = np.asarray(self.onset_profile, dtype=float)
+        if not (prof.ndim == 2 and prof.shape[1] == 2 and len(prof) >= 2
+                and np.all(np.diff(prof, axis=0) > 0)):
+            raise ValueError("ObserveParams.onset_profile: expected increasing "
+                             "(displacement m, time s) pairs")
+
+    def onset_latency(self, displacement: float) -> float:
+        """Time after the command onset at which the wrist has moved ``displacement`` m.
+
+        Parameters
+        ----------
+        displacement : float
+            Wrist displacement from rest, m.
+        """
+        d, t = np.asarray(self.onset_profile, dtype=float).T
+        return float(np.interp(displacement, d, t))
+
+
+def alpha_beta(z: np.ndarray, dt: np.ndarray | float, alpha: float, beta: float) -> np.ndarray:
+    """Causal alpha-beta filter of positions, coasting through gaps.
+
+    Parameters
+    ----------
+    z : (N, ..., 2) array
+        Positions; NaN where missing.
+    dt : float or (N,) array
+        Frame period(s), s (``dt[i]`` is the time from frame i-1 to i).
+    alpha, beta : float
+        Position and velocity gains.
+
+    Returns
+    -------
+    (N, ..., 2) array
+        Filtered positions; NaN where the input is missing (a gap is not filled;
+        the filter restarts from the first measurement after it).
+    """
+    z = np.asarray(z, dtype=float)
+    dt = np.broadcast_to(np.asarray(dt, dtype=float), (z.shape[0],))
+    out = np.full_like(z, np.nan)
+    x = np.full(z.shape[1:], np.nan)
+    v = np.zeros(z.shape[1:])
+    shape = z.shape[1:-1] + (1,)
+    missing_before = np.ones(shape, dtype=bool)
+    second = np.zeros(shape, dtype=bool)  # first measurement after a (re)start
+    for i in range(z.shape[0]):
+        zi = z[i]
+        have = np.isfinite(zi).all(axis=-1, keepdims=True)
+        pred = x + v * dt[i]
+        resid = zi - pred
+        x_new = np.where(have, pred + alpha * resid, pred)
+        v_new = np.where(have, v + beta / max(dt[i], 1e-9) * resid, v)
+        # After a gap, start again from the measurement (coasting on an old
+        # velocity lands far from the marker), and take the velocity from the
+        # first two measurements back (two-point initiation).
+        fresh = have & missing_before
+        two = have & second & ~fresh
+        v_new = np.where(two, (zi - x) / max(dt[i], 1e-9), np.where(fresh, 0.0, v_new))
+        x_new = np.where(fresh | two, zi, x_new)
+        second = fresh | (second & ~have)
+        missing_before = ~have
+        x, v = x_new, v_new
+        out[i] = np.where(have, x, np.nan)
+    return out
+
+
+@dataclass(frozen=True)
+class MovementSpan:
+    """The part of a clip that is scored: from movement onset to the end of activity.
+
+    Attributes
+    ----------
+    start, stop : int
+        Rows of the tracks, ``[start, stop)``.
+    onset_frame, end_frame : int
+        Video frames of the first and last scored rows.
+    onset_time : float
+        Time of the movement's (command) onset on the clip's clock, s; the
+        first scored frame is at or just after it.
+    """
+
+    start: int
+    stop: int
+    onset_frame: int
+    end_frame: int
+    onset_time: float
+
+    @property
+    def rows(self) -> slice:
+        """``slice(start, stop)`` of the tracks' rows."""
+        return slice(self.start, self.stop)
+
+    @property
+    def n_frames(self) -> int:
+        """Scored frames."""
+        return self.stop - self.start
+
+
+@dataclass(frozen=True, eq=False)
+class Observation:
+    """A demonstration in the model frame, from movement onset to the end of activity.
+
+    Attributes
+    ----------
+    clip : str
+        Clip name.
+    frame : (N,) int array
+        Video frame of each sample.
+    time : (N,) array
+        Time since the movement's onset, s (from the container's time stamps;
+        the first sample is at or just after the onset).
+    wrist, finger, thumb : (N, 2) arrays
+        Causally filtered positions, m; NaN where the marker is lost. The digit
+        markers' separation at rest (digits touching) is taken off, so finger
+        and thumb are the tips.
+    raw : dict of (N, 2) arrays
+        Unfiltered positions of the same markers.
+    scene : SimilarityTransform
+        The pixel-to-model transform.
+    dt : float
+        Median frame period, s.
+    onset_frame, end_frame : int
+        Frames where the scored movement starts and ends (inclusive): the
+        :class:`MovementSpan` of the tracks.
+    start_distance : float
+        Distance from the wrist at rest to the object centre, m.
+    hand_offset : (2,) array
+        Grip midpoint relative to the wrist at rest, m (the hand's size and posture).
+    marker_separation : float
+        Distance between the digit markers at rest, m (removed from finger and thumb).
+    noise : float
+        Tracking noise of the positions at rest (robust SD), m.
+    object_diameter : float
+        Object diameter, m.
+    """
+
+    clip: str
+    frame: np.ndarray
+    time: np.ndarray
+    wrist: np.ndarray = field(repr=False)
+    finger: np.ndarray = field(repr=False)
+    thumb: np.ndarray = field(repr=False)
+    raw: dict = field(repr=False)
+    scene: SimilarityTransform = field(repr=False)
+    dt: float = 1 / 30
+    onset_frame: int = 0
+    end_frame: int = 0
+    start_distance: float = 0.0
+    hand_offset: np.ndarray = field(default_factory=lambda: np.zeros(2), repr=False)
+    object_diameter: float = DEFAULT_OBJECT_DIAMETER
+    marker_separation: float = 0.0
+    noise: float = 0.0
+
+    @property
+    def n_frames(self) -> int:
+        """Number of scored samples N."""
+        return len(self.time)
+
+    @property
+    def midpoint(self) -> np.ndarray:
+        """(N, 2) grip midpoint (finger + thumb) / 2, m (thesis eq. 5.3)."""
+        return 0.5 * (self.finger + self.thumb)
+
+    @property
+    def r(self) -> np.ndarray:
+        """(N,) distance from grip midpoint to object centre, m (thesis eq. 5.4)."""
+        return np.linalg.norm(self.midpoint, axis=-1)
+
+    @property
+    def g(self) -> np.ndarray:
+        """(N,) grip aperture |finger - thumb|, m (thesis eq. 5.5)."""
+        return np.linalg.norm(self.finger - self.thumb, axis=-1)
+
+
+class _Prepared(NamedTuple):
+    """Everything known about a clip once its movement is found."""
+
+    name: str
+    frames: np.ndarray
+    time: np.ndarray
+    dt: float
+    transform: SimilarityTransform
+    raw: np.ndarray      # (T, 3, 2) m, DIGIT_MARKERS order
+    filtered: np.ndarray  # (T, 3, 2) m
+    rest_mean: np.ndarray  # (3, 2) m
+    noise: float
+    span: MovementSpan
+
+
+def _clip_name(tracks, clip: str | None) -> str:
+    return clip or getattr(tracks, "name", None) or "clip"
+
+
+def _marker_pixels(tracks, params: ObserveParams, name: str) -> dict[str, np.ndarray]:
+    """(T, 2) px of every needed marker; refuses tracks that cannot be scored."""
+    markers = list(tracks.markers)
+    pos = np.asarray(tracks.position, dtype=float)
+    px = {}
+    for m in NEEDED_MARKERS:
+        what = "object" if m == "object" else f"marker '{m}'"
+        if m not in markers:
+            raise InputError(f"marker '{m}' is not in the tracks (have {', '.join(markers)})",
+                             name)
+        px[m] = pos[:, markers.index(m)]
+        if not np.isfinite(px[m]).all(axis=1).any():
+            raise InputError(f"{what} is never seen in the clip", name)
+        if np.isinf(px[m]).any():
+            raise InputError(f"marker '{m}' has infinite positions", name)
+    if len(pos) < params.min_frames:
+        raise InputError(f"clip too short to score: {len(pos)} frames "
+                         f"(need at least {params.min_frames})", name)
+    return px
+
+
+def _frame_times(tracks, params: ObserveParams, name: str) -> tuple[np.ndarray, np.ndarray]:
+    """Time stamps (T,) s and frame periods (T-1,) s, checked."""
+    time = np.asarray(tracks.time, dtype=float)
+    if not np.isfinite(time).all():
+        raise InputError(f"{int((~np.isfinite(time)).sum())} time stamps are not finite", name)
+    dts = np.diff(time)
+    if np.any(dts <= 0):
+        raise InputError("time stamps do not increase", name)
+    lo, hi = params.frame_period_range
+    dt = float(np.median(dts))
+    if not lo <= dt <= hi:
+        raise InputError(f"implausible frame period {dt:g} s (time stamps must be in "
+                         f"seconds, {1 / hi:g}-{1 / lo:g} frames/s)", name)
+    return time, dts
+
+
+def _scene_transform(px: dict[str, np.ndarray], tracks, params: ObserveParams,
+                     name: str) -> SimilarityTransform:
+    """The pixel -> model transform from the first frames: object, scale, approach."""
+    rest = slice(0, params.rest_frames)
+    for m in NEEDED_MARKERS:
+        if not np.isfinite(px[m][rest]).all():
+            what = "object" if m == "object" else f"marker '{m}'"
+            raise InputError(f"the clip must start with the hand at rest and visible: the "
+                             f"{what} is lost in its first {params.rest_frames} frames", name)
+    # The object stays put while the hand is away: twice the rest frames
+    # average its centre better and are still long before the hand arrives.
+    origin = np.median(px["object"][: 2 * params.rest_frames], axis=0)
+    scale = params.px_per_m
+    if scale is None:
+        dpx = tracks.object_diameter_px()
+        if dpx is None:
+            raise InputError("image scale unknown: the tracks carry no object size; "
+                             "give px_per_m (--px-per-m)", name)
+        scale = dpx / params.object_diameter
+    d = np.median(px["wrist"][rest], axis=0) - origin
+    approach = np.array([-d[0], d[1]])  # from wrist toward object, in y-up image coordinates
+    if np.linalg.norm(approach) < 1e-6:
+        raise InputError("impossible geometry: the wrist starts on the object", name)
+    return SimilarityTransform(origin, float(scale), float(np.arctan2(approach[1], approach[0])),
+                               params.mirror)
+
+
+def _rest_noise(raw: np.ndarray, params: ObserveParams, name: str) -> tuple[float, np.ndarray]:
+    """Tracking noise at rest (robust SD, m) and the mean rest posture (3, 2) m.
+
+    Refuses a clip whose hand is not still over the rest frames.
+    """
+    rest = raw[: params.rest_frames]
+    steps = np.diff(rest, axis=0).ravel()
+    # A frame-to-frame change carries the noise of two frames: divide by sqrt 2.
+    noise = MAD_TO_SD * np.median(np.abs(steps - np.median(steps))) / np.sqrt(2)
+    mean = rest.mean(axis=0)
+    drift = np.linalg.norm(rest - mean, axis=-1).max()
+    if noise > params.max_rest_noise or drift > max(params.max_rest_drift,
+                                                    params.rest_noise_factor * noise):
+        raise InputError(f"the clip must start with the hand at rest: its markers move "
+                         f"{drift * 1000:.1f} mm (noise {noise * 1000:.1f} mm) over the first "
+                         f"{params.rest_frames} frames", name)
+    return float(noise), mean
+
+
+def _onset_time(filtered: np.ndarray, time: np.ndarray, noise: float, params: ObserveParams,
+                name: str) -> float:
+    """When the movement's command began, s: the wrist's crossing less the model's latency.
+
+    The crossing is where the wrist's displacement from rest first exceeds
+    the threshold for ``onset_hold_frames`` frames, interpolated between frames.
+    """
+    w = filtered[:, 0]
+    disp = np.linalg.norm(w - np.median(w[: params.rest_frames], axis=0), axis=1)
+    threshold = max(params.onset_displacement, params.onset_noise_factor * noise)
+    above = np.nan_to_num(disp, nan=0.0) > threshold
+    hold = params.onset_hold_frames
+    held = np.ones_like(above)
+    for k in range(hold):
+        held &= np.roll(above, -k)
+    held[len(held) - hold + 1:] = False  # np.roll wrapped the last frames around
+    if not held.any():
+        raise InputError("no movement found: the wrist never leaves its rest position", name)
+    i = int(np.argmax(held))
+    if i > 0 and np.isfinite(disp[i - 1]):
+        frac = (threshold - disp[i - 1]) / (disp[i] - disp[i - 1])
+        crossing = time[i - 1] + frac * (time[i] - time[i - 1])
+    else:
+        crossing = time[i]
+    return float(crossing - params.onset_latency(threshold))
+
+
+def _end_row(filtered: np.ndarray, time: np.ndarray, noise: float, dt: float,
+             params: ObserveParams) -> int:
+    """The last row of the movement: a few frames after any hand marker last moved."""
+    speed = np.linalg.norm(np.diff(filtered, axis=0), axis=-1) / np.diff(time)[:, None]
+    floor = max(params.end_speed, params.end_noise_factor * noise / dt)
+    moving = np.nanmax(np.where(np.isfinite(speed), speed, 0), axis=1) > floor
+    active = np.flatnonzero(moving)
+    last = len(time) - 1
+    return int(min(last, active[-1] + params.end_pad_frames)) if len(active) else last
+
+
+def _prepare(tracks, params: ObserveParams, name: str) -> _Prepared:
+    """Scene, smoothed model-frame positions and the movement span of some tracks."""
+    px = _marker_pixels(tracks, params, name)
+    time, dts = _frame_times(tracks, params, name)
+    dt = float(np.median(dts))
+    transform = _scene_transform(px, tracks, params, name)
+    raw = np.stack([transform.to_model(px[m]) for m in DIGIT_MARKERS], axis=1)
+    noise, rest_mean = _rest_noise(raw, params, name)
+    filtered = alpha_beta(raw, np.concatenate([[dt], dts]), params.alpha, params.beta)
+    onset_time = _onset_time(filtered, time, noise, params, name)
+    start = int(np.searchsorted(time, onset_time))
+    end = _end_row(filtered, time, noise, dt, params)
+    if end - start + 1 < params.min_frames:
+        raise InputError(f"movement too short to score: {end - start + 1} frames "
+                         f"(need at least {params.min_frames})", name)
+    frames = np.asarray(getattr(tracks, "frame", np.arange(len(time))))
+    span = MovementSpan(start, end + 1, int(frames[start]), int(frames[end]), onset_time)
+    return _Prepared(name, frames, time, dt, transform, raw, filtered, rest_mean, noise, span)
+
+
+def movement_span(tracks, params: ObserveParams | None = None, *,
+                  clip: str | None = None) -> MovementSpan:
+    """The movement :func:`observe` scores: onset to end of activity.
+
+    Parameters
+    ----------
+    tracks : Tracks
+        See :func:`observe`.
+    params : ObserveParams, optional
+        Scale, filter and onset settings.
+    clip : str, optional
+        Clip name for messages.
+
+    Raises
+    ------
+    InputError
+        As :func:`observe`, for everything up to finding the movement.
+    """
+    params = ObserveParams() if params is None else params
+    return _prepare(tracks, params, _clip_name(tracks, clip)).span
+
+
+def _check_hand(rest_mean: np.ndarray, params: ObserveParams, name: str) -> None:
+    """The rest posture must look like a hand: digits touching, in front of the wrist."""
+    wrist, finger, thumb = rest_mean
+    apart = float(np.linalg.norm(finger - thumb))
+    size = float(np.linalg.norm(0.5 * (finger + thumb) - wrist))
+    lo, hi = params.hand_size_range
+    if apart > params.max_rest_aperture or not lo <= size <= hi:
+        raise InputError(f"the hand at rest does not look like a hand: finger and thumb "
+                         f"markers {apart * 100:.1f} cm apart, {size * 100:.1f} cm from the "
+                         "wrist (a same-coloured object taken for a marker? give --roi when "
+                         "tracking, or check --px-per-m)", name)
+
+
+def observe(tracks, params: ObserveParams | None = None, *, clip: str | None = None) -> Observation:
+    """Turn marker tracks into an :class:`Observation` in the model frame.
+
+    Parameters
+    ----------
+    tracks : Tracks
+        Tracks with ``time`` (T,) s, ``frame`` (T,), ``markers`` (names),
+        ``position`` (T, M, 2) px with NaN where lost, and the object's apparent
+        size (``object_diameter_px()``); the markers ``wrist``, ``finger``,
+        ``thumb`` and ``object`` are needed.
+    params : ObserveParams, optional
+        Scale, filter and onset settings.
+    clip : str, optional
+        Clip name for messages and results (default: from the tracks).
+
+    Returns
+    -------
+    Observation
+
+    Raises
+    ------
+    InputError
+        If a needed marker is missing or never seen, the object is never seen,
+        the scale is unknown, the time stamps are not finite seconds, the clip
+        does not start with a still, visible hand that looks like a hand, no
+        movement is found, or the movement is too short to score.
+    """
+    params = ObserveParams() if params is None else params
+    p = _prepare(tracks, params, _clip_name(tracks, clip))
+    _check_hand(p.rest_mean, params, p.name)
+    start, finger0, thumb0 = p.rest_mean
+    # The digits touch at rest (as in the model), so the markers' separation
+    # then is where they sit on the digits, outside the tips: take it off.
+    half = 0.5 * (finger0 - thumb0)
+    filt = p.filtered.copy()
+    filt[:, 1] -= half
+    filt[:, 2] += half
+    sl = p.span.rows
+    log.info("%s: onset at frame %d, %d frames scored, start distance %.3f m",
+             p.name, p.span.onset_frame, p.span.n_frames, np.linalg.norm(start))
+    return Observation(
+        clip=p.name,
+        frame=p.frames[sl],
+        time=p.time[sl] - p.span.onset_time,
+        wrist=filt[sl, 0],
+        finger=filt[sl, 1],
+        thumb=filt[sl, 2],
+        raw={m: p.raw[sl, i] for i, m in enumerate(DIGIT_MARKERS)},
+        noise=p.noise,
+        scene=p.transform,
+        dt=p.dt,
+        onset_frame=p.span.onset_frame,
+        end_frame=p.span.end_frame,
+        start_distance=float(np.linalg.norm(start)),
+        hand_offset=0.5 * (finger0 + thumb0) - start,
+        object_diameter=params.object_diameter,
+        marker_separation=float(np.linalg.norm(2 * half)),
+    )

@@ -1,0 +1,82 @@
+"""Planning HAMMER-MV models with the minimum variance grasp model (:func:`minvar.plan_grasp`)."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+import numpy as np
+
+from minvar import plan_grasp
+from minvar.lqg import estimation_error_covariance
+from perception.recognition.models import (
+    KINDS,
+    ChainModel,
+    ModelSpec,
+    MotorModel,
+    SceneSpec,
+    model_substeps,
+)
+
+__all__ = ["DEFAULT_DURATIONS", "build_model", "default_specs"]
+
+#: Movement-time variants of the default repertoire, s.
+DEFAULT_DURATIONS = (0.8, 0.9, 1.0, 1.1, 1.2)
+
+
+def _chain_model(role: str, chain_plan) -> ChainModel:
+    problem, solution = chain_plan.problem, chain_plan.solution
+    P = estimation_error_covariance(problem, solution.K, solution.L)[:, :2, :2]
+    q_ref = np.asarray(chain_plan.q_goal, dtype=float)
+    chain = chain_plan.chain
+    return ChainModel(
+        role=role,
+        l1=float(chain.l1),
+        l2=float(chain.l2),
+        base=np.asarray(chain.base, dtype=float),
+        elbow=1 if q_ref[1] >= 0 else -1,
+        A=np.asarray(problem.A),
+        B=np.asarray(problem.B),
+        H=np.asarray(problem.H),
+        K=np.asarray(solution.K),
+        L=np.asarray(solution.L),
+        P=P,
+        x0=np.asarray(problem.X1),
+    )
+
+
+def build_model(spec: ModelSpec, scene: SceneSpec) -> MotorModel:
+    """Plan ``spec`` in ``scene`` with the minimum variance grasp model.
+
+    Parameters
+    ----------
+    spec : ModelSpec
+        The movement.
+    scene : SceneSpec
+        Distance, object size and frame period.
+    """
+    task = spec.grasp_task(scene)
+    plan = plan_grasp(task)
+    return MotorModel(
+        spec=spec,
+        scene=scene,
+        substeps=model_substeps(scene.frame_period),
+        dt=task.plant.dt,
+        arm=_chain_model("arm", plan.arm),
+        finger=_chain_model("finger", plan.finger),
+        thumb=_chain_model("thumb", plan.thumb),
+    )
+
+
+def default_specs(durations: Iterable[float] = DEFAULT_DURATIONS) -> list[ModelSpec]:
+    """Grasp and reach-only models at each movement time.
+
+    Parameters
+    ----------
+    durations : iterable of float
+        Movement times, s.
+    """
+    specs = []
+    for kind in KINDS:
+        for d in durations:
+            specs.append(ModelSpec(f"{kind}-{d:.1f}s", kind, {"duration": float(d)}))
+    return specs

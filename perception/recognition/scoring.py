@@ -1,0 +1,119 @@
+"""The two confidence rules that score each model's one-step predictions.
+
+``thesis`` (eqs. 5.6-5.8)
+    ``dC_r = sgn(dr_obs) sgn(dr_pred) |dr_pred| w_r``, likewise ``dC_g`` with
+    ``w_g``; ``sgn(0) = +1``; ``w_r / w_g = 1/2``. The thesis prints the last
+    factor without the absolute value; its text (agreeing motion raises
+    confidence, faster agreement raises it faster) needs the magnitude.
+    Reach-only models use ``dC_r`` alone. It rewards agreeing directions, so
+    it yields the chapter 5 confidence profiles, but it cannot prefer a model
+    that predicts no grip motion over one that does.
+``likelihood``
+    The log-likelihood of each observed ``(r, g)`` under the model's own
+    predictive distribution: the plan's estimation-error covariance mapped
+    through the chains' Jacobians, plus the tracking noise. Every model is
+    scored on the same quantities, so it can tell kinds and speeds apart.
+
+With ``r`` the distance from the grip midpoint to the object centre and
+``g`` the grip aperture (thesis eqs. 5.3-5.5). See docs/recognition.md.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["RULES", "thesis_rule", "likelihood_rule"]
+
+#: Rules that can pick the winner.
+RULES = ("likelihood", "thesis")
+
+
+def _sgn(x: np.ndarray) -> np.ndarray:
+    return np.where(x >= 0, 1.0, -1.0)
+
+
+def thesis_rule(r_obs: np.ndarray, g_obs: np.ndarray, r_pred: np.ndarray, g_pred: np.ndarray,
+                grasp: np.ndarray, valid: np.ndarray, w_r: float,
+                w_g: float) -> tuple[np.ndarray, np.ndarray]:
+    """Per-step transport and grip terms of the thesis rule (eqs. 5.6-5.7).
+
+    Parameters
+    ----------
+    r_obs, g_obs : (N,) arrays
+        Observed r and g, m.
+    r_pred, g_pred : (M, N) arrays
+        Each model's one-step prediction of r and g, m (NaN at n = 0).
+    grasp : (M,) bool array
+        Which models have a grip channel (reach-only models score ``dC_r`` alone).
+    valid : (M, N) bool array
+        Steps that count; others score 0.
+    w_r, w_g : float
+        Weights of the transport and grip terms.
+
+    Returns
+    -------
+    dC_r, dC_g : (M, N) arrays
+        The terms; the confidence is ``cumsum(dC_r + dC_g)`` (eq. 5.8).
+    """
+    dr_obs = np.diff(r_obs, prepend=np.nan)
+    dg_obs = np.diff(g_obs, prepend=np.nan)
+    dr_pred = r_pred - np.concatenate([[np.nan], r_obs[:-1]])
+    dg_pred = g_pred - np.concatenate([[np.nan], g_obs[:-1]])
+    dC_r = _sgn(dr_obs) * _sgn(dr_pred) * np.abs(dr_pred) * w_r
+    dC_g = _sgn(dg_obs) * _sgn(dg_pred) * np.abs(dg_pred) * w_g * grasp[:, None]
+    # sgn(NaN) is +1, not NaN: what counts must come from the inputs.
+    ok = valid & np.isfinite(dr_pred) & np.isfinite(dg_pred)
+    return np.where(ok, dC_r, 0.0), np.where(ok, dC_g, 0.0)
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    norm = np.linalg.norm(v, axis=-1, keepdims=True)
+    return np.where(norm > 1e-9, v / np.where(norm > 1e-9, norm, 1), np.array([1.0, 0.0]))
+
+
+def likelihood_rule(r_obs: np.ndarray, g_obs: np.ndarray, midpoint: np.ndarray,
+                    opening: np.ndarray, cov_tips: np.ndarray, valid: np.ndarray,
+                    obs_sd: float) -> np.ndarray:
+    """Per-step log-likelihood of the observed ``(r, g)`` under each model's prediction.
+
+    The predicted wrist, finger and thumb positions have Cartesian covariances
+    ``cov_tips``; r and g are linearised about the prediction (along the unit
+    vectors of the predicted midpoint and opening), and the tracked positions
+    add ``obs_sd`` of independent noise per coordinate.
+
+    Parameters
+    ----------
+    r_obs, g_obs : (N,) arrays
+        Observed r and g, m.
+    midpoint, opening : (M, N, 2) arrays
+        Predicted grip midpoint (finger + thumb) / 2 and opening finger - thumb, m.
+    cov_tips : (M, N, 3, 2, 2) array
+        Predicted covariance of the wrist, finger and thumb positions, m^2.
+    valid : (M, N) bool array
+        Steps that count; others score 0.
+    obs_sd : float
+        SD of a tracked position after filtering, m.
+
+    Returns
+    -------
+    (M, N) array
+        Log-likelihood of each step (0 where not valid).
+    """
+    Sw, Sf, St = cov_tips[:, :, 0], cov_tips[:, :, 1], cov_tips[:, :, 2]
+    eye = np.eye(2)
+    var = obs_sd**2
+    # The midpoint moves with the wrist and half of each digit; the opening
+    # with both digits; their covariance comes from the digits alone.
+    cov_m = Sw + 0.25 * (Sf + St) + 0.5 * var * eye
+    cov_d = Sf + St + 2 * var * eye
+    cov_md = 0.5 * (Sf - St)
+    um, ud = _unit(midpoint), _unit(opening)
+    var_r = np.einsum("mni,mnij,mnj->mn", um, cov_m, um)
+    var_g = np.einsum("mni,mnij,mnj->mn", ud, cov_d, ud)
+    cov_rg = np.einsum("mni,mnij,mnj->mn", um, cov_md, ud)
+    det = var_r * var_g - cov_rg**2
+    er = r_obs[None] - np.linalg.norm(midpoint, axis=-1)
+    eg = g_obs[None] - np.linalg.norm(opening, axis=-1)
+    maha = (var_g * er**2 - 2 * cov_rg * er * eg + var_r * eg**2) / det
+    dll = -0.5 * (np.log(det) + maha) - np.log(2 * np.pi)
+    return np.where(valid & np.isfinite(dll), dll, 0.0)

@@ -1,0 +1,354 @@
+"""What a synthetic clip shows: the scene, the camera and the rendering style.
+
+A :class:`Scene` holds the wrist, index-finger and thumb paths in the world
+frame (metres, origin at the object centre, +y from the demonstrator's start
+toward the object; docs/coordinates.md) and the object. A :class:`Camera`
+maps world to pixels by the similarity transform of :mod:`perception.geometry`.
+A :class:`RenderStyle` says how hard the clip is: textured table,
+skin-coloured hand and forearm under the markers (skin's hue is close to the
+red thumb marker's), similar-hue :class:`Distractor` discs,
+:class:`Occlusion` intervals, camera noise, blur, a lighting gradient, frame
+rate, resolution and codec. :mod:`perception.synthetic.render` draws them.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import numpy as np
+
+from perception.geometry import DEFAULT_OBJECT_DIAMETER, SimilarityTransform
+
+__all__ = ["Camera", "Distractor", "Occlusion", "RenderStyle", "Scene", "visibility"]
+
+
+@dataclass(frozen=True)
+class Camera:
+    """Where the renderer's camera looks: world (m) to image (px).
+
+    ``pixel = origin_px + px_per_m * R(angle) @ (x, -y)``: at ``angle_deg = 0``
+    world +x points right and +y up the image; a positive angle rotates the
+    world counter-clockwise on screen, so the approach need not be vertical.
+    The mapping itself is :attr:`transform`, the same similarity transform
+    observation uses to go back from pixels to metres.
+
+    Parameters
+    ----------
+    px_per_m : float
+        Scale, px/m.
+    origin_px : (float, float)
+        Image position of the world origin (the object centre), px.
+    angle_deg : float
+        Rotation of the world axes in the image, degrees.
+    """
+
+    px_per_m: float = 800.0
+    origin_px: tuple[float, float] = (320.0, 144.0)
+    angle_deg: float = 0.0
+
+    def __post_init__(self) -> None:
+        origin = tuple(float(v) for v in self.origin_px)
+        object.__setattr__(self, "origin_px", origin)
+        object.__setattr__(self, "px_per_m", float(self.px_per_m))
+        object.__setattr__(self, "angle_deg", float(self.angle_deg))
+        self.transform  # noqa: B018 - validates scale, origin and angle
+
+    @classmethod
+    def for_frame(
+        cls,
+        width: int,
+        height: int,
+        *,
+        px_per_m: float | None = None,
+        angle_deg: float = 0.0,
+        origin: tuple[float, float] = (0.5, 0.3),
+    ) -> Camera:
+        """A camera whose frame height spans 0.6 m of table, object 30 % from the top.
+
+        Parameters
+        ----------
+        width, height : int
+            Frame size, px.
+        px_per_m : float, optional
+            Scale, px/m (default ``height / 0.6``).
+        angle_deg : float
+            See :class:`Camera`.
+        origin : (float, float)
+            Object position as fractions of (width, height).
+        """
+        scale = height / 0.6 if px_per_m is None else px_per_m
+        return cls(scale, (origin[0] * width, origin[1] * height), angle_deg)
+
+    @property
+    def transform(self) -> SimilarityTransform:
+        """The world <-> pixel similarity (the model's +y at ``angle_deg + 90`` degrees)."""
+        return SimilarityTransform(self.origin_px, self.px_per_m,
+                                   math.radians(self.angle_deg) + math.pi / 2)
+
+    @property
+    def matrix(self) -> np.ndarray:
+        """(2, 3) affine matrix: ``pixel = M[:, :2] @ world + M[:, 2]``."""
+        return self.transform.matrix
+
+    def world_to_pixel(self, xy: np.ndarray) -> np.ndarray:
+        """Map (..., 2) world positions ``xy`` (m) to (..., 2) pixels."""
+        return self.transform.to_pixels(xy)
+
+    def pixel_to_world(self, px: np.ndarray) -> np.ndarray:
+        """Map (..., 2) pixels ``px`` to (..., 2) world positions (m)."""
+        return self.transform.to_model(px)
+
+
+@dataclass(frozen=True)
+class Distractor:
+    """A disc of a marker's colour (or any colour) on the table.
+
+    Parameters
+    ----------
+    colour : str or (int, int, int)
+        A marker name (its render colour is used) or BGR.
+    start : (float, float)
+        World position, m, at the first visible frame.
+    end : (float, float), optional
+        World position at the last visible frame; linear motion between
+        (``None``: static).
+    diameter : float
+        m.
+    frames : (int, int), optional
+        Visible frames ``[first, stop)`` (default: the whole clip).
+    """
+
+    colour: str | tuple[int, int, int]
+    start: tuple[float, float]
+    end: tuple[float, float] | None = None
+    diameter: float = 0.02
+    frames: tuple[int, int] | None = None
+
+    def position(self, index: int, n_frames: int) -> np.ndarray | None:
+        """World position (2,) m at frame ``index``, or None when not visible."""
+        first, stop = self.frames if self.frames is not None else (0, n_frames)
+        if not first <= index < stop:
+            return None
+        start = np.asarray(self.start, dtype=np.float64)
+        if self.end is None or stop - first <= 1:
+            return start
+        w = (index - first) / (stop - first - 1)
+        return start + w * (np.asarray(self.end, dtype=np.float64) - start)
+
+
+@dataclass(frozen=True)
+class Occlusion:
+    """Hide ``marker`` (not drawn) during frames ``[start, stop)``."""
+
+    marker: str
+    start: int
+    stop: int
+
+
+@dataclass(frozen=True)
+class RenderStyle:
+    """How a clip looks.
+
+    Parameters
+    ----------
+    fps : float
+        Frame rate, frames/s (30; 25 and 60 work).
+    width, height : int
+        Frame size, px (640 x 480; 1280 x 720 works).
+    codec : str, optional
+        FourCC; default from the output extension (``.mp4`` mp4v, ``.avi``
+        MJPG, ``.mkv`` FFV1).
+    texture : bool
+        Textured (wood-like) table instead of a plain one.
+    hand : bool
+        Draw a skin-coloured hand and forearm under the markers.
+    marker_diameter : float
+        Thumb and finger marker discs, m.
+    band_size : (float, float)
+        Wrist band (across, along the forearm), m.
+    noise_sd : float
+        Camera noise, grey levels (Gaussian, per channel).
+    blur_sigma : float
+        Optical blur, px (Gaussian sigma; 0 = none).
+    lighting : float
+        Lighting gradient: brightness falls linearly to ``1 - lighting`` of
+        full across the frame (0 = even light).
+    lighting_angle_deg : float
+        Direction of the gradient in the image (0 = darkening to the right).
+    distractors : tuple of Distractor
+        Similar-hue objects on the table.
+    occlusions : tuple of Occlusion
+        Intervals in which a marker is hidden.
+    """
+
+    fps: float = 30.0
+    width: int = 640
+    height: int = 480
+    codec: str | None = None
+    texture: bool = True
+    hand: bool = False
+    marker_diameter: float = 0.02
+    band_size: tuple[float, float] = (0.07, 0.025)
+    noise_sd: float = 0.0
+    blur_sigma: float = 0.0
+    lighting: float = 0.0
+    lighting_angle_deg: float = 30.0
+    distractors: tuple[Distractor, ...] = ()
+    occlusions: tuple[Occlusion, ...] = ()
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.fps) and self.fps > 0):
+            raise ValueError(f"RenderStyle.fps: expected a positive frame rate, got {self.fps!r}")
+        if int(self.width) < 16 or int(self.height) < 16:
+            raise ValueError(
+                f"RenderStyle: expected width, height >= 16 px, got {self.width} x {self.height}"
+            )
+        for name in ("noise_sd", "blur_sigma", "marker_diameter"):
+            if not getattr(self, name) >= 0:
+                raise ValueError(f"RenderStyle.{name}: expected >= 0, got {getattr(self, name)!r}")
+        if not 0 <= self.lighting < 1:
+            raise ValueError(
+                f"RenderStyle.lighting: expected 0 <= lighting < 1, got {self.lighting!r}"
+            )
+        object.__setattr__(self, "distractors", tuple(self.distractors))
+        object.__setattr__(self, "occlusions", tuple(self.occlusions))
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-data form (JSON-ready)."""
+        return asdict(self)
+
+
+@dataclass(frozen=True, eq=False)
+class Scene:
+    """What moves: hand marker paths and the object, in the world frame.
+
+    Parameters
+    ----------
+    wrist, finger, thumb : (T, 2) array_like
+        Marker centres, m.
+    object_centre : (float, float)
+        m (the world origin by definition, but settable).
+    object_diameter : float
+        m (default: the thesis's 0.10 m ball).
+    """
+
+    wrist: np.ndarray
+    finger: np.ndarray
+    thumb: np.ndarray
+    object_centre: tuple[float, float] = (0.0, 0.0)
+    object_diameter: float = DEFAULT_OBJECT_DIAMETER
+
+    def __post_init__(self) -> None:
+        n = None
+        for name in ("wrist", "finger", "thumb"):
+            arr = np.asarray(getattr(self, name), dtype=np.float64)
+            if arr.ndim != 2 or arr.shape[1] != 2 or arr.shape[0] < 1:
+                raise ValueError(f"Scene.{name}: expected shape (T, 2) in m, got {arr.shape}")
+            if n is not None and arr.shape[0] != n:
+                raise ValueError(
+                    f"Scene.{name}: expected T = {n} rows like wrist, got {arr.shape[0]}"
+                )
+            if not np.all(np.isfinite(arr)):
+                raise ValueError(f"Scene.{name}: expected finite positions, found NaN or inf")
+            n = arr.shape[0]
+            object.__setattr__(self, name, arr)
+        if not self.object_diameter > 0:
+            raise ValueError(f"Scene.object_diameter: expected > 0 m, got {self.object_diameter!r}")
+        object.__setattr__(self, "object_centre", tuple(float(v) for v in self.object_centre))
+
+    @property
+    def n_frames(self) -> int:
+        """T."""
+        return int(self.wrist.shape[0])
+
+    def positions(self, names: tuple[str, ...]) -> np.ndarray:
+        """(T, M) x 2 world positions of the named markers (the object is static), m."""
+        out = np.empty((self.n_frames, len(names), 2))
+        for j, name in enumerate(names):
+            out[:, j] = self.object_centre if name == "object" else getattr(self, name)
+        return out
+
+    @classmethod
+    def reach_to_grasp(
+        cls,
+        n_frames: int,
+        fps: float,
+        *,
+        start: tuple[float, float] = (0.0, -0.40),
+        onset: float = 0.3,
+        duration: float = 1.0,
+        aperture: tuple[float, float] = (0.035, 0.14),
+        peak_at: float = 0.7,
+        object_diameter: float = DEFAULT_OBJECT_DIAMETER,
+        wrist_offset: float = 0.06,
+    ) -> Scene:
+        """Analytic reach-to-grasp: minimum-jerk transport, aperture up then down.
+
+        A stand-in for grasp-model stimuli in tests and benchmarks. The wrist
+        moves from ``start`` to ``wrist_offset`` short of the object centre
+        along +y; the digit tips lead the wrist by ``wrist_offset`` and sit
+        ``aperture/2`` either side of the approach axis (thumb at -x, a right
+        hand seen from above), so they end on the object's surface.
+
+        Parameters
+        ----------
+        n_frames : int
+            T.
+        fps : float
+            frames/s.
+        start : (float, float)
+            Wrist start, m.
+        onset, duration : float
+            Movement start and duration, s; the hand rests before and after.
+        aperture : (float, float)
+            Initial and maximal grip aperture, m; the final one is the object
+            diameter.
+        peak_at : float
+            Time of maximal aperture as a fraction of the movement.
+        object_diameter : float
+            m.
+        wrist_offset : float
+            m.
+        """
+        t = np.arange(n_frames) / fps
+        tau = np.clip((t - onset) / duration, 0.0, 1.0)
+        s = _min_jerk(tau)
+        start_arr = np.asarray(start, dtype=np.float64)
+        goal = np.array([0.0, -wrist_offset])
+        wrist = start_arr + s[:, None] * (goal - start_arr)
+        a0, amax = aperture
+        opening = _min_jerk(np.clip(tau / peak_at, 0, 1))
+        closing = _min_jerk(np.clip((tau - peak_at) / (1 - peak_at), 0, 1))
+        ap = a0 + (amax - a0) * opening + (object_diameter - amax) * closing
+        ahead = wrist + np.array([0.0, wrist_offset])
+        lateral = np.stack([ap / 2, np.zeros_like(ap)], axis=1)
+        return cls(wrist, ahead + lateral, ahead - lateral, object_diameter=object_diameter)
+
+
+def _min_jerk(tau: np.ndarray) -> np.ndarray:
+    return tau**3 * (10 - 15 * tau + 6 * tau**2)
+
+
+def visibility(style: RenderStyle, names: tuple[str, ...], n_frames: int) -> np.ndarray:
+    """Which markers are drawn in which frame.
+
+    Parameters
+    ----------
+    style : RenderStyle
+        Its ``occlusions`` hide markers.
+    names : tuple of str
+        Marker names, M of them.
+    n_frames : int
+        T.
+
+    Returns
+    -------
+    (T, M) bool
+        False where an :class:`Occlusion` hides the marker.
+    """
+    vis = np.ones((n_frames, len(names)), dtype=bool)
+    for occ in style.occlusions:
+        vis[max(occ.start, 0) : max(occ.stop, 0), names.index(occ.marker)] = False
+    return vis
