@@ -1,6 +1,7 @@
 """The one similarity transform between image pixels and the model frame.
 
-Image: pixels, x right, y down, origin at the top-left corner. Model (world)
+Image: pixels, x right, y down, the centre of the top-left pixel at (0, 0)
+(as OpenCV's moments and drawing have it). Model (world)
 frame: metres, origin at the object's centre, +y from the demonstrator's
 start toward the object (docs/coordinates.md). The two differ by a
 similarity: a translation (where the object is in the image), a scale

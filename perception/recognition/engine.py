@@ -9,8 +9,10 @@ predicts the state at frame n (several model steps per frame). Forward
 kinematics turn the predicted joint angles into predicted wrist, finger and
 thumb positions, from which the predicted distance-to-object ``r`` and grip
 aperture ``g`` follow (thesis eqs. 5.3-5.5); :mod:`perception.recognition.scoring`
-scores them. Where a needed marker is missing at n or n-1, neither rule
-updates and the filters coast.
+scores them. A step n counts only if all three hand markers were seen at
+n-1 (the state the prediction starts from; the wrist anchors every chain)
+and the digits at n (the outcome); otherwise neither rule updates and the
+filters coast.
 
 The engine predicts and scores only: the models come planned for the clip's
 scene (:meth:`perception.recognition.repertoire.Repertoire.for_scene`).

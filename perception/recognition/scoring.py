@@ -11,7 +11,8 @@
 ``likelihood``
     The log-likelihood of each observed ``(r, g)`` under the model's own
     predictive distribution: the plan's estimation-error covariance mapped
-    through the chains' Jacobians, plus the tracking noise. Every model is
+    through the chains' Jacobians, plus a fixed tracking noise
+    (``HammerParams.obs_sd``, 1 mm). Every model is
     scored on the same quantities, so it can tell kinds and speeds apart.
 
 With ``r`` the distance from the grip midpoint to the object centre and

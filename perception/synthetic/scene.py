@@ -28,9 +28,11 @@ __all__ = ["Camera", "Distractor", "Occlusion", "RenderStyle", "Scene", "visibil
 class Camera:
     """Where the renderer's camera looks: world (m) to image (px).
 
-    ``pixel = origin_px + px_per_m * R(angle) @ (x, -y)``: at ``angle_deg = 0``
-    world +x points right and +y up the image; a positive angle rotates the
-    world counter-clockwise on screen, so the approach need not be vertical.
+    ``(px - ox, oy - py) = px_per_m * R(angle) @ (x, y)`` with ``R`` the
+    counter-clockwise rotation and ``(ox, oy) = origin_px``: at
+    ``angle_deg = 0`` world +x points right and +y up the image; a positive
+    angle rotates the world counter-clockwise on screen, so the approach
+    need not be vertical.
     The mapping itself is :attr:`transform`, the same similarity transform
     observation uses to go back from pixels to metres.
 
