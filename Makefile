@@ -23,8 +23,10 @@ test: $(STAMP)
 test-fast: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/python -m pytest -n $(JOBS) -q -m "not slow"
 
+# ruff for style and bugs; vulture for code that can never run
 lint: $(STAMP)
 	$(BIN)/ruff check .
+	$(BIN)/vulture minvar perception hammer_mv tools tests --min-confidence 100
 
 bench: $(STAMP)
 	$(BIN)/python tools/bench.py

@@ -26,8 +26,8 @@ def main() -> None:
     from _demos import demo_tracks
 
     from perception.batch import discover, run_batch
-    from perception.recognition.engine import recognize
     from perception.observation import observe
+    from perception.recognition.engine import recognize
     from perception.recognition.repertoire import Repertoire, SceneSpec
     from perception.synthetic.recipes import load_recipe, synthesize
 

@@ -28,10 +28,10 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from perception.io.tracks import Tracks
 from perception.synthetic.render import render_clip
 from perception.synthetic.scene import Camera, RenderStyle, Scene
 from perception.tracking.tracker import track_video
-from perception.io.tracks import Tracks
 
 _CHILD = """
 import resource, sys
