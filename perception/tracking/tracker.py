@@ -47,7 +47,7 @@ import math
 import os
 import sys
 from collections.abc import Iterable, Mapping
-from dataclasses import asdict, dataclass
+from dataclasses import asdict
 from pathlib import Path
 from typing import Any, NamedTuple
 
@@ -55,113 +55,14 @@ import cv2
 import numpy as np
 
 from perception.errors import InputError
-from perception.tracking.markers import MarkerColour, MarkerSet, default_markers
 from perception.io.tracks import Status, TracksWriter, tracks_path_for
 from perception.io.video import FrameSource
+from perception.tracking.markers import MarkerColour, MarkerSet, default_markers
+from perception.tracking.params import TrackerParams
 
 logger = logging.getLogger(__name__)
-#: Blobs of each colour considered when a hand marker is first found (largest first).
-_INIT_CANDIDATES = 6
-
 #: A region of interest: ``(x, y, width, height)``, px.
 ROI = tuple[int, int, int, int]
-
-
-@dataclass(frozen=True)
-class TrackerParams:
-    """Tracker parameters (saved to the ``/tracker`` attributes).
-
-    Parameters
-    ----------
-    min_window_px : int
-        Smallest CamShift window side, px.
-    search_margin_px : int
-        Margin around the predicted window searched each frame, px.
-    initial_margin_px : int
-        Margin used until a marker's velocity is known (first frames and
-        after re-acquisition), px; covers fast motion from rest.
-    velocity_margin : float
-        Extra margin per px/frame of predicted speed.
-    alpha, beta : float
-        Alpha-beta filter gains (position, velocity) of the motion prediction.
-    lost_ratio : float
-        Window mass below this fraction of the reference: lost.
-    reacquire_ratio : float
-        A re-acquired blob needs at least this fraction of the reference mass.
-    split_ratio : float
-        Window mass above this multiple of the reference: separate
-        same-coloured blobs by connected components.
-    merge_ratio : float
-        A component above this multiple of the reference is the marker merged
-        with something of its colour.
-    max_area_ratio : float
-        Global-search components larger than this multiple are not the marker.
-    hold_ratio : float
-        A still marker whose mass is below this fraction of the reference is
-        partly hidden and keeps its position.
-    still_jump_px : float
-        A still marker's measurement this far (px) from its estimate means it
-        was moved: the estimate restarts there.
-    still_markers : tuple of str
-        Markers expected not to move (the object).
-    term_eps_px, term_max_iter : float, int
-        CamShift termination criteria: window shift below ``term_eps_px``
-        px or ``term_max_iter`` iterations.
-    min_area_px : int
-        Smallest blob counted as a marker when initialising, px.
-    search_scale : int
-        Downscale factor of the global search (0: from the marker's size).
-    ref_update : float
-        Rate at which the reference mass follows a confidently tracked marker.
-    lost_velocity_decay : float
-        Per-frame decay of the predicted velocity while lost.
-    """
-
-    min_window_px: int = 8
-    search_margin_px: int = 10
-    initial_margin_px: int = 64
-    velocity_margin: float = 0.5
-    alpha: float = 0.85
-    beta: float = 0.5
-    lost_ratio: float = 0.3
-    reacquire_ratio: float = 0.5
-    split_ratio: float = 1.15
-    merge_ratio: float = 1.5
-    max_area_ratio: float = 4.0
-    hold_ratio: float = 0.97
-    still_jump_px: float = 2.0
-    still_markers: tuple[str, ...] = ("object",)
-    term_eps_px: float = 0.5
-    term_max_iter: int = 10
-    min_area_px: int = 12
-    search_scale: int = 0
-    ref_update: float = 0.05
-    lost_velocity_decay: float = 0.8
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "still_markers", tuple(self.still_markers))
-        if not 0 < self.lost_ratio <= self.reacquire_ratio <= 1:
-            raise ValueError(
-                "TrackerParams: expected 0 < lost_ratio <= reacquire_ratio <= 1, got "
-                f"{self.lost_ratio}, {self.reacquire_ratio}"
-            )
-        if not 1 <= self.split_ratio <= self.merge_ratio <= self.max_area_ratio:
-            raise ValueError(
-                "TrackerParams: expected 1 <= split_ratio <= merge_ratio <= max_area_ratio"
-            )
-        if self.min_window_px < 3 or self.term_max_iter < 1 or self.term_eps_px <= 0:
-            raise ValueError(
-                "TrackerParams: expected min_window_px >= 3, term_max_iter >= 1, term_eps_px > 0"
-            )
-
-    @property
-    def criteria(self) -> tuple[int, int, float]:
-        """OpenCV termination criteria for CamShift."""
-        return (
-            cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT,
-            int(self.term_max_iter),
-            float(self.term_eps_px),
-        )
 
 
 class Measurement(NamedTuple):
@@ -358,7 +259,7 @@ class Tracker:
             if tr.n_obs == 0 or np.hypot(*(z - tr.x)) > p.still_jump_px:
                 tr.x = z
             else:
-                tr.x = tr.x + max(1.0 / (tr.n_obs + 1), 0.1) * (z - tr.x)
+                tr.x = tr.x + max(1.0 / (tr.n_obs + 1), p.still_min_rate) * (z - tr.x)
             tr.v = np.zeros(2)
         elif tr.n_obs == 0:
             tr.x, tr.v = z, np.zeros(2)
@@ -376,9 +277,9 @@ class Tracker:
         tr.n_obs += 1
         tr.lost = False
         if not meas.merged:
-            tr.win = _clamp_window(meas.window, p.min_window_px, tr.ref)
+            tr.win = _clamp_window(meas.window, tr.ref, p)
             ratio = meas.mass / tr.ref
-            if 0.8 < ratio < 1.25:
+            if 1 / p.ref_update_band < ratio < p.ref_update_band:
                 tr.ref += p.ref_update * (meas.mass - tr.ref)
 
     def _mark_lost(self, tr: _Track) -> None:
@@ -476,7 +377,8 @@ class Tracker:
         if mass <= 0 or mass > p.split_ratio * tr.ref:
             return None
         centre = (mo["m10"] / mass + x0, mo["m01"] / mass + y0)
-        if mass >= p.hold_ratio * tr.ref and math.hypot(centre[0] - cx, centre[1] - cy) > 1.0:
+        shift = math.hypot(centre[0] - cx, centre[1] - cy)
+        if mass >= p.hold_ratio * tr.ref and shift > p.still_shift_px:
             return None  # whole but off-centre: it is moving
         # A blob touching the region's edge may extend beyond it: search properly.
         rh, rw = bp.shape
@@ -579,7 +481,8 @@ class Tracker:
         large a distant blob is. A still marker (the object), or a marker
         without rivals, takes its largest blob.
         """
-        cands = {j: self._candidates(self._tracks[j], frame)[:_INIT_CANDIDATES] for j in todo}
+        n_cands = self.params.init_candidates
+        cands = {j: self._candidates(self._tracks[j], frame)[:n_cands] for j in todo}
         free = [j for j in todo if cands[j] and not self._tracks[j].still
                 and self._tracks[j].roi is None]
         anchors = [t.x for t in self._tracks if t.found and not t.lost and not t.still] + [
@@ -608,7 +511,7 @@ class Tracker:
         p = self.params
         centre, area, win = blob
         tr.ref = area
-        tr.win = _clamp_window(win, p.min_window_px, tr.ref)
+        tr.win = _clamp_window(win, tr.ref, p)
         meas = self._measure(tr, frame, centre, p.search_margin_px, tr.win)
         if meas is None:
             return None
@@ -640,11 +543,12 @@ class Tracker:
 
     def _auto_scale(self) -> int:
         # Keep the smallest marker >= ~5 px across after downscaling.
+        p = self.params
         refs = [t.ref for t in self._tracks if t.found and t.ref > 0]
         if not refs:
             return 1
         diameter = 2 * math.sqrt(min(refs) / math.pi)
-        return int(min(max(diameter // 5, 1), 4))
+        return int(min(max(diameter // p.search_marker_px, 1), p.search_max_scale))
 
     def _reacquire(self, tr: _Track, frame: np.ndarray):
         """Global search while lost: nearest plausible blob to the prediction."""
@@ -656,7 +560,7 @@ class Tracker:
             return None
         areas = stats[1:, cv2.CC_STAT_AREA] * (fx * fy)
         # Downscaled areas are rough; the full-resolution refinement decides.
-        ok = (areas >= 0.25 * tr.ref) & (areas <= p.max_area_ratio * tr.ref)
+        ok = (areas >= p.search_min_ratio * tr.ref) & (areas <= p.max_area_ratio * tr.ref)
         if not ok.any():
             return None
         centres = np.column_stack(
@@ -664,7 +568,7 @@ class Tracker:
         )
         pred = tr.x
         d = np.hypot(centres[:, 0] - pred[0], centres[:, 1] - pred[1])
-        for k in np.argsort(np.where(ok, d, np.inf))[:3]:
+        for k in np.argsort(np.where(ok, d, np.inf))[: p.search_tries]:
             if not ok[k]:
                 break
             meas = self._measure(tr, frame, centres[k], p.search_margin_px, tr.win)
@@ -748,10 +652,11 @@ def _ref_side(ref: float) -> int:
     return max(int(round(2 * math.sqrt(ref / math.pi))) + 4, 3)
 
 
-def _clamp_window(win: tuple[int, int], min_side: int, ref: float) -> tuple[int, int]:
+def _clamp_window(win: tuple[int, int], ref: float, p: TrackerParams) -> tuple[int, int]:
     # Never below the minimum, never much larger than the marker itself: a
     # window allowed to grow over a same-coloured neighbour would stay on it.
-    cap = max(3 * _ref_side(ref), min_side) if ref > 0 else 10**6
+    min_side = p.min_window_px
+    cap = max(int(p.max_window_ratio * _ref_side(ref)), min_side) if ref > 0 else 10**6
     return (min(max(int(win[0]), min_side), cap), min(max(int(win[1]), min_side), cap))
 
 
