@@ -3,13 +3,13 @@ import numpy as np
 import pytest
 
 from perception.errors import InputError
+from perception.synthetic.render import SKIN_BGR, TABLE_BGR
 from perception.tracking.markers import (
     MARKER_NAMES,
     MarkerColour,
     default_markers,
     load_markers,
 )
-from perception.synthetic.render import SKIN_BGR, TABLE_BGR
 
 
 def test_default_set_order_and_render_colours_pass_their_own_gate():

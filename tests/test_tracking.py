@@ -3,10 +3,10 @@ import pytest
 from _clips import HARD, errors, render, track
 
 from perception.errors import InputError
-from perception.tracking.markers import default_markers
-from perception.synthetic.render import Distractor, Occlusion, Scene
-from perception.tracking.tracker import Tracker, TrackerParams, track_video
 from perception.io.tracks import Status, Tracks
+from perception.synthetic.render import Distractor, Occlusion, Scene
+from perception.tracking.markers import default_markers
+from perception.tracking.tracker import Tracker, TrackerParams, track_video
 
 
 def _check_accuracy(tracks, truth, visible, median=1.0, p95=3.0):

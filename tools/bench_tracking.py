@@ -28,9 +28,9 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from perception.io.tracks import Tracks
 from perception.synthetic.render import Camera, RenderStyle, Scene, render_clip
 from perception.tracking.tracker import track_video
-from perception.io.tracks import Tracks
 
 _CHILD = """
 import resource, sys
