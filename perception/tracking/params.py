@@ -16,6 +16,7 @@ measured when it is first found and then followed slowly
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import cv2
 
@@ -158,9 +159,9 @@ class TrackerParams:
                 "TrackerParams: expected ref_update_band >= 1 and 0 < still_min_rate <= 1"
             )
 
-    @property
+    @cached_property
     def criteria(self) -> tuple[int, int, float]:
-        """OpenCV termination criteria for CamShift."""
+        """OpenCV termination criteria for CamShift (computed once: it is read per measurement)."""
         return (
             cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT,
             int(self.term_max_iter),

@@ -85,8 +85,10 @@ class _Track:
     """Mutable state of one marker's track (private to one :class:`Tracker`).
 
     ``x`` and ``v`` are the alpha-beta filter's position and velocity (px,
-    px/frame), ``win`` the CamShift window (px), ``ref`` the reference mass
-    (px), ``n_obs`` the measurements since the track (re)started.
+    px/frame) as ``(x, y)`` float pairs: on two numbers numpy's per-call
+    cost would exceed the arithmetic. ``win`` is the CamShift window (px),
+    ``ref`` the reference mass (px), ``n_obs`` the measurements since the
+    track (re)started.
     """
 
     __slots__ = ("colour", "still", "roi", "found", "lost", "x", "v", "win", "ref", "n_obs",
@@ -98,12 +100,17 @@ class _Track:
         self.roi = roi
         self.found = False
         self.lost = True
-        self.x = np.zeros(2)
-        self.v = np.zeros(2)
+        self.x = (0.0, 0.0)
+        self.v = (0.0, 0.0)
         self.win = (0, 0)
         self.ref = 0.0
         self.n_obs = 0
         self.diameter = float("nan")  # apparent diameter of a still round marker, px
+
+    @property
+    def predicted(self) -> tuple[float, float]:
+        """Where the marker should be in the next frame, px."""
+        return self.x[0] + self.v[0], self.x[1] + self.v[1]
 
     def margin(self, p: TrackerParams) -> float:
         """Search margin around the predicted window, px."""
@@ -113,29 +120,31 @@ class _Track:
 
     def observe(self, meas: Measurement, p: TrackerParams) -> None:
         """Feed a measurement to the motion estimate, the window and the reference mass."""
-        z = np.asarray(meas.centre)
+        zx, zy = meas.centre
+        x, y = self.x
         if self.still:
             # A still marker's position is the running mean of its whole-blob
             # measurements, restarted when it jumps (it was moved): slight,
             # unnoticed occlusions then barely move it.
-            if self.n_obs == 0 or np.hypot(*(z - self.x)) > p.still_jump_px:
-                self.x = z
+            if self.n_obs == 0 or np.hypot(zx - x, zy - y) > p.still_jump_px:
+                self.x = (zx, zy)
             else:
-                self.x = self.x + max(1.0 / (self.n_obs + 1), p.still_min_rate) * (z - self.x)
-            self.v = np.zeros(2)
+                rate = max(1.0 / (self.n_obs + 1), p.still_min_rate)
+                self.x = (x + rate * (zx - x), y + rate * (zy - y))
+            self.v = (0.0, 0.0)
         elif self.n_obs == 0:
-            self.x, self.v = z, np.zeros(2)
+            self.x, self.v = (zx, zy), (0.0, 0.0)
         elif self.n_obs == 1:
-            self.v = z - self.x
-            self.x = z
+            self.v = (zx - x, zy - y)
+            self.x = (zx, zy)
         elif meas.merged:
             # A merged blob's centroid is unreliable: keep the velocity.
-            self.x = z
+            self.x = (zx, zy)
         else:
-            pred = self.x + self.v
-            r = z - pred
-            self.x = pred + p.alpha * r
-            self.v = self.v + p.beta * r
+            (px, py), (vx, vy) = self.predicted, self.v
+            rx, ry = zx - px, zy - py
+            self.x = (px + p.alpha * rx, py + p.alpha * ry)
+            self.v = (vx + p.beta * rx, vy + p.beta * ry)
         self.n_obs += 1
         self.lost = False
         if not meas.merged:
@@ -147,8 +156,8 @@ class _Track:
     def coast(self, p: TrackerParams) -> None:
         """Not seen this frame: the prediction moves on, slowing down."""
         if self.found:
-            self.x = self.x + self.v
-            self.v = self.v * p.lost_velocity_decay
+            self.x = self.predicted
+            self.v = (self.v[0] * p.lost_velocity_decay, self.v[1] * p.lost_velocity_decay)
         self.lost = True
         self.n_obs = 0
 
@@ -336,7 +345,7 @@ class Tracker:
         p = self.params
         meas = measure_still(frame, tr.colour, tr.x, tr.win, tr.ref, p) if tr.still else None
         if meas is None:
-            meas = measure(frame, tr.colour, tr.x + tr.v, tr.win, tr.ref, tr.margin(p), p)
+            meas = measure(frame, tr.colour, tr.predicted, tr.win, tr.ref, tr.margin(p), p)
         if meas is None:
             return None
         ratio = meas.mass / tr.ref
@@ -346,9 +355,9 @@ class Tracker:
             if ratio < p.hold_ratio:
                 # Partly hidden (the hand closing on the object): the visible
                 # part's centroid is biased, the object has not moved.
-                return (tr.x[0], tr.x[1]), min(ratio, 1.0), Status.TRACKED
+                return tr.x, min(ratio, 1.0), Status.TRACKED
             tr.observe(meas, p)
-            return (tr.x[0], tr.x[1]), likelihood(ratio), Status.TRACKED
+            return tr.x, likelihood(ratio), Status.TRACKED
         tr.observe(meas, p)
         return meas.centre, likelihood(ratio), Status.TRACKED
 
@@ -360,7 +369,7 @@ class Tracker:
             return None
         ratio = meas.mass / tr.ref
         tr.n_obs = 0
-        tr.v = np.zeros(2)
+        tr.v = (0.0, 0.0)
         tr.observe(meas, p)
         return meas.centre, likelihood(ratio), Status.REACQUIRED
 
