@@ -5,7 +5,12 @@ import inspect
 
 import pytest
 
-MODULES = ["tracking.markers", "io.video", "io.tracks", "synthetic.render", "tracking.tracker"]
+MODULES = [
+    "tracking", "tracking.markers", "tracking.params", "tracking.blobs", "tracking.measurement",
+    "tracking.detection", "tracking.tracker", "io.video", "io.tracks", "io.repertoire",
+    "synthetic.scene", "synthetic.render", "synthetic.demos", "geometry", "observation",
+    "pipeline", "recognition.models", "recognition.engine", "recognition.scoring",
+]
 
 
 def _public(module):

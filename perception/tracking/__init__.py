@@ -1,0 +1,39 @@
+"""Colour-marker tracking: videos of marked hands -> tracks files.
+
+``from perception.tracking import track_video`` is all most users need;
+:class:`Tracker` tracks frame by frame. The modules, each one job:
+
+* :mod:`~perception.tracking.markers` — the colour models (``docs/markers.md``).
+* :mod:`~perception.tracking.params` — :class:`TrackerParams`, every tunable.
+* :mod:`~perception.tracking.blobs` — connected components of a colour mask.
+* :mod:`~perception.tracking.measurement` — locating a marker near a prediction
+  (CamShift, splitting merged blobs, the still-object fast path, its diameter).
+* :mod:`~perception.tracking.detection` — finding markers without a prediction
+  (first detection, re-acquisition of lost markers).
+* :mod:`~perception.tracking.tracker` — the per-frame loop and motion
+  prediction, :func:`track_frames`, :func:`track_video`.
+
+The tracks file it writes is described in ``docs/tracks-format.md``.
+"""
+
+from perception.tracking.markers import (
+    MARKER_NAMES,
+    MarkerColour,
+    MarkerSet,
+    default_markers,
+    load_markers,
+)
+from perception.tracking.params import TrackerParams
+from perception.tracking.tracker import Tracker, track_frames, track_video
+
+__all__ = [
+    "MARKER_NAMES",
+    "MarkerColour",
+    "MarkerSet",
+    "Tracker",
+    "TrackerParams",
+    "default_markers",
+    "load_markers",
+    "track_frames",
+    "track_video",
+]

@@ -1,180 +1,95 @@
 """CamShift colour-marker tracker that survives real footage.
 
-Each marker has a colour model (:mod:`perception.tracking.markers`) and its own
-search window. Per frame and marker:
+Each marker has a colour model (:mod:`perception.tracking.markers`;
+``docs/markers.md``) and its own search window. :class:`Tracker` is the
+per-frame loop; for each marker and frame it decides what to do and
+delegates:
 
-1. **Prediction.** An alpha-beta filter predicts the marker's position; the
-   search region is the window around the prediction plus a margin that
-   grows with speed. Only this region is converted to HSV and
-   back-projected, so decoding, not tracking, limits throughput.
-2. **CamShift** on the back-projection (hue range, saturation and value
-   minimums) from the predicted window, with a minimum window size.
-3. **Measurement.** Centroid and mass (pixel count) of the back-projection in
-   the converged window. If the mass is well above the marker's reference
-   mass, same-coloured pixels joined the window (a distractor): connected
-   components in the region split them and the component nearest the
-   prediction is kept; if the blobs touch, the centroid is taken in a
-   reference-sized window at the prediction and the likelihood drops.
-4. **Lost test.** A mass below ``lost_ratio`` x reference means the marker is
+1. **Not found yet: first detection** (:mod:`perception.tracking.detection`).
+   Markers are found automatically on the first frames (the largest blob of
+   each colour; among blobs of comparable size a hand marker takes the one
+   nearest the other hand markers) or inside user-given ROIs.
+2. **Tracked: follow.** An alpha-beta filter predicts the marker's position;
+   the search region is the window around the prediction plus a margin that
+   grows with speed. CamShift there gives the centroid and mass (pixel
+   count) of the marker's colour, splitting off same-coloured blobs that
+   joined the window (:mod:`perception.tracking.measurement`).
+3. **Lost test.** A mass below ``lost_ratio`` x reference means the marker is
    hidden or gone: it is reported lost (NaN, likelihood 0, status 2), never
    as a stale position.
-5. **Re-acquisition**, only once the local search has failed and while the
-   marker stays lost: connected components of the thresholded
-   back-projection of a downscaled full frame (computed once per frame for
-   all lost markers); the one nearest the prediction with a plausible area is
-   refined at full resolution and reported with status 1.
+4. **Lost: re-acquisition**, only once the local search has failed and while
+   the marker stays lost: a global search of a downscaled frame for the
+   plausible blob nearest the prediction, refined at full resolution and
+   reported with status 1 (:mod:`perception.tracking.detection`).
 
-Markers are found automatically on the first frames (the largest blob of
-each colour; among blobs of comparable size a hand marker takes the one
-nearest the other hand markers) or inside user-given ROIs. Markers listed in
-``still_markers`` (the object) are expected to stay put and to be partly
-hidden by the hand at the end: their position is the running mean of
-whole-blob measurements (restarted if the blob jumps, i.e. the object was
-moved), and while less than ``hold_ratio`` of the blob is visible the
-position is held, with likelihood equal to the visible fraction.
+Markers listed in ``still_markers`` (the object) are expected to stay put and
+to be partly hidden by the hand at the end: their position is the running
+mean of whole-blob measurements (restarted if the blob jumps, i.e. the
+object was moved), and while less than ``hold_ratio`` of the blob is visible
+the position is held, with likelihood equal to the visible fraction.
 
 Likelihood is ``min(r, 1/r)`` with ``r`` the measured mass over the
 reference mass: 1 for a whole, uncontaminated marker; lower when partly
-hidden or merged with similar colour.
+hidden or merged with similar colour. The tunables are
+:class:`~perception.tracking.params.TrackerParams`; the tracks file, its
+status codes and the ``/tracker`` attributes are described in
+``docs/tracks-format.md``.
 """
 
 from __future__ import annotations
 
-import itertools
 import json
 import logging
 import math
 import os
 import sys
 from collections.abc import Iterable, Mapping
-from dataclasses import asdict, dataclass
+from dataclasses import asdict
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import Any
 
-import cv2
 import numpy as np
 
 from perception.errors import InputError
 from perception.io.tracks import Status, TracksWriter, tracks_path_for
 from perception.io.video import FrameSource
+from perception.tracking.blobs import Blob
+from perception.tracking.detection import (
+    ROI,
+    closest_combination,
+    downscaled_hsv,
+    find_candidates,
+    reacquire,
+    search_scale,
+)
 from perception.tracking.markers import MarkerColour, MarkerSet, default_markers
+from perception.tracking.measurement import (
+    Measurement,
+    clamp_window,
+    likelihood,
+    measure,
+    measure_still,
+    soft_diameter,
+)
+from perception.tracking.params import TrackerParams
+
+__all__ = ["ROI", "Measurement", "Tracker", "TrackerParams", "track_frames", "track_video"]
 
 logger = logging.getLogger(__name__)
-#: Blobs of each colour considered when a hand marker is first found (largest first).
-_INIT_CANDIDATES = 6
 
-#: A region of interest: ``(x, y, width, height)``, px.
-ROI = tuple[int, int, int, int]
-
-
-@dataclass(frozen=True)
-class TrackerParams:
-    """Tracker parameters (saved to the ``/tracker`` attributes).
-
-    Parameters
-    ----------
-    min_window_px : int
-        Smallest CamShift window side, px.
-    search_margin_px : int
-        Margin around the predicted window searched each frame, px.
-    initial_margin_px : int
-        Margin used until a marker's velocity is known (first frames and
-        after re-acquisition), px; covers fast motion from rest.
-    velocity_margin : float
-        Extra margin per px/frame of predicted speed.
-    alpha, beta : float
-        Alpha-beta filter gains (position, velocity) of the motion prediction.
-    lost_ratio : float
-        Window mass below this fraction of the reference: lost.
-    reacquire_ratio : float
-        A re-acquired blob needs at least this fraction of the reference mass.
-    split_ratio : float
-        Window mass above this multiple of the reference: separate
-        same-coloured blobs by connected components.
-    merge_ratio : float
-        A component above this multiple of the reference is the marker merged
-        with something of its colour.
-    max_area_ratio : float
-        Global-search components larger than this multiple are not the marker.
-    hold_ratio : float
-        A still marker whose mass is below this fraction of the reference is
-        partly hidden and keeps its position.
-    still_jump_px : float
-        A still marker's measurement this far (px) from its estimate means it
-        was moved: the estimate restarts there.
-    still_markers : tuple of str
-        Markers expected not to move (the object).
-    term_eps_px, term_max_iter : float, int
-        CamShift termination criteria: window shift below ``term_eps_px``
-        px or ``term_max_iter`` iterations.
-    min_area_px : int
-        Smallest blob counted as a marker when initialising, px.
-    search_scale : int
-        Downscale factor of the global search (0: from the marker's size).
-    ref_update : float
-        Rate at which the reference mass follows a confidently tracked marker.
-    lost_velocity_decay : float
-        Per-frame decay of the predicted velocity while lost.
-    """
-
-    min_window_px: int = 8
-    search_margin_px: int = 10
-    initial_margin_px: int = 64
-    velocity_margin: float = 0.5
-    alpha: float = 0.85
-    beta: float = 0.5
-    lost_ratio: float = 0.3
-    reacquire_ratio: float = 0.5
-    split_ratio: float = 1.15
-    merge_ratio: float = 1.5
-    max_area_ratio: float = 4.0
-    hold_ratio: float = 0.97
-    still_jump_px: float = 2.0
-    still_markers: tuple[str, ...] = ("object",)
-    term_eps_px: float = 0.5
-    term_max_iter: int = 10
-    min_area_px: int = 12
-    search_scale: int = 0
-    ref_update: float = 0.05
-    lost_velocity_decay: float = 0.8
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "still_markers", tuple(self.still_markers))
-        if not 0 < self.lost_ratio <= self.reacquire_ratio <= 1:
-            raise ValueError(
-                "TrackerParams: expected 0 < lost_ratio <= reacquire_ratio <= 1, got "
-                f"{self.lost_ratio}, {self.reacquire_ratio}"
-            )
-        if not 1 <= self.split_ratio <= self.merge_ratio <= self.max_area_ratio:
-            raise ValueError(
-                "TrackerParams: expected 1 <= split_ratio <= merge_ratio <= max_area_ratio"
-            )
-        if self.min_window_px < 3 or self.term_max_iter < 1 or self.term_eps_px <= 0:
-            raise ValueError(
-                "TrackerParams: expected min_window_px >= 3, term_max_iter >= 1, term_eps_px > 0"
-            )
-
-    @property
-    def criteria(self) -> tuple[int, int, float]:
-        """OpenCV termination criteria for CamShift."""
-        return (
-            cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT,
-            int(self.term_max_iter),
-            float(self.term_eps_px),
-        )
-
-
-class Measurement(NamedTuple):
-    """One marker located in one frame: centre (x, y) px, mass px, window (w, h) px."""
-
-    centre: tuple[float, float]
-    mass: float
-    window: tuple[int, int]
-    merged: bool = False
+#: What locating a marker in a frame gives: centre (x, y) px, likelihood, status.
+_Located = tuple[tuple[float, float], float, int]
 
 
 class _Track:
-    """Mutable state of one marker's track (private to one :class:`Tracker`)."""
+    """Mutable state of one marker's track (private to one :class:`Tracker`).
+
+    ``x`` and ``v`` are the alpha-beta filter's position and velocity (px,
+    px/frame) as ``(x, y)`` float pairs: on two numbers numpy's per-call
+    cost would exceed the arithmetic. ``win`` is the CamShift window (px),
+    ``ref`` the reference mass (px), ``n_obs`` the measurements since the
+    track (re)started.
+    """
 
     __slots__ = ("colour", "still", "roi", "found", "lost", "x", "v", "win", "ref", "n_obs",
                  "diameter")
@@ -185,12 +100,66 @@ class _Track:
         self.roi = roi
         self.found = False
         self.lost = True
-        self.x = np.zeros(2)
-        self.v = np.zeros(2)
+        self.x = (0.0, 0.0)
+        self.v = (0.0, 0.0)
         self.win = (0, 0)
         self.ref = 0.0
         self.n_obs = 0
         self.diameter = float("nan")  # apparent diameter of a still round marker, px
+
+    @property
+    def predicted(self) -> tuple[float, float]:
+        """Where the marker should be in the next frame, px."""
+        return self.x[0] + self.v[0], self.x[1] + self.v[1]
+
+    def margin(self, p: TrackerParams) -> float:
+        """Search margin around the predicted window, px."""
+        if self.n_obs < 2 and not self.still:
+            return p.initial_margin_px
+        return p.search_margin_px + p.velocity_margin * math.hypot(self.v[0], self.v[1])
+
+    def observe(self, meas: Measurement, p: TrackerParams) -> None:
+        """Feed a measurement to the motion estimate, the window and the reference mass."""
+        zx, zy = meas.centre
+        x, y = self.x
+        if self.still:
+            # A still marker's position is the running mean of its whole-blob
+            # measurements, restarted when it jumps (it was moved): slight,
+            # unnoticed occlusions then barely move it.
+            if self.n_obs == 0 or np.hypot(zx - x, zy - y) > p.still_jump_px:
+                self.x = (zx, zy)
+            else:
+                rate = max(1.0 / (self.n_obs + 1), p.still_min_rate)
+                self.x = (x + rate * (zx - x), y + rate * (zy - y))
+            self.v = (0.0, 0.0)
+        elif self.n_obs == 0:
+            self.x, self.v = (zx, zy), (0.0, 0.0)
+        elif self.n_obs == 1:
+            self.v = (zx - x, zy - y)
+            self.x = (zx, zy)
+        elif meas.merged:
+            # A merged blob's centroid is unreliable: keep the velocity.
+            self.x = (zx, zy)
+        else:
+            (px, py), (vx, vy) = self.predicted, self.v
+            rx, ry = zx - px, zy - py
+            self.x = (px + p.alpha * rx, py + p.alpha * ry)
+            self.v = (vx + p.beta * rx, vy + p.beta * ry)
+        self.n_obs += 1
+        self.lost = False
+        if not meas.merged:
+            self.win = clamp_window(meas.window, self.ref, p)
+            ratio = meas.mass / self.ref
+            if 1 / p.ref_update_band < ratio < p.ref_update_band:
+                self.ref += p.ref_update * (meas.mass - self.ref)
+
+    def coast(self, p: TrackerParams) -> None:
+        """Not seen this frame: the prediction moves on, slowing down."""
+        if self.found:
+            self.x = self.predicted
+            self.v = (self.v[0] * p.lost_velocity_decay, self.v[1] * p.lost_velocity_decay)
+        self.lost = True
+        self.n_obs = 0
 
 
 class Tracker:
@@ -232,7 +201,6 @@ class Tracker:
             _Track(m, m.name in self.params.still_markers, self.rois.get(m.name))
             for m in self.markers
         ]
-        self._criteria = self.params.criteria
         self.n_frames = 0
         self._frame_shape: tuple[int, int] | None = None
         self._small: tuple[np.ndarray, float, float] | None = None
@@ -282,19 +250,10 @@ class Tracker:
         status : (M,) int8
             :class:`~perception.io.tracks.Status` codes.
         """
-        if frame.ndim != 3 or frame.shape[2] != 3 or frame.dtype != np.uint8:
-            raise ValueError(
-                f"Tracker.update: expected an (H, W, 3) uint8 BGR frame, got {frame.shape} "
-                f"{frame.dtype}"
-            )
-        if self._frame_shape is None:
-            self._frame_shape = frame.shape[:2]
-            for t in self._tracks:
-                if t.roi is not None:
-                    _roi_in_frame(t.colour.name, t.roi, frame.shape)
+        self._check_frame(frame)
         m = len(self._tracks)
         position = np.full((m, 2), np.nan)
-        likelihood = np.zeros(m, np.float32)
+        lik = np.zeros(m, np.float32)
         status = np.full(m, Status.LOST, np.int8)
         self._small = None
         todo = [j for j, tr in enumerate(self._tracks) if not tr.found]
@@ -309,315 +268,68 @@ class Tracker:
             if tr.found and result is None:
                 result = self._reacquire(tr, frame)
             if result is None:
-                self._mark_lost(tr)
+                tr.coast(self.params)
                 continue
-            (cx, cy), lik, st = result
-            position[j, 0] = cx
-            position[j, 1] = cy
-            likelihood[j] = lik
-            status[j] = st
+            (position[j, 0], position[j, 1]), lik[j], status[j] = result
         self.n_frames += 1
-        return position, likelihood, status
+        return position, lik, status
 
     # -- steps --------------------------------------------------------------
-    def _margin(self, tr: _Track) -> float:
-        p = self.params
-        if tr.n_obs < 2 and not tr.still:
-            return p.initial_margin_px
-        return p.search_margin_px + p.velocity_margin * math.hypot(tr.v[0], tr.v[1])
-
-    def _follow(self, tr: _Track, frame: np.ndarray):
-        """Track from the prediction; None if the marker is not in its region."""
-        p = self.params
-        meas = self._measure_still(tr, frame) if tr.still else None
-        if meas is None:
-            meas = self._measure(tr, frame, tr.x + tr.v, self._margin(tr), tr.win)
-        if meas is None:
-            return None
-        ratio = meas.mass / tr.ref
-        if ratio < p.lost_ratio:
-            return None
-        if tr.still:
-            if ratio < p.hold_ratio:
-                # Partly hidden (the hand closing on the object): the visible
-                # part's centroid is biased, the object has not moved.
-                return (tr.x[0], tr.x[1]), min(ratio, 1.0), Status.TRACKED
-            self._observe(tr, meas)
-            return (tr.x[0], tr.x[1]), _likelihood(ratio), Status.TRACKED
-        self._observe(tr, meas)
-        return meas.centre, _likelihood(ratio), Status.TRACKED
-
-    def _observe(self, tr: _Track, meas: Measurement) -> None:
-        """Feed a measurement to the alpha-beta filter and the reference mass."""
-        p = self.params
-        z = np.asarray(meas.centre)
-        if tr.still:
-            # A still marker's position is the running mean of its whole-blob
-            # measurements, restarted when it jumps (it was moved): slight,
-            # unnoticed occlusions then barely move it.
-            if tr.n_obs == 0 or np.hypot(*(z - tr.x)) > p.still_jump_px:
-                tr.x = z
-            else:
-                tr.x = tr.x + max(1.0 / (tr.n_obs + 1), 0.1) * (z - tr.x)
-            tr.v = np.zeros(2)
-        elif tr.n_obs == 0:
-            tr.x, tr.v = z, np.zeros(2)
-        elif tr.n_obs == 1:
-            tr.v = z - tr.x
-            tr.x = z
-        elif meas.merged:
-            # A merged blob's centroid is unreliable: keep the velocity.
-            tr.x = z
-        else:
-            pred = tr.x + tr.v
-            r = z - pred
-            tr.x = pred + p.alpha * r
-            tr.v = tr.v + p.beta * r
-        tr.n_obs += 1
-        tr.lost = False
-        if not meas.merged:
-            tr.win = _clamp_window(meas.window, p.min_window_px, tr.ref)
-            ratio = meas.mass / tr.ref
-            if 0.8 < ratio < 1.25:
-                tr.ref += p.ref_update * (meas.mass - tr.ref)
-
-    def _mark_lost(self, tr: _Track) -> None:
-        if tr.found:
-            tr.x = tr.x + tr.v
-            tr.v = tr.v * self.params.lost_velocity_decay
-        tr.lost = True
-        tr.n_obs = 0
-
-    def _measure(
-        self,
-        tr: _Track,
-        frame: np.ndarray,
-        centre: np.ndarray,
-        margin: float,
-        window: tuple[int, int],
-        recentre: bool = True,
-    ) -> Measurement | None:
-        """CamShift in the region around ``centre``; centroid and mass of the result.
-
-        If the blob reaches the region's edge (the marker moved further than
-        the margin allowed for), the region is centred on it and measured once
-        more, so a cut-off blob never biases the centroid.
-        """
-        p = self.params
-        h, w = frame.shape[:2]
-        ww, wh = window
-        cx, cy = float(centre[0]), float(centre[1])
-        if not (math.isfinite(cx) and math.isfinite(cy)):
-            return None
-        x0 = max(int(cx - ww / 2 - margin), 0)
-        x1 = min(int(cx + ww / 2 + margin) + 1, w)
-        y0 = max(int(cy - wh / 2 - margin), 0)
-        y1 = min(int(cy + wh / 2 + margin) + 1, h)
-        if x1 - x0 < 3 or y1 - y0 < 3:
-            return None  # the prediction left the frame
-        hsv = cv2.cvtColor(frame[y0:y1, x0:x1], cv2.COLOR_BGR2HSV)
-        bp = tr.colour.backproject(hsv)
-        rw, rh = x1 - x0, y1 - y0
-        wx = min(max(int(round(cx - ww / 2)) - x0, 0), rw - 1)
-        wy = min(max(int(round(cy - wh / 2)) - y0, 0), rh - 1)
-        win = (wx, wy, max(min(ww, rw - wx), 1), max(min(wh, rh - wy), 1))
-        box, (bx, by, bw, bh) = cv2.CamShift(bp, win, self._criteria)
-        if box[1][0] <= 0 or bw <= 0 or bh <= 0:
-            # Nothing of the colour in the window: look for it in the region.
-            found = self._nearest_component(bp, (cx - x0, cy - y0), tr.ref)
-            if found is None:
-                return None
-            box, (bx, by, bw, bh) = cv2.CamShift(bp, found, self._criteria)
-            if box[1][0] <= 0 or bw <= 0 or bh <= 0:
-                return None
-        # CamShift's window of a round blob can be as small as 0.71 x its
-        # diameter (it boxes the rotated ellipse axis by axis): measure in a
-        # square 1.5 x larger around its centre so the whole blob counts.
-        half = 0.75 * max(bw, bh) + 2
-        bcx, bcy = box[0]
-        mx0, my0 = max(int(bcx - half), 0), max(int(bcy - half), 0)
-        mx1, my1 = min(int(bcx + half) + 2, rw), min(int(bcy + half) + 2, rh)
-        mo = cv2.moments(bp[my0:my1, mx0:mx1], True)
-        mass = mo["m00"]
-        if mass <= 0:
-            return None
-        # Next window: the blob's extent (4 sigma per axis, 2r for a disc).
-        extent = (
-            int(4 * math.sqrt(mo["mu20"] / mass)) + 4,
-            int(4 * math.sqrt(mo["mu02"] / mass)) + 4,
-        )
-        meas = Measurement((mo["m10"] / mass + x0 + mx0, mo["m01"] / mass + y0 + my0), mass, extent)
-        if tr.ref > 0 and mass > p.split_ratio * tr.ref:
-            meas = self._split(tr, bp, (x0, y0), (cx - x0, cy - y0)) or meas
-        if recentre and not meas.merged and _cut_off(bp, meas, (x0, y0, x1, y1), (w, h)):
-            again = self._measure(tr, frame, meas.centre, p.search_margin_px, meas.window, False)
-            if again is not None:
-                return again
-        return meas
-
-    def _measure_still(self, tr: _Track, frame: np.ndarray) -> Measurement | None:
-        """Moments in the window of a marker that has not moved; None if it seems to have.
-
-        A still object needs no mean-shift search while it stays put: one
-        moments call at its position costs a third of a CamShift. Any sign
-        of motion or of a neighbour of its colour falls back to :meth:`_measure`.
-        """
-        p = self.params
-        h, w = frame.shape[:2]
-        half = 0.5 * max(tr.win) + 4
-        cx, cy = float(tr.x[0]), float(tr.x[1])
-        x0, y0 = max(int(cx - half), 0), max(int(cy - half), 0)
-        x1, y1 = min(int(cx + half) + 2, w), min(int(cy + half) + 2, h)
-        if x1 - x0 < 3 or y1 - y0 < 3:
-            return None
-        bp = tr.colour.backproject(cv2.cvtColor(frame[y0:y1, x0:x1], cv2.COLOR_BGR2HSV))
-        mo = cv2.moments(bp, True)
-        mass = mo["m00"]
-        if mass <= 0 or mass > p.split_ratio * tr.ref:
-            return None
-        centre = (mo["m10"] / mass + x0, mo["m01"] / mass + y0)
-        if mass >= p.hold_ratio * tr.ref and math.hypot(centre[0] - cx, centre[1] - cy) > 1.0:
-            return None  # whole but off-centre: it is moving
-        # A blob touching the region's edge may extend beyond it: search properly.
-        rh, rw = bp.shape
-        if (
-            (x0 > 0 and cv2.countNonZero(bp[:, 0]))
-            or (y0 > 0 and cv2.countNonZero(bp[0, :]))
-            or (x1 < w and cv2.countNonZero(bp[:, rw - 1]))
-            or (y1 < h and cv2.countNonZero(bp[rh - 1, :]))
-        ):
-            return None
-        extent = (
-            int(4 * math.sqrt(mo["mu20"] / mass)) + 4,
-            int(4 * math.sqrt(mo["mu02"] / mass)) + 4,
-        )
-        return Measurement(centre, mass, extent)
-
-    def _nearest_component(
-        self, bp: np.ndarray, centre: tuple[float, float], ref: float
-    ) -> tuple[int, int, int, int] | None:
-        """Bounding box of the plausible blob nearest ``centre`` (region coords)."""
-        n, _, stats, cents = cv2.connectedComponentsWithStats(bp, connectivity=8)
-        if n <= 1:
-            return None
-        areas = stats[1:, cv2.CC_STAT_AREA]
-        ok = areas >= max(self.params.lost_ratio * ref, 1)
-        if not ok.any():
-            return None
-        d = np.hypot(cents[1:, 0] - centre[0], cents[1:, 1] - centre[1])
-        k = int(np.argmin(np.where(ok, d, np.inf))) + 1
-        x, y, bw, bh = (int(v) for v in stats[k, :4])
-        return x, y, bw, bh
-
-    def _split(
-        self, tr: _Track, bp: np.ndarray, offset: tuple[int, int], pred: tuple[float, float]
-    ) -> Measurement | None:
-        """Separate same-coloured blobs that joined the window; keep the nearest."""
-        p = self.params
-        n, _, stats, cents = cv2.connectedComponentsWithStats(bp, connectivity=8)
-        if n <= 1:
-            return None
-        areas = stats[1:, cv2.CC_STAT_AREA].astype(np.float64)
-        ok = areas >= p.lost_ratio * tr.ref
-        if not ok.any():
-            return None
-        d = np.hypot(cents[1:, 0] - pred[0], cents[1:, 1] - pred[1])
-        k = int(np.argmin(np.where(ok, d, np.inf)))
-        area = areas[k]
-        if area <= p.merge_ratio * tr.ref:
-            c = cents[k + 1]
-            w, h = int(stats[k + 1, cv2.CC_STAT_WIDTH]), int(stats[k + 1, cv2.CC_STAT_HEIGHT])
-            return Measurement((c[0] + offset[0], c[1] + offset[1]), area, (w, h))
-        # Touching blobs: take the centroid in a reference-sized window at the
-        # prediction, so the neighbour can pull the estimate only partly.
-        side = _ref_side(tr.ref)
-        x0 = max(int(round(pred[0] - side / 2)), 0)
-        y0 = max(int(round(pred[1] - side / 2)), 0)
-        mo = cv2.moments(bp[y0 : y0 + side, x0 : x0 + side], True)
-        if mo["m00"] <= 0:
-            return None
-        centre = (mo["m10"] / mo["m00"] + x0 + offset[0], mo["m01"] / mo["m00"] + y0 + offset[1])
-        return Measurement(centre, area, tr.win, merged=True)
-
-    def _candidates(self, tr: _Track, frame: np.ndarray) -> list[tuple[np.ndarray, float, tuple]]:
-        """Blobs of a marker's colour (in its ROI, if any), largest first.
-
-        Each is ``(centre (2,) px, area px, (w, h) px)``.
-        """
-        if tr.roi is not None:
-            if self.n_frames > 0:
-                return []
-            x, y, w, h = tr.roi
-            region, offset = frame[y : y + h, x : x + w], np.array([x, y])
-        else:
-            region, offset = frame, np.zeros(2)
-        bp = tr.colour.backproject(cv2.cvtColor(region, cv2.COLOR_BGR2HSV))
-        n, _, stats, cents = cv2.connectedComponentsWithStats(bp, connectivity=8)
-        out = [
-            (
-                cents[k] + offset,
-                float(stats[k, cv2.CC_STAT_AREA]),
-                (int(stats[k, cv2.CC_STAT_WIDTH]), int(stats[k, cv2.CC_STAT_HEIGHT])),
+    def _check_frame(self, frame: np.ndarray) -> None:
+        if frame.ndim != 3 or frame.shape[2] != 3 or frame.dtype != np.uint8:
+            raise ValueError(
+                f"Tracker.update: expected an (H, W, 3) uint8 BGR frame, got {frame.shape} "
+                f"{frame.dtype}"
             )
-            for k in range(1, n)
-            if stats[k, cv2.CC_STAT_AREA] >= self.params.min_area_px
+        if self._frame_shape is None:
+            self._frame_shape = frame.shape[:2]
+            for t in self._tracks:
+                if t.roi is not None:
+                    _roi_in_frame(t.colour.name, t.roi, frame.shape)
+
+    def _initialise(self, frame: np.ndarray, todo: list[int]) -> dict[int, _Located | None]:
+        """Find markers for the first time (see :mod:`perception.tracking.detection`).
+
+        Hand markers without a ROI are chosen together, as the combination
+        lying closest together and to the hand markers already placed
+        (tracked ones, and those given a ROI).
+        """
+        p, tracks = self.params, self._tracks
+        cands = {j: self._candidates(tracks[j], frame)[: p.init_candidates] for j in todo}
+        hand = [j for j in todo if cands[j] and not tracks[j].still]
+        free = [j for j in hand if tracks[j].roi is None]
+        anchors = [t.x for t in tracks if t.found and not t.lost and not t.still] + [
+            cands[j][0].centre for j in hand if tracks[j].roi is not None
         ]
-        if not out and tr.roi is not None:
-            raise InputError(
-                f"{tr.colour.name}: nothing of its colour in the ROI {list(tr.roi)} "
-                "on the first frame"
-            )
-        return sorted(out, key=lambda c: -c[1])
-
-    def _initialise(self, frame: np.ndarray, todo: list[int]) -> dict[int, Any]:
-        """Find markers for the first time.
-
-        The hand's markers sit within a hand's width of each other, while
-        same-coloured things on the table need not: of the few largest blobs
-        of each hand marker's colour, the combination whose markers lie
-        closest together (with any hand marker already tracked) wins, however
-        large a distant blob is. A still marker (the object), or a marker
-        without rivals, takes its largest blob.
-        """
-        cands = {j: self._candidates(self._tracks[j], frame)[:_INIT_CANDIDATES] for j in todo}
-        free = [j for j in todo if cands[j] and not self._tracks[j].still
-                and self._tracks[j].roi is None]
-        anchors = [t.x for t in self._tracks if t.found and not t.lost and not t.still] + [
-            cands[j][0][0] for j in todo if cands[j] and not self._tracks[j].still
-            and self._tracks[j].roi is not None]
-        chosen: dict[int, tuple] = {}
+        chosen: dict[int, Blob] = {}
         if free and len(free) + len(anchors) >= 2:
-
-            def spread(combo):
-                pts = [cands[j][k][0] for j, k in zip(free, combo)] + anchors
-                return sum(float(np.hypot(*(p - q))) for i, p in enumerate(pts)
-                           for q in pts[i + 1:])
-
-            best = min(itertools.product(*(range(len(cands[j])) for j in free)), key=spread)
+            best = closest_combination([cands[j] for j in free], anchors)
             chosen = {j: cands[j][k] for j, k in zip(free, best)}
-        results: dict[int, Any] = {}
-        for j in todo:
-            if not cands[j]:
-                results[j] = None
-                continue
-            results[j] = self._start(self._tracks[j], frame, chosen.get(j, cands[j][0]))
-        return results
+        return {
+            j: self._start(tracks[j], frame, chosen.get(j, cands[j][0])) if cands[j] else None
+            for j in todo
+        }
 
-    def _start(self, tr: _Track, frame: np.ndarray, blob: tuple[np.ndarray, float, tuple]):
-        """Begin a track on a blob found by :meth:`_candidates`."""
+    def _candidates(self, tr: _Track, frame: np.ndarray) -> list[Blob]:
+        # A ROI says where the marker is on the first frame only.
+        if tr.roi is not None and self.n_frames > 0:
+            return []
+        return find_candidates(frame, tr.colour, self.params.min_area_px, tr.roi)
+
+    def _start(self, tr: _Track, frame: np.ndarray, blob: Blob) -> _Located | None:
+        """Begin a track on a blob found by first detection."""
         p = self.params
-        centre, area, win = blob
-        tr.ref = area
-        tr.win = _clamp_window(win, p.min_window_px, tr.ref)
-        meas = self._measure(tr, frame, centre, p.search_margin_px, tr.win)
+        tr.ref = blob.area
+        tr.win = clamp_window(blob.size, tr.ref, p)
+        meas = measure(frame, tr.colour, blob.centre, tr.win, tr.ref, p.search_margin_px, p)
         if meas is None:
             return None
         tr.found = True
         tr.ref = meas.mass
         tr.n_obs = 0
         if tr.still and not np.isfinite(tr.diameter):
-            tr.diameter = _soft_diameter(frame, tr.colour, meas.centre, meas.window)
-        self._observe(tr, meas)
+            tr.diameter = soft_diameter(frame, tr.colour, meas.centre, meas.window)
+        tr.observe(meas, p)
         logger.info(
             "%s found at (%.1f, %.1f) px on frame %d, %d px of its colour",
             tr.colour.name,
@@ -628,131 +340,45 @@ class Tracker:
         status = Status.TRACKED if self.n_frames == 0 else Status.REACQUIRED
         return meas.centre, 1.0, status
 
+    def _follow(self, tr: _Track, frame: np.ndarray) -> _Located | None:
+        """Track from the prediction; None if the marker is not in its region."""
+        p = self.params
+        meas = measure_still(frame, tr.colour, tr.x, tr.win, tr.ref, p) if tr.still else None
+        if meas is None:
+            meas = measure(frame, tr.colour, tr.predicted, tr.win, tr.ref, tr.margin(p), p)
+        if meas is None:
+            return None
+        ratio = meas.mass / tr.ref
+        if ratio < p.lost_ratio:
+            return None
+        if tr.still:
+            if ratio < p.hold_ratio:
+                # Partly hidden (the hand closing on the object): the visible
+                # part's centroid is biased, the object has not moved.
+                return tr.x, min(ratio, 1.0), Status.TRACKED
+            tr.observe(meas, p)
+            return tr.x, likelihood(ratio), Status.TRACKED
+        tr.observe(meas, p)
+        return meas.centre, likelihood(ratio), Status.TRACKED
+
+    def _reacquire(self, tr: _Track, frame: np.ndarray) -> _Located | None:
+        """Global search while lost (see :func:`perception.tracking.detection.reacquire`)."""
+        p = self.params
+        meas = reacquire(frame, self._small_hsv(frame), tr.colour, tr.ref, tr.x, tr.win, p)
+        if meas is None:
+            return None
+        ratio = meas.mass / tr.ref
+        tr.n_obs = 0
+        tr.v = (0.0, 0.0)
+        tr.observe(meas, p)
+        return meas.centre, likelihood(ratio), Status.REACQUIRED
+
     def _small_hsv(self, frame: np.ndarray) -> tuple[np.ndarray, float, float]:
         """Downscaled HSV of the whole frame, once per frame, for the global search."""
         if self._small is None:
-            k = self.params.search_scale or self._auto_scale()
-            h, w = frame.shape[:2]
-            sw, sh = max(w // k, 1), max(h // k, 1)
-            small = cv2.resize(frame, (sw, sh), interpolation=cv2.INTER_AREA)
-            self._small = (cv2.cvtColor(small, cv2.COLOR_BGR2HSV), w / sw, h / sh)
+            refs = [t.ref for t in self._tracks if t.found and t.ref > 0]
+            self._small = downscaled_hsv(frame, search_scale(refs, self.params))
         return self._small
-
-    def _auto_scale(self) -> int:
-        # Keep the smallest marker >= ~5 px across after downscaling.
-        refs = [t.ref for t in self._tracks if t.found and t.ref > 0]
-        if not refs:
-            return 1
-        diameter = 2 * math.sqrt(min(refs) / math.pi)
-        return int(min(max(diameter // 5, 1), 4))
-
-    def _reacquire(self, tr: _Track, frame: np.ndarray):
-        """Global search while lost: nearest plausible blob to the prediction."""
-        p = self.params
-        hsv, fx, fy = self._small_hsv(frame)
-        bp = tr.colour.backproject(hsv)
-        n, _, stats, cents = cv2.connectedComponentsWithStats(bp, connectivity=8)
-        if n <= 1:
-            return None
-        areas = stats[1:, cv2.CC_STAT_AREA] * (fx * fy)
-        # Downscaled areas are rough; the full-resolution refinement decides.
-        ok = (areas >= 0.25 * tr.ref) & (areas <= p.max_area_ratio * tr.ref)
-        if not ok.any():
-            return None
-        centres = np.column_stack(
-            ((cents[1:, 0] + 0.5) * fx - 0.5, (cents[1:, 1] + 0.5) * fy - 0.5)
-        )
-        pred = tr.x
-        d = np.hypot(centres[:, 0] - pred[0], centres[:, 1] - pred[1])
-        for k in np.argsort(np.where(ok, d, np.inf))[:3]:
-            if not ok[k]:
-                break
-            meas = self._measure(tr, frame, centres[k], p.search_margin_px, tr.win)
-            if meas is None or meas.merged:
-                continue
-            ratio = meas.mass / tr.ref
-            if p.reacquire_ratio <= ratio <= p.max_area_ratio:
-                tr.n_obs = 0
-                tr.v = np.zeros(2)
-                self._observe(tr, meas)
-                return meas.centre, _likelihood(ratio), Status.REACQUIRED
-        return None
-
-
-def _cut_off(
-    bp: np.ndarray, meas: Measurement, region: tuple[int, int, int, int], size: tuple[int, int]
-) -> bool:
-    """Whether the measured blob reaches an edge of its region that is not the frame's."""
-    x0, y0, x1, y1 = region
-    w, h = size
-    rh, rw = bp.shape
-    cx, cy = meas.centre[0] - x0, meas.centre[1] - y0
-    hx, hy = meas.window[0] / 2 + 1, meas.window[1] / 2 + 1
-    lx, hx_ = max(int(cx - hx), 0), min(int(cx + hx) + 1, rw)
-    ly, hy_ = max(int(cy - hy), 0), min(int(cy + hy) + 1, rh)
-    if lx >= hx_ or ly >= hy_:
-        return False
-    return bool(
-        (lx == 0 < x0 and cv2.countNonZero(bp[ly:hy_, 0]))
-        or (ly == 0 < y0 and cv2.countNonZero(bp[0, lx:hx_]))
-        or (hx_ == rw and x1 < w and cv2.countNonZero(bp[ly:hy_, rw - 1]))
-        or (hy_ == rh and y1 < h and cv2.countNonZero(bp[rh - 1, lx:hx_]))
-    )
-
-
-def _soft_diameter(frame: np.ndarray, colour: MarkerColour, centre: np.ndarray,
-                   window: tuple[int, int]) -> float:
-    """Apparent diameter (px) of a round blob, from its colour-unmixed area.
-
-    The colour gate counts every rim pixel the blur or the codec has partly
-    coloured, which makes a 10 cm ball about 3 % too large and every length
-    measured against it 3 % too small. Here each pixel near the blob counts
-    by how far its colour lies from the surrounding table toward the blob's
-    own (0 to 1): the area is then unbiased under any symmetric blur.
-    """
-    h, w = frame.shape[:2]
-    half = int(max(window) * 0.75 + 12)
-    cx, cy = int(round(centre[0])), int(round(centre[1]))
-    x0, y0 = max(cx - half, 0), max(cy - half, 0)
-    x1, y1 = min(cx + half + 1, w), min(cy + half + 1, h)
-    region = frame[y0:y1, x0:x1]
-    gate = colour.backproject(cv2.cvtColor(region, cv2.COLOR_BGR2HSV))
-    n, labels = cv2.connectedComponents((gate > 0).astype(np.uint8))
-    lab = labels[min(cy - y0, labels.shape[0] - 1), min(cx - x0, labels.shape[1] - 1)]
-    if n < 2 or lab == 0:
-        return float("nan")
-    blob = (labels == lab).astype(np.uint8)
-    kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (3, 3))
-    inner = cv2.erode(blob, kernel, iterations=2).astype(bool)
-    near = cv2.dilate(blob, kernel, iterations=3).astype(bool)
-    ring = cv2.dilate(blob, kernel, iterations=7).astype(bool) & ~cv2.dilate(
-        blob, kernel, iterations=4).astype(bool)
-    if inner.sum() < 10 or ring.sum() < 10:
-        return float("nan")
-    pix = region.astype(np.float64)
-    obj, bg = np.median(pix[inner], axis=0), np.median(pix[ring], axis=0)
-    axis = obj - bg
-    norm = float(axis @ axis)
-    if norm < 100.0:  # the blob hardly differs from its surroundings
-        return float("nan")
-    alpha = np.clip((pix[near] - bg) @ axis / norm, 0.0, 1.0)
-    return float(2.0 * np.sqrt(alpha.sum() / np.pi))
-
-
-def _likelihood(ratio: float) -> float:
-    return float(min(ratio, 1.0 / ratio)) if ratio > 0 else 0.0
-
-
-def _ref_side(ref: float) -> int:
-    """Side of a square window about the size of a blob of ``ref`` px."""
-    return max(int(round(2 * math.sqrt(ref / math.pi))) + 4, 3)
-
-
-def _clamp_window(win: tuple[int, int], min_side: int, ref: float) -> tuple[int, int]:
-    # Never below the minimum, never much larger than the marker itself: a
-    # window allowed to grow over a same-coloured neighbour would stay on it.
-    cap = max(3 * _ref_side(ref), min_side) if ref > 0 else 10**6
-    return (min(max(int(win[0]), min_side), cap), min(max(int(win[1]), min_side), cap))
 
 
 def _check_roi(name: str, roi: Any) -> ROI:
