@@ -18,10 +18,10 @@ import numpy as np
 import pandas as pd
 from reproduce_common import Progress, borderline, claim, no_progress, rng_for, save
 
+from minvar.plotting.viapoints import criteria_figure, curvature_figure, generalisation_figure
 from minvar.reach import simulate_reach
 from minvar.similarity import path_distance
 from minvar.task import ReachTask, ViaPoint
-from minvar.thesis_figures import criteria_figure, curvature_figure, generalisation_figure
 from minvar.viapoints import CRITERIA, compare_criteria, letter_a, replay
 
 #: The observed movements of Fig. A.1 (m, s); all within a 0.30 + 0.30 m arm's reach.

@@ -23,16 +23,16 @@ from minvar.analysis import (
     peak_to_mean_speed,
     speed_accuracy,
 )
-from minvar.figures import reach_figure, speed_accuracy_figure
-from minvar.reach import simulate_reach
-from minvar.similarity import path_distance
-from minvar.task import ReachTask, ViaPoint
-from minvar.thesis_figures import (
+from minvar.plotting.reach import reach_figure, speed_accuracy_figure
+from minvar.plotting.viapoints import (
     letter_durations_figure,
     letter_figure,
     merging_figure,
     viapoint_timing_figure,
 )
+from minvar.reach import simulate_reach
+from minvar.similarity import path_distance
+from minvar.task import ReachTask, ViaPoint
 from minvar.viapoints import expected_path, letter_a, viapoint_timing
 
 #: Fig. 3.4 (thesis coordinates, shoulder at the origin).

@@ -34,11 +34,11 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
+from hammer_mv.cli.grasp import write_experiment  # noqa: E402
 from minvar.grasp import GraspTask, plan_grasp, simulate_grasp  # noqa: E402
 from minvar.grasp_experiments import EXPERIMENTS, GraspExperiment  # noqa: E402
-from minvar.grasp_figures import grasp_figure, setup_figure  # noqa: E402
+from minvar.plotting.grasp import grasp_figure, setup_figure  # noqa: E402
 from perception.io.atomic import save_figure, write_csv  # noqa: E402
-from hammer_mv.cli.grasp import write_experiment  # noqa: E402
 
 log = logging.getLogger("reproduce_ch4")
 

@@ -15,7 +15,6 @@ from pathlib import Path
 
 from minvar.grasp import GraspTask
 from minvar.plant import PointMassPlant
-
 from perception.io.atomic import save_figure, write_csv, write_json
 
 log = logging.getLogger(__name__)
@@ -109,8 +108,8 @@ def _check_trials(trials: int) -> None:
 def run_simulate(args: argparse.Namespace) -> int:
     """Execute ``hammer-mv grasp simulate`` with parsed ``args``; return the exit status."""
     from minvar.grasp import plan_grasp, simulate_grasp
-    from minvar.grasp_figures import grasp_figure, setup_figure
     from minvar.grasp_stats import grasp_moments, summarize_grasp
+    from minvar.plotting import grasp_figure, setup_figure
 
     _check_trials(args.trials)
     _check_output(args.output)
@@ -163,15 +162,18 @@ def run_experiment(args: argparse.Namespace) -> int:
     for name in names:
         t0 = time.perf_counter()
         exp = EXPERIMENTS[name](trials=args.trials, seed=args.seed)
-        write_experiment(exp, out)
+        written = write_experiment(exp, out)
         print(f"{name}: {len(exp.summary)} settings x {args.trials} repetitions in "
               f"{time.perf_counter() - t0:.1f} s -> {out / (name + '.csv')}, "
-              + ", ".join(f"{stem}.png" for stem in exp.figures))
+              + ", ".join(p.name for p in written if p.suffix == ".png"))
     return 0
 
 
 def write_experiment(exp, out: Path) -> list[Path]:
     """Write an experiment's tables, statistics and figures into ``out``.
+
+    The figures are drawn here (:meth:`~minvar.grasp_experiments.GraspExperiment.plot`)
+    and written as ``<stem>.png``, one at a time.
 
     Parameters
     ----------
@@ -191,5 +193,5 @@ def write_experiment(exp, out: Path) -> list[Path]:
         write_csv(out / f"{exp.name}_curves.csv", exp.curves),
         write_json(out / f"{exp.name}_stats.json", exp.stats),
     ]
-    written += [save_figure(out / f"{stem}.png", fig) for stem, fig in exp.figures.items()]
+    written += [save_figure(out / f"{stem}.png", fig) for stem, fig in exp.plot().items()]
     return written

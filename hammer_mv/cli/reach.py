@@ -20,7 +20,6 @@ from minvar.analysis import (
 from minvar.plant import PointMassPlant
 from minvar.reach import simulate_reach
 from minvar.task import ReachTask, ViaPoint
-
 from perception.io.atomic import save_figure, write_csv, write_json
 
 log = logging.getLogger(__name__)
@@ -65,7 +64,7 @@ def register(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Execute ``hammer-mv reach`` with parsed ``args``; return the exit status."""
-    from minvar.figures import reach_figure, speed_accuracy_figure
+    from minvar.plotting import reach_figure, speed_accuracy_figure
 
     plant = PointMassPlant(sigma_u=args.sigma_u, sigma_s=args.sigma_s)
     vias = tuple(ViaPoint((x, y), fraction=f) for x, y, f in args.via)

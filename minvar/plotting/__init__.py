@@ -1,0 +1,74 @@
+"""Figures of the model's results, built on request.
+
+Data flows one way: the model computes results (:mod:`minvar.reach`,
+:mod:`minvar.grasp`, :mod:`minvar.grasp_experiments`, ...) and these modules
+draw them. They import result classes only for type checking, so any object
+with the same attributes can be drawn, and nothing in the model imports
+matplotlib. Every function returns a :class:`matplotlib.figure.Figure` built
+without pyplot's global state; save it with ``fig.savefig(path)``.
+
+* :mod:`~minvar.plotting.canvas` — :func:`new_figure`, the blank figure.
+* :mod:`~minvar.plotting.reach` — repeated reaches, speed-accuracy (Figs. 3.4-3.7).
+* :mod:`~minvar.plotting.baselines` — minimum jerk family (Figs. 2.5-2.8).
+* :mod:`~minvar.plotting.viapoints` — via-point movements (Figs. 3.2-3.3,
+  3.8-3.9, A.1-A.3).
+* :mod:`~minvar.plotting.grasp` — one grasp: set-up and repetitions (Figs. 4.1, 4.6).
+* :mod:`~minvar.plotting.grasp_experiments` — the chapter-4 sweeps (Figs.
+  4.2-4.5, 4.7-4.16); :func:`experiment_figures` builds all of one sweep's.
+"""
+
+from .baselines import (
+    angle_jerk_hand_figure,
+    angle_jerk_joint_figure,
+    derivative_order_figure,
+    minimum_jerk_figure,
+)
+from .canvas import new_figure
+from .grasp import grasp_figure, setup_figure
+from .grasp_experiments import (
+    EXPERIMENT_FIGURES,
+    accuracy_figure,
+    experiment_figures,
+    mga_figure,
+    paths_figure,
+    sd_peaks_figure,
+    sd_time_figure,
+    viapoint_height_paths_figure,
+)
+from .reach import reach_figure, speed_accuracy_figure
+from .viapoints import (
+    criteria_figure,
+    curvature_figure,
+    generalisation_figure,
+    letter_durations_figure,
+    letter_figure,
+    merging_figure,
+    viapoint_timing_figure,
+)
+
+__all__ = [
+    "EXPERIMENT_FIGURES",
+    "accuracy_figure",
+    "angle_jerk_hand_figure",
+    "angle_jerk_joint_figure",
+    "criteria_figure",
+    "curvature_figure",
+    "derivative_order_figure",
+    "experiment_figures",
+    "generalisation_figure",
+    "grasp_figure",
+    "letter_durations_figure",
+    "letter_figure",
+    "merging_figure",
+    "mga_figure",
+    "minimum_jerk_figure",
+    "new_figure",
+    "paths_figure",
+    "reach_figure",
+    "sd_peaks_figure",
+    "sd_time_figure",
+    "setup_figure",
+    "speed_accuracy_figure",
+    "viapoint_height_paths_figure",
+    "viapoint_timing_figure",
+]
