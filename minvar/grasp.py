@@ -47,6 +47,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from .grasp_stats import grip_aperture, max_grip_aperture, path_sd
 from .kinematics import TwoLinkChain
 from .lqg import LQGProblem, LQGSolution, solve
 from .plant import POSITION, VELOCITY, PointMassPlant
@@ -601,8 +602,7 @@ class GraspResult:
     @property
     def aperture(self) -> np.ndarray:
         """(trials, S+1) grip aperture ``|finger - thumb|``, m."""
-        d = self.finger - self.thumb
-        return np.hypot(d[..., 0], d[..., 1])
+        return grip_aperture(self.finger, self.thumb)
 
     @property
     def wrist_speed(self) -> np.ndarray:
@@ -619,25 +619,27 @@ class GraspResult:
         """(trials, S+1) thumb-tip speed (world frame), m/s."""
         return np.hypot(self.thumb_velocity[..., 0], self.thumb_velocity[..., 1])
 
+    # The measures below are those of minvar.grasp_stats applied to this
+    # result, so simulated and observed grasps are measured the same way.
     @property
     def mga(self) -> np.ndarray:
         """(trials,) maximum grip aperture of each repetition, m."""
-        return self.aperture.max(axis=1)
+        return max_grip_aperture(self.aperture, self.relative_time)[0]
 
     @property
     def mga_time(self) -> np.ndarray:
         """(trials,) time of each repetition's maximum aperture, fraction of the movement."""
-        return self.relative_time[np.argmax(self.aperture, axis=1)]
+        return max_grip_aperture(self.aperture, self.relative_time)[1]
 
     @property
     def wrist_sd(self) -> np.ndarray:
         """(S+1,) SD of the wrist position across repetitions, ``sqrt(var x + var y)``, m."""
-        return np.sqrt(self.wrist.var(axis=0, ddof=1).sum(axis=-1))
+        return path_sd(self.wrist)
 
     @property
     def aperture_sd(self) -> np.ndarray:
         """(S+1,) SD of the grip aperture across repetitions, m."""
-        return self.aperture.std(axis=0, ddof=1)
+        return path_sd(self.aperture)
 
     @property
     def finger_end(self) -> np.ndarray:
