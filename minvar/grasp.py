@@ -43,9 +43,9 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from .grasp_stats import grip_aperture, max_grip_aperture, path_sd
 from .kinematics import TwoLinkChain
@@ -53,6 +53,12 @@ from .lqg import LQGProblem, LQGSolution, solve
 from .plant import POSITION, VELOCITY, PointMassPlant
 from .simulate import simulate
 from .task import ReachTask, ViaPoint, reach_problem
+
+if TYPE_CHECKING:  # pragma: no cover
+    import pandas as pd
+
+# pandas is imported when a table is asked for: `import minvar` stays light
+# (pandas takes about half a second to import).
 
 __all__ = [
     "GripVia",
@@ -658,6 +664,8 @@ class GraspResult:
         thumb_x, thumb_y, aperture (m), arm_q1, arm_q2, finger_q1, finger_q2,
         thumb_q1, thumb_q2 (rad).
         """
+        import pandas as pd
+
         trials, steps = self.wrist.shape[:2]
         cols = {
             "trial": np.repeat(np.arange(trials), steps),
