@@ -1,8 +1,8 @@
 """Reach-to-grasp with the minimum variance model (thesis chapter 4).
 
-Geometry (DESIGN.md, "Grasping"). World frame: origin at the object centre,
-+y from the wrist's start toward the object, metres. The object is a disk of
-diameter ``object_size``.
+Geometry (frames: docs/coordinates.md; model: docs/model.md). World frame:
+origin at the object centre, +y from the wrist's start toward the object,
+metres. The object is a disk of diameter ``object_size``.
 
 * **Arm**: a 2-link planar chain (links 0.30 m). Its shoulder sits at
   ``shoulder_offset`` from the wrist's start position ``(0, -distance)`` —
@@ -180,9 +180,11 @@ class GraspTask:
     digit_links : (2,) tuple
         Lengths of the two links of each digit (thesis 0.10 m each).
     r : float
-        Effort weight of every chain's cost (``R = r dt / T I``).
+        Effort weight of every chain's cost (``R = r dt / T I``); the reach
+        default, not the thesis's printed 0.002 (see :mod:`minvar.task`).
     w_v, w_f : float
-        Final velocity and force weights of every chain's goal cost.
+        Final velocity and force weights of every chain's goal cost (the
+        reach defaults).
     """
 
     object_size: float = 0.04

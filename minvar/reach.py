@@ -120,7 +120,8 @@ def simulate_reach(
     seed : int or numpy.random.Generator, optional
         Randomness of the execution noise.
     plant : PointMassPlant, optional
-        Plant and noise parameters (default: DESIGN.md values).
+        Plant and noise parameters (default: :class:`~minvar.plant.PointMassPlant`'s,
+        docs/model.md).
     solution : LQGSolution, optional
         Gains already solved for this task and plant (skips planning).
 
