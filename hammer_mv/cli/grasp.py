@@ -14,15 +14,11 @@ import time
 from pathlib import Path
 
 from minvar.grasp import GraspTask
+from minvar.grasp_experiments import EXPERIMENTS, THESIS_TRIALS, check_trials
 from minvar.plant import PointMassPlant
 from perception.io.atomic import save_figure, write_csv, write_json
 
 log = logging.getLogger(__name__)
-
-_EXPERIMENT_NAMES = (
-    "viapoint-height", "viapoint-time", "viapoint-distance", "object-size",
-    "movement-time", "variability-size", "variability-distance",
-)
 
 
 def register(sub) -> None:
@@ -55,7 +51,8 @@ def register(sub) -> None:
                    help=f"digit via-point distance outside the object, m "
                         f"(default {d.viapoint_offset})")
     s.add_argument("--viapoint-height", type=float, default=d.viapoint_height, metavar="M",
-                   help="digit via-point height above the target line, m (default 0)")
+                   help=f"digit via-point height above the target line, m "
+                        f"(default {d.viapoint_height:g})")
     s.add_argument("--viapoint-time", type=float, default=d.viapoint_time, metavar="F",
                    help=f"digit via-point time, fraction of the movement "
                         f"(default {d.viapoint_time})")
@@ -66,8 +63,8 @@ def register(sub) -> None:
                         f"(default {d.execution_cv})")
     s.add_argument("--dt", type=float, default=d.plant.dt, metavar="S",
                    help=f"time step, s (default {d.plant.dt})")
-    s.add_argument("--trials", type=int, default=500, metavar="N",
-                   help="repetitions (default 500)")
+    s.add_argument("--trials", type=int, default=THESIS_TRIALS, metavar="N",
+                   help=f"repetitions (default {THESIS_TRIALS})")
     s.add_argument("--seed", type=int, default=0, metavar="N", help="random seed (default 0)")
     s.add_argument("-o", "--output", required=True, type=Path, metavar="DIR",
                    help="folder for the figures and tables")
@@ -80,10 +77,10 @@ def register(sub) -> None:
         "NAME.csv (one row per setting), NAME_trials.csv, NAME_curves.csv, NAME_stats.json "
         "and the figures as PNG, named after the thesis's (e.g. fig4_10_object_size_mga.png).",
     )
-    e.add_argument("name", choices=(*_EXPERIMENT_NAMES, "all"), metavar="NAME",
-                   help=f"one of {', '.join(_EXPERIMENT_NAMES)}, all")
-    e.add_argument("--trials", type=int, default=500, metavar="N",
-                   help="repetitions per setting (default 500, as in the thesis)")
+    e.add_argument("name", choices=(*EXPERIMENTS, "all"), metavar="NAME",
+                   help=f"one of {', '.join(EXPERIMENTS)}, all")
+    e.add_argument("--trials", type=int, default=THESIS_TRIALS, metavar="N",
+                   help=f"repetitions per setting (default {THESIS_TRIALS}, as in the thesis)")
     e.add_argument("--seed", type=int, default=0, metavar="N", help="random seed (default 0)")
     e.add_argument("-o", "--output", required=True, type=Path, metavar="DIR",
                    help="folder for the tables and figures")
@@ -100,18 +97,13 @@ def _check_output(out: Path) -> None:
         raise ValueError(f"{out}: output exists and is not a folder")
 
 
-def _check_trials(trials: int) -> None:
-    if trials < 2:
-        raise ValueError(f"--trials: need at least 2 repetitions, got {trials}")
-
-
 def run_simulate(args: argparse.Namespace) -> int:
     """Execute ``hammer-mv grasp simulate`` with parsed ``args``; return the exit status."""
     from minvar.grasp import plan_grasp, simulate_grasp
     from minvar.grasp_stats import grasp_moments, summarize_grasp
     from minvar.plotting import grasp_figure, setup_figure
 
-    _check_trials(args.trials)
+    check_trials(args.trials, name="--trials")
     _check_output(args.output)
     task = GraspTask(
         object_size=args.object_size, distance=args.distance, duration=args.duration,
@@ -153,9 +145,7 @@ def run_simulate(args: argparse.Namespace) -> int:
 
 def run_experiment(args: argparse.Namespace) -> int:
     """Execute ``hammer-mv grasp experiment`` with parsed ``args``; return the exit status."""
-    from minvar.grasp_experiments import EXPERIMENTS
-
-    _check_trials(args.trials)
+    check_trials(args.trials, name="--trials")
     _check_output(args.output)
     names = list(EXPERIMENTS) if args.name == "all" else [args.name]
     out: Path = args.output
