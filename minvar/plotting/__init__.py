@@ -17,34 +17,31 @@ without pyplot's global state; save it with ``fig.savefig(path)``.
   4.2-4.5, 4.7-4.16); :func:`experiment_figures` builds all of one sweep's.
 """
 
-from .baselines import (
-    angle_jerk_hand_figure,
-    angle_jerk_joint_figure,
-    derivative_order_figure,
-    minimum_jerk_figure,
-)
+from importlib import import_module as _import_module
+
 from .canvas import new_figure
-from .grasp import grasp_figure, setup_figure
-from .grasp_experiments import (
-    EXPERIMENT_FIGURES,
-    accuracy_figure,
-    experiment_figures,
-    mga_figure,
-    paths_figure,
-    sd_peaks_figure,
-    sd_time_figure,
-    viapoint_height_paths_figure,
-)
-from .reach import reach_figure, speed_accuracy_figure
-from .viapoints import (
-    criteria_figure,
-    curvature_figure,
-    generalisation_figure,
-    letter_durations_figure,
-    letter_figure,
-    merging_figure,
-    viapoint_timing_figure,
-)
+
+# The figure functions are imported from their modules on first use (PEP
+# 562), so `from minvar.plotting import new_figure` costs matplotlib.figure
+# alone, not the model modules the figures of every chapter need (scipy
+# among them, about a second).
+_HOMES = {
+    "baselines": (
+        "angle_jerk_hand_figure", "angle_jerk_joint_figure", "derivative_order_figure",
+        "minimum_jerk_figure",
+    ),
+    "grasp": ("grasp_figure", "setup_figure"),
+    "grasp_experiments": (
+        "EXPERIMENT_FIGURES", "accuracy_figure", "experiment_figures", "mga_figure",
+        "paths_figure", "sd_peaks_figure", "sd_time_figure", "viapoint_height_paths_figure",
+    ),
+    "reach": ("reach_figure", "speed_accuracy_figure"),
+    "viapoints": (
+        "criteria_figure", "curvature_figure", "generalisation_figure",
+        "letter_durations_figure", "letter_figure", "merging_figure", "viapoint_timing_figure",
+    ),
+}
+_HOME = {name: module for module, names in _HOMES.items() for name in names}
 
 __all__ = [
     "EXPERIMENT_FIGURES",
@@ -72,3 +69,23 @@ __all__ = [
     "viapoint_height_paths_figure",
     "viapoint_timing_figure",
 ]
+
+
+def __getattr__(name: str):
+    """A figure function or plotting submodule, imported on first use (PEP 562).
+
+    Parameters
+    ----------
+    name : str
+        The attribute asked for.
+    """
+    if name in _HOME:
+        return getattr(_import_module(f"{__name__}.{_HOME[name]}"), name)
+    if name in _HOMES or name == "canvas":
+        return _import_module(f"{__name__}.{name}")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    """The package's names, its lazily imported functions and submodules included."""
+    return sorted({*globals(), *_HOME, *_HOMES})
