@@ -8,8 +8,13 @@ processes. The caller saves a figure with ``fig.savefig(path)``.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from matplotlib.figure import Figure
+
+if TYPE_CHECKING:  # pragma: no cover
+    from matplotlib.axes import Axes
 
 __all__ = ["new_figure", "path_axes", "time_axes"]
 
@@ -38,7 +43,7 @@ def new_figure(
     return fig, axes
 
 
-def path_axes(ax, title: str) -> None:
+def path_axes(ax: Axes, title: str) -> None:
     """Label an axes showing a path in the plane: x and y in m, equal aspect.
 
     Parameters
@@ -54,7 +59,7 @@ def path_axes(ax, title: str) -> None:
     ax.set_title(title)
 
 
-def time_axes(ax, title: str, ylabel: str = "speed (m/s)") -> None:
+def time_axes(ax: Axes, title: str, ylabel: str = "speed (m/s)") -> None:
     """Label an axes showing a quantity over time in s.
 
     Parameters

@@ -21,6 +21,7 @@ from .canvas import new_figure, path_axes, time_axes
 
 if TYPE_CHECKING:  # pragma: no cover - results are duck-typed at run time
     import pandas as pd
+    from numpy.typing import ArrayLike
 
     from ..reach import ReachResult
     from ..viapoints import CriteriaComparison
@@ -39,7 +40,7 @@ __all__ = [
 def viapoint_timing_figure(
     paths: Mapping[str, tuple[np.ndarray, np.ndarray]],
     timing: pd.DataFrame,
-    via_point=None,
+    via_point: ArrayLike | None = None,
 ) -> Figure:
     """Effect of a via-point's timing (thesis Fig. 3.2).
 
@@ -183,7 +184,7 @@ def criteria_figure(comparison: CriteriaComparison) -> Figure:
     return fig
 
 
-def curvature_figure(time, position, indices) -> Figure:
+def curvature_figure(time: ArrayLike, position: ArrayLike, indices: Sequence[int]) -> Figure:
     """A trajectory with via-points at its curvature extrema (thesis Fig. A.2).
 
     Panels: (a) path with the via-points; (b) x(t) and the spatio-temporal
