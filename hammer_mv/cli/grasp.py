@@ -32,7 +32,11 @@ def register(sub) -> None:
     )
     p.set_defaults(func=lambda args: _usage(p))
     gsub = p.add_subparsers(dest="grasp_command", metavar="{simulate,experiment}")
+    _add_simulate(gsub)
+    _add_experiment(gsub)
 
+
+def _add_simulate(gsub) -> None:
     s = gsub.add_parser(
         "simulate",
         help="noisy repetitions of one grasp (figures + CSV)",
@@ -70,10 +74,13 @@ def register(sub) -> None:
                    help="folder for the figures and tables")
     s.set_defaults(func=run_simulate)
 
+
+def _add_experiment(gsub) -> None:
     e = gsub.add_parser(
         "experiment",
         help="one of the thesis's chapter 4 experiments, or all",
-        description="Run a chapter 4 sweep (500 repetitions per setting by default) and write "
+        description=f"Run a chapter 4 sweep ({THESIS_TRIALS} repetitions per setting by "
+        "default) and write "
         "NAME.csv (one row per setting), NAME_trials.csv, NAME_curves.csv, NAME_stats.json "
         "and the figures as PNG, named after the thesis's (e.g. fig4_10_object_size_mga.png).",
     )
