@@ -43,32 +43,7 @@ _HOMES = {
 }
 _HOME = {name: module for module, names in _HOMES.items() for name in names}
 
-__all__ = [
-    "EXPERIMENT_FIGURES",
-    "accuracy_figure",
-    "angle_jerk_hand_figure",
-    "angle_jerk_joint_figure",
-    "criteria_figure",
-    "curvature_figure",
-    "derivative_order_figure",
-    "experiment_figures",
-    "generalisation_figure",
-    "grasp_figure",
-    "letter_durations_figure",
-    "letter_figure",
-    "merging_figure",
-    "mga_figure",
-    "minimum_jerk_figure",
-    "new_figure",
-    "paths_figure",
-    "reach_figure",
-    "sd_peaks_figure",
-    "sd_time_figure",
-    "setup_figure",
-    "speed_accuracy_figure",
-    "viapoint_height_paths_figure",
-    "viapoint_timing_figure",
-]
+__all__ = ["new_figure", *sorted(_HOME)]
 
 
 def __getattr__(name: str):
