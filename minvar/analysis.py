@@ -7,14 +7,20 @@ or small tables, so they serve simulated and observed movements alike.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from .lqg import solve
 from .plant import PointMassPlant
 from .reach import simulate_reach
 from .task import ReachTask, reach_problem
+
+if TYPE_CHECKING:  # pragma: no cover
+    import pandas as pd
+
+# pandas is imported when a table is asked for: `import minvar` stays light
+# (pandas takes about half a second to import).
 
 __all__ = [
     "EndpointStats",
@@ -190,6 +196,8 @@ def speed_accuracy(
     -------
     SpeedAccuracy
     """
+    import pandas as pd
+
     durations = [float(d) for d in durations]
     if not durations:
         raise ValueError("speed_accuracy: durations must not be empty")

@@ -1,8 +1,8 @@
 """Reach-to-grasp with the minimum variance model (thesis chapter 4).
 
-Geometry (DESIGN.md, "Grasping"). World frame: origin at the object centre,
-+y from the wrist's start toward the object, metres. The object is a disk of
-diameter ``object_size``.
+Geometry (frames: docs/coordinates.md; model: docs/model.md). World frame:
+origin at the object centre, +y from the wrist's start toward the object,
+metres. The object is a disk of diameter ``object_size``.
 
 * **Arm**: a 2-link planar chain (links 0.30 m). Its shoulder sits at
   ``shoulder_offset`` from the wrist's start position ``(0, -distance)`` —
@@ -43,15 +43,22 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
+from .grasp_stats import grip_aperture, max_grip_aperture, path_sd
 from .kinematics import TwoLinkChain
 from .lqg import LQGProblem, LQGSolution, solve
 from .plant import POSITION, VELOCITY, PointMassPlant
 from .simulate import simulate
 from .task import ReachTask, ViaPoint, reach_problem
+
+if TYPE_CHECKING:  # pragma: no cover
+    import pandas as pd
+
+# pandas is imported when a table is asked for: `import minvar` stays light
+# (pandas takes about half a second to import).
 
 __all__ = [
     "GripVia",
@@ -173,9 +180,11 @@ class GraspTask:
     digit_links : (2,) tuple
         Lengths of the two links of each digit (thesis 0.10 m each).
     r : float
-        Effort weight of every chain's cost (``R = r dt / T I``).
+        Effort weight of every chain's cost (``R = r dt / T I``); the reach
+        default, not the thesis's printed 0.002 (see :mod:`minvar.task`).
     w_v, w_f : float
-        Final velocity and force weights of every chain's goal cost.
+        Final velocity and force weights of every chain's goal cost (the
+        reach defaults).
     """
 
     object_size: float = 0.04
@@ -601,8 +610,7 @@ class GraspResult:
     @property
     def aperture(self) -> np.ndarray:
         """(trials, S+1) grip aperture ``|finger - thumb|``, m."""
-        d = self.finger - self.thumb
-        return np.hypot(d[..., 0], d[..., 1])
+        return grip_aperture(self.finger, self.thumb)
 
     @property
     def wrist_speed(self) -> np.ndarray:
@@ -619,25 +627,27 @@ class GraspResult:
         """(trials, S+1) thumb-tip speed (world frame), m/s."""
         return np.hypot(self.thumb_velocity[..., 0], self.thumb_velocity[..., 1])
 
+    # The measures below are those of minvar.grasp_stats applied to this
+    # result, so simulated and observed grasps are measured the same way.
     @property
     def mga(self) -> np.ndarray:
         """(trials,) maximum grip aperture of each repetition, m."""
-        return self.aperture.max(axis=1)
+        return max_grip_aperture(self.aperture, self.relative_time)[0]
 
     @property
     def mga_time(self) -> np.ndarray:
         """(trials,) time of each repetition's maximum aperture, fraction of the movement."""
-        return self.relative_time[np.argmax(self.aperture, axis=1)]
+        return max_grip_aperture(self.aperture, self.relative_time)[1]
 
     @property
     def wrist_sd(self) -> np.ndarray:
         """(S+1,) SD of the wrist position across repetitions, ``sqrt(var x + var y)``, m."""
-        return np.sqrt(self.wrist.var(axis=0, ddof=1).sum(axis=-1))
+        return path_sd(self.wrist)
 
     @property
     def aperture_sd(self) -> np.ndarray:
         """(S+1,) SD of the grip aperture across repetitions, m."""
-        return self.aperture.std(axis=0, ddof=1)
+        return path_sd(self.aperture)
 
     @property
     def finger_end(self) -> np.ndarray:
@@ -656,6 +666,8 @@ class GraspResult:
         thumb_x, thumb_y, aperture (m), arm_q1, arm_q2, finger_q1, finger_q2,
         thumb_q1, thumb_q2 (rad).
         """
+        import pandas as pd
+
         trials, steps = self.wrist.shape[:2]
         cols = {
             "trial": np.repeat(np.arange(trials), steps),

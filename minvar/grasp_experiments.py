@@ -9,8 +9,10 @@ leaves the others unchanged.
 
 The result holds three tidy tables — ``summary`` (one row per setting),
 ``trials`` (one row per repetition) and ``curves`` (one row per setting and
-time step: mean paths, speeds, aperture and SDs) — the experiment's
-statistics and its figures, named after the thesis's.
+time step: mean paths, speeds, aperture and SDs) — and the experiment's
+statistics. Its figures, named after the thesis's, are drawn from these on
+request: :meth:`GraspExperiment.plot` (or
+:func:`minvar.plotting.experiment_figures`).
 
 Variability (4.2.3) is compared across settings by one-way ANOVA
 (:func:`scipy.stats.f_oneway`) on each repetition's peak deviation from its
@@ -25,10 +27,10 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
-from scipy import stats as sps
 
 from .grasp import GraspTask, plan_grasp, simulate_grasp
 from .grasp_stats import (
@@ -39,11 +41,20 @@ from .grasp_stats import (
     summarize_grasp,
 )
 
+if TYPE_CHECKING:  # pragma: no cover
+    from matplotlib.figure import Figure
+
+# scipy.stats is imported where the statistics are computed, not here: it
+# takes about a second to import, and the command line reads EXPERIMENTS
+# when it builds its parser, before any experiment runs.
+
 log = logging.getLogger(__name__)
 
 __all__ = [
     "GraspExperiment",
     "EXPERIMENTS",
+    "THESIS_TRIALS",
+    "check_trials",
     "run_experiment",
     "run_sweep",
     "viapoint_height_experiment",
@@ -54,6 +65,9 @@ __all__ = [
     "variability_size_experiment",
     "variability_distance_experiment",
 ]
+
+#: Repetitions per setting in the thesis.
+THESIS_TRIALS = 500
 
 #: Settings of the thesis's sweeps (SI units; via-point time as a fraction).
 VIAPOINT_HEIGHTS = tuple(np.round(np.arange(-0.02, 0.0201, 0.005), 4))
@@ -67,7 +81,7 @@ TRANSPORT_DISTANCES = (0.08, 0.12, 0.16, 0.20, 0.24)
 
 @dataclass(frozen=True, eq=False)
 class GraspExperiment:
-    """One chapter-4 sweep: tables, statistics and figures.
+    """One chapter-4 sweep: tables and statistics; figures on request (:meth:`plot`).
 
     Attributes
     ----------
@@ -91,9 +105,6 @@ class GraspExperiment:
         ``wrist_sd``, ``aperture_sd`` and their ``*_exact`` values (m).
     stats : dict
         Experiment-level numbers (regression slope, ANOVA F and p, ...).
-    figures : dict of str to matplotlib.figure.Figure
-        Figures keyed by file stem named after the thesis figure
-        (e.g. ``"fig4_10_object_size_mga"``); empty if not requested.
     """
 
     name: str
@@ -103,7 +114,6 @@ class GraspExperiment:
     trials: pd.DataFrame = field(repr=False)
     curves: pd.DataFrame = field(repr=False)
     stats: dict = field(default_factory=dict)
-    figures: dict = field(default_factory=dict, repr=False)
 
     @property
     def values(self) -> np.ndarray:
@@ -114,11 +124,47 @@ class GraspExperiment:
         """The per-setting summary table."""
         return self.summary
 
+    def plot(self) -> dict[str, Figure]:
+        """Draw this experiment's figures (matplotlib is imported here, not before).
 
-def _check_trials(trials) -> int:
+        Returns
+        -------
+        dict of str to matplotlib.figure.Figure
+            Keyed by file stem named after the thesis figure, e.g.
+            ``"fig4_10_object_size_mga"``; see
+            :func:`minvar.plotting.experiment_figures`.
+        """
+        from .plotting.grasp_experiments import experiment_figures
+
+        return experiment_figures(self)
+
+
+def check_trials(trials, *, name: str = "trials") -> int:
+    """Check a number of repetitions per setting: an integer of at least 2.
+
+    Two is the fewest from which a standard deviation can be computed.
+
+    Parameters
+    ----------
+    trials : int
+        The number to check.
+    name : str
+        What to call it in the error message (e.g. ``"--trials"`` on the
+        command line).
+
+    Returns
+    -------
+    int
+        ``trials`` as a Python int.
+
+    Raises
+    ------
+    ValueError
+        If ``trials`` is not an integer >= 2 (a bool is not an integer here).
+    """
     if isinstance(trials, bool) or not isinstance(trials, int | np.integer) or trials < 2:
         raise ValueError(
-            f"trials: expected an integer >= 2 repetitions per setting, got {trials!r}"
+            f"{name}: expected an integer number of repetitions >= 2, got {trials!r}"
         )
     return int(trials)
 
@@ -127,7 +173,7 @@ def run_sweep(
     parameter: str,
     values: Sequence[float],
     *,
-    trials: int = 500,
+    trials: int = THESIS_TRIALS,
     seed: int | np.random.SeedSequence = 0,
     base: GraspTask | None = None,
 ) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame]:
@@ -156,7 +202,7 @@ def run_sweep(
     ValueError
         If a setting is not a valid task (the message names the field).
     """
-    trials = _check_trials(trials)
+    trials = check_trials(trials)
     base = GraspTask() if base is None else base
     values = [float(v) for v in values]
     if not values:
@@ -219,6 +265,8 @@ def run_sweep(
 
 def _anova(trials: pd.DataFrame, column: str, keep=None) -> tuple[float, float]:
     """One-way ANOVA of ``column`` across settings: (F, p)."""
+    from scipy import stats as sps
+
     groups = [g[column].to_numpy() for _, g in trials.groupby("setting", sort=True)]
     if keep is not None:
         groups = [g for g, k in zip(groups, keep) if k]
@@ -229,6 +277,8 @@ def _anova(trials: pd.DataFrame, column: str, keep=None) -> tuple[float, float]:
 
 
 def _variability_stats(summary: pd.DataFrame, trials: pd.DataFrame, parameter: str) -> dict:
+    from scipy import stats as sps
+
     out = {"anova_measure": "per-repetition peak deviation from the setting's mean path"}
     for comp in ("wrist", "aperture"):
         f, p = _anova(trials, f"{comp}_peak_dev")
@@ -245,25 +295,21 @@ def _variability_stats(summary: pd.DataFrame, trials: pd.DataFrame, parameter: s
     return out
 
 
-def _experiment(name, parameter, values, trials, seed, base, figures, builders, extra=None):
+def _experiment(name, parameter, values, trials, seed, base, extra=None) -> GraspExperiment:
     summary, tr, curves = run_sweep(parameter, values, trials=trials, seed=seed, base=base)
     stats = extra(summary, tr) if extra else {}
-    exp = GraspExperiment(
+    return GraspExperiment(
         name=name, parameter=parameter, base=GraspTask() if base is None else base,
         summary=summary, trials=tr, curves=curves, stats=stats,
     )
-    if figures:
-        exp = replace(exp, figures={stem: build(exp) for stem, build in builders.items()})
-    return exp
 
 
 def viapoint_height_experiment(
     heights: Sequence[float] = VIAPOINT_HEIGHTS,
     *,
-    trials: int = 500,
+    trials: int = THESIS_TRIALS,
     seed: int | np.random.SeedSequence = 0,
     base: GraspTask | None = None,
-    figures: bool = True,
 ) -> GraspExperiment:
     """Via-point vertical position vs digit end-point accuracy (thesis 4.2.1.1, Figs. 4.2-4.3).
 
@@ -277,25 +323,16 @@ def viapoint_height_experiment(
         Root seed; setting ``i`` uses its child ``i``.
     base : GraspTask, optional
         Task the settings modify.
-    figures : bool
-        Build the figures.
     """
-    from . import grasp_figures as gf
-
-    return _experiment(
-        "viapoint-height", "viapoint_height", heights, trials, seed, base, figures,
-        {"fig4_2_viapoint_height_paths": gf.viapoint_height_paths_figure,
-         "fig4_3_viapoint_height_accuracy": gf.accuracy_figure},
-    )
+    return _experiment("viapoint-height", "viapoint_height", heights, trials, seed, base)
 
 
 def viapoint_time_experiment(
     fractions: Sequence[float] = VIAPOINT_TIMES,
     *,
-    trials: int = 500,
+    trials: int = THESIS_TRIALS,
     seed: int | np.random.SeedSequence = 0,
     base: GraspTask | None = None,
-    figures: bool = True,
 ) -> GraspExperiment:
     """Via-point timing vs digit end-point accuracy (thesis 4.2.1.2, Figs. 4.4-4.5).
 
@@ -309,20 +346,14 @@ def viapoint_time_experiment(
         Root seed; setting ``i`` uses its child ``i``.
     base : GraspTask, optional
         Task the settings modify.
-    figures : bool
-        Build the figures.
     """
-    from . import grasp_figures as gf
-
-    return _experiment(
-        "viapoint-time", "viapoint_time", fractions, trials, seed, base, figures,
-        {"fig4_4_viapoint_time_paths": gf.paths_figure,
-         "fig4_5_viapoint_time_accuracy": gf.accuracy_figure},
-    )
+    return _experiment("viapoint-time", "viapoint_time", fractions, trials, seed, base)
 
 
 def _mga_stats(parameter):
     def stats(summary, trials):
+        from scipy import stats as sps
+
         x = summary[parameter].to_numpy()
         fit = sps.linregress(x, summary["mga_mean"].to_numpy())
         tfit = sps.linregress(x, summary["mga_time_mean"].to_numpy())
@@ -339,10 +370,9 @@ def _mga_stats(parameter):
 def viapoint_distance_experiment(
     offsets: Sequence[float] = VIAPOINT_DISTANCES,
     *,
-    trials: int = 500,
+    trials: int = THESIS_TRIALS,
     seed: int | np.random.SeedSequence = 0,
     base: GraspTask | None = None,
-    figures: bool = True,
 ) -> GraspExperiment:
     """Via-point distance from the object vs MGA and its timing (thesis 4.2.2.1, Figs. 4.7-4.8).
 
@@ -356,15 +386,9 @@ def viapoint_distance_experiment(
         Root seed; setting ``i`` uses its child ``i``.
     base : GraspTask, optional
         Task the settings modify.
-    figures : bool
-        Build the figures.
     """
-    from . import grasp_figures as gf
-
     return _experiment(
-        "viapoint-distance", "viapoint_offset", offsets, trials, seed, base, figures,
-        {"fig4_7_viapoint_distance_paths": gf.paths_figure,
-         "fig4_8_viapoint_distance_mga": gf.mga_figure},
+        "viapoint-distance", "viapoint_offset", offsets, trials, seed, base,
         _mga_stats("viapoint_offset"),
     )
 
@@ -372,10 +396,9 @@ def viapoint_distance_experiment(
 def object_size_experiment(
     sizes: Sequence[float] = OBJECT_SIZES,
     *,
-    trials: int = 500,
+    trials: int = THESIS_TRIALS,
     seed: int | np.random.SeedSequence = 0,
     base: GraspTask | None = None,
-    figures: bool = True,
 ) -> GraspExperiment:
     """Object size vs MGA (regression slope) and its timing (thesis 4.2.2.2, Figs. 4.9-4.10).
 
@@ -389,22 +412,14 @@ def object_size_experiment(
         Root seed; setting ``i`` uses its child ``i``.
     base : GraspTask, optional
         Task the settings modify.
-    figures : bool
-        Build the figures.
     """
-    from . import grasp_figures as gf
-
     return _experiment(
-        "object-size", "object_size", sizes, trials, seed, base, figures,
-        {"fig4_9_object_size_paths": gf.paths_figure,
-         "fig4_10_object_size_mga": gf.mga_figure},
+        "object-size", "object_size", sizes, trials, seed, base,
         _mga_stats("object_size"),
     )
 
 
-def _variability(name, parameter, values, figs, trials, seed, base, figures):
-    from . import grasp_figures as gf
-
+def _variability(name, parameter, values, trials, seed, base):
     def extra(summary, tr):
         out = _variability_stats(summary, tr, parameter)
         if parameter == "object_size":  # the thesis's exception: no object at all
@@ -413,19 +428,15 @@ def _variability(name, parameter, values, figs, trials, seed, base, figures):
                 tr, "wrist_peak_dev", keep)
         return out
 
-    return _experiment(
-        name, parameter, values, trials, seed, base, figures,
-        {figs[0]: gf.sd_time_figure, figs[1]: gf.sd_peaks_figure}, extra,
-    )
+    return _experiment(name, parameter, values, trials, seed, base, extra)
 
 
 def movement_time_experiment(
     durations: Sequence[float] = MOVEMENT_TIMES,
     *,
-    trials: int = 500,
+    trials: int = THESIS_TRIALS,
     seed: int | np.random.SeedSequence = 0,
     base: GraspTask | None = None,
-    figures: bool = True,
 ) -> GraspExperiment:
     """Wrist and aperture variability vs movement time (thesis 4.2.3.1, Figs. 4.11-4.12).
 
@@ -439,23 +450,16 @@ def movement_time_experiment(
         Root seed; setting ``i`` uses its child ``i``.
     base : GraspTask, optional
         Task the settings modify.
-    figures : bool
-        Build the figures.
     """
-    return _variability(
-        "movement-time", "duration", durations,
-        ("fig4_11_movement_time_sd", "fig4_12_movement_time_peaks"),
-        trials, seed, base, figures,
-    )
+    return _variability("movement-time", "duration", durations, trials, seed, base)
 
 
 def variability_size_experiment(
     sizes: Sequence[float] = VARIABILITY_SIZES,
     *,
-    trials: int = 500,
+    trials: int = THESIS_TRIALS,
     seed: int | np.random.SeedSequence = 0,
     base: GraspTask | None = None,
-    figures: bool = True,
 ) -> GraspExperiment:
     """Wrist and aperture variability vs object size (thesis 4.2.3.2, Figs. 4.13-4.14).
 
@@ -469,23 +473,16 @@ def variability_size_experiment(
         Root seed; setting ``i`` uses its child ``i``.
     base : GraspTask, optional
         Task the settings modify.
-    figures : bool
-        Build the figures.
     """
-    return _variability(
-        "variability-size", "object_size", sizes,
-        ("fig4_13_variability_size_sd", "fig4_14_variability_size_peaks"),
-        trials, seed, base, figures,
-    )
+    return _variability("variability-size", "object_size", sizes, trials, seed, base)
 
 
 def variability_distance_experiment(
     distances: Sequence[float] = TRANSPORT_DISTANCES,
     *,
-    trials: int = 500,
+    trials: int = THESIS_TRIALS,
     seed: int | np.random.SeedSequence = 0,
     base: GraspTask | None = None,
-    figures: bool = True,
 ) -> GraspExperiment:
     """Wrist and aperture variability vs transport distance (thesis 4.2.3.3, Figs. 4.15-4.16).
 
@@ -499,14 +496,8 @@ def variability_distance_experiment(
         Root seed; setting ``i`` uses its child ``i``.
     base : GraspTask, optional
         Task the settings modify.
-    figures : bool
-        Build the figures.
     """
-    return _variability(
-        "variability-distance", "distance", distances,
-        ("fig4_15_variability_distance_sd", "fig4_16_variability_distance_peaks"),
-        trials, seed, base, figures,
-    )
+    return _variability("variability-distance", "distance", distances, trials, seed, base)
 
 
 #: Experiment functions by CLI name, in thesis order.
@@ -524,10 +515,9 @@ EXPERIMENTS: dict[str, Callable[..., GraspExperiment]] = {
 def run_experiment(
     name: str,
     *,
-    trials: int = 500,
+    trials: int = THESIS_TRIALS,
     seed: int | np.random.SeedSequence = 0,
     base: GraspTask | None = None,
-    figures: bool = True,
 ) -> GraspExperiment:
     """Run one chapter-4 experiment by name with the thesis's settings.
 
@@ -536,15 +526,13 @@ def run_experiment(
     name : str
         One of :data:`EXPERIMENTS`.
     trials : int
-        Repetitions per setting (thesis: 500).
+        Repetitions per setting (thesis: :data:`THESIS_TRIALS`, 500).
     seed : int or numpy.random.SeedSequence
         Root seed; setting ``i`` uses its child ``i``.
     base : GraspTask, optional
         Task the settings modify.
-    figures : bool
-        Build the figures.
     """
     if name not in EXPERIMENTS:
         raise ValueError(f"experiment: unknown name {name!r}; expected one of "
                          f"{', '.join(EXPERIMENTS)}")
-    return EXPERIMENTS[name](trials=_check_trials(trials), seed=seed, base=base, figures=figures)
+    return EXPERIMENTS[name](trials=check_trials(trials), seed=seed, base=base)

@@ -1,7 +1,10 @@
 """Statistics of grasps (thesis chapter 4): grip aperture, variability, end-points.
 
 Functions take arrays, so they serve simulated and observed grasps alike;
-:func:`summarize_grasp` collects them for one :class:`~minvar.grasp.GraspResult`.
+:func:`summarize_grasp` collects them for one :class:`~minvar.grasp.GraspResult`,
+whose own ``aperture``, ``mga``, ``wrist_sd``, ... properties call them too.
+This module needs nothing of :mod:`minvar.grasp` at run time (its classes
+are imported for type checking only), so :mod:`minvar.grasp` can build on it.
 :func:`grasp_moments` gives the same variabilities without sampling error,
 from the exact joint-space moments of each chain's plan
 (:func:`minvar.lqg.state_moments`) mapped through the kinematics to first
@@ -12,24 +15,45 @@ part in 10^4 at the thesis's 1 % execution noise.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .analysis import endpoint_stats
-from .grasp import GraspPlan, GraspResult
 from .lqg import state_moments
 from .plant import POSITION
+
+if TYPE_CHECKING:  # pragma: no cover - minvar.grasp imports this module
+    from .grasp import GraspPlan, GraspResult
 
 __all__ = [
     "GraspMoments",
     "GraspSummary",
     "grasp_moments",
+    "grip_aperture",
     "max_grip_aperture",
     "path_sd",
     "peak",
     "peak_deviation",
     "summarize_grasp",
 ]
+
+
+def grip_aperture(finger: np.ndarray, thumb: np.ndarray) -> np.ndarray:
+    """Grip aperture: the distance between the finger and thumb tips.
+
+    Parameters
+    ----------
+    finger, thumb : (..., 2) arrays
+        Tip positions (any frame, the same for both), m.
+
+    Returns
+    -------
+    (...) array
+        ``|finger - thumb|``, m.
+    """
+    d = np.asarray(finger, dtype=float) - np.asarray(thumb, dtype=float)
+    return np.hypot(d[..., 0], d[..., 1])
 
 
 def max_grip_aperture(aperture: np.ndarray, relative_time: np.ndarray):
@@ -188,7 +212,7 @@ def grasp_moments(plan: GraspPlan) -> GraspMoments:
     f_pos, _, f_cov = mapped(plan.finger, "finger")
     t_pos, _, t_cov = mapped(plan.thumb, "thumb")
     d = f_pos - t_pos
-    a = np.hypot(d[:, 0], d[:, 1])
+    a = grip_aperture(f_pos, t_pos)
     # direction of the aperture; undefined with the tips together, where any
     # unit vector gives the (then meaningless) first-order value
     u = np.where(a[:, None] > 1e-12, d / np.maximum(a, 1e-12)[:, None], [1.0, 0.0])

@@ -3,14 +3,20 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from .lqg import LQGSolution, solve
 from .plant import FORCE, POSITION, VELOCITY, PointMassPlant
 from .simulate import simulate
 from .task import ReachTask, reach_problem
+
+if TYPE_CHECKING:  # pragma: no cover
+    import pandas as pd
+
+# pandas is imported when a table is asked for: `import minvar` stays light
+# (pandas takes about half a second to import).
 
 __all__ = ["ReachResult", "simulate_reach"]
 
@@ -76,6 +82,8 @@ class ReachResult:
 
         Columns: trial, step, time (s), x, y (m), vx, vy, speed (m/s), fx, fy (N).
         """
+        import pandas as pd
+
         trials, steps = self.position.shape[:2]
         return pd.DataFrame(
             {
@@ -112,7 +120,8 @@ def simulate_reach(
     seed : int or numpy.random.Generator, optional
         Randomness of the execution noise.
     plant : PointMassPlant, optional
-        Plant and noise parameters (default: DESIGN.md values).
+        Plant and noise parameters (default: :class:`~minvar.plant.PointMassPlant`'s,
+        docs/model.md).
     solution : LQGSolution, optional
         Gains already solved for this task and plant (skips planning).
 

@@ -363,7 +363,8 @@ def expected_path(task: ReachTask, plant: PointMassPlant | None = None):
     task : ReachTask
         The movement.
     plant : PointMassPlant, optional
-        Plant and noise parameters (default: DESIGN.md values).
+        Plant and noise parameters (default: :class:`~minvar.plant.PointMassPlant`'s,
+        docs/model.md).
 
     Returns
     -------

@@ -20,7 +20,7 @@ from minvar.grasp_experiments import (
 
 @pytest.fixture(scope="module")
 def sizes():
-    return object_size_experiment(trials=100, seed=1, figures=False)
+    return object_size_experiment(trials=100, seed=1)
 
 
 def test_mga_grows_with_object_size_with_slope_near_one(sizes):
@@ -40,8 +40,7 @@ def test_mga_time_within_human_range_and_later_for_larger_objects(sizes):
 
 
 def test_larger_viapoint_offset_gives_larger_earlier_mga():
-    e = viapoint_distance_experiment((0.0, 0.005, 0.01, 0.02), trials=100, seed=2,
-                                     figures=False)
+    e = viapoint_distance_experiment((0.0, 0.005, 0.01, 0.02), trials=100, seed=2)
     s = e.summary
     assert np.all(np.diff(s.mga_mean) > 0.003)
     assert np.all(np.diff(s.mga_time_mean) <= 0) and s.mga_time_mean.iloc[-1] < \
@@ -49,8 +48,7 @@ def test_larger_viapoint_offset_gives_larger_earlier_mga():
 
 
 def test_endpoint_sd_lowest_with_level_viapoints():
-    e = viapoint_height_experiment((-0.02, -0.01, 0.0, 0.01, 0.02), trials=200, seed=3,
-                                   figures=False)
+    e = viapoint_height_experiment((-0.02, -0.01, 0.0, 0.01, 0.02), trials=200, seed=3)
     s = e.summary
     for digit in ("finger", "thumb"):
         exact = np.hypot(s[f"{digit}_sd_x_exact"], s[f"{digit}_sd_y_exact"]).to_numpy()
@@ -65,7 +63,7 @@ def test_endpoint_sd_lowest_with_level_viapoints():
 
 @pytest.mark.slow
 def test_wrist_and_aperture_sd_fall_as_movement_time_grows():
-    e = movement_time_experiment((0.6, 0.9, 1.2), trials=200, seed=4, figures=False)
+    e = movement_time_experiment((0.6, 0.9, 1.2), trials=200, seed=4)
     s = e.summary
     for comp in ("wrist", "aperture"):
         assert np.all(np.diff(s[f"{comp}_sd_peak_exact"]) < 0)
@@ -85,9 +83,8 @@ def test_wrist_and_aperture_sd_fall_as_movement_time_grows():
 
 
 def test_variability_with_size_and_distance():
-    size = variability_size_experiment((0.0, 0.04, 0.08), trials=100, seed=5, figures=False)
-    dist = variability_distance_experiment((0.08, 0.16, 0.24), trials=100, seed=6,
-                                           figures=False)
+    size = variability_size_experiment((0.0, 0.04, 0.08), trials=100, seed=5)
+    dist = variability_distance_experiment((0.08, 0.16, 0.24), trials=100, seed=6)
     # the wrist does not see the object's size; the grip does not see the distance
     assert size.stats["wrist_sd_peak_exact_range"] == 0.0
     assert dist.stats["aperture_sd_peak_exact_range"] == 0.0
@@ -135,9 +132,10 @@ def test_bad_experiment_inputs():
 
 def test_figures_are_built_and_named_after_the_thesis():
     e = variability_size_experiment((0.02, 0.06), trials=10, seed=0)
-    assert set(e.figures) == {"fig4_13_variability_size_sd", "fig4_14_variability_size_peaks"}
-    assert all(isinstance(f, Figure) for f in e.figures.values())
-    assert len(e.figures["fig4_14_variability_size_peaks"].axes) == 4
+    figures = e.plot()
+    assert set(figures) == {"fig4_13_variability_size_sd", "fig4_14_variability_size_peaks"}
+    assert all(isinstance(f, Figure) for f in figures.values())
+    assert len(figures["fig4_14_variability_size_peaks"].axes) == 4
     assert set(EXPERIMENTS) == {"viapoint-height", "viapoint-time", "viapoint-distance",
                                 "object-size", "movement-time", "variability-size",
                                 "variability-distance"}

@@ -1,4 +1,4 @@
-"""Reaching behaviour the thesis (ch. 3) and DESIGN.md report."""
+"""Reaching behaviour the thesis (ch. 3) and docs/model.md report."""
 
 import numpy as np
 import pytest
@@ -71,7 +71,7 @@ def test_s_movement_passes_via_points_and_reaches_goal():
     r = simulate_reach(S_TASK, 200, seed=3)
     mean = r.mean_position
     for v in S_TASK.via_points:
-        assert closest_approach(mean, v.position) < 0.005  # DESIGN.md: within 5 mm
+        assert closest_approach(mean, v.position) < 0.005  # docs/model.md: within 5 mm
     assert np.linalg.norm(mean[-1] - S_TASK.goal) < 0.01
     assert count_speed_peaks(r.mean_speed) == 3  # three strokes of the 's'
 

@@ -1,4 +1,4 @@
-"""The plant and task builders against DESIGN.md and the reference inputs."""
+"""The plant and task builders against docs/model.md and the reference inputs."""
 
 import numpy as np
 import pytest

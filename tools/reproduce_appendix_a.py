@@ -18,10 +18,10 @@ import numpy as np
 import pandas as pd
 from reproduce_common import Progress, borderline, claim, no_progress, rng_for, save
 
+from minvar.plotting.viapoints import criteria_figure, curvature_figure, generalisation_figure
 from minvar.reach import simulate_reach
 from minvar.similarity import path_distance
 from minvar.task import ReachTask, ViaPoint
-from minvar.thesis_figures import criteria_figure, curvature_figure, generalisation_figure
 from minvar.viapoints import CRITERIA, compare_criteria, letter_a, replay
 
 #: The observed movements of Fig. A.1 (m, s); all within a 0.30 + 0.30 m arm's reach.
@@ -63,34 +63,7 @@ def _coincident(table: pd.DataFrame, a: str, b: str, steps: int) -> tuple[int, i
     return near, total
 
 
-def reproduce(
-    out: Path,
-    *,
-    trials: int | None = None,
-    seed: int = 0,
-    repeats: int = REPEATS,
-    progress: Progress = no_progress,
-) -> list[dict]:
-    """Figs. A.1-A.3 into ``out``; the appendix's claims.
-
-    Parameters
-    ----------
-    out : Path
-        Output folder.
-    trials : int, optional
-        Repetitions drawn for Fig. A.3 (default 50).
-    seed : int
-        Base seed; each figure draws from its own stream.
-    repeats : int
-        Observed repetitions of each test movement in Fig. A.1.
-    progress : callable
-        Called with the name of each figure as it starts.
-    """
-    out = Path(out)
-    n = 50 if trials is None else int(trials)
-    claims = []
-
-    progress("figA_1")
+def _fig_a1(out: Path, claims: list, seed: int, repeats: int):
     names, trajs = _observed(seed, repeats)
     comparison = compare_criteria(trajs)
     table = comparison.table.assign(movement=[names[k] for k in comparison.table["trajectory"]])
@@ -129,8 +102,10 @@ def reproduce(
         f"lowest on each movement: {wins}",
         best == "curvature", note + " " + how,
     ))
+    return names, trajs, comparison
 
-    progress("figA_2")
+
+def _fig_a2(out: Path, names: list, trajs: list, comparison) -> None:
     k = names.index("bowed reach")
     t, p = trajs[k]
     rows = comparison.table
@@ -138,7 +113,8 @@ def reproduce(
     idx = idx.iloc[0]
     save(out, "figA_2_curvature_viapoints", curvature_figure(t, p, idx))
 
-    progress("figA_3")
+
+def _fig_a3(out: Path, claims: list, n: int, seed: int) -> None:
     rng = rng_for(seed, "figA_3")
     movement = letter_a(duration=A3_SLOW)
     faster = movement.retime(A3_FAST)
@@ -174,4 +150,39 @@ def reproduce(
               "Judged within 5 % of the scaled letter's height. Not exact: signal-dependent "
               "noise scales with the movement but the sensory noise does not."),
     ]
+
+
+def reproduce(
+    out: Path,
+    *,
+    trials: int | None = None,
+    seed: int = 0,
+    repeats: int = REPEATS,
+    progress: Progress = no_progress,
+) -> list[dict]:
+    """Figs. A.1-A.3 into ``out``; the appendix's claims.
+
+    Parameters
+    ----------
+    out : Path
+        Output folder.
+    trials : int, optional
+        Repetitions drawn for Fig. A.3 (default 50).
+    seed : int
+        Base seed; each figure draws from its own stream.
+    repeats : int
+        Observed repetitions of each test movement in Fig. A.1.
+    progress : callable
+        Called with the name of each figure as it starts.
+    """
+    out = Path(out)
+    n = 50 if trials is None else int(trials)
+    claims = []
+
+    progress("figA_1")
+    names, trajs, comparison = _fig_a1(out, claims, seed, repeats)
+    progress("figA_2")
+    _fig_a2(out, names, trajs, comparison)
+    progress("figA_3")
+    _fig_a3(out, claims, n, seed)
     return claims

@@ -20,7 +20,7 @@ from minvar.baselines import (
     minimum_jerk,
     peak_to_mean_ratio,
 )
-from minvar.thesis_figures import (
+from minvar.plotting.baselines import (
     angle_jerk_hand_figure,
     angle_jerk_joint_figure,
     derivative_order_figure,
@@ -41,27 +41,7 @@ def _movements(seed: int, count: int = 10) -> list[tuple[np.ndarray, np.ndarray]
     return [(START + j[0], GOAL + j[1]) for j in jitter]
 
 
-def reproduce(
-    out: Path, *, trials: int | None = None, seed: int = 0, progress: Progress = no_progress
-) -> list[dict]:
-    """Figs. 2.5-2.8 into ``out``; the chapter's claims.
-
-    Parameters
-    ----------
-    out : Path
-        Output folder.
-    trials : int, optional
-        Unused (the models are noiseless); accepted for a uniform interface.
-    seed : int
-        Places the ten jittered movements.
-    progress : callable
-        Called with the name of each figure as it starts.
-    """
-    out = Path(out)
-    claims = []
-    pairs = _movements(seed)
-
-    progress("fig2_5")
+def _fig2_5(out: Path, claims: list, pairs: list) -> None:
     jerk = [minimum_jerk(s, g, DURATION, dt=0.001) for s, g in pairs]
     rows = [
         {
@@ -86,17 +66,18 @@ def reproduce(
         "bell-shaped", f"{bells}/{len(jerk)} profiles with one peak", bells == len(jerk),
     ))
 
-    progress("fig2_6")
+
+def _fig2_6(out: Path, claims: list) -> None:
     ratios = {n: peak_to_mean_ratio(n) for n in ORDERS}
-    sampled = {}
-    for n in ORDERS:
-        m = minimum_derivative(n, (0.0, 0.0), (0.20, 0.0), 1.0, dt=0.001)
-        sampled[n] = peak_to_mean_speed(m.speed, m.time)
+    # 20 cm in 1 s, sampled at 1 ms: the thesis's Fig. 2.6
+    movements = {n: minimum_derivative(n, (0.0, 0.0), (0.20, 0.0), 1.0, dt=0.001)
+                 for n in ORDERS}
+    sampled = {n: peak_to_mean_speed(m.speed, m.time) for n, m in movements.items()}
     table = pd.DataFrame(
         {"order": list(ORDERS), "ratio_closed_form": [ratios[n] for n in ORDERS],
          "ratio_sampled_1ms": [sampled[n] for n in ORDERS]}
     )
-    save(out, "fig2_6_derivative_order", derivative_order_figure(ORDERS), table)
+    save(out, "fig2_6_derivative_order", derivative_order_figure(movements), table)
     claims.append(claim(
         "2.2.3, Fig. 2.6(c)", "Peak/mean velocity ratio r of minimum jerk (n = 3)",
         "1.875", f"{sampled[3]:.4f} (profile sampled at 1 ms); closed form 15/8 = {ratios[3]:.4f}",
@@ -116,7 +97,8 @@ def reproduce(
         "n = 3", f"n = {nearest}", nearest == 3,
     ))
 
-    progress("fig2_7")
+
+def _fig2_7(out: Path, claims: list, pairs: list) -> list:
     arm = [minimum_angle_jerk(s, g, DURATION, dt=0.005) for s, g in pairs]
     save(out, "fig2_7_angle_jerk_joints", angle_jerk_joint_figure(arm))
     joint_dev = max(
@@ -128,8 +110,10 @@ def reproduce(
         "straight joint paths", f"max deviation {joint_dev:.1e} rad over {len(arm)} movements",
         joint_dev < 1e-9,
     ))
+    return arm
 
-    progress("fig2_8")
+
+def _fig2_8(out: Path, claims: list, pairs: list, arm: list) -> None:
     hand_dev = np.array([
         np.abs(path_deviation(m.hand.position, s, g)).max() for (s, g), m in zip(pairs, arm)
     ])
@@ -159,4 +143,34 @@ def reproduce(
         f"{table['hand_peak_to_mean'].min():.2f}-{table['hand_peak_to_mean'].max():.2f}",
         bool((peaks == 1).all()),
     ))
+
+
+def reproduce(
+    out: Path, *, trials: int | None = None, seed: int = 0, progress: Progress = no_progress
+) -> list[dict]:
+    """Figs. 2.5-2.8 into ``out``; the chapter's claims.
+
+    Parameters
+    ----------
+    out : Path
+        Output folder.
+    trials : int, optional
+        Unused (the models are noiseless); accepted for a uniform interface.
+    seed : int
+        Places the ten jittered movements.
+    progress : callable
+        Called with the name of each figure as it starts.
+    """
+    out = Path(out)
+    claims = []
+    pairs = _movements(seed)
+
+    progress("fig2_5")
+    _fig2_5(out, claims, pairs)
+    progress("fig2_6")
+    _fig2_6(out, claims)
+    progress("fig2_7")
+    arm = _fig2_7(out, claims, pairs)
+    progress("fig2_8")
+    _fig2_8(out, claims, pairs, arm)
     return claims

@@ -23,16 +23,16 @@ from minvar.analysis import (
     peak_to_mean_speed,
     speed_accuracy,
 )
-from minvar.figures import reach_figure, speed_accuracy_figure
-from minvar.reach import simulate_reach
-from minvar.similarity import path_distance
-from minvar.task import ReachTask, ViaPoint
-from minvar.thesis_figures import (
+from minvar.plotting.reach import reach_figure, speed_accuracy_figure
+from minvar.plotting.viapoints import (
     letter_durations_figure,
     letter_figure,
     merging_figure,
     viapoint_timing_figure,
 )
+from minvar.reach import simulate_reach
+from minvar.similarity import path_distance
+from minvar.task import ReachTask, ViaPoint
 from minvar.viapoints import expected_path, letter_a, viapoint_timing
 
 #: Fig. 3.4 (thesis coordinates, shoulder at the origin).
@@ -129,7 +129,8 @@ def _fig3_4_3_5(out: Path, claims: list, trials: int, seed: int) -> None:
         claim("3.3.1, Fig. 3.4(d)", "Peak/mean speed ratio human-like",
               "humans ≈ 1.875", f"{ratio:.2f} (mean profile of {r.trials})",
               abs(ratio - 1.875) < 0.2,
-              "Judged human-like within ±0.2. DESIGN.md's cost weights (r = 2e-4, w_v = 0.2), "
+              "Judged human-like within ±0.2. The model's cost weights (r = 2e-4, w_v = 0.2; "
+              "docs/model.md), "
               "not the thesis's r = 0.002, w_v = 0.1, which leave the hand short of the goal."),
         claim("3.3.1, Fig. 3.4(c)", "The mean path is a straight line",
               "straight", f"max deviation {mean_dev * 1000:.1f} mm over a 36 cm reach "
@@ -175,7 +176,7 @@ def _fig3_6_3_7(out: Path, claims: list, trials: int, seed: int) -> None:
               "expected path " + ", ".join(f"{m * 1000:.1f}" for m in miss)
               + f" mm from the via-points, {end * 1000:.1f} mm from the goal",
               max(miss) < 0.005 and end < 0.01,
-              "Judged within 5 mm of each via-point (DESIGN.md) and 1 cm of the goal, on the "
+              "Judged within 5 mm of each via-point (docs/model.md) and 1 cm of the goal, on the "
               "expected (noise-averaged) path; the mean of our "
               f"{r.trials} repetitions passes " + ", ".join(f"{m * 1000:.1f}" for m in miss_mc)
               + " mm away. The via-point cost is soft, so the path cuts the corners."

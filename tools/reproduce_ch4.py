@@ -15,8 +15,8 @@ claim is about a standard deviation (``*_exact`` columns), so they do not hinge
 on sampling error; the Monte Carlo values are in the tables and figures too.
 Nothing in the model was tuned to match these numbers: the parameters are the
 thesis's (links, 6 cm wrist stand-off, 1 cm via-point at 70 %, 1 % execution
-noise) and DESIGN.md's cost weights; the geometric choices the thesis leaves
-open are documented in :mod:`minvar.grasp`.
+noise) and the model's cost weights (docs/model.md); the geometric choices the
+thesis leaves open are documented in :mod:`minvar.grasp` and docs/coordinates.md.
 """
 
 from __future__ import annotations
@@ -37,7 +37,7 @@ if str(ROOT) not in sys.path:
 from hammer_mv.cli.grasp import write_experiment  # noqa: E402
 from minvar.grasp import GraspTask, plan_grasp, simulate_grasp  # noqa: E402
 from minvar.grasp_experiments import EXPERIMENTS, GraspExperiment  # noqa: E402
-from minvar.grasp_figures import grasp_figure, setup_figure  # noqa: E402
+from minvar.plotting.grasp import grasp_figure, setup_figure  # noqa: E402
 from perception.io.atomic import save_figure, write_csv  # noqa: E402
 
 log = logging.getLogger("reproduce_ch4")

@@ -14,15 +14,11 @@ import time
 from pathlib import Path
 
 from minvar.grasp import GraspTask
+from minvar.grasp_experiments import EXPERIMENTS, THESIS_TRIALS, check_trials
 from minvar.plant import PointMassPlant
 from perception.io.atomic import save_figure, write_csv, write_json
 
 log = logging.getLogger(__name__)
-
-_EXPERIMENT_NAMES = (
-    "viapoint-height", "viapoint-time", "viapoint-distance", "object-size",
-    "movement-time", "variability-size", "variability-distance",
-)
 
 
 def register(sub) -> None:
@@ -36,7 +32,11 @@ def register(sub) -> None:
     )
     p.set_defaults(func=lambda args: _usage(p))
     gsub = p.add_subparsers(dest="grasp_command", metavar="{simulate,experiment}")
+    _add_simulate(gsub)
+    _add_experiment(gsub)
 
+
+def _add_simulate(gsub) -> None:
     s = gsub.add_parser(
         "simulate",
         help="noisy repetitions of one grasp (figures + CSV)",
@@ -55,7 +55,8 @@ def register(sub) -> None:
                    help=f"digit via-point distance outside the object, m "
                         f"(default {d.viapoint_offset})")
     s.add_argument("--viapoint-height", type=float, default=d.viapoint_height, metavar="M",
-                   help="digit via-point height above the target line, m (default 0)")
+                   help=f"digit via-point height above the target line, m "
+                        f"(default {d.viapoint_height:g})")
     s.add_argument("--viapoint-time", type=float, default=d.viapoint_time, metavar="F",
                    help=f"digit via-point time, fraction of the movement "
                         f"(default {d.viapoint_time})")
@@ -66,24 +67,27 @@ def register(sub) -> None:
                         f"(default {d.execution_cv})")
     s.add_argument("--dt", type=float, default=d.plant.dt, metavar="S",
                    help=f"time step, s (default {d.plant.dt})")
-    s.add_argument("--trials", type=int, default=500, metavar="N",
-                   help="repetitions (default 500)")
+    s.add_argument("--trials", type=int, default=THESIS_TRIALS, metavar="N",
+                   help=f"repetitions (default {THESIS_TRIALS})")
     s.add_argument("--seed", type=int, default=0, metavar="N", help="random seed (default 0)")
     s.add_argument("-o", "--output", required=True, type=Path, metavar="DIR",
                    help="folder for the figures and tables")
     s.set_defaults(func=run_simulate)
 
+
+def _add_experiment(gsub) -> None:
     e = gsub.add_parser(
         "experiment",
         help="one of the thesis's chapter 4 experiments, or all",
-        description="Run a chapter 4 sweep (500 repetitions per setting by default) and write "
+        description=f"Run a chapter 4 sweep ({THESIS_TRIALS} repetitions per setting by "
+        "default) and write "
         "NAME.csv (one row per setting), NAME_trials.csv, NAME_curves.csv, NAME_stats.json "
         "and the figures as PNG, named after the thesis's (e.g. fig4_10_object_size_mga.png).",
     )
-    e.add_argument("name", choices=(*_EXPERIMENT_NAMES, "all"), metavar="NAME",
-                   help=f"one of {', '.join(_EXPERIMENT_NAMES)}, all")
-    e.add_argument("--trials", type=int, default=500, metavar="N",
-                   help="repetitions per setting (default 500, as in the thesis)")
+    e.add_argument("name", choices=(*EXPERIMENTS, "all"), metavar="NAME",
+                   help=f"one of {', '.join(EXPERIMENTS)}, all")
+    e.add_argument("--trials", type=int, default=THESIS_TRIALS, metavar="N",
+                   help=f"repetitions per setting (default {THESIS_TRIALS}, as in the thesis)")
     e.add_argument("--seed", type=int, default=0, metavar="N", help="random seed (default 0)")
     e.add_argument("-o", "--output", required=True, type=Path, metavar="DIR",
                    help="folder for the tables and figures")
@@ -100,18 +104,13 @@ def _check_output(out: Path) -> None:
         raise ValueError(f"{out}: output exists and is not a folder")
 
 
-def _check_trials(trials: int) -> None:
-    if trials < 2:
-        raise ValueError(f"--trials: need at least 2 repetitions, got {trials}")
-
-
 def run_simulate(args: argparse.Namespace) -> int:
     """Execute ``hammer-mv grasp simulate`` with parsed ``args``; return the exit status."""
     from minvar.grasp import plan_grasp, simulate_grasp
-    from minvar.grasp_figures import grasp_figure, setup_figure
     from minvar.grasp_stats import grasp_moments, summarize_grasp
+    from minvar.plotting import grasp_figure, setup_figure
 
-    _check_trials(args.trials)
+    check_trials(args.trials, name="--trials")
     _check_output(args.output)
     task = GraspTask(
         object_size=args.object_size, distance=args.distance, duration=args.duration,
@@ -153,24 +152,25 @@ def run_simulate(args: argparse.Namespace) -> int:
 
 def run_experiment(args: argparse.Namespace) -> int:
     """Execute ``hammer-mv grasp experiment`` with parsed ``args``; return the exit status."""
-    from minvar.grasp_experiments import EXPERIMENTS
-
-    _check_trials(args.trials)
+    check_trials(args.trials, name="--trials")
     _check_output(args.output)
     names = list(EXPERIMENTS) if args.name == "all" else [args.name]
     out: Path = args.output
     for name in names:
         t0 = time.perf_counter()
         exp = EXPERIMENTS[name](trials=args.trials, seed=args.seed)
-        write_experiment(exp, out)
+        written = write_experiment(exp, out)
         print(f"{name}: {len(exp.summary)} settings x {args.trials} repetitions in "
               f"{time.perf_counter() - t0:.1f} s -> {out / (name + '.csv')}, "
-              + ", ".join(f"{stem}.png" for stem in exp.figures))
+              + ", ".join(p.name for p in written if p.suffix == ".png"))
     return 0
 
 
 def write_experiment(exp, out: Path) -> list[Path]:
     """Write an experiment's tables, statistics and figures into ``out``.
+
+    The figures are drawn here (:meth:`~minvar.grasp_experiments.GraspExperiment.plot`)
+    and written as ``<stem>.png``, one at a time.
 
     Parameters
     ----------
@@ -190,5 +190,5 @@ def write_experiment(exp, out: Path) -> list[Path]:
         write_csv(out / f"{exp.name}_curves.csv", exp.curves),
         write_json(out / f"{exp.name}_stats.json", exp.stats),
     ]
-    written += [save_figure(out / f"{stem}.png", fig) for stem, fig in exp.figures.items()]
+    written += [save_figure(out / f"{stem}.png", fig) for stem, fig in exp.plot().items()]
     return written

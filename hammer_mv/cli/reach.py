@@ -49,14 +49,18 @@ def register(sub) -> None:
     p.add_argument("--sweep", action="store_true",
                    help="speed-accuracy sweep over --durations instead of one movement")
     p.add_argument("--durations", nargs="+", type=float, default=list(THESIS_DURATIONS),
-                   metavar="S", help="movement times for --sweep, s (default: 0.5 ... 1.2)")
-    p.add_argument("--r", type=float, default=ReachTask.r, help="effort weight r (default: 2e-4)")
-    p.add_argument("--w-v", type=float, default=ReachTask.w_v, help="final velocity weight")
-    p.add_argument("--w-f", type=float, default=ReachTask.w_f, help="final force weight")
+                   metavar="S", help=f"movement times for --sweep, s (default: "
+                                     f"{THESIS_DURATIONS[0]:g} ... {THESIS_DURATIONS[-1]:g})")
+    p.add_argument("--r", type=float, default=ReachTask.r,
+                   help=f"effort weight r (default: {ReachTask.r:g})")
+    p.add_argument("--w-v", type=float, default=ReachTask.w_v,
+                   help=f"final velocity weight (default: {ReachTask.w_v:g})")
+    p.add_argument("--w-f", type=float, default=ReachTask.w_f,
+                   help=f"final force weight (default: {ReachTask.w_f:g})")
     p.add_argument("--sigma-u", type=float, default=PointMassPlant.sigma_u,
-                   help="control-dependent noise scale (default: 0.4)")
+                   help=f"control-dependent noise scale (default: {PointMassPlant.sigma_u:g})")
     p.add_argument("--sigma-s", type=float, default=PointMassPlant.sigma_s,
-                   help="sensory noise scale (default: 0.4)")
+                   help=f"sensory noise scale (default: {PointMassPlant.sigma_s:g})")
     p.add_argument("-o", "--output", required=True, type=Path, metavar="DIR",
                    help="folder for the figures and tables")
     p.set_defaults(func=run)
@@ -64,7 +68,7 @@ def register(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Execute ``hammer-mv reach`` with parsed ``args``; return the exit status."""
-    from minvar.figures import reach_figure, speed_accuracy_figure
+    from minvar.plotting import reach_figure, speed_accuracy_figure
 
     plant = PointMassPlant(sigma_u=args.sigma_u, sigma_s=args.sigma_s)
     vias = tuple(ViaPoint((x, y), fraction=f) for x, y, f in args.via)

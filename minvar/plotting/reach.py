@@ -1,34 +1,24 @@
-"""Figures of the reaching chapter (thesis Figs. 3.4-3.7).
+"""Figures of reaching movements (thesis Figs. 3.4-3.7).
 
-Each function returns a :class:`matplotlib.figure.Figure` built without pyplot's
-global state, so figures can be made in worker processes and saved by the
-caller (``fig.savefig(path)``).
+Each function takes a result already computed (:class:`~minvar.reach.ReachResult`,
+:class:`~minvar.analysis.SpeedAccuracy`) and returns a
+:class:`matplotlib.figure.Figure` made by :func:`~minvar.plotting.new_figure`.
 """
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from matplotlib.figure import Figure
 
-from .analysis import SpeedAccuracy
-from .reach import ReachResult
+from .canvas import new_figure
 
-__all__ = ["reach_figure", "speed_accuracy_figure", "new_figure"]
+if TYPE_CHECKING:  # pragma: no cover - results are duck-typed at run time
+    from ..analysis import SpeedAccuracy
+    from ..reach import ReachResult
 
-
-def new_figure(rows: int, cols: int, *, size: tuple[float, float] | None = None):
-    """A figure and its axes grid, independent of pyplot.
-
-    Parameters
-    ----------
-    rows, cols : int
-        Grid of axes.
-    size : (width, height), optional
-        Figure size in inches (default: 4 x 3.4 per panel).
-    """
-    fig = Figure(figsize=size or (4.0 * cols, 3.4 * rows), layout="constrained")
-    axes = fig.subplots(rows, cols, squeeze=False)
-    return fig, axes
+__all__ = ["reach_figure", "speed_accuracy_figure"]
 
 
 def reach_figure(result: ReachResult, *, shown: int = 50, title: str | None = None) -> Figure:

@@ -1,34 +1,32 @@
-"""Figures of the thesis's chapter 2 baselines, chapter 3 via-points and appendix A.
+"""Figures of via-point movements: thesis chapter 3 (Figs. 3.2-3.3, 3.8-3.9) and appendix A.
 
-Figs. 2.5-2.8 (minimum jerk, higher derivatives, minimum angle jerk), 3.2-3.3
-(via-point timing, merging movements), 3.8-3.9 (the letter 'a') and A.1-A.3
-(via-point criteria, spatio-temporal curvature, generalisation). The
-point-to-point and 's' figures (3.4-3.7) are in :mod:`minvar.figures`.
-
-Like :mod:`minvar.figures`, every function returns a
-:class:`matplotlib.figure.Figure` built without pyplot's global state and
-takes results already computed, so the caller decides trials and seeds.
+Via-point timing, merging movements, the letter 'a' (chapter 3) and the
+via-point criteria, spatio-temporal curvature and generalisation of appendix A
+(Figs. A.1-A.3). The point-to-point and 's' figures (3.4-3.7) are in
+:mod:`minvar.plotting.reach`. Every function takes results already computed,
+so the caller decides trials and seeds, and returns a
+:class:`matplotlib.figure.Figure` made by :func:`~minvar.plotting.new_figure`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 from matplotlib.figure import Figure
 
-from .analysis import peak_to_mean_speed
-from .baselines import ArmTrajectory, SmoothTrajectory, minimum_derivative, peak_to_mean_ratio
-from .figures import new_figure
-from .reach import ReachResult
-from .viapoints import CRITERIA, CriteriaComparison, ViaPointMovement, spatiotemporal_curvature
+from ..viapoints import CRITERIA, spatiotemporal_curvature
+from .canvas import new_figure, path_axes, time_axes
+
+if TYPE_CHECKING:  # pragma: no cover - results are duck-typed at run time
+    import pandas as pd
+    from numpy.typing import ArrayLike
+
+    from ..reach import ReachResult
+    from ..viapoints import CriteriaComparison
 
 __all__ = [
-    "minimum_jerk_figure",
-    "derivative_order_figure",
-    "angle_jerk_joint_figure",
-    "angle_jerk_hand_figure",
     "viapoint_timing_figure",
     "merging_figure",
     "letter_figure",
@@ -38,138 +36,11 @@ __all__ = [
     "generalisation_figure",
 ]
 
-#: Human peak/mean velocity ratio quoted by the thesis (section 2.2.3).
-HUMAN_PEAK_TO_MEAN = 1.875
-
-
-def _path_axes(ax, title: str) -> None:
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
-    ax.set_aspect("equal", adjustable="datalim")
-    ax.set_title(title)
-
-
-def _time_axes(ax, title: str, ylabel: str = "speed (m/s)") -> None:
-    ax.set_xlabel("time (s)")
-    ax.set_ylabel(ylabel)
-    ax.set_title(title)
-
-
-def minimum_jerk_figure(movements: Sequence[SmoothTrajectory]) -> Figure:
-    """Hand paths and speed profiles of minimum jerk movements (thesis Fig. 2.5).
-
-    Parameters
-    ----------
-    movements : sequence of SmoothTrajectory
-        E.g. ten movements between nearby points (:func:`minvar.baselines.minimum_jerk`).
-    """
-    fig, ax = new_figure(1, 2, size=(10, 4))
-    for m in movements:
-        ax[0, 0].plot(*m.position.T, lw=1)
-        ax[0, 1].plot(m.time, m.speed, lw=1)
-    _path_axes(ax[0, 0], "(a) hand paths")
-    _time_axes(ax[0, 1], "(b) tangential speed")
-    fig.suptitle(f"Minimum jerk: {len(movements)} movements")
-    return fig
-
-
-def derivative_order_figure(
-    orders: Sequence[int] = (2, 3, 4, 5, 6), *, distance: float = 0.20, duration: float = 1.0
-) -> Figure:
-    """Minimum n-th derivative movements and their peak/mean velocity ratio (Fig. 2.6).
-
-    Panels: (a) x(t), (b) x velocity, (c) ratio r against n with the human
-    value 1.875 dashed.
-
-    Parameters
-    ----------
-    orders : sequence of int
-        Derivative orders n (2 acceleration, 3 jerk, ...).
-    distance : float
-        Movement amplitude, m (thesis: 0.20).
-    duration : float
-        Movement time, s (thesis: 1).
-    """
-    fig, ax = new_figure(1, 3, size=(13, 3.8))
-    ratios = []
-    for n in orders:
-        m = minimum_derivative(n, (0.0, 0.0), (distance, 0.0), duration, dt=duration / 1000)
-        ax[0, 0].plot(m.time, m.position[:, 0] * 100, label=f"n = {n}")
-        ax[0, 1].plot(m.time, m.velocity[:, 0] * 100, label=f"n = {n}")
-        ratios.append(peak_to_mean_speed(m.speed, m.time))
-    ax[0, 0].legend(fontsize=8)
-    _time_axes(ax[0, 0], "(a) x trajectory", "x (cm)")
-    _time_axes(ax[0, 1], "(b) x velocity", "velocity (cm/s)")
-    fine = np.arange(1, max(orders) + 1)
-    ax[0, 2].plot(fine, [peak_to_mean_ratio(int(n)) for n in fine], "k-", lw=0.8)
-    ax[0, 2].plot(list(orders), ratios, "ko")
-    ax[0, 2].axhline(HUMAN_PEAK_TO_MEAN, color="tab:red", ls="--", label="humans, r = 1.875")
-    ax[0, 2].set_xlabel("derivative order n")
-    ax[0, 2].set_ylabel("peak / mean velocity r")
-    ax[0, 2].set_title("(c) r against n")
-    ax[0, 2].legend(fontsize=8)
-    return fig
-
-
-def angle_jerk_joint_figure(movements: Sequence[ArmTrajectory]) -> Figure:
-    """Joint angles, velocities and accelerations of minimum angle jerk movements (Fig. 2.7).
-
-    Parameters
-    ----------
-    movements : sequence of ArmTrajectory
-        E.g. ten movements (:func:`minvar.baselines.minimum_angle_jerk`).
-    """
-    fig, ax = new_figure(1, 3, size=(13, 3.8))
-    for m in movements:
-        j = m.joints
-        for a, values in zip(ax[0], (j.position, j.velocity, j.acceleration)):
-            a.plot(j.time, np.degrees(values[:, 0]), "tab:blue", lw=0.8)
-            a.plot(j.time, np.degrees(values[:, 1]), "tab:orange", lw=0.8)
-    ax[0, 0].plot([], [], "tab:blue", label="shoulder")
-    ax[0, 0].plot([], [], "tab:orange", label="elbow")
-    ax[0, 0].legend(fontsize=8)
-    _time_axes(ax[0, 0], "(a) joint angles", "angle (deg)")
-    _time_axes(ax[0, 1], "(b) joint velocities", "velocity (deg/s)")
-    _time_axes(ax[0, 2], "(c) joint accelerations", "acceleration (deg/s$^2$)")
-    fig.suptitle(f"Minimum angle jerk: {len(movements)} movements")
-    return fig
-
-
-def angle_jerk_hand_figure(
-    movement: ArmTrajectory, straight: SmoothTrajectory | None = None
-) -> Figure:
-    """Hand path and speed of a minimum angle jerk movement (Fig. 2.8).
-
-    Parameters
-    ----------
-    movement : ArmTrajectory
-        The movement; the arm is drawn at its start and end.
-    straight : SmoothTrajectory, optional
-        The minimum (Cartesian) jerk movement between the same points, dashed,
-        to show the curvature.
-    """
-    fig, ax = new_figure(1, 2, size=(10, 4.2))
-    hand = movement.hand
-    ax[0, 0].plot(*hand.position.T, "k-", lw=1.5, label="minimum angle jerk")
-    if straight is not None:
-        ax[0, 0].plot(*straight.position.T, "k--", lw=0.8, label="minimum jerk")
-        ax[0, 1].plot(straight.time, straight.speed, "k--", lw=0.8, label="minimum jerk")
-    chain = movement.chain
-    for q, style in ((movement.joints.position[0], "o-"), (movement.joints.position[-1], "o:")):
-        arm = np.array([chain.base, chain.elbow(q), chain.forward(q)])
-        ax[0, 0].plot(*arm.T, style, color="0.6", lw=1, ms=3)
-    ax[0, 0].legend(fontsize=8)
-    _path_axes(ax[0, 0], "(a) hand path")
-    ax[0, 1].plot(hand.time, hand.speed, "k-", lw=1.5, label="minimum angle jerk")
-    ax[0, 1].legend(fontsize=8)
-    _time_axes(ax[0, 1], "(b) hand speed")
-    return fig
-
 
 def viapoint_timing_figure(
     paths: Mapping[str, tuple[np.ndarray, np.ndarray]],
     timing: pd.DataFrame,
-    via_point=None,
+    via_point: ArrayLike | None = None,
 ) -> Figure:
     """Effect of a via-point's timing (thesis Fig. 3.2).
 
@@ -188,7 +59,7 @@ def viapoint_timing_figure(
     if via_point is not None:
         ax[0, 0].plot(*via_point, "s", mfc="none", mec="tab:red", ms=8, label="via-point")
     ax[0, 0].legend(fontsize=8)
-    _path_axes(ax[0, 0], "(a) expected paths")
+    path_axes(ax[0, 0], "(a) expected paths")
     ms = timing["via_time"] * 1000
     ax[0, 1].plot(ms, timing["msd"], "ko-", ms=3)
     ref = timing.loc[timing["shift"].abs().idxmin(), "via_time"] * 1000
@@ -223,9 +94,9 @@ def merging_figure(first: ReachResult, second: ReachResult, merged: ReachResult)
         ax[0, 0].annotate(name, p, textcoords="offset points", xytext=(4, 4))
         ax[0, 0].plot(*p, "ko", ms=4)
     ax[0, 0].legend(fontsize=8)
-    _path_axes(ax[0, 0], f"(a) mean paths of {merged.trials}")
+    path_axes(ax[0, 0], f"(a) mean paths of {merged.trials}")
     ax[0, 1].legend(fontsize=8)
-    _time_axes(ax[0, 1], "(b) mean speed")
+    time_axes(ax[0, 1], "(b) mean speed")
     return fig
 
 
@@ -257,8 +128,8 @@ def letter_figure(result: ReachResult) -> Figure:
     ax[0, 1].plot(result.time, result.speed[0], "k-", lw=1.2)
     _mark_vias(ax[0, 0], ax[0, 1], result.task)
     ax[0, 0].legend(fontsize=8)
-    _path_axes(ax[0, 0], "(a) hand path")
-    _time_axes(ax[0, 1], "(b) speed")
+    path_axes(ax[0, 0], "(a) hand path")
+    time_axes(ax[0, 1], "(b) speed")
     return fig
 
 
@@ -276,8 +147,8 @@ def letter_durations_figure(results: Sequence[ReachResult]) -> Figure:
         line, = ax[0, 0].plot(*r.position[0].T, lw=1.2, label=f"{d * 1000:.0f} ms")
         ax[0, 1].plot(r.time / d, r.speed[0], lw=1.2, color=line.get_color())
     ax[0, 0].legend(fontsize=8)
-    _path_axes(ax[0, 0], "(a) hand paths")
-    _time_axes(ax[0, 1], "(b) speed")
+    path_axes(ax[0, 0], "(a) hand paths")
+    time_axes(ax[0, 1], "(b) speed")
     ax[0, 1].set_xlabel("time / movement time")
     return fig
 
@@ -313,7 +184,7 @@ def criteria_figure(comparison: CriteriaComparison) -> Figure:
     return fig
 
 
-def curvature_figure(time, position, indices) -> Figure:
+def curvature_figure(time: ArrayLike, position: ArrayLike, indices: Sequence[int]) -> Figure:
     """A trajectory with via-points at its curvature extrema (thesis Fig. A.2).
 
     Panels: (a) path with the via-points; (b) x(t) and the spatio-temporal
@@ -338,10 +209,10 @@ def curvature_figure(time, position, indices) -> Figure:
     ax[0, 0].plot(*position[ends].T, "ko", ms=5, label="start, goal")
     ax[0, 0].plot(*position[idx].T, "s", mfc="none", mec="tab:red", ms=8, label="via-points")
     ax[0, 0].legend(fontsize=8)
-    _path_axes(ax[0, 0], "(a) path and curvature via-points")
+    path_axes(ax[0, 0], "(a) path and curvature via-points")
     ax[0, 1].plot(time, position[:, 0], "k-", lw=1.2)
     ax[0, 1].plot(time[idx], position[idx, 0], "s", mfc="none", mec="tab:red", ms=8)
-    _time_axes(ax[0, 1], "(b) x and curvature", "x (m)")
+    time_axes(ax[0, 1], "(b) x and curvature", "x (m)")
     twin = ax[0, 1].twinx()
     twin.plot(time, kappa, ":", color="tab:blue")
     twin.plot(time[idx], kappa[idx], "o", color="tab:blue", ms=4)
@@ -368,14 +239,12 @@ def generalisation_figure(
     for a in ax[0]:
         a.plot(*original.position[0].T, "k:", lw=1.5, label=f"original, {d0 * 1000:.0f} ms")
     ax[0, 0].plot(*retimed.position[0].T, "k-", lw=1.2, label=f"re-timed, {d1 * 1000:.0f} ms")
-    m0 = ViaPointMovement.from_task(original.task)
-    m1 = ViaPointMovement.from_task(scaled.task)
-    alpha = np.linalg.norm(np.subtract(m1.goal, m1.start)) / np.linalg.norm(
-        np.subtract(m0.goal, m0.start)
+    t0, t1 = original.task, scaled.task
+    alpha = np.linalg.norm(np.subtract(t1.goal, t1.start)) / np.linalg.norm(
+        np.subtract(t0.goal, t0.start)
     )
     ax[0, 1].plot(*scaled.position[0].T, "k-", lw=1.2, label=f"scaled by {alpha:.2g}")
     for a, title in zip(ax[0], ("(a) temporal generalisation", "(b) spatial generalisation")):
         a.legend(fontsize=8)
-        _path_axes(a, title)
+        path_axes(a, title)
     return fig
-
