@@ -3,7 +3,7 @@
 Todorov's (2005) LQG with signal-dependent noise (:mod:`minvar.lqg`), the
 point-mass/muscle plant of Todorov & Jordan 2002 (:mod:`minvar.plant`),
 reaching tasks with via-points (:mod:`minvar.task`), vectorised Monte Carlo
-execution (:mod:`minvar.simulate`, :mod:`minvar.reach`), two-link kinematics
+execution (:mod:`minvar.execution`, :mod:`minvar.reach`), two-link kinematics
 (:mod:`minvar.kinematics`), the analyses of the thesis's chapter 3
 (:mod:`minvar.analysis`), chapter 2's comparison models
 (:mod:`minvar.baselines`), appendix A's via-point representation
@@ -14,69 +14,52 @@ Figures of all of these are drawn on request by :mod:`minvar.plotting`.
 numpy/scipy only: no video, no files. The model and its parameters are
 described in docs/model.md.
 
-Every submodule above is an attribute of the package (``minvar.grasp_experiments``),
-imported the first time it is used, so ``import minvar`` loads neither
-matplotlib nor pandas. The one exception is ``minvar.simulate``, which is the
-function :func:`minvar.simulate.simulate`.
+Every name below and every submodule above is an attribute of the package
+(``minvar.solve``, ``minvar.grasp_experiments``), imported the first time it
+is used: ``import minvar`` itself loads nothing heavy (no scipy, pandas or
+matplotlib), so a command that only asks for the version starts at once.
 """
 
 from importlib import import_module as _import_module
 
-from .analysis import endpoint_stats, peak_to_mean_speed, speed_accuracy
-from .grasp import (
-    ChainPlan,
-    GraspPlan,
-    GraspResult,
-    GraspTask,
-    GripVia,
-    plan_grasp,
-    simulate_grasp,
-)
-from .grasp_stats import GraspMoments, GraspSummary, grasp_moments, summarize_grasp
-from .lqg import LQGProblem, LQGSolution, expected_cost, solve, state_moments
-from .plant import PointMassPlant
-from .reach import ReachResult, simulate_reach
-from .simulate import Trajectories, simulate
-from .task import ReachTask, ViaPoint, reach_problem
+from minvar._version import __version__
 
-__version__ = "0.1.0"
-
-__all__ = [
-    "ChainPlan",
-    "GraspMoments",
-    "GraspPlan",
-    "GraspResult",
-    "GraspSummary",
-    "GraspTask",
-    "GripVia",
-    "LQGProblem",
-    "LQGSolution",
-    "PointMassPlant",
-    "ReachResult",
-    "ReachTask",
-    "Trajectories",
-    "ViaPoint",
-    "endpoint_stats",
-    "expected_cost",
-    "grasp_moments",
-    "peak_to_mean_speed",
-    "plan_grasp",
-    "reach_problem",
-    "simulate",
-    "simulate_grasp",
-    "simulate_reach",
-    "solve",
-    "speed_accuracy",
-    "state_moments",
-    "summarize_grasp",
-]
+#: Public names and the submodule each comes from (imported on first use).
+_NAMES = {
+    'endpoint_stats': 'analysis',
+    'peak_to_mean_speed': 'analysis',
+    'speed_accuracy': 'analysis',
+    'ChainPlan': 'grasp',
+    'GraspPlan': 'grasp',
+    'GraspResult': 'grasp',
+    'GraspTask': 'grasp',
+    'GripVia': 'grasp',
+    'plan_grasp': 'grasp',
+    'simulate_grasp': 'grasp',
+    'GraspMoments': 'grasp_stats',
+    'GraspSummary': 'grasp_stats',
+    'grasp_moments': 'grasp_stats',
+    'summarize_grasp': 'grasp_stats',
+    'LQGProblem': 'lqg',
+    'LQGSolution': 'lqg',
+    'expected_cost': 'lqg',
+    'solve': 'lqg',
+    'state_moments': 'lqg',
+    'PointMassPlant': 'plant',
+    'ReachResult': 'reach',
+    'simulate_reach': 'reach',
+    'Trajectories': 'execution',
+    'simulate': 'execution',
+    'ReachTask': 'task',
+    'ViaPoint': 'task',
+    'reach_problem': 'task',
+}
 
 # Submodules reachable as attributes of the package, imported on first use.
-# Not "simulate": minvar.simulate is the function exported above (as it always
-# was); its module is reached with `from minvar.simulate import ...`.
 _SUBMODULES = (
     "analysis",
     "baselines",
+    "execution",
     "grasp",
     "grasp_experiments",
     "grasp_stats",
@@ -90,20 +73,26 @@ _SUBMODULES = (
     "viapoints",
 )
 
+__all__ = ["__version__", *sorted(_NAMES)]
+
 
 def __getattr__(name: str):
-    """``minvar.<submodule>`` without importing it first (PEP 562).
+    """``minvar.<name>`` and ``minvar.<submodule>`` without importing them first (PEP 562).
 
     Parameters
     ----------
     name : str
         The attribute asked for.
     """
+    if name in _NAMES:
+        value = getattr(_import_module(f"{__name__}.{_NAMES[name]}"), name)
+        globals()[name] = value  # found once, then an ordinary attribute
+        return value
     if name in _SUBMODULES:
         return _import_module(f"{__name__}.{name}")
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def __dir__() -> list[str]:
-    """The package's names, its lazily imported submodules included."""
-    return sorted({*globals(), *_SUBMODULES})
+    """The package's names, its lazily imported names and submodules included."""
+    return sorted({*globals(), *_NAMES, *_SUBMODULES})

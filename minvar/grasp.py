@@ -47,11 +47,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .execution import simulate
 from .grasp_stats import grip_aperture, max_grip_aperture, path_sd
 from .kinematics import TwoLinkChain
 from .lqg import LQGProblem, LQGSolution, solve
 from .plant import POSITION, VELOCITY, PointMassPlant
-from .simulate import simulate
 from .task import ReachTask, ViaPoint, reach_problem
 
 if TYPE_CHECKING:  # pragma: no cover

@@ -482,7 +482,7 @@ def state_moments(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Exact mean and covariance of the true state under gains ``K``, ``L``.
 
-    The distribution the Monte Carlo of :func:`minvar.simulate.simulate`
+    The distribution the Monte Carlo of :func:`minvar.execution.simulate`
     samples from, without sampling error (e.g. the exact end-point SD).
 
     Parameters

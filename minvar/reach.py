@@ -7,9 +7,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .execution import simulate
 from .lqg import LQGSolution, solve
 from .plant import FORCE, POSITION, VELOCITY, PointMassPlant
-from .simulate import simulate
 from .task import ReachTask, reach_problem
 
 if TYPE_CHECKING:  # pragma: no cover

@@ -118,13 +118,15 @@ def test_plotting_imports_result_classes_for_type_checking_only():
 def test_import_minvar_is_light_and_exposes_its_submodules():
     code = (
         "import sys, minvar\n"
-        "heavy = [m for m in ('matplotlib', 'pandas') if m in sys.modules]\n"
+        "heavy = [m for m in ('matplotlib', 'pandas', 'scipy') if m in sys.modules]\n"
         "assert not heavy, heavy\n"
         "for name in ('analysis', 'baselines', 'grasp', 'grasp_experiments', 'grasp_stats',\n"
         "             'kinematics', 'lqg', 'plant', 'reach', 'similarity', 'task',\n"
-        "             'viapoints'):\n"
+        "             'viapoints', 'execution'):\n"
         "    assert getattr(minvar, name).__name__ == 'minvar.' + name, name\n"
         "assert callable(minvar.simulate)  # the function, exported since the start\n"
+        "import minvar.reach  # imports minvar.execution: minvar.simulate stays the function\n"
+        "assert callable(minvar.simulate) and minvar.solve.__module__ == 'minvar.lqg'\n"
         "assert 'matplotlib' not in sys.modules\n"
         "assert callable(minvar.plotting.new_figure)\n"
         "assert 'grasp_experiments' in dir(minvar)\n"

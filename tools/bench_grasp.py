@@ -10,8 +10,8 @@ import sys
 
 from bench import table, timeit  # also puts the project root on sys.path
 
+from minvar.execution import simulate
 from minvar.grasp import GraspTask, plan_grasp, simulate_grasp
-from minvar.simulate import simulate
 
 
 def _per_trial_loop(task: GraspTask, trials: int) -> None:

@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from minvar.figures import new_figure
+from minvar.plotting import new_figure
 from perception.recognition.result import Recognition
 
 __all__ = ["condition_figure", "confidence_figure", "paths_figure"]
