@@ -1,0 +1,25 @@
+"""README's Python examples run as written, in order, in one namespace."""
+
+import re
+from pathlib import Path
+
+README = Path(__file__).resolve().parents[1] / "README.md"
+
+
+def _python_blocks() -> list[str]:
+    return re.findall(r"```python\n(.*?)```", README.read_text(), flags=re.S)
+
+
+def test_readme_python_blocks_run(tmp_path, monkeypatch):
+    blocks = _python_blocks()
+    assert len(blocks) >= 3
+    monkeypatch.chdir(tmp_path)  # any file an example writes lands here
+    namespace: dict = {}
+    for i, block in enumerate(blocks):
+        try:
+            exec(compile(block, f"README.md python block {i + 1}", "exec"), namespace)
+        except Exception as exc:  # pragma: no cover - the message is the point
+            raise AssertionError(f"README python block {i + 1} fails: {exc!r}\n{block}") from exc
+    # the examples compute what they say
+    assert namespace["rec"].winner.startswith("grasp-")
+    assert namespace["peak_to_mean_ratio"](3) == 1.875
