@@ -9,7 +9,8 @@ Schema (docs/tracks-format.md), written with h5py::
     /tracks/markers    str     (M,)      thumb, finger, wrist, object
     /tracks/position   float64 (T,M,2)   px; NaN where lost (never 0)
     /tracks/likelihood float32 (T,M)     0..1; 0 where lost
-    /tracks/status     int8    (T,M)     0 tracked, 1 reacquired, 2 lost, 3 interpolated
+    /tracks/status     int8    (T,M)     0 tracked, 1 reacquired, 2 lost, 3 interpolated,
+                                        4 ambiguous
     /tracker     attrs: colour models, termination criteria, parameters
 
 The datasets are chunked and resizable; :class:`TracksWriter` appends to them
@@ -52,6 +53,7 @@ class Status(enum.IntEnum):
     REACQUIRED = 1
     LOST = 2
     INTERPOLATED = 3
+    AMBIGUOUS = 4
 
 
 def _attr_value(value: Any) -> Any:
