@@ -100,7 +100,9 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
         clips.append(
             f"<h3>{html.escape(rec.clip)} — winner {html.escape(rec.winner)} ({rec.rule})</h3>"
             f'<img src="{p["confidence_png"].name}" width="49%">'
-            f'<img src="{p["paths_png"].name}" width="49%">')
+            f'<img src="{p["paths_png"].name}" width="49%">'
+            + (f'<img src="{rec.clip}.tracking.png" width="98%" alt="tracked markers">'
+               if (out / f"{rec.clip}.tracking.png").exists() else ""))
     body = "\n".join([
         f"<h1>{html.escape(title)}</h1>",
         f"<p>{len(summary)} clips: {len(ok)} scored, {len(failed)} failed. "

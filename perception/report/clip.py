@@ -39,6 +39,8 @@ class ClipSummary:
         The winning model.
     rule : str
         Rule that picked the winner.
+    tracking : dict, optional
+        The clip's tracking quality (the JSON's ``tracking`` key).
     """
 
     clip: str
@@ -49,6 +51,7 @@ class ClipSummary:
     final_log_likelihood: np.ndarray
     winner: str
     rule: str
+    tracking: dict | None = None
 
     @classmethod
     def from_dict(cls, d: dict) -> ClipSummary:
@@ -70,6 +73,7 @@ class ClipSummary:
                                            for m in d["models"]], dtype=float),
             winner=d["winner"],
             rule=d["rule"],
+            tracking=d.get("tracking"),
         )
 
     @classmethod

@@ -38,6 +38,7 @@ status codes and the ``/tracker`` attributes are described in
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import json
 import logging
@@ -786,6 +787,7 @@ def track_video(
     rois: Mapping[str, ROI] | None = None,
     progress: bool = False,
     prefetch: int = 8,
+    labelled_video: str | os.PathLike | None = None,
 ) -> Path:
     """Track a video file into a tracks file (``<stem>.tracks.h5`` beside it by default).
 
@@ -801,6 +803,9 @@ def track_video(
         Show a progress bar on stderr.
     prefetch : int
         Frames decoded ahead in a background thread.
+    labelled_video : str or os.PathLike, optional
+        Also write the video with the markers drawn on it
+        (:class:`~perception.tracking.overlay.Labeller`), atomically.
 
     Returns
     -------
@@ -811,42 +816,50 @@ def track_video(
     ------
     InputError
         Bad video (see :class:`~perception.io.video.FrameSource`), a bad ROI, or a
-        marker never found; no output file is left behind.
+        marker never found (the message says why: rejected candidates, or
+        ambiguity); no output file is left behind.
     """
     markers = default_markers() if markers is None else markers
     out_path = tracks_path_for(video) if out is None else Path(out)
     tracker = Tracker(markers, params, rois)
-    with FrameSource(video, prefetch=prefetch) as src:
-        with TracksWriter(out_path, markers.names, video=src.attrs(), tracker=tracker.attrs()) as w:
-            bar = None
-            if progress:
-                from tqdm import tqdm
+    with contextlib.ExitStack() as stack:
+        src = stack.enter_context(FrameSource(video, prefetch=prefetch))
+        w = stack.enter_context(TracksWriter(out_path, markers.names, video=src.attrs(),
+                                             tracker=tracker.attrs()))
+        each = None
+        if labelled_video is not None:
+            from perception.io.video import VideoWriter
+            from perception.tracking.overlay import Labeller
 
-                bar = tqdm(
-                    total=src.info.n_frames_header or None,
-                    unit="frame",
-                    file=sys.stderr,
-                    desc=Path(video).name,
-                    leave=False,
-                )
-            try:
-                track_frames(src, w, tracker, progress=bar.update if bar else None)
-            except InputError as exc:
-                if exc.path is None:
-                    raise InputError(exc.problem, video) from None
-                raise
-            finally:
-                if bar is not None:
-                    bar.close()
-            missing = tracker.never_found
-            if missing:
-                why = "; ".join(f"{m}: {tracker.why_not_found(m)}" for m in missing)
-                raise InputError(
-                    f"marker{'s' if len(missing) > 1 else ''} {', '.join(missing)} never found "
-                    f"in {src.n_decoded} frames ({why}); check the colour models and marker "
-                    "sizes (hammer-mv calibrate, --setup), or give --roi MARKER X Y W H",
-                    video,
-                )
-            w.update(video=src.attrs(), tracker=tracker.attrs())
+            vw = stack.enter_context(VideoWriter(labelled_video, src.info.fps_nominal or 30.0,
+                                                 (src.info.width, src.info.height)))
+            labeller = Labeller(markers.names, [m.bgr for m in markers])
+
+            def each(index, time_s, frame, position, likelihood, status):
+                vw.write(labeller.draw(frame, position, likelihood, status))
+
+        bar = None
+        if progress:
+            from tqdm import tqdm
+
+            bar = stack.enter_context(tqdm(total=src.info.n_frames_header or None, unit="frame",
+                                           file=sys.stderr, desc=Path(video).name,
+                                           leave=False))
+        try:
+            track_frames(src, w, tracker, progress=bar.update if bar else None, each_frame=each)
+        except InputError as exc:
+            if exc.path is None:
+                raise InputError(exc.problem, video) from None
+            raise
+        missing = tracker.never_found
+        if missing:
+            why = "; ".join(f"{m}: {tracker.why_not_found(m)}" for m in missing)
+            raise InputError(
+                f"marker{'s' if len(missing) > 1 else ''} {', '.join(missing)} never found "
+                f"in {src.n_decoded} frames ({why}); check the colour models and marker "
+                "sizes (hammer-mv calibrate, --setup), or give --roi MARKER X Y W H",
+                video,
+            )
+        w.update(video=src.attrs(), tracker=tracker.attrs())
     logger.info("%s: tracked %d frames -> %s", video, src.n_decoded, out_path)
     return out_path
