@@ -47,10 +47,18 @@ class HandChoice:
         Markers placed without doubt.
     ambiguous : dict of str to list of Candidate
         Markers with more than one plausible blob (the rivals, best first).
+    cost : float
+        Cost of the best placement (inf: none).
     """
 
     chosen: dict[str, Candidate] = field(default_factory=dict)
     ambiguous: dict[str, list[Candidate]] = field(default_factory=dict)
+    cost: float = math.inf
+
+    @property
+    def placed(self) -> int:
+        """Markers placed, with or without doubt."""
+        return len(self.chosen) + len(self.ambiguous)
 
 
 def _dist(p: Sequence[float], q: Sequence[float]) -> float:
@@ -146,14 +154,14 @@ def choose_hand(candidates: Mapping[str, Sequence[Candidate]],
             cost += _COLOUR_WEIGHT * sum(1 - c.purity for c in picked.values())
             scored.append((cost, picked))
     if not scored:
-        # No combination of all: place the markers that fit on their own.
-        if len(names) > 1:
-            singles = [choose_hand({n: candidates[n]}, anchors, px_per_m, params,
-                                   at_rest=at_rest, separation_px=separation_px)
-                       for n in names]
-            return HandChoice({k: v for s in singles for k, v in s.chosen.items()},
-                              {k: v for s in singles for k, v in s.ambiguous.items()})
-        return HandChoice()
+        # No combination of all: the most markers that do make a hand (one of
+        # them may be hidden, or only something else of its colour in view).
+        if len(names) == 1 or not anchors and len(names) == 2:
+            return HandChoice()
+        subsets = [choose_hand({n: candidates[n] for n in names if n != drop}, anchors,
+                               px_per_m, params, at_rest=at_rest, separation_px=separation_px)
+                   for drop in names]
+        return min(subsets, key=lambda c: (-c.placed, c.cost))
     scored.sort(key=lambda s: s[0])
     best_cost, best = scored[0]
     close = [p for c, p in scored if c <= best_cost + params.ambiguity_margin]
@@ -167,4 +175,4 @@ def choose_hand(candidates: Mapping[str, Sequence[Candidate]],
             chosen[n] = best[n]
         else:
             ambiguous[n] = rivals
-    return HandChoice(chosen, ambiguous)
+    return HandChoice(chosen, ambiguous, best_cost)
