@@ -237,6 +237,8 @@ class Tracker:
         self._scale: float | None = None
         self._time = 0.0
         self._rest: dict[str, tuple[float, float]] | None = None  # hand markers at frame 0
+        self._order = sorted(range(len(self._tracks)), key=lambda j: (
+            not self._tracks[j].still, self._tracks[j].name != "wrist", j))
 
     # -- public -------------------------------------------------------------
     @property
@@ -333,9 +335,11 @@ class Tracker:
         self._small = self._hsv = None
         todo = [j for j, tr in enumerate(self._tracks) if not tr.found]
         started = self._initialise(frame, todo) if todo else {}
-        results = {j: started[j] if j in started else (self._follow(tr, frame) if not tr.lost
-                                                         else None)
-                   for j, tr in enumerate(self._tracks)}
+        results = {}
+        for j in self._order:  # the object, the band, then the digits, which move relative to it
+            tr = self._tracks[j]
+            results[j] = started[j] if j in started else (self._follow(tr, frame) if not tr.lost
+                                                          else None)
         # Lost markers are searched for once every followed one has moved on:
         # the hand's structure is then judged on this frame's positions.
         for j, tr in enumerate(self._tracks):
@@ -592,7 +596,7 @@ class Tracker:
             meas.mass,
         )
         status = Status.TRACKED if self.n_frames == 0 else Status.REACQUIRED
-        return meas.centre, 1.0, status
+        return meas.centre, self._likelihood(tr, meas), status
 
     def _anchor(self, tr: _Track, position: np.ndarray | None = None
                 ) -> tuple[float, float] | None:
@@ -636,6 +640,18 @@ class Tracker:
         drift = min(p.hand_drift * max(tr.n_lost, 1), p.max_drift) * self._scale
         return (anchor[0] + tr.offset[0], anchor[1] + tr.offset[1]), drift + max(tr.win) / 2
 
+    def _with_the_hand(self, tr: _Track, centre: tuple[float, float]) -> bool:
+        """Whether a digit marker kept its place relative to the band (within ``hand_drift``)."""
+        if tr.still or tr.name == "wrist" or tr.offset is None or self._scale is None:
+            return True
+        anchor = self._anchor(tr)
+        if anchor is None:
+            return True
+        p = self.params
+        allowed = p.hand_drift * self._scale + max(tr.win) / 2
+        return math.hypot(centre[0] - anchor[0] - tr.offset[0],
+                          centre[1] - anchor[1] - tr.offset[1]) <= allowed
+
     def _reach_px(self, tr: _Track) -> float:
         """How far (px) a marker can have moved since it was last seen."""
         if self._scale is None:
@@ -656,6 +672,8 @@ class Tracker:
             return None  # hidden, or swallowed by something of its colour: search again
         if math.hypot(meas.centre[0] - tr.x[0], meas.centre[1] - tr.x[1]) > self._reach_px(tr):
             return None  # faster than a hand: something else
+        if not self._with_the_hand(tr, meas.centre):
+            return None  # left the rest of the hand: something else
         if tr.still:
             if ratio < p.hold_ratio:
                 # Partly hidden (the hand closing on the object): the visible
