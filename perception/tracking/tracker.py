@@ -491,11 +491,15 @@ class Tracker:
             self._scale = d / self.params.object_diameter
         return located
 
-    def _find_hand(self, frame: np.ndarray, todo: list[int]) -> dict[int, _Located | None]:
-        """Thumb, finger and wrist together: survivors of the tests, then the hand's structure."""
+    def _find_hand(self, frame: np.ndarray, todo: list[int], moving: bool = False
+                   ) -> dict[int, _Located | None]:
+        """Thumb, finger and wrist together: survivors of the tests, then the hand's structure.
+
+        ``moving``: the clip does not start at rest; the hand's looser rules apply.
+        """
         p, tracks = self.params, self._tracks
         scale = self._scale_or_guess()
-        at_rest = self._hand_at_rest()
+        at_rest = self._hand_at_rest() and not moving
         cands = {j: self._not_rivals(tracks[j], self._candidates(tracks[j], frame,
                                                                 later=at_rest))
                  for j in todo}
@@ -509,10 +513,12 @@ class Tracker:
             target = expected_area(tr.name, scale, p) or 1.0
             keep.sort(key=lambda c: abs(math.log(c.area / target)))
             survivors[j] = keep[: p.init_candidates]
-        if self._later is not None and not any(survivors.values()):
-            # Nothing of the hand is still: the clip starts moving; stillness cannot help.
+        if self._later is not None and any(
+                not survivors[j] and tracks[j].rejected["moving"] for j in todo):
+            # A hand marker is there but moving: the clip does not start at rest, and
+            # stillness cannot tell the markers from the rest.
             self._later = None
-            return self._find_hand(frame, todo)
+            return self._find_hand(frame, todo, moving=True)
         anchors = {t.name: t.x for t in tracks if t.found and not t.lost and not t.still}
         free = {tracks[j].name: survivors[j] for j in todo if tracks[j].roi is None}
         for j in todo:
