@@ -190,8 +190,7 @@ def flicker_gain(index: int, fps: float, amplitude: float, phase: float = 0.0) -
     return 1.0 + amplitude * math.sin(2 * math.pi * beat * index / fps + phase)
 
 
-def _lit(shape_mask: np.ndarray, light: np.ndarray, bgr, shading: float,
-         spec: np.ndarray) -> np.ndarray:
+def _lit(light: np.ndarray, bgr, shading: float, spec: np.ndarray) -> np.ndarray:
     """The marker's colour under a light: diffuse scaled by ``light``, plus a white highlight."""
     base = np.asarray(bgr, np.float32)
     diffuse = (1.0 - shading) + shading * light
@@ -245,7 +244,7 @@ def shaded_disc(img: np.ndarray, centre, radius: float, bgr, shading: float) -> 
     nx, ny = dx / max(radius, 1e-6), dy / max(radius, 1e-6)
     light = np.clip((-0.45 * nx - 0.45 * ny + 0.77 * nz), 0.0, 1.0)
     spec = np.clip((-0.3 * nx - 0.3 * ny + 0.9 * nz), 0.0, 1.0) ** 40
-    _composite(img, x0, y0, cover, _lit(cover, 0.35 + 0.65 * light, bgr, shading, spec))
+    _composite(img, x0, y0, cover, _lit(0.35 + 0.65 * light, bgr, shading, spec))
 
 
 def shaded_band(img: np.ndarray, corners: np.ndarray, bgr, shading: float) -> None:
@@ -280,7 +279,7 @@ def shaded_band(img: np.ndarray, corners: np.ndarray, bgr, shading: float) -> No
     u = (dx * axis[0] + dy * axis[1]) / (2 * length * length)  # -0.5..0.5 along the band
     light = np.sqrt(np.clip(1 - (2 * u) ** 2, 0, 1))
     spec = np.clip(1 - np.abs(u + 0.15) * 12, 0, 1) ** 2
-    _composite(img, x0, y0, cover, _lit(cover, 0.3 + 0.7 * light, bgr, shading, spec * 0.5))
+    _composite(img, x0, y0, cover, _lit(0.3 + 0.7 * light, bgr, shading, spec * 0.5))
 
 
 class H264Writer:

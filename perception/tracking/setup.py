@@ -46,6 +46,7 @@ import numpy as np
 from perception.errors import InputError
 from perception.io.atomic import write_text
 from perception.tracking.markers import MarkerColour, MarkerSet, default_markers
+from perception.tracking.measurement import soft_diameter
 from perception.tracking.params import TrackerParams
 
 __all__ = ["TrackingSetup", "calibrate", "load_setup", "write_setup"]
@@ -302,8 +303,14 @@ def calibrate(frames: Sequence[np.ndarray], *, rois: Mapping[str, tuple[int, int
     if scale is None:
         raise InputError("cannot calibrate: the object's size could not be measured")
     sizes = {}
-    digits = [2 * math.sqrt(masks[n].sum() / math.pi) / scale for n in ("thumb", "finger")
-              if n in masks]
+    digits = []
+    for j, name in enumerate(tracker.markers.names):
+        if name in ("thumb", "finger"):
+            # unbiased by the partly coloured rim, which is large on small discs
+            d = soft_diameter(frames[0], tracker.markers[name], position[j],
+                              tracker._tracks[j].win)
+            digits.append((d if np.isfinite(d) else 2 * math.sqrt(masks[name].sum() / math.pi))
+                          / scale)
     if digits:
         sizes["marker_diameter"] = float(np.mean(digits))
     if "wrist" in masks:
