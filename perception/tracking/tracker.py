@@ -5,22 +5,30 @@ Each marker has a colour model (:mod:`perception.tracking.markers`;
 per-frame loop; for each marker and frame it decides what to do and
 delegates:
 
-1. **Not found yet: first detection** (:mod:`perception.tracking.detection`).
-   Markers are found automatically on the first frames (the largest blob of
-   each colour; among blobs of comparable size a hand marker takes the one
-   nearest the other hand markers) or inside user-given ROIs.
+1. **Not found yet: first detection** (:mod:`perception.tracking.candidates`,
+   :mod:`perception.tracking.hand`). On the first frames (the hand at rest)
+   every blob of a marker's colour is a candidate, refused when its size,
+   shape, colour purity or stillness does not fit the marker; the object
+   (largest round candidate) sets the scale the expected sizes follow; the
+   hand markers are chosen together by the hand's structure. Two equally
+   plausible blobs make the marker *ambiguous* (status 4): it is not guessed.
+   A user-given ROI says where a marker is.
 2. **Tracked: follow.** An alpha-beta filter predicts the marker's position;
    the search region is the window around the prediction plus a margin that
    grows with speed. CamShift there gives the centroid and mass (pixel
    count) of the marker's colour, splitting off same-coloured blobs that
    joined the window (:mod:`perception.tracking.measurement`).
 3. **Lost test.** A mass below ``lost_ratio`` x reference means the marker is
-   hidden or gone: it is reported lost (NaN, likelihood 0, status 2), never
-   as a stale position.
+   hidden or gone; above ``max_area_ratio`` it was swallowed by something of
+   its colour; a jump faster than a hand (``max_speed``) or a digit leaving
+   its place relative to the band (``hand_drift``) is something else: the
+   marker is reported lost (NaN, likelihood 0, status 2), never as a stale
+   or borrowed position.
 4. **Lost: re-acquisition**, only once the local search has failed and while
    the marker stays lost: a global search of a downscaled frame for the
-   plausible blob nearest the prediction, refined at full resolution and
-   reported with status 1 (:mod:`perception.tracking.detection`).
+   plausible blob nearest where the rest of the hand puts it, refined at full
+   resolution, checked for shape and colour, and reported with status 1
+   (:mod:`perception.tracking.detection`).
 
 Markers listed in ``still_markers`` (the object) are expected to stay put and
 to be partly hidden by the hand at the end: their position is the running
@@ -30,7 +38,9 @@ the position is held, with likelihood equal to the visible fraction.
 
 Likelihood is ``min(r, 1/r)`` with ``r`` the measured mass over the
 reference mass: 1 for a whole, uncontaminated marker; lower when partly
-hidden or merged with similar colour. The tunables are
+hidden or merged with similar colour, and at most ``merged_likelihood``
+(under 0.5) where the position may be off: merged with a neighbour of its
+colour, or among more of its colour than itself. The tunables are
 :class:`~perception.tracking.params.TrackerParams`; the tracks file, its
 status codes and the ``/tracker`` attributes are described in
 ``docs/tracks-format.md``.
@@ -608,28 +618,29 @@ class Tracker:
                 ) -> tuple[float, float] | None:
         """Where the rest of the hand is: the wrist for a digit, the digits for the wrist."""
         names = ("thumb", "finger") if tr.name == "wrist" else ("wrist",)
-        pts = []
+        xs, ys = [], []
         for j, t in enumerate(self._tracks):
             if t.name not in names or t is tr:
                 continue
             if position is not None:
-                if np.isfinite(position[j]).all():
-                    pts.append(position[j])
+                x, y = float(position[j, 0]), float(position[j, 1])
+                if math.isfinite(x) and math.isfinite(y):
+                    xs.append(x)
+                    ys.append(y)
             elif t.found and not t.lost:
-                pts.append(t.x)
-        if not pts:
-            return None
-        mean = np.mean(pts, axis=0)
-        return float(mean[0]), float(mean[1])
+                xs.append(t.x[0])
+                ys.append(t.x[1])
+        # plain floats: numpy's per-call cost would exceed the arithmetic
+        return (sum(xs) / len(xs), sum(ys) / len(ys)) if xs else None
 
     def _record_offsets(self, position: np.ndarray) -> None:
         """Each measured hand marker's offset from the rest of the hand, for re-acquisition."""
         for j, tr in enumerate(self._tracks):
-            if tr.still or not np.isfinite(position[j]).all():
+            x, y = float(position[j, 0]), float(position[j, 1])
+            if tr.still or not (math.isfinite(x) and math.isfinite(y)):
                 continue
             anchor = self._anchor(tr, position)
-            tr.offset = None if anchor is None else (position[j, 0] - anchor[0],
-                                                     position[j, 1] - anchor[1])
+            tr.offset = None if anchor is None else (x - anchor[0], y - anchor[1])
 
     def _expected_here(self, tr: _Track) -> tuple[tuple[float, float], float]:
         """Where a lost marker should be and how far from it (px) it may be found.
