@@ -25,7 +25,7 @@ import numpy as np
 
 from perception import __version__
 from perception.errors import InputError
-from perception.io.atomic import atomic_path
+from perception.io.atomic import atomic_hdf5
 
 __all__ = ["SCHEMA", "SCHEMA_VERSION", "StoredChain", "StoredModel", "read_repertoire",
            "write_repertoire"]
@@ -101,10 +101,9 @@ def write_repertoire(path: str | os.PathLike, config: Mapping[str, Any],
     models : sequence of StoredModel
         The models, in order.
     """
-    import h5py
 
     path = Path(path)
-    with atomic_path(path) as tmp, h5py.File(tmp, "w") as f:
+    with atomic_hdf5(path) as f:
         f.attrs["schema"] = SCHEMA
         f.attrs["schema_version"] = SCHEMA_VERSION
         f.attrs["software_version"] = __version__

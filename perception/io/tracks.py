@@ -24,6 +24,7 @@ import contextlib
 import enum
 import json
 import os
+import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -36,7 +37,7 @@ import pandas as pd
 
 from minvar import __version__
 from perception.errors import InputError
-from perception.io.atomic import atomic_path
+from perception.io.atomic import atomic_hdf5, atomic_path
 
 SCHEMA = "hammer-mv/tracks"
 SCHEMA_VERSION = 1
@@ -430,8 +431,9 @@ class TracksWriter:
 
     Rows are buffered in memory ``chunk_frames`` at a time and appended to
     chunked, resizable datasets, so memory stays flat however long the video.
-    The file is written under a temporary name and renamed when the block
-    exits cleanly; if it raises, nothing is left behind.
+    The file is built in memory (a few tens of bytes per frame) and written
+    under a temporary name, renamed when the block exits cleanly; if it
+    raises, or the disk is full, nothing is left behind.
 
     Parameters
     ----------
@@ -495,8 +497,7 @@ class TracksWriter:
     def __enter__(self) -> TracksWriter:
         stack = contextlib.ExitStack()
         try:
-            tmp = stack.enter_context(atomic_path(self.path))
-            fh = stack.enter_context(h5py.File(tmp, "w"))
+            fh = stack.enter_context(atomic_hdf5(self.path))
             g = fh.create_group("tracks")
             c = self.chunk
             g.create_dataset(
@@ -512,8 +513,10 @@ class TracksWriter:
                     fillvalue=np.nan if name == "position" else 0,
                 )
         except BaseException:
-            stack.close()
-            raise
+            # Exit the stack *with* the error: a plain close() would let the
+            # atomic output rename its empty temporary file into place.
+            if not stack.__exit__(*sys.exc_info()):
+                raise
         self._stack, self._fh = stack, fh
         return self
 
@@ -601,8 +604,6 @@ class TracksWriter:
                 _write_attrs(fh.require_group("video").attrs, self.meta["video"])
                 _write_attrs(fh.require_group("tracker").attrs, self.meta["tracker"])
             except BaseException:
-                import sys
-
                 self._stack.__exit__(*sys.exc_info())
                 raise
         return bool(self._stack.__exit__(exc_type, exc, tb))

@@ -20,6 +20,7 @@ import logging
 import math
 import os
 import queue
+import sys
 import threading
 from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import asdict, dataclass
@@ -333,6 +334,30 @@ def open_video(path: str | os.PathLike, **kwargs: Any) -> FrameSource:
     return FrameSource(path, **kwargs)
 
 
+@contextlib.contextmanager
+def quiet_native_stderr() -> Iterator[None]:
+    """Silence what OpenCV and FFmpeg print straight to the process's stderr.
+
+    Their messages about a file we then report ourselves ("tag ... is not
+    found", "Could not open codec") would make a one-line error three lines.
+    Only file descriptor 2 is redirected, and only for the block.
+    """
+    try:
+        fd = sys.stderr.fileno()
+    except (AttributeError, OSError, ValueError):  # no real stderr (e.g. captured)
+        yield
+        return
+    sys.stderr.flush()
+    saved = os.dup(fd)
+    try:
+        with open(os.devnull, "w") as null:
+            os.dup2(null.fileno(), fd)
+            yield
+    finally:
+        os.dup2(saved, fd)
+        os.close(saved)
+
+
 def codec_for(path: str | os.PathLike, codec: str | None = None) -> str:
     """FourCC to write ``path`` with: ``codec`` if given, else from the extension.
 
@@ -396,14 +421,18 @@ class VideoWriter:
         stack = contextlib.ExitStack()
         try:
             self.tmp_path = stack.enter_context(atomic_path(self.path))
-            vw = cv2.VideoWriter(
-                os.fspath(self.tmp_path), cv2.VideoWriter_fourcc(*self.codec), self.fps, self.size
-            )
+            with quiet_native_stderr():
+                vw = cv2.VideoWriter(
+                    os.fspath(self.tmp_path), cv2.VideoWriter_fourcc(*self.codec), self.fps,
+                    self.size
+                )
             if not vw.isOpened():
                 raise OSError(f"{self.path}: OpenCV cannot write {self.codec!r} video here")
         except BaseException:
-            stack.close()
-            raise
+            # Exit the stack *with* the error: a plain close() would let the
+            # atomic output rename its empty temporary file into place.
+            if not stack.__exit__(*sys.exc_info()):
+                raise
         self._stack, self._vw = stack, vw
         return self
 
@@ -421,11 +450,39 @@ class VideoWriter:
     def __exit__(self, exc_type, exc, tb) -> bool:
         assert self._stack is not None and self._vw is not None
         self._vw.release()
-        if exc_type is None and self.n_written == 0:
-            err = ValueError(f"{self.path}: no frames written")
-            self._stack.__exit__(ValueError, err, None)  # removes the temporary file
-            raise err
+        if exc_type is None:
+            err = None
+            if self.n_written == 0:
+                err = ValueError(f"{self.path}: no frames written")
+            elif not _readable(self.tmp_path, self.n_written):
+                # OpenCV reports no write errors: a full disk shows as a file
+                # FFmpeg cannot open, or one with fewer frames than written.
+                err = OSError(f"cannot write {self.path}: the video came out incomplete "
+                              "(is the disk full?)")
+            if err is not None:
+                self._stack.__exit__(type(err), err, None)  # removes the temporary file
+                raise err
         return bool(self._stack.__exit__(exc_type, exc, tb))
+
+
+def _readable(path: Path, n_frames: int) -> bool:
+    """Whether FFmpeg opens a just-written clip and its header counts ``n_frames``."""
+    with quiet_native_stderr():
+        cap = cv2.VideoCapture(os.fspath(path), cv2.CAP_FFMPEG)
+    try:
+        if not cap.isOpened():
+            return False
+        count = cap.get(cv2.CAP_PROP_FRAME_COUNT)
+        if math.isfinite(count) and count > 0:
+            return int(count) == n_frames
+        # No count in the header (an unfinished AVI, for one): count what decodes.
+        with quiet_native_stderr():
+            decoded = 0
+            while decoded <= n_frames and cap.grab():
+                decoded += 1
+        return decoded == n_frames
+    finally:
+        cap.release()
 
 
 def write_video(
