@@ -41,6 +41,12 @@ CODECS: Mapping[str, str] = MappingProxyType({".mp4": "mp4v", ".avi": "MJPG", ".
 
 #: Values of :attr:`FrameSource.time_source`.
 TIME_SOURCES = ("container", "index/fps", "mixed")
+#: Highest frame rate believed from a header, frames/s (high-speed cameras
+#: filming reaches run at 100-500; a higher claim is a broken header).
+MAX_FPS = 1000.0
+#: A stream counts as truncated when it ends this fraction (and at least 2
+#: frames) short of the count its header claims.
+TRUNCATION_TOLERANCE = 0.02
 
 
 def sha256_file(path: str | os.PathLike, chunk: int = 1 << 20) -> str:
@@ -98,10 +104,13 @@ class TimeResolver:
     ----------
     fps : float
         Nominal frame rate, frames/s, for the fallback.
+    use_container : bool
+        Use the container's times at all (False: every frame at ``index / fps``).
     """
 
-    def __init__(self, fps: float):
+    def __init__(self, fps: float, *, use_container: bool = True):
         self.fps = fps
+        self.use_container = use_container
         self.previous: float | None = None
         self.n_container = 0
         self.n_fallback = 0
@@ -109,7 +118,8 @@ class TimeResolver:
     def __call__(self, pos_msec: float) -> float:
         """Return the time (s) of the next frame given its ``CAP_PROP_POS_MSEC``."""
         t = pos_msec / 1000.0
-        if math.isfinite(t) and t >= 0 and (self.previous is None or t > self.previous):
+        if (self.use_container and math.isfinite(t) and t >= 0
+                and (self.previous is None or t > self.previous)):
             self.n_container += 1
         else:
             if not (self.fps > 0 and math.isfinite(self.fps)):
@@ -145,6 +155,12 @@ class FrameSource:
         Frames decoded ahead (0: decode in the caller's thread).
     hash : bool
         Compute the file's SHA-256 (one extra sequential read of the file).
+    keep_truncated : bool
+        Keep the frames of a stream that ends well before the frame count its
+        header claims (a truncated or corrupt file) instead of refusing it.
+    fps : float, optional
+        The true frame rate, frames/s: frame times become ``index / fps``,
+        whatever the container says (for files whose header is wrong).
 
     Raises
     ------
@@ -161,9 +177,15 @@ class FrameSource:
         True once the stream has been read to its end.
     """
 
-    def __init__(self, path: str | os.PathLike, *, prefetch: int = 8, hash: bool = True):
+    def __init__(self, path: str | os.PathLike, *, prefetch: int = 8, hash: bool = True,
+                 keep_truncated: bool = False, fps: float | None = None):
         self.path = Path(path)
         self.prefetch = int(prefetch)
+        self.keep_truncated = bool(keep_truncated)
+        if fps is not None and not (math.isfinite(fps) and 0 < fps <= MAX_FPS):
+            raise InputError(f"--fps: expected a frame rate in (0, {MAX_FPS:g}] frames/s, "
+                             f"got {fps!r}")
+        self.fps_override = fps
         if not self.path.exists():
             raise InputError("no such file", self.path)
         if not self.path.is_file():
@@ -193,7 +215,11 @@ class FrameSource:
             height=int(height),
             fourcc=_fourcc_str(cap.get(cv2.CAP_PROP_FOURCC)),
         )
-        self._times = TimeResolver(self.info.fps_nominal)
+        if self.fps_override is not None:
+            self._times = TimeResolver(self.fps_override, use_container=False)
+        else:
+            self._check_rate()
+            self._times = TimeResolver(self.info.fps_nominal)
         self.n_decoded = 0
         self.complete = False
         self._started = False
@@ -263,18 +289,29 @@ class FrameSource:
                 raise item
             yield item
 
+    def _check_rate(self) -> None:
+        """Refuse a header frame rate no camera films a hand at (it would rescale time)."""
+        fps = self.info.fps_nominal
+        if fps > MAX_FPS:
+            self.close()
+            raise InputError(f"the container claims {fps:g} frames/s, more than any camera "
+                             f"filming a hand ({MAX_FPS:g}); give the true rate with --fps",
+                             self.path)
+
     def _check_count(self) -> None:
         claimed = self.info.n_frames_header
-        if claimed and self.n_decoded < claimed:
-            logger.warning(
-                "%s: decoded %d of the %d frames the header claims (truncated or corrupt?); "
-                "keeping the %d decoded",
-                self.path,
-                self.n_decoded,
-                claimed,
-                self.n_decoded,
-            )
-        if self._times.n_fallback:
+        # Header counts of some containers are estimates (duration x rate):
+        # a frame or two short is not a truncated file.
+        missing = claimed - self.n_decoded
+        if claimed and missing > max(2, TRUNCATION_TOLERANCE * claimed):
+            if not self.keep_truncated:
+                raise InputError(
+                    f"truncated or corrupt video: decoded {self.n_decoded} of the {claimed} "
+                    "frames its header claims (--keep-truncated uses the decoded frames)",
+                    self.path)
+            logger.warning("%s: decoded %d of the %d frames the header claims; keeping them "
+                           "(--keep-truncated)", self.path, self.n_decoded, claimed)
+        if self._times.n_fallback and self.fps_override is None:
             logger.warning(
                 "%s: %d of %d frames had no usable container timestamp; used previous + 1/fps",
                 self.path,
