@@ -293,7 +293,7 @@ class FrameSource:
         """Refuse a header frame rate no camera films a hand at (it would rescale time)."""
         fps = self.info.fps_nominal
         if fps > MAX_FPS:
-            self.close()
+            self._cap.release()
             raise InputError(f"the container claims {fps:g} frames/s, more than any camera "
                              f"filming a hand ({MAX_FPS:g}); give the true rate with --fps",
                              self.path)
