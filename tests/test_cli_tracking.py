@@ -87,16 +87,14 @@ def test_track_roi_and_colours_options(clips, tmp_path):
     assert np.median(errors(tracks, truth)[:, 0]) < 1.0
 
 
-def test_truncated_avi_is_tracked_with_a_warning_and_true_count(clips, tmp_path):
+def test_truncated_avi_is_refused_in_one_line(clips, tmp_path):
     data = clips["avi"].video.read_bytes()
     video = tmp_path / "cut.avi"
     video.write_bytes(data[: len(data) * 2 // 3])
     proc = hammer("track", video, "--quiet")
-    assert proc.returncode == 0, proc.stderr
-    assert "header claims" in proc.stderr
-    tracks = Tracks.load(tmp_path / "cut.tracks.h5")
-    assert 0 < tracks.n_frames < 24
-    assert tracks.video["n_frames"] == tracks.n_frames and tracks.video["n_frames_header"] == 24
+    assert proc.returncode == 2
+    assert proc.stderr.count("\n") == 1 and "header claims" in proc.stderr
+    assert not (tmp_path / "cut.tracks.h5").exists()
 
 
 def test_tracks_info(clips, tmp_path):

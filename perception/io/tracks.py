@@ -25,6 +25,7 @@ import contextlib
 import enum
 import json
 import os
+import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -37,7 +38,8 @@ import pandas as pd
 
 from minvar import __version__
 from perception.errors import InputError
-from perception.io.atomic import atomic_path
+from perception.io.atomic import atomic_hdf5, atomic_path
+from perception.io.hdf5 import decode_attrs, open_hdf5, read_dataset, scalar_attr
 
 SCHEMA = "hammer-mv/tracks"
 SCHEMA_VERSION = 1
@@ -73,17 +75,6 @@ def _attr_value(value: Any) -> Any:
     ):
         return np.asarray(value)
     return json.dumps(value)
-
-
-def _read_attrs(attrs: h5py.AttributeManager) -> dict[str, Any]:
-    out = {}
-    for key, value in attrs.items():
-        if isinstance(value, bytes):
-            value = value.decode("utf-8")
-        elif isinstance(value, np.generic):
-            value = value.item()
-        out[key] = value
-    return out
 
 
 def _write_attrs(attrs: h5py.AttributeManager, values: Mapping[str, Any]) -> None:
@@ -380,51 +371,71 @@ class Tracks:
 
     @classmethod
     def load(cls, path: str | os.PathLike) -> Tracks:
-        """Read a tracks file, checking its schema and version.
+        """Read a tracks file, checking its schema, version and every object it reads.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The ``.tracks.h5`` (or ``.truth.h5``) file.
 
         Raises
         ------
         InputError
-            Missing file, not HDF5, another schema or version, or a missing or
-            misshapen dataset; the message names the file.
+            Missing file, not HDF5, another schema or version, a missing,
+            linked, misshapen or mistyped dataset or attribute; the message
+            names the file and the object.
         """
         p = Path(path)
-        if not p.exists():
-            raise InputError("no such file", p)
-        try:
-            fh = h5py.File(p, "r")
-        except OSError:
-            raise InputError("not an HDF5 file (or unreadable)", p) from None
-        with fh:
-            root = _read_attrs(fh.attrs)
-            schema = root.pop("schema", None)
-            version = root.pop("schema_version", None)
+        with open_hdf5(p, "tracks file") as fh:
+            root = decode_attrs(fh.attrs, "/", p)
+            schema = scalar_attr(root, "schema", "string", "/", p)
             if schema != SCHEMA:
                 raise InputError(
                     f"not a hammer-mv tracks file (schema {schema!r}, expected {SCHEMA!r})", p
                 )
+            version = scalar_attr(root, "schema_version", "integer", "/", p)
             if version != SCHEMA_VERSION:
                 raise InputError(
                     f"tracks schema_version {version!r} is not supported "
                     f"(this hammer-mv reads version {SCHEMA_VERSION})",
                     p,
                 )
-            root.pop("software_version", None)
-            data = {}
-            for name in ("frame", "time", "markers", "position", "likelihood", "status"):
-                key = f"tracks/{name}"
-                if key not in fh or not isinstance(fh[key], h5py.Dataset):
-                    raise InputError(f"missing dataset /{key}", p)
-                data[name] = fh[key][()]
+            for key in ("schema", "schema_version", "software_version"):
+                root.pop(key, None)
+            data = {name: read_dataset(fh, f"tracks/{name}", kind, ndim, p)
+                    for name, (kind, ndim) in _DATASETS.items()}
             markers = tuple(
                 m.decode("utf-8") if isinstance(m, bytes) else str(m) for m in data.pop("markers")
             )
-            video = _read_attrs(fh["video"].attrs) if "video" in fh else {}
-            tracker = _read_attrs(fh["tracker"].attrs) if "tracker" in fh else {}
+            video = _group_attrs(fh, "video", p)
+            for key, kind in _VIDEO_ATTRS.items():
+                scalar_attr(video, key, kind, "/video", p)
+            tracker = _group_attrs(fh, "tracker", p)
         try:
             return cls(markers=markers, video=video, tracker=tracker, attrs=root, path=p, **data)
         except ValueError as exc:
             raise InputError(f"inconsistent datasets: {exc}", p) from None
+
+
+#: The datasets of ``/tracks``: (kind of dtype, number of dimensions).
+_DATASETS = {"frame": ("integer", 1), "time": ("number", 1), "markers": ("string", 1),
+             "position": ("number", 3), "likelihood": ("number", 2), "status": ("integer", 2)}
+#: ``/video`` attributes readers use, and what each must be.
+_VIDEO_ATTRS = {"path": "string", "sha256": "string", "fps_nominal": "number",
+                "n_frames": "integer", "n_frames_header": "integer", "width": "integer",
+                "height": "integer", "fourcc": "string", "time_source": "string"}
+
+
+def _group_attrs(fh, name: str, path: Path) -> dict[str, Any]:
+    """The attributes of group ``/name`` (empty if there is none)."""
+    import h5py
+
+    if name not in fh:
+        return {}
+    if not isinstance(fh.get(name, getlink=True), h5py.HardLink) or not isinstance(
+            fh[name], h5py.Group):
+        raise InputError(f"/{name} is not a group stored in the file", path)
+    return decode_attrs(fh[name].attrs, f"/{name}", path)
 
 
 class TracksWriter:
@@ -432,8 +443,9 @@ class TracksWriter:
 
     Rows are buffered in memory ``chunk_frames`` at a time and appended to
     chunked, resizable datasets, so memory stays flat however long the video.
-    The file is written under a temporary name and renamed when the block
-    exits cleanly; if it raises, nothing is left behind.
+    The file is built in memory (a few tens of bytes per frame) and written
+    under a temporary name, renamed when the block exits cleanly; if it
+    raises, or the disk is full, nothing is left behind.
 
     Parameters
     ----------
@@ -497,8 +509,7 @@ class TracksWriter:
     def __enter__(self) -> TracksWriter:
         stack = contextlib.ExitStack()
         try:
-            tmp = stack.enter_context(atomic_path(self.path))
-            fh = stack.enter_context(h5py.File(tmp, "w"))
+            fh = stack.enter_context(atomic_hdf5(self.path))
             g = fh.create_group("tracks")
             c = self.chunk
             g.create_dataset(
@@ -514,8 +525,10 @@ class TracksWriter:
                     fillvalue=np.nan if name == "position" else 0,
                 )
         except BaseException:
-            stack.close()
-            raise
+            # Exit the stack *with* the error: a plain close() would let the
+            # atomic output rename its empty temporary file into place.
+            if not stack.__exit__(*sys.exc_info()):
+                raise
         self._stack, self._fh = stack, fh
         return self
 
@@ -603,8 +616,6 @@ class TracksWriter:
                 _write_attrs(fh.require_group("video").attrs, self.meta["video"])
                 _write_attrs(fh.require_group("tracker").attrs, self.meta["tracker"])
             except BaseException:
-                import sys
-
                 self._stack.__exit__(*sys.exc_info())
                 raise
         return bool(self._stack.__exit__(exc_type, exc, tb))
