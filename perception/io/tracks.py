@@ -44,8 +44,10 @@ from perception.io.hdf5 import decode_attrs, open_hdf5, read_dataset, scalar_att
 SCHEMA = "hammer-mv/tracks"
 SCHEMA_VERSION = 1
 
-#: Export formats of :meth:`Tracks.export`.
-EXPORT_FORMATS = ("dlc", "trackpy", "csv")
+#: An interpolated point's likelihood is this fraction of the weaker of the
+#: two detections it bridges: below DeepLabCut's default cutoff (0.6), so
+#: tools that filter by likelihood never take a bridge for a detection.
+INTERPOLATED_LIKELIHOOD = 0.5
 
 
 class Status(enum.IntEnum):
@@ -203,6 +205,12 @@ class Tracks:
         """(T, M) bool, True where the position is known (not lost)."""
         return np.isfinite(self.position).all(axis=-1)
 
+    def __repr__(self) -> str:
+        span = f"{self.time[0]:.3f}-{self.time[-1]:.3f} s" if self.n_frames else "empty"
+        where = f", {self.path.name}" if self.path is not None else ""
+        return (f"Tracks({self.n_frames} frames, {span}, markers {', '.join(self.markers)}"
+                f"{where})")
+
     def replace(self, **changes: Any) -> Tracks:
         """Copy with some attributes replaced."""
         kwargs = {
@@ -229,8 +237,9 @@ class Tracks:
 
         A gap is a run of lost frames with a known position on both sides;
         runs at the start or end, and runs longer than ``max_gap`` frames, stay
-        NaN. A filled sample's likelihood is the lower of the two bounding
-        likelihoods: the bridge is no more certain than its weaker end.
+        NaN. A filled sample's likelihood is :data:`INTERPOLATED_LIKELIHOOD`
+        times the lower of the two bounding likelihoods: a bridge is less
+        certain than either end, and stays below the usual likelihood cutoffs.
 
         Parameters
         ----------
@@ -260,7 +269,8 @@ class Tracks:
                 inner = slice(a + 1, b)
                 w = (self.time[inner] - self.time[a]) / (self.time[b] - self.time[a])
                 position[inner, j] = position[a, j] + w[:, None] * (position[b, j] - position[a, j])
-                likelihood[inner, j] = min(likelihood[a, j], likelihood[b, j])
+                weaker = min(likelihood[a, j], likelihood[b, j])
+                likelihood[inner, j] = INTERPOLATED_LIKELIHOOD * weaker
                 status[inner, j] = Status.INTERPOLATED
         return self.replace(position=position, likelihood=likelihood, status=status)
 
@@ -302,14 +312,14 @@ class Tracks:
         return pd.DataFrame(data, index=pd.Index(self.frame, name="frame"), columns=cols)
 
     def to_trackpy(self) -> pd.DataFrame:
-        """trackpy-style long table, one row per frame and marker.
+        """trackpy-style long table, one row per frame and *seen* marker.
 
         Columns: ``frame, time, particle`` (marker column index), ``marker,
-        x, y, likelihood, status``. Lost rows are kept with NaN ``x, y``;
-        drop them with ``df.dropna(subset=["x", "y"])`` where trackpy needs.
+        x, y, likelihood, status``. Lost points have no row: trackpy's
+        ``link`` and ``imsd`` expect only real positions.
         """
         t, m = self.n_frames, len(self.markers)
-        return pd.DataFrame(
+        table = pd.DataFrame(
             {
                 "frame": np.repeat(self.frame, m),
                 "time": np.repeat(self.time, m),
@@ -323,6 +333,13 @@ class Tracks:
                 "status": self.status.ravel(),
             }
         )
+        return table[self.valid.ravel()].reset_index(drop=True)
+
+    def to_status(self) -> pd.DataFrame:
+        """Status codes as a wide table: ``frame`` then one column per marker (:class:`Status`)."""
+        data: dict[str, Any] = {"frame": self.frame}
+        data.update({name: self.status[:, j] for j, name in enumerate(self.markers)})
+        return pd.DataFrame(data)
 
     def to_pandas(self) -> pd.DataFrame:
         """Plain wide table: ``frame, time`` then ``<marker>_x, _y, _likelihood, _status``."""
@@ -333,32 +350,6 @@ class Tracks:
             data[f"{name}_likelihood"] = self.likelihood[:, j]
             data[f"{name}_status"] = self.status[:, j]
         return pd.DataFrame(data)
-
-    def export(self, path: str | os.PathLike, format: str = "csv") -> Path:
-        """Write a table as CSV, atomically.
-
-        Parameters
-        ----------
-        path : str or os.PathLike
-            Output file.
-        format : {"dlc", "trackpy", "csv"}
-            :meth:`to_dlc` (three header rows, as DeepLabCut writes),
-            :meth:`to_trackpy` or :meth:`to_pandas`.
-        """
-        if format == "dlc":
-            # DeepLabCut's files have the three header rows and no index-name row.
-            table, index = self.to_dlc().rename_axis(None), True
-        elif format == "trackpy":
-            table, index = self.to_trackpy(), False
-        elif format == "csv":
-            table, index = self.to_pandas(), False
-        else:
-            raise ValueError(
-                f"export: format: expected one of {', '.join(EXPORT_FORMATS)}, got {format!r}"
-            )
-        with atomic_path(path) as tmp:
-            table.to_csv(tmp, index=index, na_rep="NaN")
-        return Path(path)
 
     # -- files ----------------------------------------------------------------
     def save(self, path: str | os.PathLike) -> Path:
