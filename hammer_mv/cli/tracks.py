@@ -16,16 +16,21 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     info.add_argument("file", type=Path, metavar="FILE", help="tracks file (.tracks.h5)")
     info.set_defaults(func=run_info)
 
-    export = actions.add_parser("export", help="export a tracks file as a CSV table")
+    export = actions.add_parser(
+        "export", help="export a tracks file for DeepLabCut, movement, trackpy or pandas",
+        description="Write the tracks of FILE in the format another tool reads "
+        "(docs/pose-files.md describes every column).")
     export.add_argument("file", type=Path, metavar="FILE", help="tracks file (.tracks.h5)")
     export.add_argument(
         "--format",
         required=True,
-        choices=("dlc", "trackpy", "csv"),
-        help="dlc: DeepLabCut wide table (scorer/bodyparts/coords header rows); "
-        "trackpy: long table, one row per frame and marker; csv: plain wide table",
+        choices=("dlc", "movement", "trackpy", "csv"),
+        help="dlc: DeepLabCut table, a real .h5 (pandas HDF, key df_with_missing) or a .csv "
+        "by OUT's ending, plus OUT's stem .status.csv; movement: a movement poses dataset "
+        "(.nc); trackpy: long table, one row per frame and seen marker; csv: plain wide table",
     )
-    export.add_argument("-o", "--output", type=Path, required=True, metavar="OUT")
+    export.add_argument("-o", "--output", type=Path, required=True, metavar="OUT",
+                        help="output file")
     export.add_argument(
         "--max-gap",
         type=int,
@@ -124,9 +129,14 @@ def run_export(args: argparse.Namespace) -> int:
         Parsed arguments.
     """
     from perception.errors import InputError
+    from perception.io.atomic import check_output
+    from perception.io.exports import export_tracks, status_path_for
     from perception.io.tracks import Tracks
     from perception.observation import movement_span
 
+    outputs = [args.output] + ([status_path_for(args.output)] if args.format == "dlc" else [])
+    for out in outputs:
+        check_output(out, inputs=[args.file])
     if args.max_gap < 0:
         raise InputError(f"--max-gap: expected >= 0 frames, got {args.max_gap}")
     t = Tracks.load(args.file)
@@ -140,7 +150,9 @@ def run_export(args: argparse.Namespace) -> int:
         t = t.interpolate(args.max_gap)
     if span is not None:
         t = t.rows(span.start, span.stop)
-    t.export(args.output, args.format)
+    written = export_tracks(t, args.output, args.format)
+    if not getattr(args, "quiet", False):
+        print(f"wrote {', '.join(map(str, written))} ({t.n_frames} frames, {args.format})")
     return 0
 
 

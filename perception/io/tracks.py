@@ -38,7 +38,7 @@ import pandas as pd
 
 from minvar import __version__
 from perception.errors import InputError
-from perception.io.atomic import atomic_hdf5, atomic_path
+from perception.io.atomic import atomic_hdf5
 from perception.io.hdf5 import decode_attrs, open_hdf5, read_dataset, scalar_attr
 
 SCHEMA = "hammer-mv/tracks"
