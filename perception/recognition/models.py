@@ -154,7 +154,7 @@ class SceneSpec:
     distance: float = 0.25
     object_size: float = DEFAULT_OBJECT_DIAMETER
     frame_period: float = 1 / 30
-    tip_start: float = 0.06
+    tip_start: float = GraspTask.tip_start  # the model's default hand (minvar.GraspTask)
 
     def __post_init__(self):
         for name in ("distance", "object_size", "frame_period", "tip_start"):
