@@ -139,9 +139,8 @@ def _best_claim(comparison, seed: int, how: str) -> dict:
         "seconds",
         note=f"in metres hand speeds are under 1, so eq. A.1 is close to |acceleration| and "
         f"the two criteria pick nearly the same points ({near} of {total} curvature points "
-        "within 30 ms of an acceleration one): a difference between them is then decided by "
-        "the few points where they part (the post-movement period), not by a systematic "
-        f"advantage. The unit changes this (table below). {how}")
+        "within 30 ms of an acceleration one), so a difference between them rests on the "
+        f"few points where they part. The unit changes this (table below). {how}")
 
 
 def _units_table(comparison, trajs, seed: int) -> dict:
