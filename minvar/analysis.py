@@ -151,6 +151,8 @@ def endpoint_stats(endpoints: np.ndarray, target) -> EndpointStats:
 #: Gauss-Hermite nodes and weights (probabilists') for :func:`expected_distance`.
 _GH_NODES, _GH_WEIGHTS = np.polynomial.hermite_e.hermegauss(48)
 _GH_WEIGHTS = _GH_WEIGHTS / _GH_WEIGHTS.sum()
+_GH_NODES.setflags(write=False)  # constants: no module-level mutable state
+_GH_WEIGHTS.setflags(write=False)
 
 
 def expected_distance(offset, cov) -> float:
