@@ -112,8 +112,8 @@ def _viapoint_height(e: GraspExperiment) -> list[dict]:
         "4.2.1.1", "Digit end-point distance from the target falls as the via-points come "
         "level with the targets and rises again above them",
         "decreases toward level, increases above", ", ".join(
-            f"{_cm(x)}: {y * UM:.0f}" for x, y in zip(h, d)) + f" µm (finger; level, 500 "
-        f"repetitions: {mc * UM:.0f} ± {half * UM:.0f} µm)",
+            f"{_cm(x)}: {y * UM:.0f}" for x, y in zip(h, d)) + f" µm (finger; level, "
+        f"{s.trials.iloc[lvl]} repetitions: {mc * UM:.0f} ± {half * UM:.0f} µm)",
         level_is_best(h, d), location="Fig. 4.3(a,b); line 788",
         measure="exact mean end-point distance (expected distance of the exact end-point "
         "distribution) per via-point height, -2 to +2 cm; agree if lowest at level and "
@@ -130,7 +130,7 @@ def _viapoint_height(e: GraspExperiment) -> list[dict]:
         f"{sd[0] * UM:.2f} µm at {_cm(h[0])}, {sd[-1] * UM:.2f} µm at {_cm(h[-1])}",
         level_is_best(h, sd), location="Fig. 4.3(c,d); line 790",
         measure="exact total finger end-point SD sqrt(sd_x^2 + sd_y^2) per height; agree if "
-        "lowest at level",
+        "lowest at level and monotone on both sides",
         note=f"shallow: the neighbouring heights are {100 * near.min():.1f}-"
         f"{100 * near.max():.1f} % higher, below the {100 * SD_ERROR_500:.0f} % sampling "
         "error of an SD from 500 repetitions, so a Monte Carlo figure need not show it"))
