@@ -314,8 +314,8 @@ def _initial_laws(opt: np.ndarray, seed: int) -> dict[str, np.ndarray]:
         "the optimum x 2": 2 * opt,
         "the optimum x 5": 5 * opt,
         "the optimum of an 's' with other via-points": other.L,
-        "random, 0.1 x its scale": 0.1 * scale * rng.standard_normal(opt.shape),
-        "random, 0.3 x its scale": 0.3 * scale * rng.standard_normal(opt.shape),
+        "random gains at 0.1 of its size": 0.1 * scale * rng.standard_normal(opt.shape),
+        "random gains at 0.3 of its size": 0.3 * scale * rng.standard_normal(opt.shape),
         "the optimum x -1": -opt,
     }
 
@@ -346,11 +346,11 @@ def _convergence(claims: list, seed: int) -> None:
         f"{len(same)} of {len(same) + len(overflow)} starts converge to the same cost and "
         f"gains (largest relative difference {worst:.0e}; {min(i for *_, i in same)}-"
         f"{max(i for *_, i in same)} iterations)"
-        + (f"; {', '.join(overflow)}: overflow in the first pass" if overflow else ""),
+        + (f"; {'; '.join(overflow)}: overflow in the first pass" if overflow else ""),
         worst < 1e-6, location="line 481 (citing Todorov & Jordan); line 483",
-        measure="the 's' of Fig. 3.6 solved from first-pass control laws: " + ", ".join(
-            _initial_laws(ref.L, seed)) + "; agree if every start whose first pass stays "
-        "finite reaches the zero start's cost and gains within 1e-6",
+        measure="the 's' of Fig. 3.6 solved from first-pass control laws: " + "; ".join(
+            _initial_laws(ref.L, seed)) + ". Agree if every start whose first pass stays "
+        "finite reaches the zero start's cost and gains within 1e-6 (relative)",
         note="a start that makes the closed loop explode (e.g. positive feedback) sends "
         "the first forward pass's second moments past the largest double (1e308) within the "
         "100 steps, so the iteration cannot be carried out in floating point: those starts "
