@@ -314,8 +314,8 @@ def _initial_laws(opt: np.ndarray, seed: int) -> dict[str, np.ndarray]:
         "the optimum x 2": 2 * opt,
         "the optimum x 5": 5 * opt,
         "the optimum of an 's' with other via-points": other.L,
-        "random gains at 0.1 of its size": 0.1 * scale * rng.standard_normal(opt.shape),
-        "random gains at 0.3 of its size": 0.3 * scale * rng.standard_normal(opt.shape),
+        "random gains at 0.1 of the optimum's size": 0.1 * scale * rng.standard_normal(opt.shape),
+        "random gains at 0.3 of the optimum's size": 0.3 * scale * rng.standard_normal(opt.shape),
         "the optimum x -1": -opt,
     }
 
