@@ -365,6 +365,7 @@ def solve(
     tol: float = 1e-12,
     atol: float = 1e-15,
     max_iter: int = 500,
+    initial_L: np.ndarray | None = None,
 ) -> LQGSolution:
     """Find the filter ``K`` and controller ``L`` that are optimal for each other.
 
@@ -384,6 +385,10 @@ def solve(
     max_iter : int, optional
         Maximum number of forward/backward iterations; ``max_iter=2`` runs
         exactly two (Todorov's ``Niter=2``).
+    initial_L : (T, m, n) array, optional
+        Control gains for the first forward pass (default zeros, as the thesis
+        and Todorov's code; thesis line 481: any start converges to the same
+        answer).
 
     Returns
     -------
@@ -393,7 +398,7 @@ def solve(
     Raises
     ------
     ValueError
-        If ``tol``, ``atol`` or ``max_iter`` are out of range.
+        If ``tol``, ``atol``, ``max_iter`` or ``initial_L`` are out of range.
     """
     if not isinstance(problem, LQGProblem):
         raise ValueError(f"solve: expected an LQGProblem, got {type(problem).__name__}")
@@ -403,7 +408,9 @@ def solve(
         raise ValueError(f"solve: max_iter must be >= 1, got {max_iter}")
     solver = _Solver(problem)
     T, m, n = problem.horizon, problem.n_controls, problem.n_states
-    L = np.zeros((T, m, n))
+    L = np.zeros((T, m, n)) if initial_L is None else np.array(initial_L, dtype=float)
+    if L.shape != (T, m, n) or not np.all(np.isfinite(L)):
+        raise ValueError(f"solve: initial_L must be finite, of shape {(T, m, n)}, got {L.shape}")
     history: list[float] = []
     converged = False
     K = None
