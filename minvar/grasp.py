@@ -42,6 +42,8 @@ kinematics, the digit bases moving with the simulated wrist.
 from __future__ import annotations
 
 import dataclasses
+import hashlib
+from collections import OrderedDict
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -503,12 +505,41 @@ def _chain_plan(name, chain, elbow, p_start, p_goal, vias, fractions, task: Gras
         task=jtask,
         problem=problem,
         execution=execution,
-        solution=solve(problem),
+        solution=_solve(problem),
         q_start=q0,
         q_goal=qg,
         q_via=qv,
         via_fractions=np.asarray(fractions, dtype=float),
     )
+
+
+#: Recently solved chain problems by content (see :func:`_solve`).
+_SOLVED: OrderedDict[bytes, LQGSolution] = OrderedDict()
+_SOLVED_MAX = 64
+
+
+def _solve(problem: LQGProblem) -> LQGSolution:
+    """:func:`~minvar.lqg.solve`, reusing the solution of an identical problem.
+
+    Grasps often share a chain's problem exactly — the arm of a grasp and of
+    the reach-only movement with the same transport, or one model re-planned
+    for several clips of a scene — and the solution of the same arrays is the
+    same (it is read-only, so it is shared as it is).
+    """
+    h = hashlib.blake2b(digest_size=20)
+    for name in ("A", "B", "C", "C0", "H", "D", "D0", "E0", "Q", "R", "X1", "S1"):
+        a = getattr(problem, name)
+        h.update(repr(a.shape).encode())
+        h.update(np.ascontiguousarray(a).tobytes())
+    key = h.digest()
+    sol = _SOLVED.get(key)
+    if sol is None:
+        sol = _SOLVED[key] = solve(problem)
+        while len(_SOLVED) > _SOLVED_MAX:
+            _SOLVED.popitem(last=False)
+    else:
+        _SOLVED.move_to_end(key)
+    return sol
 
 
 def plan_grasp(task: GraspTask) -> GraspPlan:

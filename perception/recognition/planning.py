@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Iterable
 
 import numpy as np
@@ -23,9 +24,18 @@ __all__ = ["DEFAULT_DURATIONS", "build_model", "default_specs"]
 DEFAULT_DURATIONS = (0.8, 0.9, 1.0, 1.1, 1.2)
 
 
+#: The joint-angle error covariance of each solution still in use (identical
+#: chain problems share one solution: see minvar.grasp).
+_ERROR_COV: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
 def _chain_model(role: str, chain_plan) -> ChainModel:
     problem, solution = chain_plan.problem, chain_plan.solution
-    P = estimation_error_covariance(problem, solution.K, solution.L)[:, :2, :2]
+    P = _ERROR_COV.get(solution)
+    if P is None:
+        P = estimation_error_covariance(problem, solution.K, solution.L)[:, :2, :2]
+        P.setflags(write=False)
+        _ERROR_COV[solution] = P
     q_ref = np.asarray(chain_plan.q_goal, dtype=float)
     chain = chain_plan.chain
     return ChainModel(
