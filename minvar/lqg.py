@@ -26,7 +26,6 @@ import logging
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.linalg.lapack import dposv as _dposv
 
 from . import _kernel
 
@@ -291,7 +290,9 @@ class _Solver:
         """``M^-1 Y`` for symmetric ``M``: Cholesky when ``M`` is positive definite,
         else the pseudo-inverse, as Todorov's code does for every step."""
         if pd:
-            _, X, info = _dposv(M, Y)
+            from scipy.linalg.lapack import dposv  # the numpy passes only: start-up time
+
+            _, X, info = dposv(M, Y)
             if info == 0:
                 return X
         return np.linalg.pinv(M).dot(Y)

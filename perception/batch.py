@@ -37,7 +37,7 @@ from perception.pipeline import (
     clip_name,
     recognize_clip,
 )
-from perception.recognition.repertoire import Repertoire
+from perception.recognition.repertoire import PlanCache, Repertoire
 from perception.report.batch import write_batch_report
 from perception.report.clip import ClipSummary, clip_outputs, write_clip_report
 
@@ -181,7 +181,7 @@ class ClipResult:
 
 def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
                  settings: RecognitionSettings, repertoire_id: str = "", *,
-                 progress: bool = False) -> ClipResult:
+                 progress: bool = False, plan_cache: PlanCache | None = None) -> ClipResult:
     """Recognise one clip through :func:`~perception.pipeline.recognize_clip` and report it.
 
     Parameters
@@ -198,6 +198,8 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
         Identity of the repertoire, part of the report's fingerprint.
     progress : bool
         Show a progress bar while tracking a video.
+    plan_cache : PlanCache, optional
+        Models re-planned for a scene, shared with the batch's other processes.
 
     Returns
     -------
@@ -214,7 +216,7 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
             return ClipResult(**base, status="reused", summary=ClipSummary.from_dict(done))
         rec = recognize_clip(item.path, repertoire, settings, clip=item.clip,
                              tracks_out=out / "tracks" / f"{item.clip}{TRACKS_SUFFIX}",
-                             progress=progress)
+                             progress=progress, plan_cache=plan_cache)
         write_clip_report(rec, out, extra={"fingerprint": fp, "condition": item.condition,
                                            "input": str(item.path)})
         return ClipResult(**base, status="ok", summary=ClipSummary.from_recognition(rec))
@@ -250,11 +252,33 @@ def _guarded(item: BatchItem, out: Path, **kwargs) -> ClipResult:
                           kwargs["settings"].hammer.rule)
 
 
+#: Thread pools of the numerical libraries, one thread each in a worker: set in
+#: the environment a worker is spawned with, because they are read when numpy
+#: (its BLAS) and OpenCV load, before any code of the worker runs.
+THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
+                    "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS")
+
+
 def _limit_threads() -> None:
     """One thread per worker process: parallelism comes from the processes."""
     import cv2
 
     cv2.setNumThreads(1)
+
+
+@contextlib.contextmanager
+def _single_threaded_children():
+    """Processes spawned inside get one BLAS/OpenMP thread (the environment they inherit)."""
+    before = {k: os.environ.get(k) for k in THREAD_VARIABLES}
+    os.environ.update({k: "1" for k in THREAD_VARIABLES})
+    try:
+        yield
+    finally:
+        for k, v in before.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
 
 
 @contextlib.contextmanager
@@ -290,9 +314,24 @@ class _Job:
     settings: RecognitionSettings
     repertoire_id: str
 
+    @property
+    def plan_cache(self) -> PlanCache:
+        """Plans of the batch's scenes, beside its report, shared by every process."""
+        return PlanCache(self.out / PLANS_FOLDER)
+
     def run(self, item: BatchItem, repertoire: Repertoire) -> ClipResult:
         return _guarded(item, self.out, repertoire=repertoire, settings=self.settings,
-                        repertoire_id=self.repertoire_id)
+                        repertoire_id=self.repertoire_id, plan_cache=self.plan_cache)
+
+    def run_on_cluster(self, item: BatchItem, repertoire: Repertoire) -> ClipResult:
+        """:meth:`run` in a dask worker: single-threaded OpenCV, as local workers are
+        (dask's nanny already starts workers with one BLAS/OpenMP thread)."""
+        _limit_threads()
+        return self.run(item, repertoire)
+
+
+#: Folder of the plan cache inside a report folder.
+PLANS_FOLDER = ".plans"
 
 
 def _work_in_worker(item: BatchItem, job: _Job) -> ClipResult:
@@ -326,8 +365,9 @@ def _run_local(items: list[BatchItem], repertoire: Repertoire, job: _Job,
     ctx = multiprocessing.get_context("spawn")
     with tempfile.TemporaryDirectory(prefix=".repertoire-", dir=job.out) as tmp, _one_thread():
         rep_file = repertoire.save(Path(tmp) / "repertoire.h5")
-        with ProcessPoolExecutor(max_workers=jobs - 1, initializer=_init_worker,
-                                 initargs=(str(rep_file),), mp_context=ctx) as pool:
+        with _single_threaded_children(), ProcessPoolExecutor(
+                max_workers=jobs - 1, initializer=_init_worker, initargs=(str(rep_file),),
+                mp_context=ctx) as pool:
             yield from _share(pending, here, pool, job, jobs - 1)
 
 
@@ -370,7 +410,7 @@ def _run_dask(items: list[BatchItem], repertoire: Repertoire, job: _Job,
 
     with Client(scheduler) as client:
         rep = client.scatter(repertoire, broadcast=True)
-        futures = [client.submit(job.run, it, rep, pure=False) for it in items]
+        futures = [client.submit(job.run_on_cluster, it, rep, pure=False) for it in items]
         for fut in dask_completed(futures):
             yield fut.result()
 

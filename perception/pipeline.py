@@ -5,8 +5,8 @@
 all go through it:
 
 1. **tracks** — a video is tracked (:func:`perception.tracking.track_video`)
-   into a tracks file; a tracks file is loaded; a :class:`Tracks` object is
-   used as it is;
+   into a tracks file, unless a current one is at hand (:func:`current_tracks`);
+   a tracks file is loaded; a :class:`Tracks` object is used as it is;
 2. **observation** — :func:`perception.observation.observe` maps the tracks to
    the model frame and finds the movement;
 3. **planning** — the repertoire's models are taken, or re-planned, for the
@@ -30,7 +30,7 @@ from perception.io.tracks import Tracks, tracks_path_for
 from perception.observation import ObserveParams, observe
 from perception.recognition.engine import HammerParams, recognize
 from perception.recognition.models import SceneSpec
-from perception.recognition.repertoire import Repertoire
+from perception.recognition.repertoire import PlanCache, Repertoire
 from perception.recognition.result import Recognition
 
 __all__ = [
@@ -39,6 +39,7 @@ __all__ = [
     "VIDEO_SUFFIXES",
     "clip_fingerprint",
     "clip_name",
+    "current_tracks",
     "load_clip",
     "recognize_clip",
 ]
@@ -123,7 +124,9 @@ def load_clip(source: str | os.PathLike | Tracks, *, tracks_out: str | os.PathLi
         A video file, a ``.tracks.h5`` file, or tracks in memory.
     tracks_out : str or os.PathLike, optional
         Where a video's tracks are written (default: ``<stem>.tracks.h5``
-        beside the video).
+        beside the video). A current tracks file of the video there, or
+        beside the video, is loaded instead of tracking again
+        (:func:`current_tracks`).
     progress : bool
         Show a progress bar while tracking.
 
@@ -141,16 +144,93 @@ def load_clip(source: str | os.PathLike | Tracks, *, tracks_out: str | os.PathLi
         raise InputError("not a video or tracks file", path)
     if kind == "tracks":
         return Tracks.load(path)
+    out = tracks_path_for(path) if tracks_out is None else Path(tracks_out)
+    current = current_tracks(path, [out, tracks_path_for(path)])
+    if current is not None:
+        return current
     from perception.tracking.tracker import track_video  # OpenCV only when there is video
 
-    out = tracks_path_for(path) if tracks_out is None else Path(tracks_out)
     return Tracks.load(track_video(path, out, progress=progress))
+
+
+#: ``/tracker`` attributes that describe what a tracker learned from the clip
+#: (not its settings): they do not decide whether a tracks file is current.
+_LEARNED = frozenset({"reference_mass_px", "diameter_px"})
+
+
+def _plain(value):
+    """An attribute value as plain JSON-able data (arrays and numpy scalars unwrapped)."""
+    import numpy as np
+
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, tuple | list):
+        return [_plain(v) for v in value]
+    return value
+
+
+def _settings(attrs: dict) -> str:
+    return json.dumps({k: _plain(v) for k, v in attrs.items() if k not in _LEARNED},
+                      sort_keys=True, default=str)
+
+
+def current_tracks(video: str | os.PathLike, candidates) -> Tracks | None:
+    """The first of ``candidates`` that is a current tracks file of ``video``, loaded.
+
+    Current means: written by this software version, of this very video
+    (``/video`` attribute ``sha256``: hashing reads the file once, far
+    cheaper than decoding and tracking it) and with the default tracker
+    settings (colour models, ROIs, criteria and parameters of ``/tracker``;
+    ``recognize`` and ``batch`` track with those). Anything else (missing,
+    unreadable, stale) is not reused.
+
+    Parameters
+    ----------
+    video : str or os.PathLike
+        The video.
+    candidates : iterable of path
+        Tracks files to consider, in order of preference.
+    """
+    import h5py
+
+    from perception.io.video import sha256_file
+
+    digest = None
+    for cand in candidates:
+        cand = Path(cand)
+        if not cand.is_file():
+            continue
+        try:
+            with h5py.File(cand, "r") as fh:
+                version = fh.attrs.get("software_version")
+            tracks = Tracks.load(cand)
+        except (InputError, OSError, ValueError):
+            continue
+        if _plain(version) != __version__ and version != __version__.encode():
+            continue
+        digest = digest or sha256_file(video)
+        if tracks.video.get("sha256") != digest:
+            continue
+        if _settings(tracks.tracker) != _settings(_default_tracker_attrs()):
+            continue
+        return tracks
+    return None
+
+
+def _default_tracker_attrs() -> dict:
+    """The ``/tracker`` settings a default tracker writes."""
+    from perception.tracking.markers import default_markers
+    from perception.tracking.tracker import Tracker
+
+    return Tracker(default_markers()).attrs()
 
 
 def recognize_clip(source: str | os.PathLike | Tracks, repertoire: Repertoire,
                    settings: RecognitionSettings | None = None, *, clip: str | None = None,
                    tracks_out: str | os.PathLike | None = None,
-                   progress: bool = False) -> Recognition:
+                   progress: bool = False, plan_cache: PlanCache | None = None) -> Recognition:
     """Track (if a video), observe, plan for the clip's scene and recognise one clip.
 
     Parameters
@@ -167,6 +247,8 @@ def recognize_clip(source: str | os.PathLike | Tracks, repertoire: Repertoire,
         Where a video's tracks are written (see :func:`load_clip`).
     progress : bool
         Show a progress bar while tracking.
+    plan_cache : PlanCache, optional
+        Models re-planned for a scene, shared with other processes.
 
     Returns
     -------
@@ -188,7 +270,7 @@ def recognize_clip(source: str | os.PathLike | Tracks, repertoire: Repertoire,
             raise
         raise InputError(exc.problem, source) from None  # name the file the user gave
     try:
-        models = repertoire.for_scene(SceneSpec.of(obs))
+        models = repertoire.for_scene(SceneSpec.of(obs), cache=plan_cache)
     except ValueError as exc:
         raise InputError(f"cannot plan the models for this clip's scene (distance "
                          f"{obs.start_distance:.3f} m; check the scale: --px-per-m, "
