@@ -64,28 +64,26 @@ def _c(a) -> np.ndarray:
 
 
 class Arrays:
-    """A problem's matrices as contiguous arrays, prepared once per solve."""
+    """A problem's matrices as contiguous arrays and their addresses, prepared once per solve."""
 
     def __init__(self, p, BC: np.ndarray, DD0, CC0, EE0, flags: int):
-        self.T, self.n, self.m, self.k = p.horizon, p.n_states, p.n_controls, p.n_outputs
-        self.A, self.B, self.H = _c(p.A), _c(p.B), _c(p.H)
-        self.C, self.BC = _c(p.C), _c(BC)
-        self.nc = len(p.C)
-        self.D = _c(p.D)
-        self.nd = len(p.D)
-        self.DD0, self.CC0, self.EE0 = _c(DD0), _c(CC0), _c(EE0)
-        self.Q, self.R = _c(p.Q), _c(p.R)
-        self.X1, self.S1 = _c(p.X1), _c(p.S1)
+        T, n, m, k = p.horizon, p.n_states, p.n_controls, p.n_outputs
+        keep = [_c(a) for a in (p.A, p.B, p.H, BC, p.C, p.D, DD0, CC0, EE0, p.Q, p.R, p.X1,
+                                p.S1)]
+        self._keep = keep  # the addresses below point into these
+        A, B, H, BC, C, D, DD0, CC0, EE0, Q, R, X1, S1 = (a.ctypes.data for a in keep)
+        dims = (T, n, m, k, len(p.C), len(p.D))
+        self.shapes = {"K": (T, n, k), "L": (T, m, n)}
+        self.fwd = (*dims, A, B, H, BC, D, DD0, CC0, EE0, S1, X1)
+        self.bwd = (*dims, A, B, H, C, D, DD0, CC0, EE0, Q, R, X1, S1)
         self.flags = flags
 
 
 def forward(a: Arrays, L: np.ndarray) -> np.ndarray | None:
     """Filter gains ``K`` for control gains ``L``, or None if Cholesky failed."""
-    K = np.empty((a.T, a.n, a.k))
+    K = np.empty(a.shapes["K"])
     L = _c(L)
-    status = _LIB.lqg_forward(a.T, a.n, a.m, a.k, a.nc, a.nd, _p(a.A), _p(a.B), _p(a.H),
-                              _p(a.BC), _p(a.D), _p(a.DD0), _p(a.CC0), _p(a.EE0), _p(a.S1),
-                              _p(a.X1), _p(L), a.flags, _p(K))
+    status = _LIB.lqg_forward(*a.fwd, L.ctypes.data, a.flags, K.ctypes.data)
     if status < 0:
         raise MemoryError("minvar: the LQG kernel ran out of memory")
     return K if status == 0 else None
@@ -93,12 +91,10 @@ def forward(a: Arrays, L: np.ndarray) -> np.ndarray | None:
 
 def backward(a: Arrays, K: np.ndarray) -> tuple[np.ndarray, float] | None:
     """Control gains ``L`` and the expected cost for filter gains ``K``, or None."""
-    L = np.empty((a.T, a.m, a.n))
+    L = np.empty(a.shapes["L"])
     cost = ctypes.c_double()
     K = _c(K)
-    status = _LIB.lqg_backward(a.T, a.n, a.m, a.k, a.nc, a.nd, _p(a.A), _p(a.B), _p(a.H),
-                               _p(a.C), _p(a.D), _p(a.DD0), _p(a.CC0), _p(a.EE0), _p(a.Q),
-                               _p(a.R), _p(a.X1), _p(a.S1), _p(K), a.flags, _p(L),
+    status = _LIB.lqg_backward(*a.bwd, K.ctypes.data, a.flags, L.ctypes.data,
                                ctypes.byref(cost))
     if status < 0:
         raise MemoryError("minvar: the LQG kernel ran out of memory")

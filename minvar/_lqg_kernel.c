@@ -89,18 +89,15 @@ static void sd(double *out, const csr *S, const double *X, int r, int accumulate
     }
 }
 
-/* out (p x S.cols) = X S, X (p x S.rows). */
+/* out (p x S.cols) = X S, X (p x S.rows): a pass over X's columns per non-zero of S. */
 static void ds(double *out, const double *X, const csr *S, int p, int accumulate) {
     const int q = S->rows, r = S->cols;
-    for (int i = 0; i < p; i++) {
-        double *o = out + (size_t)i * r;
-        if (!accumulate) memset(o, 0, sizeof(double) * r);
-        const double *x = X + (size_t)i * q;
-        for (int l = 0; l < q; l++) {
-            double xv = x[l];
-            if (xv == 0.0) continue;
-            if (accumulate < 0) xv = -xv;
-            for (int t = S->start[l]; t < S->start[l + 1]; t++) o[S->col[t]] += xv * S->val[t];
+    if (!accumulate) memset(out, 0, sizeof(double) * (size_t)p * r);
+    for (int l = 0; l < q; l++) {
+        for (int t = S->start[l]; t < S->start[l + 1]; t++) {
+            const int j = S->col[t];
+            const double v = accumulate < 0 ? -S->val[t] : S->val[t];
+            for (int i = 0; i < p; i++) out[(size_t)i * r + j] += v * X[(size_t)i * q + l];
         }
     }
 }
@@ -179,17 +176,26 @@ static int chol_solve(const double *M, double *Y, double *U, int d, int r) {
             U[j * d + i] = t / ujj;
         }
     }
-    for (int c = 0; c < r; c++) {
-        for (int i = 0; i < d; i++) { /* U' z = y */
-            double s = Y[i * r + c];
-            for (int l = 0; l < i; l++) s -= U[l * d + i] * Y[l * r + c];
-            Y[i * r + c] = s / U[i * d + i];
+    /* all right-hand sides at once, a row at a time (contiguous) */
+    for (int i = 0; i < d; i++) { /* U' z = y */
+        double *yi = Y + (size_t)i * r;
+        for (int l = 0; l < i; l++) {
+            const double u = U[l * d + i];
+            const double *yl = Y + (size_t)l * r;
+            for (int c = 0; c < r; c++) yi[c] -= u * yl[c];
         }
-        for (int i = d - 1; i >= 0; i--) { /* U x = z */
-            double s = Y[i * r + c];
-            for (int l = i + 1; l < d; l++) s -= U[i * d + l] * Y[l * r + c];
-            Y[i * r + c] = s / U[i * d + i];
+        const double uii = U[i * d + i];
+        for (int c = 0; c < r; c++) yi[c] /= uii;
+    }
+    for (int i = d - 1; i >= 0; i--) { /* U x = z */
+        double *yi = Y + (size_t)i * r;
+        for (int l = i + 1; l < d; l++) {
+            const double u = U[i * d + l];
+            const double *yl = Y + (size_t)l * r;
+            for (int c = 0; c < r; c++) yi[c] -= u * yl[c];
         }
+        const double uii = U[i * d + i];
+        for (int c = 0; c < r; c++) yi[c] /= uii;
     }
     return 0;
 }
@@ -356,9 +362,11 @@ int lqg_backward(int T, int n, int m, int k, int nc, int nd, const double *A, co
         if (flags & NOISE_COST) {
             /* tr(Sx CC0) + tr(Se (K DD0 K' + EE0 + CC0)), tr(Se K DD0 K') = sum (Se K DD0) .* K */
             double s = 0.0;
-            for (size_t i = 0; i < nn; i++)
-                s += Sx[i] * CC0[(i % n) * n + i / n] + Se[i] * (EE0[(i % n) * n + i / n]
-                                                                 + CC0[(i % n) * n + i / n]);
+            if (flags & ADD_NOISE)
+                for (int i = 0; i < n; i++)
+                    for (int j = 0; j < n; j++)
+                        s += Sx[i * n + j] * CC0[j * n + i]
+                             + Se[i * n + j] * (EE0[j * n + i] + CC0[j * n + i]);
             cost += s;
             dd(Kbuf, SeK, DD0, n, k, k, 0);
             s = 0.0;

@@ -41,7 +41,6 @@ kinematics, the digit bases moving with the simulated wrist.
 
 from __future__ import annotations
 
-import dataclasses
 import hashlib
 from collections import OrderedDict
 from dataclasses import dataclass, field
@@ -495,9 +494,8 @@ def _chain_plan(name, chain, elbow, p_start, p_goal, vias, fractions, task: Gras
     cv = task.execution_cv
     # each joint's command gets its own noise: u_i (1 + cv eps_i)
     noise = [cv * np.diag([1.0, 0.0]), cv * np.diag([0.0, 1.0])]
-    execution = dataclasses.replace(
-        problem, C=noise, D0=task.execution_sigma_s * np.diag(task.plant.sensory_sd)
-    )
+    execution = problem.with_noise(C=noise,
+                                   D0=task.execution_sigma_s * np.diag(task.plant.sensory_sd))
     return ChainPlan(
         name=name,
         chain=chain,

@@ -22,6 +22,8 @@ code's ``K``, ``L``, expected trajectory and cost per iteration (see
 
 from __future__ import annotations
 
+import copy
+import functools
 import logging
 from dataclasses import dataclass, field
 
@@ -170,6 +172,20 @@ class LQGProblem:
         for key, val in values.items():
             object.__setattr__(self, key, val)
 
+    def with_noise(self, *, C=None, D0=None) -> LQGProblem:
+        """This problem with other control-dependent (``C``) or sensory (``D0``) noise.
+
+        The same as ``dataclasses.replace(problem, C=..., D0=...)``, checking
+        only the new matrices (a grasp's execution model, planned once per chain).
+        """
+        new = copy.copy(self)
+        m, k = self.n_controls, self.n_outputs
+        if C is not None:
+            object.__setattr__(new, "C", _as_stack("C", C, (m, m), "m x m"))
+        if D0 is not None:
+            object.__setattr__(new, "D0", _as_matrix("D0", D0, (k, None)))
+        return new
+
     @property
     def n_states(self) -> int:
         """Number of states n."""
@@ -246,10 +262,6 @@ class _Solver:
         self.Bt = np.ascontiguousarray(B.T)
         self.Ht = np.ascontiguousarray(p.H.T)
         self.BC = np.einsum("ij,cjk->cik", B, p.C)  # (c, n, m): thesis C_i
-        n, m = p.n_states, p.n_controls
-        # sum_i X_i M X_i' as one product on vec(M) (row-major: vec(X M Y) = (X kron Y') vec(M))
-        self.noise_fwd = sum((np.kron(BCi, BCi) for BCi in self.BC), np.zeros((n * n, m * m)))
-        self.noise_bwd = sum((np.kron(Ci.T, Ci.T) for Ci in p.C), np.zeros((m * m, m * m)))
         self.DD0 = p.D0 @ p.D0.T
         self.CC0 = p.C0 @ p.C0.T
         self.EE0 = p.E0 @ p.E0.T
@@ -284,6 +296,19 @@ class _Solver:
         K, AKH = self.forward(L)
         L, cost = self.backward(K, AKH)
         return K, L, cost
+
+    @functools.cached_property
+    def noise_fwd(self) -> np.ndarray:
+        """sum_i X_i M X_i' as one product on vec(M), X_i = B C_i (row-major:
+        vec(X M Y) = (X kron Y') vec(M)); the numpy passes only."""
+        n, m = self.p.n_states, self.p.n_controls
+        return sum((np.kron(BCi, BCi) for BCi in self.BC), np.zeros((n * n, m * m)))
+
+    @functools.cached_property
+    def noise_bwd(self) -> np.ndarray:
+        """sum_i C_i' M C_i as one product on vec(M); the numpy passes only."""
+        m = self.p.n_controls
+        return sum((np.kron(Ci.T, Ci.T) for Ci in self.p.C), np.zeros((m * m, m * m)))
 
     @staticmethod
     def _solve(M: np.ndarray, Y: np.ndarray, pd: bool) -> np.ndarray:

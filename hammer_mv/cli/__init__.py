@@ -36,6 +36,9 @@ COMMANDS = {
 
 _EVERY = object()
 
+#: Thread-pool sizes of numpy's BLAS and OpenMP, read when they load.
+THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+
 
 class _Parser(argparse.ArgumentParser):
     """An argparse parser whose errors are one line and exit status 2."""
@@ -81,6 +84,11 @@ def main(argv: list[str] | None = None) -> int:
     # we report those files in one line ourselves. Set before any video opens.
     os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "-8")
     os.environ.setdefault("OPENCV_LOG_LEVEL", "ERROR")
+    # One BLAS/OpenMP thread unless the user says otherwise: every matrix here
+    # is small, and waking a BLAS thread pool costs more than it saves (planning
+    # a repertoire: 0.17 s with one thread, 0.25 s with two). Set before numpy loads.
+    for name in THREAD_VARIABLES:
+        os.environ.setdefault(name, "1")
     argv = sys.argv[1:] if argv is None else list(argv)
     parser = build_parser(_command(argv))
     args = parser.parse_args(argv)
