@@ -348,19 +348,27 @@ int lqg_backward(int T, int n, int m, int k, int nc, int nd, const double *A, co
     double *BSxB = KZ + blk, *temp = BSxB + blk, *BSeB = temp + blk, *Ctmp = BSeB + blk;
     double *U = Ctmp + blk, *KSeK = U + blk, *Kbuf = KSeK + blk;
     double cost = 0.0;
+    char *Qzero = NULL;
     transpose(At, A, n, n);
     transpose(Bt, B, n, m);
     transpose(Ht, H, k, n);
     if (csr_make(&sA, A, n, n) || csr_make(&sAt, At, n, n) || csr_make(&sB, B, n, m)
         || csr_make(&sBt, Bt, m, n) || csr_make(&sH, H, k, n) || csr_make(&sHt, Ht, n, k))
         goto done;
+    Qzero = malloc((size_t)T + 1);
+    if (!Qzero) goto done;
+    for (int t = 0; t <= T; t++) {
+        const double *Qt = Q + (size_t)t * nn;
+        Qzero[t] = 1;
+        for (size_t i = 0; i < nn && Qzero[t]; i++) Qzero[t] = Qt[i] == 0.0;
+    }
     memcpy(Sx, Q + (size_t)T * nn, sizeof(double) * nn);
     memset(Se, 0, sizeof(double) * nn);
     for (int t = T - 1; t >= 0; t--) {
         const double *Kt = K + (size_t)t * n * k;
-        dd(SeK, Se, Kt, n, n, k, 0);                   /* Se K */
+        dtd(SeK, Kt, Se, k, n, n, 0);                  /* K' Se (k x n) */
         if (flags & NOISE_COST) {
-            /* tr(Sx CC0) + tr(Se (K DD0 K' + EE0 + CC0)), tr(Se K DD0 K') = sum (Se K DD0) .* K */
+            /* tr(Sx CC0) + tr(Se (K DD0 K' + EE0 + CC0)), tr(Se K DD0 K') = sum (DD0 K'Se) .* K' */
             double s = 0.0;
             if (flags & ADD_NOISE)
                 for (int i = 0; i < n; i++)
@@ -368,9 +376,10 @@ int lqg_backward(int T, int n, int m, int k, int nc, int nd, const double *A, co
                         s += Sx[i * n + j] * CC0[j * n + i]
                              + Se[i * n + j] * (EE0[j * n + i] + CC0[j * n + i]);
             cost += s;
-            dd(Kbuf, SeK, DD0, n, k, k, 0);
+            dd(Kbuf, DD0, SeK, k, k, n, 0);             /* DD0 K' Se (k x n) */
             s = 0.0;
-            for (size_t i = 0; i < (size_t)n * k; i++) s += Kbuf[i] * Kt[i];
+            for (int a = 0; a < k; a++)
+                for (int i = 0; i < n; i++) s += Kbuf[a * n + i] * Kt[i * k + a];
             cost += s;
         }
         ds(SxB, Sx, &sB, n, 0);                        /* Sx B */
@@ -398,7 +407,13 @@ int lqg_backward(int T, int n, int m, int k, int nc, int nd, const double *A, co
         /* Se' = ASBL + akh' Se akh, akh = A - K H:
          * Z = Se akh = Se A - (Se K) H;  akh' Z = A' Z - H' (K' Z) */
         ds(T1, Se, &sA, n, 0);
-        ds(T1, SeK, &sH, n, -1);                       /* Z */
+        for (int a = 0; a < k; a++)                    /* Z = Se A - (Se K) H */
+            for (int p = sH.start[a]; p < sH.start[a + 1]; p++) {
+                const int j = sH.col[p];
+                const double v = sH.val[p];
+                const double *z = SeK + (size_t)a * n;
+                for (int i = 0; i < n; i++) T1[(size_t)i * n + j] -= v * z[i];
+            }
         sd(SeNew, &sAt, T1, n, 0);
         dtd(KZ, Kt, T1, k, n, n, 0);                   /* K' Z (k x n) */
         sd(SeNew, &sHt, KZ, n, -1);
@@ -406,7 +421,10 @@ int lqg_backward(int T, int n, int m, int k, int nc, int nd, const double *A, co
         /* Sx' = Q[t] + A' Sx A - ASBL */
         ds(SxNew, AtSx, &sA, n, 0);
         const double *Qt = Q + (size_t)t * nn;
-        for (size_t i = 0; i < nn; i++) SxNew[i] += Qt[i] - ASBL[i];
+        if (Qzero[t])  /* most steps cost nothing: leave Q[t] unread */
+            for (size_t i = 0; i < nn; i++) SxNew[i] -= ASBL[i];
+        else
+            for (size_t i = 0; i < nn; i++) SxNew[i] += Qt[i] - ASBL[i];
         if (flags & HAS_D) {
             dtd(T2, Kt, Se, k, n, n, 0);               /* K' Se (k x n) */
             dd(KSeK, T2, Kt, k, n, k, 0);              /* K' Se K */
@@ -434,6 +452,7 @@ int lqg_backward(int T, int n, int m, int k, int nc, int nd, const double *A, co
     *cost_out = cost;
     status = 0;
 done:
+    free(Qzero);
     csr_free(&sA);
     csr_free(&sAt);
     csr_free(&sB);

@@ -42,6 +42,7 @@ kinematics, the digit bases moving with the simulated wrist.
 from __future__ import annotations
 
 import hashlib
+import threading
 from collections import OrderedDict
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
@@ -514,6 +515,7 @@ def _chain_plan(name, chain, elbow, p_start, p_goal, vias, fractions, task: Gras
 #: Recently solved chain problems by content (see :func:`_solve`).
 _SOLVED: OrderedDict[bytes, LQGSolution] = OrderedDict()
 _SOLVED_MAX = 64
+_SOLVED_LOCK = threading.Lock()
 
 
 def _solve(problem: LQGProblem) -> LQGSolution:
@@ -530,13 +532,16 @@ def _solve(problem: LQGProblem) -> LQGSolution:
         h.update(repr(a.shape).encode())
         h.update(np.ascontiguousarray(a).tobytes())
     key = h.digest()
-    sol = _SOLVED.get(key)
-    if sol is None:
-        sol = _SOLVED[key] = solve(problem)
+    with _SOLVED_LOCK:
+        sol = _SOLVED.get(key)
+        if sol is not None:
+            _SOLVED.move_to_end(key)
+            return sol
+    sol = solve(problem)  # outside the lock: plans may run in several threads
+    with _SOLVED_LOCK:
+        _SOLVED[key] = sol
         while len(_SOLVED) > _SOLVED_MAX:
             _SOLVED.popitem(last=False)
-    else:
-        _SOLVED.move_to_end(key)
     return sol
 
 

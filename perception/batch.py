@@ -37,6 +37,7 @@ from perception.pipeline import (
     clip_name,
     recognize_clip,
 )
+from perception.recognition.planning import THREADS_VARIABLE
 from perception.recognition.repertoire import PlanCache, Repertoire
 from perception.report.batch import write_batch_report
 from perception.report.clip import ClipSummary, clip_outputs, write_clip_report
@@ -269,8 +270,9 @@ def _limit_threads() -> None:
 @contextlib.contextmanager
 def _single_threaded_children():
     """Processes spawned inside get one BLAS/OpenMP thread (the environment they inherit)."""
-    before = {k: os.environ.get(k) for k in THREAD_VARIABLES}
-    os.environ.update({k: "1" for k in THREAD_VARIABLES})
+    names = (*THREAD_VARIABLES, THREADS_VARIABLE)
+    before = {k: os.environ.get(k) for k in names}
+    os.environ.update({k: "1" for k in names})
     try:
         yield
     finally:
@@ -327,6 +329,7 @@ class _Job:
         """:meth:`run` in a dask worker: single-threaded OpenCV, as local workers are
         (dask's nanny already starts workers with one BLAS/OpenMP thread)."""
         _limit_threads()
+        os.environ[THREADS_VARIABLE] = "1"  # the cluster's other workers use the other cores
         return self.run(item, repertoire)
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import weakref
 from collections.abc import Iterable
 
@@ -18,7 +19,8 @@ from perception.recognition.models import (
     model_substeps,
 )
 
-__all__ = ["DEFAULT_DURATIONS", "build_model", "default_specs"]
+__all__ = ["DEFAULT_DURATIONS", "build_model", "build_models", "default_specs",
+           "planning_threads"]
 
 #: Movement-time variants of the default repertoire, s.
 DEFAULT_DURATIONS = (0.8, 0.9, 1.0, 1.1, 1.2)
@@ -75,6 +77,42 @@ def build_model(spec: ModelSpec, scene: SceneSpec) -> MotorModel:
         finger=_chain_model("finger", plan.finger),
         thumb=_chain_model("thumb", plan.thumb),
     )
+
+
+#: Environment variable: threads that plan a repertoire's models (default: up to 2).
+THREADS_VARIABLE = "HAMMER_MV_PLAN_THREADS"
+
+
+def planning_threads() -> int:
+    """Threads :func:`build_models` uses: ``$HAMMER_MV_PLAN_THREADS``, else up to 2.
+
+    The solver's compiled passes release the GIL, so two models plan at once
+    on two cores. A batch's workers plan with one (they already use every core).
+    """
+    value = os.environ.get(THREADS_VARIABLE, "")
+    if value.strip().isdigit() and int(value) >= 1:
+        return int(value)
+    return max(1, min(2, os.cpu_count() or 1))
+
+
+def build_models(specs: Iterable[ModelSpec], scene: SceneSpec) -> list[MotorModel]:
+    """:func:`build_model` of every spec, in order, on :func:`planning_threads` threads.
+
+    Parameters
+    ----------
+    specs : iterable of ModelSpec
+        The movements.
+    scene : SceneSpec
+        The scene.
+    """
+    specs = list(specs)
+    threads = min(planning_threads(), len(specs))
+    if threads <= 1:
+        return [build_model(s, scene) for s in specs]
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(threads, thread_name_prefix="plan") as pool:
+        return list(pool.map(lambda spec: build_model(spec, scene), specs))
 
 
 def default_specs(durations: Iterable[float] = DEFAULT_DURATIONS) -> list[ModelSpec]:

@@ -25,7 +25,7 @@ from pathlib import Path
 from perception.errors import InputError
 from perception.io.repertoire import StoredChain, StoredModel, read_repertoire, write_repertoire
 from perception.recognition.models import CHAIN_ARRAYS, ChainModel, ModelSpec, MotorModel, SceneSpec
-from perception.recognition.planning import DEFAULT_DURATIONS, build_model, default_specs
+from perception.recognition.planning import DEFAULT_DURATIONS, build_models, default_specs
 
 __all__ = ["PlanCache", "Repertoire"]
 
@@ -91,7 +91,7 @@ class Repertoire:
         scene = SceneSpec() if scene is None else scene
         config = {"scene": dataclasses.asdict(scene),
                   "models": [dataclasses.asdict(s) for s in specs]}
-        return cls([build_model(s, scene) for s in specs], config)
+        return cls(build_models(specs, scene), config)
 
     @classmethod
     def from_config(cls, path: str | Path) -> Repertoire:
@@ -147,7 +147,7 @@ class Repertoire:
                 log.info("re-planning %d models for distance %.3f m, object %.3f m, hand "
                          "%.3f m, %.1f frames/s", len(todo), grid.distance, grid.object_size,
                          grid.tip_start, 1 / grid.frame_period)
-                return [build_model(m.spec, grid) for m in todo]
+                return build_models([m.spec for m in todo], grid)
 
             planned = plan() if cache is None else cache.get(grid, [m.spec for m in todo], plan)
             for m, new in zip(todo, planned):
@@ -201,7 +201,7 @@ class _DefaultRepertoire(Repertoire):
     @property
     def models(self) -> list[MotorModel]:  # type: ignore[override]
         if self._models is None:
-            self._models = [build_model(s, self._scene) for s in self._specs]
+            self._models = build_models(self._specs, self._scene)
         return self._models
 
     @property
