@@ -155,3 +155,16 @@ def test_synth_jobs_give_the_same_clips(tmp_path):
     assert one.equals(two)
     for name in one["video"]:
         assert (tmp_path / "one" / name).read_bytes() == (tmp_path / "two" / name).read_bytes()
+
+
+def test_models_planned_on_threads_are_the_same(monkeypatch):
+    from perception.recognition.planning import build_models
+
+    scene = SceneSpec(distance=0.28)
+    monkeypatch.setenv("HAMMER_MV_PLAN_THREADS", "2")
+    two = build_models(_specs(), scene)
+    monkeypatch.setenv("HAMMER_MV_PLAN_THREADS", "1")
+    one = build_models(_specs(), scene)
+    for a, b in zip(one, two):
+        for ca, cb in zip(a.chains, b.chains):
+            np.testing.assert_array_equal(ca.L, cb.L)

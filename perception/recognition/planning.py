@@ -79,20 +79,23 @@ def build_model(spec: ModelSpec, scene: SceneSpec) -> MotorModel:
     )
 
 
-#: Environment variable: threads that plan a repertoire's models (default: up to 2).
+#: Environment variable: threads that plan a repertoire's models (default 1).
 THREADS_VARIABLE = "HAMMER_MV_PLAN_THREADS"
 
 
 def planning_threads() -> int:
-    """Threads :func:`build_models` uses: ``$HAMMER_MV_PLAN_THREADS``, else up to 2.
+    """Threads :func:`build_models` uses: ``$HAMMER_MV_PLAN_THREADS``, else 1.
 
-    The solver's compiled passes release the GIL, so two models plan at once
-    on two cores. A batch's workers plan with one (they already use every core).
+    The solver's compiled passes release the GIL, so on idle cores several
+    models plan at once (about half of planning is the compiled passes, so two
+    threads save at most a third). On a busy machine threads only add
+    hand-offs, so one is the default; a batch's workers always use one (they
+    already use every core).
     """
     value = os.environ.get(THREADS_VARIABLE, "")
     if value.strip().isdigit() and int(value) >= 1:
         return int(value)
-    return max(1, min(2, os.cpu_count() or 1))
+    return 1
 
 
 def build_models(specs: Iterable[ModelSpec], scene: SceneSpec) -> list[MotorModel]:
