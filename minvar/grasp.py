@@ -530,7 +530,7 @@ def _solve(problem: LQGProblem) -> LQGSolution:
     for name in ("A", "B", "C", "C0", "H", "D", "D0", "E0", "Q", "R", "X1", "S1"):
         a = getattr(problem, name)
         h.update(repr(a.shape).encode())
-        h.update(np.ascontiguousarray(a).tobytes())
+        h.update(np.ascontiguousarray(a).data)
     key = h.digest()
     with _SOLVED_LOCK:
         sol = _SOLVED.get(key)

@@ -71,12 +71,16 @@ def _check_psd(name: str, M: np.ndarray) -> None:
     """Raise unless ``M`` (or each of a stack) is symmetric positive semi-definite."""
     if M.ndim == 3:  # a cost per step is mostly zeros: check the others
         M = M[M.any(axis=(1, 2))]
-        if not len(M):
-            return
-    scale = max(float(np.abs(M).max()), np.finfo(float).tiny)
+    if not M.any():
+        return
+    scale = float(np.abs(M).max())
     if np.abs(M - np.swapaxes(M, -1, -2)).max() > 1e-10 * scale:
         raise ValueError(f"LQGProblem.{name}: expected a symmetric matrix")
-    lowest = np.linalg.eigvalsh(0.5 * (M + np.swapaxes(M, -1, -2))).min()
+    d = np.diagonal(M, axis1=-2, axis2=-1)
+    if M.ndim == 2 and np.count_nonzero(M) == np.count_nonzero(d):  # diagonal
+        lowest = float(d.min())
+    else:
+        lowest = np.linalg.eigvalsh(0.5 * (M + np.swapaxes(M, -1, -2))).min()
     if lowest < -1e-10 * scale:
         raise ValueError(f"LQGProblem.{name}: expected a positive semi-definite matrix "
                          f"(an eigenvalue is {lowest:.3g})")
