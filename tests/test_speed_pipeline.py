@@ -168,3 +168,11 @@ def test_models_planned_on_threads_are_the_same(monkeypatch):
     for a, b in zip(one, two):
         for ca, cb in zip(a.chains, b.chains):
             np.testing.assert_array_equal(ca.L, cb.L)
+
+
+def test_tracking_starts_without_pandas_scipy_or_matplotlib():
+    code = ("import sys, perception.tracking.tracker, perception.io.tracks, hammer_mv.cli.track\n"
+            "print(sorted({'pandas', 'scipy', 'matplotlib'} & set(sys.modules)))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True)
+    assert out.stdout.strip() == "[]"
