@@ -48,7 +48,9 @@ kinematics, the digit bases moving with the simulated wrist.
 
 from __future__ import annotations
 
-import dataclasses
+import hashlib
+import threading
+from collections import OrderedDict
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -510,9 +512,8 @@ def _chain_plan(name, chain, elbow, p_start, p_goal, vias, fractions, task: Gras
     cv = task.execution_cv
     # each joint's command gets its own noise: u_i (1 + cv eps_i)
     noise = [cv * np.diag([1.0, 0.0]), cv * np.diag([0.0, 1.0])]
-    execution = dataclasses.replace(
-        problem, C=noise, D0=task.execution_sigma_s * np.diag(task.plant.sensory_sd)
-    )
+    execution = problem.with_noise(C=noise,
+                                   D0=task.execution_sigma_s * np.diag(task.plant.sensory_sd))
     return ChainPlan(
         name=name,
         chain=chain,
@@ -520,12 +521,45 @@ def _chain_plan(name, chain, elbow, p_start, p_goal, vias, fractions, task: Gras
         task=jtask,
         problem=problem,
         execution=execution,
-        solution=solve(problem),
+        solution=_solve(problem),
         q_start=q0,
         q_goal=qg,
         q_via=qv,
         via_fractions=np.asarray(fractions, dtype=float),
     )
+
+
+#: Recently solved chain problems by content (see :func:`_solve`).
+_SOLVED: OrderedDict[bytes, LQGSolution] = OrderedDict()
+_SOLVED_MAX = 64
+_SOLVED_LOCK = threading.Lock()
+
+
+def _solve(problem: LQGProblem) -> LQGSolution:
+    """:func:`~minvar.lqg.solve`, reusing the solution of an identical problem.
+
+    Grasps often share a chain's problem exactly — the arm of a grasp and of
+    the reach-only movement with the same transport, or one model re-planned
+    for several clips of a scene — and the solution of the same arrays is the
+    same (it is read-only, so it is shared as it is).
+    """
+    h = hashlib.blake2b(digest_size=20)
+    for name in ("A", "B", "C", "C0", "H", "D", "D0", "E0", "Q", "R", "X1", "S1"):
+        a = getattr(problem, name)
+        h.update(repr(a.shape).encode())
+        h.update(np.ascontiguousarray(a).data)
+    key = h.digest()
+    with _SOLVED_LOCK:
+        sol = _SOLVED.get(key)
+        if sol is not None:
+            _SOLVED.move_to_end(key)
+            return sol
+    sol = solve(problem)  # outside the lock: plans may run in several threads
+    with _SOLVED_LOCK:
+        _SOLVED[key] = sol
+        while len(_SOLVED) > _SOLVED_MAX:
+            _SOLVED.popitem(last=False)
+    return sol
 
 
 def plan_grasp(task: GraspTask) -> GraspPlan:
