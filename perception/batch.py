@@ -19,6 +19,7 @@ import json
 import logging
 import multiprocessing
 import os
+import re
 import sys
 import tempfile
 from collections import deque
@@ -52,12 +53,16 @@ log = logging.getLogger(__name__)
 #: Files that sit beside clips and are not inputs: ground truth, the synth
 #: manifest, and what a batch writes (so a report folder can be its own input).
 COMPANION_SUFFIXES = (".truth.h5", ".recognition.json", ".confidence.csv", ".confidence.png",
-                      ".paths.png", ".tracking.png")
-#: Which file stands for a clip found more than once (a tracks file spares tracking).
-_PREFERENCE = {"tracks": 2, "video": 1, "unknown": 0}
+                      ".paths.png", ".tracking.png", ".status.csv")
+#: Which file stands for a clip found more than once (a tracks file spares
+#: tracking; a pose file beside its video is what the lab tracked it with).
+_PREFERENCE = {"tracks": 3, "pose": 2, "video": 1, "unknown": 0}
 COMPANION_NAMES = ("manifest.csv", "README.md", "recipe.toml", "summary.csv", "statistics.csv",
                    "condition_profiles.csv", "condition_profiles.png", "report.html",
                    "batch.json", "repertoire.h5")
+#: A clip name becomes file names in the report folder: no separators, no
+#: leading dot, nothing that is not printable.
+_CLIP_NAME = re.compile(r"[^/\\\x00-\x1f\x7f]+")
 
 
 @dataclass(frozen=True)
@@ -67,11 +72,11 @@ class BatchItem:
     Attributes
     ----------
     clip : str
-        Clip name (file stem).
+        Clip name (file stem; the file name when two files share a stem).
     path : Path
-        Video or tracks file.
+        Video, tracks or pose file.
     kind : str
-        ``video``, ``tracks`` or ``unknown`` (recorded as a failure).
+        ``video``, ``tracks``, ``pose`` or ``unknown`` (recorded as a failure).
     condition : str or None
         Stimulus condition, when a manifest gives it.
     """
@@ -80,6 +85,50 @@ class BatchItem:
     path: Path
     kind: str
     condition: str | None = None
+
+
+def check_clip_name(name: str, where: str) -> str:
+    """``name`` if it can name a clip's report files inside the report folder.
+
+    Parameters
+    ----------
+    name : str
+        The clip name (from a manifest or a file name).
+    where : str
+        Where it comes from, for the message.
+
+    Raises
+    ------
+    InputError
+        An empty name, one with a path separator or control character, one
+        starting with a dot (``..`` included) or longer than 200 characters.
+    """
+    if (not name or len(name) > 200 or name.startswith(".")
+            or not _CLIP_NAME.fullmatch(name)):
+        raise InputError(f"clip name {name!r} cannot name report files (no path separators, "
+                         "no leading dot, printable, at most 200 characters)", where)
+    return name
+
+
+def _from_manifest(source: Path) -> list[BatchItem]:
+    try:
+        man = pd.read_csv(source, dtype=str, keep_default_na=False)
+    except (OSError, ValueError, pd.errors.ParserError) as exc:
+        raise InputError(f"unreadable manifest: {exc}", source) from None
+    if "clip" not in man.columns or "video" not in man.columns:
+        raise InputError("manifest needs columns clip and video", source)
+    rows: dict[str, int] = {}
+    items = []
+    for i, row in enumerate(man.itertuples(index=False), start=2):  # row 1: the header
+        clip = check_clip_name(str(row.clip), f"{source} row {i}")
+        if clip in rows:
+            raise InputError(f"clip {clip!r} appears twice (rows {rows[clip]} and {i}); "
+                             "clip names must be unique", source)
+        rows[clip] = i
+        path = (source.parent / str(row.video)).resolve()
+        cond = str(getattr(row, "condition", "") or "") or None
+        items.append(BatchItem(clip, path, clip_name(path)[1], cond))
+    return sorted(items, key=lambda i: i.clip)
 
 
 def discover(source: str | os.PathLike) -> list[BatchItem]:
@@ -94,13 +143,17 @@ def discover(source: str | os.PathLike) -> list[BatchItem]:
     Returns
     -------
     list of BatchItem
-        Sorted by clip name. A clip with both a video and a tracks file uses the
-        tracks file. Other files become ``unknown`` items (reported as failed).
+        Sorted by clip name. A clip found as several files uses, in order of
+        preference, its tracks file, pose file or video; two files of equal
+        standing with one stem (``dup.avi``, ``dup.mp4``) are both clips, named
+        by their file names. Other files become ``unknown`` items (reported as
+        failed).
 
     Raises
     ------
     InputError
-        If the source does not exist, or a manifest is unreadable.
+        If the source does not exist, a manifest is unreadable, or a manifest's
+        clip names are not unique or would name files outside the report folder.
     """
     source = Path(source)
     if not source.exists():
@@ -108,34 +161,27 @@ def discover(source: str | os.PathLike) -> list[BatchItem]:
     if source.is_file():
         if source.suffix.lower() != ".csv":
             raise InputError("batch input must be a folder or a manifest.csv", source)
-        try:
-            man = pd.read_csv(source)
-        except (OSError, ValueError, pd.errors.ParserError) as exc:
-            raise InputError(f"unreadable manifest: {exc}", source) from None
-        if "clip" not in man.columns or "video" not in man.columns:
-            raise InputError("manifest needs columns clip and video", source)
-        items = []
-        for row in man.itertuples(index=False):
-            path = (source.parent / str(row.video)).resolve()
-            cond = getattr(row, "condition", None)
-            cond = None if cond is None or pd.isna(cond) else str(cond)
-            items.append(BatchItem(str(row.clip), path, clip_name(path)[1], cond))
-        return sorted(items, key=lambda i: i.clip)
-    found: dict[str, BatchItem] = {}
+        return _from_manifest(source)
     conditions = {}
     manifest = source / "manifest.csv"
     if manifest.is_file():
-        conditions = {i.clip: i.condition for i in discover(manifest)}
+        conditions = {i.clip: i.condition for i in _from_manifest(manifest)}
+    by_stem: dict[str, list[BatchItem]] = {}
     for path in sorted(source.iterdir()):
         if path.name.startswith(".") or path.is_dir() or path.name in COMPANION_NAMES:
             continue
         if path.name.endswith(COMPANION_SUFFIXES):
             continue
         clip, kind = clip_name(path)
-        prev = found.get(clip)
-        if prev is None or _PREFERENCE[kind] > _PREFERENCE[prev.kind]:
-            found[clip] = BatchItem(clip, path, kind, conditions.get(clip))
-    return sorted(found.values(), key=lambda i: i.clip)
+        by_stem.setdefault(clip, []).append(BatchItem(clip, path, kind, conditions.get(clip)))
+    items = []
+    for found in by_stem.values():
+        best = max(_PREFERENCE[i.kind] for i in found)
+        chosen = [i for i in found if _PREFERENCE[i.kind] == best]
+        if len(chosen) > 1:  # the stem alone would not tell them apart
+            chosen = [BatchItem(i.path.name, i.path, i.kind, i.condition) for i in chosen]
+        items += chosen
+    return sorted(items, key=lambda i: i.clip)
 
 
 def _current_report(item: BatchItem, out: Path, fingerprint: str) -> dict | None:

@@ -138,3 +138,54 @@ def test_files_that_are_not_pose_files(tmp_path):
         PoseImport(keypoints={"elbow": "x"})
     with pytest.raises(ValueError, match="--pcutoff"):
         PoseImport(pcutoff=2.0)
+
+
+@pytest.mark.slow
+def test_recognize_a_dlc_file_like_its_tracks(tracks, tmp_path):
+    """The CLI scores a DeepLabCut export as it scores the tracks it came from."""
+    import json
+
+    from hammer_mv.cli import main
+
+    src = tracks.save(tmp_path / "clip.tracks.h5")
+    pose, _ = export_tracks(tracks, tmp_path / "pose" / "clip.csv", "dlc")
+    config = tmp_path / "pose.toml"
+    config.write_text("fps = 30\n"
+                      f"object_diameter_px = {tracks.object_diameter_px()}\n"
+                      "[keypoints]\nthumb = \"thumb\"\n")
+    assert main(["recognize", str(src), "-o", str(tmp_path / "a"), "--no-figures",
+                 "--quiet"]) == 0
+    assert main(["recognize", str(pose), "-o", str(tmp_path / "b"), "--no-figures",
+                 "--quiet", "--pose-config", str(config)]) == 0
+    a, b = (json.loads((tmp_path / d / "clip.recognition.json").read_text()) for d in "ab")
+    assert a["winner"] == b["winner"]
+    for ma, mb in zip(a["models"], b["models"]):
+        assert mb["final_log_likelihood"] == pytest.approx(ma["final_log_likelihood"],
+                                                           rel=1e-3, abs=0.5)
+
+
+@pytest.mark.parametrize("text, message", [
+    ("[keypoint]\nthumb = 'x'\n", "did you mean 'keypoints'"),
+    ("[keypoints]\nthum = 'x'\n", "did you mean 'thumb'"),
+    ("pcutoff = 'high'\n", "pcutoff"),
+    ("keypoints = 3\n", "table"),
+])
+def test_a_pose_config_is_read_strictly(tmp_path, text, message):
+    from perception.io.pose import load_pose_config
+
+    path = tmp_path / "pose.toml"
+    path.write_text(text)
+    with pytest.raises(InputError, match=message):
+        load_pose_config(path)
+
+
+def test_pose_options_override_the_config(tmp_path):
+    from hammer_mv.cli import build_parser
+    from hammer_mv.cli.options import pose_import
+
+    path = tmp_path / "pose.toml"
+    path.write_text("fps = 25\n[keypoints]\nthumb = 'T'\nwrist = 'W'\n")
+    args = build_parser().parse_args(["recognize", "x.csv", "-o", "o", "--pose-config",
+                                      str(path), "--fps", "30", "--keypoints", "wrist=Wr"])
+    got = pose_import(args)
+    assert got.fps == 30 and got.keypoints == {"thumb": "T", "wrist": "Wr"}

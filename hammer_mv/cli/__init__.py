@@ -2,7 +2,9 @@
 
 Each subcommand lives in its own module of this package and exposes
 ``register(subparsers)``, which adds its parser and sets ``func`` (a callable
-taking the parsed ``argparse.Namespace`` and returning an exit status).
+taking the parsed ``argparse.Namespace`` and returning an exit status). Every
+parser shows its defaults, and every command takes ``-v/--verbose`` and
+``--quiet`` before or after its name.
 
 A user's mistake (``InputError``, ``ValueError``, ``OSError``) is printed as one
 line on stderr and exits with status 2; anything else is a bug and shows a
@@ -16,6 +18,7 @@ import importlib
 import logging
 import os
 import sys
+import warnings
 
 from minvar import __version__
 
@@ -41,11 +44,64 @@ _EVERY = object()
 THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
 
+#: What ``hammer-mv --help`` says before the commands.
+DESCRIPTION = """\
+Minimum variance models of reaching and grasping, and HAMMER-MV grasp recognition.
+
+  video --track--> tracks (.tracks.h5) --observe--> the movement in metres
+        --recognize--> every model of the repertoire predicts each frame
+        --report--> winner, verdict, confidence profiles (JSON, CSV, figures, HTML)
+
+example:
+  hammer-mv synth datasets/smoke.toml -o clips      # render test clips
+  hammer-mv recognize clips/normal-01.mp4 -o out    # track and recognise one
+  hammer-mv batch clips/manifest.csv -o report      # all of them: report/report.html
+
+'hammer-mv COMMAND --help' describes each command; docs/ describes the files."""
+
+
+class _Formatter(argparse.RawDescriptionHelpFormatter):
+    """Descriptions as written; each option's default shown unless its help gives it."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        default = action.default
+        if ("default" in text or default is None or default is argparse.SUPPRESS
+                or isinstance(default, bool) or action.option_strings == []):
+            return text
+        shown = " ".join(map(str, default)) if isinstance(default, list | tuple) else default
+        return f"{text} (default: {shown})"
+
+
 class _Parser(argparse.ArgumentParser):
-    """An argparse parser whose errors are one line and exit status 2."""
+    """An argparse parser whose errors are one line and exit status 2, defaults shown."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("formatter_class", _Formatter)
+        super().__init__(*args, **kwargs)
 
     def error(self, message: str):  # noqa: D401 - argparse API
         self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+def _common_flags(parser: argparse.ArgumentParser) -> None:
+    """Give ``parser`` and every parser below it ``-v/--verbose`` and ``--quiet``.
+
+    Below the top level they default to SUPPRESS, so ``hammer-mv -v track``
+    and ``hammer-mv track -v`` mean the same.
+    """
+    subs = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
+    for child in {id(c): c for a in subs for c in a.choices.values()}.values():
+        _common_flags(child)
+    if parser.prog == "hammer-mv" or subs:
+        return
+    flags = {s for a in parser._actions for s in a.option_strings}
+    if "--verbose" not in flags:
+        parser.add_argument("-v", "--verbose", action="store_true", default=argparse.SUPPRESS,
+                            help="log progress details")
+    if "--quiet" not in flags:
+        parser.add_argument("--quiet", action="store_true", default=argparse.SUPPRESS,
+                            help="no progress bars or summaries")
 
 
 def build_parser(command: str | None | object = _EVERY) -> argparse.ArgumentParser:
@@ -57,15 +113,17 @@ def build_parser(command: str | None | object = _EVERY) -> argparse.ArgumentPars
         Register only this subcommand in full (the others get a stub that
         lists them in ``--help``), or none with None; by default every one.
     """
-    parser = _Parser(prog="hammer-mv", description=__doc__.splitlines()[0])
+    parser = _Parser(prog="hammer-mv", description=DESCRIPTION)
     parser.add_argument("--version", action="version", version=f"hammer-mv {__version__}")
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress details")
+    parser.add_argument("--quiet", action="store_true", help="no progress bars or summaries")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     for name, summary in COMMANDS.items():
         if command is _EVERY or command == name:
             importlib.import_module(f"{__name__}.{name}").register(sub)
         else:
             sub.add_parser(name, help=summary)
+    _common_flags(parser)
     return parser
 
 
@@ -97,6 +155,10 @@ def main(argv: list[str] | None = None) -> int:
         level=logging.INFO if args.verbose else logging.WARNING,
         format="%(levelname)s %(name)s: %(message)s",
     )
+    if not args.verbose:
+        # numpy's RuntimeWarnings and the like are for developers: a user's
+        # error is one line (below), and our own warnings go through logging.
+        warnings.simplefilter("ignore")
     if not getattr(args, "func", None):
         parser.print_help(sys.stderr)
         return 2

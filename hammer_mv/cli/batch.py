@@ -24,9 +24,12 @@ def register(sub) -> None:
                        "parallel; write REPORT_DIR/report.html, summary.csv, statistics and "
                        "per-clip reports. Rerunning skips clips whose report is current. "
                        "Exits 1 if any clip failed (each failure is in the report).")
-    p.add_argument("input", type=Path, metavar="INPUT")
-    p.add_argument("-o", "--output", type=Path, required=True, metavar="REPORT_DIR")
-    p.add_argument("--jobs", type=int, default=1, metavar="N", help="local worker processes")
+    p.add_argument("input", type=Path, metavar="INPUT",
+                   help="folder of videos, .tracks.h5 or pose files, or a manifest.csv")
+    p.add_argument("-o", "--output", type=Path, required=True, metavar="REPORT_DIR",
+                   help="report folder (report.html, summary.csv, per-clip reports)")
+    p.add_argument("--jobs", type=int, default=1, metavar="N",
+                   help="local processes working on clips (this one and N-1 workers)")
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="run on a dask.distributed scheduler, e.g. tcp://host:8786")
     add_recognition_options(p)
@@ -50,8 +53,11 @@ def run(args: argparse.Namespace) -> int:
     summary = run_batch(items, args.output, rep, recognition_settings(args), jobs=args.jobs,
                         scheduler=args.scheduler, repertoire_id=rep_id, quiet=args.quiet)
     failed = int((summary["status"] != "ok").sum())
-    print(f"{len(summary) - failed}/{len(summary)} clips recognised -> "
-          f"{args.output / 'report.html'}")
+    reused = int(summary["reused"].sum())
+    if not args.quiet:
+        print(f"{len(summary)} clips: {len(summary) - failed - reused} recognised, "
+              f"{reused} reused (their reports were current), {failed} failed -> "
+              f"{args.output / 'report.html'}")
     if failed:
         print(f"hammer-mv batch: {failed} clip(s) failed; see the report", file=sys.stderr)
         return 1

@@ -49,10 +49,74 @@ def add_recognition_options(p: argparse.ArgumentParser) -> None:
                    help="image scale (default: from the object's apparent size)")
     g.add_argument("--mirror", action="store_true",
                    help="mirror the image so the finger lies on the model's +x side")
+    add_pose_options(p)
     g.add_argument("--setup", type=Path, metavar="SETUP.toml",
                    help="colour models and marker sizes for tracking videos "
                         "(hammer-mv calibrate)")
-    p.add_argument("--quiet", action="store_true", help="no progress bars")
+
+
+def add_pose_options(p: argparse.ArgumentParser) -> None:
+    """Add the options that turn pose files (DeepLabCut, SLEAP, ...) into tracks.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser.
+    """
+    g = p.add_argument_group("pose files (DeepLabCut, SLEAP, Lightning Pose, NWB, movement; "
+                             "docs/pose-files.md)")
+    g.add_argument("--keypoints", nargs="+", metavar="MARKER=NAME", default=None,
+                   help="which keypoint is which marker: thumb=NAME finger=NAME wrist=NAME "
+                        "object=NAME (markers left out take the keypoint of their own name)")
+    g.add_argument("--pose-config", type=Path, metavar="FILE",
+                   help="TOML with a [keypoints] table and any of pcutoff, fps, "
+                        "object_diameter_px, individual (for a batch)")
+    g.add_argument("--pcutoff", type=float, default=None, metavar="P",
+                   help="points below this likelihood count as lost (default: 0.6, "
+                        "DeepLabCut's)")
+    g.add_argument("--individual", metavar="NAME",
+                   help="the individual to score in a multi-individual file")
+    g.add_argument("--fps", type=float, default=None, metavar="F",
+                   help="frame rate of pose files that carry none (DeepLabCut, Lightning Pose)")
+    g.add_argument("--object-diameter-px", type=float, default=None, metavar="D",
+                   help="the object's apparent diameter in pixels: sets the metric scale of "
+                        "a pose file (or give --px-per-m)")
+
+
+def _mapping(pairs: list[str]) -> dict[str, str]:
+    out = {}
+    for pair in pairs:
+        marker, sep, name = pair.partition("=")
+        if not sep or not marker or not name:
+            raise ValueError(f"--keypoints {pair}: expected MARKER=NAME, e.g. thumb=Thumb_tip")
+        out[marker] = name
+    return out
+
+
+def pose_import(args: argparse.Namespace):
+    """The :class:`~perception.io.pose.PoseImport` the pose options ask for, or None if none.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments of :func:`add_pose_options`.
+    """
+    given = {k: getattr(args, k, None) for k in ("pcutoff", "individual", "fps",
+                                                 "object_diameter_px")}
+    given = {k: v for k, v in given.items() if v is not None}
+    if getattr(args, "keypoints", None):
+        given["keypoints"] = _mapping(args.keypoints)
+    config = getattr(args, "pose_config", None)
+    if config is None and not given:
+        return None
+    import dataclasses
+
+    from perception.io.pose import PoseImport, load_pose_config
+
+    base = load_pose_config(config) if config is not None else PoseImport()
+    if "keypoints" in given:
+        given["keypoints"] = {**base.keypoints, **given["keypoints"]}
+    return dataclasses.replace(base, **given)
 
 
 def recognition_settings(args: argparse.Namespace) -> RecognitionSettings:
@@ -72,7 +136,8 @@ def recognition_settings(args: argparse.Namespace) -> RecognitionSettings:
         from perception.tracking.setup import load_setup
 
         tracking = load_setup(args.setup)
-    return RecognitionSettings(observe=observe, hammer=hammer, tracking=tracking)
+    return RecognitionSettings(observe=observe, hammer=hammer, tracking=tracking,
+                               pose=pose_import(args))
 
 
 def load_repertoire(args: argparse.Namespace) -> tuple[Repertoire, str]:

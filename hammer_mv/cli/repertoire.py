@@ -22,7 +22,8 @@ def register(sub) -> None:
                          "object_size, frame_period) and [[model]] entries (name, kind, "
                          "and GraspTask fields such as duration or grip_via).")
     b.add_argument("config", nargs="?", type=Path, help="TOML configuration")
-    b.add_argument("-o", "--output", type=Path, required=True, metavar="REP.h5")
+    b.add_argument("-o", "--output", type=Path, required=True, metavar="REP.h5",
+                   help="repertoire file to write (HDF5)")
     b.add_argument("--durations", nargs="+", type=float, default=list(DEFAULT_DURATIONS),
                    metavar="S", help="movement times without CONFIG (default: 0.8 ... 1.2)")
     b.add_argument("--distance", type=float, default=SceneSpec.distance,
@@ -32,7 +33,7 @@ def register(sub) -> None:
     b.add_argument("--fps", type=float, default=30.0, help="video frame rate (without CONFIG)")
     b.set_defaults(func=run_build)
     i = verbs.add_parser("info", help="list the models of a repertoire file")
-    i.add_argument("file", type=Path)
+    i.add_argument("file", type=Path, metavar="REP.h5", help="repertoire file")
     i.set_defaults(func=run_info)
 
 

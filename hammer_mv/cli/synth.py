@@ -14,12 +14,13 @@ def register(sub) -> None:
                        "normal, delayed-opening and open-close-open grasps from the minimum "
                        "variance model, each with ground truth (<clip>.truth.h5), plus "
                        "DIR/manifest.csv.")
-    p.add_argument("recipe", type=Path, metavar="RECIPE")
-    p.add_argument("-o", "--output", type=Path, required=True, metavar="DIR")
+    p.add_argument("recipe", type=Path, metavar="RECIPE",
+                   help="recipe file (TOML; docs/recipes.md), e.g. datasets/smoke.toml")
+    p.add_argument("-o", "--output", type=Path, required=True, metavar="DIR",
+                   help="folder for the clips, their ground truth and manifest.csv")
     p.add_argument("--seed", type=int, default=0, metavar="N", help="master seed (default: 0)")
     p.add_argument("--jobs", type=int, default=1, metavar="N",
                    help="processes rendering clips (default: 1); the clips do not depend on it")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=run)
 
 

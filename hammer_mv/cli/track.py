@@ -52,7 +52,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         metavar="OUT.mp4",
         help="also write the video with every marker drawn (name, likelihood, trail)",
     )
-    p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
     p.set_defaults(func=run)
 
 

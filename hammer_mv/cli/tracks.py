@@ -54,7 +54,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     render.add_argument("file", type=Path, metavar="TRACKS.h5", help="tracks file")
     render.add_argument("video", type=Path, nargs="?", metavar="VIDEO",
                         help="the tracked video (default: /video path of the tracks)")
-    render.add_argument("-o", "--output", type=Path, required=True, metavar="LABELLED.mp4")
+    render.add_argument("-o", "--output", type=Path, required=True, metavar="LABELLED.mp4",
+                        help="labelled video to write (.mp4, .avi or .mkv)")
     render.add_argument("--trail", type=int, default=12, metavar="N",
                         help="frames of trail behind each marker (default 12)")
     render.set_defaults(func=run_render)
@@ -102,7 +103,20 @@ def run_info(args: argparse.Namespace) -> int:
     for q in tracking_quality(t).markers:
         print(f"{q.marker:<8} {100 * q.tracked:>8.1f} {q.min_likelihood:>8.3f} "
               f"{q.median_likelihood:>11.3f} {q.reacquisitions:>14} {q.ambiguous:>9}")
+    if not args.quiet:
+        print(INFO_LEGEND)
     return 0
+
+
+#: What the columns of ``tracks info`` mean (docs/tracks-format.md has the codes).
+INFO_LEGEND = """\
+columns: frames per status code - tracked (0: found where predicted), reacq. (1: found
+  again by a search of the whole frame after being lost), lost (2: not found; no position),
+  interp. (3: filled by --max-gap), ambig. (4: two candidates fit; not guessed); mean lik.
+  over the frames with a position. active: the frames recognition scores (movement onset
+  to end of activity). quality: the share of frames with a position, the lowest and
+  median likelihood of those, how often the marker was re-acquired, frames ambiguous.
+  (--quiet drops this note)"""
 
 
 def _movement_line(t) -> str:

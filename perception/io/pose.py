@@ -37,6 +37,7 @@ __all__ = [
     "POSE_SUFFIXES",
     "PoseImport",
     "is_pose_file",
+    "load_pose_config",
     "read_pose",
     "write_dlc",
     "write_movement",
@@ -123,6 +124,51 @@ class PoseImport:
             One of :data:`MARKERS`.
         """
         return self.keypoints.get(marker, marker)
+
+
+#: Keys of a pose config file besides its ``[keypoints]`` table.
+_CONFIG_KEYS = ("individual", "pcutoff", "fps", "object_diameter_px")
+
+
+def load_pose_config(path: str | os.PathLike) -> PoseImport:
+    """Read a pose config (TOML) for a batch of pose files.
+
+    ::
+
+        pcutoff = 0.6               # optional, as the options of the same names
+        fps = 30
+        object_diameter_px = 82.0
+        individual = "mouse1"
+
+        [keypoints]                 # marker = keypoint name in the files
+        thumb = "Thumb_tip"
+        finger = "Index_tip"
+        wrist = "Wrist"
+        object = "ball"
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+
+    Raises
+    ------
+    InputError
+        Missing or malformed file, an unknown table or key, or bad values.
+    """
+    from perception.io.config import check_keys, read_toml
+
+    cfg = read_toml(path, "pose config")
+    try:
+        check_keys(cfg, ("keypoints", *_CONFIG_KEYS), "the top level")
+        mapping = cfg.get("keypoints", {})
+        if not isinstance(mapping, dict):
+            raise ValueError("[keypoints] must be a table of marker = keypoint name")
+        check_keys(mapping, MARKERS, "[keypoints]")
+        return PoseImport(keypoints={k: str(v) for k, v in mapping.items()},
+                          **{k: cfg[k] for k in _CONFIG_KEYS if k in cfg})
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"bad pose config: {exc}", path) from None
 
 
 def is_pose_file(path: str | os.PathLike) -> bool:
