@@ -487,6 +487,8 @@ def track_video(
     progress: bool = False,
     prefetch: int = 8,
     labelled_video: str | os.PathLike | None = None,
+    keep_truncated: bool = False,
+    fps: float | None = None,
 ) -> Path:
     """Track a video file into a tracks file (``<stem>.tracks.h5`` beside it by default).
 
@@ -505,6 +507,13 @@ def track_video(
     labelled_video : str or os.PathLike, optional
         Also write the video with the markers drawn on it
         (:class:`~perception.tracking.overlay.Labeller`), atomically.
+    keep_truncated : bool
+        Track the frames a truncated video does hold (its header claims
+        more) instead of refusing it; a warning says how many are missing.
+    fps : float, optional
+        The true frame rate, frames/s, for a container whose rate or times
+        are wrong: frame times become ``index / fps`` (the labelled video
+        is written at this rate too).
 
     Returns
     -------
@@ -514,15 +523,17 @@ def track_video(
     Raises
     ------
     InputError
-        Bad video (see :class:`~perception.io.video.FrameSource`), a bad ROI, or a
-        marker never found (the message says why: rejected candidates, or
-        ambiguity); no output file is left behind.
+        Bad video (see :class:`~perception.io.video.FrameSource`: truncated
+        unless ``keep_truncated``, a frame rate no camera has unless ``fps``),
+        a bad ROI, or a marker never found (the message says why: rejected
+        candidates, or ambiguity); no output file is left behind.
     """
     markers = default_markers() if markers is None else markers
     out_path = tracks_path_for(video) if out is None else Path(out)
     tracker = Tracker(markers, params, rois)
     with contextlib.ExitStack() as stack:
-        src = stack.enter_context(FrameSource(video, prefetch=prefetch))
+        src = stack.enter_context(FrameSource(video, prefetch=prefetch,
+                                              keep_truncated=keep_truncated, fps=fps))
         w = stack.enter_context(TracksWriter(out_path, markers.names, video=src.attrs(),
                                              tracker=tracker.attrs()))
         each = None
@@ -530,7 +541,8 @@ def track_video(
             from perception.io.video import VideoWriter
             from perception.tracking.overlay import Labeller
 
-            vw = stack.enter_context(VideoWriter(labelled_video, src.info.fps_nominal or 30.0,
+            rate = fps or src.info.fps_nominal or 30.0
+            vw = stack.enter_context(VideoWriter(labelled_video, rate,
                                                  (src.info.width, src.info.height)))
             labeller = Labeller(markers.names, [m.bgr for m in markers])
 
