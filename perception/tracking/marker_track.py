@@ -26,6 +26,18 @@ Located = tuple[tuple[float, float], float, int]
 class MarkerTrack:
     """Mutable state of one marker's track (private to one tracker).
 
+    Parameters
+    ----------
+    colour : MarkerColour
+        The marker's colour model (first detection may narrow it).
+    still : bool
+        Whether the marker stays put (the object): its position is then a
+        running mean of whole-blob measurements, not an alpha-beta filter's.
+    roi : (x, y, w, h) or None
+        Where the user says the marker is on the first frame, px.
+
+    Notes
+    -----
     ``x`` and ``v`` are the alpha-beta filter's position and velocity (px,
     px/frame) as ``(x, y)`` float pairs: on two numbers numpy's per-call
     cost would exceed the arithmetic. ``win`` is the CamShift window (px),
