@@ -60,8 +60,8 @@ def test_json_override(tmp_path):
     [
         ("[thumb]\nhue = [200, 5]\n", "thumb.hue"),
         ("[thumb]\nsat_min = 300\n", "thumb.sat_min"),
-        ("[thumb]\ncolor = 1\n", "thumb.color"),
-        ("[index]\nhue = [1, 2]\n", "unknown marker 'index'"),
+        ("[thumb]\ncolor = 1\n", "marker 'thumb': unknown key 'color'"),
+        ("[index]\nhue = [1, 2]\n", "unknown key 'index'"),
         ("[thumb]\nbgr = [1, 2]\n", "thumb.bgr"),
         ("[thumb\n", "not valid TOML"),
     ],
@@ -73,6 +73,24 @@ def test_bad_colours_file_names_file_and_field(tmp_path, text, expected):
         load_markers(f)
     assert str(err.value).startswith(str(f))
     assert expected in str(err.value)
+
+
+@pytest.mark.parametrize(
+    "name, text, hint",
+    [
+        ("c.toml", "[thum]\nhue = [[170, 8]]\n", "'thumb'"),
+        ("c.toml", "[thumb]\nsat_mn = 120\n", "'sat_min'"),
+        ("c.toml", "[finger]\nval_minn = 40\n", "'val_min'"),
+        ("c.json", '{"wrist": {"hues": [100, 130]}}', "'hue'"),
+        ("c.json", '{"objet": {"hue": [20, 34]}}', "'object'"),
+    ],
+)
+def test_misspelt_marker_or_field_is_refused_naming_the_nearest(tmp_path, name, text, hint):
+    f = tmp_path / name
+    f.write_text(text)
+    with pytest.raises(InputError, match=f"did you mean {hint}") as err:
+        load_markers(f)
+    assert str(err.value).startswith(str(f))
 
 
 def test_missing_colours_file(tmp_path):

@@ -12,6 +12,7 @@ MODULES = [
     "pipeline", "recognition.models", "recognition.engine", "recognition.scoring",
     "tracking.candidates", "tracking.hand", "tracking.overlay", "tracking.setup",
     "synthetic.footage", "synthetic.realistic", "report.tracking",
+    "tracking.first_detection", "tracking.marker_track",
 ]
 
 

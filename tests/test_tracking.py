@@ -194,3 +194,19 @@ def test_progress_bar_goes_to_stderr_only_when_asked(tmp_path, capsys):
     track_video(clip.video, tmp_path / "b.h5", progress=True)
     captured = capsys.readouterr()
     assert "/6 [" in captured.err and "frame/s" in captured.err and captured.out == ""
+
+
+def test_truncated_video_is_refused_unless_kept_and_fps_overrides_the_container(tmp_path):
+    clip, _ = render(tmp_path, "c.avi", n=30, fps=30.0, width=160, height=120)
+    cut = tmp_path / "cut.avi"
+    data = clip.video.read_bytes()
+    cut.write_bytes(data[: int(len(data) * 0.6)])  # the AVI index and the last frames gone
+    out = tmp_path / "cut.tracks.h5"
+    with pytest.raises(InputError, match="truncated or corrupt video.*--keep-truncated") as err:
+        track_video(cut, out)
+    assert str(err.value).startswith(str(cut)) and not out.exists()
+    tracks = Tracks.load(track_video(cut, out, keep_truncated=True))
+    assert 0 < tracks.n_frames < 30 and tracks.video["n_frames_header"] == 30
+    assert (tracks.status[0] == Status.TRACKED).all()
+    slow = Tracks.load(track_video(clip.video, tmp_path / "slow.h5", fps=25.0))
+    np.testing.assert_allclose(slow.time, np.arange(30) / 25.0)

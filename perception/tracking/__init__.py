@@ -12,6 +12,10 @@
   first frames and why one is refused (size, shape, colour purity, stillness).
 * :mod:`~perception.tracking.hand` — which candidates together look like a
   hand; ambiguity.
+* :mod:`~perception.tracking.first_detection` — starting the tracks of
+  markers not found yet: candidates, the object's scale, the hand, ROIs.
+* :mod:`~perception.tracking.marker_track` — one marker's track: motion
+  estimate, window, reference mass.
 * :mod:`~perception.tracking.reacquisition` — the global search of lost markers.
 * :mod:`~perception.tracking.setup` — a session's colour models and marker
   sizes: ``hammer-mv calibrate`` and ``--setup``.

@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import json
 import os
-import tomllib
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field, fields, replace
 from functools import cached_property
@@ -32,6 +31,7 @@ import cv2
 import numpy as np
 
 from perception.errors import InputError
+from perception.io.config import check_keys, read_toml
 
 #: Marker names in file order (``/tracks/markers``).
 MARKER_NAMES: tuple[str, ...] = ("thumb", "finger", "wrist", "object")
@@ -288,26 +288,33 @@ def load_markers(path: str | os.PathLike, base: MarkerSet | None = None) -> Mark
     Raises
     ------
     InputError
-        Missing or unparsable file, unknown marker or field, invalid value;
-        the message names the file and ``marker.field``.
+        Missing or unparsable file; an unknown marker or field (the nearest
+        valid name is suggested); an invalid value (the message names
+        ``marker.field``). The message names the file.
     """
     p = Path(path)
     base = default_markers() if base is None else base
-    try:
-        raw = p.read_bytes()
-    except FileNotFoundError:
-        raise InputError("colours file not found", p) from None
-    except OSError as exc:
-        raise InputError(f"cannot read colours file ({exc.strerror})", p) from None
-    try:
-        if p.suffix.lower() == ".json":
+    if p.suffix.lower() == ".json":
+        try:
+            raw = p.read_bytes()
+        except FileNotFoundError:
+            raise InputError("colours file not found", p) from None
+        except OSError as exc:
+            raise InputError(f"cannot read colours file ({exc.strerror})", p) from None
+        try:
             data = json.loads(raw.decode("utf-8"))
-        else:
-            data = tomllib.loads(raw.decode("utf-8"))
-    except (UnicodeDecodeError, json.JSONDecodeError, tomllib.TOMLDecodeError) as exc:
-        kind = "JSON" if p.suffix.lower() == ".json" else "TOML"
-        raise InputError(f"not valid {kind}: {exc}", p) from None
+        except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+            raise InputError(f"not valid JSON: {exc}", p) from None
+    else:
+        data = read_toml(p, "colours file")
     try:
+        # Here rather than in with_overrides: a hand-written file's usual
+        # mistake is a misspelling, and the nearest valid name fixes it.
+        if isinstance(data, Mapping):
+            check_keys(data, base.names, "the top level")
+            for name, table in data.items():
+                if isinstance(table, Mapping):
+                    check_keys(table, _FIELDS, f"marker {name!r}")
         return base.with_overrides(data, source="colours")
     except ValueError as exc:
         raise InputError(str(exc).removeprefix("colours: "), p) from None
