@@ -31,7 +31,7 @@ from pathlib import Path
 import pandas as pd
 
 from perception.errors import InputError
-from perception.io.atomic import write_json
+from perception.io.atomic import owner_tag, remove_stale, write_json
 from perception.pipeline import (
     TRACKS_SUFFIX,
     RecognitionSettings,
@@ -265,7 +265,8 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
         if done is not None:
             return ClipResult(**base, status="reused", summary=ClipSummary.from_dict(done))
         tracks = load_clip(item.path, tracks_out=out / "tracks" / f"{item.clip}{TRACKS_SUFFIX}",
-                           progress=progress, setup=settings.tracking, pose=settings.pose)
+                           progress=progress, setup=settings.tracking, pose=settings.pose,
+                           **settings.video_options())
         rec = recognize_tracks(tracks, repertoire, settings, clip=item.clip, source=item.path,
                                plan_cache=plan_cache)
         tracking = write_tracking_report(tracks, out, item.clip)
@@ -418,7 +419,9 @@ def _run_local(items: list[BatchItem], repertoire: Repertoire, job: _Job,
     # spawn, not fork: a parent that has already rendered or planned holds
     # OpenCV/BLAS thread pools, and forking those deadlocks the workers
     ctx = multiprocessing.get_context("spawn")
-    with tempfile.TemporaryDirectory(prefix=".repertoire-", dir=job.out) as tmp, _one_thread():
+    remove_stale(job.out, ".repertoire-h*p*")  # left by a batch that was killed
+    with tempfile.TemporaryDirectory(prefix=f".repertoire-{owner_tag()}-", dir=job.out) as tmp, \
+            _one_thread():
         rep_file = repertoire.save(Path(tmp) / "repertoire.h5")
         with _single_threaded_children(), ProcessPoolExecutor(
                 max_workers=jobs - 1, initializer=_init_worker, initargs=(str(rep_file),),

@@ -78,12 +78,23 @@ class RecognitionSettings:
     pose : PoseImport, optional
         How pose files become tracks (keypoint mapping, likelihood cutoff,
         frame rate, object size); default: :class:`~perception.io.pose.PoseImport`.
+    keep_truncated : bool
+        Track the frames a truncated video decodes instead of refusing it
+        (``--keep-truncated``).
+    fps : float, optional
+        The true frame rate of videos whose header is wrong, frames/s (``--fps``).
     """
 
     observe: ObserveParams = field(default_factory=ObserveParams)
     hammer: HammerParams = field(default_factory=HammerParams)
     tracking: TrackingSetup | None = None
     pose: PoseImport | None = None
+    keep_truncated: bool = False
+    fps: float | None = None
+
+    def video_options(self) -> dict:
+        """How to read videos, as keyword arguments of :func:`load_clip`."""
+        return {"keep_truncated": self.keep_truncated, "fps": self.fps}
 
     def fingerprint(self) -> dict:
         """JSON-able settings that change results."""
@@ -94,6 +105,8 @@ class RecognitionSettings:
             out["tracking"] = self.tracking.to_dict()
         if self.pose is not None:
             out["pose"] = self.pose.to_dict()
+        if self.keep_truncated or self.fps is not None:
+            out["video"] = self.video_options()
         return out
 
 
@@ -164,7 +177,8 @@ def _sha256(key: tuple[Path, int, int]) -> str:
 
 def load_clip(source: str | os.PathLike | Tracks, *, tracks_out: str | os.PathLike | None = None,
               progress: bool = False, setup: TrackingSetup | None = None,
-              pose: PoseImport | None = None) -> Tracks:
+              pose: PoseImport | None = None, keep_truncated: bool = False,
+              fps: float | None = None) -> Tracks:
     """The tracks of a clip: tracked from a video, read from a tracks or pose file, or as given.
 
     Parameters
@@ -182,6 +196,12 @@ def load_clip(source: str | os.PathLike | Tracks, *, tracks_out: str | os.PathLi
         Colour models and marker sizes for tracking a video.
     pose : PoseImport, optional
         How a pose file becomes tracks.
+    keep_truncated : bool
+        Track the frames a truncated video decodes instead of refusing it.
+    fps : float, optional
+        A video's true frame rate, frames/s, whatever its header says. With
+        this or ``keep_truncated``, a video is always tracked afresh (its
+        existing tracks file may have been made without them).
 
     Raises
     ------
@@ -202,13 +222,15 @@ def load_clip(source: str | os.PathLike | Tracks, *, tracks_out: str | os.PathLi
 
         return read_pose(path, pose)
     out = tracks_path_for(path) if tracks_out is None else Path(tracks_out)
-    current = current_tracks(path, [out, tracks_path_for(path)], setup)
-    if current is not None:
-        return current
+    if not keep_truncated and fps is None:
+        current = current_tracks(path, [out, tracks_path_for(path)], setup)
+        if current is not None:
+            return current
     from perception.tracking.tracker import track_video  # OpenCV only when there is video
 
     kw = {} if setup is None else {"markers": setup.markers, "params": setup.params}
-    return Tracks.load(track_video(path, out, progress=progress, **kw))
+    return Tracks.load(track_video(path, out, progress=progress, keep_truncated=keep_truncated,
+                                   fps=fps, **kw))
 
 
 #: ``/tracker`` attributes that describe what a tracker learned from the clip
@@ -354,6 +376,7 @@ def recognize_clip(source: str | os.PathLike | Tracks, repertoire: Repertoire,
     is_file = not isinstance(source, Tracks)
     name = clip or (clip_name(source)[0] if is_file else None)
     tracks = load_clip(source, tracks_out=tracks_out, progress=progress,
-                       setup=settings.tracking, pose=settings.pose)
+                       setup=settings.tracking, pose=settings.pose,
+                       **settings.video_options())
     return recognize_tracks(tracks, repertoire, settings, clip=name,
                             source=source if is_file else None, plan_cache=plan_cache)

@@ -91,7 +91,7 @@ def test_config_file(tmp_path):
     with pytest.raises(InputError, match="kind must be one of"):
         Repertoire.from_config(cfg)
     cfg.write_text('[[model]]\nname = "x"\nwobble = 3\n')
-    with pytest.raises(InputError, match="unknown task fields"):
+    with pytest.raises(InputError, match="unknown task field"):
         Repertoire.from_config(cfg)
 
 

@@ -40,9 +40,11 @@ def run(args: argparse.Namespace) -> int:
     import dataclasses
 
     from perception.errors import InputError
+    from perception.io.atomic import check_output
     from perception.io.video import FrameSource
     from perception.tracking.setup import TrackingSetup, calibrate, load_setup, write_setup
 
+    check_output(args.output, [p for p in (args.video, args.setup) if p is not None])
     base = load_setup(args.setup) if args.setup else TrackingSetup()
     params = base.params
     if args.object_diameter is not None:

@@ -11,6 +11,7 @@ import hashlib
 import json
 from pathlib import Path
 
+from hammer_mv.cli.flags import FPS_HELP, add_video_options
 from perception.observation import ObserveParams
 from perception.pipeline import RecognitionSettings
 from perception.recognition.engine import RULES, HammerParams
@@ -50,6 +51,7 @@ def add_recognition_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--mirror", action="store_true",
                    help="mirror the image so the finger lies on the model's +x side")
     add_pose_options(p)
+    add_video_options(p, fps=False)
     g.add_argument("--setup", type=Path, metavar="SETUP.toml",
                    help="colour models and marker sizes for tracking videos "
                         "(hammer-mv calibrate)")
@@ -77,7 +79,8 @@ def add_pose_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--individual", metavar="NAME",
                    help="the individual to score in a multi-individual file")
     g.add_argument("--fps", type=float, default=None, metavar="F",
-                   help="frame rate of pose files that carry none (DeepLabCut, Lightning Pose)")
+                   help=FPS_HELP + "; pose files that carry none (DeepLabCut, Lightning Pose) "
+                        "need it")
     g.add_argument("--object-diameter-px", type=float, default=None, metavar="D",
                    help="the object's apparent diameter in pixels: sets the metric scale of "
                         "a pose file (or give --px-per-m)")
@@ -137,7 +140,8 @@ def recognition_settings(args: argparse.Namespace) -> RecognitionSettings:
 
         tracking = load_setup(args.setup)
     return RecognitionSettings(observe=observe, hammer=hammer, tracking=tracking,
-                               pose=pose_import(args))
+                               pose=pose_import(args), keep_truncated=args.keep_truncated,
+                               fps=args.fps)
 
 
 def load_repertoire(args: argparse.Namespace) -> tuple[Repertoire, str]:

@@ -66,7 +66,8 @@ def run(args: argparse.Namespace) -> int:
     rep, rep_id = load_repertoire(args)
     tracks = load_clip(path, tracks_out=args.output / "tracks" / f"{clip}{TRACKS_SUFFIX}",
                        progress=not args.quiet and sys.stderr.isatty(),
-                       setup=settings.tracking, pose=settings.pose)
+                       setup=settings.tracking, pose=settings.pose,
+                       **settings.video_options())
     rec = recognize_tracks(tracks, rep, settings, clip=clip, source=path)
     extra = {"fingerprint": clip_fingerprint(path, settings, rep_id), "condition": None,
              "input": str(path),

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from perception.limits import MAX_FPS
 from perception.recognition.models import SceneSpec
 from perception.recognition.planning import DEFAULT_DURATIONS, default_specs
 from perception.recognition.repertoire import Repertoire
@@ -39,11 +40,15 @@ def register(sub) -> None:
 
 def run_build(args: argparse.Namespace) -> int:
     """Execute ``repertoire build`` with parsed ``args``; return the exit status."""
+    from perception.io.atomic import check_output
+
+    check_output(args.output, [args.config] if args.config is not None else [])
     if args.config is not None:
         rep = Repertoire.from_config(args.config)
     else:
-        if not args.fps > 0:
-            raise ValueError(f"--fps: expected a positive frame rate, got {args.fps}")
+        if not 0 < args.fps <= MAX_FPS:
+            raise ValueError(f"--fps: expected a frame rate in (0, {MAX_FPS:g}] frames/s, "
+                             f"got {args.fps}")
         scene = SceneSpec(distance=args.distance, object_size=args.object_size,
                           frame_period=1.0 / args.fps)
         rep = Repertoire.build(default_specs(args.durations), scene)

@@ -6,6 +6,8 @@ import argparse
 import sys
 from pathlib import Path
 
+from hammer_mv.cli.flags import add_video_options
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``track`` subcommand to ``subparsers`` (an argparse subparsers action)."""
@@ -52,6 +54,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         metavar="OUT.mp4",
         help="also write the video with every marker drawn (name, likelihood, trail)",
     )
+    add_video_options(p)
     p.set_defaults(func=run)
 
 
@@ -94,17 +97,23 @@ def parse_rois(specs: list[list[str]], names: tuple[str, ...]) -> dict[str, tupl
 
 def run(args: argparse.Namespace) -> int:
     """Track ``args.video``; print a one-line summary unless ``--quiet``."""
-    from perception.io.tracks import Status, Tracks
+    from perception.io.atomic import check_output
+    from perception.io.tracks import Status, Tracks, tracks_path_for
     from perception.tracking.markers import load_markers
     from perception.tracking.setup import TrackingSetup, load_setup
     from perception.tracking.tracker import track_video
 
+    inputs = [p for p in (args.video, args.colours, args.setup) if p is not None]
+    out = check_output(args.output or tracks_path_for(args.video), inputs)
+    if args.labelled_video is not None:
+        check_output(args.labelled_video, [*inputs, out])
     setup = load_setup(args.setup) if args.setup else TrackingSetup()
     markers = load_markers(args.colours, setup.markers) if args.colours else setup.markers
     rois = parse_rois(args.roi, markers.names)
     progress = not args.quiet and sys.stderr.isatty()
-    out = track_video(args.video, args.output, markers=markers, params=setup.params, rois=rois,
-                      progress=progress, labelled_video=args.labelled_video)
+    out = track_video(args.video, out, markers=markers, params=setup.params, rois=rois,
+                      progress=progress, labelled_video=args.labelled_video,
+                      keep_truncated=args.keep_truncated, fps=args.fps)
     if not args.quiet:
         tracks = Tracks.load(out)
         found = ", ".join(

@@ -179,11 +179,13 @@ def run_render(args: argparse.Namespace) -> int:
         Parsed arguments.
     """
     from perception.errors import InputError
+    from perception.io.atomic import check_output
     from perception.io.tracks import Tracks
     from perception.tracking.overlay import render_labelled
 
     if args.trail < 1:
         raise InputError(f"--trail: expected >= 1 frame, got {args.trail}")
+    check_output(args.output, [p for p in (args.file, args.video) if p is not None])
     t = Tracks.load(args.file)
     out = render_labelled(t, args.video, args.output, trail=args.trail)
     print(f"{out}: {t.n_frames} frames labelled")

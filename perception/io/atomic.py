@@ -10,6 +10,12 @@ is one of the command's inputs. A write that fails for want of space or
 permission ends in one :class:`OSError` naming the file, with the temporary
 file removed.
 
+Temporary names carry their writer's host and process (:func:`owner_tag`):
+a write killed by SIGKILL or a power cut leaves its temporary file behind,
+and the next write of the same output removes it once that process is gone
+(:func:`remove_stale`), without touching what a live writer — another batch
+into the same folder — is still writing.
+
 HDF5 files are built in memory and written with plain file I/O
 (:func:`atomic_hdf5`): HDF5's own writes on a full disk fail late, at close
 or at interpreter exit, where they cannot be caught (and crash h5py).
@@ -18,7 +24,11 @@ or at interpreter exit, where they cannot be caught (and crash h5py).
 from __future__ import annotations
 
 import contextlib
+import glob
+import hashlib
 import os
+import re
+import socket
 import stat
 import tempfile
 from collections.abc import Iterable, Iterator
@@ -31,6 +41,9 @@ __all__ = [
     "atomic_path",
     "check_output",
     "jsonable",
+    "owner_gone",
+    "owner_tag",
+    "remove_stale",
     "save_figure",
     "write_bytes",
     "write_csv",
@@ -51,6 +64,62 @@ def _refuse_non_regular(final: Path) -> None:
     if not stat.S_ISREG(mode):
         raise InputError("exists and is not a regular file (a device, FIFO or socket); "
                          "refusing to replace it", final)
+
+
+#: This host, shortly: temporary names from other hosts (a shared folder) are
+#: never judged by this host's process table.
+_HOST = hashlib.sha1(socket.gethostname().encode()).hexdigest()[:6]
+_TAG = re.compile(r"(?:^|[.-])h([0-9a-f]{6})p(\d+)(?:[.-]|$)")
+
+
+def owner_tag() -> str:
+    """``h<host>p<pid>``: who is writing a temporary file or folder."""
+    return f"h{_HOST}p{os.getpid()}"
+
+
+def owner_gone(name: str) -> bool:
+    """Whether the writer tagged in ``name`` is a process of this host that has ended."""
+    tags = list(_TAG.finditer(name))  # the last: a clip's own name may look like one
+    m = tags[-1] if tags else None
+    if m is None or m.group(1) != _HOST:
+        return False
+    try:
+        os.kill(int(m.group(2)), 0)
+    except ProcessLookupError:
+        return True
+    except (PermissionError, OverflowError):
+        return False  # alive, someone else's
+    return False
+
+
+def remove_stale(folder: str | os.PathLike, pattern: str) -> int:
+    """Remove the temporary files and folders matching ``pattern`` whose writer has ended.
+
+    Parameters
+    ----------
+    folder : str or os.PathLike
+        Where to look.
+    pattern : str
+        Glob of the temporary names (e.g. ``".clip.h*p*.part*"``).
+
+    Returns
+    -------
+    int
+        How many were removed.
+    """
+    import shutil
+
+    removed = 0
+    for path in Path(folder).glob(pattern):
+        if not owner_gone(path.name):
+            continue
+        with contextlib.suppress(OSError):
+            if path.is_dir() and not path.is_symlink():
+                shutil.rmtree(path)
+            else:
+                path.unlink()
+            removed += 1
+    return removed
 
 
 def check_output(path: str | os.PathLike, inputs: Iterable[str | os.PathLike] = ()) -> Path:
@@ -109,8 +178,9 @@ def atomic_path(path: str | os.PathLike, *, suffix: str | None = None) -> Iterat
     suffix = final.suffix if suffix is None else suffix
     try:
         final.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{final.stem}.", suffix=f".part{suffix}",
-                                   dir=final.parent)
+        remove_stale(final.parent, f".{glob.escape(final.stem)}.h*p*.part*")
+        fd, tmp = tempfile.mkstemp(prefix=f".{final.stem}.{owner_tag()}.",
+                                   suffix=f".part{suffix}", dir=final.parent)
     except OSError as exc:
         raise OSError(exc.errno, f"cannot write {final}: {exc.strerror or exc}") from None
     os.close(fd)

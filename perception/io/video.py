@@ -33,6 +33,7 @@ import numpy as np
 
 from perception.errors import InputError
 from perception.io.atomic import atomic_path
+from perception.limits import MAX_FPS
 
 logger = logging.getLogger(__name__)
 
@@ -41,9 +42,6 @@ CODECS: Mapping[str, str] = MappingProxyType({".mp4": "mp4v", ".avi": "MJPG", ".
 
 #: Values of :attr:`FrameSource.time_source`.
 TIME_SOURCES = ("container", "index/fps", "mixed")
-#: Highest frame rate believed from a header, frames/s (high-speed cameras
-#: filming reaches run at 100-500; a higher claim is a broken header).
-MAX_FPS = 1000.0
 #: A stream counts as truncated when it ends this fraction (and at least 2
 #: frames) short of the count its header claims.
 TRUNCATION_TOLERANCE = 0.02

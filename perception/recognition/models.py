@@ -222,11 +222,13 @@ class ModelSpec:
         if self.kind not in KINDS:
             raise ValueError(f"model '{self.name}': kind must be one of {KINDS}, got {self.kind!r}")
         known = {f.name for f in dataclasses.fields(GraspTask)} - SCENE_FIELDS
-        bad = set(self.task) - known
+        bad = sorted(set(self.task) - known)
         if bad:
-            raise ValueError(f"model '{self.name}': unknown task fields {sorted(bad)} "
-                             f"(the scene sets {sorted(SCENE_FIELDS)}; a model may set "
-                             f"{sorted(known)})")
+            from perception.io.config import suggest
+
+            raise ValueError(f"model '{self.name}': unknown task field {bad[0]!r}"
+                             f"{suggest(bad[0], known)} (the scene sets "
+                             f"{sorted(SCENE_FIELDS)}; a model may set {sorted(known)})")
         vias = self.task.get("grip_via")
         if vias is not None:
             if not isinstance(vias, list | tuple):

@@ -18,11 +18,11 @@ import json
 import logging
 import os
 import time
-import tomllib
 from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 
 from perception.errors import InputError
+from perception.io.atomic import owner_gone, owner_tag
 from perception.io.repertoire import StoredChain, StoredModel, read_repertoire, write_repertoire
 from perception.recognition.models import CHAIN_ARRAYS, ChainModel, ModelSpec, MotorModel, SceneSpec
 from perception.recognition.planning import DEFAULT_DURATIONS, build_models, default_specs
@@ -102,14 +102,16 @@ class Repertoire:
         path : str or Path
             The configuration file.
         """
+        from perception.io.config import check_keys, read_toml
+
         path = Path(path)
+        cfg = read_toml(path, "repertoire config")
         try:
-            cfg = tomllib.loads(path.read_text())
-        except (OSError, UnicodeDecodeError) as exc:
-            raise InputError(f"cannot read repertoire config: {exc}", path) from None
-        except tomllib.TOMLDecodeError as exc:
-            raise InputError(f"not valid TOML: {exc}", path) from None
-        try:
+            check_keys(cfg, ("scene", "model", "durations"), "the top level")
+            if not isinstance(cfg.get("scene", {}), dict):
+                raise ValueError("[scene] must be a table")
+            check_keys(cfg.get("scene", {}), [f.name for f in dataclasses.fields(SceneSpec)],
+                       "[scene]")
             scene = SceneSpec(**cfg.get("scene", {}))
             entries = cfg.get("model") or []
             if entries:
@@ -285,10 +287,13 @@ class PlanCache:
             try:
                 fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY)
             except FileExistsError:
+                if self._abandoned(lock):
+                    continue
                 if time.monotonic() < deadline and not self._stale(lock):
                     time.sleep(0.05)
                     continue
                 return plan()  # the owner is slow or gone: plan here, leave its lock
+            os.write(fd, owner_tag().encode())  # so a killed owner's lock is known stale
             os.close(fd)
             try:
                 models = self._read(path, specs)  # written between our read and our lock
@@ -305,6 +310,17 @@ class PlanCache:
             return time.time() - lock.stat().st_mtime > self.stale_s
         except FileNotFoundError:
             return False
+
+    @staticmethod
+    def _abandoned(lock: Path) -> bool:
+        """Remove ``lock`` if the process that took it has ended (killed mid-plan)."""
+        try:
+            gone = owner_gone(lock.read_text(errors="replace"))
+        except OSError:
+            return False
+        if gone:
+            lock.unlink(missing_ok=True)
+        return gone
 
     @staticmethod
     def _read(path: Path, specs: list[ModelSpec]) -> list[MotorModel] | None:

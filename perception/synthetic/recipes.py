@@ -13,7 +13,6 @@ import dataclasses
 import json
 import logging
 import os
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -23,6 +22,7 @@ import pandas as pd
 from perception.errors import InputError
 from perception.io.atomic import write_csv
 from perception.io.video import CODECS
+from perception.limits import MAX_CLIPS
 from perception.synthetic.footage import load_background
 from perception.synthetic.render import render_clip
 from perception.synthetic.scene import Camera, Distractor, Occlusion, RenderStyle, Scene
@@ -68,6 +68,10 @@ class Recipe:
         return int(sum(self.counts.values()))
 
 
+#: The tables of a recipe file.
+RECIPE_TABLES = ("conditions", "scene", "variation", "render")
+
+
 def load_recipe(path: str | os.PathLike) -> Recipe:
     """Read a recipe TOML file.
 
@@ -81,14 +85,18 @@ def load_recipe(path: str | os.PathLike) -> Recipe:
     InputError
         If the file is missing, not TOML, or has unknown or bad fields.
     """
+    from perception.io.config import check_keys, read_toml
+
     path = Path(path)
+    cfg = read_toml(path, "recipe")
     try:
-        cfg = tomllib.loads(path.read_text())
-    except FileNotFoundError:
-        raise InputError("recipe not found", path) from None
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
-        raise InputError(f"not a readable TOML recipe: {exc}", path) from None
-    try:
+        check_keys(cfg, RECIPE_TABLES, "the top level")
+        for name in RECIPE_TABLES:
+            if not isinstance(cfg.get(name, {}), dict):
+                raise ValueError(f"[{name}] must be a table")
+        check_keys(cfg.get("scene", {}),
+                   [f.name for f in dataclasses.fields(StimulusParams) if f.name != "condition"],
+                   "[scene]")
         table = cfg.get("conditions", {})
         if not isinstance(table, dict):
             raise ValueError("[conditions] must be a table of clip counts, e.g. normal = 2")
@@ -100,6 +108,9 @@ def load_recipe(path: str | os.PathLike) -> Recipe:
             raise ValueError("[conditions]: give a whole, non-negative clip count per "
                              "condition, and at least one clip")
         counts = {str(k): int(v) for k, v in table.items()}
+        if sum(counts.values()) > MAX_CLIPS:
+            raise ValueError(f"[conditions]: at most {MAX_CLIPS} clips per recipe, got "
+                             f"{sum(counts.values())}")
         stim = StimulusParams(**cfg.get("scene", {}))
         var = dict(cfg.get("variation", {}))
         angle = tuple(float(a) for a in var.pop("camera_angle_deg", (0.0, 0.0)))

@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from perception.geometry import DEFAULT_OBJECT_DIAMETER, SimilarityTransform
+from perception.limits import MAX_FPS, MAX_FRAME_SIDE
 from perception.synthetic.footage import check_background
 
 __all__ = ["Camera", "Distractor", "Occlusion", "RenderStyle", "Scene", "visibility"]
@@ -249,12 +250,12 @@ class RenderStyle:
     sleeve: str | tuple[int, int, int] | None = None
 
     def __post_init__(self) -> None:
-        if not (math.isfinite(self.fps) and self.fps > 0):
-            raise ValueError(f"RenderStyle.fps: expected a positive frame rate, got {self.fps!r}")
-        if int(self.width) < 16 or int(self.height) < 16:
-            raise ValueError(
-                f"RenderStyle: expected width, height >= 16 px, got {self.width} x {self.height}"
-            )
+        if not (math.isfinite(self.fps) and 0 < self.fps <= MAX_FPS):
+            raise ValueError(f"RenderStyle.fps: expected a frame rate in (0, {MAX_FPS:g}] "
+                             f"frames/s, got {self.fps!r}")
+        if not all(16 <= int(side) <= MAX_FRAME_SIDE for side in (self.width, self.height)):
+            raise ValueError(f"RenderStyle: expected width and height of 16 to {MAX_FRAME_SIDE} "
+                             f"px, got {self.width} x {self.height}")
         for name in ("noise_sd", "blur_sigma", "marker_diameter", "exposure", "flicker"):
             if not getattr(self, name) >= 0:
                 raise ValueError(f"RenderStyle.{name}: expected >= 0, got {getattr(self, name)!r}")

@@ -25,6 +25,7 @@ import numpy as np
 
 from minvar import GraspTask, GripVia, simulate_grasp
 from perception.geometry import DEFAULT_OBJECT_DIAMETER, DEFAULT_TIP_START
+from perception.limits import MAX_REST_S
 
 __all__ = ["CONDITIONS", "StimulusParams", "stimulus_task", "stimulus_paths"]
 
@@ -74,6 +75,10 @@ class StimulusParams:
                     and (value > 0 if positive else value >= 0)):
                 raise ValueError(f"[scene] {name}: expected a finite value "
                                  f"{'> 0' if positive else '>= 0'}, got {value!r}")
+        for name in ("rest_before", "rest_after"):
+            if getattr(self, name) > MAX_REST_S:
+                raise ValueError(f"[scene] {name}: at most {MAX_REST_S:g} s of rest, got "
+                                 f"{getattr(self, name)!r}")
 
 
 def stimulus_task(p: StimulusParams) -> GraspTask:
