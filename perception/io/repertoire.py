@@ -6,6 +6,8 @@ Layout (schema ``hammer-mv/repertoire``, version 1)::
     /models/<name>   attrs: order, kind, task (JSON), scene (JSON), substeps, dt
     /models/<name>/<arm|finger|thumb>
                      datasets A, B, H, K, L, P, x0; attrs: l1, l2, base, elbow
+    /models/<name>/calibration          (optional; files before it lack it)
+                     dataset misfit; attrs: frame_period, params (JSON)
 
 This module knows the layout and nothing of what the models mean: it writes
 and reads plain records (:class:`StoredModel`); :mod:`perception.recognition`
@@ -27,8 +29,8 @@ from perception import __version__
 from perception.errors import InputError
 from perception.io.atomic import atomic_path
 
-__all__ = ["SCHEMA", "SCHEMA_VERSION", "StoredChain", "StoredModel", "read_repertoire",
-           "write_repertoire"]
+__all__ = ["SCHEMA", "SCHEMA_VERSION", "StoredCalibration", "StoredChain", "StoredModel",
+           "read_repertoire", "write_repertoire"]
 
 SCHEMA = "hammer-mv/repertoire"
 SCHEMA_VERSION = 1
@@ -62,6 +64,25 @@ class StoredChain:
 
 
 @dataclass(frozen=True)
+class StoredCalibration:
+    """A model's familiarity calibration as stored.
+
+    Attributes
+    ----------
+    misfit : (K,) array
+        Misfits of the model's own demonstrations.
+    frame_period : float
+        Their frame period, s.
+    params : dict
+        How the demonstrations were made (JSON in the file).
+    """
+
+    misfit: np.ndarray
+    frame_period: float
+    params: dict
+
+
+@dataclass(frozen=True)
 class StoredModel:
     """One model as stored: its name, kind, task and scene, and its chains.
 
@@ -77,6 +98,8 @@ class StoredModel:
         Model time step, s.
     chains : mapping of str to StoredChain
         ``arm``, ``finger``, ``thumb``.
+    calibration : StoredCalibration or None
+        The familiarity calibration (None in files written before it existed).
     """
 
     name: str
@@ -86,6 +109,7 @@ class StoredModel:
     substeps: int
     dt: float
     chains: Mapping[str, StoredChain] = field(repr=False)
+    calibration: StoredCalibration | None = field(default=None, repr=False)
 
 
 def write_repertoire(path: str | os.PathLike, config: Mapping[str, Any],
@@ -121,6 +145,11 @@ def write_repertoire(path: str | os.PathLike, config: Mapping[str, Any],
                     cg.create_dataset(key, data=c.arrays[key],
                                       compression="gzip" if key in _COMPRESSED else None)
                 cg.attrs.update(l1=c.l1, l2=c.l2, base=c.base, elbow=c.elbow)
+            if m.calibration is not None:
+                cal = mg.create_group("calibration")
+                cal.create_dataset("misfit", data=np.asarray(m.calibration.misfit, dtype=float))
+                cal.attrs.update(frame_period=m.calibration.frame_period,
+                                 params=json.dumps(m.calibration.params))
     return path
 
 
@@ -131,11 +160,21 @@ def _read_chain(cg) -> StoredChain:
                        elbow=int(cg.attrs["elbow"]))
 
 
+def _read_calibration(mg) -> StoredCalibration | None:
+    if "calibration" not in mg:
+        return None
+    cal = mg["calibration"]
+    return StoredCalibration(misfit=np.asarray(cal["misfit"][()], dtype=float),
+                             frame_period=float(cal.attrs["frame_period"]),
+                             params=json.loads(cal.attrs["params"]))
+
+
 def _read_model(name: str, mg) -> StoredModel:
     return StoredModel(name=name, kind=str(mg.attrs["kind"]), task=json.loads(mg.attrs["task"]),
                        scene=json.loads(mg.attrs["scene"]), substeps=int(mg.attrs["substeps"]),
                        dt=float(mg.attrs["dt"]),
-                       chains={role: _read_chain(mg[role]) for role in ROLES})
+                       chains={role: _read_chain(mg[role]) for role in ROLES},
+                       calibration=_read_calibration(mg))
 
 
 def read_repertoire(path: str | os.PathLike) -> tuple[dict, list[StoredModel]]:

@@ -19,9 +19,17 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 from perception.errors import InputError
-from perception.io.repertoire import StoredChain, StoredModel, read_repertoire, write_repertoire
+from perception.io.repertoire import (
+    StoredCalibration,
+    StoredChain,
+    StoredModel,
+    read_repertoire,
+    write_repertoire,
+)
+from perception.recognition.calibration import calibrate
 from perception.recognition.models import CHAIN_ARRAYS, ChainModel, ModelSpec, MotorModel, SceneSpec
 from perception.recognition.planning import DEFAULT_DURATIONS, build_model, default_specs
+from perception.recognition.verdict import Calibration, CalibrationParams
 
 __all__ = ["Repertoire"]
 
@@ -37,6 +45,9 @@ class Repertoire:
         The models, in report order; names must be unique.
     config : dict, optional
         The configuration the repertoire was built from (stored in the file).
+
+    Every model gets a familiarity calibration
+    (:mod:`perception.recognition.calibration`) if it has none: once, here.
     """
 
     def __init__(self, models: Iterable[MotorModel], config: dict | None = None):
@@ -46,6 +57,12 @@ class Repertoire:
             raise ValueError(f"repertoire: duplicate model names in {names}")
         if not self.models:
             raise ValueError("repertoire: needs at least one model")
+        bare = [m for m in self.models if m.calibration is None]
+        if bare:
+            log.info("calibrating %d model(s) on their own demonstrations", len(bare))
+            done = dict(zip([m.name for m in bare], calibrate(bare)))
+            self.models = [dataclasses.replace(m, calibration=done[m.name])
+                           if m.name in done else m for m in self.models]
         self.config = config or {}
         self._replanned: dict[tuple, MotorModel] = {}
 
@@ -128,7 +145,9 @@ class Repertoire:
                 log.info("re-planning %s for distance %.3f m, object %.3f m, hand %.3f m, "
                          "%.1f frames/s", m.name, grid.distance, grid.object_size,
                          grid.tip_start, 1 / grid.frame_period)
-                self._replanned[key] = build_model(m.spec, grid)
+                # familiarity transfers across scenes (docs/recognition.md)
+                self._replanned[key] = dataclasses.replace(build_model(m.spec, grid),
+                                                           calibration=m.calibration)
             out.append(self._replanned[key])
         return out
 
@@ -152,6 +171,9 @@ class Repertoire:
         path : str or Path
             The HDF5 file.
 
+        A file written before familiarity calibrations were stored is
+        calibrated as it is loaded (the file is not changed).
+
         Raises
         ------
         InputError
@@ -167,9 +189,12 @@ class Repertoire:
 def _stored(m: MotorModel) -> StoredModel:
     chains = {c.role: StoredChain(arrays={k: getattr(c, k) for k in CHAIN_ARRAYS}, l1=c.l1,
                                   l2=c.l2, base=c.base, elbow=c.elbow) for c in m.chains}
+    cal = m.calibration
+    stored_cal = None if cal is None else StoredCalibration(
+        misfit=cal.misfit, frame_period=cal.frame_period, params=dataclasses.asdict(cal.params))
     return StoredModel(name=m.name, kind=m.kind, task=m.spec.task,
                        scene=dataclasses.asdict(m.scene), substeps=m.substeps, dt=m.dt,
-                       chains=chains)
+                       chains=chains, calibration=stored_cal)
 
 
 def _model(s: StoredModel) -> MotorModel:
@@ -179,5 +204,8 @@ def _model(s: StoredModel) -> MotorModel:
         spec = ModelSpec(s.name, s.kind, s.task)
     except ValueError as exc:
         raise ValueError(f"model '{s.name}': {exc}") from None
+    cal = s.calibration
+    calibration = None if cal is None else Calibration(
+        cal.misfit, cal.frame_period, CalibrationParams(**cal.params))
     return MotorModel(spec=spec, scene=SceneSpec(**s.scene), substeps=s.substeps, dt=s.dt,
-                      **chains)
+                      calibration=calibration, **chains)
