@@ -51,6 +51,9 @@ FIGURES = (
      "mean ± SD confidence per condition at select points, with its transport and grip terms"),
 )
 
+#: The figure drawn across the page (three panels).
+WIDE = "condition_profiles.png"
+
 _CSS = """
 body{font-family:system-ui,sans-serif;max-width:1240px;margin:1.5em auto;padding:0 12px;
      line-height:1.4;color:#222}
@@ -60,7 +63,8 @@ table.t td,table.t th{padding:3px 9px;border-bottom:1px solid #ddd;text-align:le
      white-space:nowrap}
 table.t td.n,table.t th.n{text-align:right}
 .scroll{max-width:100%;overflow-x:auto}
-figure{margin:1em 0} figure img,.clip img{width:100%;height:auto;border:1px solid #eee}
+figure{margin:0} figure img,.clip img{width:100%;height:auto;border:1px solid #eee}
+.grid{display:grid;grid-template-columns:1fr 1fr;gap:14px} .grid figure.wide{grid-column:1/-1}
 figcaption,.note{font-size:90%;color:#555}
 .v-normal{color:#1b6e20;font-weight:bold} .v-reach{color:#1f4e99;font-weight:bold}
 .v-abnormal{color:#b3261e;font-weight:bold} .v-failed{color:#777}
@@ -135,7 +139,7 @@ def _main_table(summary: pd.DataFrame, anchors: dict[str, str], reference: str |
                      _num(r.familiarity, ".2f"), _num(r.margin, ".1f"), _e(r.winner),
                      _num(r.winner_log_likelihood, ".1f"),
                      _num(r.reference_confidence * 100, ".2f"), _e(r.status)])
-    return _table(headers, rows, numeric={3, 4, 6, 7})
+    return _table(headers, rows, numeric={3, 4, 6, 7}, cls="t main")
 
 
 def _models_table(summary: pd.DataFrame) -> str:
@@ -248,10 +252,12 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
         stats_df = condition_statistics(summary, profile_model)
         write_csv(out / "statistics.csv", stats_df)
         sections.append(f"<h2>Chapter 5, read on the reference grasp model "
-                        f"{_e(profile_model)}</h2>" + "".join(
-                            f'<figure><a href="{name}"><img src="{name}" alt="{fig}"></a>'
-                            f"<figcaption>{fig}: {html.escape(caption)}</figcaption></figure>"
-                            for name, fig, caption in FIGURES))
+                        f"{_e(profile_model)}</h2><div class=grid>" + "".join(
+                            f'<figure{" class=wide" if name == WIDE else ""}><a href="{name}">'
+                            f'<img src="{name}" alt="{fig}"></a>'
+                            f"<figcaption>{fig}: {html.escape(caption)} (click for full size)"
+                            "</figcaption></figure>" for name, fig, caption in FIGURES)
+                        + "</div>")
         if len(stats_df):
             sections.append("<h2>Statistics of the reference model's final confidence</h2>"
                             + _statistics_html(stats_df))
@@ -269,9 +275,9 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
         f"<h1>{html.escape(title)}</h1>",
         f"<p>{len(summary)} clips: {len(ok)} scored, {len(failed)} failed. Tables: "
         + ", ".join(tables) + '. <span class="note">' + _HOW_TO_READ + "</span></p>",
-        _verdict_counts(ok), *sections[:1],
+        _verdict_counts(ok),
         "<h2>Summary</h2>", _main_table(summary, anchors, profile_model), _models_table(summary),
-        *sections[1:], "<h2>Clips</h2>", *clips,
+        *sections, "<h2>Clips</h2>", *clips,
     ])
     page = ("<!doctype html><html><head><meta charset='utf-8'>"
             "<meta name='viewport' content='width=device-width, initial-scale=1'>"

@@ -249,7 +249,8 @@ def independent_paths(p: IndependentParams, fps: float, *,
         Frame times, s.
     paths : dict of (F, 2) arrays
         ``wrist``, ``finger``, ``thumb`` marker positions, m (object centre at
-        the origin); ``aperture`` (F,) is the tip-to-tip aperture, m.
+        the origin); ``aperture`` (F,) is the tip-to-tip aperture (markers' offsets
+        taken off), m.
     """
     if not (math.isfinite(fps) and fps > 0):
         raise ValueError(f"fps: expected a positive frame rate, got {fps!r}")
@@ -271,14 +272,13 @@ def independent_paths(p: IndependentParams, fps: float, *,
     thumb = tips - (p.thumb_share * g)[:, None] * across
     # the wrist carries the grip midpoint to the object: shift it by the digits' asymmetry
     shift = ((0.5 - p.thumb_share) * g)[:, None] * across
-    wrist, finger, thumb = wrist - shift, finger - shift, thumb - shift
-    finger = finger + p.marker_offset * across
-    thumb = thumb - p.marker_offset * across
+    tips = {"wrist": wrist - shift, "finger": finger - shift, "thumb": thumb - shift}
+    tips = {name: xy + _wobble(p, t, rng) for name, xy in tips.items()}
     rot = math.radians(p.approach_angle_deg)
     R = np.array([[math.cos(rot), -math.sin(rot)], [math.sin(rot), math.cos(rot)]])
-    paths = {name: (xy + _wobble(p, t, rng)) @ R.T
-             for name, xy in (("wrist", wrist), ("finger", finger), ("thumb", thumb))}
-    paths["aperture"] = g
+    marker = {"wrist": 0.0, "finger": p.marker_offset, "thumb": -p.marker_offset}
+    paths = {name: (xy + marker[name] * across) @ R.T for name, xy in tips.items()}
+    paths["aperture"] = np.linalg.norm(tips["finger"] - tips["thumb"], axis=1)
     return t, paths
 
 
