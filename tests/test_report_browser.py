@@ -21,6 +21,8 @@ from perception.batch import ClipResult, summary_table
 from perception.pipeline import recognize_clip
 from perception.report import ClipSummary, write_batch_report, write_clip_report
 
+pytestmark = pytest.mark.slow
+
 #: A clip name that would break out of an attribute, a link and a URL if not escaped.
 NASTY = 'a" onerror="alert(1)" x=#1%20'
 WIDTH, HEIGHT = 1280, 900
@@ -48,13 +50,15 @@ def _run(browser: str, profile, *args: str) -> str:
 
 @pytest.fixture(scope="module")
 def report(tmp_path_factory):
-    """A batch report of three scored clips (one with a hostile name) and a failed one."""
+    """A batch report of five scored clips (one with a hostile name) and a failed one."""
     out = tmp_path_factory.mktemp("report")
     rep = default_repertoire()
     results = []
-    for name, cond in ((NASTY, "normal"), ("open-close-open-01", "open-close-open"),
-                       ("reach-01", "reach")):
-        rec = recognize_clip(demo_tracks(cond, 1)[0], rep, clip=name)
+    for i, (name, cond) in enumerate(((NASTY, "normal"), ("normal-02", "normal"),
+                                      ("open-close-open-01", "open-close-open"),
+                                      ("open-close-open-02", "open-close-open"),
+                                      ("reach-01", "reach"))):
+        rec = recognize_clip(demo_tracks(cond, i)[0], rep, clip=name)
         write_clip_report(rec, out, extra={"condition": cond})
         results.append(ClipResult(name, cond, "ok", summary=ClipSummary.from_recognition(rec)))
     results.append(ClipResult("broken", "normal", "failed", error="empty.mp4: not a video"))
@@ -103,7 +107,7 @@ def test_the_page_loads_with_its_figures_and_the_main_table_fits(report, tmp_pat
     assert 0 < m["table_right"] <= WIDTH, m  # the main table fits a 1280 px window
     assert m["page"] <= WIDTH, m  # and nothing else widens the page
     # every figure: 4 of the batch, 2 per clip
-    assert m["images"] == 4 + 2 * 3 and m["loaded"] == m["images"], m
+    assert m["images"] == 4 + 2 * 5 and m["loaded"] == m["images"], m
     assert m["injected"] == 0 and m["alerts"] == 0, m
     assert NASTY in m["clip_ids"]
 
