@@ -10,7 +10,8 @@ in the same hard rendering style, tracks and recognises them with
 batch outputs (``summary.csv``, each clip's JSON). Per generator it writes
 ``ch5/<generator>/report/`` (the batch report with Figs. 5.4d, 5.8a-c and
 every clip's Figs. 5.5-5.7), ``ch5/verdict_<generator>.csv`` (the confusion
-table) and ``ch5/claims.csv``; it returns one dict per claim (section,
+table), ``ch5/claims.csv`` and ``ch5/repertoire.h5`` (the calibrated
+repertoire used); it returns one dict per claim (section,
 claim, thesis, ours, agrees, note). ``tools/reproduce_thesis.py`` calls it;
 alone::
 
@@ -412,6 +413,7 @@ def reproduce(out: Path, *, clips: int = 10, seed: int = 0, jobs: int = 2,
     out.mkdir(parents=True, exist_ok=True)
     progress("ch5: repertoire")
     rep = Repertoire.build()
+    rep.save(out / "repertoire.h5")  # with its calibration: what the numbers were made with
     progress("ch5: rendering")
     folders = render_sets(out, clips, seed)
     progress("ch5: batches")
