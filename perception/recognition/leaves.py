@@ -53,8 +53,6 @@ class Leaves:
             self.Lg[:, i, :, :k] = c.L[t]
             self.P[:, i] = c.P[np.minimum(np.arange(steps), c.horizon)]
             self.x0[i, :k] = c.x0
-        # the closed loop x' = (A - B L) x of every step, built once
-        self.F = self.A[None] - np.einsum("lim,slmn->slin", self.B, self.Lg)
         self.l1 = np.array([c.l1 for c in chains])
         self.l2 = np.array([c.l2 for c in chains])
         self.base = np.array([c.base for c in chains])
@@ -74,9 +72,7 @@ class Leaves:
 
         ``state`` is (L, n) or (L, k, n) for k states per leaf.
         """
-        if state.ndim == 2:
-            return np.einsum("lij,lj->li", self.F[s], state)
-        return np.matmul(state, np.swapaxes(self.F[s], -1, -2))
+        return self.advance(state, self.command(state, s))
 
 
 def forward_kinematics(q: np.ndarray, l1: np.ndarray, l2: np.ndarray
