@@ -42,6 +42,7 @@ from perception.recognition.repertoire import Repertoire
 from perception.report.batch import write_batch_report
 from perception.report.clip import ClipSummary, clip_outputs, write_clip_report
 from perception.report.conditions import reference_model
+from perception.report.tracking import tracking_columns, write_tracking_report
 
 __all__ = ["BatchItem", "ClipResult", "discover", "process_clip", "run_batch", "summary_table"]
 
@@ -50,7 +51,7 @@ log = logging.getLogger(__name__)
 #: Files that sit beside clips and are not inputs: ground truth, the synth
 #: manifest, and what a batch writes (so a report folder can be its own input).
 COMPANION_SUFFIXES = (".truth.h5", ".recognition.json", ".confidence.csv", ".confidence.png",
-                      ".paths.png")
+                      ".paths.png", ".tracking.png")
 #: Which file stands for a clip found more than once (a tracks file spares tracking).
 _PREFERENCE = {"tracks": 2, "video": 1, "unknown": 0}
 COMPANION_NAMES = ("manifest.csv", "README.md", "recipe.toml", "summary.csv", "statistics.csv",
@@ -215,10 +216,13 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
         done = _current_report(item, out, fp)
         if done is not None:
             return ClipResult(**base, status="reused", summary=ClipSummary.from_dict(done))
+        tracks_out = out / "tracks" / f"{item.clip}{TRACKS_SUFFIX}"
         rec = recognize_clip(item.path, repertoire, settings, clip=item.clip,
-                             tracks_out=out / "tracks" / f"{item.clip}{TRACKS_SUFFIX}",
-                             progress=progress)
-        extra = {"fingerprint": fp, "condition": item.condition, "input": str(item.path)}
+                             tracks_out=tracks_out, progress=progress)
+        tracking = write_tracking_report(item.path if item.kind == "tracks" else tracks_out,
+                                         out, item.clip)
+        extra = {"fingerprint": fp, "condition": item.condition, "input": str(item.path),
+                 "tracking": tracking}
         write_clip_report(rec, out, extra=extra)
         return ClipResult(**base, status="ok", summary=ClipSummary.from_recognition(rec, extra))
     except (InputError, ValueError, OSError) as exc:
@@ -427,6 +431,7 @@ def summary_table(results: list[ClipResult], reference: str | None = None) -> pd
         for n in names:
             entry[f"conf_{n}"] = (_first_model(s, n, s.confidence[:, -1]) if s is not None
                                   else float("nan"))
+        entry.update(tracking_columns(s.tracking if s is not None else None))
         entry["status"] = "failed" if r.status == "failed" else "ok"
         entry["reused"] = r.status == "reused"
         entry["error"] = r.error

@@ -23,6 +23,7 @@ import json
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from perception import __version__
 from perception.errors import InputError
@@ -32,6 +33,9 @@ from perception.recognition.engine import HammerParams, recognize
 from perception.recognition.models import SceneSpec
 from perception.recognition.repertoire import Repertoire
 from perception.recognition.result import Recognition
+
+if TYPE_CHECKING:  # the tracker (OpenCV) is imported only when there is video
+    from perception.tracking.setup import TrackingSetup
 
 __all__ = [
     "RecognitionSettings",
@@ -59,15 +63,21 @@ class RecognitionSettings:
         Tracks -> observation settings.
     hammer : HammerParams
         Rule and weights of the engine.
+    tracking : TrackingSetup, optional
+        Colour models and marker sizes for tracking videos (``--setup``).
     """
 
     observe: ObserveParams = field(default_factory=ObserveParams)
     hammer: HammerParams = field(default_factory=HammerParams)
+    tracking: TrackingSetup | None = None
 
     def fingerprint(self) -> dict:
         """JSON-able settings that change results."""
-        return {"observe": dataclasses.asdict(self.observe),
-                "hammer": dataclasses.asdict(self.hammer)}
+        out = {"observe": dataclasses.asdict(self.observe),
+               "hammer": dataclasses.asdict(self.hammer)}
+        if self.tracking is not None:
+            out["tracking"] = self.tracking.to_dict()
+        return out
 
 
 def clip_name(path: str | os.PathLike) -> tuple[str, str]:
@@ -114,7 +124,7 @@ def clip_fingerprint(path: str | os.PathLike, settings: RecognitionSettings,
 
 
 def load_clip(source: str | os.PathLike | Tracks, *, tracks_out: str | os.PathLike | None = None,
-              progress: bool = False) -> Tracks:
+              progress: bool = False, setup: TrackingSetup | None = None) -> Tracks:
     """The tracks of a clip: tracked from a video, loaded from a tracks file, or as given.
 
     Parameters
@@ -126,6 +136,8 @@ def load_clip(source: str | os.PathLike | Tracks, *, tracks_out: str | os.PathLi
         beside the video).
     progress : bool
         Show a progress bar while tracking.
+    setup : TrackingSetup, optional
+        Colour models and marker sizes for tracking a video.
 
     Raises
     ------
@@ -144,7 +156,8 @@ def load_clip(source: str | os.PathLike | Tracks, *, tracks_out: str | os.PathLi
     from perception.tracking.tracker import track_video  # OpenCV only when there is video
 
     out = tracks_path_for(path) if tracks_out is None else Path(tracks_out)
-    return Tracks.load(track_video(path, out, progress=progress))
+    kw = {} if setup is None else {"markers": setup.markers, "params": setup.params}
+    return Tracks.load(track_video(path, out, progress=progress, **kw))
 
 
 def recognize_clip(source: str | os.PathLike | Tracks, repertoire: Repertoire,
@@ -180,7 +193,8 @@ def recognize_clip(source: str | os.PathLike | Tracks, repertoire: Repertoire,
     settings = RecognitionSettings() if settings is None else settings
     is_file = not isinstance(source, Tracks)
     name = clip or (clip_name(source)[0] if is_file else None)
-    tracks = load_clip(source, tracks_out=tracks_out, progress=progress)
+    tracks = load_clip(source, tracks_out=tracks_out, progress=progress,
+                       setup=settings.tracking)
     try:
         obs = observe(tracks, settings.observe, clip=name)
     except InputError as exc:

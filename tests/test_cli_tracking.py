@@ -87,16 +87,14 @@ def test_track_roi_and_colours_options(clips, tmp_path):
     assert np.median(errors(tracks, truth)[:, 0]) < 1.0
 
 
-def test_truncated_avi_is_tracked_with_a_warning_and_true_count(clips, tmp_path):
+def test_truncated_avi_is_refused_in_one_line(clips, tmp_path):
     data = clips["avi"].video.read_bytes()
     video = tmp_path / "cut.avi"
     video.write_bytes(data[: len(data) * 2 // 3])
     proc = hammer("track", video, "--quiet")
-    assert proc.returncode == 0, proc.stderr
-    assert "header claims" in proc.stderr
-    tracks = Tracks.load(tmp_path / "cut.tracks.h5")
-    assert 0 < tracks.n_frames < 24
-    assert tracks.video["n_frames"] == tracks.n_frames and tracks.video["n_frames_header"] == 24
+    assert proc.returncode == 2
+    assert proc.stderr.count("\n") == 1 and "header claims" in proc.stderr
+    assert not (tmp_path / "cut.tracks.h5").exists()
 
 
 def test_tracks_info(clips, tmp_path):
@@ -260,3 +258,74 @@ def test_bad_input_exits_2_with_one_line_and_no_output(clips, tmp_path, case):
     assert "Traceback" not in proc.stderr
     assert names in lines[0] and problem in lines[0], lines[0]
     assert {p.name for p in tmp_path.rglob("*")} == before  # no output, no temporary file
+
+
+def _frame_count(path):
+    import cv2
+
+    cap = cv2.VideoCapture(str(path))
+    n = 0
+    while cap.read()[0]:
+        n += 1
+    return n
+
+
+def test_labelled_video_from_track_and_from_tracks_render(clips, tmp_path):
+    import cv2
+    import numpy as np
+
+    video = _copy(clips["good"], tmp_path)
+    labelled = tmp_path / "labelled.mp4"
+    proc = hammer("track", video, "--labelled-video", labelled, "--quiet")
+    assert proc.returncode == 0, proc.stderr
+    assert _frame_count(labelled) == 24
+    again = tmp_path / "again.mp4"
+    proc = hammer("tracks", "render", tmp_path / "good.tracks.h5", "-o", again)
+    assert proc.returncode == 0, proc.stderr and "24 frames labelled" in proc.stdout
+    assert _frame_count(again) == 24
+    # the drawing is there: the labelled frame differs from the video near the thumb
+    from perception.io.tracks import Tracks
+
+    t = Tracks.load(tmp_path / "good.tracks.h5")
+    x, y = t.position[5, t.index("thumb")].round().astype(int)
+    a, b = (cv2.VideoCapture(str(p)) for p in (video, again))
+    for _ in range(6):
+        fa, fb = a.read()[1], b.read()[1]
+    diff = np.abs(fa.astype(int) - fb.astype(int))[y - 15:y + 15, x - 15:x + 15].sum(axis=-1)
+    assert (diff > 60).sum() > 20
+    proc = hammer("tracks", "render", tmp_path / "good.tracks.h5", tmp_path / "none.mp4",
+                  "-o", tmp_path / "x.mp4")
+    assert proc.returncode == 2 and "none.mp4" in proc.stderr
+    assert not (tmp_path / "x.mp4").exists()
+
+
+def test_tracks_info_prints_the_quality_table(clips, tmp_path):
+    video = _copy(clips["good"], tmp_path)
+    assert hammer("track", video, "--quiet").returncode == 0
+    proc = hammer("tracks", "info", tmp_path / "good.tracks.h5")
+    assert proc.returncode == 0, proc.stderr
+    assert "quality:" in proc.stdout and "reacquisitions" in proc.stdout
+    thumb = next(line for line in proc.stdout.splitlines()[::-1] if line.startswith("thumb"))
+    assert thumb.split()[1] == "100.0"  # tracked in every frame
+
+
+def test_recognize_reports_tracking_quality_and_a_contact_sheet(tmp_path):
+    import json
+
+    from perception.synthetic.demos import render_demo_clip
+    from perception.synthetic.scene import Scene
+
+    scene = Scene.reach_to_grasp(45, 30, start=(0.0, -0.25), onset=0.3, duration=0.8)
+    clip, _ = render_demo_clip(tmp_path, "clip.mp4", n=45, angle=0.0, hand=True, scene=scene)
+    out = tmp_path / "out"
+    proc = hammer("recognize", clip.video, "-o", out)
+    assert proc.returncode == 0, proc.stderr
+    report = json.loads((out / "clip.recognition.json").read_text())
+    quality = report["tracking"]
+    assert quality["frames"] == 45 and quality["contact_sheet"] == "clip.tracking.png"
+    assert quality["markers"]["thumb"]["tracked"] == 1.0
+    assert quality["markers"]["wrist"]["min_likelihood"] > 0.5
+    import cv2
+
+    sheet = cv2.imread(str(out / "clip.tracking.png"))
+    assert sheet is not None and sheet.shape[1] == 1200

@@ -10,6 +10,8 @@ MODULES = [
     "tracking.detection", "tracking.tracker", "io.video", "io.tracks", "io.repertoire",
     "synthetic.scene", "synthetic.render", "synthetic.demos", "geometry", "observation",
     "pipeline", "recognition.models", "recognition.engine", "recognition.scoring",
+    "tracking.candidates", "tracking.hand", "tracking.overlay", "tracking.setup",
+    "synthetic.footage", "synthetic.realistic", "report.tracking",
 ]
 
 

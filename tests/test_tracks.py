@@ -6,7 +6,15 @@ import pandas as pd
 import pytest
 
 from perception.errors import InputError
-from perception.io.tracks import SCHEMA, SCHEMA_VERSION, Status, Tracks, TracksWriter
+from perception.io.exports import export_tracks, status_path_for
+from perception.io.tracks import (
+    INTERPOLATED_LIKELIHOOD,
+    SCHEMA,
+    SCHEMA_VERSION,
+    Status,
+    Tracks,
+    TracksWriter,
+)
 
 MARKERS = ("thumb", "finger", "wrist", "object")
 
@@ -139,7 +147,9 @@ def test_interpolation_fills_short_gaps_only():
     # 3-frame gap in linear motion: filled exactly, status 3.
     np.testing.assert_allclose(filled.position[20:23, 0], truth.position[20:23, 0])
     assert (filled.status[20:23, 0] == Status.INTERPOLATED).all()
-    assert (filled.likelihood[20:23, 0] == 1).all()
+    # a bridge is less sure than its ends, and below DeepLabCut's 0.6 cutoff
+    assert (filled.likelihood[20:23, 0] == INTERPOLATED_LIKELIHOOD).all()
+    assert INTERPOLATED_LIKELIHOOD < 0.6
     # 10-frame gap: longer than max_gap, stays lost.
     assert np.isnan(filled.position[20:30, 1]).all()
     assert (filled.status[20:30, 1] == Status.LOST).all()
@@ -184,23 +194,29 @@ def test_dlc_export(tmp_path):
     assert np.isnan(df[("hammer-mv", "finger", "x")].iloc[3])
     assert df[("hammer-mv", "finger", "likelihood")].iloc[3] == 0
     assert df[("hammer-mv", "wrist", "x")].iloc[20] == pytest.approx(tr.position[20, 2, 0])
-    path = tr.export(tmp_path / "c.csv", "dlc")
+    path, status = export_tracks(tr, tmp_path / "c.csv", "dlc")
     back = pd.read_csv(path, header=[0, 1, 2], index_col=0)
     np.testing.assert_allclose(back.to_numpy(), df.to_numpy(), equal_nan=True)
+    # the status codes DeepLabCut's table cannot hold, beside it
+    assert status == status_path_for(path) == tmp_path / "c.status.csv"
+    codes = pd.read_csv(status)
+    assert list(codes.columns) == ["frame", *MARKERS]
+    assert (codes.finger[3:5] == Status.LOST).all() and (codes.finger[5:] == 0).all()
 
 
 def test_trackpy_and_plain_exports(tmp_path):
     tr = _tracks(lost=[(0, slice(3, 4))])
     long = tr.to_trackpy()
-    assert len(long) == tr.n_frames * 4
+    assert len(long) == tr.n_frames * 4 - 1  # the lost point has no row
     assert {"frame", "time", "particle", "marker", "x", "y", "likelihood", "status"} <= set(long)
-    row = long[(long.frame == 3) & (long.marker == "thumb")].iloc[0]
-    assert np.isnan(row.x) and row.status == Status.LOST and row.likelihood == 0
+    assert long[(long.frame == 3) & (long.marker == "thumb")].empty
+    assert np.isfinite(long[["x", "y"]].to_numpy()).all()
     row = long[(long.frame == 20) & (long.marker == "wrist")].iloc[0]
     assert (row.x, row.y) == pytest.approx(tuple(tr.position[20, 2]))
-    back = pd.read_csv(tr.export(tmp_path / "t.csv", "trackpy"))
-    assert len(back) == len(long) and back.x.isna().sum() == 1
-    plain = pd.read_csv(tr.export(tmp_path / "p.csv", "csv"))
+    (path,) = export_tracks(tr, tmp_path / "t.csv", "trackpy")
+    back = pd.read_csv(path)
+    assert len(back) == len(long) and back.x.isna().sum() == 0
+    plain = pd.read_csv(export_tracks(tr, tmp_path / "p.csv", "csv")[0])
     assert list(plain.columns[:6]) == [
         "frame",
         "time",
@@ -211,8 +227,13 @@ def test_trackpy_and_plain_exports(tmp_path):
     ]
     assert np.isnan(plain.thumb_x[3]) and plain.wrist_x[20] == pytest.approx(tr.position[20, 2, 0])
     with pytest.raises(ValueError, match="format"):
-        tr.export(tmp_path / "x.csv", "excel")
+        export_tracks(tr, tmp_path / "x.csv", "excel")
     assert not (tmp_path / "x.csv").exists()
+
+
+def test_repr_is_one_line():
+    text = repr(_tracks())
+    assert "\n" not in text and len(text) < 120 and "50 frames" in text
 
 
 def test_loaded_tracks_save_again(tmp_path):

@@ -109,19 +109,34 @@ def test_mp4_cut_before_its_index_is_unreadable(tmp_path):
         FrameSource(cut)
 
 
-def test_truncated_avi_keeps_decoded_frames_warns_and_records_true_count(tmp_path, caplog):
+def test_truncated_avi_is_refused_unless_asked_to_keep_it(tmp_path, caplog):
     path = tmp_path / "clip.avi"
     write_video(_frames(30), path, 30)
     cut = tmp_path / "cut.avi"
     cut.write_bytes(path.read_bytes()[: path.stat().st_size // 2])
     src = FrameSource(cut)
     assert src.info.n_frames_header == 30
+    with pytest.raises(InputError, match="truncated or corrupt video: decoded .* of the 30"):
+        sum(1 for _ in src)
+    src = FrameSource(cut, keep_truncated=True)
     with caplog.at_level(logging.WARNING, logger="perception.io.video"):
         n = sum(1 for _ in src)
     assert 0 < n < 30
     assert src.attrs()["n_frames"] == n
     assert src.attrs()["n_frames_header"] == 30
     assert any("header claims" in r.getMessage() for r in caplog.records)
+
+
+def test_a_frame_rate_no_camera_has_is_refused_and_fps_overrides_the_container(tmp_path):
+    path = tmp_path / "fast.mp4"  # (OpenCV's AVI muxer cannot write 2000 frames/s at all)
+    write_video(_frames(10), path, 2000.0)
+    with pytest.raises(InputError, match="claims 2000 frames/s.*--fps"):
+        FrameSource(path)
+    src = FrameSource(path, fps=25.0)
+    times = [t for _, t, _ in src]
+    np.testing.assert_allclose(times, np.arange(10) / 25.0)
+    with pytest.raises(InputError, match="--fps"):
+        FrameSource(path, fps=0.0)
 
 
 def test_time_resolver_uses_container_times_and_falls_back_per_frame():

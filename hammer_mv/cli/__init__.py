@@ -20,7 +20,8 @@ import sys
 from minvar import __version__
 
 #: Subcommand modules, in the order ``--help`` lists them.
-COMMANDS = ("reach", "grasp", "synth", "track", "tracks", "repertoire", "recognize", "batch")
+COMMANDS = ("reach", "grasp", "synth", "calibrate", "track", "tracks", "repertoire", "recognize",
+            "batch")
 
 
 class _Parser(argparse.ArgumentParser):

@@ -49,6 +49,9 @@ def add_recognition_options(p: argparse.ArgumentParser) -> None:
                    help="image scale (default: from the object's apparent size)")
     g.add_argument("--mirror", action="store_true",
                    help="mirror the image so the finger lies on the model's +x side")
+    g.add_argument("--setup", type=Path, metavar="SETUP.toml",
+                   help="colour models and marker sizes for tracking videos "
+                        "(hammer-mv calibrate)")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
 
 
@@ -64,7 +67,12 @@ def recognition_settings(args: argparse.Namespace) -> RecognitionSettings:
                             mirror=args.mirror)
     hammer = HammerParams(rule=args.rule, w_r=args.w_r, w_g=args.w_g,
                           filter_gain=args.filter_gain)
-    return RecognitionSettings(observe=observe, hammer=hammer)
+    tracking = None
+    if getattr(args, "setup", None) is not None:
+        from perception.tracking.setup import load_setup
+
+        tracking = load_setup(args.setup)
+    return RecognitionSettings(observe=observe, hammer=hammer, tracking=tracking)
 
 
 def load_repertoire(args: argparse.Namespace) -> tuple[Repertoire, str]:

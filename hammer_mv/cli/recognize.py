@@ -10,6 +10,7 @@ from hammer_mv.cli.options import add_recognition_options, load_repertoire, reco
 from perception.errors import InputError
 from perception.pipeline import TRACKS_SUFFIX, clip_fingerprint, clip_name, recognize_clip
 from perception.report.clip import write_clip_report
+from perception.report.tracking import write_tracking_report
 
 
 def register(sub) -> None:
@@ -54,6 +55,8 @@ def run(args: argparse.Namespace) -> int:
                          progress=not args.quiet and sys.stderr.isatty())
     extra = {"fingerprint": clip_fingerprint(path, settings, rep_id), "condition": None,
              "input": str(path)}
+    tracks_file = path if kind == "tracks" else args.output / "tracks" / f"{clip}{TRACKS_SUFFIX}"
+    extra["tracking"] = write_tracking_report(tracks_file, args.output, clip)
     paths = write_clip_report(rec, args.output, extra=extra)
     print(f"{clip}: winner {rec.winner} ({rec.rule} rule) -> {paths['json']}")
     return 0

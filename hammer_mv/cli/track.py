@@ -39,6 +39,19 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         metavar=("MARKER", "X", "Y", "W", "H"),
         help="look for MARKER only inside this first-frame rectangle (px); repeatable",
     )
+    p.add_argument(
+        "--setup",
+        type=Path,
+        metavar="SETUP.toml",
+        help="colour models and marker sizes of the session (hammer-mv calibrate); "
+        "--colours overrides its colours",
+    )
+    p.add_argument(
+        "--labelled-video",
+        type=Path,
+        metavar="OUT.mp4",
+        help="also write the video with every marker drawn (name, likelihood, trail)",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
     p.set_defaults(func=run)
 
@@ -82,18 +95,23 @@ def parse_rois(specs: list[list[str]], names: tuple[str, ...]) -> dict[str, tupl
 
 def run(args: argparse.Namespace) -> int:
     """Track ``args.video``; print a one-line summary unless ``--quiet``."""
-    from perception.io.tracks import Tracks
-    from perception.tracking.markers import default_markers, load_markers
+    from perception.io.tracks import Status, Tracks
+    from perception.tracking.markers import load_markers
+    from perception.tracking.setup import TrackingSetup, load_setup
     from perception.tracking.tracker import track_video
 
-    markers = load_markers(args.colours) if args.colours else default_markers()
+    setup = load_setup(args.setup) if args.setup else TrackingSetup()
+    markers = load_markers(args.colours, setup.markers) if args.colours else setup.markers
     rois = parse_rois(args.roi, markers.names)
     progress = not args.quiet and sys.stderr.isatty()
-    out = track_video(args.video, args.output, markers=markers, rois=rois, progress=progress)
+    out = track_video(args.video, args.output, markers=markers, params=setup.params, rois=rois,
+                      progress=progress, labelled_video=args.labelled_video)
     if not args.quiet:
         tracks = Tracks.load(out)
         found = ", ".join(
             f"{name} {100 * tracks.valid[:, j].mean():.0f} %"
+            + (f" ({int(n)} frames ambiguous)"
+               if (n := (tracks.status[:, j] == Status.AMBIGUOUS).sum()) else "")
             for j, name in enumerate(tracks.markers)
         )
         print(f"{out}: {tracks.n_frames} frames; found {found}")

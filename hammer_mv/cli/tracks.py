@@ -1,4 +1,4 @@
-"""``hammer-mv tracks info|export FILE``: inspect a tracks file or export it as a table."""
+"""``hammer-mv tracks info|export|render FILE``: inspect, export or draw a tracks file."""
 
 from __future__ import annotations
 
@@ -16,16 +16,21 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     info.add_argument("file", type=Path, metavar="FILE", help="tracks file (.tracks.h5)")
     info.set_defaults(func=run_info)
 
-    export = actions.add_parser("export", help="export a tracks file as a CSV table")
+    export = actions.add_parser(
+        "export", help="export a tracks file for DeepLabCut, movement, trackpy or pandas",
+        description="Write the tracks of FILE in the format another tool reads "
+        "(docs/pose-files.md describes every column).")
     export.add_argument("file", type=Path, metavar="FILE", help="tracks file (.tracks.h5)")
     export.add_argument(
         "--format",
         required=True,
-        choices=("dlc", "trackpy", "csv"),
-        help="dlc: DeepLabCut wide table (scorer/bodyparts/coords header rows); "
-        "trackpy: long table, one row per frame and marker; csv: plain wide table",
+        choices=("dlc", "movement", "trackpy", "csv"),
+        help="dlc: DeepLabCut table, a real .h5 (pandas HDF, key df_with_missing) or a .csv "
+        "by OUT's ending, plus OUT's stem .status.csv; movement: a movement poses dataset "
+        "(.nc); trackpy: long table, one row per frame and seen marker; csv: plain wide table",
     )
-    export.add_argument("-o", "--output", type=Path, required=True, metavar="OUT")
+    export.add_argument("-o", "--output", type=Path, required=True, metavar="OUT",
+                        help="output file")
     export.add_argument(
         "--max-gap",
         type=int,
@@ -41,6 +46,19 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     export.set_defaults(func=run_export)
 
+    render = actions.add_parser(
+        "render", help="draw the tracked markers on their video (a labelled video)",
+        description="Write VIDEO (default: the video the tracks record) with every marker "
+        "drawn: name, likelihood and a short trail; lost markers are a grey cross at their "
+        "last position, ambiguous ones are marked in the legend.")
+    render.add_argument("file", type=Path, metavar="TRACKS.h5", help="tracks file")
+    render.add_argument("video", type=Path, nargs="?", metavar="VIDEO",
+                        help="the tracked video (default: /video path of the tracks)")
+    render.add_argument("-o", "--output", type=Path, required=True, metavar="LABELLED.mp4")
+    render.add_argument("--trail", type=int, default=12, metavar="N",
+                        help="frames of trail behind each marker (default 12)")
+    render.set_defaults(func=run_render)
+
 
 def run_info(args: argparse.Namespace) -> int:
     """Print a summary of ``args.file``.
@@ -51,6 +69,7 @@ def run_info(args: argparse.Namespace) -> int:
         Parsed arguments.
     """
     from perception.io.tracks import Status, Tracks
+    from perception.report.tracking import tracking_quality
 
     t = Tracks.load(args.file)
     v = t.video
@@ -67,14 +86,22 @@ def run_info(args: argparse.Namespace) -> int:
         print(f"time: {t.time[0]:.3f} .. {t.time[-1]:.3f} s")
         print(_movement_line(t))
     header = (
-        f"{'marker':<8} {'tracked':>8} {'reacq.':>7} {'lost':>7} {'interp.':>8} {'mean lik.':>9}"
+        f"{'marker':<8} {'tracked':>8} {'reacq.':>7} {'lost':>7} {'interp.':>8} {'ambig.':>7} "
+        f"{'mean lik.':>9}"
     )
     print(header)
     for j, name in enumerate(t.markers):
         counts = [int((t.status[:, j] == s).sum()) for s in Status]
         valid = t.valid[:, j]
         lik = float(t.likelihood[valid, j].mean()) if valid.any() else 0.0
-        print(f"{name:<8} {counts[0]:>8} {counts[1]:>7} {counts[2]:>7} {counts[3]:>8} {lik:>9.3f}")
+        print(f"{name:<8} {counts[0]:>8} {counts[1]:>7} {counts[2]:>7} {counts[3]:>8} "
+              f"{counts[4]:>7} {lik:>9.3f}")
+    print("quality:")
+    print(f"{'marker':<8} {'frames %':>8} {'min lik.':>8} {'median lik.':>11} "
+          f"{'reacquisitions':>14} {'ambiguous':>9}")
+    for q in tracking_quality(t).markers:
+        print(f"{q.marker:<8} {100 * q.tracked:>8.1f} {q.min_likelihood:>8.3f} "
+              f"{q.median_likelihood:>11.3f} {q.reacquisitions:>14} {q.ambiguous:>9}")
     return 0
 
 
@@ -102,9 +129,14 @@ def run_export(args: argparse.Namespace) -> int:
         Parsed arguments.
     """
     from perception.errors import InputError
+    from perception.io.atomic import check_output
+    from perception.io.exports import export_tracks, status_path_for
     from perception.io.tracks import Tracks
     from perception.observation import movement_span
 
+    outputs = [args.output] + ([status_path_for(args.output)] if args.format == "dlc" else [])
+    for out in outputs:
+        check_output(out, inputs=[args.file])
     if args.max_gap < 0:
         raise InputError(f"--max-gap: expected >= 0 frames, got {args.max_gap}")
     t = Tracks.load(args.file)
@@ -118,5 +150,27 @@ def run_export(args: argparse.Namespace) -> int:
         t = t.interpolate(args.max_gap)
     if span is not None:
         t = t.rows(span.start, span.stop)
-    t.export(args.output, args.format)
+    written = export_tracks(t, args.output, args.format)
+    if not getattr(args, "quiet", False):
+        print(f"wrote {', '.join(map(str, written))} ({t.n_frames} frames, {args.format})")
+    return 0
+
+
+def run_render(args: argparse.Namespace) -> int:
+    """Write the labelled video of ``args.file`` to ``args.output``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments.
+    """
+    from perception.errors import InputError
+    from perception.io.tracks import Tracks
+    from perception.tracking.overlay import render_labelled
+
+    if args.trail < 1:
+        raise InputError(f"--trail: expected >= 1 frame, got {args.trail}")
+    t = Tracks.load(args.file)
+    out = render_labelled(t, args.video, args.output, trail=args.trail)
+    print(f"{out}: {t.n_frames} frames labelled")
     return 0

@@ -1,12 +1,90 @@
-"""Outputs appear whole or not at all: write to a temporary name, then rename."""
+"""Outputs appear whole or not at all, and never in place of something that is not ours.
+
+Every writer goes through :func:`atomic_path`: the output is written under a
+temporary name beside its final one and renamed only when complete, so a
+crash, a Ctrl-C or a full disk never leaves a half-written file under the
+final name. Before anything is written the destination is checked: an
+existing directory, FIFO, device or socket is refused (``-o /dev/null``
+must not replace /dev/null), and :func:`check_output` refuses an output that
+is one of the command's inputs. A write that fails for want of space or
+permission ends in one :class:`OSError` naming the file, with the temporary
+file removed.
+
+HDF5 files are built in memory and written with plain file I/O
+(:func:`atomic_hdf5`): HDF5's own writes on a full disk fail late, at close
+or at interpreter exit, where they cannot be caught (and crash h5py).
+"""
 
 from __future__ import annotations
 
 import contextlib
 import os
+import stat
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from pathlib import Path
+
+from perception.errors import InputError
+
+__all__ = [
+    "atomic_hdf5",
+    "atomic_path",
+    "check_output",
+    "jsonable",
+    "save_figure",
+    "write_bytes",
+    "write_csv",
+    "write_json",
+    "write_text",
+]
+
+
+def _refuse_non_regular(final: Path) -> None:
+    try:
+        mode = final.stat().st_mode
+    except FileNotFoundError:
+        return
+    except OSError as exc:
+        raise OSError(exc.errno, f"cannot write {final}: {exc.strerror}") from None
+    if stat.S_ISDIR(mode):
+        raise InputError("is a folder, not a file to write", final)
+    if not stat.S_ISREG(mode):
+        raise InputError("exists and is not a regular file (a device, FIFO or socket); "
+                         "refusing to replace it", final)
+
+
+def check_output(path: str | os.PathLike, inputs: Iterable[str | os.PathLike] = ()) -> Path:
+    """Refuse an output path that would destroy an input or something that is not a file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The output the command is about to write.
+    inputs : iterable of str or os.PathLike
+        The command's input files.
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Raises
+    ------
+    InputError
+        ``path`` is one of ``inputs`` (the same file, through any name or
+        link), or exists and is not a regular file.
+    """
+    final = Path(path)
+    _refuse_non_regular(final)
+    for source in inputs:
+        source = Path(source)
+        same = False
+        with contextlib.suppress(OSError):
+            same = final.exists() and source.exists() and os.path.samefile(final, source)
+        if same or final.resolve() == source.resolve():
+            raise InputError(f"is also an input of this command ({source}); "
+                             "choose another output name", final)
+    return final
 
 
 @contextlib.contextmanager
@@ -14,20 +92,27 @@ def atomic_path(path: str | os.PathLike, *, suffix: str | None = None) -> Iterat
     """Yield a temporary path beside ``path``; rename it to ``path`` on success.
 
     If the body raises, the temporary file is removed and ``path`` is left as it
-    was (absent or the previous complete version).
+    was (absent or the previous complete version). An :class:`OSError` (a full
+    disk, no permission) is raised again as one naming ``path``.
 
     Parameters
     ----------
     path : str or os.PathLike
-        Final destination. Its folder is created if missing.
+        Final destination. Its folder is created if missing; it must not be
+        a folder, device, FIFO or socket.
     suffix : str, optional
         Suffix of the temporary name (default: that of ``path``), for writers
         that infer the format from the extension (OpenCV, matplotlib).
     """
     final = Path(path)
-    final.parent.mkdir(parents=True, exist_ok=True)
+    _refuse_non_regular(final)
     suffix = final.suffix if suffix is None else suffix
-    fd, tmp = tempfile.mkstemp(prefix=f".{final.stem}.", suffix=f".part{suffix}", dir=final.parent)
+    try:
+        final.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{final.stem}.", suffix=f".part{suffix}",
+                                   dir=final.parent)
+    except OSError as exc:
+        raise OSError(exc.errno, f"cannot write {final}: {exc.strerror or exc}") from None
     os.close(fd)
     tmp_path = Path(tmp)
     # mkstemp creates the file 0600; the output should get the usual
@@ -38,17 +123,69 @@ def atomic_path(path: str | os.PathLike, *, suffix: str | None = None) -> Iterat
     try:
         yield tmp_path
         os.replace(tmp_path, final)
+    except OSError as exc:
+        with contextlib.suppress(FileNotFoundError):
+            tmp_path.unlink()
+        if isinstance(exc, InputError | FileNotFoundError) or exc.errno is None:
+            raise
+        raise OSError(exc.errno, f"cannot write {final}: {exc.strerror or exc}") from None
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             tmp_path.unlink()
         raise
 
 
-def write_text(path: str | os.PathLike, text: str) -> Path:
-    """Write ``text`` to ``path`` atomically; return the path."""
-    with atomic_path(path) as tmp:
-        tmp.write_text(text)
+def write_bytes(path: str | os.PathLike, data: bytes) -> Path:
+    """Write ``data`` to ``path`` atomically; return the path.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Output file.
+    data : bytes
+        Its content.
+    """
+    with atomic_path(path) as tmp, open(tmp, "wb") as fh:
+        fh.write(data)
+        fh.flush()
+        os.fsync(fh.fileno())  # a full disk shows here, not after the rename
     return Path(path)
+
+
+@contextlib.contextmanager
+def atomic_hdf5(path: str | os.PathLike) -> Iterator:
+    """Yield a new, in-memory ``h5py.File``; write it to ``path`` whole when the block ends.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Final destination (checked as by :func:`atomic_path`).
+    """
+    import h5py
+
+    _refuse_non_regular(Path(path))
+    # A unique in-memory name: h5py's core driver keys open files by name.
+    fh = h5py.File(f"hammer-mv-{id(object())}.h5", "w", driver="core", backing_store=False)
+    try:
+        yield fh
+        fh.flush()
+        image = fh.id.get_file_image()
+    finally:
+        fh.close()
+    write_bytes(path, image)
+
+
+def write_text(path: str | os.PathLike, text: str) -> Path:
+    """Write ``text`` to ``path`` atomically; return the path.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Output file.
+    text : str
+        Its content (written as UTF-8).
+    """
+    return write_bytes(path, text.encode("utf-8"))
 
 
 def jsonable(value):

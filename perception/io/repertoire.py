@@ -27,7 +27,8 @@ import numpy as np
 
 from perception import __version__
 from perception.errors import InputError
-from perception.io.atomic import atomic_path
+from perception.io.atomic import atomic_hdf5
+from perception.io.hdf5 import decode_attrs, open_hdf5, read_dataset, scalar_attr
 
 __all__ = ["SCHEMA", "SCHEMA_VERSION", "StoredCalibration", "StoredChain", "StoredModel",
            "read_repertoire", "write_repertoire"]
@@ -125,10 +126,9 @@ def write_repertoire(path: str | os.PathLike, config: Mapping[str, Any],
     models : sequence of StoredModel
         The models, in order.
     """
-    import h5py
 
     path = Path(path)
-    with atomic_path(path) as tmp, h5py.File(tmp, "w") as f:
+    with atomic_hdf5(path) as f:
         f.attrs["schema"] = SCHEMA
         f.attrs["schema_version"] = SCHEMA_VERSION
         f.attrs["software_version"] = __version__
@@ -153,28 +153,90 @@ def write_repertoire(path: str | os.PathLike, config: Mapping[str, Any],
     return path
 
 
-def _read_chain(cg) -> StoredChain:
-    arrays = {k: np.asarray(cg[k][()], dtype=float) for k in ARRAYS}
-    return StoredChain(arrays=arrays, l1=float(cg.attrs["l1"]), l2=float(cg.attrs["l2"]),
-                       base=np.asarray(cg.attrs["base"], dtype=float),
-                       elbow=int(cg.attrs["elbow"]))
+def _read_chain(cg, path: Path) -> StoredChain:
+    arrays = {k: np.asarray(read_dataset(cg, k, "number", _NDIM[k], path), dtype=float)
+              for k in ARRAYS}
+    attrs = decode_attrs(cg.attrs, cg.name, path)
+    base = np.asarray(attrs.get("base"), dtype=float) if "base" in attrs else None
+    if base is None or base.shape != (2,):
+        raise InputError(f"attribute {cg.name}.base must be 2 numbers", path)
+    return StoredChain(arrays=arrays, l1=scalar_attr(attrs, "l1", "number", cg.name, path),
+                       l2=scalar_attr(attrs, "l2", "number", cg.name, path), base=base,
+                       elbow=scalar_attr(attrs, "elbow", "integer", cg.name, path))
 
 
-def _read_calibration(mg) -> StoredCalibration | None:
+def _read_calibration(mg, path: Path) -> StoredCalibration | None:
+    """The model's calibration group, or None in a file written before it existed."""
+    import h5py
+
     if "calibration" not in mg:
         return None
     cal = mg["calibration"]
-    return StoredCalibration(misfit=np.asarray(cal["misfit"][()], dtype=float),
-                             frame_period=float(cal.attrs["frame_period"]),
-                             params=json.loads(cal.attrs["params"]))
+    if not isinstance(cal, h5py.Group):
+        raise InputError(f"{cal.name} is not a group", path)
+    misfit = np.asarray(read_dataset(cal, "misfit", "number", 1, path), dtype=float)
+    attrs = decode_attrs(cal.attrs, cal.name, path)
+    period = scalar_attr(attrs, "frame_period", "number", cal.name, path)
+    if period is None or not period > 0:
+        raise InputError(f"attribute {cal.name}.frame_period must be a positive time, "
+                         f"got {period!r}", path)
+    params = _json_attr(attrs, "params", cal.name, path)
+    if not isinstance(params, dict):
+        raise InputError(f"attribute {cal.name}.params must be a JSON object", path)
+    return StoredCalibration(misfit=misfit, frame_period=period, params=params)
 
 
-def _read_model(name: str, mg) -> StoredModel:
-    return StoredModel(name=name, kind=str(mg.attrs["kind"]), task=json.loads(mg.attrs["task"]),
-                       scene=json.loads(mg.attrs["scene"]), substeps=int(mg.attrs["substeps"]),
-                       dt=float(mg.attrs["dt"]),
-                       chains={role: _read_chain(mg[role]) for role in ROLES},
-                       calibration=_read_calibration(mg))
+def _json_attr(attrs: dict, key: str, where: str, path: Path):
+    text = scalar_attr(attrs, key, "string", where, path)
+    try:
+        return json.loads(text)
+    except (TypeError, ValueError):
+        raise InputError(f"attribute {where}.{key} is not JSON", path) from None
+
+
+def _read_model(name: str, mg, path: Path) -> StoredModel:
+    import h5py
+
+    if not isinstance(mg, h5py.Group):
+        raise InputError(f"/models/{name} is not a group", path)
+    a = decode_attrs(mg.attrs, mg.name, path)
+    for role in ROLES:
+        if role not in mg or not isinstance(mg.get(role, getlink=True), h5py.HardLink):
+            raise InputError(f"missing group {mg.name}/{role}", path)
+    dt = scalar_attr(a, "dt", "number", mg.name, path)
+    if dt is None or dt <= 0:
+        raise InputError(f"attribute {mg.name}.dt must be a positive time step, got {dt!r}",
+                         path)
+    return StoredModel(name=name, kind=scalar_attr(a, "kind", "string", mg.name, path),
+                       task=_json_attr(a, "task", mg.name, path),
+                       scene=_json_attr(a, "scene", mg.name, path),
+                       substeps=scalar_attr(a, "substeps", "integer", mg.name, path), dt=dt,
+                       chains={role: _read_chain(mg[role], path) for role in ROLES},
+                       calibration=_read_calibration(mg, path))
+
+
+def _read_file(f, path: Path) -> tuple[dict, list[StoredModel]]:
+    root = decode_attrs(f.attrs, "/", path)
+    schema = scalar_attr(root, "schema", "string", "/", path)
+    if schema != SCHEMA:
+        raise InputError(f"not a hammer-mv repertoire (schema {schema!r}, "
+                         f"expected {SCHEMA!r})", path)
+    version = scalar_attr(root, "schema_version", "integer", "/", path)
+    if version != SCHEMA_VERSION:
+        raise InputError(f"repertoire schema version {version} is not supported "
+                         f"(this is version {SCHEMA_VERSION}); rebuild it", path)
+    config = _json_attr(root, "config", "/", path) if "config" in root else {}
+    if "models" not in f:
+        raise InputError("missing group /models", path)
+    groups = list(f["models"].items())
+    order = [scalar_attr(decode_attrs(g.attrs, g.name, path), "order", "integer", g.name,
+                         path) for _, g in groups]
+    ranked = sorted(range(len(groups)), key=lambda i: (order[i] if order[i] is not None else i))
+    return config, [_read_model(*groups[i], path) for i in ranked]
+
+
+#: Dimensions of each stored chain array.
+_NDIM = {"A": 2, "B": 2, "H": 2, "K": 3, "L": 3, "P": 3, "x0": 1}
 
 
 def read_repertoire(path: str | os.PathLike) -> tuple[dict, list[StoredModel]]:
@@ -190,27 +252,14 @@ def read_repertoire(path: str | os.PathLike) -> tuple[dict, list[StoredModel]]:
     InputError
         If the file is missing, not HDF5, of another schema or version, or corrupt.
     """
-    import h5py
 
     path = Path(path)
-    if not path.is_file():
-        raise InputError("repertoire file not found", path)
     try:
-        with h5py.File(path, "r") as f:
-            schema = f.attrs.get("schema")
-            if schema != SCHEMA:
-                raise InputError(f"not a hammer-mv repertoire (schema {schema!r}, "
-                                 f"expected {SCHEMA!r})", path)
-            version = int(f.attrs.get("schema_version", -1))
-            if version != SCHEMA_VERSION:
-                raise InputError(f"repertoire schema version {version} is not supported "
-                                 f"(this is version {SCHEMA_VERSION}); rebuild it", path)
-            config = json.loads(f.attrs.get("config", "{}"))
-            groups = sorted(f["models"].items(), key=lambda kv: kv[1].attrs["order"])
-            models = [_read_model(name, mg) for name, mg in groups]
+        with open_hdf5(path, "repertoire") as f:
+            config, models = _read_file(f, path)
     except InputError:
         raise
-    except (OSError, KeyError, ValueError, TypeError) as exc:
+    except (OSError, KeyError, ValueError, TypeError) as exc:  # a corruption we did not foresee
         raise InputError(f"corrupt or unreadable repertoire: {exc}", path) from None
     if not models:
         raise InputError("repertoire holds no models", path)

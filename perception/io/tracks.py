@@ -9,7 +9,8 @@ Schema (docs/tracks-format.md), written with h5py::
     /tracks/markers    str     (M,)      thumb, finger, wrist, object
     /tracks/position   float64 (T,M,2)   px; NaN where lost (never 0)
     /tracks/likelihood float32 (T,M)     0..1; 0 where lost
-    /tracks/status     int8    (T,M)     0 tracked, 1 reacquired, 2 lost, 3 interpolated
+    /tracks/status     int8    (T,M)     0 tracked, 1 reacquired, 2 lost, 3 interpolated,
+                                        4 ambiguous
     /tracker     attrs: colour models, termination criteria, parameters
 
 The datasets are chunked and resizable; :class:`TracksWriter` appends to them
@@ -24,6 +25,7 @@ import contextlib
 import enum
 import json
 import os
+import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -36,13 +38,16 @@ import pandas as pd
 
 from minvar import __version__
 from perception.errors import InputError
-from perception.io.atomic import atomic_path
+from perception.io.atomic import atomic_hdf5
+from perception.io.hdf5 import decode_attrs, open_hdf5, read_dataset, scalar_attr
 
 SCHEMA = "hammer-mv/tracks"
 SCHEMA_VERSION = 1
 
-#: Export formats of :meth:`Tracks.export`.
-EXPORT_FORMATS = ("dlc", "trackpy", "csv")
+#: An interpolated point's likelihood is this fraction of the weaker of the
+#: two detections it bridges: below DeepLabCut's default cutoff (0.6), so
+#: tools that filter by likelihood never take a bridge for a detection.
+INTERPOLATED_LIKELIHOOD = 0.5
 
 
 class Status(enum.IntEnum):
@@ -52,6 +57,7 @@ class Status(enum.IntEnum):
     REACQUIRED = 1
     LOST = 2
     INTERPOLATED = 3
+    AMBIGUOUS = 4
 
 
 def _attr_value(value: Any) -> Any:
@@ -71,17 +77,6 @@ def _attr_value(value: Any) -> Any:
     ):
         return np.asarray(value)
     return json.dumps(value)
-
-
-def _read_attrs(attrs: h5py.AttributeManager) -> dict[str, Any]:
-    out = {}
-    for key, value in attrs.items():
-        if isinstance(value, bytes):
-            value = value.decode("utf-8")
-        elif isinstance(value, np.generic):
-            value = value.item()
-        out[key] = value
-    return out
 
 
 def _write_attrs(attrs: h5py.AttributeManager, values: Mapping[str, Any]) -> None:
@@ -210,6 +205,12 @@ class Tracks:
         """(T, M) bool, True where the position is known (not lost)."""
         return np.isfinite(self.position).all(axis=-1)
 
+    def __repr__(self) -> str:
+        span = f"{self.time[0]:.3f}-{self.time[-1]:.3f} s" if self.n_frames else "empty"
+        where = f", {self.path.name}" if self.path is not None else ""
+        return (f"Tracks({self.n_frames} frames, {span}, markers {', '.join(self.markers)}"
+                f"{where})")
+
     def replace(self, **changes: Any) -> Tracks:
         """Copy with some attributes replaced."""
         kwargs = {
@@ -236,8 +237,9 @@ class Tracks:
 
         A gap is a run of lost frames with a known position on both sides;
         runs at the start or end, and runs longer than ``max_gap`` frames, stay
-        NaN. A filled sample's likelihood is the lower of the two bounding
-        likelihoods: the bridge is no more certain than its weaker end.
+        NaN. A filled sample's likelihood is :data:`INTERPOLATED_LIKELIHOOD`
+        times the lower of the two bounding likelihoods: a bridge is less
+        certain than either end, and stays below the usual likelihood cutoffs.
 
         Parameters
         ----------
@@ -267,7 +269,8 @@ class Tracks:
                 inner = slice(a + 1, b)
                 w = (self.time[inner] - self.time[a]) / (self.time[b] - self.time[a])
                 position[inner, j] = position[a, j] + w[:, None] * (position[b, j] - position[a, j])
-                likelihood[inner, j] = min(likelihood[a, j], likelihood[b, j])
+                weaker = min(likelihood[a, j], likelihood[b, j])
+                likelihood[inner, j] = INTERPOLATED_LIKELIHOOD * weaker
                 status[inner, j] = Status.INTERPOLATED
         return self.replace(position=position, likelihood=likelihood, status=status)
 
@@ -309,14 +312,14 @@ class Tracks:
         return pd.DataFrame(data, index=pd.Index(self.frame, name="frame"), columns=cols)
 
     def to_trackpy(self) -> pd.DataFrame:
-        """trackpy-style long table, one row per frame and marker.
+        """trackpy-style long table, one row per frame and *seen* marker.
 
         Columns: ``frame, time, particle`` (marker column index), ``marker,
-        x, y, likelihood, status``. Lost rows are kept with NaN ``x, y``;
-        drop them with ``df.dropna(subset=["x", "y"])`` where trackpy needs.
+        x, y, likelihood, status``. Lost points have no row: trackpy's
+        ``link`` and ``imsd`` expect only real positions.
         """
         t, m = self.n_frames, len(self.markers)
-        return pd.DataFrame(
+        table = pd.DataFrame(
             {
                 "frame": np.repeat(self.frame, m),
                 "time": np.repeat(self.time, m),
@@ -330,6 +333,13 @@ class Tracks:
                 "status": self.status.ravel(),
             }
         )
+        return table[self.valid.ravel()].reset_index(drop=True)
+
+    def to_status(self) -> pd.DataFrame:
+        """Status codes as a wide table: ``frame`` then one column per marker (:class:`Status`)."""
+        data: dict[str, Any] = {"frame": self.frame}
+        data.update({name: self.status[:, j] for j, name in enumerate(self.markers)})
+        return pd.DataFrame(data)
 
     def to_pandas(self) -> pd.DataFrame:
         """Plain wide table: ``frame, time`` then ``<marker>_x, _y, _likelihood, _status``."""
@@ -340,32 +350,6 @@ class Tracks:
             data[f"{name}_likelihood"] = self.likelihood[:, j]
             data[f"{name}_status"] = self.status[:, j]
         return pd.DataFrame(data)
-
-    def export(self, path: str | os.PathLike, format: str = "csv") -> Path:
-        """Write a table as CSV, atomically.
-
-        Parameters
-        ----------
-        path : str or os.PathLike
-            Output file.
-        format : {"dlc", "trackpy", "csv"}
-            :meth:`to_dlc` (three header rows, as DeepLabCut writes),
-            :meth:`to_trackpy` or :meth:`to_pandas`.
-        """
-        if format == "dlc":
-            # DeepLabCut's files have the three header rows and no index-name row.
-            table, index = self.to_dlc().rename_axis(None), True
-        elif format == "trackpy":
-            table, index = self.to_trackpy(), False
-        elif format == "csv":
-            table, index = self.to_pandas(), False
-        else:
-            raise ValueError(
-                f"export: format: expected one of {', '.join(EXPORT_FORMATS)}, got {format!r}"
-            )
-        with atomic_path(path) as tmp:
-            table.to_csv(tmp, index=index, na_rep="NaN")
-        return Path(path)
 
     # -- files ----------------------------------------------------------------
     def save(self, path: str | os.PathLike) -> Path:
@@ -378,51 +362,71 @@ class Tracks:
 
     @classmethod
     def load(cls, path: str | os.PathLike) -> Tracks:
-        """Read a tracks file, checking its schema and version.
+        """Read a tracks file, checking its schema, version and every object it reads.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The ``.tracks.h5`` (or ``.truth.h5``) file.
 
         Raises
         ------
         InputError
-            Missing file, not HDF5, another schema or version, or a missing or
-            misshapen dataset; the message names the file.
+            Missing file, not HDF5, another schema or version, a missing,
+            linked, misshapen or mistyped dataset or attribute; the message
+            names the file and the object.
         """
         p = Path(path)
-        if not p.exists():
-            raise InputError("no such file", p)
-        try:
-            fh = h5py.File(p, "r")
-        except OSError:
-            raise InputError("not an HDF5 file (or unreadable)", p) from None
-        with fh:
-            root = _read_attrs(fh.attrs)
-            schema = root.pop("schema", None)
-            version = root.pop("schema_version", None)
+        with open_hdf5(p, "tracks file") as fh:
+            root = decode_attrs(fh.attrs, "/", p)
+            schema = scalar_attr(root, "schema", "string", "/", p)
             if schema != SCHEMA:
                 raise InputError(
                     f"not a hammer-mv tracks file (schema {schema!r}, expected {SCHEMA!r})", p
                 )
+            version = scalar_attr(root, "schema_version", "integer", "/", p)
             if version != SCHEMA_VERSION:
                 raise InputError(
                     f"tracks schema_version {version!r} is not supported "
                     f"(this hammer-mv reads version {SCHEMA_VERSION})",
                     p,
                 )
-            root.pop("software_version", None)
-            data = {}
-            for name in ("frame", "time", "markers", "position", "likelihood", "status"):
-                key = f"tracks/{name}"
-                if key not in fh or not isinstance(fh[key], h5py.Dataset):
-                    raise InputError(f"missing dataset /{key}", p)
-                data[name] = fh[key][()]
+            for key in ("schema", "schema_version", "software_version"):
+                root.pop(key, None)
+            data = {name: read_dataset(fh, f"tracks/{name}", kind, ndim, p)
+                    for name, (kind, ndim) in _DATASETS.items()}
             markers = tuple(
                 m.decode("utf-8") if isinstance(m, bytes) else str(m) for m in data.pop("markers")
             )
-            video = _read_attrs(fh["video"].attrs) if "video" in fh else {}
-            tracker = _read_attrs(fh["tracker"].attrs) if "tracker" in fh else {}
+            video = _group_attrs(fh, "video", p)
+            for key, kind in _VIDEO_ATTRS.items():
+                scalar_attr(video, key, kind, "/video", p)
+            tracker = _group_attrs(fh, "tracker", p)
         try:
             return cls(markers=markers, video=video, tracker=tracker, attrs=root, path=p, **data)
         except ValueError as exc:
             raise InputError(f"inconsistent datasets: {exc}", p) from None
+
+
+#: The datasets of ``/tracks``: (kind of dtype, number of dimensions).
+_DATASETS = {"frame": ("integer", 1), "time": ("number", 1), "markers": ("string", 1),
+             "position": ("number", 3), "likelihood": ("number", 2), "status": ("integer", 2)}
+#: ``/video`` attributes readers use, and what each must be.
+_VIDEO_ATTRS = {"path": "string", "sha256": "string", "fps_nominal": "number",
+                "n_frames": "integer", "n_frames_header": "integer", "width": "integer",
+                "height": "integer", "fourcc": "string", "time_source": "string"}
+
+
+def _group_attrs(fh, name: str, path: Path) -> dict[str, Any]:
+    """The attributes of group ``/name`` (empty if there is none)."""
+    import h5py
+
+    if name not in fh:
+        return {}
+    if not isinstance(fh.get(name, getlink=True), h5py.HardLink) or not isinstance(
+            fh[name], h5py.Group):
+        raise InputError(f"/{name} is not a group stored in the file", path)
+    return decode_attrs(fh[name].attrs, f"/{name}", path)
 
 
 class TracksWriter:
@@ -430,8 +434,9 @@ class TracksWriter:
 
     Rows are buffered in memory ``chunk_frames`` at a time and appended to
     chunked, resizable datasets, so memory stays flat however long the video.
-    The file is written under a temporary name and renamed when the block
-    exits cleanly; if it raises, nothing is left behind.
+    The file is built in memory (a few tens of bytes per frame) and written
+    under a temporary name, renamed when the block exits cleanly; if it
+    raises, or the disk is full, nothing is left behind.
 
     Parameters
     ----------
@@ -495,8 +500,7 @@ class TracksWriter:
     def __enter__(self) -> TracksWriter:
         stack = contextlib.ExitStack()
         try:
-            tmp = stack.enter_context(atomic_path(self.path))
-            fh = stack.enter_context(h5py.File(tmp, "w"))
+            fh = stack.enter_context(atomic_hdf5(self.path))
             g = fh.create_group("tracks")
             c = self.chunk
             g.create_dataset(
@@ -512,8 +516,10 @@ class TracksWriter:
                     fillvalue=np.nan if name == "position" else 0,
                 )
         except BaseException:
-            stack.close()
-            raise
+            # Exit the stack *with* the error: a plain close() would let the
+            # atomic output rename its empty temporary file into place.
+            if not stack.__exit__(*sys.exc_info()):
+                raise
         self._stack, self._fh = stack, fh
         return self
 
@@ -601,8 +607,6 @@ class TracksWriter:
                 _write_attrs(fh.require_group("video").attrs, self.meta["video"])
                 _write_attrs(fh.require_group("tracker").attrs, self.meta["tracker"])
             except BaseException:
-                import sys
-
                 self._stack.__exit__(*sys.exc_info())
                 raise
         return bool(self._stack.__exit__(exc_type, exc, tb))

@@ -20,6 +20,7 @@ import logging
 import math
 import os
 import queue
+import sys
 import threading
 from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import asdict, dataclass
@@ -40,6 +41,12 @@ CODECS: Mapping[str, str] = MappingProxyType({".mp4": "mp4v", ".avi": "MJPG", ".
 
 #: Values of :attr:`FrameSource.time_source`.
 TIME_SOURCES = ("container", "index/fps", "mixed")
+#: Highest frame rate believed from a header, frames/s (high-speed cameras
+#: filming reaches run at 100-500; a higher claim is a broken header).
+MAX_FPS = 1000.0
+#: A stream counts as truncated when it ends this fraction (and at least 2
+#: frames) short of the count its header claims.
+TRUNCATION_TOLERANCE = 0.02
 
 
 def sha256_file(path: str | os.PathLike, chunk: int = 1 << 20) -> str:
@@ -97,10 +104,13 @@ class TimeResolver:
     ----------
     fps : float
         Nominal frame rate, frames/s, for the fallback.
+    use_container : bool
+        Use the container's times at all (False: every frame at ``index / fps``).
     """
 
-    def __init__(self, fps: float):
+    def __init__(self, fps: float, *, use_container: bool = True):
         self.fps = fps
+        self.use_container = use_container
         self.previous: float | None = None
         self.n_container = 0
         self.n_fallback = 0
@@ -108,7 +118,8 @@ class TimeResolver:
     def __call__(self, pos_msec: float) -> float:
         """Return the time (s) of the next frame given its ``CAP_PROP_POS_MSEC``."""
         t = pos_msec / 1000.0
-        if math.isfinite(t) and t >= 0 and (self.previous is None or t > self.previous):
+        if (self.use_container and math.isfinite(t) and t >= 0
+                and (self.previous is None or t > self.previous)):
             self.n_container += 1
         else:
             if not (self.fps > 0 and math.isfinite(self.fps)):
@@ -144,6 +155,12 @@ class FrameSource:
         Frames decoded ahead (0: decode in the caller's thread).
     hash : bool
         Compute the file's SHA-256 (one extra sequential read of the file).
+    keep_truncated : bool
+        Keep the frames of a stream that ends well before the frame count its
+        header claims (a truncated or corrupt file) instead of refusing it.
+    fps : float, optional
+        The true frame rate, frames/s: frame times become ``index / fps``,
+        whatever the container says (for files whose header is wrong).
 
     Raises
     ------
@@ -160,9 +177,15 @@ class FrameSource:
         True once the stream has been read to its end.
     """
 
-    def __init__(self, path: str | os.PathLike, *, prefetch: int = 8, hash: bool = True):
+    def __init__(self, path: str | os.PathLike, *, prefetch: int = 8, hash: bool = True,
+                 keep_truncated: bool = False, fps: float | None = None):
         self.path = Path(path)
         self.prefetch = int(prefetch)
+        self.keep_truncated = bool(keep_truncated)
+        if fps is not None and not (math.isfinite(fps) and 0 < fps <= MAX_FPS):
+            raise InputError(f"--fps: expected a frame rate in (0, {MAX_FPS:g}] frames/s, "
+                             f"got {fps!r}")
+        self.fps_override = fps
         if not self.path.exists():
             raise InputError("no such file", self.path)
         if not self.path.is_file():
@@ -192,7 +215,11 @@ class FrameSource:
             height=int(height),
             fourcc=_fourcc_str(cap.get(cv2.CAP_PROP_FOURCC)),
         )
-        self._times = TimeResolver(self.info.fps_nominal)
+        if self.fps_override is not None:
+            self._times = TimeResolver(self.fps_override, use_container=False)
+        else:
+            self._check_rate()
+            self._times = TimeResolver(self.info.fps_nominal)
         self.n_decoded = 0
         self.complete = False
         self._started = False
@@ -262,18 +289,29 @@ class FrameSource:
                 raise item
             yield item
 
+    def _check_rate(self) -> None:
+        """Refuse a header frame rate no camera films a hand at (it would rescale time)."""
+        fps = self.info.fps_nominal
+        if fps > MAX_FPS:
+            self._cap.release()
+            raise InputError(f"the container claims {fps:g} frames/s, more than any camera "
+                             f"filming a hand ({MAX_FPS:g}); give the true rate with --fps",
+                             self.path)
+
     def _check_count(self) -> None:
         claimed = self.info.n_frames_header
-        if claimed and self.n_decoded < claimed:
-            logger.warning(
-                "%s: decoded %d of the %d frames the header claims (truncated or corrupt?); "
-                "keeping the %d decoded",
-                self.path,
-                self.n_decoded,
-                claimed,
-                self.n_decoded,
-            )
-        if self._times.n_fallback:
+        # Header counts of some containers are estimates (duration x rate):
+        # a frame or two short is not a truncated file.
+        missing = claimed - self.n_decoded
+        if claimed and missing > max(2, TRUNCATION_TOLERANCE * claimed):
+            if not self.keep_truncated:
+                raise InputError(
+                    f"truncated or corrupt video: decoded {self.n_decoded} of the {claimed} "
+                    "frames its header claims (--keep-truncated uses the decoded frames)",
+                    self.path)
+            logger.warning("%s: decoded %d of the %d frames the header claims; keeping them "
+                           "(--keep-truncated)", self.path, self.n_decoded, claimed)
+        if self._times.n_fallback and self.fps_override is None:
             logger.warning(
                 "%s: %d of %d frames had no usable container timestamp; used previous + 1/fps",
                 self.path,
@@ -331,6 +369,30 @@ def open_video(path: str | os.PathLike, **kwargs: Any) -> FrameSource:
         Passed to :class:`FrameSource` (``prefetch``, ``hash``).
     """
     return FrameSource(path, **kwargs)
+
+
+@contextlib.contextmanager
+def quiet_native_stderr() -> Iterator[None]:
+    """Silence what OpenCV and FFmpeg print straight to the process's stderr.
+
+    Their messages about a file we then report ourselves ("tag ... is not
+    found", "Could not open codec") would make a one-line error three lines.
+    Only file descriptor 2 is redirected, and only for the block.
+    """
+    try:
+        fd = sys.stderr.fileno()
+    except (AttributeError, OSError, ValueError):  # no real stderr (e.g. captured)
+        yield
+        return
+    sys.stderr.flush()
+    saved = os.dup(fd)
+    try:
+        with open(os.devnull, "w") as null:
+            os.dup2(null.fileno(), fd)
+            yield
+    finally:
+        os.dup2(saved, fd)
+        os.close(saved)
 
 
 def codec_for(path: str | os.PathLike, codec: str | None = None) -> str:
@@ -396,14 +458,18 @@ class VideoWriter:
         stack = contextlib.ExitStack()
         try:
             self.tmp_path = stack.enter_context(atomic_path(self.path))
-            vw = cv2.VideoWriter(
-                os.fspath(self.tmp_path), cv2.VideoWriter_fourcc(*self.codec), self.fps, self.size
-            )
+            with quiet_native_stderr():
+                vw = cv2.VideoWriter(
+                    os.fspath(self.tmp_path), cv2.VideoWriter_fourcc(*self.codec), self.fps,
+                    self.size
+                )
             if not vw.isOpened():
                 raise OSError(f"{self.path}: OpenCV cannot write {self.codec!r} video here")
         except BaseException:
-            stack.close()
-            raise
+            # Exit the stack *with* the error: a plain close() would let the
+            # atomic output rename its empty temporary file into place.
+            if not stack.__exit__(*sys.exc_info()):
+                raise
         self._stack, self._vw = stack, vw
         return self
 
@@ -421,11 +487,39 @@ class VideoWriter:
     def __exit__(self, exc_type, exc, tb) -> bool:
         assert self._stack is not None and self._vw is not None
         self._vw.release()
-        if exc_type is None and self.n_written == 0:
-            err = ValueError(f"{self.path}: no frames written")
-            self._stack.__exit__(ValueError, err, None)  # removes the temporary file
-            raise err
+        if exc_type is None:
+            err = None
+            if self.n_written == 0:
+                err = ValueError(f"{self.path}: no frames written")
+            elif not _readable(self.tmp_path, self.n_written):
+                # OpenCV reports no write errors: a full disk shows as a file
+                # FFmpeg cannot open, or one with fewer frames than written.
+                err = OSError(f"cannot write {self.path}: the video came out incomplete "
+                              "(is the disk full?)")
+            if err is not None:
+                self._stack.__exit__(type(err), err, None)  # removes the temporary file
+                raise err
         return bool(self._stack.__exit__(exc_type, exc, tb))
+
+
+def _readable(path: Path, n_frames: int) -> bool:
+    """Whether FFmpeg opens a just-written clip and its header counts ``n_frames``."""
+    with quiet_native_stderr():
+        cap = cv2.VideoCapture(os.fspath(path), cv2.CAP_FFMPEG)
+    try:
+        if not cap.isOpened():
+            return False
+        count = cap.get(cv2.CAP_PROP_FRAME_COUNT)
+        if math.isfinite(count) and count > 0:
+            return int(count) == n_frames
+        # No count in the header (an unfinished AVI, for one): count what decodes.
+        with quiet_native_stderr():
+            decoded = 0
+            while decoded <= n_frames and cap.grab():
+                decoded += 1
+        return decoded == n_frames
+    finally:
+        cap.release()
 
 
 def write_video(

@@ -155,6 +155,25 @@ def _models_table(summary: pd.DataFrame) -> str:
             f'<div class="scroll">{table}</div></details>')
 
 
+#: summary.csv columns the main table or the per-model table shows.
+_SHOWN = {"clip", "condition", "winner", "rule", "verdict", "familiarity", "margin",
+          "winner_log_likelihood", "reference_model", "reference_confidence", "status",
+          "reused", "error"}
+
+
+def _other_columns_table(summary: pd.DataFrame) -> str:
+    """summary.csv's other columns (the tracking quality, …), folded away."""
+    cols = [c for c in summary.columns if c not in _SHOWN and not c.startswith("conf_")]
+    if not cols:
+        return ""
+    rows = [[_e(r["clip"])] + [_num(r[c], ".3g") if isinstance(r[c], int | float | np.number)
+                               else _e(r[c]) for c in cols]
+            for _, r in summary[summary["status"] == "ok"].iterrows()]
+    table = _table(["clip", *cols], rows, numeric=set(range(1, len(cols) + 1)))
+    return ("<details><summary>Tracking quality and other columns of summary.csv</summary>"
+            f'<div class="scroll">{table}</div></details>')
+
+
 def _verdict_counts(ok: pd.DataFrame) -> str:
     if not len(ok):
         return ""
@@ -277,6 +296,7 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
         + ", ".join(tables) + '. <span class="note">' + _HOW_TO_READ + "</span></p>",
         _verdict_counts(ok),
         "<h2>Summary</h2>", _main_table(summary, anchors, profile_model), _models_table(summary),
+        _other_columns_table(summary),
         *sections, "<h2>Clips</h2>", *clips,
     ])
     page = ("<!doctype html><html><head><meta charset='utf-8'>"

@@ -71,7 +71,8 @@ class ClipSummary:
     aperture : (N,) array
         Observed grip aperture, m.
     extras : dict
-        The JSON's other keys (``fingerprint``, ``condition``, ``input``, …).
+        The JSON's other keys (``fingerprint``, ``condition``, ``input``,
+        ``tracking``, …).
     """
 
     clip: str
@@ -90,6 +91,11 @@ class ClipSummary:
     transport: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     aperture: np.ndarray = field(default_factory=lambda: np.zeros(0))
     extras: dict = field(default_factory=dict)
+
+    @property
+    def tracking(self) -> dict | None:
+        """The clip's tracking quality (the JSON's ``tracking`` key), if recorded."""
+        return self.extras.get("tracking")
 
     @property
     def grip(self) -> np.ndarray:

@@ -23,6 +23,7 @@ import pandas as pd
 from perception.errors import InputError
 from perception.io.atomic import write_csv
 from perception.io.video import CODECS
+from perception.synthetic.footage import load_background
 from perception.synthetic.render import render_clip
 from perception.synthetic.scene import Camera, Distractor, Occlusion, RenderStyle, Scene
 from perception.synthetic.stimuli import CONDITIONS, StimulusParams, stimulus_paths, stimulus_task
@@ -119,6 +120,17 @@ def load_recipe(path: str | os.PathLike) -> Recipe:
     return recipe
 
 
+def _refuse_unknown(table: dict, valid, where: str) -> None:
+    """Refuse a key that is not in ``valid``, naming the nearest valid one."""
+    import difflib
+
+    for key in table:
+        if key not in valid:
+            near = difflib.get_close_matches(str(key), list(valid), n=1)
+            hint = f"did you mean {near[0]!r}?" if near else f"expected one of {sorted(valid)}"
+            raise ValueError(f"{where}: unknown key {key!r} ({hint})")
+
+
 def render_style(table: dict) -> RenderStyle:
     """A :class:`~perception.synthetic.render.RenderStyle` from a recipe's ``[render]`` table.
 
@@ -126,24 +138,37 @@ def render_style(table: dict) -> RenderStyle:
     ----------
     table : dict
         RenderStyle fields; ``distractors`` and ``occlusions`` as lists of tables
-        (``{colour, start, end, diameter, frames}``, ``{marker, start, stop}``).
+        (``{colour, start, end, diameter, frames, shape, aspect, angle_deg}``,
+        ``{marker, start, stop}``); ``background = "photo:NAME"`` or
+        ``"video:PATH"``. An unknown key is refused, naming the nearest valid one.
     """
     fields = dict(table)
+    _refuse_unknown(fields, {f.name for f in dataclasses.fields(RenderStyle)}, "[render]")
 
     def tup(v):
         return None if v is None else tuple(v)
 
     if "distractors" in fields:
+        valid = {f.name for f in dataclasses.fields(Distractor)}
+        for d in fields["distractors"]:
+            _refuse_unknown(d, valid, "[[render.distractors]]")
         fields["distractors"] = tuple(
             Distractor(colour=d["colour"] if isinstance(d["colour"], str) else tuple(d["colour"]),
                        start=tuple(d["start"]), end=tup(d.get("end")),
-                       diameter=float(d.get("diameter", 0.02)), frames=tup(d.get("frames")))
+                       diameter=float(d.get("diameter", 0.02)), frames=tup(d.get("frames")),
+                       shape=str(d.get("shape", "disc")), aspect=float(d.get("aspect", 1.0)),
+                       angle_deg=float(d.get("angle_deg", 0.0)))
             for d in fields["distractors"])
     if "occlusions" in fields:
+        for o in fields["occlusions"]:
+            _refuse_unknown(o, {"marker", "start", "stop"}, "[[render.occlusions]]")
         fields["occlusions"] = tuple(Occlusion(**o) for o in fields["occlusions"])
     if "band_size" in fields:
         fields["band_size"] = tuple(fields["band_size"])
-    return RenderStyle(**fields)
+    style = RenderStyle(**fields)
+    if style.background:  # a missing photograph or package: refused before rendering
+        next(load_background(style.background, 16, 16))
+    return style
 
 
 def clip_plans(recipe: Recipe, seed: int) -> list[tuple]:

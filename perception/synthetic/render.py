@@ -32,6 +32,14 @@ import numpy as np
 from perception.io.atomic import jsonable
 from perception.io.tracks import TracksWriter
 from perception.io.video import VideoWriter, codec_for, sha256_file
+from perception.synthetic.footage import (
+    H264_CODECS,
+    H264Writer,
+    flicker_gain,
+    load_background,
+    shaded_band,
+    shaded_disc,
+)
 from perception.synthetic.scene import Camera, RenderStyle, Scene, visibility
 from perception.tracking.markers import MarkerSet, default_markers
 
@@ -194,6 +202,77 @@ class _NoiseBank:
         return self.bank[k][dy : dy + self.h, dx : dx + self.w]
 
 
+def _at(path: np.ndarray, t: float) -> np.ndarray:
+    """Position on a (T, 2) path at fractional frame ``t`` (linear, clamped to the clip)."""
+    t = min(max(t, 0.0), path.shape[0] - 1.0)
+    i = min(int(t), path.shape[0] - 2) if path.shape[0] > 1 else 0
+    w = t - i
+    return path[i] if w == 0 or path.shape[0] == 1 else (1 - w) * path[i] + w * path[i + 1]
+
+
+def _instants(style: RenderStyle) -> np.ndarray:
+    """Offsets (frames) of the instants averaged into a frame: the exposure, centred."""
+    n = int(style.motion_samples) if style.exposure > 0 else 1
+    if n == 1:
+        return np.zeros(1)
+    return (np.arange(n) / (n - 1) - 0.5) * style.exposure * style.fps
+
+
+def _draw_distractors(img, camera: Camera, style: RenderStyle, colours, i: int,
+                      n_frames: int) -> None:
+    k = camera.px_per_m
+    for d in style.distractors:
+        pos = d.position(i, n_frames)
+        if pos is None:
+            continue
+        bgr = colours[d.colour] if isinstance(d.colour, str) else tuple(d.colour)
+        if d.shape == "disc" and d.aspect == 1:
+            _disc(img, camera.world_to_pixel(pos), d.diameter / 2 * k, bgr)
+            continue
+        a = math.radians(d.angle_deg)
+        axis = np.array([math.cos(a), math.sin(a)])
+        side = np.array([-axis[1], axis[0]])
+        half_l, half_w = d.diameter / 2, d.diameter * d.aspect / 2
+        if d.shape == "bar":
+            pts = [pos + sx * half_l * axis + sy * half_w * side
+                   for sx, sy in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
+        else:
+            pts = [pos + half_l * c * axis + half_w * s_ * side for c, s_ in _unit_circle()]
+        _poly(img, camera.world_to_pixel(np.array(pts)), bgr)
+
+
+def _draw_moving(img, camera: Camera, style: RenderStyle, scene: Scene, t: float,
+                 names: tuple[str, ...], visible: np.ndarray, colours) -> None:
+    """The hand, the sleeve and the hand markers at fractional frame ``t``."""
+    k = camera.px_per_m
+    wrist, finger, thumb = (_at(getattr(scene, n), t) for n in ("wrist", "finger", "thumb"))
+    if style.hand:
+        _draw_hand(img, camera, wrist, finger, thumb)
+    half = np.array(style.band_size) / 2
+    if style.sleeve is not None:
+        bgr = colours[style.sleeve] if isinstance(style.sleeve, str) else style.sleeve
+        # The sleeve's cuff touches the band and runs up the forearm.
+        cuff = _rect(wrist + (0.0, -half[1] - 0.06), (half[0] * 0.95, 0.06))
+        _poly(img, camera.world_to_pixel(cuff), bgr)
+    world = {"wrist": wrist, "finger": finger, "thumb": thumb}
+    for j, name in enumerate(names):
+        if name == "object" or not visible[j]:
+            continue
+        if name == "wrist":
+            corners = camera.world_to_pixel(_rect(wrist, (half[0], half[1])))
+            if style.shading > 0:
+                shaded_band(img, corners, colours[name], style.shading)
+            else:
+                _poly(img, corners, colours[name])
+        else:
+            centre = camera.world_to_pixel(world[name])
+            if style.shading > 0:
+                shaded_disc(img, centre, style.marker_diameter / 2 * k, colours[name],
+                            style.shading)
+            else:
+                _disc(img, centre, style.marker_diameter / 2 * k, colours[name])
+
+
 def render_frames(
     scene: Scene,
     camera: Camera,
@@ -222,53 +301,61 @@ def render_frames(
     ------
     RenderedFrame
         ``(index, time, image, truth, visible)``; see :class:`RenderedFrame`.
+        The truth is each marker's centre at the frame's time (the middle
+        of the exposure).
     """
     style = RenderStyle() if style is None else style
     markers = default_markers() if markers is None else markers
     names = markers.names
     _check_scene(scene, style, markers)
     rng = np.random.default_rng(seed)
-    background = _background(style, rng)
+    table = _background(style, rng)
+    photos = (load_background(style.background, style.width, style.height)
+              if style.background else None)
     gain = _lighting_gain(style)
     noise = _NoiseBank(style, rng) if style.noise_sd > 0 else None
-    world = scene.positions(names)  # (T, M, 2) m
-    truth = camera.world_to_pixel(world)  # (T, M, 2) px
+    phase = float(rng.uniform(0, 2 * np.pi)) if style.flicker > 0 else 0.0
+    truth = camera.world_to_pixel(scene.positions(names))  # (T, M, 2) px
     visible = visibility(style, names, scene.n_frames)
-    k = camera.px_per_m
     colours = {m.name: m.bgr for m in markers}
-    band = np.array(style.band_size) / 2
-    band_corners = _rect(np.zeros(2), (band[0], band[1]))
+    obj = names.index("object")
+    instants = _instants(style)
     for i in range(scene.n_frames):
-        img = background.copy()
-        if visible[i, names.index("object")]:
-            _disc(
-                img,
-                truth[i, names.index("object")],
-                scene.object_diameter / 2 * k,
-                colours["object"],
-            )
-        for d in style.distractors:
-            pos = d.position(i, scene.n_frames)
-            if pos is not None:
-                bgr = colours[d.colour] if isinstance(d.colour, str) else tuple(d.colour)
-                _disc(img, camera.world_to_pixel(pos), d.diameter / 2 * k, bgr)
-        if style.hand:
-            _draw_hand(img, camera, scene.wrist[i], scene.finger[i], scene.thumb[i])
-        for j, name in enumerate(names):
-            if name == "object" or not visible[i, j]:
-                continue
-            if name == "wrist":
-                _poly(img, camera.world_to_pixel(band_corners + scene.wrist[i]), colours[name])
-            else:
-                _disc(img, truth[i, j], style.marker_diameter / 2 * k, colours[name])
-        if gain is not None:
-            img = cv2.multiply(img, gain, dtype=cv2.CV_8U)
+        still = (next(photos) if photos is not None else table).copy()
+        if visible[i, obj]:
+            _disc(still, truth[i, obj], scene.object_diameter / 2 * camera.px_per_m,
+                  colours["object"])
+        _draw_distractors(still, camera, style, colours, i, scene.n_frames)
+        if len(instants) == 1:
+            img = still
+            _draw_moving(img, camera, style, scene, float(i), names, visible[i], colours)
+        else:  # motion blur: the moving parts at instants across the exposure, averaged
+            acc = np.zeros(still.shape, np.float32)
+            for dt in instants:
+                sub = still.copy()
+                _draw_moving(sub, camera, style, scene, i + float(dt), names, visible[i],
+                             colours)
+                acc += sub
+            img = (acc / len(instants) + 0.5).astype(np.uint8)
+        img = _light(img, gain, style, i, phase)
         if style.blur_sigma > 0:
             img = cv2.GaussianBlur(img, (0, 0), style.blur_sigma)
         if noise is not None:
             img = cv2.add(img, noise.next(), dtype=cv2.CV_8U)
         yield RenderedFrame(i, i / style.fps, img, truth[i], visible[i])
 
+
+def _light(img: np.ndarray, gain: np.ndarray | None, style: RenderStyle, i: int,
+           phase: float) -> np.ndarray:
+    """The lighting gradient and the flicker of frame ``i``."""
+    f = flicker_gain(i, style.fps, style.flicker, phase) if style.flicker > 0 else 1.0
+    if gain is None and f == 1.0:
+        return img
+    if gain is None:
+        g = np.full(img.shape, f, np.float32)
+    else:
+        g = gain if f == 1.0 else gain * np.float32(f)
+    return cv2.multiply(img, g, dtype=cv2.CV_8U)
 
 
 def _check_scene(scene: Scene, style: RenderStyle, markers: MarkerSet) -> None:
@@ -307,7 +394,8 @@ def render_clip(
     scene, camera, style, seed, markers
         As :func:`render_frames`.
     out_path : str or os.PathLike
-        Video file (``.mp4``, ``.avi``, ``.mkv``; see :class:`RenderStyle`).
+        Video file (``.mp4``, ``.avi``, ``.mkv``; see :class:`RenderStyle`;
+        codec ``h264`` writes H.264 4:2:0 in an ``.mp4``).
     label : str, optional
         Stimulus label (e.g. ``"normal"``, ``"delayed_opening"``).
     params : mapping, optional
@@ -341,7 +429,10 @@ def render_clip(
     video_done = False
     try:
         with TracksWriter(truth_path, markers.names, tracker=tracker, attrs=root) as tw:
-            with VideoWriter(out, style.fps, (style.width, style.height), codec) as vw:
+            size = (style.width, style.height)
+            writer = (H264Writer(out, style.fps, size) if codec in H264_CODECS
+                      else VideoWriter(out, style.fps, size, codec))
+            with writer as vw:
                 for fr in render_frames(scene, camera, style, seed=seed, markers=markers):
                     vw.write(fr.image)
                     tw.append(fr.index, fr.time, fr.truth, ones, zeros)

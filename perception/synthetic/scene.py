@@ -6,9 +6,12 @@ toward the object; docs/coordinates.md) and the object. A :class:`Camera`
 maps world to pixels by the similarity transform of :mod:`perception.geometry`.
 A :class:`RenderStyle` says how hard the clip is: textured table,
 skin-coloured hand and forearm under the markers (skin's hue is close to the
-red thumb marker's), similar-hue :class:`Distractor` discs,
+red thumb marker's), similar-hue :class:`Distractor` discs and bars,
 :class:`Occlusion` intervals, camera noise, blur, a lighting gradient, frame
-rate, resolution and codec. :mod:`perception.synthetic.render` draws them.
+rate, resolution and codec, and what real cameras add
+(:mod:`perception.synthetic.footage`): a photograph or footage under the
+hand, motion blur from the exposure, flicker, lit markers, H.264.
+:mod:`perception.synthetic.render` draws them.
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from perception.geometry import DEFAULT_OBJECT_DIAMETER, SimilarityTransform
+from perception.synthetic.footage import check_background
 
 __all__ = ["Camera", "Distractor", "Occlusion", "RenderStyle", "Scene", "visibility"]
 
@@ -117,9 +121,16 @@ class Distractor:
         World position at the last visible frame; linear motion between
         (``None``: static).
     diameter : float
-        m.
+        m; a bar's length.
     frames : (int, int), optional
         Visible frames ``[first, stop)`` (default: the whole clip).
+    shape : {"disc", "bar"}
+        A disc (an ellipse when ``aspect`` < 1) or a rectangle (a stripe,
+        a pen, a sleeve's cuff).
+    aspect : float
+        Width over length (0 < aspect <= 1; 1: round or square).
+    angle_deg : float
+        Direction of the long axis in the world frame, degrees from +x.
     """
 
     colour: str | tuple[int, int, int]
@@ -127,6 +138,17 @@ class Distractor:
     end: tuple[float, float] | None = None
     diameter: float = 0.02
     frames: tuple[int, int] | None = None
+    shape: str = "disc"
+    aspect: float = 1.0
+    angle_deg: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.shape not in ("disc", "bar"):
+            raise ValueError(f"Distractor.shape: expected 'disc' or 'bar', got {self.shape!r}")
+        if not 0 < self.aspect <= 1:
+            raise ValueError(f"Distractor.aspect: expected 0 < aspect <= 1, got {self.aspect!r}")
+        if not self.diameter > 0:
+            raise ValueError(f"Distractor.diameter: expected > 0 m, got {self.diameter!r}")
 
     def position(self, index: int, n_frames: int) -> np.ndarray | None:
         """World position (2,) m at frame ``index``, or None when not visible."""
@@ -183,6 +205,26 @@ class RenderStyle:
         Similar-hue objects on the table.
     occlusions : tuple of Occlusion
         Intervals in which a marker is hidden.
+    background : str, optional
+        Replace the table: ``photo:NAME`` (a sample photograph that
+        scikit-image ships, e.g. ``photo:coffee``, or an image file) or
+        ``video:PATH`` (a video's frames, looped); see
+        :mod:`perception.synthetic.footage`.
+    exposure : float
+        Shutter time, s (0: instantaneous). Moving parts are drawn at
+        ``motion_samples`` instants across the exposure, centred on the
+        frame's time, and averaged: motion blur.
+    motion_samples : int
+        Instants averaged per frame when ``exposure`` > 0.
+    flicker : float
+        Mains-light flicker: peak relative change of brightness between
+        frames (0.04: +-4 %).
+    shading : float
+        Markers lit from one side, 0 (flat colour) to 1 (a ball's dark rim
+        and specular highlight; the band shaded like a cylinder).
+    sleeve : str or (int, int, int), optional
+        Draw a sleeve of this colour (a marker name or BGR) on the forearm,
+        touching the wrist band: the hardest case for the band.
     """
 
     fps: float = 30.0
@@ -199,6 +241,12 @@ class RenderStyle:
     lighting_angle_deg: float = 30.0
     distractors: tuple[Distractor, ...] = ()
     occlusions: tuple[Occlusion, ...] = ()
+    background: str | None = None
+    exposure: float = 0.0
+    motion_samples: int = 5
+    flicker: float = 0.0
+    shading: float = 0.0
+    sleeve: str | tuple[int, int, int] | None = None
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.fps) and self.fps > 0):
@@ -207,13 +255,25 @@ class RenderStyle:
             raise ValueError(
                 f"RenderStyle: expected width, height >= 16 px, got {self.width} x {self.height}"
             )
-        for name in ("noise_sd", "blur_sigma", "marker_diameter"):
+        for name in ("noise_sd", "blur_sigma", "marker_diameter", "exposure", "flicker"):
             if not getattr(self, name) >= 0:
                 raise ValueError(f"RenderStyle.{name}: expected >= 0, got {getattr(self, name)!r}")
         if not 0 <= self.lighting < 1:
             raise ValueError(
                 f"RenderStyle.lighting: expected 0 <= lighting < 1, got {self.lighting!r}"
             )
+        if not 0 <= self.shading <= 1:
+            raise ValueError(f"RenderStyle.shading: expected 0 <= shading <= 1, "
+                             f"got {self.shading!r}")
+        if self.exposure > 1 / self.fps:
+            raise ValueError(f"RenderStyle.exposure: expected at most one frame period "
+                             f"({1 / self.fps:.4f} s), got {self.exposure!r}")
+        if int(self.motion_samples) < 1:
+            raise ValueError(f"RenderStyle.motion_samples: expected >= 1, got "
+                             f"{self.motion_samples!r}")
+        check_background(self.background)
+        if isinstance(self.sleeve, (list, tuple)):
+            object.__setattr__(self, "sleeve", tuple(int(c) for c in self.sleeve))
         object.__setattr__(self, "distractors", tuple(self.distractors))
         object.__setattr__(self, "occlusions", tuple(self.occlusions))
 

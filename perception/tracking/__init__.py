@@ -8,8 +8,15 @@
 * :mod:`~perception.tracking.blobs` — connected components of a colour mask.
 * :mod:`~perception.tracking.measurement` — locating a marker near a prediction
   (CamShift, splitting merged blobs, the still-object fast path, its diameter).
-* :mod:`~perception.tracking.detection` — finding markers without a prediction
-  (first detection, re-acquisition of lost markers).
+* :mod:`~perception.tracking.candidates` — a marker's candidate blobs on the
+  first frames and why one is refused (size, shape, colour purity, stillness).
+* :mod:`~perception.tracking.hand` — which candidates together look like a
+  hand; ambiguity.
+* :mod:`~perception.tracking.detection` — the global search of lost markers.
+* :mod:`~perception.tracking.setup` — a session's colour models and marker
+  sizes: ``hammer-mv calibrate`` and ``--setup``.
+* :mod:`~perception.tracking.overlay` — markers drawn on frames (labelled
+  videos, contact sheets).
 * :mod:`~perception.tracking.tracker` — the per-frame loop and motion
   prediction, :func:`track_frames`, :func:`track_video`.
 

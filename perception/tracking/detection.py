@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import cv2
 import numpy as np
@@ -215,6 +215,7 @@ def reacquire(
     pred: Sequence[float],
     window: tuple[int, int],
     params: TrackerParams,
+    accept: Callable[[Measurement], bool] | None = None,
 ) -> Measurement | None:
     """Global search for a lost marker: the nearest blob that refines to a plausible mass.
 
@@ -234,17 +235,23 @@ def reacquire(
         The marker's window (width, height), px.
     params : TrackerParams
         The search settings.
+    accept : callable, optional
+        ``accept(measurement) -> bool``: the caller's own plausibility test
+        (how far the marker can have moved, the hand's structure).
 
     Returns
     -------
     Measurement or None
         A whole (not merged) measurement with mass from ``reacquire_ratio``
-        to ``max_area_ratio`` times ``ref``; None if no candidate has one.
+        to ``max_area_ratio`` times ``ref`` that ``accept`` accepts; None if
+        no candidate has one.
     """
     for blob in search_blobs(small, colour, ref, pred, params):
         meas = measure(frame, colour, blob.centre, window, ref, params.search_margin_px, params)
         if meas is None or meas.merged:
             continue
-        if params.reacquire_ratio <= meas.mass / ref <= params.max_area_ratio:
+        if not params.reacquire_ratio <= meas.mass / ref <= params.max_area_ratio:
+            continue
+        if accept is None or accept(meas):
             return meas
     return None

@@ -60,13 +60,16 @@ class Measurement(NamedTuple):
     """One marker located in one frame: centre (x, y) px, mass px, window (w, h) px.
 
     ``merged`` marks a centroid taken among touching same-coloured blobs: it
-    is unreliable, and its window is the marker's previous one.
+    is unreliable, and its window is the marker's previous one. ``clutter``
+    is the mass (px) of the marker's colour elsewhere in the searched region:
+    a marker among things of its colour.
     """
 
     centre: tuple[float, float]
     mass: float
     window: tuple[int, int]
     merged: bool = False
+    clutter: float = 0.0
 
 
 def likelihood(ratio: float) -> float:
@@ -213,6 +216,7 @@ def _measure_region(
     )
     if ref > 0 and mass > params.split_ratio * ref:
         meas = split_merged(bp, pred, (x0, y0), ref, params, merged_window) or meas
+    meas = meas._replace(clutter=max(cv2.countNonZero(bp) - meas.mass, 0.0))
     return meas, bp, region
 
 

@@ -20,6 +20,8 @@ from functools import cached_property
 
 import cv2
 
+from perception.geometry import DEFAULT_OBJECT_DIAMETER
+
 
 @dataclass(frozen=True)
 class TrackerParams:
@@ -70,9 +72,10 @@ class TrackerParams:
     lost_velocity_decay : float
         Per-frame decay of the predicted velocity while lost.
     init_candidates : int
-        Blobs of each colour (largest first) among which a hand marker is
-        chosen when first found; the number of combinations tried grows as
-        its power.
+        Candidates of each colour that pass the size, shape, purity and
+        stillness tests (those nearest the expected size first) among which
+        a hand marker is chosen by the hand's structure; the number of
+        combinations tried grows as its power.
     search_min_ratio : float
         Global search: a downscaled blob with less than this fraction of the
         reference area is not refined. Lower than ``reacquire_ratio``
@@ -103,6 +106,71 @@ class TrackerParams:
         A marker's window side is at most this multiple of the side of a
         square holding its reference mass: a window allowed to grow over a
         same-coloured neighbour would stay on it.
+    object_diameter : float
+        The object's real diameter, m: with its apparent size it gives the
+        image scale that the expected marker sizes follow.
+    marker_diameter : float
+        Thumb and finger marker diameter, m (markers of 1-2.5 cm pass
+        ``size_tolerance``; calibrate a setup for others).
+    band_size : (float, float)
+        Wrist band: across the forearm, along it, m.
+    size_tolerance : float
+        A candidate's area must lie within this factor of its expected area,
+        either way.
+    min_roundness : float
+        Smallest minor / major axis ratio of a digit marker or the object.
+    band_elongation : (float, float)
+        Range of the wrist band's major / minor axis ratio.
+    min_saturation_ratio, min_value_ratio : float
+        A candidate's median saturation and value must reach these fractions
+        of its marker's own colour (``MarkerColour.hsv``).
+    strict_saturation_ratio, strict_value_ratio : float
+        The narrower gate of a marker that touches a large thing of its hue:
+        pixels at least these fractions of its own saturation and value.
+    own_saturation_margin : int
+        A hand marker, once found, keeps only pixels at most this far below
+        the 10th percentile of its own saturation (0 disables).
+    own_value_ratio : float
+        ... and at least this fraction of the 5th percentile of its own value.
+    rest_motion_px : float
+        A candidate that moves more than this (px) between the first frame
+        and frame ``init_frames - 1`` is not a marker of a resting hand.
+    init_frames : int
+        Frames of the rest looked at before the markers are chosen (1: the
+        first frame alone, no stillness test).
+    digit_gap : float
+        Largest thumb-finger marker distance at rest, m.
+    hand_span : float
+        Largest distance of a digit marker from the band (and, while moving,
+        from the other digit), m.
+    min_band_distance : float
+        Smallest distance of a digit marker from the band, m.
+    ambiguity_margin : float
+        Two placements of the hand whose costs differ by less than this are
+        equally plausible: a marker they put on different blobs is reported
+        ambiguous.
+    max_speed : float
+        Fastest a marker moves, m/s: a measurement or re-acquisition further
+        from the last known position than this allows (plus the marker's
+        size) is a jump to something else, and the marker is lost instead.
+    merged_likelihood : float
+        Likelihood ceiling of a centroid taken among touching blobs of the
+        same colour, or of a marker with more than ``clutter_ratio`` times
+        its own mass of its colour around it (below 0.5: not to be trusted).
+    clutter_ratio : float
+        Mass of a hand marker's colour in its search region besides the
+        marker, as a multiple of its reference, above which its position is
+        not trusted (likelihood at most ``merged_likelihood``).
+    max_merged_frames : int
+        A marker measured merged with a neighbour of its colour for more
+        frames in a row than this is reported lost (its window still
+        follows it) until it stands apart again.
+    hand_drift : float
+        How far a lost hand marker can move relative to the rest of the hand
+        per frame lost, m: it is re-acquired only that near where the hand
+        markers still tracked put it.
+    max_drift : float
+        The most a hand marker moves relative to the rest of the hand, m.
     """
 
     min_window_px: int = 8
@@ -134,9 +202,50 @@ class TrackerParams:
     still_min_rate: float = 0.1
     still_shift_px: float = 1.0
     max_window_ratio: float = 3.0
+    object_diameter: float = DEFAULT_OBJECT_DIAMETER
+    marker_diameter: float = 0.015
+    band_size: tuple[float, float] = (0.07, 0.025)
+    size_tolerance: float = 4.0
+    min_roundness: float = 0.5
+    band_elongation: tuple[float, float] = (1.4, 5.0)
+    min_saturation_ratio: float = 0.55
+    min_value_ratio: float = 0.3
+    strict_saturation_ratio: float = 0.8
+    strict_value_ratio: float = 0.45
+    own_saturation_margin: int = 30
+    own_value_ratio: float = 0.5
+    rest_motion_px: float = 3.0
+    init_frames: int = 5
+    digit_gap: float = 0.05
+    hand_span: float = 0.2
+    min_band_distance: float = 0.02
+    ambiguity_margin: float = 0.3
+    max_speed: float = 6.0
+    merged_likelihood: float = 0.45
+    clutter_ratio: float = 1.0
+    max_merged_frames: int = 3
+    hand_drift: float = 0.01
+    max_drift: float = 0.06
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "still_markers", tuple(self.still_markers))
+        for name in ("band_size", "band_elongation"):
+            value = tuple(float(v) for v in getattr(self, name))
+            if len(value) != 2 or not all(v > 0 for v in value):
+                raise ValueError(f"TrackerParams.{name}: expected two positive numbers, "
+                                 f"got {getattr(self, name)!r}")
+            object.__setattr__(self, name, value)
+        for name in ("object_diameter", "marker_diameter", "digit_gap", "hand_span",
+                     "max_speed", "rest_motion_px"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"TrackerParams.{name}: expected > 0, got "
+                                 f"{getattr(self, name)!r}")
+        if self.size_tolerance < 1 or not 0 < self.min_roundness <= 1:
+            raise ValueError("TrackerParams: expected size_tolerance >= 1 and "
+                             "0 < min_roundness <= 1")
+        if self.init_frames < 1 or not 0 <= self.merged_likelihood < 0.5:
+            raise ValueError("TrackerParams: expected init_frames >= 1 and "
+                             "0 <= merged_likelihood < 0.5")
         if not 0 < self.lost_ratio <= self.reacquire_ratio <= 1:
             raise ValueError(
                 "TrackerParams: expected 0 < lost_ratio <= reacquire_ratio <= 1, got "

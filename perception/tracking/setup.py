@@ -1,0 +1,320 @@
+"""A tracking setup: the colour models and marker sizes of one filming session.
+
+A lab films many clips in one setup (same markers, lights, camera). ``hammer-mv
+calibrate VIDEO -o setup.toml`` learns, from the first frames of one clip,
+each marker's colour (hue, saturation and value ranges of its own pixels) and
+the markers' physical sizes (against the object's known diameter), and
+writes a setup file; ``track``, ``recognize`` and ``batch`` take it with
+``--setup setup.toml``. The file (docs/markers.md)::
+
+    [setup]                   # where it was learned (informative)
+    source = "clip.mp4"
+    frames = 5
+
+    [sizes]                   # TrackerParams sizes, m
+    object_diameter = 0.1
+    marker_diameter = 0.0121
+    band_size = [0.0702, 0.0249]
+
+    [markers.thumb]           # MarkerColour fields, as in a colours file
+    bgr = [40, 35, 190]
+    hue = [[174, 4]]
+    sat_min = 160
+    val_min = 70
+
+    [tracker]                 # any other TrackerParams field (optional)
+    size_tolerance = 3.0
+
+Unknown tables and keys are refused, naming the nearest valid one.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import difflib
+import math
+import os
+import tomllib
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+
+from perception.errors import InputError
+from perception.io.atomic import write_text
+from perception.tracking.markers import MarkerColour, MarkerSet, default_markers
+from perception.tracking.measurement import soft_diameter
+from perception.tracking.params import TrackerParams
+
+__all__ = ["TrackingSetup", "calibrate", "load_setup", "write_setup"]
+
+_TABLES = ("setup", "sizes", "markers", "tracker")
+_SIZES = ("object_diameter", "marker_diameter", "band_size")
+_MARKER_KEYS = ("bgr", "rgb", "hue", "sat_min", "val_min")
+#: Hue units (0..179) added to each side of the hue range a marker shows.
+_HUE_PAD = 4
+#: Saturation units below the 5th percentile a marker shows that still count.
+_SAT_PAD = 25
+#: Fraction of the 5th percentile of value that still counts (shade, flicker).
+_VAL_FRACTION = 0.55
+
+
+@dataclass(frozen=True)
+class TrackingSetup:
+    """Colour models and tracker parameters (with the marker sizes) of one session.
+
+    Parameters
+    ----------
+    markers : MarkerSet
+        The colour models.
+    params : TrackerParams
+        Tracker parameters, including ``object_diameter``, ``marker_diameter``
+        and ``band_size``.
+    source : str
+        Where it was learned (a video), informative.
+    frames : int
+        Frames it was learned from.
+    """
+
+    markers: MarkerSet = field(default_factory=default_markers)
+    params: TrackerParams = field(default_factory=TrackerParams)
+    source: str = ""
+    frames: int = 0
+
+    def to_dict(self) -> dict[str, Any]:
+        """The setup file's tables (``tracker`` holds only fields off their defaults)."""
+        p, base = self.params, TrackerParams()
+        tracker = {f.name: _toml_value(getattr(p, f.name)) for f in dataclasses.fields(p)
+                   if f.name not in _SIZES and getattr(p, f.name) != getattr(base, f.name)}
+        out = {"setup": {"source": self.source, "frames": self.frames},
+               "sizes": {k: _toml_value(getattr(p, k)) for k in _SIZES},
+               "markers": self.markers.to_dict()}
+        if tracker:
+            out["tracker"] = tracker
+        return out
+
+
+def _toml_value(v: Any) -> Any:
+    if isinstance(v, tuple):
+        return [_toml_value(x) for x in v]
+    if isinstance(v, float):
+        return round(v, 6)
+    return v
+
+
+def _toml(v: Any) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_toml(x) for x in v) + "]"
+    return repr(v)
+
+
+def write_setup(path: str | os.PathLike, setup: TrackingSetup) -> Path:
+    """Write ``setup`` as a TOML setup file (atomically).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+    setup : TrackingSetup
+        What to write.
+    """
+    d = setup.to_dict()
+    lines = ["# hammer-mv tracking setup (hammer-mv calibrate); docs/markers.md", ""]
+    for table in ("setup", "sizes"):
+        lines.append(f"[{table}]")
+        lines += [f"{k} = {_toml(v)}" for k, v in d[table].items()]
+        lines.append("")
+    for name, fields in d["markers"].items():
+        lines.append(f"[markers.{name}]")
+        lines += [f"{k} = {_toml(v)}" for k, v in fields.items()]
+        lines.append("")
+    if "tracker" in d:
+        lines.append("[tracker]")
+        lines += [f"{k} = {_toml(v)}" for k, v in d["tracker"].items()]
+        lines.append("")
+    return write_text(path, "\n".join(lines))
+
+
+def _refuse(keys, valid: Sequence[str], where: str) -> None:
+    for key in keys:
+        if key not in valid:
+            near = difflib.get_close_matches(str(key), list(valid), n=1)
+            hint = f"did you mean {near[0]!r}?" if near else f"expected one of {', '.join(valid)}"
+            raise ValueError(f"{where}: unknown key {key!r} ({hint})")
+
+
+def load_setup(path: str | os.PathLike) -> TrackingSetup:
+    """Read a setup file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The TOML file ``hammer-mv calibrate`` writes (or one written by hand).
+
+    Raises
+    ------
+    InputError
+        Missing or unparsable file, an unknown table or key (the nearest
+        valid one is named), or a bad value; the message names the file.
+    """
+    p = Path(path)
+    try:
+        data = tomllib.loads(p.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise InputError("setup file not found", p) from None
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+        raise InputError(f"not a readable TOML setup file: {exc}", p) from None
+    try:
+        _refuse(data, _TABLES, "setup file")
+        meta = data.get("setup", {})
+        _refuse(meta, ("source", "frames"), "[setup]")
+        sizes = data.get("sizes", {})
+        _refuse(sizes, _SIZES, "[sizes]")
+        tracker = data.get("tracker", {})
+        _refuse(tracker, [f.name for f in dataclasses.fields(TrackerParams)
+                          if f.name not in _SIZES], "[tracker]")
+        markers = data.get("markers", {})
+        for name, table in markers.items():
+            _refuse([name], default_markers().names, "[markers]")
+            _refuse(table, _MARKER_KEYS, f"[markers.{name}]")
+        params = TrackerParams(**{**tracker, **sizes})
+        colours = default_markers().with_overrides(markers, source="[markers]")
+        return TrackingSetup(colours, params, str(meta.get("source", "")),
+                             int(meta.get("frames", 0)))
+    except (TypeError, ValueError) as exc:
+        raise InputError(str(exc), p) from None
+
+
+# -- calibration ------------------------------------------------------------------
+def _hue_range(hues: np.ndarray) -> tuple[int, int]:
+    """The hue range (OpenCV units, may wrap through 0) holding 98 % of ``hues``."""
+    h = hues.astype(int)
+    # Centre the data away from the wrap before taking percentiles.
+    centre = int(np.degrees(np.angle(np.exp(1j * np.radians(h * 2.0)).mean())) / 2) % 180
+    shifted = (h - centre + 90) % 180
+    lo, hi = np.percentile(shifted, [1, 99])
+    lo = int(math.floor(lo)) - _HUE_PAD + centre - 90
+    hi = int(math.ceil(hi)) + _HUE_PAD + centre - 90
+    if hi - lo >= 179:
+        return 0, 179
+    return lo % 180, hi % 180
+
+
+def _learn_colour(colour: MarkerColour, frame: np.ndarray, hsv: np.ndarray,
+                  centre: Sequence[float], half: int) -> tuple[MarkerColour, np.ndarray]:
+    """The marker's colour model from its own pixels around ``centre``; and its mask."""
+    h, w = frame.shape[:2]
+    cx, cy = int(round(centre[0])), int(round(centre[1]))
+    x0, y0 = max(cx - half, 0), max(cy - half, 0)
+    x1, y1 = min(cx + half + 1, w), min(cy + half + 1, h)
+    region = hsv[y0:y1, x0:x1]
+    n, labels = cv2.connectedComponents(colour.backproject(region))
+    lab = labels[min(cy - y0, labels.shape[0] - 1), min(cx - x0, labels.shape[1] - 1)]
+    if n < 2 or lab == 0:
+        raise ValueError(f"{colour.name}: no pixels of its colour at ({cx}, {cy}) px")
+    mask = labels == lab
+    pix = region[mask]
+    lo, hi = _hue_range(pix[:, 0])
+    learned = dataclasses.replace(
+        colour,
+        bgr=tuple(int(v) for v in np.median(frame[y0:y1, x0:x1][mask], axis=0)),
+        hue=((lo, hi),),
+        sat_min=int(max(np.percentile(pix[:, 1], 5) - _SAT_PAD, 40)),
+        val_min=int(max(_VAL_FRACTION * np.percentile(pix[:, 2], 5), 30)),
+    )
+    full = np.zeros((h, w), bool)
+    full[y0:y1, x0:x1] = mask
+    return learned, full
+
+
+def _axes(mask: np.ndarray) -> tuple[float, float]:
+    """Major and minor standard deviations (px) of a blob."""
+    mo = cv2.moments(mask.astype(np.uint8), True)
+    m = max(mo["m00"], 1.0)
+    a, b, c = mo["mu20"] / m, mo["mu11"] / m, mo["mu02"] / m
+    root = math.sqrt(max((a - c) ** 2 / 4 + b * b, 0.0))
+    return math.sqrt((a + c) / 2 + root), math.sqrt(max((a + c) / 2 - root, 0.0))
+
+
+def calibrate(frames: Sequence[np.ndarray], *, rois: Mapping[str, tuple[int, int, int, int]]
+              | None = None, markers: MarkerSet | None = None,
+              params: TrackerParams | None = None, source: str = "") -> TrackingSetup:
+    """Learn a setup from the first frames of a clip (the hand at rest, every marker in view).
+
+    The markers are found as the tracker finds them (automatically, or in
+    the given ROIs); each marker's hue range, saturation and value minimums
+    are then taken from its own pixels, and the markers' sizes measured
+    against the object's apparent diameter and its known
+    ``params.object_diameter``.
+
+    Parameters
+    ----------
+    frames : sequence of (H, W, 3) uint8
+        The clip's first frames (BGR); the first is measured, the last is
+        the stillness test's look ahead.
+    rois : mapping of str to (x, y, w, h), optional
+        Where markers are on the first frame, px.
+    markers : MarkerSet, optional
+        Colour models to start from (default: the defaults).
+    params : TrackerParams, optional
+        Parameters to start from (its ``object_diameter`` sets the scale).
+    source : str
+        Where the frames come from (recorded in the setup).
+
+    Raises
+    ------
+    InputError
+        A marker not found, or ambiguous, on the first frames: the message
+        names it and asks for a ROI.
+    """
+    from perception.tracking.tracker import Tracker
+
+    if not frames:
+        raise InputError("no frames to calibrate from")
+    params = TrackerParams() if params is None else params
+    tracker = Tracker(markers, params, rois)
+    if len(frames) > 1:
+        tracker.look_ahead(frames[-1])
+    position, _, _ = tracker.update(frames[0])
+    missing = [n for j, n in enumerate(tracker.markers.names)
+               if not np.isfinite(position[j]).all()]
+    if missing:
+        why = "; ".join(f"{m}: {tracker.why_not_found(m)}" for m in missing)
+        raise InputError(f"cannot calibrate: {why}; give --roi "
+                         f"{missing[0]} X Y W H around it on the first frame")
+    hsv = cv2.cvtColor(frames[0], cv2.COLOR_BGR2HSV)
+    learned, masks = [], {}
+    for j, colour in enumerate(tracker.markers):
+        half = int(max(tracker._tracks[j].win)) + 6
+        try:
+            model, mask = _learn_colour(colour, frames[0], hsv, position[j], half)
+        except ValueError as exc:
+            raise InputError(f"cannot calibrate: {exc}") from None
+        learned.append(model)
+        masks[colour.name] = mask
+    scale = tracker.px_per_m
+    if scale is None:
+        raise InputError("cannot calibrate: the object's size could not be measured")
+    sizes = {}
+    digits = []
+    for j, name in enumerate(tracker.markers.names):
+        if name in ("thumb", "finger"):
+            # unbiased by the partly coloured rim, which is large on small discs
+            d = soft_diameter(frames[0], tracker.markers[name], position[j],
+                              tracker._tracks[j].win)
+            digits.append((d if np.isfinite(d) else 2 * math.sqrt(masks[name].sum() / math.pi))
+                          / scale)
+    if digits:
+        sizes["marker_diameter"] = float(np.mean(digits))
+    if "wrist" in masks:
+        major, minor = _axes(masks["wrist"])
+        sizes["band_size"] = (math.sqrt(12) * major / scale, math.sqrt(12) * minor / scale)
+    return TrackingSetup(MarkerSet(tuple(learned)), dataclasses.replace(params, **sizes),
+                         source, len(frames))
