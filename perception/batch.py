@@ -382,7 +382,8 @@ def _run_dask(items: list[BatchItem], repertoire: Repertoire, job: _Job,
             yield fut.result()
 
 
-def _first_model(s: ClipSummary, name: str, values: np.ndarray) -> float:
+def _model_value(s: ClipSummary, name: str, values: np.ndarray) -> float:
+    """``values`` (one per model of ``s``) of the model ``name``; NaN if it has none."""
     return float(values[s.names.index(name)]) if name in s.names else float("nan")
 
 
@@ -393,7 +394,7 @@ CLIP_COLUMNS: list[tuple[str, Callable[[ClipSummary], object]]] = [
     ("verdict", lambda s: s.verdict),
     ("familiarity", lambda s: s.familiarity),
     ("margin", lambda s: s.margin),
-    ("winner_log_likelihood", lambda s: _first_model(s, s.winner, s.final_log_likelihood)),
+    ("winner_log_likelihood", lambda s: _model_value(s, s.winner, s.final_log_likelihood)),
 ]
 
 
@@ -404,8 +405,10 @@ def summary_table(results: list[ClipResult], reference: str | None = None) -> pd
     (``verdict, familiarity, margin, winner_log_likelihood``),
     ``reference_model`` and ``reference_confidence`` (its final thesis-rule
     confidence, m), ``conf_<model>`` (final thesis-rule confidence of each
-    model of the first scored clip, m), ``status`` (``ok`` or ``failed``),
-    ``reused`` (the report was already current), ``error``.
+    model of the first scored clip, m), the tracking quality
+    (``track_<marker>``, ``minlik_<marker>``, ``reacquisitions``,
+    ``ambiguous_frames``), ``status`` (``ok`` or ``failed``), ``reused`` (the
+    report was already current), ``error``.
 
     Parameters
     ----------
@@ -426,10 +429,10 @@ def summary_table(results: list[ClipResult], reference: str | None = None) -> pd
         for column, value in CLIP_COLUMNS:
             entry[column] = value(s) if s is not None else None
         entry["reference_model"] = reference if s is not None else None
-        entry["reference_confidence"] = (_first_model(s, reference, s.confidence[:, -1])
+        entry["reference_confidence"] = (_model_value(s, reference, s.confidence[:, -1])
                                          if s is not None and reference else float("nan"))
         for n in names:
-            entry[f"conf_{n}"] = (_first_model(s, n, s.confidence[:, -1]) if s is not None
+            entry[f"conf_{n}"] = (_model_value(s, n, s.confidence[:, -1]) if s is not None
                                   else float("nan"))
         entry.update(tracking_columns(s.tracking if s is not None else None))
         entry["status"] = "failed" if r.status == "failed" else "ok"

@@ -15,7 +15,9 @@ and the digits at n (the outcome); otherwise neither rule updates and the
 filters coast.
 
 The engine predicts and scores only: the models come planned for the clip's
-scene (:meth:`perception.recognition.repertoire.Repertoire.for_scene`).
+scene (:meth:`perception.recognition.repertoire.Repertoire.for_scene`) and
+calibrated (:mod:`perception.recognition.verdict`); each model's familiarity
+is read off its calibration.
 """
 
 from __future__ import annotations
