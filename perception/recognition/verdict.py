@@ -32,10 +32,10 @@ at one frame rate is applied at another by rescaling the clip's misfit by
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.special import ndtr
 
 __all__ = ["DEFAULT_THRESHOLD", "VERDICTS", "Calibration", "CalibrationParams", "Verdict",
            "decide", "misfit"]
@@ -162,8 +162,8 @@ class Calibration:
             return float("nan")
         if frame_period:
             misfit = misfit * (self.frame_period / frame_period) ** 2
-        z = (np.log(max(misfit, 1e-300)) - self.log_centre) / self.log_scale
-        return float(ndtr(-z))
+        z = (math.log(max(misfit, 1e-300)) - self.log_centre) / self.log_scale
+        return 0.5 * math.erfc(z / math.sqrt(2))  # the normal upper tail
 
 
 def misfit(mahalanobis: np.ndarray, scored: np.ndarray) -> np.ndarray:
