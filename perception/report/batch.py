@@ -132,13 +132,17 @@ def _main_table(summary: pd.DataFrame, anchors: dict[str, str], reference: str |
                "winner", "winner log-lik.", f"C of {reference or 'reference'} (cm)", "status"]
     rows = []
     for r in summary.itertuples(index=False):
+        def get(name, r=r):  # a summary written by other code may lack columns
+            return getattr(r, name, None)
+
         clip = _e(r.clip)
         if r.clip in anchors:
             clip = f'<a href="#{anchors[r.clip]}">{clip}</a>'
-        rows.append([clip, _e(r.condition), _verdict_cell(r.verdict, r.status),
-                     _num(r.familiarity, ".2f"), _num(r.margin, ".1f"), _e(r.winner),
-                     _num(r.winner_log_likelihood, ".1f"),
-                     _num(r.reference_confidence * 100, ".2f"), _e(r.status)])
+        ref = get("reference_confidence")
+        rows.append([clip, _e(r.condition), _verdict_cell(get("verdict"), r.status),
+                     _num(get("familiarity"), ".2f"), _num(get("margin"), ".1f"), _e(r.winner),
+                     _num(get("winner_log_likelihood"), ".1f"),
+                     _num(ref * 100 if ref is not None else None, ".2f"), _e(r.status)])
     return _table(headers, rows, numeric={3, 4, 6, 7}, cls="t main")
 
 
@@ -175,7 +179,7 @@ def _other_columns_table(summary: pd.DataFrame) -> str:
 
 
 def _verdict_counts(ok: pd.DataFrame) -> str:
-    if not len(ok):
+    if not len(ok) or "verdict" not in ok:
         return ""
     cond = ok["condition"].where(ok["condition"].notna(), "unlabelled")
     counts = pd.crosstab(cond, ok["verdict"].fillna("none"))
