@@ -224,6 +224,16 @@ def _chapter5(recs: list[ClipSummary], conds: list[str], reference: str, models,
     save_figure(out / "condition_profiles.png", condition_figure(prof, reference))
 
 
+def _figures_html(reference: str) -> str:
+    """The chapter 5 figures in a grid, each a link to itself at full size."""
+    figures = "".join(
+        f'<figure{" class=wide" if name == WIDE else ""}><a href="{name}">'
+        f'<img src="{name}" alt="{fig}"></a><figcaption>{fig}: {html.escape(caption)} '
+        "(click for full size)</figcaption></figure>" for name, fig, caption in FIGURES)
+    return (f"<h2>Chapter 5, read on the reference grasp model {_e(reference)}</h2>"
+            f"<div class=grid>{figures}</div>")
+
+
 def _statistics_html(stats_df: pd.DataFrame) -> str:
     rows = [[_e(r.test), _e(r.groups), str(int(r.n)), _e(r.statistic_type),
              _num(r.statistic, ".3g"), _e(r.df), _num(r.p_value, ".3g"),
@@ -274,13 +284,7 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
         _chapter5(recs, conds, profile_model, models, out)
         stats_df = condition_statistics(summary, profile_model)
         write_csv(out / "statistics.csv", stats_df)
-        sections.append(f"<h2>Chapter 5, read on the reference grasp model "
-                        f"{_e(profile_model)}</h2><div class=grid>" + "".join(
-                            f'<figure{" class=wide" if name == WIDE else ""}><a href="{name}">'
-                            f'<img src="{name}" alt="{fig}"></a>'
-                            f"<figcaption>{fig}: {html.escape(caption)} (click for full size)"
-                            "</figcaption></figure>" for name, fig, caption in FIGURES)
-                        + "</div>")
+        sections.append(_figures_html(profile_model))
         if len(stats_df):
             sections.append("<h2>Statistics of the reference model's final confidence</h2>"
                             + _statistics_html(stats_df))
