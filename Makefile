@@ -7,7 +7,7 @@ JOBS ?= 2
 
 .PHONY: demo test test-fast lint bench reproduce clean
 
-$(STAMP): pyproject.toml
+$(STAMP): pyproject.toml setup.py minvar/_lqg_kernel.c
 	$(PYTHON) -c 'import sys; assert sys.version_info >= (3, 11), "hammer-mv needs Python >= 3.11"'
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip

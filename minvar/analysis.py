@@ -28,6 +28,7 @@ __all__ = [
     "closest_approach",
     "count_speed_peaks",
     "endpoint_stats",
+    "expected_distance",
     "path_deviation",
     "peak_to_mean_speed",
     "speed_accuracy",
@@ -145,6 +146,44 @@ def endpoint_stats(endpoints: np.ndarray, target) -> EndpointStats:
         distance_mean=float(dist.mean()),
         distance_sd=float(dist.std(ddof=1)),
     )
+
+
+#: Gauss-Hermite nodes and weights (probabilists') for :func:`expected_distance`.
+_GH_NODES, _GH_WEIGHTS = np.polynomial.hermite_e.hermegauss(48)
+_GH_WEIGHTS = _GH_WEIGHTS / _GH_WEIGHTS.sum()
+_GH_NODES.setflags(write=False)  # constants: no module-level mutable state
+_GH_WEIGHTS.setflags(write=False)
+
+
+def expected_distance(offset, cov) -> float:
+    """Mean distance from a target of normally distributed end-points, without sampling.
+
+    The exact counterpart of :attr:`EndpointStats.distance_mean` for end-points
+    ``N(target + offset, cov)`` (e.g. from :func:`minvar.lqg.state_moments`),
+    by Gauss-Hermite quadrature along the principal axes (48 nodes each). The
+    error is below 0.3 % even with the mean on the target, where ``|x|`` has a
+    kink, and far smaller once the systematic error is a few SDs: well under
+    the 2-3 % sampling error of a mean over 500 repetitions.
+
+    Parameters
+    ----------
+    offset : (2,) array_like
+        Mean end-point minus the target (the systematic error), m.
+    cov : (2, 2) array_like
+        End-point covariance, m^2.
+
+    Returns
+    -------
+    float
+        ``E |offset + e|``, ``e ~ N(0, cov)``, m.
+    """
+    offset = np.asarray(offset, dtype=float)
+    w, v = np.linalg.eigh(np.asarray(cov, dtype=float))
+    sd = np.sqrt(np.maximum(w, 0.0))
+    z = (_GH_NODES[:, None, None] * sd[0] * v[:, 0]
+         + _GH_NODES[None, :, None] * sd[1] * v[:, 1])
+    dist = np.linalg.norm(offset + z, axis=-1)
+    return float(np.einsum("i,j,ij->", _GH_WEIGHTS, _GH_WEIGHTS, dist))
 
 
 @dataclass(frozen=True, eq=False)

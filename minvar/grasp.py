@@ -9,15 +9,22 @@ metres. The object is a disk of diameter ``object_size``.
   by default 0.15 m to the right of and 0.25 m behind it, a right arm whose
   elbow bends outward (to +x of the shoulder-wrist line), 122 deg at the
   start. The wrist target is ``wrist_offset`` (6 cm) short of the object
-  centre along the approach: ``(0, -wrist_offset)``.
+  centre along the approach: ``(0, -wrist_offset)`` (thesis line 724). The
+  wrist therefore travels ``distance - wrist_offset``
+  (:attr:`GraspTask.transport_distance`): 20 cm by default, the thesis's
+  "distance to be moved" (line 953; "20cm in front of the hand", line 770).
 * **Gripper**: two 2-link digits (links 0.10 m), the finger and the thumb,
   both based at the wrist. The hand frame is the world frame translated (not
-  rotated) to the wrist. At the start the digit tips touch at
-  ``(0, tip_start)`` in the hand frame, on the approach axis (by default 6 cm
-  ahead of the wrist: the grip line once the wrist is on its target, so
-  grasping is opening and closing). The finger's middle joint bends outward
-  to +x, the thumb's to -x (the elbow branches are fixed for each chain, so
-  the joint angles stay continuous).
+  rotated) to the wrist. At the start the digit tips touch (line 730) at
+  ``(0, tip_start)`` in the hand frame, on the approach axis: by default
+  2 cm ahead of the wrist, 4 cm below the line of the digit targets (which
+  lies ``wrist_offset`` ahead of the wrist once it is on its target). The
+  thesis gives no value; its Fig. 4.4(a) (line 814) has the digits reach "a
+  point level with the target position" during the movement, so they start
+  below it (docs/model.md tabulates how the chapter's verdicts depend on
+  this choice). The finger's middle joint bends outward to +x, the thumb's
+  to -x (the elbow branches are fixed for each chain, so the joint angles
+  stay continuous).
 * **Targets**: the digit tips end on the object surface on the line through
   its centre perpendicular to the approach, the finger at ``(+size/2, 0)``
   and the thumb at ``(-size/2, 0)`` (world frame; hand frame
@@ -41,7 +48,9 @@ kinematics, the digit bases moving with the simulated wrist.
 
 from __future__ import annotations
 
-import dataclasses
+import hashlib
+import threading
+from collections import OrderedDict
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -140,7 +149,10 @@ class GraspTask:
     object_size : float
         Diameter of the disk to grasp (>= 0; thesis 0-8 cm).
     distance : float
-        Distance from the wrist's start to the object centre (thesis 8-24 cm).
+        Distance from the wrist's start to the object centre (> 0). The wrist
+        travels ``distance - wrist_offset`` (:attr:`transport_distance`); the
+        default 0.26 m makes that the thesis's 20 cm (line 953: "the distance
+        to be moved", swept over 8-24 cm).
     duration : float
         Movement time (> 0; thesis 0.6-1.2 s). Must span at least 2 plant steps.
     viapoint_offset : float
@@ -172,7 +184,9 @@ class GraspTask:
         (> 0; thesis 6 cm).
     tip_start : float
         Where the touching digit tips start, ahead of the wrist along the
-        approach axis (hand frame).
+        approach axis (hand frame). Default 0.02: below the line of the digit
+        targets (``wrist_offset`` ahead of the wrist at the goal), as thesis
+        Fig. 4.4(a) implies (line 814); the thesis gives no value.
     shoulder_offset : (2,) tuple
         Shoulder position relative to the wrist's start position (world axes).
     arm_links : (2,) tuple
@@ -188,7 +202,7 @@ class GraspTask:
     """
 
     object_size: float = 0.04
-    distance: float = 0.20
+    distance: float = 0.26
     duration: float = 1.0
     viapoint_offset: float = 0.01
     viapoint_height: float = 0.0
@@ -199,7 +213,7 @@ class GraspTask:
     execution_cv: float = 0.01
     execution_sigma_s: float = 0.0
     wrist_offset: float = 0.06
-    tip_start: float = 0.06
+    tip_start: float = 0.02
     shoulder_offset: tuple[float, float] = (0.15, -0.25)
     arm_links: tuple[float, float] = (0.30, 0.30)
     digit_links: tuple[float, float] = (0.10, 0.10)
@@ -303,6 +317,11 @@ class GraspTask:
     def wrist_start(self) -> tuple[float, float]:
         """Wrist position at the start, m."""
         return (0.0, -self.distance)
+
+    @property
+    def transport_distance(self) -> float:
+        """How far the wrist travels, start to target: ``distance - wrist_offset``, m."""
+        return self.distance - self.wrist_offset
 
     @property
     def wrist_target(self) -> tuple[float, float]:
@@ -493,9 +512,8 @@ def _chain_plan(name, chain, elbow, p_start, p_goal, vias, fractions, task: Gras
     cv = task.execution_cv
     # each joint's command gets its own noise: u_i (1 + cv eps_i)
     noise = [cv * np.diag([1.0, 0.0]), cv * np.diag([0.0, 1.0])]
-    execution = dataclasses.replace(
-        problem, C=noise, D0=task.execution_sigma_s * np.diag(task.plant.sensory_sd)
-    )
+    execution = problem.with_noise(C=noise,
+                                   D0=task.execution_sigma_s * np.diag(task.plant.sensory_sd))
     return ChainPlan(
         name=name,
         chain=chain,
@@ -503,12 +521,45 @@ def _chain_plan(name, chain, elbow, p_start, p_goal, vias, fractions, task: Gras
         task=jtask,
         problem=problem,
         execution=execution,
-        solution=solve(problem),
+        solution=_solve(problem),
         q_start=q0,
         q_goal=qg,
         q_via=qv,
         via_fractions=np.asarray(fractions, dtype=float),
     )
+
+
+#: Recently solved chain problems by content (see :func:`_solve`).
+_SOLVED: OrderedDict[bytes, LQGSolution] = OrderedDict()
+_SOLVED_MAX = 64
+_SOLVED_LOCK = threading.Lock()
+
+
+def _solve(problem: LQGProblem) -> LQGSolution:
+    """:func:`~minvar.lqg.solve`, reusing the solution of an identical problem.
+
+    Grasps often share a chain's problem exactly — the arm of a grasp and of
+    the reach-only movement with the same transport, or one model re-planned
+    for several clips of a scene — and the solution of the same arrays is the
+    same (it is read-only, so it is shared as it is).
+    """
+    h = hashlib.blake2b(digest_size=20)
+    for name in ("A", "B", "C", "C0", "H", "D", "D0", "E0", "Q", "R", "X1", "S1"):
+        a = getattr(problem, name)
+        h.update(repr(a.shape).encode())
+        h.update(np.ascontiguousarray(a).data)
+    key = h.digest()
+    with _SOLVED_LOCK:
+        sol = _SOLVED.get(key)
+        if sol is not None:
+            _SOLVED.move_to_end(key)
+            return sol
+    sol = solve(problem)  # outside the lock: plans may run in several threads
+    with _SOLVED_LOCK:
+        _SOLVED[key] = sol
+        while len(_SOLVED) > _SOLVED_MAX:
+            _SOLVED.popitem(last=False)
+    return sol
 
 
 def plan_grasp(task: GraspTask) -> GraspPlan:

@@ -14,12 +14,15 @@ statistics. Its figures, named after the thesis's, are drawn from these on
 request: :meth:`GraspExperiment.plot` (or
 :func:`minvar.plotting.experiment_figures`).
 
-Variability (4.2.3) is compared across settings by one-way ANOVA
-(:func:`scipy.stats.f_oneway`) on each repetition's peak deviation from its
-setting's mean path (:func:`minvar.grasp_stats.peak_deviation`): the SD over
-time is the root mean square of these deviations, so a parameter that changes
-the variability changes their mean. The SDs themselves are reported both from
-the repetitions and exactly (:func:`minvar.grasp_stats.grasp_moments`).
+Variability (4.2.3) is reported as effect sizes with confidence intervals,
+not p-values: the peak SD over time and its timing, exactly
+(:func:`minvar.grasp_stats.grasp_moments`) and from the repetitions with a
+95 % bootstrap interval (:func:`minvar.grasp_stats.bootstrap_peak`), and
+their change across settings with its interval. (The thesis compared settings
+by one-way ANOVA; over 500 repetitions per setting, or exact moments, any
+nonzero effect is "significant", so the size of the effect is what tells.)
+The transport-distance sweep is expressed as the thesis does, as the distance
+the wrist moves (line 953); the object centre is ``wrist_offset`` further.
 """
 
 from __future__ import annotations
@@ -27,13 +30,15 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 import pandas as pd
 
 from .grasp import GraspTask, plan_grasp, simulate_grasp
 from .grasp_stats import (
+    GraspMoments,
+    bootstrap_peak,
     grasp_moments,
     max_grip_aperture,
     path_sd,
@@ -52,6 +57,7 @@ log = logging.getLogger(__name__)
 
 __all__ = [
     "GraspExperiment",
+    "SweepTables",
     "EXPERIMENTS",
     "THESIS_TRIALS",
     "check_trials",
@@ -68,6 +74,8 @@ __all__ = [
 
 #: Repetitions per setting in the thesis.
 THESIS_TRIALS = 500
+#: Bootstrap resamples behind the variability experiments' confidence intervals.
+BOOTSTRAP_DRAWS = 400
 
 #: Settings of the thesis's sweeps (SI units; via-point time as a fraction).
 VIAPOINT_HEIGHTS = tuple(np.round(np.arange(-0.02, 0.0201, 0.005), 4))
@@ -76,7 +84,11 @@ VIAPOINT_DISTANCES = tuple(np.round(np.arange(10) * 0.0025, 4))
 OBJECT_SIZES = tuple(np.round(np.arange(9) * 0.01, 3))
 MOVEMENT_TIMES = (0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2)
 VARIABILITY_SIZES = (0.0, 0.02, 0.04, 0.06, 0.08)
+#: How far the wrist travels in the distance sweep, m (thesis line 953).
 TRANSPORT_DISTANCES = (0.08, 0.12, 0.16, 0.20, 0.24)
+#: The peak-SD quantities bootstrapped per setting (columns of ``bootstrap``).
+PEAK_COLUMNS = ("wrist_sd_peak", "wrist_sd_peak_time", "aperture_sd_peak",
+                "aperture_sd_peak_time")
 
 
 @dataclass(frozen=True, eq=False)
@@ -104,7 +116,17 @@ class GraspExperiment:
         ``wrist_x`` ... ``thumb_y`` (m), mean speeds (m/s), mean ``aperture``,
         ``wrist_sd``, ``aperture_sd`` and their ``*_exact`` values (m).
     stats : dict
-        Experiment-level numbers (regression slope, ANOVA F and p, ...).
+        Experiment-level numbers: effect sizes with their 95 % intervals
+        (``*_ci`` pairs), regression slopes, ...
+    bootstrap : pandas.DataFrame
+        One row per setting and bootstrap resample of its repetitions
+        (``setting``, ``draw`` and :data:`PEAK_COLUMNS`); empty for the
+        experiments that do not need it.
+    moments : tuple of GraspMoments
+        The exact moments of each setting's plan, in setting order.
+    axis : str, optional
+        The column shown on the figures' x axes when it is not ``parameter``
+        (``transport_distance`` for the distance sweep).
     """
 
     name: str
@@ -114,11 +136,19 @@ class GraspExperiment:
     trials: pd.DataFrame = field(repr=False)
     curves: pd.DataFrame = field(repr=False)
     stats: dict = field(default_factory=dict)
+    bootstrap: pd.DataFrame = field(default_factory=pd.DataFrame, repr=False)
+    moments: tuple[GraspMoments, ...] = field(default=(), repr=False)
+    axis: str | None = None
 
     @property
     def values(self) -> np.ndarray:
         """(settings,) values of the varied parameter."""
         return self.summary[self.parameter].to_numpy()
+
+    @property
+    def shown(self) -> str:
+        """The column the figures plot against: ``axis``, else ``parameter``."""
+        return self.axis or self.parameter
 
     def to_pandas(self) -> pd.DataFrame:
         """The per-setting summary table."""
@@ -169,6 +199,24 @@ def check_trials(trials, *, name: str = "trials") -> int:
     return int(trials)
 
 
+class SweepTables(NamedTuple):
+    """What :func:`run_sweep` returns (the attributes of :class:`GraspExperiment`).
+
+    Attributes
+    ----------
+    summary, trials, curves, bootstrap : pandas.DataFrame
+        As in :class:`GraspExperiment`.
+    moments : tuple of GraspMoments
+        Exact moments per setting.
+    """
+
+    summary: pd.DataFrame
+    trials: pd.DataFrame
+    curves: pd.DataFrame
+    bootstrap: pd.DataFrame
+    moments: tuple[GraspMoments, ...]
+
+
 def run_sweep(
     parameter: str,
     values: Sequence[float],
@@ -176,7 +224,8 @@ def run_sweep(
     trials: int = THESIS_TRIALS,
     seed: int | np.random.SeedSequence = 0,
     base: GraspTask | None = None,
-) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame]:
+    bootstrap: int = 0,
+) -> SweepTables:
     """Simulate a grasp for each value of one task parameter and tabulate it.
 
     Parameters
@@ -191,11 +240,14 @@ def run_sweep(
         Root seed; setting ``i`` uses child ``i`` of ``SeedSequence(seed)``.
     base : GraspTask, optional
         The task the settings modify (default: the thesis's).
+    bootstrap : int
+        Bootstrap resamples of each setting's peak SDs (0: none).
 
     Returns
     -------
-    summary, trials, curves : pandas.DataFrame
-        The tables described in :class:`GraspExperiment`.
+    SweepTables
+        ``(summary, trials, curves, bootstrap, moments)``, described in
+        :class:`GraspExperiment`.
 
     Raises
     ------
@@ -216,91 +268,128 @@ def run_sweep(
     else:
         root = np.random.SeedSequence(seed)
     children = root.spawn(len(values))
-    summaries, trial_rows, curve_rows = [], [], []
-    for i, (value, task, child) in enumerate(zip(values, tasks, children)):
-        log.debug("%s = %g: %d repetitions", parameter, value, trials)
-        plan = plan_grasp(task)
-        res = simulate_grasp(task, trials, seed=child, plan=plan)
-        mom = grasp_moments(plan)
-        s = summarize_grasp(res, mom)
-        summaries.append(
-            {"setting": i, parameter: value, **s.as_dict(),
-             "finger_sd": s.finger_sd, "thumb_sd": s.thumb_sd}
-        )
-        rt = res.relative_time
-        mga, mga_t = max_grip_aperture(res.aperture, rt)
-        w_dev, w_t = peak_deviation(res.wrist, rt)
-        a_dev, a_t = peak_deviation(res.aperture, rt)
-        fe, te = res.finger_end, res.thumb_end
-        trial_rows.append(pd.DataFrame({
-            "setting": i, parameter: value, "trial": np.arange(trials),
-            "mga": mga, "mga_time": mga_t,
-            "finger_end_x": fe[:, 0], "finger_end_y": fe[:, 1],
-            "finger_distance": np.linalg.norm(fe - task.finger_target, axis=1),
-            "thumb_end_x": te[:, 0], "thumb_end_y": te[:, 1],
-            "thumb_distance": np.linalg.norm(te - task.thumb_target, axis=1),
-            "wrist_peak_dev": w_dev, "wrist_peak_dev_time": w_t,
-            "aperture_peak_dev": a_dev, "aperture_peak_dev_time": a_t,
-        }))
-        mean = {k: getattr(res, k).mean(axis=0) for k in ("wrist", "finger", "thumb")}
-        curve_rows.append(pd.DataFrame({
-            "setting": i, parameter: value, "step": np.arange(len(rt)),
-            "time": res.time, "relative_time": rt,
-            "wrist_x": mean["wrist"][:, 0], "wrist_y": mean["wrist"][:, 1],
-            "finger_x": mean["finger"][:, 0], "finger_y": mean["finger"][:, 1],
-            "thumb_x": mean["thumb"][:, 0], "thumb_y": mean["thumb"][:, 1],
-            "wrist_speed": res.wrist_speed.mean(axis=0),
-            "finger_speed": res.finger_speed.mean(axis=0),
-            "thumb_speed": res.thumb_speed.mean(axis=0),
-            "aperture": res.aperture.mean(axis=0),
-            "wrist_sd": path_sd(res.wrist), "aperture_sd": path_sd(res.aperture),
-            "wrist_sd_exact": mom.wrist_sd, "aperture_sd_exact": mom.aperture_sd,
-        }))
-    return (
-        pd.DataFrame(summaries),
+    tables = [_setting(i, parameter, task, child, trials, int(bootstrap))
+              for i, (task, child) in enumerate(zip(tasks, children))]
+    summary, trial_rows, curve_rows, boot_rows, moments = zip(*tables)
+    return SweepTables(
+        pd.DataFrame(list(summary)),
         pd.concat(trial_rows, ignore_index=True),
         pd.concat(curve_rows, ignore_index=True),
+        pd.concat(boot_rows, ignore_index=True),
+        tuple(moments),
     )
 
 
-def _anova(trials: pd.DataFrame, column: str, keep=None) -> tuple[float, float]:
-    """One-way ANOVA of ``column`` across settings: (F, p)."""
-    from scipy import stats as sps
+def _setting(i: int, parameter: str, task: GraspTask, child, trials: int, draws: int):
+    """Setting ``i``'s rows of the four tables, and its moments: plan, simulate, measure."""
+    value = getattr(task, parameter)
+    log.debug("%s = %g: %d repetitions", parameter, value, trials)
+    plan = plan_grasp(task)
+    res = simulate_grasp(task, trials, seed=child, plan=plan)
+    mom = grasp_moments(plan)
+    s = summarize_grasp(res, mom)
+    summary = {"setting": i, parameter: value, **s.as_dict(),
+               "finger_sd": s.finger_sd, "thumb_sd": s.thumb_sd}
+    rt = res.relative_time
+    mga, mga_t = max_grip_aperture(res.aperture, rt)
+    w_dev, w_t = peak_deviation(res.wrist, rt)
+    a_dev, a_t = peak_deviation(res.aperture, rt)
+    fe, te = res.finger_end, res.thumb_end
+    per_trial = pd.DataFrame({
+        "setting": i, parameter: value, "trial": np.arange(trials),
+        "mga": mga, "mga_time": mga_t,
+        "finger_end_x": fe[:, 0], "finger_end_y": fe[:, 1],
+        "finger_distance": np.linalg.norm(fe - task.finger_target, axis=1),
+        "thumb_end_x": te[:, 0], "thumb_end_y": te[:, 1],
+        "thumb_distance": np.linalg.norm(te - task.thumb_target, axis=1),
+        "wrist_peak_dev": w_dev, "wrist_peak_dev_time": w_t,
+        "aperture_peak_dev": a_dev, "aperture_peak_dev_time": a_t,
+    })
+    mean = {k: getattr(res, k).mean(axis=0) for k in ("wrist", "finger", "thumb")}
+    curves = pd.DataFrame({
+        "setting": i, parameter: value, "step": np.arange(len(rt)),
+        "time": res.time, "relative_time": rt,
+        "wrist_x": mean["wrist"][:, 0], "wrist_y": mean["wrist"][:, 1],
+        "finger_x": mean["finger"][:, 0], "finger_y": mean["finger"][:, 1],
+        "thumb_x": mean["thumb"][:, 0], "thumb_y": mean["thumb"][:, 1],
+        "wrist_speed": res.wrist_speed.mean(axis=0),
+        "finger_speed": res.finger_speed.mean(axis=0),
+        "thumb_speed": res.thumb_speed.mean(axis=0),
+        "aperture": res.aperture.mean(axis=0),
+        "wrist_sd": path_sd(res.wrist), "aperture_sd": path_sd(res.aperture),
+        "wrist_sd_exact": mom.wrist_sd, "aperture_sd_exact": mom.aperture_sd,
+    })
+    boot = pd.DataFrame(columns=["setting", "draw", *PEAK_COLUMNS])
+    if draws:
+        # its own stream, apart from the simulation's children of ``child``
+        rng = np.random.default_rng(
+            np.random.SeedSequence(child.entropy, spawn_key=(*child.spawn_key, 2**31)))
+        w, a = bootstrap_peak(res.wrist, rt, draws, rng), bootstrap_peak(res.aperture, rt,
+                                                                          draws, rng)
+        boot = pd.DataFrame({"setting": i, "draw": np.arange(draws),
+                             "wrist_sd_peak": w[:, 0], "wrist_sd_peak_time": w[:, 1],
+                             "aperture_sd_peak": a[:, 0], "aperture_sd_peak_time": a[:, 1]})
+    return summary, per_trial, curves, boot, mom
 
-    groups = [g[column].to_numpy() for _, g in trials.groupby("setting", sort=True)]
-    if keep is not None:
-        groups = [g for g, k in zip(groups, keep) if k]
-    if len(groups) < 2:
-        return float("nan"), float("nan")
-    res = sps.f_oneway(*groups)
-    return float(res.statistic), float(res.pvalue)
+
+def _percentiles(draws: np.ndarray) -> list[float]:
+    """The central 95 % interval of ``draws``, as a JSON-ready pair."""
+    return [float(x) for x in np.percentile(draws, [2.5, 97.5])]
 
 
-def _variability_stats(summary: pd.DataFrame, trials: pd.DataFrame, parameter: str) -> dict:
-    from scipy import stats as sps
+def _peak_effects(summary: pd.DataFrame, boot: pd.DataFrame) -> dict:
+    """How the peak SDs and their times change across settings, with 95 % intervals.
 
-    out = {"anova_measure": "per-repetition peak deviation from the setting's mean path"}
-    for comp in ("wrist", "aperture"):
-        f, p = _anova(trials, f"{comp}_peak_dev")
-        out[f"{comp}_anova_F"], out[f"{comp}_anova_p"] = f, p
-        f, p = _anova(trials, f"{comp}_peak_dev_time")
-        out[f"{comp}_time_anova_F"], out[f"{comp}_time_anova_p"] = f, p
-        peaks = summary[f"{comp}_sd_peak_exact"].to_numpy()
-        # relative spread of the exact peaks: 0 when the parameter cannot act
-        # on this component (e.g. the arm plan does not depend on object size)
-        out[f"{comp}_sd_peak_exact_range"] = float(np.ptp(peaks) / np.mean(peaks))
-        constant = np.ptp(peaks) <= 1e-9 * np.mean(peaks)
-        out[f"{comp}_sd_peak_spearman"] = (
-            0.0 if constant else float(sps.spearmanr(summary[parameter], peaks).statistic))
+    For each of :data:`PEAK_COLUMNS`: ``*_change`` (last setting minus first)
+    and ``*_max_diff`` (largest minus smallest setting, signed by their order),
+    exact, each with a ``*_ci`` interval from the bootstrap draws: what 500
+    repetitions per setting can resolve. Also ``*_exact_range``: the exact
+    spread relative to the mean, 0 when the parameter cannot act on the
+    component (e.g. the arm's plan does not depend on object size).
+    """
+    out = {}
+    for col in PEAK_COLUMNS:
+        exact = summary[f"{col}_exact"].to_numpy()
+        d = boot.pivot(index="draw", columns="setting", values=col).to_numpy()
+        hi, lo = int(np.argmax(exact)), int(np.argmin(exact))
+        first, last = (min(lo, hi), max(lo, hi)) if hi != lo else (0, len(exact) - 1)
+        out[f"{col}_change"] = float(exact[-1] - exact[0])
+        out[f"{col}_change_ci"] = _percentiles(d[:, -1] - d[:, 0])
+        out[f"{col}_max_diff"] = float(exact[last] - exact[first])
+        out[f"{col}_max_diff_ci"] = _percentiles(d[:, last] - d[:, first])
+        out[f"{col}_exact_range"] = float(np.ptp(exact) / np.mean(exact))
     return out
 
 
-def _experiment(name, parameter, values, trials, seed, base, extra=None) -> GraspExperiment:
-    summary, tr, curves = run_sweep(parameter, values, trials=trials, seed=seed, base=base)
-    stats = extra(summary, tr) if extra else {}
+def _with_intervals(summary: pd.DataFrame, boot: pd.DataFrame) -> pd.DataFrame:
+    """``summary`` with 95 % intervals: MGA and its time (normal, from the repetitions'
+    SD) and, where bootstrapped, the peak SDs and their times."""
+    se = 1.959964 / np.sqrt(summary["trials"])
+    out = summary.assign(
+        mga_ci_low=summary.mga_mean - se * summary.mga_sd,
+        mga_ci_high=summary.mga_mean + se * summary.mga_sd,
+        mga_time_ci_low=summary.mga_time_mean - se * summary.mga_time_sd,
+        mga_time_ci_high=summary.mga_time_mean + se * summary.mga_time_sd,
+    )
+    if len(boot):
+        q = boot.groupby("setting")[list(PEAK_COLUMNS)].quantile([0.025, 0.975]).unstack()
+        for col in PEAK_COLUMNS:
+            out[f"{col}_ci_low"] = q[(col, 0.025)].to_numpy()
+            out[f"{col}_ci_high"] = q[(col, 0.975)].to_numpy()
+    return out
+
+
+def _experiment(name, parameter, values, trials, seed, base, extra=None, *, draws=0,
+                axis=None) -> GraspExperiment:
+    sweep = run_sweep(parameter, values, trials=trials, seed=seed, base=base, bootstrap=draws)
+    summary = _with_intervals(sweep.summary, sweep.bootstrap)
+    stats = extra(summary, sweep.trials) if extra else {}
+    if draws:
+        stats.update(_peak_effects(summary, sweep.bootstrap))
     return GraspExperiment(
         name=name, parameter=parameter, base=GraspTask() if base is None else base,
-        summary=summary, trials=tr, curves=curves, stats=stats,
+        summary=summary, trials=sweep.trials, curves=sweep.curves, stats=stats,
+        bootstrap=sweep.bootstrap, moments=sweep.moments, axis=axis,
     )
 
 
@@ -357,9 +446,14 @@ def _mga_stats(parameter):
         x = summary[parameter].to_numpy()
         fit = sps.linregress(x, summary["mga_mean"].to_numpy())
         tfit = sps.linregress(x, summary["mga_time_mean"].to_numpy())
+        # the slope's uncertainty from the repetitions themselves (same slope as
+        # the means' regression: every setting has the same number of them)
+        each = sps.linregress(trials[parameter].to_numpy(), trials["mga"].to_numpy())
+        half = 1.959964 * float(each.stderr)
         return {
             "mga_slope": float(fit.slope), "mga_intercept": float(fit.intercept),
             "mga_r": float(fit.rvalue),
+            "mga_slope_ci": [float(fit.slope) - half, float(fit.slope) + half],
             "mga_time_slope": float(tfit.slope),
             "mga_time_min": float(summary["mga_time_mean"].min()),
             "mga_time_max": float(summary["mga_time_mean"].max()),
@@ -419,16 +513,9 @@ def object_size_experiment(
     )
 
 
-def _variability(name, parameter, values, trials, seed, base):
-    def extra(summary, tr):
-        out = _variability_stats(summary, tr, parameter)
-        if parameter == "object_size":  # the thesis's exception: no object at all
-            keep = summary[parameter].to_numpy() > 0
-            out["wrist_anova_F_nonzero"], out["wrist_anova_p_nonzero"] = _anova(
-                tr, "wrist_peak_dev", keep)
-        return out
-
-    return _experiment(name, parameter, values, trials, seed, base, extra)
+def _variability(name, parameter, values, trials, seed, base, axis=None):
+    return _experiment(name, parameter, values, trials, seed, base, draws=BOOTSTRAP_DRAWS,
+                       axis=axis)
 
 
 def movement_time_experiment(
@@ -486,10 +573,15 @@ def variability_distance_experiment(
 ) -> GraspExperiment:
     """Wrist and aperture variability vs transport distance (thesis 4.2.3.3, Figs. 4.15-4.16).
 
+    The thesis gives "the distance to be moved" (line 953): each setting's
+    object centre is ``base.wrist_offset`` beyond where the wrist stops, i.e.
+    :class:`~minvar.grasp.GraspTask` ``distance = d + wrist_offset``. The tables
+    hold both ``distance`` and ``transport_distance``; figures show the latter.
+
     Parameters
     ----------
     distances : sequence of float
-        Distances from the wrist's start to the object centre, m (default 8-24 cm).
+        How far the wrist travels, m (default 8-24 cm).
     trials : int
         Repetitions per setting.
     seed : int or numpy.random.SeedSequence
@@ -497,7 +589,15 @@ def variability_distance_experiment(
     base : GraspTask, optional
         Task the settings modify.
     """
-    return _variability("variability-distance", "distance", distances, trials, seed, base)
+    base = GraspTask() if base is None else base
+    moved = [float(d) for d in distances]
+    exp = _variability("variability-distance", "distance",
+                       [d + base.wrist_offset for d in moved], trials, seed, base,
+                       axis="transport_distance")
+    by_setting = dict(enumerate(moved))
+    for table in (exp.summary, exp.trials, exp.curves):
+        table.insert(2, "transport_distance", table["setting"].map(by_setting))
+    return exp
 
 
 #: Experiment functions by CLI name, in thesis order.

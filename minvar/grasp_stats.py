@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .analysis import endpoint_stats
+from .analysis import endpoint_stats, expected_distance
 from .lqg import state_moments
 from .plant import POSITION
 
@@ -29,6 +29,8 @@ if TYPE_CHECKING:  # pragma: no cover - minvar.grasp imports this module
 __all__ = [
     "GraspMoments",
     "GraspSummary",
+    "bootstrap_peak",
+    "end_distance",
     "grasp_moments",
     "grip_aperture",
     "max_grip_aperture",
@@ -140,6 +142,47 @@ def peak_deviation(paths: np.ndarray, relative_time: np.ndarray):
     return dist[np.arange(len(i)), i], np.asarray(relative_time, dtype=float)[i]
 
 
+def bootstrap_peak(
+    paths: np.ndarray, relative_time: np.ndarray, draws: int, rng: np.random.Generator
+) -> np.ndarray:
+    """Bootstrap draws of the peak of the SD over time, and of its time.
+
+    The repetitions are resampled with replacement ``draws`` times; each
+    resample's SD curve (:func:`path_sd`) gives one (peak, time) pair. Their
+    spread is what the repetitions can resolve: a confidence interval for the
+    peak SD and its timing, and, across settings, for their differences.
+
+    Parameters
+    ----------
+    paths : (trials, S+1) or (trials, S+1, 2) array
+        Scalar (e.g. aperture, m) or 2-D positions (m) over time.
+    relative_time : (S+1,) array
+        Time of each sample, fraction of the movement.
+    draws : int
+        Number of resamples (>= 1).
+    rng : numpy.random.Generator
+        Randomness of the resampling.
+
+    Returns
+    -------
+    (draws, 2) array
+        Peak SD (unit of ``paths``) and its time, per resample.
+    """
+    x = np.asarray(paths, dtype=float)
+    n = x.shape[0]
+    flat = x.reshape(n, -1)
+    flat = flat - flat.mean(axis=0)  # centred: the sums below lose no precision
+    # resampling as multinomial counts: every draw's moments by two matrix products
+    counts = rng.multinomial(n, np.full(n, 1.0 / n), size=int(draws)).astype(float)
+    mean = counts @ flat / n
+    var = (counts @ flat**2 / n - mean**2) * n / (n - 1)
+    var = var.reshape((int(draws), *x.shape[1:]))
+    sd = np.sqrt(np.maximum(var.sum(axis=-1) if x.ndim == 3 else var, 0.0))
+    i = np.argmax(sd, axis=1)
+    return np.stack([sd[np.arange(len(i)), i], np.asarray(relative_time, dtype=float)[i]],
+                    axis=1)
+
+
 @dataclass(frozen=True, eq=False)
 class GraspMoments:
     """Exact (first-order) means and covariances of a planned grasp's execution.
@@ -181,6 +224,36 @@ class GraspMoments:
     def thumb_end_sd(self) -> np.ndarray:
         """(2,) SD of the final thumb-tip position in x and y, m."""
         return np.sqrt(np.diag(self.thumb_cov[-1]))
+
+    def with_transport(self, other: GraspMoments) -> GraspMoments:
+        """This grasp's grip carried by ``other``'s transport.
+
+        The chains are independent and the grip is planned in the hand frame,
+        so a grasp that differs only in its transport (e.g. its distance) has
+        this grasp's hand-frame digit moments and ``other``'s wrist moments:
+        the result is exact, without planning the grip again.
+
+        Parameters
+        ----------
+        other : GraspMoments
+            Moments of a grasp with the same number of steps.
+        """
+        if other.wrist_mean.shape != self.wrist_mean.shape:
+            raise ValueError("GraspMoments.with_transport: other: expected the same number "
+                             f"of steps, got {len(other.wrist_mean)} vs {len(self.wrist_mean)}")
+        dm = other.wrist_mean - self.wrist_mean
+        dc = other.wrist_cov - self.wrist_cov
+        return GraspMoments(
+            relative_time=self.relative_time,
+            wrist_mean=other.wrist_mean,
+            finger_mean=self.finger_mean + dm,
+            thumb_mean=self.thumb_mean + dm,
+            wrist_cov=other.wrist_cov,
+            finger_cov=self.finger_cov + dc,
+            thumb_cov=self.thumb_cov + dc,
+            aperture_mean=self.aperture_mean,
+            aperture_sd=self.aperture_sd,
+        )
 
 
 def grasp_moments(plan: GraspPlan) -> GraspMoments:
@@ -262,6 +335,11 @@ class GraspSummary:
         Peak aperture SD and its time, exact.
     finger_sd_x_exact, finger_sd_y_exact, thumb_sd_x_exact, thumb_sd_y_exact : float
         End-point SDs, exact.
+    finger_distance_exact, thumb_distance_exact : float
+        Mean end-point distance from the target, exact
+        (:func:`minvar.analysis.expected_distance` of the exact moments).
+    mga_exact, mga_time_exact : float
+        Maximum of the exact mean aperture, and its time.
     """
 
     trials: int
@@ -289,6 +367,10 @@ class GraspSummary:
     finger_sd_y_exact: float = float("nan")
     thumb_sd_x_exact: float = float("nan")
     thumb_sd_y_exact: float = float("nan")
+    finger_distance_exact: float = float("nan")
+    thumb_distance_exact: float = float("nan")
+    mga_exact: float = float("nan")
+    mga_time_exact: float = float("nan")
 
     @property
     def finger_sd(self) -> float:
@@ -305,6 +387,22 @@ class GraspSummary:
         from dataclasses import asdict
 
         return asdict(self)
+
+
+def end_distance(moments: GraspMoments, digit: str, target) -> float:
+    """Exact mean distance of a digit's final position from its target, m.
+
+    Parameters
+    ----------
+    moments : GraspMoments
+        Exact moments of the grasp.
+    digit : {"finger", "thumb"}
+        Which tip.
+    target : (2,) array_like
+        Its target, world frame, m.
+    """
+    mean, cov = getattr(moments, f"{digit}_mean")[-1], getattr(moments, f"{digit}_cov")[-1]
+    return expected_distance(mean - np.asarray(target, dtype=float), cov)
 
 
 def summarize_grasp(result: GraspResult, moments: GraspMoments | None = None) -> GraspSummary:
@@ -334,6 +432,7 @@ def summarize_grasp(result: GraspResult, moments: GraspMoments | None = None) ->
     if moments is not None:
         mw = peak(moments.wrist_sd, moments.relative_time)
         ma = peak(moments.aperture_sd, moments.relative_time)
+        mg = peak(moments.aperture_mean, moments.relative_time)
         exact = dict(
             wrist_sd_peak_exact=mw[0],
             wrist_sd_peak_time_exact=mw[1],
@@ -343,6 +442,10 @@ def summarize_grasp(result: GraspResult, moments: GraspMoments | None = None) ->
             finger_sd_y_exact=float(moments.finger_end_sd[1]),
             thumb_sd_x_exact=float(moments.thumb_end_sd[0]),
             thumb_sd_y_exact=float(moments.thumb_end_sd[1]),
+            finger_distance_exact=end_distance(moments, "finger", result.task.finger_target),
+            thumb_distance_exact=end_distance(moments, "thumb", result.task.thumb_target),
+            mga_exact=mg[0],
+            mga_time_exact=mg[1],
         )
     return GraspSummary(
         trials=result.trials,

@@ -22,11 +22,14 @@ code's ``K``, ``L``, expected trajectory and cost per iteration (see
 
 from __future__ import annotations
 
+import copy
+import functools
 import logging
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.linalg.lapack import dposv as _dposv
+
+from . import _kernel
 
 log = logging.getLogger(__name__)
 
@@ -66,10 +69,18 @@ def _as_stack(name: str, value, shape: tuple[int, int], what: str) -> np.ndarray
 
 def _check_psd(name: str, M: np.ndarray) -> None:
     """Raise unless ``M`` (or each of a stack) is symmetric positive semi-definite."""
-    scale = max(float(np.abs(M).max()), np.finfo(float).tiny)
-    if not np.allclose(M, np.swapaxes(M, -1, -2), rtol=0, atol=1e-10 * scale):
+    if M.ndim == 3:  # a cost per step is mostly zeros: check the others
+        M = M[M.any(axis=(1, 2))]
+    if not M.any():
+        return
+    scale = float(np.abs(M).max())
+    if np.abs(M - np.swapaxes(M, -1, -2)).max() > 1e-10 * scale:
         raise ValueError(f"LQGProblem.{name}: expected a symmetric matrix")
-    lowest = np.linalg.eigvalsh(0.5 * (M + np.swapaxes(M, -1, -2))).min()
+    d = np.diagonal(M, axis1=-2, axis2=-1)
+    if M.ndim == 2 and np.count_nonzero(M) == np.count_nonzero(d):  # diagonal
+        lowest = float(d.min())
+    else:
+        lowest = np.linalg.eigvalsh(0.5 * (M + np.swapaxes(M, -1, -2))).min()
     if lowest < -1e-10 * scale:
         raise ValueError(f"LQGProblem.{name}: expected a positive semi-definite matrix "
                          f"(an eigenvalue is {lowest:.3g})")
@@ -165,6 +176,20 @@ class LQGProblem:
         for key, val in values.items():
             object.__setattr__(self, key, val)
 
+    def with_noise(self, *, C=None, D0=None) -> LQGProblem:
+        """This problem with other control-dependent (``C``) or sensory (``D0``) noise.
+
+        The same as ``dataclasses.replace(problem, C=..., D0=...)``, checking
+        only the new matrices (a grasp's execution model, planned once per chain).
+        """
+        new = copy.copy(self)
+        m, k = self.n_controls, self.n_outputs
+        if C is not None:
+            object.__setattr__(new, "C", _as_stack("C", C, (m, m), "m x m"))
+        if D0 is not None:
+            object.__setattr__(new, "D0", _as_matrix("D0", D0, (k, None)))
+        return new
+
     @property
     def n_states(self) -> int:
         """Number of states n."""
@@ -241,10 +266,6 @@ class _Solver:
         self.Bt = np.ascontiguousarray(B.T)
         self.Ht = np.ascontiguousarray(p.H.T)
         self.BC = np.einsum("ij,cjk->cik", B, p.C)  # (c, n, m): thesis C_i
-        n, m = p.n_states, p.n_controls
-        # sum_i X_i M X_i' as one product on vec(M) (row-major: vec(X M Y) = (X kron Y') vec(M))
-        self.noise_fwd = sum((np.kron(BCi, BCi) for BCi in self.BC), np.zeros((n * n, m * m)))
-        self.noise_bwd = sum((np.kron(Ci.T, Ci.T) for Ci in p.C), np.zeros((m * m, m * m)))
         self.DD0 = p.D0 @ p.D0.T
         self.CC0 = p.C0 @ p.C0.T
         self.EE0 = p.E0 @ p.E0.T
@@ -258,13 +279,49 @@ class _Solver:
         self.filter_pd = _is_positive_definite(self.DD0)
         self.control_pd = _is_positive_definite(p.R)
         self.XX1 = np.outer(p.X1, p.X1)
+        # The compiled passes cover the Cholesky case (every planning problem
+        # of this project); the pseudo-inverse case runs in numpy.
+        self.fast = None
+        if _kernel.available() and self.filter_pd and self.control_pd:
+            flags = ((_kernel.HAS_C if self.has_C else 0) | (_kernel.HAS_D if self.has_D else 0)
+                     | (_kernel.TRACK_XE if self.has_E0 else 0)
+                     | (_kernel.ADD_NOISE if self.has_C0 or self.has_E0 else 0)
+                     | (_kernel.NOISE_COST if self.has_noise_cost else 0))
+            self.fast = _kernel.Arrays(p, self.BC, self.DD0, self.CC0, self.EE0, flags)
+
+    def step(self, L: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+        """One iteration: ``K`` optimal for ``L``, then the new ``L`` and its expected cost."""
+        if self.fast is not None:
+            K = _kernel.forward(self.fast, L)
+            if K is not None:
+                out = _kernel.backward(self.fast, K)
+                if out is not None:
+                    return K, *out
+        K, AKH = self.forward(L)
+        L, cost = self.backward(K, AKH)
+        return K, L, cost
+
+    @functools.cached_property
+    def noise_fwd(self) -> np.ndarray:
+        """sum_i X_i M X_i' as one product on vec(M), X_i = B C_i (row-major:
+        vec(X M Y) = (X kron Y') vec(M)); the numpy passes only."""
+        n, m = self.p.n_states, self.p.n_controls
+        return sum((np.kron(BCi, BCi) for BCi in self.BC), np.zeros((n * n, m * m)))
+
+    @functools.cached_property
+    def noise_bwd(self) -> np.ndarray:
+        """sum_i C_i' M C_i as one product on vec(M); the numpy passes only."""
+        m = self.p.n_controls
+        return sum((np.kron(Ci.T, Ci.T) for Ci in self.p.C), np.zeros((m * m, m * m)))
 
     @staticmethod
     def _solve(M: np.ndarray, Y: np.ndarray, pd: bool) -> np.ndarray:
         """``M^-1 Y`` for symmetric ``M``: Cholesky when ``M`` is positive definite,
         else the pseudo-inverse, as Todorov's code does for every step."""
         if pd:
-            _, X, info = _dposv(M, Y)
+            from scipy.linalg.lapack import dposv  # the numpy passes only: start-up time
+
+            _, X, info = dposv(M, Y)
             if info == 0:
                 return X
         return np.linalg.pinv(M).dot(Y)
@@ -362,38 +419,51 @@ class _Solver:
 def solve(
     problem: LQGProblem,
     *,
-    tol: float = 1e-12,
     atol: float = 1e-15,
+    tol: float = 0.0,
     max_iter: int = 500,
+    initial_L: np.ndarray | None = None,
 ) -> LQGSolution:
     """Find the filter ``K`` and controller ``L`` that are optimal for each other.
+
+    The stopping rule is that of Todorov's ``kalman_lqg.m``, so ``K``, ``L``
+    and the mean states match his code's output to rounding on any problem.
 
     Parameters
     ----------
     problem : LQGProblem
         The problem to solve.
-    tol : float, optional
-        Stop when the expected cost changes by less than ``tol`` times its value
-        between iterations ...
     atol : float, optional
-        ... or by less than ``atol`` (the floor for problems of near-zero cost;
-        Todorov's code uses this absolute test, with 1e-15). As in his code,
-        iteration also stops when the cost rises more than 3 times in the last
-        10 iterations: it is then bouncing on its rounding floor, and counts
-        as converged if those changes are below 1e-6 of the cost.
+        Stop when the expected cost changes by less than ``atol`` between
+        iterations (Todorov's absolute test, with his 1e-15). As in his code,
+        iteration also stops when the cost rose more than 3 times in the last
+        10 iterations (after 20): it is then bouncing on its rounding floor,
+        and counts as converged if those changes are below 1e-6 of the cost.
+    tol : float, optional
+        Also stop when the change is below ``tol`` times the cost (a relative
+        test; 0, off, by default as in Todorov's code).
     max_iter : int, optional
         Maximum number of forward/backward iterations; ``max_iter=2`` runs
         exactly two (Todorov's ``Niter=2``).
+    initial_L : (T, m, n) array, optional
+        Control gains for the first forward pass (default zeros, as the thesis
+        and Todorov's code; thesis line 481: any start converges to the same
+        answer).
 
     Returns
     -------
     LQGSolution
         Gains, expected cost, cost per iteration and the noise-free mean states.
+        A problem that does not converge in ``max_iter`` iterations has
+        ``converged=False`` and is reported once per process in the log.
 
     Raises
     ------
     ValueError
-        If ``tol``, ``atol`` or ``max_iter`` are out of range.
+        If ``tol``, ``atol``, ``max_iter`` or ``initial_L`` are out of range, or the
+        recursions break down: non-finite moments or gains (e.g. dynamics so
+        unstable that the moments overflow), or a singular observation noise
+        whose filter system cannot be solved. The message names the cause.
     """
     if not isinstance(problem, LQGProblem):
         raise ValueError(f"solve: expected an LQGProblem, got {type(problem).__name__}")
@@ -403,13 +473,20 @@ def solve(
         raise ValueError(f"solve: max_iter must be >= 1, got {max_iter}")
     solver = _Solver(problem)
     T, m, n = problem.horizon, problem.n_controls, problem.n_states
-    L = np.zeros((T, m, n))
+    L = np.zeros((T, m, n)) if initial_L is None else np.array(initial_L, dtype=float)
+    if L.shape != (T, m, n) or not np.all(np.isfinite(L)):
+        raise ValueError(f"solve: initial_L must be finite, of shape {(T, m, n)}, got {L.shape}")
     history: list[float] = []
     converged = False
     K = None
-    for _ in range(int(max_iter)):
-        K, AKH = solver.forward(L)
-        L, cost = solver.backward(K, AKH)
+    for it in range(int(max_iter)):
+        with np.errstate(all="ignore"):  # overflow is reported below, by its cause
+            try:
+                K, L, cost = solver.step(L)
+            except np.linalg.LinAlgError as exc:
+                raise ValueError(_breakdown(solver, it, f"a linear solve failed ({exc})")) from None
+        if not (np.isfinite(cost) and np.isfinite(K).all() and np.isfinite(L).all()):
+            raise ValueError(_breakdown(solver, it, _first_bad(K, L)))
         history.append(cost)
         if len(history) > 1:
             change = abs(history[-2] - history[-1])
@@ -425,9 +502,7 @@ def solve(
                 converged = bool(np.abs(recent).max() <= _FLOOR_RTOL * abs(history[-1]))
                 break
     if not converged:
-        log.warning("solve: the cost did not converge in %d iterations (last change %.3g, "
-                    "cost %.6g)", len(history), abs(history[-2] - history[-1])
-                    if len(history) > 1 else float("nan"), history[-1])
+        _report_unconverged(problem, history)
     for arr in (K, L):
         arr.setflags(write=False)
     return LQGSolution(
@@ -439,6 +514,47 @@ def solve(
         converged=converged,
         mean_states=solver.mean_states(L),
     )
+
+
+def _first_bad(K: np.ndarray, L: np.ndarray) -> str:
+    """Which gains went non-finite first, and at which step."""
+    for name, G in (("filter gains K", K), ("control gains L", L)):
+        bad = ~np.isfinite(G).reshape(len(G), -1).all(axis=1)
+        if bad.any():
+            return f"the {name} are not finite from step {int(np.argmax(bad))}"
+    return "the expected cost is not finite"
+
+
+def _breakdown(solver: _Solver, iteration: int, what: str) -> str:
+    """The message of a solve that broke down: what happened and the likely cause."""
+    p = solver.p
+    causes = []
+    growth = float(np.abs(np.linalg.eigvals(p.A)).max())
+    if p.horizon * np.log10(max(growth, 1e-300)) > 100:
+        causes.append(f"the dynamics A grow by {growth:.3g} per step, so the moments "
+                      f"overflow within {p.horizon} steps")
+    if not solver.filter_pd:
+        causes.append("the observation noise D0 D0' is singular (some sensor has no "
+                      "noise), so the filter's system H S H' + D0 D0' can be singular")
+    cause = "; ".join(causes) or "the problem's moments overflow or cancel"
+    return f"solve: iteration {iteration + 1}: {what}: {cause}"
+
+
+#: Problems whose failure to converge has been reported in this process.
+_REPORTED: set[tuple] = set()
+
+
+def _report_unconverged(problem: LQGProblem, history: list[float]) -> None:
+    """Log a plan that did not converge: once per problem and process, at warning level."""
+    key = (problem.n_states, problem.horizon, round(history[-1], 12))
+    last = abs(history[-2] - history[-1]) if len(history) > 1 else float("nan")
+    msg = ("solve: the expected cost did not converge in %d iterations (last change %.3g, "
+           "cost %.6g): the gains are those of the last iteration")
+    if key in _REPORTED:
+        log.debug(msg, len(history), last, history[-1])
+        return
+    _REPORTED.add(key)
+    log.warning(msg, len(history), last, history[-1])
 
 
 def _joint_moments(problem: LQGProblem, K: np.ndarray, L: np.ndarray):
@@ -531,7 +647,12 @@ def estimation_error_covariance(problem: LQGProblem, K: np.ndarray, L: np.ndarra
     (T+1, n, n) array
         ``Cov[x[t] - xhat[t]]`` for t = 0..T.
     """
-    n = problem.n_states
+    p = problem
+    T, n, m, k = p.horizon, p.n_states, p.n_controls, p.n_outputs
+    K = np.asarray(K, dtype=float)
+    L = np.asarray(L, dtype=float)
+    if _kernel.available() and K.shape == (T, n, k) and L.shape == (T, m, n):
+        return _kernel.error_covariance(p, K, L)  # the same recursion, compiled
     out = []
     for _, _, S in _joint_moments(problem, K, L):
         out.append(S[:n, :n] - S[:n, n:] - S[n:, :n] + S[n:, n:])

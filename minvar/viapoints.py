@@ -65,14 +65,18 @@ def _derivatives(p: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return v, np.gradient(v, t, axis=0, edge_order=2)
 
 
-def spatiotemporal_curvature(position, time) -> np.ndarray:
+def spatiotemporal_curvature(position, time, *, unit: float = 1.0) -> np.ndarray:
     """Curvature of the spatio-temporal trajectory ``(x(t), y(t), t)`` (thesis eq. A.1).
 
     ``kappa = sqrt(x''^2 + y''^2 + (x' y'' - x'' y')^2) / (x'^2 + y'^2 + 1)^(3/2)``,
-    derivatives by second-order finite differences. The time axis is measured
-    in s beside positions in m, so kappa depends on those units (as in the
-    thesis): a straight line at constant speed has kappa = 0; a circle of
-    radius R at angular speed w has ``kappa = R w^2 / (1 + R^2 w^2)``.
+    derivatives by second-order finite differences. The time axis (s) sits
+    beside positions measured in ``unit``, so kappa depends on that unit (the
+    thesis does not give it): a straight line at constant speed has kappa = 0;
+    a circle of radius R at angular speed w has ``kappa = R w^2 / (1 + R^2 w^2)``.
+    In metres, hand speeds are well under 1, the ``+ 1`` dominates the
+    denominator and ``|a|^2`` the numerator, so kappa is close to the
+    acceleration's magnitude; in centimetres or millimetres it is closer to
+    the path's ordinary curvature wherever the hand moves.
 
     Parameters
     ----------
@@ -80,20 +84,24 @@ def spatiotemporal_curvature(position, time) -> np.ndarray:
         Sampled path, m.
     time : (S,) array_like
         Sample times, s, strictly increasing.
+    unit : float
+        Length unit of eq. A.1, m (1: metres, 0.01: centimetres, 0.001: mm).
 
     Returns
     -------
     (S,) array
-        kappa at each sample (units of the thesis's mixed m/s expression).
+        kappa at each sample (units of the thesis's mixed expression).
     """
     p, t = _trajectory("spatiotemporal_curvature", position, time)
-    v, a = _derivatives(p, t)
+    if not (np.isfinite(unit) and unit > 0):
+        raise ValueError(f"spatiotemporal_curvature: unit must be a length > 0 in m, got {unit}")
+    v, a = _derivatives(p / unit, t)
     cross = v[:, 0] * a[:, 1] - a[:, 0] * v[:, 1]
     num = np.sqrt(a[:, 0] ** 2 + a[:, 1] ** 2 + cross**2)
     return num / (v[:, 0] ** 2 + v[:, 1] ** 2 + 1.0) ** 1.5
 
 
-def criterion_signal(position, time, criterion: str) -> np.ndarray:
+def criterion_signal(position, time, criterion: str, *, unit: float = 1.0) -> np.ndarray:
     """The signal whose extrema give via-points under one appendix A criterion.
 
     Parameters
@@ -105,6 +113,9 @@ def criterion_signal(position, time, criterion: str) -> np.ndarray:
     criterion : {"speed", "acceleration", "curvature"}
         Speed (m/s), acceleration magnitude (m/s^2) or spatio-temporal
         curvature (eq. A.1).
+    unit : float
+        Length unit of eq. A.1, m (curvature only: the extrema of speed and
+        acceleration do not depend on units).
 
     Returns
     -------
@@ -114,7 +125,7 @@ def criterion_signal(position, time, criterion: str) -> np.ndarray:
     if criterion not in CRITERIA:
         raise ValueError(f"criterion: expected one of {CRITERIA}, got {criterion!r}")
     if criterion == "curvature":
-        return spatiotemporal_curvature(p, t)
+        return spatiotemporal_curvature(p, t, unit=unit)
     v, a = _derivatives(p, t)
     x = v if criterion == "speed" else a
     return np.hypot(x[:, 0], x[:, 1])
@@ -151,7 +162,8 @@ def local_extrema(signal, *, prominence: float = 0.05) -> np.ndarray:
 
 
 def extract_via_points(
-    position, time, criterion: str = "curvature", *, prominence: float = 0.05
+    position, time, criterion: str = "curvature", *, prominence: float = 0.05,
+    unit: float = 1.0,
 ) -> np.ndarray:
     """Sample indices of candidate via-points: the extrema of ``criterion``.
 
@@ -165,6 +177,8 @@ def extract_via_points(
         Which signal's maxima and minima to take (appendix A.1).
     prominence : float
         Ripples smaller than this fraction of the signal's range are ignored.
+    unit : float
+        Length unit of eq. A.1, m (:func:`spatiotemporal_curvature`).
 
     Returns
     -------
@@ -172,7 +186,8 @@ def extract_via_points(
         Sorted interior indices (start and goal are part of every
         representation already).
     """
-    return local_extrema(criterion_signal(position, time, criterion), prominence=prominence)
+    return local_extrema(criterion_signal(position, time, criterion, unit=unit),
+                         prominence=prominence)
 
 
 @dataclass(frozen=True)
@@ -437,6 +452,7 @@ def compare_criteria(
     prominence: float = 0.05,
     chain: TwoLinkChain | None = None,
     plant: PointMassPlant | None = None,
+    unit: float = 1.0,
 ) -> CriteriaComparison:
     """Extract via-points by each criterion, replay, and score the replays (Fig. A.1).
 
@@ -462,6 +478,9 @@ def compare_criteria(
         Arm for the joint-space comparison (default: two 0.30 m links).
     plant : PointMassPlant, optional
         Plant of the replay; its ``dt`` must match the trajectories' sampling.
+    unit : float
+        Length unit of eq. A.1, m (curvature only; see
+        :func:`spatiotemporal_curvature`).
 
     Returns
     -------
@@ -482,7 +501,7 @@ def compare_criteria(
                 f"compare_criteria: trajectories[{k}] must be sampled every plant.dt = {plant.dt} s"
             )
         for c in criteria:
-            idx = extract_via_points(p, t, c, prominence=prominence)
+            idx = extract_via_points(p, t, c, prominence=prominence, unit=unit)
             movement = ViaPointMovement.from_samples(p, t, idx)
             _, copy = replay(movement, plant=plant)
             d = joint_msd(p, copy, chain=chain)

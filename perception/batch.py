@@ -36,9 +36,11 @@ from perception.pipeline import (
     RecognitionSettings,
     clip_fingerprint,
     clip_name,
-    recognize_clip,
+    load_clip,
+    recognize_tracks,
 )
-from perception.recognition.repertoire import Repertoire
+from perception.recognition.planning import THREADS_VARIABLE
+from perception.recognition.repertoire import PlanCache, Repertoire
 from perception.report.batch import write_batch_report
 from perception.report.clip import ClipSummary, clip_outputs, write_clip_report
 from perception.report.conditions import reference_model
@@ -185,8 +187,8 @@ class ClipResult:
 
 def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
                  settings: RecognitionSettings, repertoire_id: str = "", *,
-                 progress: bool = False) -> ClipResult:
-    """Recognise one clip through :func:`~perception.pipeline.recognize_clip` and report it.
+                 progress: bool = False, plan_cache: PlanCache | None = None) -> ClipResult:
+    """Recognise one clip through the pipeline (:mod:`perception.pipeline`) and report it.
 
     Parameters
     ----------
@@ -202,6 +204,8 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
         Identity of the repertoire, part of the report's fingerprint.
     progress : bool
         Show a progress bar while tracking a video.
+    plan_cache : PlanCache, optional
+        Models re-planned for a scene, shared with the batch's other processes.
 
     Returns
     -------
@@ -216,11 +220,11 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
         done = _current_report(item, out, fp)
         if done is not None:
             return ClipResult(**base, status="reused", summary=ClipSummary.from_dict(done))
-        tracks_out = out / "tracks" / f"{item.clip}{TRACKS_SUFFIX}"
-        rec = recognize_clip(item.path, repertoire, settings, clip=item.clip,
-                             tracks_out=tracks_out, progress=progress)
-        tracking = write_tracking_report(item.path if item.kind == "tracks" else tracks_out,
-                                         out, item.clip)
+        tracks = load_clip(item.path, tracks_out=out / "tracks" / f"{item.clip}{TRACKS_SUFFIX}",
+                           progress=progress, setup=settings.tracking, pose=settings.pose)
+        rec = recognize_tracks(tracks, repertoire, settings, clip=item.clip, source=item.path,
+                               plan_cache=plan_cache)
+        tracking = write_tracking_report(tracks, out, item.clip)
         extra = {"fingerprint": fp, "condition": item.condition, "input": str(item.path),
                  "tracking": tracking}
         write_clip_report(rec, out, extra=extra)
@@ -257,11 +261,34 @@ def _guarded(item: BatchItem, out: Path, **kwargs) -> ClipResult:
                           kwargs["settings"].hammer.rule)
 
 
+#: Thread pools of the numerical libraries, one thread each in a worker: set in
+#: the environment a worker is spawned with, because they are read when numpy
+#: (its BLAS) and OpenCV load, before any code of the worker runs.
+THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
+                    "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS")
+
+
 def _limit_threads() -> None:
     """One thread per worker process: parallelism comes from the processes."""
     import cv2
 
     cv2.setNumThreads(1)
+
+
+@contextlib.contextmanager
+def _single_threaded_children():
+    """Processes spawned inside get one BLAS/OpenMP thread (the environment they inherit)."""
+    names = (*THREAD_VARIABLES, THREADS_VARIABLE)
+    before = {k: os.environ.get(k) for k in names}
+    os.environ.update({k: "1" for k in names})
+    try:
+        yield
+    finally:
+        for k, v in before.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
 
 
 @contextlib.contextmanager
@@ -297,9 +324,25 @@ class _Job:
     settings: RecognitionSettings
     repertoire_id: str
 
+    @property
+    def plan_cache(self) -> PlanCache:
+        """Plans of the batch's scenes, beside its report, shared by every process."""
+        return PlanCache(self.out / PLANS_FOLDER)
+
     def run(self, item: BatchItem, repertoire: Repertoire) -> ClipResult:
         return _guarded(item, self.out, repertoire=repertoire, settings=self.settings,
-                        repertoire_id=self.repertoire_id)
+                        repertoire_id=self.repertoire_id, plan_cache=self.plan_cache)
+
+    def run_on_cluster(self, item: BatchItem, repertoire: Repertoire) -> ClipResult:
+        """:meth:`run` in a dask worker: single-threaded OpenCV, as local workers are
+        (dask's nanny already starts workers with one BLAS/OpenMP thread)."""
+        _limit_threads()
+        os.environ[THREADS_VARIABLE] = "1"  # the cluster's other workers use the other cores
+        return self.run(item, repertoire)
+
+
+#: Folder of the plan cache inside a report folder.
+PLANS_FOLDER = ".plans"
 
 
 def _work_in_worker(item: BatchItem, job: _Job) -> ClipResult:
@@ -333,8 +376,9 @@ def _run_local(items: list[BatchItem], repertoire: Repertoire, job: _Job,
     ctx = multiprocessing.get_context("spawn")
     with tempfile.TemporaryDirectory(prefix=".repertoire-", dir=job.out) as tmp, _one_thread():
         rep_file = repertoire.save(Path(tmp) / "repertoire.h5")
-        with ProcessPoolExecutor(max_workers=jobs - 1, initializer=_init_worker,
-                                 initargs=(str(rep_file),), mp_context=ctx) as pool:
+        with _single_threaded_children(), ProcessPoolExecutor(
+                max_workers=jobs - 1, initializer=_init_worker, initargs=(str(rep_file),),
+                mp_context=ctx) as pool:
             yield from _share(pending, here, pool, job, jobs - 1)
 
 
@@ -377,7 +421,7 @@ def _run_dask(items: list[BatchItem], repertoire: Repertoire, job: _Job,
 
     with Client(scheduler) as client:
         rep = client.scatter(repertoire, broadcast=True)
-        futures = [client.submit(job.run, it, rep, pure=False) for it in items]
+        futures = [client.submit(job.run_on_cluster, it, rep, pure=False) for it in items]
         for fut in dask_completed(futures):
             yield fut.result()
 

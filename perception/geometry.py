@@ -19,11 +19,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["DEFAULT_OBJECT_DIAMETER", "SimilarityTransform"]
+__all__ = ["DEFAULT_OBJECT_DIAMETER", "DEFAULT_TIP_START", "SimilarityTransform"]
 
 #: Diameter of the thesis's ball, m: the default object, which sets the
 #: metric scale of a clip (its apparent size in pixels over this).
 DEFAULT_OBJECT_DIAMETER = 0.10
+#: How far ahead of the wrist band a demonstrator's touching digit tips rest, m:
+#: a human hand, for the default scene and the synthetic demonstrations. Not the
+#: grasp model's chapter-4 start (``minvar.GraspTask.tip_start``, 2 cm): that
+#: close, the digit markers would overlap the wrist band.
+DEFAULT_TIP_START = 0.06
 
 
 @dataclass(frozen=True)

@@ -5,19 +5,23 @@
 all go through it:
 
 1. **tracks** — a video is tracked (:func:`perception.tracking.track_video`)
-   into a tracks file; a tracks file is loaded; a :class:`Tracks` object is
-   used as it is;
+   into a tracks file, unless a current one is at hand (:func:`current_tracks`);
+   a tracks file is loaded; a :class:`Tracks` object is used as it is;
 2. **observation** — :func:`perception.observation.observe` maps the tracks to
    the model frame and finds the movement;
 3. **planning** — the repertoire's models are taken, or re-planned, for the
    scene of the clip's first frames (:meth:`Repertoire.for_scene`);
 4. **recognition** — :func:`perception.recognition.engine.recognize` scores
    every model's one-step predictions.
+
+Steps 2-4 are :func:`recognize_tracks`, for callers that hold the tracks
+(the reports show the tracking's quality too).
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
 import json
 import os
@@ -31,10 +35,11 @@ from perception.io.tracks import Tracks, tracks_path_for
 from perception.observation import ObserveParams, observe
 from perception.recognition.engine import HammerParams, recognize
 from perception.recognition.models import SceneSpec
-from perception.recognition.repertoire import Repertoire
+from perception.recognition.repertoire import PlanCache, Repertoire
 from perception.recognition.result import Recognition
 
-if TYPE_CHECKING:  # the tracker (OpenCV) is imported only when there is video
+if TYPE_CHECKING:  # the tracker (OpenCV) and movement are imported only when needed
+    from perception.io.pose import PoseImport
     from perception.tracking.setup import TrackingSetup
 
 __all__ = [
@@ -43,14 +48,19 @@ __all__ = [
     "VIDEO_SUFFIXES",
     "clip_fingerprint",
     "clip_name",
+    "current_tracks",
+    "current_tracks",
     "load_clip",
     "recognize_clip",
+    "recognize_tracks",
 ]
 
 #: Video file extensions the pipeline accepts (case-insensitive).
 VIDEO_SUFFIXES = (".mp4", ".avi", ".mkv", ".mov", ".m4v")
 #: Name ending of a tracks file.
 TRACKS_SUFFIX = ".tracks.h5"
+#: Endings of pose files (a ``.h5`` that is not a tracks file is read as one).
+POSE_SUFFIXES = (".h5", ".csv", ".slp", ".nc", ".nwb")
 
 
 @dataclass(frozen=True)
@@ -65,23 +75,30 @@ class RecognitionSettings:
         Rule and weights of the engine.
     tracking : TrackingSetup, optional
         Colour models and marker sizes for tracking videos (``--setup``).
+    pose : PoseImport, optional
+        How pose files become tracks (keypoint mapping, likelihood cutoff,
+        frame rate, object size); default: :class:`~perception.io.pose.PoseImport`.
     """
 
     observe: ObserveParams = field(default_factory=ObserveParams)
     hammer: HammerParams = field(default_factory=HammerParams)
     tracking: TrackingSetup | None = None
+    pose: PoseImport | None = None
 
     def fingerprint(self) -> dict:
         """JSON-able settings that change results."""
         out = {"observe": dataclasses.asdict(self.observe),
                "hammer": dataclasses.asdict(self.hammer)}
+        # only when set, so that reports made without them stay current
         if self.tracking is not None:
             out["tracking"] = self.tracking.to_dict()
+        if self.pose is not None:
+            out["pose"] = self.pose.to_dict()
         return out
 
 
 def clip_name(path: str | os.PathLike) -> tuple[str, str]:
-    """Clip name and input kind (``video``, ``tracks`` or ``unknown``) of a file.
+    """Clip name and input kind (``video``, ``tracks``, ``pose`` or ``unknown``) of a file.
 
     Parameters
     ----------
@@ -94,6 +111,8 @@ def clip_name(path: str | os.PathLike) -> tuple[str, str]:
         return name[: -len(TRACKS_SUFFIX)], "tracks"
     if path.suffix.lower() in VIDEO_SUFFIXES:
         return path.stem, "video"
+    if path.suffix.lower() in POSE_SUFFIXES:
+        return path.stem, "pose"
     return path.stem, "unknown"
 
 
@@ -101,9 +120,10 @@ def clip_fingerprint(path: str | os.PathLike, settings: RecognitionSettings,
                      repertoire_id: str) -> str:
     """A short hash of what decides a clip's recognition report.
 
-    The input file (path, size, modification time), the settings, the
-    repertoire's identity and the software version: a report carrying the
-    same fingerprint is current and need not be made again.
+    The input file's content (its SHA-256, not its size and time: a
+    different video of the same size is a different clip), the settings,
+    the repertoire's identity and the software version: a report carrying
+    the same fingerprint is current and need not be made again.
 
     Parameters
     ----------
@@ -114,72 +134,214 @@ def clip_fingerprint(path: str | os.PathLike, settings: RecognitionSettings,
     repertoire_id : str
         Identity of the repertoire (e.g. its file name and content hash).
     """
-    path = Path(path)
-    st = path.stat()
-    source = {"path": str(path.resolve()), "size": st.st_size, "mtime_ns": st.st_mtime_ns}
+    source = {"sha256": file_sha256(path)}
     payload = json.dumps({"input": source, "settings": settings.fingerprint(),
                           "repertoire": repertoire_id, "software": __version__},
                          sort_keys=True)
     return hashlib.sha256(payload.encode()).hexdigest()[:16]
 
 
+def file_sha256(path: str | os.PathLike) -> str:
+    """The SHA-256 of a file's content, computed once per process for a file that has not changed.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+    """
+    p = Path(path).resolve()
+    st = p.stat()
+    return _sha256(p, st.st_size, st.st_mtime_ns)
+
+
+@functools.lru_cache(maxsize=256)
+def _sha256(path: Path, size: int, mtime_ns: int) -> str:
+    from perception.io.video import sha256_file
+
+    return sha256_file(path)
+
+
 def load_clip(source: str | os.PathLike | Tracks, *, tracks_out: str | os.PathLike | None = None,
-              progress: bool = False, setup: TrackingSetup | None = None) -> Tracks:
-    """The tracks of a clip: tracked from a video, loaded from a tracks file, or as given.
+              progress: bool = False, setup: TrackingSetup | None = None,
+              pose: PoseImport | None = None) -> Tracks:
+    """The tracks of a clip: tracked from a video, read from a tracks or pose file, or as given.
 
     Parameters
     ----------
     source : str, os.PathLike or Tracks
-        A video file, a ``.tracks.h5`` file, or tracks in memory.
+        A video file, a ``.tracks.h5`` file, a pose file, or tracks in memory.
     tracks_out : str or os.PathLike, optional
         Where a video's tracks are written (default: ``<stem>.tracks.h5``
-        beside the video).
+        beside the video). A current tracks file of the video there, or
+        beside the video, is loaded instead of tracking again
+        (:func:`current_tracks`).
     progress : bool
         Show a progress bar while tracking.
     setup : TrackingSetup, optional
         Colour models and marker sizes for tracking a video.
+    pose : PoseImport, optional
+        How a pose file becomes tracks.
 
     Raises
     ------
     InputError
-        A file that is neither a video nor a tracks file, or that cannot be
-        read, tracked or loaded.
+        A file that is neither a video, a tracks file nor a pose file, or that
+        cannot be read, tracked or loaded.
     """
     if isinstance(source, Tracks):
         return source
     path = Path(source)
     kind = clip_name(path)[1]
     if kind == "unknown":
-        raise InputError("not a video or tracks file", path)
+        raise InputError("not a video, tracks or pose file", path)
     if kind == "tracks":
         return Tracks.load(path)
+    if kind == "pose":
+        from perception.io.pose import read_pose  # movement only for pose files
+
+        return read_pose(path, pose)
+    out = tracks_path_for(path) if tracks_out is None else Path(tracks_out)
+    current = current_tracks(path, [out, tracks_path_for(path)], setup)
+    if current is not None:
+        return current
     from perception.tracking.tracker import track_video  # OpenCV only when there is video
 
-    out = tracks_path_for(path) if tracks_out is None else Path(tracks_out)
     kw = {} if setup is None else {"markers": setup.markers, "params": setup.params}
     return Tracks.load(track_video(path, out, progress=progress, **kw))
 
 
-def recognize_clip(source: str | os.PathLike | Tracks, repertoire: Repertoire,
-                   settings: RecognitionSettings | None = None, *, clip: str | None = None,
-                   tracks_out: str | os.PathLike | None = None,
-                   progress: bool = False) -> Recognition:
-    """Track (if a video), observe, plan for the clip's scene and recognise one clip.
+#: ``/tracker`` attributes that describe what a tracker learned from the clip
+#: (not its settings): they do not decide whether a tracks file is current.
+_LEARNED = frozenset({"reference_mass_px", "diameter_px"})
+
+
+def _settings(attrs: dict) -> str:
+    from perception.io.atomic import jsonable
+
+    return json.dumps({k: v for k, v in attrs.items() if k not in _LEARNED},
+                      sort_keys=True, default=jsonable)
+
+
+def current_tracks(video: str | os.PathLike, candidates,
+                   setup: TrackingSetup | None = None) -> Tracks | None:
+    """The first of ``candidates`` that is a current tracks file of ``video``, loaded.
+
+    Current means: written by this software version, of this very video
+    (``/video`` attribute ``sha256``: hashing reads the file once, far
+    cheaper than decoding and tracking it) and with the tracker settings a
+    tracker of ``setup`` (default: the default colour models and parameters)
+    would write (``/tracker`` colour models, ROIs, criteria and parameters).
+    Anything else (missing, unreadable, stale) is not reused.
 
     Parameters
     ----------
-    source : str, os.PathLike or Tracks
-        A video, a tracks file or tracks in memory (see :func:`load_clip`).
+    video : str or os.PathLike
+        The video.
+    candidates : iterable of path
+        Tracks files to consider, in order of preference.
+    setup : TrackingSetup, optional
+        The tracking setup the tracks must have been made with.
+    """
+    import h5py
+
+    expected = None
+    for cand in map(Path, candidates):
+        if not cand.is_file():
+            continue
+        try:
+            with h5py.File(cand, "r") as fh:
+                version = fh.attrs.get("software_version")
+            tracks = Tracks.load(cand)
+        except (InputError, OSError, ValueError):
+            continue
+        version = version.decode() if isinstance(version, bytes) else version
+        if version != __version__ or tracks.video.get("sha256") != file_sha256(video):
+            continue
+        expected = expected or _settings(_tracker_attrs(setup))
+        if _settings(tracks.tracker) == expected:
+            return tracks
+    return None
+
+
+def _tracker_attrs(setup: TrackingSetup | None) -> dict:
+    """The ``/tracker`` settings a tracker of ``setup`` writes."""
+    from perception.tracking.markers import default_markers
+    from perception.tracking.tracker import Tracker
+
+    if setup is None:
+        return Tracker(default_markers()).attrs()
+    return Tracker(setup.markers, setup.params).attrs()
+
+
+def recognize_tracks(tracks: Tracks, repertoire: Repertoire,
+                     settings: RecognitionSettings | None = None, *, clip: str | None = None,
+                     source: str | os.PathLike | None = None,
+                     plan_cache: PlanCache | None = None) -> Recognition:
+    """Observe tracks, plan the models for their scene and recognise the movement.
+
+    Parameters
+    ----------
+    tracks : Tracks
+        The clip's tracks (see :func:`load_clip`).
     repertoire : Repertoire
         The models to score against.
     settings : RecognitionSettings, optional
         Observation and engine settings.
+    clip : str, optional
+        Clip name.
+    source : str or os.PathLike, optional
+        The file the user gave, named in errors (default: the clip's name).
+    plan_cache : PlanCache, optional
+        Models re-planned for a scene, shared with other processes.
+
+    Raises
+    ------
+    InputError
+        The tracks cannot be observed, or their scene cannot be planned.
+    """
+    settings = RecognitionSettings() if settings is None else settings
+    try:
+        obs = observe(tracks, settings.observe, clip=clip)
+    except InputError as exc:
+        if source is None:
+            raise
+        raise InputError(exc.problem, source) from None  # name the file the user gave
+    try:
+        models = repertoire.for_scene(SceneSpec.of(obs), cache=plan_cache)
+    except ValueError as exc:
+        raise InputError(f"cannot plan the models for this clip's scene (distance "
+                         f"{obs.start_distance:.3f} m; check the scale: --px-per-m, "
+                         f"--object-diameter): {exc}", source or obs.clip) from None
+    rec = recognize(obs, models, settings.hammer)
+    if rec.verdict is None:  # the default repertoire calibrates only the models it needs
+        rec = recognize(obs, repertoire.calibrated(models, rec.decision.best), settings.hammer)
+    return rec
+
+
+def recognize_clip(source: str | os.PathLike | Tracks, repertoire: Repertoire,
+                   settings: RecognitionSettings | None = None, *, clip: str | None = None,
+                   tracks_out: str | os.PathLike | None = None, progress: bool = False,
+                   plan_cache: PlanCache | None = None) -> Recognition:
+    """Track (if a video), observe, plan for the clip's scene and recognise one clip.
+
+    :func:`load_clip` then :func:`recognize_tracks`.
+
+    Parameters
+    ----------
+    source : str, os.PathLike or Tracks
+        A video, a tracks file, a pose file or tracks in memory (see :func:`load_clip`).
+    repertoire : Repertoire
+        The models to score against.
+    settings : RecognitionSettings, optional
+        Observation, engine, tracking and pose settings.
     clip : str, optional
         Clip name (default: from the file name).
     tracks_out : str or os.PathLike, optional
         Where a video's tracks are written (see :func:`load_clip`).
     progress : bool
         Show a progress bar while tracking.
+    plan_cache : PlanCache, optional
+        Models re-planned for a scene, shared with other processes.
 
     Returns
     -------
@@ -194,17 +356,6 @@ def recognize_clip(source: str | os.PathLike | Tracks, repertoire: Repertoire,
     is_file = not isinstance(source, Tracks)
     name = clip or (clip_name(source)[0] if is_file else None)
     tracks = load_clip(source, tracks_out=tracks_out, progress=progress,
-                       setup=settings.tracking)
-    try:
-        obs = observe(tracks, settings.observe, clip=name)
-    except InputError as exc:
-        if not is_file:
-            raise
-        raise InputError(exc.problem, source) from None  # name the file the user gave
-    try:
-        models = repertoire.for_scene(SceneSpec.of(obs))
-    except ValueError as exc:
-        raise InputError(f"cannot plan the models for this clip's scene (distance "
-                         f"{obs.start_distance:.3f} m; check the scale: --px-per-m, "
-                         f"--object-diameter): {exc}", source if is_file else name) from None
-    return recognize(obs, models, settings.hammer)
+                       setup=settings.tracking, pose=settings.pose)
+    return recognize_tracks(tracks, repertoire, settings, clip=name,
+                            source=source if is_file else None, plan_cache=plan_cache)

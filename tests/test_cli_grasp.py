@@ -17,10 +17,20 @@ def test_grasp_simulate_writes_figures_and_table(tmp_path):
     assert df[df.step == 100].finger_x.mean() == pytest.approx(0.03, abs=5e-4)
     info = json.loads((out / "summary.json").read_text())
     assert info["task"]["object_size"] == 0.06
+    assert info["task"]["transport_distance"] == pytest.approx(0.20)  # thesis line 953
     assert info["summary"]["mga_mean"] == pytest.approx(0.0807, abs=0.002)
     assert all(c["converged"] for c in info["solver"].values())
     assert (out / "grasp.png").stat().st_size > 10_000
     assert (out / "setup.png").stat().st_size > 10_000
+
+
+def test_grasp_tip_start_sets_where_the_closed_tips_start(tmp_path):
+    assert main(["grasp", "simulate", "--tip-start", "0.05", "--trials", "3",
+                 "-o", str(tmp_path)]) == 0
+    df = pd.read_csv(tmp_path / "trajectories.csv")
+    first = df[df.step == 0].iloc[0]
+    assert first.finger_y - first.wrist_y == pytest.approx(0.05, abs=1e-9)
+    assert json.loads((tmp_path / "summary.json").read_text())["task"]["tip_start"] == 0.05
 
 
 def test_grasp_reach_only_and_time_step(tmp_path):
@@ -46,6 +56,7 @@ def test_grasp_experiment_writes_tables_and_figures(tmp_path):
     ["grasp", "simulate", "--object-size", "0.5"],
     ["grasp", "simulate", "--distance", "0.6"],
     ["grasp", "simulate", "--viapoint-time", "1.5"],
+    ["grasp", "simulate", "--tip-start", "0.3"],
     ["grasp", "simulate", "--duration", "0"],
     ["grasp", "simulate", "--trials", "0"],
     ["grasp", "experiment", "movement-time", "--trials", "1"],

@@ -176,7 +176,10 @@ def test_costs_and_initial_covariance_must_be_psd(reference_problem, field, valu
         dataclasses.replace(reference_problem, **{field: value})
 
 
-def test_unconverged_solve_is_reported(reference_problem, caplog):
+def test_unconverged_solve_is_reported(reference_problem, caplog, monkeypatch):
+    import minvar.lqg
+
+    monkeypatch.setattr(minvar.lqg, "_REPORTED", set())  # reported once per process
     solve(reference_problem, max_iter=2)
     assert "did not converge" in caplog.text
 

@@ -7,7 +7,7 @@ import pytest
 
 MODULES = [
     "tracking", "tracking.markers", "tracking.params", "tracking.blobs", "tracking.measurement",
-    "tracking.detection", "tracking.tracker", "io.video", "io.tracks", "io.repertoire",
+    "tracking.reacquisition", "tracking.tracker", "io.video", "io.tracks", "io.repertoire",
     "synthetic.scene", "synthetic.render", "synthetic.demos", "geometry", "observation",
     "pipeline", "recognition.models", "recognition.engine", "recognition.scoring",
     "tracking.candidates", "tracking.hand", "tracking.overlay", "tracking.setup",

@@ -12,6 +12,7 @@ TOOLS = Path(__file__).resolve().parents[1] / "tools"
 sys.path.insert(0, str(TOOLS))
 
 import reproduce_thesis  # noqa: E402
+from reproduce_common import claim, sensitivity  # noqa: E402
 
 FIGURES = [
     "fig2_5_minimum_jerk", "fig2_6_derivative_order", "fig2_7_angle_jerk_joints",
@@ -35,19 +36,33 @@ def test_quick_run_writes_every_figure_and_the_claims_table(tmp_path, capsys):
     assert len(sweep) == 8 and sweep["sd_total"].iloc[0] > sweep["sd_total"].iloc[-1]
 
     md = (tmp_path / "numbers.md").read_text()
-    rows = [line for line in md.splitlines() if line.startswith("| ") and "---" not in line]
-    header, body = rows[0], rows[1:]
-    assert header == "| section | claim | thesis | ours | agrees | note |"
+    header = "| claim | thesis location | measure | thesis value | ours | verdict | why |"
+    body, inside = [], False
+    for line in md.splitlines():  # the rows of each chapter's claims table
+        inside = line == header or (inside and line.startswith("|"))
+        if inside and line != header and not line.startswith("|---"):
+            body.append(line)
     assert len(body) >= 20
-    assert all(len(re.split(r"(?<!\\)\|", r)) == 8 for r in body)  # six cells each
+    assert all(len(re.split(r"(?<!\\)\|", r)) == 9 for r in body)  # seven cells each
+    assert "## Chapter 3" in md and "## Appendix A" in md
+    assert "#### Sensitivity: the length unit of eq. A.1" in md
     assert "skipped (--skip-ch4)" in md
-    claims = pd.read_csv(tmp_path / "numbers.csv")
-    assert list(claims.columns) == ["section", "claim", "thesis", "ours", "agrees", "note"]
-    jerk = claims[claims["claim"].str.contains("minimum jerk \\(n = 3\\)")]
-    assert jerk["ours"].iloc[0].startswith("1.8750") and jerk["agrees"].iloc[0]
-    for needle in ("Fig. 3.2(b)", "Fig. 3.5", "Fig. 3.7", "Fig. 3.6(c)", "Fig. 3.8(b)",
-                   "Fig. A.1(b)", "Fig. 3.4(c)", "Fig. 3.4(a)"):
-        assert claims["section"].str.contains(needle, regex=False).any(), needle
+    claims = pd.read_csv(tmp_path / "numbers.csv", keep_default_na=False)
+    assert len(claims) == len(body)
+    assert list(claims.columns) == ["chapter", "section", "claim", "location", "measure",
+                                    "thesis", "ours", "verdict", "agrees", "why"]
+    # every row carries a thesis location and a measure
+    assert (claims["location"].str.len() > 0).all() and (claims["measure"].str.len() > 0).all()
+    assert set(claims["verdict"]) <= set(reproduce_thesis.VERDICTS)
+    human = claims[claims["claim"].str.contains("closest to minimum jerk")].iloc[0]
+    assert "15/8" in human["ours"] and human["verdict"] == "agree"
+    assert "human" in human["thesis"]  # 1.875 is the thesis's human value
+    # the 'a' reverses at 70 % because we put its via-point there
+    assert (claims[claims["claim"].str.contains("reversal comes")]["verdict"]
+            == "by construction").all()
+    for needle in ("Fig. 3.2(b)", "Fig. 3.5", "Fig. 3.7", "Fig. 3.6(a,c)", "Fig. 3.8(b)",
+                   "Fig. A.1(b)", "Fig. A.2", "Fig. 3.4(c)", "Fig. 3.4(a)", "line 481"):
+        assert claims["location"].str.contains(needle, regex=False).any(), needle
     assert "15 figures" in capsys.readouterr().out
 
 
@@ -102,12 +117,55 @@ def test_missing_chapter4_is_noted_and_a_failing_one_reported(tmp_path, monkeypa
 
 
 def test_numbers_markdown_escapes_cells_and_checks_keys():
+    # a record of the original six keys still renders, as a row of the new table
     row = dict(section="A.1", claim="a | b", thesis="1", ours="2", agrees=False, note="n")
     md = reproduce_thesis.numbers_markdown([row], ["note line"], ["header"])
-    assert "| A.1 | a \\| b | 1 | 2 | **no** | n |" in md
-    assert "- note line" in md and "0 of 1 claims agree" in md
+    assert "| a \\| b | A.1 | not stated | 1 | 2 | **differs** | n |" in md
+    assert "- note line" in md and "1 claims: 0 agree, 1 differ" in md
     with pytest.raises(ValueError, match="lacks"):
         reproduce_thesis.numbers_markdown([{"section": "x"}], [], [])
+
+
+def test_claims_and_tables_are_grouped_by_chapter():
+    rows = [
+        dict(claim("2.2", "c1", "t", "o", True, location="Fig. 2.6(c); line 276",
+                   measure="m1"), chapter="Chapter 2"),
+        dict(claim("4.2", "c2", "t", "o", verdict="thesis inconsistent", note="both",
+                   location="line 903 vs line 971", measure="m2"), chapter="Chapter 4"),
+        dict(sensitivity("tip_start", "not given", "we use 2 cm", ["tip_start", "verdict"],
+                         [["1 cm", "yes"], ["6 cm", "**no**"]]), chapter="Chapter 4"),
+    ]
+    md = reproduce_thesis.numbers_markdown(rows, [], ["header"])
+    assert md.index("## Chapter 2") < md.index("| c1 |") < md.index("## Chapter 4")
+    assert "| c1 | Fig. 2.6(c); line 276 | m1 | t | o | agree |  |" in md
+    assert "| **thesis inconsistent** | both |" in md
+    assert "#### Sensitivity: tip_start" in md and "| 6 cm | **no** |" in md
+    assert "2 claims: 1 agree, 0 differ, 0 by construction, 1 thesis inconsistent." in md
+
+
+def test_claim_record():
+    c = claim("3.2.3", "c", "t", "o", False, "why", location="Fig. 3.2(b); line 591",
+              measure="m")
+    assert c["verdict"] == "differs" and c["agrees"] is False and c["why"] == "why"
+    assert claim("3.2", "c", "t", "o", True)["location"] == "3.2"  # defaults to the section
+    b = claim("3.3.2", "c", "t", "o", verdict="by construction")
+    assert b["verdict"] == "by construction" and not b["agrees"]
+    with pytest.raises(ValueError, match="verdict"):
+        claim("x", "c", "t", "o", verdict="maybe")
+    with pytest.raises(ValueError, match="agrees or verdict"):
+        claim("x", "c", "t", "o")
+    with pytest.raises(ValueError, match="cells"):
+        sensitivity("p", "l", "n", ["a", "b"], [["1"]])
+
+
+def test_chapters_in_two_processes_give_the_same_records(tmp_path):
+    ch = [("Chapter 2", "reproduce_ch2"), ("Appendix A", "reproduce_appendix_a")]
+    one, _, _, ok1 = reproduce_thesis.run(tmp_path / "a", trials=3, seed=2, quick=True,
+                                          chapters=ch)
+    two, _, timings, ok2 = reproduce_thesis.run(tmp_path / "b", trials=3, seed=2, quick=True,
+                                                chapters=ch, jobs=2)
+    assert ok1 and ok2 and [t.split(":")[0] for t in timings] == ["Chapter 2", "Appendix A"]
+    assert one == two  # same order (the thesis's), same numbers
 
 
 def test_bad_options_exit_2(tmp_path):

@@ -7,15 +7,7 @@ import numpy as np
 import pytest
 
 import perception.tracking as tracking
-from perception.errors import InputError
 from perception.tracking.blobs import Blob, by_distance, find_blobs, nearest_blob
-from perception.tracking.detection import (
-    closest_combination,
-    downscaled_hsv,
-    find_candidates,
-    reacquire,
-    search_scale,
-)
 from perception.tracking.markers import default_markers
 from perception.tracking.measurement import (
     clamp_window,
@@ -26,6 +18,11 @@ from perception.tracking.measurement import (
     split_merged,
 )
 from perception.tracking.params import TrackerParams
+from perception.tracking.reacquisition import (
+    downscaled_hsv,
+    reacquire,
+    search_scale,
+)
 from perception.tracking.tracker import Tracker
 
 TABLE = (150, 160, 170)
@@ -157,27 +154,6 @@ def test_likelihood_and_window_bounds():
 
 
 # -- detection -------------------------------------------------------------
-def test_hand_markers_are_chosen_together_not_by_size():
-    near = [Blob((100.0, 100.0), 50, (0, 0, 8, 8)), Blob((112.0, 100.0), 50, (0, 0, 8, 8))]
-    decoys = [Blob((300.0, 20.0), 400, (0, 0, 20, 20)), Blob((20.0, 200.0), 400, (0, 0, 20, 20))]
-    thumb = [decoys[0], near[0]]  # largest first
-    finger = [decoys[1], near[1]]
-    assert closest_combination([thumb, finger]) == (1, 1)
-    # With one hand marker placed already, the others join it.
-    assert closest_combination([thumb], anchors=[np.array([105.0, 110.0])]) == (1,)
-
-
-def test_candidates_are_largest_first_and_a_roi_must_hold_the_colour():
-    frame = _frame([(60.0, 60.0, 5, THUMB.bgr), (200.0, 100.0, 9, THUMB.bgr),
-                    (100.0, 180.0, 1, THUMB.bgr)])
-    cands = find_candidates(frame, THUMB, P.min_area_px)
-    assert [round(c.centre[0]) for c in cands] == [200, 60]  # the speck is too small
-    (inside,) = find_candidates(frame, THUMB, P.min_area_px, roi=(40, 40, 40, 40))
-    assert inside.centre == pytest.approx((60, 60))
-    with pytest.raises(InputError, match="nothing of its colour in the ROI"):
-        find_candidates(frame, THUMB, P.min_area_px, roi=(0, 0, 20, 20))
-
-
 def test_global_search_finds_the_nearest_plausible_blob():
     frame = _frame([(60.0, 60.0, 6, THUMB.bgr), (250.0, 150.0, 6, THUMB.bgr),
                     (200.0, 40.0, 20, THUMB.bgr)])

@@ -97,9 +97,16 @@ def test_the_calibration_is_stored_and_old_files_still_load(small, tmp_path):
     with h5py.File(path, "a") as f:  # as written before calibrations existed
         for name in f["models"]:
             del f["models"][name]["calibration"]
-    old = Repertoire.load(path)  # calibrated as it loads
-    for a, b in zip(small, old):
-        np.testing.assert_array_equal(a.calibration.misfit, b.calibration.misfit)
+    old = Repertoire.load(path)
+    assert all(m.calibration is None for m in old)
+    # the model a verdict rests on is calibrated then, as the built one was
+    tracks = demo_tracks("normal", 2)[0]
+    fresh, built = recognize_clip(tracks, old), recognize_clip(tracks, small)
+    assert fresh.verdict == built.verdict == "normal"
+    assert fresh.decision.familiarity == pytest.approx(built.decision.familiarity)
+    again = old.for_scene(SceneSpec.of(fresh.observation))
+    assert again[fresh.decision.best].calibration is not None  # kept for the next clip
+    assert sum(m.calibration is not None for m in again) == 1  # and only that one
 
 
 def test_replanned_models_keep_their_calibration(small):

@@ -50,6 +50,26 @@ def test_curvature_of_accelerating_line_is_its_acceleration_over_speed_term():
                                rtol=1e-9)
 
 
+def test_curvature_unit_is_the_length_unit_of_eq_a1():
+    # the same circle in centimetres: R -> 100 R in the formula
+    R, w = 0.1, 2 * np.pi
+    t = np.linspace(0, 2, 4001)
+    p = R * np.stack([np.cos(w * t), np.sin(w * t)], axis=1)
+    kappa = spatiotemporal_curvature(p, t, unit=0.01)
+    Rc = 100 * R
+    np.testing.assert_allclose(kappa, Rc * w**2 / (1 + Rc**2 * w**2), rtol=1e-4)
+    # speed and acceleration extrema do not depend on it; curvature's do
+    r = simulate_reach(CURVED, 1, seed=0)
+    for c in ("speed", "acceleration"):
+        np.testing.assert_array_equal(extract_via_points(r.position[0], r.time, c),
+                                      extract_via_points(r.position[0], r.time, c, unit=0.01))
+    metres = extract_via_points(r.position[0], r.time, "curvature")
+    cm = extract_via_points(r.position[0], r.time, "curvature", unit=0.01)
+    assert not np.array_equal(metres, cm)
+    with pytest.raises(ValueError, match="unit"):
+        spatiotemporal_curvature(p, t, unit=0.0)
+
+
 # --- extraction -------------------------------------------------------------------------
 
 def test_local_extrema_of_a_synthetic_profile():

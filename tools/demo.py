@@ -25,7 +25,8 @@ def run() -> int:
     clips, rep = out / "clips", out / "repertoire.h5"
     start = time.perf_counter()
     if not (clips / "manifest.csv").exists():
-        if main(["synth", str(ROOT / "datasets" / "smoke.toml"), "-o", str(clips), "--seed", "0"]):
+        if main(["synth", str(ROOT / "datasets" / "smoke.toml"), "-o", str(clips), "--seed", "0",
+                 "--jobs", "2"]):
             return 2
     if not rep.exists() and main(["repertoire", "build", "-o", str(rep)]):
         return 2

@@ -1,20 +1,26 @@
 """Regenerate the thesis's figures and a table of its quantitative claims beside ours.
 
     python tools/reproduce_thesis.py [-o out/thesis] [--trials N] [--seed N] [--quick]
+                                     [--skip-ch4] [--skip-ch5] [--jobs N]
 
 Writes, into the output folder, every figure of chapter 2 (2.5-2.8), chapter 3
 (3.2-3.9) and appendix A (A.1-A.3) as PNG named after the thesis figure
 (``fig3_5_speed_accuracy.png``), CSV tables beside the figures that have
 numbers, the chapter 4 figures when ``tools/reproduce_ch4.py`` exists, chapter 5
 from rendered video in ``ch5/`` (``tools/reproduce_ch5.py``; not with
-``--quick``), and
-``numbers.md``: one row per quantitative claim of the thesis with our value,
-whether it agrees, and why not where it does not. Every file is written to a
+``--quick``), and ``numbers.md``: per chapter, one row per quantitative claim of the thesis —
+the claim, where the thesis makes it (section, figure, line of the thesis
+text), the measure it is judged by, the thesis's value, ours, the verdict
+(agree / differs / by construction / thesis inconsistent) and why — then a
+sensitivity table for each parameter the thesis leaves open that a verdict
+depends on. ``numbers.csv`` holds the claims. Every file is written to a
 temporary name and renamed when complete.
 
 ``--trials`` sets the Monte Carlo repetitions everywhere (default: the
 thesis's counts, 500 per setting in chapter 4); ``--quick`` is a smoke run
-(10 repetitions, one observed movement per test trajectory in Fig. A.1).
+(10 repetitions, one observed movement per test trajectory in Fig. A.1);
+``--jobs N`` runs N chapters at once, each in its own process (default 2:
+chapter 4 beside the others; the numbers do not depend on it).
 Exit status: 0 when every chapter ran, 1 when one failed (numbers.md says
 which), 2 on bad options.
 """
@@ -28,6 +34,7 @@ import logging
 import sys
 import time
 from collections.abc import Callable
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -36,7 +43,14 @@ for _p in (ROOT, ROOT / "tools"):
         sys.path.insert(0, str(_p))
 
 import pandas as pd  # noqa: E402
-from reproduce_common import CLAIM_KEYS  # noqa: E402
+from reproduce_common import (  # noqa: E402
+    CLAIM_KEYS,
+    TABLE_HEADINGS,
+    TABLE_KEYS,
+    VERDICTS,
+    as_claim,
+    is_sensitivity,
+)
 from tqdm import tqdm  # noqa: E402
 
 from perception.io.atomic import write_csv, write_text  # noqa: E402
@@ -74,42 +88,143 @@ def load_chapter(module: str) -> Callable | None:
 
 
 def _cell(value) -> str:
-    if isinstance(value, bool):
-        return "yes" if value else "**no**"
     return str(value).replace("|", "\\|").replace("\n", " ")
 
 
-def numbers_markdown(claims: list[dict], notes: list[str], header: list[str]) -> str:
-    """numbers.md: a header, run notes, and one table row per claim.
+def _row(cells) -> str:
+    return "| " + " | ".join(_cell(c) for c in cells) + " |"
+
+
+def verdict_counts(claims: list[dict]) -> str:
+    """``"37 agree, 5 differ, ..."`` over the claims, in the order of ``VERDICTS``.
 
     Parameters
     ----------
     claims : list of dict
-        Rows with keys section, claim, thesis, ours, agrees, note.
+        Claim records (current form).
+    """
+    n = {v: sum(c["verdict"] == v for c in claims) for v in VERDICTS}
+    words = {"agree": "agree", "differs": "differ", "by construction": "by construction",
+             "thesis inconsistent": "thesis inconsistent"}
+    return ", ".join(f"{n[v]} {words[v]}" for v in VERDICTS)
+
+
+def _sensitivity_md(table: dict) -> list[str]:
+    lines = [f"#### Sensitivity: {table['title']}", "",
+             f"Thesis: {table['location']}. {table['note']}", ""]
+    lines.append(_row(table["columns"]))
+    lines.append("|" + "---|" * len(table["columns"]))
+    lines += [_row(r) for r in table["rows"]]
+    return lines + [""]
+
+
+def numbers_markdown(records: list[dict], notes: list[str], header: list[str]) -> str:
+    """numbers.md: a header, run notes, and per chapter its claims and sensitivity tables.
+
+    Parameters
+    ----------
+    records : list of dict
+        Claims (:func:`reproduce_common.claim`, or the original six-key
+        record) and sensitivity tables (:func:`reproduce_common.sensitivity`),
+        each with a ``chapter`` title (records without one are listed under
+        "Claims").
     notes : list of str
-        Lines about the run (missing or failed chapters), shown above the table.
+        Lines about the run (missing or failed chapters), shown above the tables.
     header : list of str
         Lines describing the run (options, timings).
     """
-    for c in claims:
-        missing = [k for k in CLAIM_KEYS if k not in c]
-        if missing:
-            raise ValueError(f"claim {c!r} lacks {missing}")
-    agree = sum(bool(c["agrees"]) for c in claims)
+    claims = [as_claim(r) for r in records if not is_sensitivity(r)]
     lines = ["# Thesis claims beside ours", "", *header, ""]
     lines += [f"- {n}" for n in notes]
-    lines += [f"- {agree} of {len(claims)} claims agree.", ""]
-    lines.append("| " + " | ".join(CLAIM_KEYS) + " |")
-    lines.append("|" + "---|" * len(CLAIM_KEYS))
-    for c in claims:
-        lines.append("| " + " | ".join(_cell(c[k]) for k in CLAIM_KEYS) + " |")
+    lines += [f"- {len(claims)} claims: {verdict_counts(claims)}.", ""]
+    lines += ["Verdicts: **agree** — ours supports the statement by the measure given; "
+              "**differs** — it does not; **by construction** — it holds only because of "
+              "how the model or the test was built; **thesis inconsistent** — the thesis "
+              "says two different things (both places are cited). Thesis locations give "
+              "the section, figure and line of the thesis text.", ""]
+    chapters = list(dict.fromkeys(r.get("chapter", "Claims") for r in records))
+    for chapter in chapters:
+        mine = [r for r in records if r.get("chapter", "Claims") == chapter]
+        rows = [as_claim(r) for r in mine if not is_sensitivity(r)]
+        lines += [f"## {chapter}", ""]
+        if rows:
+            lines += [f"{len(rows)} claims: {verdict_counts(rows)}.", ""]
+            lines.append(_row(TABLE_HEADINGS))
+            lines.append("|" + "---|" * len(TABLE_HEADINGS))
+            for c in rows:
+                cells = [c[k] for k in TABLE_KEYS]
+                cells[TABLE_KEYS.index("measure")] = c["measure"] or "not stated"
+                if c["verdict"] != "agree":
+                    cells[TABLE_KEYS.index("verdict")] = f"**{c['verdict']}**"
+                lines.append(_row(cells))
+            lines.append("")
+        for table in (r for r in mine if is_sensitivity(r)):
+            lines += _sensitivity_md(table)
     return "\n".join(lines) + "\n"
 
 
+def run_chapter(
+    title: str, module: str, out: Path, *, trials: int | None, seed: int, quick: bool,
+    progress=None,
+) -> tuple[list[dict], str | None, float | None, bool]:
+    """Run one chapter into ``out``.
+
+    Parameters
+    ----------
+    title : str
+        The chapter's title in numbers.md.
+    module : str
+        Its module in tools/.
+    out : Path
+        Output folder.
+    trials : int or None
+        Repetitions everywhere (None: the thesis's counts).
+    seed : int
+        Base seed.
+    quick : bool
+        Smoke run (fewer observed movements in appendix A).
+    progress : callable, optional
+        Called with the name of each figure as it starts (chapters 2, 3, A).
+
+    Returns
+    -------
+    records : list of dict
+        Its claims and tables, each given ``chapter=title``.
+    note : str or None
+        Why it is missing or how it failed.
+    seconds : float or None
+        How long it took (None if it is missing).
+    ok : bool
+        False if it failed.
+    """
+    start = time.perf_counter()
+    try:
+        reproduce = load_chapter(module)
+        if reproduce is None:
+            if module not in OPTIONAL:
+                raise ModuleNotFoundError(f"tools/{module}.py is missing")
+            return [], (f"{title}: tools/{module}.py is missing, so its figures and claims "
+                        "are not in this run."), None, True
+        if module == "reproduce_ch4":  # its interface: (out, *, trials, seed)
+            got = reproduce(out, trials=CH4_TRIALS if trials is None else trials, seed=seed)
+        elif module == "reproduce_ch5":  # (out, *, clips, seed, progress): video, not trials
+            got = reproduce(out, clips=CH5_CLIPS, seed=seed,
+                            progress=progress or (lambda name: None))
+        else:
+            kwargs = {"repeats": 1} if quick and module == "reproduce_appendix_a" else {}
+            got = reproduce(out, trials=trials, seed=seed,
+                            progress=progress or (lambda name: None), **kwargs)
+        return [dict(r, chapter=title) for r in got], None, time.perf_counter() - start, True
+    except Exception as exc:  # report and go on with the other chapters
+        log.exception("%s failed", title)
+        return ([], f"{title} FAILED: {type(exc).__name__}: {exc}",
+                time.perf_counter() - start, False)
+
+
 def run(
-    out: Path, *, trials: int | None, seed: int, quick: bool, chapters=CHAPTERS
+    out: Path, *, trials: int | None, seed: int, quick: bool, chapters=CHAPTERS, jobs: int = 1
 ) -> tuple[list[dict], list[str], list[str], bool]:
-    """Run every chapter into ``out``.
+    """Run every chapter into ``out``, in this process or in ``jobs`` worker processes.
 
     Parameters
     ----------
@@ -123,47 +238,48 @@ def run(
         Smoke run: few repetitions everywhere.
     chapters : sequence of (title, module)
         Which chapters to run.
+    jobs : int
+        Chapters run at once, each in its own process (1: one after the other,
+        here). Every chapter draws from its own seeds, so the results do not
+        depend on it.
 
     Returns
     -------
     claims, notes, timings : lists
-        All claims; notes on missing/failed chapters; a timing line per chapter.
+        Every chapter's records (claims and sensitivity tables, each given the
+        chapter's title as ``chapter``), in the order of ``chapters``; notes on
+        missing/failed chapters; a timing line per chapter.
     ok : bool
         False if a chapter failed.
     """
     if quick and trials is None:
         trials = QUICK_TRIALS
-    ok, claims, notes, timings = True, [], [], []
-    bar = tqdm(chapters, unit="chapter", disable=not sys.stderr.isatty())
-    for title, module in bar:
-        bar.set_description(title)
-        start = time.perf_counter()
-        try:
-            reproduce = load_chapter(module)
-            if reproduce is None:
-                if module not in OPTIONAL:
-                    raise ModuleNotFoundError(f"tools/{module}.py is missing")
-                notes.append(f"{title}: tools/{module}.py is missing, so its figures and "
-                             "claims are not in this run.")
-                start = None
-                continue
-            if module == "reproduce_ch4":  # another engineer's interface: (out, *, trials, seed)
-                got = reproduce(out, trials=CH4_TRIALS if trials is None else trials, seed=seed)
-            elif module == "reproduce_ch5":  # (out, *, clips, seed, progress): video, not trials
-                got = reproduce(out, clips=CH5_CLIPS, seed=seed,
-                                progress=lambda name: bar.set_postfix_str(name))
-            else:
-                kwargs = {"repeats": 1} if quick and module == "reproduce_appendix_a" else {}
-                got = reproduce(out, trials=trials, seed=seed,
-                                progress=lambda name: bar.set_postfix_str(name), **kwargs)
-            claims += list(got)
-        except Exception as exc:  # report and go on with the other chapters
-            ok = False
-            log.exception("%s failed", title)
-            notes.append(f"{title} FAILED: {type(exc).__name__}: {exc}")
-        finally:
-            if start is not None:
-                timings.append(f"{title}: {time.perf_counter() - start:.1f} s")
+    kw = dict(trials=trials, seed=seed, quick=quick)
+    bar = tqdm(total=len(chapters), unit="chapter", disable=not sys.stderr.isatty())
+    results = {}
+    if jobs <= 1 or len(chapters) < 2:
+        for title, module in chapters:
+            bar.set_description(title)
+            results[title] = run_chapter(title, module, out, **kw,
+                                         progress=lambda name: bar.set_postfix_str(name))
+            bar.update()
+    else:
+        # the later chapters take longest: start them first so the workers finish together
+        with ProcessPoolExecutor(max_workers=min(jobs, len(chapters))) as pool:
+            futures = {pool.submit(run_chapter, title, module, out, **kw): title
+                       for title, module in reversed(chapters)}
+            for f in as_completed(futures):
+                results[futures[f]] = f.result()
+                bar.set_description(futures[f])
+                bar.update()
+    bar.close()
+    claims, notes, timings, ok = [], [], [], True
+    for title, _ in chapters:
+        records, note, seconds, fine = results[title]
+        claims += records
+        notes += [note] if note else []
+        timings += [f"{title}: {seconds:.1f} s"] if seconds is not None else []
+        ok = ok and fine
     return claims, notes, timings, ok
 
 
@@ -186,9 +302,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--skip-ch4", action="store_true", help="do not run chapter 4")
     parser.add_argument("--skip-ch5", action="store_true",
                         help="do not run chapter 5 (--quick skips it too: it renders video)")
+    parser.add_argument("--jobs", type=int, default=2, metavar="N",
+                        help="chapters run at once, each in its own process (default 2; "
+                             "results do not depend on it)")
     args = parser.parse_args(argv)
     if args.trials is not None and args.trials < 2:
         parser.error("--trials must be at least 2 (standard deviations need two)")
+    if args.jobs < 1:
+        parser.error("--jobs must be at least 1")
     logging.basicConfig(level=logging.WARNING, format="%(name)s: %(message)s")
 
     out = args.out
@@ -198,7 +319,8 @@ def main(argv: list[str] | None = None) -> int:
                 and not (skip_ch5 and c[1] == "reproduce_ch5")]
     start = time.perf_counter()
     claims, notes, timings, ok = run(
-        out, trials=args.trials, seed=args.seed, quick=args.quick, chapters=chapters
+        out, trials=args.trials, seed=args.seed, quick=args.quick, chapters=chapters,
+        jobs=args.jobs,
     )
     if args.skip_ch4:
         notes.insert(0, "Chapter 4: skipped (--skip-ch4).")
@@ -210,15 +332,17 @@ def main(argv: list[str] | None = None) -> int:
         f"Generated by `tools/reproduce_thesis.py` (seed {args.seed}; repetitions: "
         + (f"{args.trials}" if args.trials else "the thesis's" if not args.quick
            else f"{QUICK_TRIALS} (--quick)")
-        + f"); {total:.0f} s in all ({'; '.join(timings)}).",
-        "Each claim names how agreement was judged; where ours differs the note says why. "
-        "Figures and CSV tables are beside this file.",
+        + f"); {total:.0f} s in all, {args.jobs} chapter(s) at a time "
+        f"({'; '.join(timings)}).",
+        "Each claim names the measure it is judged by; the why column says how the verdict "
+        "follows and, where ours differs, why. Figures and CSV tables are beside this file.",
     ]
-    write_csv(out / "numbers.csv", pd.DataFrame(claims, columns=list(CLAIM_KEYS)))
+    rows = [dict(as_claim(r), chapter=r["chapter"]) for r in claims if not is_sensitivity(r)]
+    write_csv(out / "numbers.csv", pd.DataFrame(rows, columns=["chapter", *CLAIM_KEYS]))
     write_text(out / "numbers.md", numbers_markdown(claims, notes, header))
     figures = sorted(p.name for p in out.glob("fig*.png"))
-    print(f"{len(figures)} figures, {len(claims)} claims "
-          f"({sum(bool(c['agrees']) for c in claims)} agree) in {out} ({total:.0f} s)")
+    print(f"{len(figures)} figures, {len(rows)} claims ({verdict_counts(rows)}) in {out} "
+          f"({total:.0f} s)")
     for n in notes:
         print(n)
     return 0 if ok else 1

@@ -48,7 +48,9 @@ def _add_simulate(gsub) -> None:
     s.add_argument("--object-size", type=float, default=d.object_size, metavar="M",
                    help=f"object diameter, m (default {d.object_size})")
     s.add_argument("--distance", type=float, default=d.distance, metavar="M",
-                   help=f"wrist start to object centre, m (default {d.distance})")
+                   help=f"wrist start to object centre, m (default {d.distance}: the wrist "
+                        f"travels {d.transport_distance:g}, stopping {d.wrist_offset:g} short "
+                        "of the centre)")
     s.add_argument("--duration", type=float, default=d.duration, metavar="S",
                    help=f"movement time, s (default {d.duration})")
     s.add_argument("--viapoint-offset", type=float, default=d.viapoint_offset, metavar="M",
@@ -60,6 +62,10 @@ def _add_simulate(gsub) -> None:
     s.add_argument("--viapoint-time", type=float, default=d.viapoint_time, metavar="F",
                    help=f"digit via-point time, fraction of the movement "
                         f"(default {d.viapoint_time})")
+    s.add_argument("--tip-start", type=float, default=d.tip_start, metavar="M",
+                   help=f"how far ahead of the wrist the closed digit tips start, m "
+                        f"(default {d.tip_start}: below the target line, "
+                        f"{d.wrist_offset:g} ahead of the wrist at the goal)")
     s.add_argument("--reach-only", action="store_true",
                    help="transport only: the digits stay closed")
     s.add_argument("--execution-cv", type=float, default=d.execution_cv, metavar="CV",
@@ -82,7 +88,9 @@ def _add_experiment(gsub) -> None:
         description=f"Run a chapter 4 sweep ({THESIS_TRIALS} repetitions per setting by "
         "default) and write "
         "NAME.csv (one row per setting), NAME_trials.csv, NAME_curves.csv, NAME_stats.json "
-        "and the figures as PNG, named after the thesis's (e.g. fig4_10_object_size_mga.png).",
+        "(effect sizes with 95 % confidence intervals), NAME_bootstrap.csv for the "
+        "variability sweeps, and the figures as PNG, named after the thesis's (e.g. "
+        "fig4_10_object_size_mga.png).",
     )
     e.add_argument("name", choices=(*EXPERIMENTS, "all"), metavar="NAME",
                    help=f"one of {', '.join(EXPERIMENTS)}, all")
@@ -115,7 +123,7 @@ def run_simulate(args: argparse.Namespace) -> int:
     task = GraspTask(
         object_size=args.object_size, distance=args.distance, duration=args.duration,
         viapoint_offset=args.viapoint_offset, viapoint_height=args.viapoint_height,
-        viapoint_time=args.viapoint_time, reach_only=args.reach_only,
+        viapoint_time=args.viapoint_time, tip_start=args.tip_start, reach_only=args.reach_only,
         execution_cv=args.execution_cv, plant=PointMassPlant(dt=args.dt),
     )
     plan = plan_grasp(task)
@@ -124,7 +132,8 @@ def run_simulate(args: argparse.Namespace) -> int:
     out: Path = args.output
     info = {
         "task": {k: getattr(task, k) for k in (
-            "object_size", "distance", "duration", "viapoint_offset", "viapoint_height",
+            "object_size", "distance", "transport_distance", "duration", "viapoint_offset",
+            "viapoint_height",
             "viapoint_time", "reach_only", "execution_cv", "execution_sigma_s",
             "wrist_offset", "tip_start", "shoulder_offset", "arm_links", "digit_links")},
         "dt_s": task.plant.dt,
@@ -190,5 +199,7 @@ def write_experiment(exp, out: Path) -> list[Path]:
         write_csv(out / f"{exp.name}_curves.csv", exp.curves),
         write_json(out / f"{exp.name}_stats.json", exp.stats),
     ]
+    if len(exp.bootstrap):
+        written.append(write_csv(out / f"{exp.name}_bootstrap.csv", exp.bootstrap))
     written += [save_figure(out / f"{stem}.png", fig) for stem, fig in exp.plot().items()]
     return written

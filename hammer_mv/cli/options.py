@@ -84,7 +84,7 @@ def load_repertoire(args: argparse.Namespace) -> tuple[Repertoire, str]:
         Parsed arguments with ``repertoire``.
     """
     if args.repertoire is None:
-        rep = Repertoire.build()
+        rep = Repertoire.default()  # planned for the clip's scene when first needed
         config = json.dumps(rep.config, sort_keys=True).encode()
         return rep, f"default:{hashlib.sha256(config).hexdigest()[:16]}"
     rep = Repertoire.load(args.repertoire)

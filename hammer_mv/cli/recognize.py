@@ -6,11 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from hammer_mv.cli.options import add_recognition_options, load_repertoire, recognition_settings
-from perception.errors import InputError
-from perception.pipeline import TRACKS_SUFFIX, clip_fingerprint, clip_name, recognize_clip
-from perception.report.clip import write_clip_report
-from perception.report.tracking import write_tracking_report
+from hammer_mv.cli.options import add_recognition_options
 
 
 def register(sub) -> None:
@@ -22,11 +18,17 @@ def register(sub) -> None:
         The top-level parser's subparsers.
     """
     p = sub.add_parser("recognize", help="recognise the grasp in one video or tracks file",
-                       description="Track INPUT (a video) or load it (a .tracks.h5), score it "
+                       description="Track INPUT (a video), load it (a .tracks.h5) or read it "
+                       "(a DeepLabCut, SLEAP, Lightning Pose or movement pose file), score it "
                        "against every model with HAMMER-MV and write DIR/<clip>.recognition.json, "
-                       "a per-step CSV and figures.")
-    p.add_argument("input", type=Path, metavar="INPUT")
-    p.add_argument("-o", "--output", type=Path, required=True, metavar="DIR")
+                       "a per-step CSV and figures. A current tracks file of the video (in "
+                       "DIR/tracks/ or beside the video) is reused instead of tracking again.")
+    p.add_argument("input", type=Path, metavar="INPUT",
+                   help="video, .tracks.h5 or pose file (.h5, .csv, .slp, .nc, .nwb)")
+    p.add_argument("-o", "--output", type=Path, required=True, metavar="DIR",
+                   help="folder for the clip's report")
+    p.add_argument("--no-figures", action="store_true",
+                   help="write the JSON and CSV only, not the figures (faster)")
     add_recognition_options(p)
     p.set_defaults(func=run)
 
@@ -39,24 +41,37 @@ def run(args: argparse.Namespace) -> int:
     args : argparse.Namespace
         Parsed arguments.
     """
+    from hammer_mv.cli.options import load_repertoire, recognition_settings
+    from perception.errors import InputError
+    from perception.pipeline import (
+        TRACKS_SUFFIX,
+        clip_fingerprint,
+        clip_name,
+        load_clip,
+        recognize_tracks,
+    )
+    from perception.report.clip import write_clip_report
+    from perception.report.tracking import write_tracking_report
+
     path: Path = args.input
     if not path.exists():
         raise InputError("input not found", path)
     if path.is_dir():
-        raise InputError("expected a video or tracks file, got a folder (use hammer-mv batch)",
-                         path)
+        raise InputError("expected a video, tracks or pose file, got a folder "
+                         "(use hammer-mv batch)", path)
     clip, kind = clip_name(path)
     if kind == "unknown":
-        raise InputError("not a video or .tracks.h5 file", path)
+        raise InputError("not a video, .tracks.h5 or pose file", path)
     settings = recognition_settings(args)
     rep, rep_id = load_repertoire(args)
-    rec = recognize_clip(path, rep, settings, clip=clip,
-                         tracks_out=args.output / "tracks" / f"{clip}{TRACKS_SUFFIX}",
-                         progress=not args.quiet and sys.stderr.isatty())
+    tracks = load_clip(path, tracks_out=args.output / "tracks" / f"{clip}{TRACKS_SUFFIX}",
+                       progress=not args.quiet and sys.stderr.isatty(),
+                       setup=settings.tracking, pose=settings.pose)
+    rec = recognize_tracks(tracks, rep, settings, clip=clip, source=path)
     extra = {"fingerprint": clip_fingerprint(path, settings, rep_id), "condition": None,
-             "input": str(path)}
-    tracks_file = path if kind == "tracks" else args.output / "tracks" / f"{clip}{TRACKS_SUFFIX}"
-    extra["tracking"] = write_tracking_report(tracks_file, args.output, clip)
-    paths = write_clip_report(rec, args.output, extra=extra)
+             "input": str(path),
+             "tracking": write_tracking_report(tracks, args.output, clip,
+                                               sheet=not args.no_figures)}
+    paths = write_clip_report(rec, args.output, extra=extra, figures=not args.no_figures)
     print(f"{clip}: winner {rec.winner} ({rec.rule} rule) -> {paths['json']}")
     return 0

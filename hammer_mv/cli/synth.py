@@ -6,8 +6,6 @@ import argparse
 import sys
 from pathlib import Path
 
-from perception.synthetic.recipes import load_recipe, synthesize
-
 
 def register(sub) -> None:
     """Add the ``synth`` subcommand to ``sub`` (an argparse subparsers action)."""
@@ -19,14 +17,20 @@ def register(sub) -> None:
     p.add_argument("recipe", type=Path, metavar="RECIPE")
     p.add_argument("-o", "--output", type=Path, required=True, metavar="DIR")
     p.add_argument("--seed", type=int, default=0, metavar="N", help="master seed (default: 0)")
+    p.add_argument("--jobs", type=int, default=1, metavar="N",
+                   help="processes rendering clips (default: 1); the clips do not depend on it")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     """Execute ``hammer-mv synth`` with parsed ``args``; return the exit status."""
+    from perception.synthetic.recipes import load_recipe, synthesize
+
+    if args.jobs < 1:
+        raise ValueError(f"--jobs: expected at least 1, got {args.jobs}")
     recipe = load_recipe(args.recipe)
-    manifest = synthesize(recipe, args.output, seed=args.seed,
+    manifest = synthesize(recipe, args.output, seed=args.seed, jobs=args.jobs,
                           progress=not args.quiet and sys.stderr.isatty())
     counts = manifest["condition"].value_counts().to_dict()
     print(f"wrote {len(manifest)} clips to {args.output} "

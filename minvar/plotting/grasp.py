@@ -50,6 +50,14 @@ def _draw_posture(ax, plan: GraspPlan, q_arm, q_finger, q_thumb, style: dict) ->
 def setup_figure(task: GraspTask | None = None, *, plan: GraspPlan | None = None) -> Figure:
     """The arm, hand and object at the start and at the goal (thesis Fig. 4.1).
 
+    Panel (a): the arm and gripper at the start (grey: the digits touching,
+    ``tip_start`` ahead of the wrist) and at the goal (black), the line of the
+    digit targets, the distance to the object r (grip midpoint to object
+    centre) and the wrist's travel. Panel (b): near the object, the hand at
+    the goal, its closed starting digits drawn at the wrist target (the frame
+    the grip is planned in: they start below the target line), the digit
+    targets (dots) and via-points (red).
+
     Parameters
     ----------
     task : GraspTask, optional
@@ -66,15 +74,25 @@ def setup_figure(task: GraspTask | None = None, *, plan: GraspPlan | None = None
     _draw_posture(a, plan, plan.arm.q_goal, plan.finger.q_goal, plan.thumb.q_goal,
                   dict(color="k", marker="o", ms=3, lw=1.5, label="goal"))
     _draw_object(a, task)
+    a.axhline(0, color="k", lw=0.5, ls=":")
     a.plot(*np.asarray(task.shoulder) * CM, "ks", ms=6)
     a.annotate("shoulder", np.asarray(task.shoulder) * CM, textcoords="offset points",
                xytext=(5, -10), fontsize=8)
-    a.set_title(f"(a) arm and gripper; object {task.object_size * CM:g} cm, "
-                f"{task.distance * CM:g} cm away", fontsize=9)
+    grip = np.asarray(task.wrist_start) + (0.0, task.tip_start)
+    a.annotate("", xy=(0, 0), xytext=grip * CM,
+               arrowprops=dict(arrowstyle="<->", color="tab:blue", lw=0.8))
+    a.annotate(f"r = {np.hypot(*grip) * CM:.0f} cm", grip * CM / 2, textcoords="offset points",
+               xytext=(-55, 0), fontsize=8, color="tab:blue")
+    a.set_title(f"(a) object {task.object_size * CM:g} cm; the wrist travels "
+                f"{task.transport_distance * CM:g} cm", fontsize=9)
     b = ax[0, 1]
     _draw_posture(b, plan, plan.arm.q_goal, plan.finger.q_goal, plan.thumb.q_goal,
-                  dict(color="k", marker="o", ms=3, lw=1.5))
+                  dict(color="k", marker="o", ms=3, lw=1.5, label="goal"))
+    _draw_posture(b, plan, plan.arm.q_goal, plan.finger.q_start, plan.thumb.q_start,
+                  dict(color="0.5", marker="o", ms=3, lw=1.2, ls="--",
+                       label="closed start posture, hand frame at the wrist target"))
     _draw_object(b, task)
+    b.axhline(0, color="k", lw=0.5, ls=":")
     wt = np.asarray(task.wrist_target)
     for via, mk in ((plan.finger_via, "s"), (plan.thumb_via, "D")):
         if len(via):
@@ -82,7 +100,10 @@ def setup_figure(task: GraspTask | None = None, *, plan: GraspPlan | None = None
     r = task.object_size / 2 + 0.04
     b.set_xlim(-r * CM, r * CM)
     b.set_ylim((wt[1] - 0.02) * CM, 0.03 * CM)
-    b.set_title("(b) at the goal: digit targets (dots), via-points (red)", fontsize=9)
+    b.set_title(f"(b) at the goal: targets (dots), via-points (red); g = "
+                f"{np.hypot(*np.subtract(task.finger_target, task.thumb_target)) * CM:g} cm",
+                fontsize=9)
+    b.legend(fontsize=7, loc="lower left")
     a.set_aspect("equal", adjustable="datalim")
     b.set_aspect("equal", adjustable="box")
     for x in (a, b):

@@ -35,13 +35,14 @@ __all__ = [
     "sd_peaks_figure",
 ]
 
-#: How each swept parameter is displayed: (label, scale, unit).
+#: How each swept quantity is displayed: (label, scale, unit).
 _DISPLAY = {
     "object_size": ("object size", 100.0, "cm"),
-    "distance": ("transport distance", 100.0, "cm"),
+    "distance": ("wrist start to object centre", 100.0, "cm"),
+    "transport_distance": ("transport distance (wrist travel)", 100.0, "cm"),
     "duration": ("movement time", 1000.0, "ms"),
     "viapoint_offset": ("via-point distance from object", 100.0, "cm"),
-    "viapoint_height": ("via-point height", 100.0, "cm"),
+    "viapoint_height": ("via-point height above the target line", 100.0, "cm"),
     "viapoint_time": ("via-point time", 100.0, "% of movement"),
 }
 
@@ -68,15 +69,20 @@ def _colours(k: int):
     return [cmap(x) for x in np.linspace(0.0, 0.9, max(k, 1))]
 
 
+def _x(exp: GraspExperiment) -> np.ndarray:
+    """The displayed quantity per setting, in display units."""
+    return exp.summary[exp.shown].to_numpy() * _display(exp.shown)[1]
+
+
 def _mean_paths(ax, exp: GraspExperiment, idx: list[int]) -> None:
-    label, scale, unit = _display(exp.parameter)
+    label, _, unit = _display(exp.shown)
     cols = _colours(len(idx))
     for c, i in zip(cols, idx):
         cur = exp.curves[exp.curves.setting == i]
-        v = exp.values[i]
+        v = _x(exp)[i]
         ax.plot(cur.finger_x * CM, cur.finger_y * CM, ":", color=c, lw=1.4)
         ax.plot(cur.thumb_x * CM, cur.thumb_y * CM, "--", color=c, lw=1.4,
-                label=f"{v * scale:g} {unit}")
+                label=f"{v:g} {unit}")
     # the objects drawn: each one shown if size is swept, else the base object
     sizes = exp.values[idx] if exp.parameter == "object_size" else [exp.base.object_size]
     for s in sizes:
@@ -122,8 +128,10 @@ def paths_figure(exp: GraspExperiment) -> Figure:
 def viapoint_height_paths_figure(exp: GraspExperiment) -> Figure:
     """Via-point lines and mean digit paths per via-point height (thesis Fig. 4.2).
 
-    Panels: (a) the hand at its goal, the target line and each setting's
-    via-points (hand frame at the wrist target); (b) mean digit paths.
+    Panels: (a) the hand's starting posture drawn at the wrist target (the
+    frame the grip is planned in: closed tips ``tip_start`` ahead of the
+    wrist), its posture at the goal (grey), the target line and each
+    setting's via-points; (b) mean digit paths.
 
     Parameters
     ----------
@@ -137,7 +145,9 @@ def viapoint_height_paths_figure(exp: GraspExperiment) -> Figure:
     task = exp.base
     plan = plan_grasp(task)
     _draw_posture(a, plan, plan.arm.q_goal, plan.finger.q_goal, plan.thumb.q_goal,
-                  dict(color="k", marker="o", ms=3, lw=1.2))
+                  dict(color="0.6", marker="o", ms=3, lw=1.0, label="hand at the goal"))
+    _draw_posture(a, plan, plan.arm.q_goal, plan.finger.q_start, plan.thumb.q_start,
+                  dict(color="k", marker="o", ms=3, lw=1.2, label="starting posture"))
     _draw_object(a, task)
     half = task.object_size / 2 + task.viapoint_offset
     for c, i in zip(cols, idx):
@@ -150,8 +160,8 @@ def viapoint_height_paths_figure(exp: GraspExperiment) -> Figure:
     a.set_aspect("equal", adjustable="box")
     a.set_xlabel("x (cm)")
     a.set_ylabel("y (cm)")
-    a.legend(fontsize=7, title="via-point line", title_fontsize=7)
-    a.set_title("(a) via-points relative to the target line", fontsize=9)
+    a.legend(fontsize=7, title="via-point line (hand frame)", title_fontsize=7)
+    a.set_title("(a) starting hand, target line (black) and via-points", fontsize=9)
     _mean_paths(ax[0, 1], exp, idx)
     ax[0, 1].set_title("(b) mean digit paths (finger dotted, thumb dashed)", fontsize=9)
     return fig
@@ -169,69 +179,75 @@ def accuracy_figure(exp: GraspExperiment) -> Figure:
     exp : GraspExperiment
         A sweep from :mod:`minvar.grasp_experiments`.
     """
-    label, scale, unit = _display(exp.parameter)
-    x = exp.values * scale
+    x = _x(exp)
+    scale = _display(exp.shown)[1]
     fig, ax = new_figure(2, 2, size=(10, 8))
     tr = exp.trials
     span = np.ptp(x) if len(x) > 1 else 1.0
     jitter = np.random.default_rng(0).uniform(-0.01, 0.01, len(tr)) * span  # display only
+    n = exp.summary.trials.iloc[0]
     for j, digit in enumerate(("finger", "thumb")):
         a = ax[0, j]
-        a.plot(tr[exp.parameter] * scale + jitter, tr[f"{digit}_distance"] * UM, "x", ms=2,
+        a.plot(tr[exp.shown] * scale + jitter, tr[f"{digit}_distance"] * UM, "x", ms=2,
                alpha=0.3, color="tab:blue")
-        a.plot(x, exp.summary[f"{digit}_distance_mean"] * UM, "k-", lw=1.5, label="mean")
+        a.plot(x, exp.summary[f"{digit}_distance_mean"] * UM, "k-", lw=1.5,
+               label=f"mean of {n}")
+        a.plot(x, exp.summary[f"{digit}_distance_exact"] * UM, "--", color="tab:red", lw=1,
+               label="exact")
         a.set_ylabel("end-point distance from target (µm)")
         a.set_title(f"({'ab'[j]}) {digit} end-point distance", fontsize=9)
         a.legend(fontsize=8)
         b = ax[1, j]
         for axis, mk, c in (("x", "o", "tab:orange"), ("y", "s", "tab:purple")):
             b.plot(x, exp.summary[f"{digit}_sd_{axis}"] * UM, mk, color=c, mfc="none",
-                   label=f"{axis} ({exp.summary.trials.iloc[0]} repetitions)")
+                   label=f"{axis} ({n} repetitions)")
             b.plot(x, exp.summary[f"{digit}_sd_{axis}_exact"] * UM, "-", color=c,
                    label=f"{axis} exact")
         b.set_ylabel("end-point SD (µm)")
         b.set_title(f"({'cd'[j]}) {digit} end-point SD", fontsize=9)
         b.legend(fontsize=7)
     for a in ax.ravel():
-        a.set_xlabel(_axis_label(exp.parameter))
+        a.set_xlabel(_axis_label(exp.shown))
     return fig
 
 
 def mga_figure(exp: GraspExperiment) -> Figure:
     """Maximum grip aperture and its timing per setting (thesis Figs. 4.8, 4.10).
 
-    Panels: (a) mean MGA with its regression line and equation; (b) mean
-    relative time of the MGA.
+    Panels: (a) mean MGA (bars: 95 % interval of the mean) with its
+    regression line and equation; (b) mean relative time of the MGA, and the
+    60-80 % band of human studies.
 
     Parameters
     ----------
     exp : GraspExperiment
         A sweep from :mod:`minvar.grasp_experiments` with MGA statistics.
     """
-    _, scale, _ = _display(exp.parameter)
-    x = exp.values * scale
+    x = _x(exp)
+    scale = _display(exp.shown)[1]
     s = exp.summary
     fig, ax = new_figure(1, 2, size=(10, 4.2))
     a = ax[0, 0]
-    a.errorbar(x, s.mga_mean * CM, yerr=s.mga_sd * CM, fmt="o", color="k", ms=4, capsize=2)
+    a.errorbar(x, s.mga_mean * CM, yerr=(s.mga_mean - s.mga_ci_low) * CM, fmt="o", color="k",
+               ms=4, capsize=2)
     slope = exp.stats.get("mga_slope")
     if slope is not None:
         icpt = exp.stats["mga_intercept"]
-        xs = np.array([exp.values.min(), exp.values.max()])
+        xs = np.array([x.min(), x.max()]) / scale
         a.plot(xs * scale, (slope * xs + icpt) * CM, "-", color="tab:blue")
         a.text(0.04, 0.92, f"MGA = {slope:.2f} x + {icpt * CM:.2f} cm",
                transform=a.transAxes, fontsize=9)
     a.set_ylabel("maximum grip aperture (cm)")
     a.set_title("(a) maximum grip aperture", fontsize=9)
     b = ax[0, 1]
-    b.errorbar(x, s.mga_time_mean * 100, yerr=s.mga_time_sd * 100, fmt="o-", color="k",
-               ms=4, capsize=2)
+    b.errorbar(x, s.mga_time_mean * 100, yerr=(s.mga_time_mean - s.mga_time_ci_low) * 100,
+               fmt="o-", color="k", ms=4, capsize=2)
     b.axhspan(60, 80, color="0.9", zorder=0, label="60-80 % (human studies)")
     b.set_ylabel("time of MGA (% of movement)")
     b.set_title("(b) relative time of the maximum", fontsize=9)
     b.legend(fontsize=8)
     for a in ax.ravel():
-        a.set_xlabel(_axis_label(exp.parameter))
+        a.set_xlabel(_axis_label(exp.shown))
     return fig
 
 
@@ -243,15 +259,17 @@ def sd_time_figure(exp: GraspExperiment) -> Figure:
     exp : GraspExperiment
         A variability sweep from :mod:`minvar.grasp_experiments`.
     """
-    label, scale, unit = _display(exp.parameter)
+    label, _, unit = _display(exp.shown)
     fig, ax = new_figure(1, 2, size=(11, 4.4))
-    for c, (i, v) in zip(_colours(len(exp.values)), enumerate(exp.values)):
+    for c, (i, v) in zip(_colours(len(exp.values)), enumerate(_x(exp))):
         cur = exp.curves[exp.curves.setting == i]
         rt = cur.relative_time * 100
-        ax[0, 0].plot(rt, cur.wrist_sd * UM, color=c, label=f"{v * scale:g} {unit}")
+        ax[0, 0].plot(rt, cur.wrist_sd * UM, color=c, label=f"{v:g} {unit}")
         ax[0, 1].plot(rt, cur.aperture_sd * UM, color=c)
     ax[0, 0].set_title("(a) wrist position SD", fontsize=9)
     ax[0, 1].set_title("(b) grip aperture SD", fontsize=9)
+    for via in {v.fraction for v in exp.base.via_schedule}:
+        ax[0, 1].axvline(via * 100, color="tab:red", lw=0.6, ls="--", alpha=0.6)
     for a in ax.ravel():
         a.set_xlabel("time (% of movement)")
         a.set_ylabel("SD (µm)")
@@ -259,38 +277,49 @@ def sd_time_figure(exp: GraspExperiment) -> Figure:
     return fig
 
 
+def _change_text(exp: GraspExperiment, col: str, scale: float, unit: str) -> str:
+    """``"change a (95 % CI b to c) unit"`` from the experiment's statistics."""
+    change = exp.stats.get(f"{col}_change")
+    if change is None:
+        return ""
+    lo, hi = exp.stats[f"{col}_change_ci"]
+    return f"change {change * scale:+.3g} {unit} (95 % CI {lo * scale:+.3g} to {hi * scale:+.3g})"
+
+
 def sd_peaks_figure(exp: GraspExperiment) -> Figure:
     """Peak SD and its relative time per setting (thesis Figs. 4.12, 4.14, 4.16).
 
     Panels: (a) wrist peak SD, (b) its time, (c) aperture peak SD, (d) its
-    time; markers from the repetitions, lines exact; one-way ANOVA p-values
-    (per-repetition peak deviations) in the titles.
+    time; markers from the repetitions with 95 % bootstrap intervals, lines
+    exact; each title gives the change from the first to the last setting
+    with its interval.
 
     Parameters
     ----------
     exp : GraspExperiment
         A variability sweep from :mod:`minvar.grasp_experiments`.
     """
-    _, scale, _ = _display(exp.parameter)
-    x = exp.values * scale
+    x = _x(exp)
     s = exp.summary
     fig, ax = new_figure(2, 2, size=(10, 8))
     for row, comp in enumerate(("wrist", "aperture")):
-        p = exp.stats.get(f"{comp}_anova_p", float("nan"))
-        pt = exp.stats.get(f"{comp}_time_anova_p", float("nan"))
-        a, b = ax[row, 0], ax[row, 1]
-        a.plot(x, s[f"{comp}_sd_peak"] * UM, "o", color="k", mfc="none", label="repetitions")
-        a.plot(x, s[f"{comp}_sd_peak_exact"] * UM, "-", color="tab:blue", label="exact")
-        a.set_ylabel("peak SD (µm)")
-        a.set_title(f"({'ac'[row]}) {comp} peak SD; ANOVA p = {p:.2g}", fontsize=9)
-        b.plot(x, s[f"{comp}_sd_peak_time"] * 100, "o", color="k", mfc="none",
-               label="repetitions")
-        b.plot(x, s[f"{comp}_sd_peak_time_exact"] * 100, "-", color="tab:blue", label="exact")
-        b.set_ylabel("time of peak SD (% of movement)")
-        b.set_title(f"({'bd'[row]}) {comp} peak SD time; ANOVA p = {pt:.2g}", fontsize=9)
-        a.legend(fontsize=8)
+        for col, (k, scale, unit, ylabel) in enumerate((
+                (f"{comp}_sd_peak", UM, "µm", "peak SD (µm)"),
+                (f"{comp}_sd_peak_time", 100, "%", "time of peak SD (% of movement)"))):
+            a = ax[row, col]
+            err = None
+            if f"{k}_ci_low" in s:
+                err = np.abs([s[k] - s[f"{k}_ci_low"], s[f"{k}_ci_high"] - s[k]]) * scale
+            a.errorbar(x, s[k] * scale, yerr=err, fmt="o", color="k", mfc="none", ms=5,
+                       capsize=2, label=f"{s.trials.iloc[0]} repetitions (95 % CI)")
+            a.plot(x, s[f"{k}_exact"] * scale, "-", color="tab:blue", label="exact")
+            a.set_ylabel(ylabel)
+            what = "peak SD" if col == 0 else "peak SD time"
+            a.set_title(f"({'abcd'[2 * row + col]}) {comp} {what}\n"
+                        f"{_change_text(exp, k, scale, unit)}", fontsize=8)
+        ax[row, 0].legend(fontsize=7)
     for a in ax.ravel():
-        a.set_xlabel(_axis_label(exp.parameter))
+        a.set_xlabel(_axis_label(exp.shown))
     return fig
 
 

@@ -184,11 +184,17 @@ def criteria_figure(comparison: CriteriaComparison) -> Figure:
     return fig
 
 
-def curvature_figure(time: ArrayLike, position: ArrayLike, indices: Sequence[int]) -> Figure:
+def curvature_figure(
+    time: ArrayLike,
+    position: ArrayLike,
+    indices: Sequence[int],
+    events: dict[str, float] | None = None,
+) -> Figure:
     """A trajectory with via-points at its curvature extrema (thesis Fig. A.2).
 
     Panels: (a) path with the via-points; (b) x(t) and the spatio-temporal
-    curvature (eq. A.1, dotted) with the extrema marked.
+    curvature (eq. A.1 in m and s, dotted) with the extrema marked, and
+    vertical lines at ``events``.
 
     Parameters
     ----------
@@ -198,6 +204,9 @@ def curvature_figure(time: ArrayLike, position: ArrayLike, indices: Sequence[int
         Path, m.
     indices : sequence of int
         Samples chosen as via-points.
+    events : dict of str to float, optional
+        Named moments to mark in (b), s (e.g. the movement's onset, its peak
+        speed, the start of the post-movement period).
     """
     time = np.asarray(time, dtype=float)
     position = np.asarray(position, dtype=float)
@@ -216,7 +225,11 @@ def curvature_figure(time: ArrayLike, position: ArrayLike, indices: Sequence[int
     twin = ax[0, 1].twinx()
     twin.plot(time, kappa, ":", color="tab:blue")
     twin.plot(time[idx], kappa[idx], "o", color="tab:blue", ms=4)
-    twin.set_ylabel("spatio-temporal curvature (eq. A.1)", color="tab:blue")
+    twin.set_ylabel("spatio-temporal curvature (eq. A.1, m and s)", color="tab:blue")
+    for k, (name, when) in enumerate((events or {}).items()):
+        ax[0, 1].axvline(when, color="0.5", lw=0.8, ls="--")
+        ax[0, 1].annotate(name, (when, 0.02 + 0.07 * k), xycoords=("data", "axes fraction"),
+                          fontsize=7, color="0.3", xytext=(3, 0), textcoords="offset points")
     return fig
 
 

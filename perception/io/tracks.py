@@ -30,11 +30,13 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import h5py
 import numpy as np
-import pandas as pd
+
+if TYPE_CHECKING:  # pragma: no cover
+    import pandas as pd  # imported by the table methods: `hammer-mv track` starts without it
 
 from minvar import __version__
 from perception.errors import InputError
@@ -302,6 +304,8 @@ class Tracks:
         Index: frame. Columns: MultiIndex ``(scorer, bodyparts, coords)`` with
         coords ``x, y, likelihood`` per marker. NaN where lost.
         """
+        import pandas as pd
+
         cols = pd.MultiIndex.from_product(
             [[scorer], list(self.markers), ["x", "y", "likelihood"]],
             names=["scorer", "bodyparts", "coords"],
@@ -318,6 +322,8 @@ class Tracks:
         x, y, likelihood, status``. Lost points have no row: trackpy's
         ``link`` and ``imsd`` expect only real positions.
         """
+        import pandas as pd
+
         t, m = self.n_frames, len(self.markers)
         table = pd.DataFrame(
             {
@@ -343,6 +349,8 @@ class Tracks:
 
     def to_pandas(self) -> pd.DataFrame:
         """Plain wide table: ``frame, time`` then ``<marker>_x, _y, _likelihood, _status``."""
+        import pandas as pd
+
         data: dict[str, Any] = {"frame": self.frame, "time": self.time}
         for j, name in enumerate(self.markers):
             data[f"{name}_x"] = self.position[:, j, 0]

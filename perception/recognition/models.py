@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from minvar import GraspTask, GripVia, PointMassPlant
-from perception.geometry import DEFAULT_OBJECT_DIAMETER
+from perception.geometry import DEFAULT_OBJECT_DIAMETER, DEFAULT_TIP_START
 
 if TYPE_CHECKING:
     from perception.observation import Observation
@@ -155,7 +155,7 @@ class SceneSpec:
     distance: float = 0.25
     object_size: float = DEFAULT_OBJECT_DIAMETER
     frame_period: float = 1 / 30
-    tip_start: float = 0.06
+    tip_start: float = DEFAULT_TIP_START
 
     def __post_init__(self):
         for name in ("distance", "object_size", "frame_period", "tip_start"):

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+import weakref
 from collections.abc import Iterable
 
 import numpy as np
@@ -17,15 +19,25 @@ from perception.recognition.models import (
     model_substeps,
 )
 
-__all__ = ["DEFAULT_DURATIONS", "build_model", "default_specs"]
+__all__ = ["DEFAULT_DURATIONS", "build_model", "build_models", "default_specs",
+           "planning_threads"]
 
 #: Movement-time variants of the default repertoire, s.
 DEFAULT_DURATIONS = (0.8, 0.9, 1.0, 1.1, 1.2)
 
 
+#: The joint-angle error covariance of each solution still in use (identical
+#: chain problems share one solution: see minvar.grasp).
+_ERROR_COV: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
 def _chain_model(role: str, chain_plan) -> ChainModel:
     problem, solution = chain_plan.problem, chain_plan.solution
-    P = estimation_error_covariance(problem, solution.K, solution.L)[:, :2, :2]
+    P = _ERROR_COV.get(solution)
+    if P is None:
+        P = estimation_error_covariance(problem, solution.K, solution.L)[:, :2, :2]
+        P.setflags(write=False)
+        _ERROR_COV[solution] = P
     q_ref = np.asarray(chain_plan.q_goal, dtype=float)
     chain = chain_plan.chain
     return ChainModel(
@@ -65,6 +77,45 @@ def build_model(spec: ModelSpec, scene: SceneSpec) -> MotorModel:
         finger=_chain_model("finger", plan.finger),
         thumb=_chain_model("thumb", plan.thumb),
     )
+
+
+#: Environment variable: threads that plan a repertoire's models (default 1).
+THREADS_VARIABLE = "HAMMER_MV_PLAN_THREADS"
+
+
+def planning_threads() -> int:
+    """Threads :func:`build_models` uses: ``$HAMMER_MV_PLAN_THREADS``, else 1.
+
+    The solver's compiled passes release the GIL, so on idle cores several
+    models plan at once (about half of planning is the compiled passes, so two
+    threads save at most a third). On a busy machine threads only add
+    hand-offs, so one is the default; a batch's workers always use one (they
+    already use every core).
+    """
+    value = os.environ.get(THREADS_VARIABLE, "")
+    if value.strip().isdigit() and int(value) >= 1:
+        return int(value)
+    return 1
+
+
+def build_models(specs: Iterable[ModelSpec], scene: SceneSpec) -> list[MotorModel]:
+    """:func:`build_model` of every spec, in order, on :func:`planning_threads` threads.
+
+    Parameters
+    ----------
+    specs : iterable of ModelSpec
+        The movements.
+    scene : SceneSpec
+        The scene.
+    """
+    specs = list(specs)
+    threads = min(planning_threads(), len(specs))
+    if threads <= 1:
+        return [build_model(s, scene) for s in specs]
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(threads, thread_name_prefix="plan") as pool:
+        return list(pool.map(lambda spec: build_model(spec, scene), specs))
 
 
 def default_specs(durations: Iterable[float] = DEFAULT_DURATIONS) -> list[ModelSpec]:

@@ -13,9 +13,13 @@ stored in HDF5 (:mod:`perception.io.repertoire`).
 from __future__ import annotations
 
 import dataclasses
+import hashlib
+import json
 import logging
+import os
+import time
 import tomllib
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 
 from perception.errors import InputError
@@ -28,10 +32,10 @@ from perception.io.repertoire import (
 )
 from perception.recognition.calibration import calibrate
 from perception.recognition.models import CHAIN_ARRAYS, ChainModel, ModelSpec, MotorModel, SceneSpec
-from perception.recognition.planning import DEFAULT_DURATIONS, build_model, default_specs
+from perception.recognition.planning import DEFAULT_DURATIONS, build_models, default_specs
 from perception.recognition.verdict import Calibration, CalibrationParams
 
-__all__ = ["Repertoire"]
+__all__ = ["PlanCache", "Repertoire"]
 
 log = logging.getLogger(__name__)
 
@@ -46,8 +50,10 @@ class Repertoire:
     config : dict, optional
         The configuration the repertoire was built from (stored in the file).
 
-    Every model gets a familiarity calibration
-    (:mod:`perception.recognition.calibration`) if it has none: once, here.
+    :meth:`build` calibrates every model's familiarity
+    (:mod:`perception.recognition.calibration`) and :meth:`save` stores it; a
+    model without one (loaded from an older file, or of the :meth:`default`
+    repertoire) is calibrated when a verdict first needs it (:meth:`calibrated`).
     """
 
     def __init__(self, models: Iterable[MotorModel], config: dict | None = None):
@@ -57,14 +63,20 @@ class Repertoire:
             raise ValueError(f"repertoire: duplicate model names in {names}")
         if not self.models:
             raise ValueError("repertoire: needs at least one model")
-        bare = [m for m in self.models if m.calibration is None]
-        if bare:
-            log.info("calibrating %d model(s) on their own demonstrations", len(bare))
-            done = dict(zip([m.name for m in bare], calibrate(bare)))
-            self.models = [dataclasses.replace(m, calibration=done[m.name])
-                           if m.name in done else m for m in self.models]
         self.config = config or {}
         self._replanned: dict[tuple, MotorModel] = {}
+        self._calibrations: dict[tuple, Calibration] = {}
+
+    @classmethod
+    def default(cls) -> Repertoire:
+        """The default repertoire (:meth:`build` with no arguments), planned when needed.
+
+        Its models are planned the first time they are asked for; a clip
+        scored first (:meth:`for_scene`) gets them planned for its own scene
+        directly, not for the default scene and then again for its own. The
+        models a clip is scored against are those of ``build()`` either way.
+        """
+        return _DefaultRepertoire()
 
     def __iter__(self) -> Iterator[MotorModel]:
         return iter(self.models)
@@ -80,7 +92,7 @@ class Repertoire:
     @classmethod
     def build(cls, specs: Iterable[ModelSpec] | None = None,
               scene: SceneSpec | None = None) -> Repertoire:
-        """Plan every model for a scene.
+        """Plan every model for a scene and calibrate its familiarity.
 
         Parameters
         ----------
@@ -93,7 +105,7 @@ class Repertoire:
         scene = SceneSpec() if scene is None else scene
         config = {"scene": dataclasses.asdict(scene),
                   "models": [dataclasses.asdict(s) for s in specs]}
-        return cls([build_model(s, scene) for s in specs], config)
+        return cls(_calibrated(build_models(specs, scene)), config)
 
     @classmethod
     def from_config(cls, path: str | Path) -> Repertoire:
@@ -126,30 +138,70 @@ class Repertoire:
         except ValueError as exc:
             raise InputError(str(exc), path) from None
 
-    def for_scene(self, scene: SceneSpec) -> list[MotorModel]:
+    def for_scene(self, scene: SceneSpec, cache: PlanCache | None = None) -> list[MotorModel]:
         """The models, re-planned for ``scene`` where their stored scene differs.
 
         Parameters
         ----------
         scene : SceneSpec
             The scene of the clip being scored.
+        cache : PlanCache, optional
+            Plans shared with other processes (a batch's workers): models
+            another process has re-planned for this scene are read, not planned.
         """
-        out = []
+        return self._for_scene(self.models, scene, cache)
+
+    def _for_scene(self, models: list[MotorModel], scene: SceneSpec,
+                   cache: PlanCache | None) -> list[MotorModel]:
         grid = scene.quantized()
-        for m in self.models:
-            if m.scene.matches(scene):
-                out.append(m)
-                continue
-            key = (m.name, grid)
-            if key not in self._replanned:
-                log.info("re-planning %s for distance %.3f m, object %.3f m, hand %.3f m, "
-                         "%.1f frames/s", m.name, grid.distance, grid.object_size,
+        todo = [m for m in models
+                if not m.scene.matches(scene) and (m.name, grid) not in self._replanned]
+        if todo:
+            def plan() -> list[MotorModel]:
+                log.info("re-planning %d models for distance %.3f m, object %.3f m, hand "
+                         "%.3f m, %.1f frames/s", len(todo), grid.distance, grid.object_size,
                          grid.tip_start, 1 / grid.frame_period)
-                # familiarity transfers across scenes (docs/recognition.md)
-                self._replanned[key] = dataclasses.replace(build_model(m.spec, grid),
-                                                           calibration=m.calibration)
-            out.append(self._replanned[key])
-        return out
+                # a re-planned model keeps its source's calibration (it transfers
+                # across scenes: docs/recognition.md)
+                return _calibrated(build_models([m.spec for m in todo], grid),
+                                   [getattr(m, "calibration", None) for m in todo],
+                                   compute=False)
+
+            planned = plan() if cache is None else cache.get(grid, [m.spec for m in todo], plan)
+            for m, new in zip(todo, planned):
+                self._replanned[(m.name, grid)] = new
+        return [self._known(m if m.scene.matches(scene) else self._replanned[(m.name, grid)])
+                for m in models]
+
+    def _known(self, m: MotorModel) -> MotorModel:
+        """``m`` with the calibration :meth:`calibrated` made for it, if any."""
+        cal = None if m.calibration is not None else self._calibrations.get((m.name, m.scene))
+        return m if cal is None else dataclasses.replace(m, calibration=cal)
+
+    def calibrated(self, models: list[MotorModel], index: int) -> list[MotorModel]:
+        """``models`` with model ``index`` calibrated: once per model and scene, then kept.
+
+        A repertoire built or loaded carries every model's calibration, and
+        models re-planned from it keep theirs; the default repertoire planned
+        for a clip's scene (:meth:`default`) calibrates only the models the
+        verdict asks for, here.
+
+        Parameters
+        ----------
+        models : list of MotorModel
+            Models from :meth:`for_scene`.
+        index : int
+            The one to calibrate.
+        """
+        m = models[index]
+        if m.calibration is not None:
+            return models
+        key = (m.name, m.scene)
+        if key not in self._calibrations:
+            log.info("calibrating %s on its own demonstrations", m.name)
+            self._calibrations[key] = calibrate([m])[0]
+        done = dataclasses.replace(m, calibration=self._calibrations[key])
+        return [*models[:index], done, *models[index + 1:]]
 
     # -- persistence -------------------------------------------------------
     def save(self, path: str | Path) -> Path:
@@ -171,8 +223,9 @@ class Repertoire:
         path : str or Path
             The HDF5 file.
 
-        A file written before familiarity calibrations were stored is
-        calibrated as it is loaded (the file is not changed).
+        A file written before familiarity calibrations were stored loads as
+        it is; its models are calibrated when a verdict first needs them
+        (:meth:`calibrated`; the file is not changed).
 
         Raises
         ------
@@ -184,6 +237,157 @@ class Repertoire:
             return cls([_model(s) for s in stored], config)
         except (KeyError, ValueError, TypeError) as exc:
             raise InputError(f"corrupt or unreadable repertoire: {exc}", path) from None
+
+
+class _DefaultRepertoire(Repertoire):
+    """:meth:`Repertoire.default`: the default models, planned on first use."""
+
+    def __init__(self):
+        self._specs = default_specs()
+        self._scene = SceneSpec()
+        self._models: list[MotorModel] | None = None
+        self.config = {"scene": dataclasses.asdict(self._scene),
+                       "models": [dataclasses.asdict(s) for s in self._specs]}
+        self._replanned = {}
+        self._calibrations = {}
+
+    @property
+    def models(self) -> list[MotorModel]:  # type: ignore[override]
+        if self._models is None:
+            self._models = build_models(self._specs, self._scene)  # calibrated when asked
+        return self._models
+
+    @property
+    def names(self) -> list[str]:
+        return [s.name for s in self._specs]
+
+    def __len__(self) -> int:
+        return len(self._specs)
+
+    def for_scene(self, scene: SceneSpec, cache: PlanCache | None = None) -> list[MotorModel]:
+        if self._models is None and not self._scene.matches(scene):
+            # the stored (default-scene) plans would all be re-planned: plan the
+            # clip's scene only, as the placeholder models below stand for
+            stand_ins = [_Unplanned(s, self._scene) for s in self._specs]
+            return self._for_scene(stand_ins, scene, cache)
+        return super().for_scene(scene, cache)
+
+
+@dataclasses.dataclass(frozen=True)
+class _Unplanned:
+    """A default model not planned yet: what :meth:`Repertoire.for_scene` reads of it."""
+
+    spec: ModelSpec
+    scene: SceneSpec
+
+    @property
+    def name(self) -> str:
+        return self.spec.name
+
+
+class PlanCache:
+    """Models re-planned for a scene, on disk, shared by the processes of a batch.
+
+    One file per scene and set of models (``<key>.h5`` in ``folder``), keyed by
+    everything that changes a plan: the scene on the 5 mm grid and its frame
+    period, each model's specification, and the software version. Files are
+    written under a temporary name and renamed, so a reader never sees half a
+    file. The first process to need a scene takes a lock file and plans it;
+    another that needs it meanwhile waits for the file (up to ``wait_s``, or
+    until the lock is older than ``stale_s`` — its owner died), then plans it
+    itself rather than wait longer. Unreadable files are planned again.
+
+    Parameters
+    ----------
+    folder : str or os.PathLike
+        Where the plans are kept (e.g. ``REPORT_DIR/.plans``).
+    wait_s : float
+        Longest wait for a scene another process is planning.
+    stale_s : float
+        Age after which a lock without its plan is ignored.
+    """
+
+    def __init__(self, folder: str | os.PathLike, *, wait_s: float = 60.0,
+                 stale_s: float = 120.0):
+        self.folder = Path(folder)
+        self.wait_s = wait_s
+        self.stale_s = stale_s
+        self.planned = 0  # scenes this process planned (the rest it read)
+
+    def key(self, scene: SceneSpec, specs: list[ModelSpec]) -> str:
+        """The file key of ``specs`` planned for ``scene`` (already on the grid)."""
+        from perception import __version__
+
+        payload = json.dumps({"scene": dataclasses.asdict(scene),
+                              "models": [dataclasses.asdict(s) for s in specs],
+                              "software": __version__}, sort_keys=True, default=str)
+        return hashlib.sha256(payload.encode()).hexdigest()[:24]
+
+    def get(self, scene: SceneSpec, specs: list[ModelSpec],
+            plan: Callable[[], list[MotorModel]]) -> list[MotorModel]:
+        """The models of ``specs`` for ``scene``: read if planned, else ``plan()`` and stored."""
+        key = self.key(scene, specs)
+        path = self.folder / f"{key}.h5"
+        lock = self.folder / f"{key}.lock"
+        self.folder.mkdir(parents=True, exist_ok=True)
+        deadline = time.monotonic() + self.wait_s
+        while True:
+            models = self._read(path, specs)
+            if models is not None:
+                return models
+            try:
+                fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY)
+            except FileExistsError:
+                if time.monotonic() < deadline and not self._stale(lock):
+                    time.sleep(0.05)
+                    continue
+                return plan()  # the owner is slow or gone: plan here, leave its lock
+            os.close(fd)
+            try:
+                models = self._read(path, specs)  # written between our read and our lock
+                if models is None:
+                    models = plan()
+                    self.planned += 1
+                    Repertoire(models, {"plan_cache": key}).save(path)
+                return models
+            finally:
+                lock.unlink(missing_ok=True)
+
+    def _stale(self, lock: Path) -> bool:
+        try:
+            return time.time() - lock.stat().st_mtime > self.stale_s
+        except FileNotFoundError:
+            return False
+
+    @staticmethod
+    def _read(path: Path, specs: list[ModelSpec]) -> list[MotorModel] | None:
+        if not path.is_file():
+            return None
+        try:
+            models = Repertoire.load(path).models
+        except (InputError, OSError):
+            return None
+        if [m.name for m in models] != [s.name for s in specs]:
+            return None  # the key says the rest
+        return models
+
+
+def _calibrated(models: list[MotorModel], sources: list[Calibration | None] | None = None,
+                *, compute: bool = True) -> list[MotorModel]:
+    """``models`` with a calibration each: their own, the one in ``sources``, else (with
+    ``compute``) a new one."""
+    sources = sources or [None] * len(models)
+    given = [m.calibration or src for m, src in zip(models, sources)]
+    bare = [m for m, cal in zip(models, given) if cal is None]
+    if bare and not compute:
+        return [m if cal is None else dataclasses.replace(m, calibration=cal)
+                for m, cal in zip(models, given)]
+    if bare:
+        log.info("calibrating %d model(s) on their own demonstrations", len(bare))
+        new = iter(calibrate(bare))
+        given = [cal if cal is not None else next(new) for cal in given]
+    return [m if m.calibration is cal else dataclasses.replace(m, calibration=cal)
+            for m, cal in zip(models, given)]
 
 
 def _stored(m: MotorModel) -> StoredModel:

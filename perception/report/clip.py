@@ -17,7 +17,6 @@ import numpy as np
 
 from perception.io.atomic import save_figure, write_csv, write_json
 from perception.recognition.result import Recognition
-from perception.report.figures import confidence_figure, paths_figure
 
 __all__ = ["ClipSummary", "clip_figures", "clip_outputs", "write_clip_report"]
 
@@ -208,8 +207,8 @@ def clip_figures(out: Path, clip: str) -> list[Path]:
     return [p for p in own if p.exists()] + others
 
 
-def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None
-                      ) -> dict[str, Path]:
+def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,
+                      figures: bool = True) -> dict[str, Path]:
     """Write ``<clip>.recognition.json``, the per-step CSV and the two figures.
 
     Parameters
@@ -220,6 +219,10 @@ def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None
         Report folder (created if missing).
     extra : dict, optional
         More keys for the JSON (e.g. the batch's input fingerprint).
+    figures : bool
+        Draw the figures (matplotlib is imported only then); without them,
+        figures of an earlier run are removed, since they would show another
+        result.
 
     Returns
     -------
@@ -227,8 +230,14 @@ def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None
         The files written (see :func:`clip_outputs`).
     """
     paths = clip_outputs(Path(out), rec.clip)
-    save_figure(paths["confidence_png"], confidence_figure(rec))
-    save_figure(paths["paths_png"], paths_figure(rec))
+    if figures:
+        from perception.report.figures import confidence_figure, paths_figure
+
+        save_figure(paths["confidence_png"], confidence_figure(rec))
+        save_figure(paths["paths_png"], paths_figure(rec))
+    else:
+        paths["confidence_png"].unlink(missing_ok=True)
+        paths["paths_png"].unlink(missing_ok=True)
     write_csv(paths["csv"], rec.to_pandas())
     # the JSON last: its presence marks the clip's report complete
     write_json(paths["json"], {**rec.to_dict(), **(extra or {})})

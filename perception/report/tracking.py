@@ -214,7 +214,7 @@ def contact_sheet(tracks: Tracks, video: str | os.PathLike | None, out: str | os
 
 
 def write_tracking_report(tracks: Tracks | str | os.PathLike, out: str | os.PathLike,
-                          clip: str) -> dict:
+                          clip: str, *, sheet: bool = True) -> dict:
     """The clip's tracking quality (JSON-ready) and its contact sheet ``<clip>.tracking.png``.
 
     The one call the clip and batch reports make: it returns the value of the
@@ -229,10 +229,12 @@ def write_tracking_report(tracks: Tracks | str | os.PathLike, out: str | os.Path
         Report folder.
     clip : str
         Clip name.
+    sheet : bool
+        Draw the contact sheet (reads frames of the video).
     """
     if not isinstance(tracks, Tracks):
         tracks = Tracks.load(tracks)
     quality = tracking_quality(tracks).to_dict()
-    sheet = contact_sheet(tracks, None, Path(out) / f"{clip}.tracking.png")
-    quality["contact_sheet"] = sheet.name if sheet is not None else None
+    drawn = contact_sheet(tracks, None, Path(out) / f"{clip}.tracking.png") if sheet else None
+    quality["contact_sheet"] = drawn.name if drawn is not None else None
     return quality

@@ -208,7 +208,7 @@ def clip_plans(recipe: Recipe, seed: int) -> list[tuple]:
 
 
 def synthesize(recipe: Recipe, out: str | os.PathLike, *, seed: int = 0,
-               progress: bool = False) -> pd.DataFrame:
+               progress: bool = False, jobs: int = 1) -> pd.DataFrame:
     """Render every clip of a recipe into ``out`` and write ``manifest.csv``.
 
     Parameters
@@ -222,6 +222,10 @@ def synthesize(recipe: Recipe, out: str | os.PathLike, *, seed: int = 0,
         so a clip does not change when other clips are added.
     progress : bool
         Show a progress bar.
+    jobs : int
+        Processes rendering clips (this one and ``jobs - 1`` spawned workers,
+        one BLAS/OpenCV thread each). Each clip comes from its own stream, so
+        the clips do not depend on ``jobs``.
 
     Returns
     -------
@@ -230,28 +234,72 @@ def synthesize(recipe: Recipe, out: str | os.PathLike, *, seed: int = 0,
     """
     from tqdm import tqdm
 
-    style = render_style(recipe.style)
+    if int(jobs) < 1:
+        raise ValueError(f"--jobs: expected at least 1, got {jobs}")
+    render_style(recipe.style)
     plans = clip_plans(recipe, seed)  # all of them first: a bad draw renders nothing
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    rows = []
-    for clip, cond, params, angle, rng in tqdm(plans, desc=f"synth {recipe.name}",
-                                               unit="clip", disable=not progress):
-        t, paths = stimulus_paths(params, style.fps, seed=rng)
-        scene = Scene(wrist=paths["wrist"], finger=paths["finger"], thumb=paths["thumb"],
-                      object_diameter=params.object_size)
-        camera = Camera.for_frame(style.width, style.height, angle_deg=angle)
-        clip_seed = int(rng.integers(2**31))
-        meta = {**dataclasses.asdict(params), "camera_angle_deg": angle, "recipe": recipe.name}
-        result = render_clip(scene, camera, style, out / f"{clip}{_suffix(style)}",
-                             seed=clip_seed, label=cond, params=meta)
-        rows.append({"clip": clip, "condition": cond, "seed": clip_seed,
-                     "video": result.video.name, "truth": result.truth.name,
-                     "parameters": json.dumps(meta)})
-        log.info("rendered %s (%d frames)", clip, result.n_frames)
+    work = [(recipe, out, plan) for plan in plans]
+    bar = tqdm(total=len(plans), desc=f"synth {recipe.name}", unit="clip", disable=not progress)
+    with bar:
+        if int(jobs) == 1 or len(plans) <= 1:
+            rows = []
+            for w in work:
+                rows.append(_render_one(w))
+                bar.update()
+        else:
+            rows = _render_parallel(work, int(jobs), bar)
     manifest = pd.DataFrame(rows)
     write_csv(out / "manifest.csv", manifest)
     return manifest
+
+
+def _render_one(work: tuple) -> dict:
+    """Render one clip of :func:`clip_plans`; its manifest row."""
+    recipe, out, (clip, cond, params, angle, rng) = work
+    style = render_style(recipe.style)
+    t, paths = stimulus_paths(params, style.fps, seed=rng)
+    scene = Scene(wrist=paths["wrist"], finger=paths["finger"], thumb=paths["thumb"],
+                  object_diameter=params.object_size)
+    camera = Camera.for_frame(style.width, style.height, angle_deg=angle)
+    clip_seed = int(rng.integers(2**31))
+    meta = {**dataclasses.asdict(params), "camera_angle_deg": angle, "recipe": recipe.name}
+    result = render_clip(scene, camera, style, out / f"{clip}{_suffix(style)}",
+                         seed=clip_seed, label=cond, params=meta)
+    log.info("rendered %s (%d frames)", clip, result.n_frames)
+    return {"clip": clip, "condition": cond, "seed": clip_seed,
+            "video": result.video.name, "truth": result.truth.name,
+            "parameters": json.dumps(meta)}
+
+
+def _render_parallel(work: list, jobs: int, bar) -> list[dict]:
+    """:func:`_render_one` of every item in ``jobs - 1`` spawned workers and this process."""
+    import multiprocessing
+    from collections import deque
+    from concurrent.futures import ProcessPoolExecutor
+
+    from perception.batch import _one_thread, _single_threaded_children
+
+    rows: list[dict | None] = [None] * len(work)
+    pending = deque(range(len(work)))
+    # spawn, not fork (OpenCV/BLAS thread pools do not survive a fork), one
+    # thread per process; this process renders too, from the end of the list
+    with _one_thread(), _single_threaded_children(), ProcessPoolExecutor(
+            max_workers=jobs - 1, mp_context=multiprocessing.get_context("spawn")) as pool:
+        running = {}
+        while pending or running:
+            while pending and len(running) < 2 * (jobs - 1):
+                i = pending.popleft()
+                running[pool.submit(_render_one, work[i])] = i
+            if pending:
+                i = pending.pop()
+                rows[i] = _render_one(work[i])
+                bar.update()
+            for f in [f for f in running if f.done() or not pending]:
+                rows[running.pop(f)] = f.result()
+                bar.update()
+    return rows
 
 
 def _suffix(style: RenderStyle) -> str:

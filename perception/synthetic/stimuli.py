@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from minvar import GraspTask, GripVia, simulate_grasp
-from perception.geometry import DEFAULT_OBJECT_DIAMETER
+from perception.geometry import DEFAULT_OBJECT_DIAMETER, DEFAULT_TIP_START
 
 __all__ = ["CONDITIONS", "StimulusParams", "stimulus_task", "stimulus_paths"]
 
@@ -86,7 +86,7 @@ def stimulus_task(p: StimulusParams) -> GraspTask:
     """
     radius = p.object_size / 2
     common = dict(object_size=p.object_size, distance=p.distance, duration=p.duration,
-                  execution_cv=p.execution_cv)
+                  execution_cv=p.execution_cv, tip_start=DEFAULT_TIP_START)
     if p.condition == "normal":
         return GraspTask(**common)
     if p.condition == "reach":

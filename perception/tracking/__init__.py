@@ -12,7 +12,7 @@
   first frames and why one is refused (size, shape, colour purity, stillness).
 * :mod:`~perception.tracking.hand` — which candidates together look like a
   hand; ambiguity.
-* :mod:`~perception.tracking.detection` — the global search of lost markers.
+* :mod:`~perception.tracking.reacquisition` — the global search of lost markers.
 * :mod:`~perception.tracking.setup` — a session's colour models and marker
   sizes: ``hammer-mv calibrate`` and ``--setup``.
 * :mod:`~perception.tracking.overlay` — markers drawn on frames (labelled

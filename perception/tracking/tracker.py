@@ -28,7 +28,7 @@ delegates:
    the marker stays lost: a global search of a downscaled frame for the
    plausible blob nearest where the rest of the hand puts it, refined at full
    resolution, checked for shape and colour, and reported with status 1
-   (:mod:`perception.tracking.detection`).
+   (:mod:`perception.tracking.reacquisition`).
 
 Markers listed in ``still_markers`` (the object) are expected to stay put and
 to be partly hidden by the hand at the end: their position is the running
@@ -76,7 +76,6 @@ from perception.tracking.candidates import (
     reject_reason,
     strict,
 )
-from perception.tracking.detection import ROI, downscaled_hsv, reacquire, search_scale
 from perception.tracking.hand import choose_hand
 from perception.tracking.markers import MarkerColour, MarkerSet, default_markers
 from perception.tracking.measurement import (
@@ -88,6 +87,7 @@ from perception.tracking.measurement import (
     soft_diameter,
 )
 from perception.tracking.params import TrackerParams
+from perception.tracking.reacquisition import ROI, downscaled_hsv, reacquire, search_scale
 
 __all__ = ["ROI", "Measurement", "Tracker", "TrackerParams", "track_frames", "track_video"]
 
@@ -716,7 +716,7 @@ class Tracker:
         return all(math.hypot(centre[0] - x, centre[1] - y) <= span for x, y in others)
 
     def _reacquire(self, tr: _Track, frame: np.ndarray) -> _Located | None:
-        """Global search while lost (see :func:`perception.tracking.detection.reacquire`)."""
+        """Global search while lost (see :func:`perception.tracking.reacquisition.reacquire`)."""
         p = self.params
         where, reach = self._expected_here(tr)
 

@@ -1,0 +1,589 @@
+/* The forward and backward passes of minvar.lqg's solver, compiled.
+ *
+ * The same recursions as minvar.lqg._Solver.forward/backward (Todorov's
+ * kalman_lqg.m), for the case every planning problem of this project is in:
+ * the filter and controller systems are positive definite (Cholesky), so no
+ * pseudo-inverse is needed. The products exploit the structure of the
+ * problems (A, B and H are mostly zeros: a plant of a few chained
+ * integrators, constant states, observations of a few states) by keeping
+ * those matrices in compressed-row form; every other product is dense. The
+ * arithmetic is that of the numpy passes up to the order of summation, so the
+ * results agree to rounding (tests/test_lqg.py compares them).
+ *
+ * The library is loaded with ctypes (minvar/_kernel.py); it is built as a
+ * Python extension module only so that setuptools compiles and installs it.
+ * Matrices are row-major doubles. Every function returns 0, or a positive
+ * code when a Cholesky factorisation fails (the caller then uses numpy) or a
+ * negative one when memory runs out.
+ */
+
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum {
+    HAS_C = 1,         /* control-dependent noise */
+    HAS_D = 2,         /* state-dependent observation noise */
+    TRACK_XE = 4,      /* internal noise: the estimate/error cross moment */
+    ADD_NOISE = 8,     /* additive process or internal noise in the error moment */
+    NOISE_COST = 16,   /* additive noise terms of the cost */
+};
+
+/* A matrix in compressed-row form. */
+typedef struct {
+    int rows, cols;
+    int *start;   /* rows + 1 */
+    int *col;
+    double *val;
+} csr;
+
+static int csr_make(csr *s, const double *X, int rows, int cols) {
+    int nnz = 0;
+    for (int i = 0; i < rows * cols; i++) nnz += X[i] != 0.0;
+    s->rows = rows;
+    s->cols = cols;
+    s->start = malloc(sizeof(int) * (rows + 1));
+    s->col = malloc(sizeof(int) * (nnz ? nnz : 1));
+    s->val = malloc(sizeof(double) * (nnz ? nnz : 1));
+    if (!s->start || !s->col || !s->val) return -1;
+    int p = 0;
+    for (int i = 0; i < rows; i++) {
+        s->start[i] = p;
+        for (int j = 0; j < cols; j++) {
+            double v = X[i * cols + j];
+            if (v != 0.0) {
+                s->col[p] = j;
+                s->val[p] = v;
+                p++;
+            }
+        }
+    }
+    s->start[rows] = p;
+    return 0;
+}
+
+static void csr_free(csr *s) {
+    free(s->start);
+    free(s->col);
+    free(s->val);
+}
+
+static void transpose(double *out, const double *X, int rows, int cols) {
+    for (int i = 0; i < rows; i++)
+        for (int j = 0; j < cols; j++) out[j * rows + i] = X[i * cols + j];
+}
+
+/* out (S.rows x r) = S X, X (S.cols x r); sign -1 subtracts from out instead. */
+static void sd(double *out, const csr *S, const double *X, int r, int accumulate) {
+    for (int i = 0; i < S->rows; i++) {
+        double *o = out + (size_t)i * r;
+        if (!accumulate) memset(o, 0, sizeof(double) * r);
+        for (int p = S->start[i]; p < S->start[i + 1]; p++) {
+            const double v = accumulate < 0 ? -S->val[p] : S->val[p];
+            const double *x = X + (size_t)S->col[p] * r;
+            for (int j = 0; j < r; j++) o[j] += v * x[j];
+        }
+    }
+}
+
+/* out (p x S.cols) = X S, X (p x S.rows): a pass over X's columns per non-zero of S. */
+static void ds(double *out, const double *X, const csr *S, int p, int accumulate) {
+    const int q = S->rows, r = S->cols;
+    if (!accumulate) memset(out, 0, sizeof(double) * (size_t)p * r);
+    for (int l = 0; l < q; l++) {
+        for (int t = S->start[l]; t < S->start[l + 1]; t++) {
+            const int j = S->col[t];
+            const double v = accumulate < 0 ? -S->val[t] : S->val[t];
+            for (int i = 0; i < p; i++) out[(size_t)i * r + j] += v * X[(size_t)i * q + l];
+        }
+    }
+}
+
+/* out (p x r) = X Y, X (p x q), Y (q x r); accumulate -1 subtracts. */
+static void dd(double *out, const double *X, const double *Y, int p, int q, int r,
+               int accumulate) {
+    for (int i = 0; i < p; i++) {
+        double *o = out + (size_t)i * r;
+        if (!accumulate) memset(o, 0, sizeof(double) * r);
+        const double *x = X + (size_t)i * q;
+        for (int l = 0; l < q; l++) {
+            double xv = x[l];
+            if (xv == 0.0) continue;
+            if (accumulate < 0) xv = -xv;
+            const double *y = Y + (size_t)l * r;
+            for (int j = 0; j < r; j++) o[j] += xv * y[j];
+        }
+    }
+}
+
+/* out (p x r) = X Y', X (p x q), Y (r x q). */
+static void ddt(double *out, const double *X, const double *Y, int p, int q, int r,
+                int accumulate) {
+    for (int i = 0; i < p; i++) {
+        const double *x = X + (size_t)i * q;
+        int zero = 1;
+        for (int l = 0; l < q && zero; l++) zero = x[l] == 0.0;
+        if (zero) { /* rows of zeros are common (gains of constant states) */
+            if (!accumulate) memset(out + (size_t)i * r, 0, sizeof(double) * r);
+            continue;
+        }
+        for (int j = 0; j < r; j++) {
+            const double *y = Y + (size_t)j * q;
+            double s = 0.0;
+            for (int l = 0; l < q; l++) s += x[l] * y[l];
+            double *o = out + (size_t)i * r + j;
+            if (accumulate < 0) *o -= s;
+            else if (accumulate) *o += s;
+            else *o = s;
+        }
+    }
+}
+
+/* out (p x r) = X' Y, X (q x p), Y (q x r). */
+static void dtd(double *out, const double *X, const double *Y, int p, int q, int r,
+                int accumulate) {
+    if (!accumulate) memset(out, 0, sizeof(double) * (size_t)p * r);
+    for (int l = 0; l < q; l++) {
+        const double *x = X + (size_t)l * p;
+        const double *y = Y + (size_t)l * r;
+        for (int i = 0; i < p; i++) {
+            double xv = x[i];
+            if (xv == 0.0) continue;
+            if (accumulate < 0) xv = -xv;
+            double *o = out + (size_t)i * r;
+            for (int j = 0; j < r; j++) o[j] += xv * y[j];
+        }
+    }
+}
+
+/* Solve M X = Y for symmetric positive definite M (d x d, its upper triangle
+ * read, as LAPACK's dposv with uplo 'U'), Y (d x r) overwritten by X.
+ * U is d x d scratch. Returns 0, or 1 if M is not positive definite. */
+static int chol_solve(const double *M, double *Y, double *U, int d, int r) {
+    /* M = U' U, U upper triangular */
+    for (int j = 0; j < d; j++) {
+        double s = M[j * d + j];
+        for (int l = 0; l < j; l++) s -= U[l * d + j] * U[l * d + j];
+        if (!(s > 0.0)) return 1;
+        const double ujj = sqrt(s);
+        U[j * d + j] = ujj;
+        for (int i = j + 1; i < d; i++) {
+            double t = M[j * d + i];
+            for (int l = 0; l < j; l++) t -= U[l * d + j] * U[l * d + i];
+            U[j * d + i] = t / ujj;
+        }
+    }
+    /* all right-hand sides at once, a row at a time (contiguous) */
+    for (int i = 0; i < d; i++) { /* U' z = y */
+        double *yi = Y + (size_t)i * r;
+        for (int l = 0; l < i; l++) {
+            const double u = U[l * d + i];
+            const double *yl = Y + (size_t)l * r;
+            for (int c = 0; c < r; c++) yi[c] -= u * yl[c];
+        }
+        const double uii = U[i * d + i];
+        for (int c = 0; c < r; c++) yi[c] /= uii;
+    }
+    for (int i = d - 1; i >= 0; i--) { /* U x = z */
+        double *yi = Y + (size_t)i * r;
+        for (int l = i + 1; l < d; l++) {
+            const double u = U[i * d + l];
+            const double *yl = Y + (size_t)l * r;
+            for (int c = 0; c < r; c++) yi[c] -= u * yl[c];
+        }
+        const double uii = U[i * d + i];
+        for (int c = 0; c < r; c++) yi[c] /= uii;
+    }
+    return 0;
+}
+
+/* Doubles in one scratch block: room for any product of the problem's sizes. */
+static size_t block_size(int n, int m, int k) {
+    int big = n > m ? n : m;
+    big = big > k ? big : k;
+    return (size_t)big * big + 8;
+}
+
+static void add(double *out, const double *X, int size) {
+    for (int i = 0; i < size; i++) out[i] += X[i];
+}
+
+/* Filter gains K (T x n x k) optimal for control gains L (T x m x n).
+ * BC: nc matrices B C_i (n x m); D: nd matrices (k x n). */
+int lqg_forward(int T, int n, int m, int k, int nc, int nd, const double *A, const double *B,
+                const double *H, const double *BC, const double *D, const double *DD0,
+                const double *CC0, const double *EE0, const double *S1, const double *X1,
+                const double *L, int flags, double *K) {
+    const size_t nn = (size_t)n * n, nk = (size_t)n * k;
+    csr sA = {0}, sAt = {0}, sB = {0}, sH = {0}, sHt = {0};
+    const size_t blk = block_size(n, m, k);
+    double *buf = malloc(sizeof(double) * blk * 24);
+    int status = -1;
+    if (!buf) return -1;
+    double *At = buf, *Ht = At + blk, *SiE = Ht + blk, *SiX = SiE + blk, *SiXE = SiX + blk;
+    double *newE = SiXE + blk, *T1 = newE + blk, *T2 = T1 + blk, *T3 = T2 + blk;
+    double *abl = T3 + blk, *akh = abl + blk, *X2 = akh + blk, *tmpS = X2 + blk;
+    double *cross = tmpS + blk, *SiEHt = cross + blk, *ASH = SiEHt + blk, *Kt = ASH + blk;
+    double *M = Kt + blk, *U = M + blk, *LS = U + blk, *LSL = LS + blk, *HS = LSL + blk;
+    double *BCL = HS + blk;
+    transpose(At, A, n, n);
+    transpose(Ht, H, k, n);
+    if (csr_make(&sA, A, n, n) || csr_make(&sAt, At, n, n) || csr_make(&sB, B, n, m)
+        || csr_make(&sH, H, k, n) || csr_make(&sHt, Ht, n, k))
+        goto done;
+    memcpy(SiE, S1, sizeof(double) * nn);
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++) SiX[i * n + j] = X1[i] * X1[j];
+    memset(SiXE, 0, sizeof(double) * nn);
+    for (int t = 0; t < T; t++) {
+        const double *Lt = L + (size_t)t * m * n;
+        double *Kout = K + (size_t)t * nk;
+        ds(SiEHt, SiE, &sHt, n, 0);                   /* SiE H' */
+        sd(M, &sH, SiEHt, k, 0);                      /* H SiE H' */
+        add(M, DD0, k * k);
+        if (flags & HAS_D) {
+            for (size_t i = 0; i < nn; i++)
+                tmpS[i] = SiE[i] + SiX[i] + SiXE[i] + SiXE[(i % n) * n + i / n];
+            for (int d = 0; d < nd; d++) {
+                const double *Dd = D + (size_t)d * k * n;
+                dd(X2, Dd, tmpS, k, n, n, 0);          /* D temp */
+                ddt(M, X2, Dd, k, n, k, 1);            /* D temp D' */
+            }
+        }
+        sd(ASH, &sA, SiEHt, k, 0);                    /* A SiE H' */
+        transpose(Kt, ASH, n, k);                     /* (k x n) */
+        if (chol_solve(M, Kt, U, k, n)) {
+            status = 1;
+            goto done;
+        }
+        transpose(Kout, Kt, k, n);                    /* K = A SiE H' M^-1 */
+        /* akh = A - K H */
+        memcpy(akh, A, sizeof(double) * nn);
+        ds(akh, Kout, &sH, n, -1);
+        /* newE = akh SiE A' = (A SiE - K (H SiE)) A' */
+        sd(T1, &sA, SiE, n, 0);
+        sd(HS, &sH, SiE, n, 0);                       /* (k x n) */
+        dd(T1, Kout, HS, n, k, n, -1);
+        ds(newE, T1, &sAt, n, 0);
+        if (flags & HAS_C) {
+            dd(LS, Lt, SiX, m, n, n, 0);
+            ddt(LSL, LS, Lt, m, n, m, 0);             /* L SiX L' */
+            for (int c = 0; c < nc; c++) {
+                const double *BCc = BC + (size_t)c * n * m;
+                dd(BCL, BCc, LSL, n, m, m, 0);
+                ddt(newE, BCL, BCc, n, m, n, 1);      /* + BC_i (L SiX L') BC_i' */
+            }
+        }
+        if (flags & ADD_NOISE) {
+            add(newE, EE0, (int)nn);
+            add(newE, CC0, (int)nn);
+        }
+        /* abl = A - B L */
+        memcpy(abl, A, sizeof(double) * nn);
+        sd(abl, &sB, Lt, n, -1);
+        double *SiXnew = T2;
+        ddt(SiXnew, Kout, ASH, n, k, n, 0);           /* K (A SiE H')' */
+        /* abl SiX abl' = (A SiX - B (L SiX)) (A - B L)' */
+        if (!(flags & HAS_C)) dd(LS, Lt, SiX, m, n, n, 0);
+        sd(T1, &sA, SiX, n, 0);
+        sd(T1, &sB, LS, n, -1);                       /* Y = abl SiX */
+        ds(SiXnew, T1, &sAt, n, 1);                   /* + Y A' */
+        ddt(T3, T1, Lt, n, n, m, 0);                  /* Y L' (n x m) */
+        {
+            /* - (Y L') B' */
+            for (int i = 0; i < n; i++)
+                for (int j = 0; j < n; j++) {
+                    double s = 0.0;
+                    for (int p = sB.start[j]; p < sB.start[j + 1]; p++)
+                        s += T3[i * m + sB.col[p]] * sB.val[p];
+                    SiXnew[i * n + j] -= s;
+                }
+        }
+        if (flags & TRACK_XE) {
+            /* cross = abl SiXE H' K' */
+            dd(T1, abl, SiXE, n, n, n, 0);
+            ds(X2, T1, &sHt, n, 0);                   /* (n x k) */
+            ddt(cross, X2, Kout, n, k, n, 0);
+            for (int i = 0; i < n; i++)
+                for (int j = 0; j < n; j++)
+                    SiXnew[i * n + j] += EE0[i * n + j] + cross[i * n + j] + cross[j * n + i];
+            /* SiXE = abl SiXE akh' - EE0 */
+            ddt(T3, T1, akh, n, n, n, 0);
+            for (size_t i = 0; i < nn; i++) SiXE[i] = T3[i] - EE0[i];
+        }
+        memcpy(SiX, SiXnew, sizeof(double) * nn);
+        memcpy(SiE, newE, sizeof(double) * nn);
+    }
+    status = 0;
+done:
+    csr_free(&sA);
+    csr_free(&sAt);
+    csr_free(&sB);
+    csr_free(&sH);
+    csr_free(&sHt);
+    free(buf);
+    return status;
+}
+
+/* Control gains L (T x m x n) optimal for filter gains K (T x n x k), and the
+ * expected cost. C: nc matrices (m x m); D: nd matrices (k x n); Q (T+1 x n x n). */
+int lqg_backward(int T, int n, int m, int k, int nc, int nd, const double *A, const double *B,
+                 const double *H, const double *C, const double *D, const double *DD0,
+                 const double *CC0, const double *EE0, const double *Q, const double *R,
+                 const double *X1, const double *S1, const double *K, int flags, double *L,
+                 double *cost_out) {
+    const size_t nn = (size_t)n * n, nm = (size_t)n * m;
+    csr sA = {0}, sAt = {0}, sB = {0}, sBt = {0}, sH = {0}, sHt = {0};
+    const size_t blk = block_size(n, m, k);
+    double *buf = malloc(sizeof(double) * blk * 26);
+    int status = -1;
+    if (!buf) return -1;
+    double *At = buf, *Bt = At + blk, *Ht = Bt + blk, *Sx = Ht + blk, *Se = Sx + blk;
+    double *SxNew = Se + blk, *SeNew = SxNew + blk, *AtSx = SeNew + blk, *T1 = AtSx + blk;
+    double *T2 = T1 + blk, *ASBL = T2 + blk, *SxB = ASBL + blk, *AtSxB = SxB + blk;
+    double *Lt = AtSxB + blk, *SeB = Lt + blk, *SeK = SeB + blk, *KZ = SeK + blk;
+    double *BSxB = KZ + blk, *temp = BSxB + blk, *BSeB = temp + blk, *Ctmp = BSeB + blk;
+    double *U = Ctmp + blk, *KSeK = U + blk, *Kbuf = KSeK + blk;
+    double cost = 0.0;
+    char *Qzero = NULL;
+    transpose(At, A, n, n);
+    transpose(Bt, B, n, m);
+    transpose(Ht, H, k, n);
+    if (csr_make(&sA, A, n, n) || csr_make(&sAt, At, n, n) || csr_make(&sB, B, n, m)
+        || csr_make(&sBt, Bt, m, n) || csr_make(&sH, H, k, n) || csr_make(&sHt, Ht, n, k))
+        goto done;
+    Qzero = malloc((size_t)T + 1);
+    if (!Qzero) goto done;
+    for (int t = 0; t <= T; t++) {
+        const double *Qt = Q + (size_t)t * nn;
+        Qzero[t] = 1;
+        for (size_t i = 0; i < nn && Qzero[t]; i++) Qzero[t] = Qt[i] == 0.0;
+    }
+    memcpy(Sx, Q + (size_t)T * nn, sizeof(double) * nn);
+    memset(Se, 0, sizeof(double) * nn);
+    for (int t = T - 1; t >= 0; t--) {
+        const double *Kt = K + (size_t)t * n * k;
+        dtd(SeK, Kt, Se, k, n, n, 0);                  /* K' Se (k x n) */
+        if (flags & NOISE_COST) {
+            /* tr(Sx CC0) + tr(Se (K DD0 K' + EE0 + CC0)), tr(Se K DD0 K') = sum (DD0 K'Se) .* K' */
+            double s = 0.0;
+            if (flags & ADD_NOISE)
+                for (int i = 0; i < n; i++)
+                    for (int j = 0; j < n; j++)
+                        s += Sx[i * n + j] * CC0[j * n + i]
+                             + Se[i * n + j] * (EE0[j * n + i] + CC0[j * n + i]);
+            cost += s;
+            dd(Kbuf, DD0, SeK, k, k, n, 0);             /* DD0 K' Se (k x n) */
+            s = 0.0;
+            for (int a = 0; a < k; a++)
+                for (int i = 0; i < n; i++) s += Kbuf[a * n + i] * Kt[i * k + a];
+            cost += s;
+        }
+        ds(SxB, Sx, &sB, n, 0);                        /* Sx B */
+        sd(BSxB, &sBt, SxB, m, 0);                     /* B' Sx B */
+        for (int i = 0; i < m * m; i++) temp[i] = R[i] + BSxB[i];
+        if (flags & HAS_C) {
+            ds(SeB, Se, &sB, n, 0);
+            sd(BSeB, &sBt, SeB, m, 0);                 /* B' Se B */
+            for (int i = 0; i < m * m; i++) BSeB[i] += BSxB[i];
+            for (int c = 0; c < nc; c++) {
+                const double *Cc = C + (size_t)c * m * m;
+                dtd(Ctmp, Cc, BSeB, m, m, m, 0);       /* C' (B'(Sx+Se)B) */
+                dd(temp, Ctmp, Cc, m, m, m, 1);        /* ... C */
+            }
+        }
+        sd(AtSx, &sAt, Sx, n, 0);                      /* A' Sx */
+        ds(AtSxB, AtSx, &sB, n, 0);                    /* A' Sx B (n x m) */
+        transpose(Lt, AtSxB, n, m);                    /* (m x n) */
+        if (chol_solve(temp, Lt, U, m, n)) {
+            status = 1;
+            goto done;
+        }
+        memcpy(L + (size_t)t * nm, Lt, sizeof(double) * nm);
+        dd(ASBL, AtSxB, Lt, n, m, n, 0);               /* A' Sx B L */
+        /* Se' = ASBL + akh' Se akh, akh = A - K H:
+         * Z = Se akh = Se A - (Se K) H;  akh' Z = A' Z - H' (K' Z) */
+        ds(T1, Se, &sA, n, 0);
+        for (int a = 0; a < k; a++)                    /* Z = Se A - (Se K) H */
+            for (int p = sH.start[a]; p < sH.start[a + 1]; p++) {
+                const int j = sH.col[p];
+                const double v = sH.val[p];
+                const double *z = SeK + (size_t)a * n;
+                for (int i = 0; i < n; i++) T1[(size_t)i * n + j] -= v * z[i];
+            }
+        sd(SeNew, &sAt, T1, n, 0);
+        dtd(KZ, Kt, T1, k, n, n, 0);                   /* K' Z (k x n) */
+        sd(SeNew, &sHt, KZ, n, -1);
+        add(SeNew, ASBL, (int)nn);
+        /* Sx' = Q[t] + A' Sx A - ASBL */
+        ds(SxNew, AtSx, &sA, n, 0);
+        const double *Qt = Q + (size_t)t * nn;
+        if (Qzero[t])  /* most steps cost nothing: leave Q[t] unread */
+            for (size_t i = 0; i < nn; i++) SxNew[i] -= ASBL[i];
+        else
+            for (size_t i = 0; i < nn; i++) SxNew[i] += Qt[i] - ASBL[i];
+        if (flags & HAS_D) {
+            dtd(T2, Kt, Se, k, n, n, 0);               /* K' Se (k x n) */
+            dd(KSeK, T2, Kt, k, n, k, 0);              /* K' Se K */
+            for (int d = 0; d < nd; d++) {
+                const double *Dd = D + (size_t)d * k * n;
+                dtd(T2, Dd, KSeK, n, k, k, 0);         /* D' KSeK (n x k) */
+                dd(SxNew, T2, Dd, n, k, n, 1);
+            }
+        }
+        memcpy(Sx, SxNew, sizeof(double) * nn);
+        memcpy(Se, SeNew, sizeof(double) * nn);
+    }
+    {
+        double s = 0.0;
+        for (int i = 0; i < n; i++) {
+            double r = 0.0;
+            for (int j = 0; j < n; j++) r += Sx[i * n + j] * X1[j];
+            s += X1[i] * r;
+        }
+        double tr = 0.0;
+        for (int i = 0; i < n; i++)
+            for (int j = 0; j < n; j++) tr += (Se[i * n + j] + Sx[i * n + j]) * S1[j * n + i];
+        cost += s + tr;
+    }
+    *cost_out = cost;
+    status = 0;
+done:
+    free(Qzero);
+    csr_free(&sA);
+    csr_free(&sAt);
+    csr_free(&sB);
+    csr_free(&sBt);
+    csr_free(&sH);
+    csr_free(&sHt);
+    free(buf);
+    return status;
+}
+
+/* Exact second moments of the estimation error e = x - xhat under arbitrary
+ * gains K, L (the covariance minvar.lqg.estimation_error_covariance returns),
+ * propagated in (xhat, e) coordinates: E[e] = 0, and with Y = A - B L,
+ * Z = K H, akh = A - K H, W = K (sum_j D_j Mxx D_j' + D0 D0') K' + E0 E0':
+ *   Mhh' = Y Mhh Y' + Y Mhe Z' + Z Meh Y' + Z Mee Z' + W
+ *   Mhe' = (Y Mhe + Z Mee) akh' - W
+ *   Mee' = akh Mee akh' + sum_i B C_i L Mhh L' C_i' B' + W + C0 C0'
+ * with Mxx = Mhh + Mhe + Meh + Mee. P receives Mee for t = 0..T. */
+int lqg_error_cov(int T, int n, int m, int k, int nc, int nd, const double *A, const double *B,
+                  const double *H, const double *BC, const double *D, const double *DD0,
+                  const double *CC0, const double *EE0, const double *S1, const double *X1,
+                  const double *K, const double *L, double *P) {
+    const size_t nn = (size_t)n * n;
+    csr sA = {0}, sAt = {0}, sB = {0}, sH = {0}, sHt = {0};
+    const size_t blk = block_size(n, m, k);
+    double *buf = malloc(sizeof(double) * blk * 20);
+    int status = -1;
+    if (!buf) return -1;
+    double *At = buf, *Ht = At + blk, *Mhh = Ht + blk, *Mhe = Mhh + blk, *Mee = Mhe + blk;
+    double *U1 = Mee + blk, *U2 = U1 + blk, *V = U2 + blk, *VH = V + blk, *W = VH + blk;
+    double *Nhh = W + blk, *Nhe = Nhh + blk, *Nee = Nhe + blk, *LP = Nee + blk;
+    double *LPL = LP + blk, *BCL = LPL + blk, *HE = BCL + blk, *VL = HE + blk;
+    double *Mxx = VL + blk, *X2 = Mxx + blk;
+    transpose(At, A, n, n);
+    transpose(Ht, H, k, n);
+    if (csr_make(&sA, A, n, n) || csr_make(&sAt, At, n, n) || csr_make(&sB, B, n, m)
+        || csr_make(&sH, H, k, n) || csr_make(&sHt, Ht, n, k))
+        goto done;
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++) Mhh[i * n + j] = X1[i] * X1[j];
+    memset(Mhe, 0, sizeof(double) * nn);
+    memcpy(Mee, S1, sizeof(double) * nn);
+    memcpy(P, Mee, sizeof(double) * nn);
+    for (int t = 0; t < T; t++) {
+        const double *Kt = K + (size_t)t * n * k, *Lt = L + (size_t)t * m * n;
+        /* W = K (Dsum + DD0) K' + EE0 */
+        memcpy(X2, DD0, sizeof(double) * k * k);
+        if (nd) {
+            for (int i = 0; i < n; i++)
+                for (int j = 0; j < n; j++)
+                    Mxx[i * n + j] = Mhh[i * n + j] + Mhe[i * n + j] + Mhe[j * n + i]
+                                     + Mee[i * n + j];
+            for (int d = 0; d < nd; d++) {
+                const double *Dd = D + (size_t)d * k * n;
+                dd(V, Dd, Mxx, k, n, n, 0);
+                ddt(X2, V, Dd, k, n, k, 1);
+            }
+        }
+        dd(VH, Kt, X2, n, k, k, 0);
+        ddt(W, VH, Kt, n, k, n, 0);
+        add(W, EE0, (int)nn);
+        /* U1 = Y Mhe = A Mhe - B (L Mhe);  U2 = Z Mee = K (H Mee) */
+        sd(U1, &sA, Mhe, n, 0);
+        dd(LP, Lt, Mhe, m, n, n, 0);
+        sd(U1, &sB, LP, n, -1);
+        sd(HE, &sH, Mee, n, 0);
+        dd(U2, Kt, HE, n, k, n, 0);
+        /* V = Y Mhh = A Mhh - B (L Mhh) */
+        dd(LP, Lt, Mhh, m, n, n, 0);
+        sd(V, &sA, Mhh, n, 0);
+        sd(V, &sB, LP, n, -1);
+        /* Nhh = V Y' = V A' - (V L') B' */
+        ds(Nhh, V, &sAt, n, 0);
+        ddt(VL, V, Lt, n, n, m, 0);
+        for (int i = 0; i < n; i++)
+            for (int j = 0; j < n; j++) {
+                double s = 0.0;
+                for (int p = sB.start[j]; p < sB.start[j + 1]; p++)
+                    s += VL[i * m + sB.col[p]] * sB.val[p];
+                Nhh[i * n + j] -= s;
+            }
+        /* + U1 Z' + Z U1' + U2 Z', with V Z' = (V H') K' */
+        ds(VH, U1, &sHt, n, 0);
+        ddt(X2, VH, Kt, n, k, n, 0);                  /* U1 Z' */
+        for (int i = 0; i < n; i++)
+            for (int j = 0; j < n; j++) Nhh[i * n + j] += X2[i * n + j] + X2[j * n + i];
+        ds(VH, U2, &sHt, n, 0);
+        ddt(Nhh, VH, Kt, n, k, n, 1);
+        add(Nhh, W, (int)nn);
+        /* Nhe = (U1 + U2) akh' - W, V akh' = V A' - (V H') K' */
+        add(U1, U2, (int)nn);
+        ds(Nhe, U1, &sAt, n, 0);
+        ds(VH, U1, &sHt, n, 0);
+        ddt(Nhe, VH, Kt, n, k, n, -1);
+        for (size_t i = 0; i < nn; i++) Nhe[i] -= W[i];
+        /* Nee = (A Mee - U2) akh' + noise + W + CC0 */
+        sd(V, &sA, Mee, n, 0);
+        for (size_t i = 0; i < nn; i++) V[i] -= U2[i];
+        ds(Nee, V, &sAt, n, 0);
+        ds(VH, V, &sHt, n, 0);
+        ddt(Nee, VH, Kt, n, k, n, -1);
+        if (nc) {
+            dd(LP, Lt, Mhh, m, n, n, 0);
+            ddt(LPL, LP, Lt, m, n, m, 0);             /* L Mhh L' */
+            for (int c = 0; c < nc; c++) {
+                const double *BCc = BC + (size_t)c * n * m;
+                dd(BCL, BCc, LPL, n, m, m, 0);
+                ddt(Nee, BCL, BCc, n, m, n, 1);
+            }
+        }
+        for (size_t i = 0; i < nn; i++) Nee[i] += W[i] + CC0[i];
+        memcpy(Mhh, Nhh, sizeof(double) * nn);
+        memcpy(Mhe, Nhe, sizeof(double) * nn);
+        memcpy(Mee, Nee, sizeof(double) * nn);
+        memcpy(P + (size_t)(t + 1) * nn, Mee, sizeof(double) * nn);
+    }
+    status = 0;
+done:
+    csr_free(&sA);
+    csr_free(&sAt);
+    csr_free(&sB);
+    csr_free(&sH);
+    csr_free(&sHt);
+    free(buf);
+    return status;
+}
+
+/* An importable (empty) module, so that setuptools builds and installs the library. */
+static struct PyModuleDef kernel_module = {
+    PyModuleDef_HEAD_INIT, "_lqg_kernel",
+    "Compiled passes of minvar.lqg's solver (loaded with ctypes by minvar._kernel).", -1, NULL,
+};
+
+PyMODINIT_FUNC PyInit__lqg_kernel(void) { return PyModule_Create(&kernel_module); }

@@ -1,0 +1,72 @@
+"""Chapter 4's trends that the thesis-derived grasp geometry makes hold (issue 13).
+
+Judged on exact moments (no sampling error). The closed digit tips start
+below the line of the digit targets (thesis Fig. 4.4(a), line 814) and the
+wrist travels the thesis's 20 cm (line 953); with the tips on the target line
+instead, the first two trends fail, which is what these tests can catch.
+"""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from minvar import GraspTask, plan_grasp
+from minvar.grasp_stats import end_distance, grasp_moments
+
+
+def _moments(task):
+    return grasp_moments(plan_grasp(task))
+
+
+def _distance(task):
+    return end_distance(_moments(task), "finger", task.finger_target)
+
+
+def _mga_time(task):
+    m = _moments(task)
+    return m.relative_time[np.argmax(m.aperture_mean)]
+
+
+HEIGHTS = (-0.01, -0.005, 0.0, 0.005, 0.01)
+
+
+def test_geometry_is_the_thesis_text():
+    t = GraspTask()
+    assert t.transport_distance == pytest.approx(0.20)  # "distance to be moved", line 953
+    assert t.wrist_target == (0.0, -0.06)  # "6cm vertically below", line 724
+    assert 0 < t.tip_start < t.wrist_offset  # tips start below the target line (line 814)
+
+
+def test_digit_distance_is_lowest_with_the_viapoints_level():
+    # thesis line 788, Figs. 4.3(a,b): falls toward level, rises above
+    d = [_distance(replace(GraspTask(), viapoint_height=h)) for h in HEIGHTS]
+    assert np.argmin(d) == 2
+    assert d[0] > d[1] > d[2] < d[3] < d[4]
+
+
+def test_mga_comes_at_60_to_80_percent_for_every_object_size():
+    # thesis line 905, Fig. 4.10(b): sizes 0-8 cm
+    times = [_mga_time(replace(GraspTask(), object_size=s)) for s in np.arange(9) * 0.01]
+    assert min(times) >= 0.60 - 1e-9 and max(times) <= 0.80
+    assert np.all(np.diff(times) >= 0)  # and later for larger objects (line 903)
+
+
+def test_viapoint_timing_sd_is_u_shaped_with_its_minimum_within_50_to_80_percent():
+    # thesis line 834, Fig. 4.5(c,d): lowest near 70 %, rising below it
+    times = np.round(np.arange(0.5, 0.851, 0.05), 2)
+    sd = []
+    for f in times:
+        m = _moments(replace(GraspTask(), viapoint_time=f))
+        sd.append(np.sqrt(np.trace(m.finger_cov[-1])))
+    i = int(np.argmin(sd))
+    assert 0 < i < len(times) - 1  # interior: the SD rises on both sides
+    assert 0.5 <= times[i] <= 0.8
+
+
+def test_with_the_tips_on_the_target_line_the_trends_fail():
+    # the previous default (tip_start = wrist_offset): what the tests above guard against
+    online = GraspTask(tip_start=GraspTask().wrist_offset)
+    d = [_distance(replace(online, viapoint_height=h)) for h in (0.0, 0.005)]
+    assert d[1] < d[0]  # lowest above level, not at it
+    assert _mga_time(replace(online, object_size=0.0)) < 0.59

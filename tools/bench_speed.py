@@ -1,0 +1,142 @@
+"""Benchmark: start-up, planning and one clip end to end (issue 11), with same-run baselines.
+
+Run ``python tools/bench_speed.py`` or ``make bench`` (``tools/bench.py`` picks
+up this module's ``main`` as the ``speed`` section). Prints, asserts nothing.
+
+* start-up: ``hammer-mv --version`` / ``--help`` in fresh processes, against
+  importing every command module (what the CLI did before it was lazy);
+* planning: the default 10-model repertoire for a new scene, against the
+  same code with the numpy passes (``MINVAR_KERNEL=numpy``);
+* one clip: ``hammer-mv recognize clip.mp4`` (2 s 640x480 clip, new scene,
+  default repertoire), whole process: tracked and planned, its tracks reused,
+  and without figures.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from bench import table  # also puts the project root on sys.path
+
+ROOT = Path(__file__).resolve().parents[1]
+HAMMER = [sys.executable, "-m", "hammer_mv"]
+
+
+def _wall(cmd: list[str], repeat: int = 5, env: dict | None = None) -> float:
+    """Median wall time of a fresh process running ``cmd``, s."""
+    runs = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        subprocess.run(cmd, check=True, capture_output=True, cwd=ROOT, env=env)
+        runs.append(time.perf_counter() - t0)
+    return statistics.median(runs)
+
+
+def _verdict(value: float, target: float) -> str:
+    return "ok" if value <= target else "MISSED"
+
+
+def startup_rows() -> list[tuple[str, str, str, str]]:
+    from hammer_mv.cli import COMMANDS
+
+    version = _wall([*HAMMER, "--version"])
+    helptext = _wall([*HAMMER, "--help"])
+    bare = _wall([sys.executable, "-c", "pass"])
+    eager = _wall([sys.executable, "-c", "; ".join(f"import hammer_mv.cli.{c}"
+                                                   for c in COMMANDS)], repeat=3)
+    base = f"every command module imported {eager:.2f} s; bare python {bare:.2f} s"
+    return [
+        ("hammer-mv --version", f"{version:.2f} s", f"target <= 0.3 s; {base}",
+         _verdict(version, 0.3)),
+        ("hammer-mv --help", f"{helptext:.2f} s", "target <= 0.3 s", _verdict(helptext, 0.3)),
+    ]
+
+
+_PLAN = """
+import sys, time
+import minvar.grasp as G
+from perception.recognition.repertoire import Repertoire
+from perception.recognition.models import SceneSpec
+Repertoire.build(scene=SceneSpec(distance=0.2))  # imports and first calls, not timed
+runs = []
+for i in range(int(sys.argv[1])):  # median and fastest printed
+    G._SOLVED.clear()  # every chain planned anew
+    scene = SceneSpec(distance=0.26 + 0.01 * i, object_size=0.06 + 0.005 * i, tip_start=0.065)
+    t0 = time.perf_counter()
+    Repertoire.build(scene=scene)
+    runs.append(time.perf_counter() - t0)
+print(sorted(runs)[len(runs) // 2], min(runs))
+"""
+
+
+def _plan_time(kernel: str, repeat: int) -> float:
+    env = {**os.environ, "MINVAR_KERNEL": kernel, "OPENBLAS_NUM_THREADS": "1",
+           "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+    out = subprocess.run([sys.executable, "-c", _PLAN, str(repeat)], check=True,
+                         capture_output=True, text=True, cwd=ROOT, env=env)
+    median, best = (float(v) for v in out.stdout.split()[-2:])
+    return median, best
+
+
+def planning_rows() -> list[tuple[str, str, str, str]]:
+    fast, best = _plan_time("compiled", 9)
+    slow, _ = _plan_time("numpy", 3)
+    return [("default repertoire (10 models) for a new scene",
+             f"{fast * 1e3:.0f} ms (best {best * 1e3:.0f})",
+             f"target <= 150 ms; numpy passes {slow * 1e3:.0f} ms",
+             f"{_verdict(fast, 0.150)}; {slow / fast:.1f}x faster")]
+
+
+def clip_rows() -> list[tuple[str, str, str, str]]:
+    from perception.synthetic.demos import render_demo_clip
+    from perception.synthetic.scene import Scene
+
+    work = Path(tempfile.mkdtemp(prefix="hammer-bench-clip-"))
+    try:
+        # a 2 s clip of a scene the default repertoire was not planned for
+        scene = Scene.reach_to_grasp(60, 30.0, start=(0.0, -0.30), onset=0.3, duration=1.2,
+                                     object_diameter=0.08)
+        clip, _ = render_demo_clip(work, "clip.mp4", n=60, scene=scene, hand=True)
+        out = work / "out"
+
+        def recognize(*extra):
+            shutil.rmtree(out, ignore_errors=True)
+            return [*HAMMER, "recognize", str(clip.video), "-o", str(out), "--quiet",
+                    "--object-diameter", "0.08", *extra]
+
+        fresh = _wall(recognize(), repeat=3)
+        cmd = recognize()
+        subprocess.run(cmd, check=True, capture_output=True, cwd=ROOT)
+        cmd = [*HAMMER, "recognize", str(clip.video), "-o", str(out), "--quiet",
+               "--object-diameter", "0.08"]
+        reuse = _wall(cmd, repeat=3)
+        nofig = _wall([*cmd, "--no-figures"], repeat=3)
+        numpy_env = {**os.environ, "MINVAR_KERNEL": "numpy"}
+        slow = _wall([*cmd, "--no-figures"], repeat=3, env=numpy_env)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    return [
+        ("recognize a 2 s clip, new scene: track + plan + figures", f"{fresh:.2f} s",
+         "target <= 1.0 s", _verdict(fresh, 1.0)),
+        ("  same, its tracks file current (reused)", f"{reuse:.2f} s", "", _verdict(reuse, 1.0)),
+        ("  same, --no-figures", f"{nofig:.2f} s",
+         f"numpy passes {slow:.2f} s", _verdict(nofig, 1.0)),
+    ]
+
+
+def main() -> None:
+    """Print the start-up, planning and per-clip table."""
+    table("hammer-mv: start-up, planning, one clip (whole processes, median)",
+          startup_rows() + planning_rows() + clip_rows())
+
+
+if __name__ == "__main__":
+    main()
+    sys.exit(0)
