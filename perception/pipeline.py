@@ -151,14 +151,15 @@ def file_sha256(path: str | os.PathLike) -> str:
     """
     p = Path(path).resolve()
     st = p.stat()
-    return _sha256(p, st.st_size, st.st_mtime_ns)
+    return _sha256((p, st.st_size, st.st_mtime_ns))
 
 
 @functools.lru_cache(maxsize=256)
-def _sha256(path: Path, size: int, mtime_ns: int) -> str:
+def _sha256(key: tuple[Path, int, int]) -> str:
+    """SHA-256 of ``key[0]``; its size and time in the key make a changed file a new entry."""
     from perception.io.video import sha256_file
 
-    return sha256_file(path)
+    return sha256_file(key[0])
 
 
 def load_clip(source: str | os.PathLike | Tracks, *, tracks_out: str | os.PathLike | None = None,

@@ -159,7 +159,11 @@ def test_changed_settings_or_input_are_rerun(clips, repfile, tmp_path):
     assert pd.read_csv(out / "summary.csv")["reused"].all()
     assert _batch(src, out, repfile, "--rule", "thesis").returncode == 0
     assert not pd.read_csv(out / "summary.csv")["reused"].any()
-    (src / "normal-01.mp4").touch()
+    (src / "normal-01.mp4").touch()  # the same content: still current
+    assert _batch(src, out, repfile, "--rule", "thesis").returncode == 0
+    assert pd.read_csv(out / "summary.csv")["reused"].all()
+    # another video under the same name (the same size, even): made again
+    shutil.copy(clips / "delayed-01.mp4", src / "normal-01.mp4")
     assert _batch(src, out, repfile, "--rule", "thesis").returncode == 0
     assert not pd.read_csv(out / "summary.csv")["reused"].any()
 

@@ -7,6 +7,7 @@ import time
 
 import numpy as np
 import pytest
+from _demos import default_repertoire
 
 from hammer_mv.cli import COMMANDS, build_parser
 from perception.recognition.models import SceneSpec
@@ -133,12 +134,17 @@ def test_current_tracks_file_is_reused_and_a_stale_one_is_not(tmp_path, monkeypa
     assert current_tracks(clip.video, [roi]) is None  # other tracker settings
 
 
-def test_no_figures_writes_the_report_files_the_report_names():
-    from hammer_mv.cli.recognize import FIGURES, TABLES
-    from perception.report.clip import clip_outputs
+def test_a_report_without_figures_removes_stale_ones(tmp_path):
+    from perception.pipeline import recognize_clip
+    from perception.report.clip import clip_outputs, write_clip_report
+    from perception.synthetic.demos import demo_tracks
 
-    names = {p.name for p in clip_outputs(__import__("pathlib").Path("."), "c").values()}
-    assert names == {n.format(clip="c") for n in (*TABLES.values(), *FIGURES)}
+    rec = recognize_clip(demo_tracks("normal", 0)[0], default_repertoire(), clip="c")
+    paths = write_clip_report(rec, tmp_path)
+    assert all(p.exists() for p in paths.values())
+    assert write_clip_report(rec, tmp_path, figures=False) == clip_outputs(tmp_path, "c")
+    assert paths["json"].exists() and paths["csv"].exists()
+    assert not paths["confidence_png"].exists() and not paths["paths_png"].exists()
 
 
 @pytest.mark.slow

@@ -332,8 +332,9 @@ def _convergence(claims: list, seed: int) -> None:
     same, overflow = [], []
     with np.errstate(all="ignore"), _quiet("minvar.lqg"):
         for name, law in _initial_laws(ref.L, seed).items():
-            sol = solve(problem, initial_L=law, max_iter=MAX_ITER)
-            if not np.isfinite(sol.cost):
+            try:
+                sol = solve(problem, initial_L=law, max_iter=MAX_ITER)
+            except ValueError:  # the first pass's moments overflow: the solver says so
                 overflow.append(name)
                 continue
             gap = max(abs(sol.cost / ref.cost - 1), np.abs(sol.L - ref.L).max()

@@ -343,6 +343,8 @@ class Tracks:
 
     def to_status(self) -> pd.DataFrame:
         """Status codes as a wide table: ``frame`` then one column per marker (:class:`Status`)."""
+        import pandas as pd
+
         data: dict[str, Any] = {"frame": self.frame}
         data.update({name: self.status[:, j] for j, name in enumerate(self.markers)})
         return pd.DataFrame(data)
