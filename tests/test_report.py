@@ -144,3 +144,75 @@ def test_the_batch_page_and_its_figures(scored):
     page = (out / "report.html").read_text()
     assert "Verdicts per condition" in page and 'href="normal-0.recognition.json"' in page
     assert 'href="#clip-0"' in page and 'id="clip-0"' in page
+
+
+#: Names from the outside world (issue 12): each would break an attribute, a tag, a link or
+#: a URL if written raw. File names cannot hold "/", so none here does.
+HOSTILE = ('a" onerror="alert(1)" x=', "50% #1?", "<b>x", "<img src=x onerror=alert(2)>",
+           "grasp é 日本 &amp;")
+
+
+@pytest.mark.filterwarnings("error::UserWarning")
+def test_hostile_clip_names_are_escaped_in_the_page_and_their_links_resolve(tmp_path):
+    from html.parser import HTMLParser
+    from urllib.parse import unquote, urlsplit
+
+    rep = default_repertoire()
+    results = []
+    for i, name in enumerate(HOSTILE):
+        cond = ("normal", "delayed")[i % 2]
+        rec = recognize_clip(demo_tracks(cond, i)[0], rep, clip=name)
+        write_clip_report(rec, tmp_path, extra={"condition": cond})
+        results.append(ClipResult(name, cond, "ok", summary=ClipSummary.from_recognition(rec)))
+    results.append(ClipResult('<i>bad" x=', "normal", "failed", error='<script>"x"</script>'))
+    summary = summary_table(results)
+    write_batch_report(summary, {r.clip: r.summary for r in results if r.summary}, tmp_path,
+                       models=rep.models)
+
+    class Page(HTMLParser):
+        def __init__(self):
+            super().__init__()
+            self.tags, self.attrs, self.text, self.h3 = [], [], [], []
+            self._in_h3 = False
+
+        def handle_starttag(self, tag, attrs):
+            self.tags.append(tag)
+            self.attrs += [(tag, k, v) for k, v in attrs]
+            self._in_h3 = tag == "h3"
+
+        def handle_endtag(self, tag):
+            self._in_h3 = False if tag == "h3" else self._in_h3
+
+        def handle_data(self, data):
+            self.text.append(data)
+            if self._in_h3:
+                self.h3.append(data)
+
+    page = Page()
+    page.feed((tmp_path / "report.html").read_text(encoding="utf-8"))
+    # no tag or attribute came from a name: only those the writer makes
+    assert set(page.tags) <= {"html", "head", "meta", "title", "style", "body", "h1", "h2", "h3",
+                              "p", "span", "b", "i", "a", "img", "table", "thead", "tbody", "tr",
+                              "th", "td", "div", "figure", "figcaption", "details", "summary",
+                              "code"}, set(page.tags)
+    assert {k for _, k, _ in page.attrs} <= {"charset", "name", "content", "class", "id",
+                                             "href", "src", "alt", "loading"}
+    assert not any(t == "img" and k == "src" and v == "x" for t, k, v in page.attrs)
+    # each name shows as itself (the parser unescapes the text)
+    assert page.h3 == list(HOSTILE)
+    text = "".join(page.text)
+    assert '<i>bad" x=' in text and '<script>"x"</script>' in text
+    # every link and image names an existing file once unquoted; in-page anchors exist
+    ids = {v for _, k, v in page.attrs if k == "id"}
+    targets = [v for _, k, v in page.attrs if k in ("href", "src")]
+    assert len(targets) > 4 * len(HOSTILE)
+    for url in targets:
+        if url.startswith("#"):
+            assert url[1:] in ids, url
+            continue
+        parts = urlsplit(url)
+        assert not (parts.scheme or parts.netloc or parts.query or parts.fragment), url
+        assert (tmp_path / unquote(parts.path)).is_file(), url
+    for name in HOSTILE:
+        for suffix in (".recognition.json", ".confidence.csv", ".confidence.png", ".paths.png"):
+            assert name + suffix in {unquote(u) for u in targets}, (name, suffix)

@@ -8,6 +8,7 @@ installs it.
 
 from __future__ import annotations
 
+import html
 import os
 import re
 import shutil
@@ -25,6 +26,10 @@ pytestmark = pytest.mark.slow
 
 #: A clip name that would break out of an attribute, a link and a URL if not escaped.
 NASTY = 'a" onerror="alert(1)" x=#1%20'
+#: More names from the outside world: a query, a fragment and a percent sign in a URL, a tag
+#: with a script, non-ASCII.
+PERCENT = "50% #1? é"
+TAG = "<img src=x onerror=alert(2)>"
 WIDTH, HEIGHT = 1280, 900
 
 
@@ -50,12 +55,12 @@ def _run(browser: str, profile, *args: str) -> str:
 
 @pytest.fixture(scope="module")
 def report(tmp_path_factory):
-    """A batch report of five scored clips (one with a hostile name) and a failed one."""
+    """A batch report of five scored clips (three with hostile names) and a failed one."""
     out = tmp_path_factory.mktemp("report")
     rep = default_repertoire()
     results = []
-    for i, (name, cond) in enumerate(((NASTY, "normal"), ("normal-02", "normal"),
-                                      ("open-close-open-01", "open-close-open"),
+    for i, (name, cond) in enumerate(((NASTY, "normal"), (PERCENT, "normal"),
+                                      (TAG, "open-close-open"),
                                       ("open-close-open-02", "open-close-open"),
                                       ("reach-01", "reach"))):
         rec = recognize_clip(demo_tracks(cond, i)[0], rep, clip=name)
@@ -102,14 +107,14 @@ def test_the_page_loads_with_its_figures_and_the_main_table_fits(report, tmp_pat
     dom = _run(browser, tmp_path / "profile", "--dump-dom", probe.as_uri())
     found = re.search(r'<pre id="probe">(.*?)</pre>', dom, re.S)
     assert found, "the page did not finish loading"
-    m = json.loads(found.group(1).replace("&quot;", '"').replace("&amp;", "&"))
+    m = json.loads(html.unescape(found.group(1)))
     assert m["viewport"] == WIDTH
     assert 0 < m["table_right"] <= WIDTH, m  # the main table fits a 1280 px window
     assert m["page"] <= WIDTH, m  # and nothing else widens the page
     # every figure: 4 of the batch, 2 per clip
     assert m["images"] == 4 + 2 * 5 and m["loaded"] == m["images"], m
     assert m["injected"] == 0 and m["alerts"] == 0, m
-    assert NASTY in m["clip_ids"]
+    assert {NASTY, PERCENT, TAG} <= set(m["clip_ids"]), m["clip_ids"]
 
 
 def test_a_screenshot_shows_the_report(report, tmp_path):
@@ -128,8 +133,10 @@ def test_a_screenshot_shows_the_report(report, tmp_path):
 
 def test_links_and_names_are_escaped_and_quoted(report):
     page = (report / "report.html").read_text()
-    assert NASTY not in page  # never raw
-    assert 'onerror="alert' not in page
+    for name in (NASTY, TAG):
+        assert name not in page  # never raw
+    assert 'onerror="alert' not in page and "<img src=x" not in page
+    assert "50%25%20%231%3F%20%C3%A9.paths.png" in page  # quoted, UTF-8
     assert "a%22%20onerror%3D%22alert%281%29%22%20x%3D%231%2520.recognition.json" in page
     for name in ("summary.csv", "statistics.csv", "aperture_profiles.png", "confidence_single.png",
                  "confidence_all.png", "condition_profiles.png", "reach-01.recognition.json",
