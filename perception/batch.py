@@ -14,7 +14,6 @@ Clips run in local processes (``jobs``) or on a dask.distributed cluster
 from __future__ import annotations
 
 import contextlib
-import dataclasses
 import json
 import logging
 import multiprocessing
@@ -23,11 +22,12 @@ import re
 import sys
 import tempfile
 from collections import deque
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from perception.errors import InputError
@@ -44,6 +44,7 @@ from perception.recognition.planning import THREADS_VARIABLE
 from perception.recognition.repertoire import PlanCache, Repertoire
 from perception.report.batch import write_batch_report
 from perception.report.clip import ClipSummary, clip_outputs, write_clip_report
+from perception.report.conditions import reference_model
 from perception.report.tracking import tracking_columns, write_tracking_report
 
 __all__ = ["BatchItem", "ClipResult", "discover", "process_clip", "run_batch", "summary_table"]
@@ -59,7 +60,8 @@ COMPANION_SUFFIXES = (".truth.h5", ".recognition.json", ".confidence.csv", ".con
 _PREFERENCE = {"tracks": 3, "pose": 2, "video": 1, "unknown": 0}
 COMPANION_NAMES = ("manifest.csv", "README.md", "recipe.toml", "summary.csv", "statistics.csv",
                    "condition_profiles.csv", "condition_profiles.png", "report.html",
-                   "batch.json", "repertoire.h5")
+                   "batch.json", "repertoire.h5", "aperture_profiles.csv",
+                   "aperture_profiles.png", "confidence_single.png", "confidence_all.png")
 #: A clip name becomes file names in the report folder: no separators, no
 #: leading dot, nothing that is not printable.
 _CLIP_NAME = re.compile(r"[^/\\\x00-\x1f\x7f]+")
@@ -270,10 +272,10 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
         rec = recognize_tracks(tracks, repertoire, settings, clip=item.clip, source=item.path,
                                plan_cache=plan_cache)
         tracking = write_tracking_report(tracks, out, item.clip)
-        write_clip_report(rec, out, extra={"fingerprint": fp, "condition": item.condition,
-                                           "input": str(item.path), "tracking": tracking})
-        summary = dataclasses.replace(ClipSummary.from_recognition(rec), tracking=tracking)
-        return ClipResult(**base, status="ok", summary=summary)
+        extra = {"fingerprint": fp, "condition": item.condition, "input": str(item.path),
+                 "tracking": tracking}
+        write_clip_report(rec, out, extra=extra)
+        return ClipResult(**base, status="ok", summary=ClipSummary.from_recognition(rec, extra))
     except (InputError, ValueError, OSError) as exc:
         msg = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         if isinstance(exc, OSError) and not isinstance(exc, InputError):
@@ -473,27 +475,58 @@ def _run_dask(items: list[BatchItem], repertoire: Repertoire, job: _Job,
             yield fut.result()
 
 
-def summary_table(results: list[ClipResult]) -> pd.DataFrame:
+def _model_value(s: ClipSummary, name: str, values: np.ndarray) -> float:
+    """``values`` (one per model of ``s``) of the model ``name``; NaN if it has none."""
+    return float(values[s.names.index(name)]) if name in s.names else float("nan")
+
+
+#: Per-clip columns of ``summary.csv`` after ``clip, condition, winner, rule``:
+#: (column, value of a scored clip's :class:`ClipSummary`). Another step may
+#: append its own (the column is empty for failed clips).
+CLIP_COLUMNS: list[tuple[str, Callable[[ClipSummary], object]]] = [
+    ("verdict", lambda s: s.verdict),
+    ("familiarity", lambda s: s.familiarity),
+    ("margin", lambda s: s.margin),
+    ("winner_log_likelihood", lambda s: _model_value(s, s.winner, s.final_log_likelihood)),
+]
+
+
+def summary_table(results: list[ClipResult], reference: str | None = None) -> pd.DataFrame:
     """The batch summary, one row per clip (``summary.csv``).
 
-    Columns: ``clip, condition, winner, rule``, ``conf_<model>`` (final
-    thesis-rule confidence of each model of the first scored clip), ``status``
-    (``ok`` or ``failed``), ``reused`` (the report was already current),
-    ``error``.
+    Columns: ``clip, condition, winner, rule``, the :data:`CLIP_COLUMNS`
+    (``verdict, familiarity, margin, winner_log_likelihood``),
+    ``reference_model`` and ``reference_confidence`` (its final thesis-rule
+    confidence, m), ``conf_<model>`` (final thesis-rule confidence of each
+    model of the first scored clip, m), the tracking quality
+    (``track_<marker>``, ``minlik_<marker>``, ``reacquisitions``,
+    ``ambiguous_frames``), ``status`` (``ok`` or ``failed``), ``reused`` (the
+    report was already current), ``error``.
 
     Parameters
     ----------
     results : list of ClipResult
         The clips, in table order.
+    reference : str, optional
+        The reference grasp model (default:
+        :func:`~perception.report.conditions.reference_model` of the scored clips).
     """
-    names = next((r.summary.names for r in results if r.summary is not None), [])
+    scored = [r for r in results if r.summary is not None]
+    names = scored[0].summary.names if scored else []
+    if reference is None:
+        reference = reference_model([r.summary for r in scored], [r.condition for r in scored])
     table = []
     for r in results:
         entry = {"clip": r.clip, "condition": r.condition, "winner": r.winner, "rule": r.rule}
         s = r.summary
+        for column, value in CLIP_COLUMNS:
+            entry[column] = value(s) if s is not None else None
+        entry["reference_model"] = reference if s is not None else None
+        entry["reference_confidence"] = (_model_value(s, reference, s.confidence[:, -1])
+                                         if s is not None and reference else float("nan"))
         for n in names:
-            entry[f"conf_{n}"] = (float(s.confidence[s.names.index(n), -1])
-                                  if s is not None and n in s.names else float("nan"))
+            entry[f"conf_{n}"] = (_model_value(s, n, s.confidence[:, -1]) if s is not None
+                                  else float("nan"))
         entry.update(tracking_columns(s.tracking if s is not None else None))
         entry["status"] = "failed" if r.status == "failed" else "ok"
         entry["reused"] = r.status == "reused"
@@ -560,7 +593,8 @@ def run_batch(
             bar.update()
     done.sort(key=lambda r: r.clip)
     summary = summary_table(done)
-    write_batch_report(summary, {r.clip: r.summary for r in done if r.summary is not None}, out)
+    write_batch_report(summary, {r.clip: r.summary for r in done if r.summary is not None}, out,
+                       models=repertoire.models)
     write_json(out / "batch.json", {"clips": len(done),
                                     "ok": int((summary["status"] == "ok").sum()),
                                     "failed": int((summary["status"] != "ok").sum()),

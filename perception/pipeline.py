@@ -335,7 +335,10 @@ def recognize_tracks(tracks: Tracks, repertoire: Repertoire,
         raise InputError(f"cannot plan the models for this clip's scene (distance "
                          f"{obs.start_distance:.3f} m; check the scale: --px-per-m, "
                          f"--object-diameter): {exc}", source or obs.clip) from None
-    return recognize(obs, models, settings.hammer)
+    rec = recognize(obs, models, settings.hammer)
+    if rec.verdict is None:  # the default repertoire calibrates only the models it needs
+        rec = recognize(obs, repertoire.calibrated(models, rec.decision.best), settings.hammer)
+    return rec
 
 
 def recognize_clip(source: str | os.PathLike | Tracks, repertoire: Repertoire,

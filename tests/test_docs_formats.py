@@ -60,6 +60,12 @@ HOMES = {
     "SceneSpec": ("perception.recognition.repertoire", "perception.recognition.models",
                   "perception.recognition", "perception.io.repertoire", "perception.repertoire"),
     "clip_outputs": ("perception.report", "perception.report.clip"),
+    "CalibrationParams": ("perception.recognition.verdict", "perception.recognition"),
+    "IndependentParams": ("perception.synthetic.independent",),
+    "FIGURES": ("perception.report.batch",),
+    "summary_table": ("perception.batch",),
+    "condition_statistics": ("perception.report.conditions", "perception.report"),
+    "condition_profiles": ("perception.report.conditions", "perception.report"),
     "build_parser": ("hammer_mv.cli",),
 }
 
@@ -213,6 +219,9 @@ def test_repertoire_config_keys_are_documented():
     [
         ("ObserveParams", "recognition.md"),
         ("HammerParams", "recognition.md"),
+        ("CalibrationParams", "recognition.md"),
+        ("CalibrationParams", "repertoire-format.md"),
+        ("IndependentParams", "recognition.md"),
         ("StimulusParams", "recipes.md"),
         ("RenderStyle", "recipes.md"),
         ("Distractor", "recipes.md"),
@@ -251,8 +260,33 @@ def test_recognition_outputs_are_documented(clip, repertoire):
     batch = ["summary.csv", "statistics.csv", "condition_profiles.csv",
              "condition_profiles.png", "report.html", "batch.json", "conf_<model>", "reused",
              "status", "error", "rule", "clips", "ok", "failed", "settings", "repertoire",
-             "p_value", "mean_difference", "statistic", "phase", "mean", "sd"]
+             "p_value", "mean_difference", "statistic", "phase", "mean", "sd",
+             "aperture_profiles.csv"]
     assert missing(batch, where) == []
+    assert missing([name for name, _, _ in find("FIGURES")], where) == []
+
+
+def test_batch_tables_are_documented(clip, repertoire):
+    """Every column summary.csv, statistics.csv and condition_profiles.csv can have."""
+    import numpy as np
+
+    from perception.batch import ClipResult
+    from perception.report import ClipSummary
+
+    rep, _ = repertoire
+    rec = find("recognize")(find("observe")(find("Tracks").load(clip["tracks"]), clip="c"), rep)
+    summary = ClipSummary.from_recognition(rec)
+    results = [ClipResult(f"c{i}", cond, "ok", summary=summary)
+               for i, cond in enumerate(["normal", "normal", "delayed", "delayed"])]
+    table = find("summary_table")(results)
+    where = spans("recognition.md")
+    columns = [c for c in table.columns if not c.startswith("conf_")]
+    assert missing(columns, where) == []
+    table[f"conf_{rec.names[0]}"] = np.arange(len(table), dtype=float)
+    stats = find("condition_statistics")(table, rec.names[0])
+    assert missing(stats.columns, where) == []
+    profiles = find("condition_profiles")([summary], ["normal"], rec.names[0])
+    assert missing(profiles.columns, where) == []
 
 
 # -- command options -------------------------------------------------------------

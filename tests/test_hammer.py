@@ -8,6 +8,7 @@ from scipy import stats
 from perception.observation import observe
 from perception.pipeline import RecognitionSettings, recognize_clip
 from perception.recognition import HammerParams, SceneSpec, recognize
+from perception.synthetic.independent import draw_independent, independent_tracks
 
 
 def _score(tracks, rep, params=None):
@@ -156,3 +157,43 @@ def test_a_gap_in_any_marker_is_not_scored_and_leaves_no_outliers(rep, marker):
         typical = np.median(np.abs(step_ll[:, ~gap]))
         assert np.abs(step_ll).max() < 20 * typical + 50
         assert rec.kinds[rec.names.index(rec.winner)] == full.kinds[full.names.index(full.winner)]
+
+
+# -- the thesis rule on demonstrations the model did not make (issue 10, item 5) ----------
+@pytest.fixture(scope="module")
+def independent(rep):
+    out = {}
+    for cond in ("normal", "delayed", "open-close-open"):
+        rngs = [np.random.default_rng(np.random.SeedSequence(5, spawn_key=(len(cond), i)))
+                for i in range(8)]
+        out[cond] = [_score(independent_tracks(draw_independent(cond, g), i)[0], rep)
+                     for i, g in enumerate(rngs)]
+    return out
+
+
+def test_normal_beats_abnormal_on_independent_demonstrations(independent):
+    """The reference grasp model's final confidence: >= 95 % of pairs, median margin >= 10 %."""
+    normal = np.array([_conf(r)[-1] for r in independent["normal"]])
+    for cond in ("delayed", "open-close-open"):
+        other = np.array([_conf(r)[-1] for r in independent[cond]])
+        assert np.mean(normal[:, None] > other[None, :]) >= 0.95, cond
+        margin = (normal[:, None] - other[None, :]) / normal[:, None]
+        assert np.median(margin) >= 0.10, cond
+
+
+def test_independent_open_close_open_falls_after_its_closing_then_recovers(independent):
+    """The mean profile falls by >= 3 % of its value after the unexpected closing (Fig. 5.8)."""
+    phase = np.linspace(0, 1, 101)
+    curves, closings = [], []
+    for rec in independent["open-close-open"]:
+        curves.append(np.interp(phase, rec.time / rec.time[-1], _conf(rec)))
+        g, ph = rec.observation.g, rec.time / rec.time[-1]
+        first = np.nanargmax(np.where(ph < 0.55, g, -np.inf))
+        closings.append(ph[first + np.nanargmin(np.where(ph[first:] < ph[first] + 0.4,
+                                                          g[first:], np.inf))])
+    mean = np.mean(curves, axis=0)
+    low = int(round(100 * np.median(closings)))
+    top = int(np.argmax(mean[: low + 1]))
+    bottom = mean[top: low + 26].min()
+    assert bottom < mean[top] * 0.97  # falls by more than 3 %
+    assert mean[-1] > bottom  # and recovers

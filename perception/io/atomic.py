@@ -31,6 +31,7 @@ import re
 import socket
 import stat
 import tempfile
+import warnings
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 
@@ -314,9 +315,11 @@ def write_csv(path: str | os.PathLike, frame) -> Path:
 def save_figure(path: str | os.PathLike, fig, *, dpi: int = 120) -> Path:
     """Save a matplotlib figure ``fig`` to ``path`` atomically at ``dpi``.
 
-    The format follows the suffix of ``path``.
+    The format follows the suffix of ``path``. A character the font lacks (a
+    clip name in another script) is drawn as a box without a warning on stderr.
     """
     final = Path(path)
-    with atomic_path(final) as tmp:
+    with atomic_path(final) as tmp, warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message="Glyph .* missing from", category=UserWarning)
         fig.savefig(tmp, dpi=dpi, format=final.suffix.lstrip(".") or "png")
     return final

@@ -6,6 +6,8 @@ Layout (schema ``hammer-mv/repertoire``, version 1)::
     /models/<name>   attrs: order, kind, task (JSON), scene (JSON), substeps, dt
     /models/<name>/<arm|finger|thumb>
                      datasets A, B, H, K, L, P, x0; attrs: l1, l2, base, elbow
+    /models/<name>/calibration          (optional; files before it lack it)
+                     dataset misfit; attrs: frame_period, params (JSON)
 
 This module knows the layout and nothing of what the models mean: it writes
 and reads plain records (:class:`StoredModel`); :mod:`perception.recognition`
@@ -28,8 +30,8 @@ from perception.errors import InputError
 from perception.io.atomic import atomic_hdf5
 from perception.io.hdf5 import decode_attrs, open_hdf5, read_dataset, scalar_attr
 
-__all__ = ["SCHEMA", "SCHEMA_VERSION", "StoredChain", "StoredModel", "read_repertoire",
-           "write_repertoire"]
+__all__ = ["SCHEMA", "SCHEMA_VERSION", "StoredCalibration", "StoredChain", "StoredModel",
+           "read_repertoire", "write_repertoire"]
 
 SCHEMA = "hammer-mv/repertoire"
 SCHEMA_VERSION = 1
@@ -63,6 +65,25 @@ class StoredChain:
 
 
 @dataclass(frozen=True)
+class StoredCalibration:
+    """A model's familiarity calibration as stored.
+
+    Attributes
+    ----------
+    misfit : (K,) array
+        Misfits of the model's own demonstrations.
+    frame_period : float
+        Their frame period, s.
+    params : dict
+        How the demonstrations were made (JSON in the file).
+    """
+
+    misfit: np.ndarray
+    frame_period: float
+    params: dict
+
+
+@dataclass(frozen=True)
 class StoredModel:
     """One model as stored: its name, kind, task and scene, and its chains.
 
@@ -78,6 +99,8 @@ class StoredModel:
         Model time step, s.
     chains : mapping of str to StoredChain
         ``arm``, ``finger``, ``thumb``.
+    calibration : StoredCalibration or None
+        The familiarity calibration (None in files written before it existed).
     """
 
     name: str
@@ -87,6 +110,7 @@ class StoredModel:
     substeps: int
     dt: float
     chains: Mapping[str, StoredChain] = field(repr=False)
+    calibration: StoredCalibration | None = field(default=None, repr=False)
 
 
 def write_repertoire(path: str | os.PathLike, config: Mapping[str, Any],
@@ -121,6 +145,11 @@ def write_repertoire(path: str | os.PathLike, config: Mapping[str, Any],
                     cg.create_dataset(key, data=c.arrays[key],
                                       compression="gzip" if key in _COMPRESSED else None)
                 cg.attrs.update(l1=c.l1, l2=c.l2, base=c.base, elbow=c.elbow)
+            if m.calibration is not None:
+                cal = mg.create_group("calibration")
+                cal.create_dataset("misfit", data=np.asarray(m.calibration.misfit, dtype=float))
+                cal.attrs.update(frame_period=m.calibration.frame_period,
+                                 params=json.dumps(m.calibration.params))
     return path
 
 
@@ -134,6 +163,27 @@ def _read_chain(cg, path: Path) -> StoredChain:
     return StoredChain(arrays=arrays, l1=scalar_attr(attrs, "l1", "number", cg.name, path),
                        l2=scalar_attr(attrs, "l2", "number", cg.name, path), base=base,
                        elbow=scalar_attr(attrs, "elbow", "integer", cg.name, path))
+
+
+def _read_calibration(mg, path: Path) -> StoredCalibration | None:
+    """The model's calibration group, or None in a file written before it existed."""
+    import h5py
+
+    if "calibration" not in mg:
+        return None
+    cal = mg["calibration"]
+    if not isinstance(cal, h5py.Group):
+        raise InputError(f"{cal.name} is not a group", path)
+    misfit = np.asarray(read_dataset(cal, "misfit", "number", 1, path), dtype=float)
+    attrs = decode_attrs(cal.attrs, cal.name, path)
+    period = scalar_attr(attrs, "frame_period", "number", cal.name, path)
+    if period is None or not period > 0:
+        raise InputError(f"attribute {cal.name}.frame_period must be a positive time, "
+                         f"got {period!r}", path)
+    params = _json_attr(attrs, "params", cal.name, path)
+    if not isinstance(params, dict):
+        raise InputError(f"attribute {cal.name}.params must be a JSON object", path)
+    return StoredCalibration(misfit=misfit, frame_period=period, params=params)
 
 
 def _json_attr(attrs: dict, key: str, where: str, path: Path):
@@ -161,7 +211,8 @@ def _read_model(name: str, mg, path: Path) -> StoredModel:
                        task=_json_attr(a, "task", mg.name, path),
                        scene=_json_attr(a, "scene", mg.name, path),
                        substeps=scalar_attr(a, "substeps", "integer", mg.name, path), dt=dt,
-                       chains={role: _read_chain(mg[role], path) for role in ROLES})
+                       chains={role: _read_chain(mg[role], path) for role in ROLES},
+                       calibration=_read_calibration(mg, path))
 
 
 def _read_file(f, path: Path) -> tuple[dict, list[StoredModel]]:

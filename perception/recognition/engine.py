@@ -15,7 +15,9 @@ and the digits at n (the outcome); otherwise neither rule updates and the
 filters coast.
 
 The engine predicts and scores only: the models come planned for the clip's
-scene (:meth:`perception.recognition.repertoire.Repertoire.for_scene`).
+scene (:meth:`perception.recognition.repertoire.Repertoire.for_scene`) and
+calibrated (:mod:`perception.recognition.verdict`); each model's familiarity
+is read off its calibration.
 """
 
 from __future__ import annotations
@@ -28,9 +30,11 @@ import numpy as np
 
 from minvar.kinematics import TwoLinkChain
 from perception.observation import Observation
+from perception.recognition.leaves import Leaves, forward_kinematics
 from perception.recognition.models import ChainModel, MotorModel
 from perception.recognition.result import Recognition
 from perception.recognition.scoring import RULES, likelihood_rule, thesis_rule
+from perception.recognition.verdict import DEFAULT_THRESHOLD, misfit
 
 __all__ = ["HammerParams", "RULES", "recognize"]
 
@@ -47,6 +51,10 @@ class HammerParams:
         Weights of the transport and grip terms of the thesis rule (w_r/w_g = 1/2).
     obs_sd : float
         SD of the tracked positions after filtering, m (likelihood rule).
+    familiarity_threshold : float
+        Lowest familiarity (0..1) of the best model for the verdict ``normal``
+        (or ``reach``); below it the verdict is ``abnormal``
+        (:mod:`perception.recognition.verdict`).
     filter_gain : float
         How strongly observed positions correct each model's own estimate of
         velocity and force: 1 applies the plan's Kalman gains as designed, 0
@@ -65,6 +73,7 @@ class HammerParams:
     w_g: float = 2.0
     obs_sd: float = 0.001
     filter_gain: float = 0.3
+    familiarity_threshold: float = DEFAULT_THRESHOLD
 
     def __post_init__(self):
         if self.rule not in RULES:
@@ -77,6 +86,9 @@ class HammerParams:
             raise ValueError(f"filter_gain: expected a value in [0, 1], got {self.filter_gain}")
         if not (np.isfinite(self.obs_sd) and self.obs_sd > 0):
             raise ValueError(f"obs_sd: expected a positive SD in m, got {self.obs_sd}")
+        if not 0 <= self.familiarity_threshold <= 1:
+            raise ValueError("familiarity_threshold: expected a value in [0, 1], got "
+                             f"{self.familiarity_threshold}")
 
 
 def _clamp_reach(p: np.ndarray, l1: float, l2: float) -> np.ndarray:
@@ -96,61 +108,11 @@ def _ik(p: np.ndarray, c: ChainModel) -> np.ndarray:
     return q
 
 
-def _fk(q: np.ndarray, l1: np.ndarray, l2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Tip positions (N, L, 2) and Jacobians (N, L, 2, 2) of leaves with link lengths (L,)."""
-    tip = np.empty(q.shape)
-    J = np.empty(q.shape + (2,))
-    geometry = np.stack([l1, l2], axis=1)
-    for g in np.unique(geometry, axis=0):  # one chain per distinct geometry (a few at most)
-        cols = np.flatnonzero((geometry == g).all(axis=1))
-        chain = TwoLinkChain(*g)
-        tip[:, cols] = chain.forward(q[:, cols])
-        J[:, cols] = chain.jacobian(q[:, cols])
-    return tip, J
-
-
 def _unwrap_to(q: np.ndarray, ref: np.ndarray) -> np.ndarray:
     """Shift the first angle of each row by 2 pi k to lie nearest ``ref``."""
     q = q.copy()
     q[..., 0] += 2 * np.pi * np.round((ref[..., 0] - q[..., 0]) / (2 * np.pi))
     return q
-
-
-class _Leaves:
-    """All chains of all models stacked (padded to one state size) for batched filtering."""
-
-    def __init__(self, models: Sequence[MotorModel], steps: int):
-        chains = [c for m in models for c in m.chains]
-        self.count = len(chains)
-        n = max(c.A.shape[0] for c in chains)
-        m_u = chains[0].B.shape[1]
-        L_ = len(chains)
-        self.A = np.zeros((L_, n, n))
-        self.B = np.zeros((L_, n, m_u))
-        self.Kp = np.zeros((steps, L_, n, 2))
-        self.Lg = np.zeros((steps, L_, m_u, n))
-        self.P = np.zeros((steps, L_, 2, 2))
-        self.x0 = np.zeros((L_, n))
-        for i, c in enumerate(chains):
-            k = c.A.shape[0]
-            self.A[i] = np.eye(n)  # padded constant states stay put
-            self.A[i, :k, :k] = c.A
-            self.B[i, :k] = c.B
-            # beyond the plan's horizon the model keeps its last gains: it holds the goal
-            t = np.minimum(np.arange(steps), c.horizon - 1)
-            self.Kp[:, i, :k] = c.K[t][:, :, :2]
-            self.Lg[:, i, :, :k] = c.L[t]
-            self.P[:, i] = c.P[np.minimum(np.arange(steps), c.horizon)]
-            self.x0[i, :k] = c.x0
-        self.l1 = np.array([c.l1 for c in chains])
-        self.l2 = np.array([c.l2 for c in chains])
-        self.base = np.array([c.base for c in chains])
-        self.chains = chains
-
-    def step(self, state: np.ndarray, s: int) -> np.ndarray:
-        """Every leaf one model step on: the command ``-L x`` through ``(A, B)``."""
-        u = -np.einsum("lmn,ln->lm", self.Lg[s], state)
-        return np.einsum("lij,lj->li", self.A, state) + np.einsum("lim,lm->li", self.B, u)
 
 
 def _model_steps(time: np.ndarray, dt: float) -> np.ndarray:
@@ -185,7 +147,7 @@ def _observed_angles(obs: Observation, chains: list[ChainModel]) -> np.ndarray:
     return q
 
 
-def _predict(leaves: _Leaves, q_obs: np.ndarray, s_of: np.ndarray,
+def _predict(leaves: Leaves, q_obs: np.ndarray, s_of: np.ndarray,
              gain: float) -> tuple[np.ndarray, np.ndarray]:
     """One-step predictions of every leaf's joint angles and their covariance.
 
@@ -204,20 +166,21 @@ def _predict(leaves: _Leaves, q_obs: np.ndarray, s_of: np.ndarray,
         y = q_obs[n - 1]
         ok = np.isfinite(y).all(axis=1)
         y = np.where(ok[:, None], _unwrap_to(np.nan_to_num(y), x[:, :2]), x[:, :2])
-        # The prediction starts from the observed joint angles; the filter's
-        # estimate supplies only what is not observed (velocity, force).
+        # Two states per leaf step together: the prediction, which starts from
+        # the observed joint angles (the filter's estimate supplies only what
+        # is not observed: velocity, force), and the filter itself, which runs
+        # on; the frame's observation enters it at its first model step, the
+        # other steps are pure prediction.
         innov = y - x[:, :2]
-        z = x.copy()
-        z[:, :2] = y
-        for s in range(s0, s1):
-            z = leaves.step(z, s)
-        q_pred[n] = z[:, :2]
-        P_pred[n] = leaves.P[s1]
-        # The filter itself runs on: the frame's observation enters at its
-        # first model step, the other steps are pure prediction.
-        x = leaves.step(x, s0) + gain * np.einsum("lip,lp->li", leaves.Kp[s0], innov)
+        both = np.stack([x, x], axis=1)
+        both[:, 0, :2] = y
+        both = leaves.step(both, s0)
+        both[:, 1] += gain * np.einsum("lip,lp->li", leaves.Kp[s0], innov)
         for s in range(s0 + 1, s1):
-            x = leaves.step(x, s)
+            both = leaves.step(both, s)
+        q_pred[n] = both[:, 0, :2]
+        P_pred[n] = leaves.P[s1]
+        x = both[:, 1]
     return q_pred, P_pred
 
 
@@ -230,11 +193,11 @@ class _Predicted(NamedTuple):
     cov: np.ndarray
 
 
-def _to_cartesian(leaves: _Leaves, q_pred: np.ndarray, P_pred: np.ndarray,
+def _to_cartesian(leaves: Leaves, q_pred: np.ndarray, P_pred: np.ndarray,
                   n_models: int) -> _Predicted:
     """Forward kinematics of the predicted angles, and their covariance through the Jacobians."""
     N = q_pred.shape[0]
-    tip, J = _fk(q_pred, leaves.l1, leaves.l2)  # (N, L, 2), (N, L, 2, 2)
+    tip, J = forward_kinematics(q_pred, leaves.l1, leaves.l2)  # (N, L, 2), (N, L, 2, 2)
     tip = (tip + leaves.base).reshape(N, n_models, 3, 2)
     J = J.reshape(N, n_models, 3, 2, 2)
     cov = J @ P_pred.reshape(N, n_models, 3, 2, 2) @ np.swapaxes(J, -1, -2)
@@ -273,7 +236,7 @@ def recognize(
     if len(dts) != 1:
         raise ValueError(f"models disagree on their time step: {sorted(dts)} s")
     s_of = _model_steps(obs.time, models[0].dt)
-    leaves = _Leaves(models, int(s_of[-1]) + 1)
+    leaves = Leaves(models, int(s_of[-1]) + 1)
     q_pred, P_pred = _predict(leaves, _observed_angles(obs, leaves.chains), s_of,
                               params.filter_gain)
     pred = _to_cartesian(leaves, q_pred, P_pred, len(models))
@@ -290,7 +253,11 @@ def recognize(
     valid = (observed & prev_ok)[None] & np.isfinite(r_pred) & np.isfinite(g_pred)
     grasp = np.array([m.kind == "grasp" for m in models])
     dC_r, dC_g = thesis_rule(r_obs, g_obs, r_pred, g_pred, grasp, valid, params.w_r, params.w_g)
-    dll = likelihood_rule(r_obs, g_obs, midpoint, opening, pred.cov, valid, params.obs_sd)
+    dll, maha = likelihood_rule(r_obs, g_obs, midpoint, opening, pred.cov, valid, params.obs_sd)
+    mis = misfit(maha, valid)
+    familiarity = np.array([np.nan if m.calibration is None
+                            else m.calibration.familiarity(float(x), obs.dt)
+                            for m, x in zip(models, mis)])
     return Recognition(
         clip=obs.clip,
         time=obs.time,
@@ -301,7 +268,12 @@ def recognize(
         dC_r=dC_r,
         dC_g=dC_g,
         log_likelihood=np.cumsum(dll, axis=1),
+        mahalanobis=maha,
+        scored=valid,
+        familiarity=familiarity,
         predicted={"wrist": pred.wrist, "finger": pred.finger, "thumb": pred.thumb},
         observation=obs,
+        models=models,
         rule=params.rule,
+        familiarity_threshold=params.familiarity_threshold,
     )

@@ -24,6 +24,7 @@ from perception.geometry import DEFAULT_OBJECT_DIAMETER, DEFAULT_TIP_START
 
 if TYPE_CHECKING:
     from perception.observation import Observation
+    from perception.recognition.verdict import Calibration
 
 __all__ = [
     "ChainModel",
@@ -269,6 +270,11 @@ class MotorModel:
         Model time step, s.
     arm, finger, thumb : ChainModel
         The leaves: transport (arm) and grip (finger, thumb).
+    calibration : Calibration, optional
+        How well the model's own demonstrations fit it
+        (:mod:`perception.recognition.verdict`); a
+        :class:`~perception.recognition.repertoire.Repertoire` gives every
+        model one. None: no familiarity and no verdict.
     """
 
     spec: ModelSpec
@@ -278,6 +284,7 @@ class MotorModel:
     arm: ChainModel = field(repr=False)
     finger: ChainModel = field(repr=False)
     thumb: ChainModel = field(repr=False)
+    calibration: Calibration | None = field(default=None, repr=False)
 
     @property
     def name(self) -> str:

@@ -23,9 +23,17 @@ from pathlib import Path
 
 from perception.errors import InputError
 from perception.io.atomic import owner_gone, owner_tag
-from perception.io.repertoire import StoredChain, StoredModel, read_repertoire, write_repertoire
+from perception.io.repertoire import (
+    StoredCalibration,
+    StoredChain,
+    StoredModel,
+    read_repertoire,
+    write_repertoire,
+)
+from perception.recognition.calibration import calibrate
 from perception.recognition.models import CHAIN_ARRAYS, ChainModel, ModelSpec, MotorModel, SceneSpec
 from perception.recognition.planning import DEFAULT_DURATIONS, build_models, default_specs
+from perception.recognition.verdict import Calibration, CalibrationParams
 
 __all__ = ["PlanCache", "Repertoire"]
 
@@ -41,6 +49,11 @@ class Repertoire:
         The models, in report order; names must be unique.
     config : dict, optional
         The configuration the repertoire was built from (stored in the file).
+
+    :meth:`build` calibrates every model's familiarity
+    (:mod:`perception.recognition.calibration`) and :meth:`save` stores it; a
+    model without one (loaded from an older file, or of the :meth:`default`
+    repertoire) is calibrated when a verdict first needs it (:meth:`calibrated`).
     """
 
     def __init__(self, models: Iterable[MotorModel], config: dict | None = None):
@@ -52,6 +65,7 @@ class Repertoire:
             raise ValueError("repertoire: needs at least one model")
         self.config = config or {}
         self._replanned: dict[tuple, MotorModel] = {}
+        self._calibrations: dict[tuple, Calibration] = {}
 
     @classmethod
     def default(cls) -> Repertoire:
@@ -78,7 +92,7 @@ class Repertoire:
     @classmethod
     def build(cls, specs: Iterable[ModelSpec] | None = None,
               scene: SceneSpec | None = None) -> Repertoire:
-        """Plan every model for a scene.
+        """Plan every model for a scene and calibrate its familiarity.
 
         Parameters
         ----------
@@ -91,7 +105,7 @@ class Repertoire:
         scene = SceneSpec() if scene is None else scene
         config = {"scene": dataclasses.asdict(scene),
                   "models": [dataclasses.asdict(s) for s in specs]}
-        return cls(build_models(specs, scene), config)
+        return cls(_calibrated(build_models(specs, scene)), config)
 
     @classmethod
     def from_config(cls, path: str | Path) -> Repertoire:
@@ -149,13 +163,47 @@ class Repertoire:
                 log.info("re-planning %d models for distance %.3f m, object %.3f m, hand "
                          "%.3f m, %.1f frames/s", len(todo), grid.distance, grid.object_size,
                          grid.tip_start, 1 / grid.frame_period)
-                return build_models([m.spec for m in todo], grid)
+                # a re-planned model keeps its source's calibration (it transfers
+                # across scenes: docs/recognition.md)
+                return _calibrated(build_models([m.spec for m in todo], grid),
+                                   [getattr(m, "calibration", None) for m in todo],
+                                   compute=False)
 
             planned = plan() if cache is None else cache.get(grid, [m.spec for m in todo], plan)
             for m, new in zip(todo, planned):
                 self._replanned[(m.name, grid)] = new
-        return [m if m.scene.matches(scene) else self._replanned[(m.name, grid)]
+        return [self._known(m if m.scene.matches(scene) else self._replanned[(m.name, grid)])
                 for m in models]
+
+    def _known(self, m: MotorModel) -> MotorModel:
+        """``m`` with the calibration :meth:`calibrated` made for it, if any."""
+        cal = None if m.calibration is not None else self._calibrations.get((m.name, m.scene))
+        return m if cal is None else dataclasses.replace(m, calibration=cal)
+
+    def calibrated(self, models: list[MotorModel], index: int) -> list[MotorModel]:
+        """``models`` with model ``index`` calibrated: once per model and scene, then kept.
+
+        A repertoire built or loaded carries every model's calibration, and
+        models re-planned from it keep theirs; the default repertoire planned
+        for a clip's scene (:meth:`default`) calibrates only the models the
+        verdict asks for, here.
+
+        Parameters
+        ----------
+        models : list of MotorModel
+            Models from :meth:`for_scene`.
+        index : int
+            The one to calibrate.
+        """
+        m = models[index]
+        if m.calibration is not None:
+            return models
+        key = (m.name, m.scene)
+        if key not in self._calibrations:
+            log.info("calibrating %s on its own demonstrations", m.name)
+            self._calibrations[key] = calibrate([m])[0]
+        done = dataclasses.replace(m, calibration=self._calibrations[key])
+        return [*models[:index], done, *models[index + 1:]]
 
     # -- persistence -------------------------------------------------------
     def save(self, path: str | Path) -> Path:
@@ -176,6 +224,10 @@ class Repertoire:
         ----------
         path : str or Path
             The HDF5 file.
+
+        A file written before familiarity calibrations were stored loads as
+        it is; its models are calibrated when a verdict first needs them
+        (:meth:`calibrated`; the file is not changed).
 
         Raises
         ------
@@ -199,11 +251,12 @@ class _DefaultRepertoire(Repertoire):
         self.config = {"scene": dataclasses.asdict(self._scene),
                        "models": [dataclasses.asdict(s) for s in self._specs]}
         self._replanned = {}
+        self._calibrations = {}
 
     @property
     def models(self) -> list[MotorModel]:  # type: ignore[override]
         if self._models is None:
-            self._models = build_models(self._specs, self._scene)
+            self._models = build_models(self._specs, self._scene)  # calibrated when asked
         return self._models
 
     @property
@@ -335,12 +388,33 @@ class PlanCache:
         return models
 
 
+def _calibrated(models: list[MotorModel], sources: list[Calibration | None] | None = None,
+                *, compute: bool = True) -> list[MotorModel]:
+    """``models`` with a calibration each: their own, the one in ``sources``, else (with
+    ``compute``) a new one."""
+    sources = sources or [None] * len(models)
+    given = [m.calibration or src for m, src in zip(models, sources)]
+    bare = [m for m, cal in zip(models, given) if cal is None]
+    if bare and not compute:
+        return [m if cal is None else dataclasses.replace(m, calibration=cal)
+                for m, cal in zip(models, given)]
+    if bare:
+        log.info("calibrating %d model(s) on their own demonstrations", len(bare))
+        new = iter(calibrate(bare))
+        given = [cal if cal is not None else next(new) for cal in given]
+    return [m if m.calibration is cal else dataclasses.replace(m, calibration=cal)
+            for m, cal in zip(models, given)]
+
+
 def _stored(m: MotorModel) -> StoredModel:
     chains = {c.role: StoredChain(arrays={k: getattr(c, k) for k in CHAIN_ARRAYS}, l1=c.l1,
                                   l2=c.l2, base=c.base, elbow=c.elbow) for c in m.chains}
+    cal = m.calibration
+    stored_cal = None if cal is None else StoredCalibration(
+        misfit=cal.misfit, frame_period=cal.frame_period, params=dataclasses.asdict(cal.params))
     return StoredModel(name=m.name, kind=m.kind, task=m.spec.task,
                        scene=dataclasses.asdict(m.scene), substeps=m.substeps, dt=m.dt,
-                       chains=chains)
+                       chains=chains, calibration=stored_cal)
 
 
 def _model(s: StoredModel) -> MotorModel:
@@ -350,5 +424,8 @@ def _model(s: StoredModel) -> MotorModel:
         spec = ModelSpec(s.name, s.kind, s.task)
     except ValueError as exc:
         raise ValueError(f"model '{s.name}': {exc}") from None
+    cal = s.calibration
+    calibration = None if cal is None else Calibration(
+        cal.misfit, cal.frame_period, CalibrationParams(**cal.params))
     return MotorModel(spec=spec, scene=SceneSpec(**s.scene), substeps=s.substeps, dt=s.dt,
-                      **chains)
+                      calibration=calibration, **chains)

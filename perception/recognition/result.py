@@ -8,8 +8,11 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pandas as pd
 
+from perception.recognition.verdict import DEFAULT_THRESHOLD, Verdict, decide, misfit
+
 if TYPE_CHECKING:
     from perception.observation import Observation
+    from perception.recognition.models import MotorModel
 
 __all__ = ["Recognition"]
 
@@ -34,12 +37,23 @@ class Recognition:
         Per-step transport and grip terms of the thesis rule.
     log_likelihood : (M, N) array
         Cumulative log-likelihood of the observed (r, g).
+    mahalanobis : (M, N) array
+        Squared Mahalanobis distance of each step's observed (r, g) from the
+        prediction (0 where not scored).
+    scored : (M, N) bool array
+        Steps that count (both rules score 0 elsewhere).
+    familiarity : (M,) array
+        Each model's familiarity, 0..1 (NaN for a model without calibration).
     predicted : dict of (M, N, 2) arrays
         Predicted ``wrist``, ``finger``, ``thumb`` positions, m (NaN at n = 0).
     observation : Observation
         What was scored.
+    models : list of MotorModel
+        The models scored (for their nominal movements).
     rule : str
         The rule that picks the winner.
+    familiarity_threshold : float
+        Lowest familiarity of the best model called familiar (the verdict).
     """
 
     clip: str
@@ -51,9 +65,14 @@ class Recognition:
     dC_r: np.ndarray = field(repr=False)
     dC_g: np.ndarray = field(repr=False)
     log_likelihood: np.ndarray = field(repr=False)
+    mahalanobis: np.ndarray = field(repr=False)
+    scored: np.ndarray = field(repr=False)
+    familiarity: np.ndarray = field(repr=False)
     predicted: dict = field(repr=False)
     observation: Observation = field(repr=False)
+    models: list[MotorModel] = field(repr=False)
     rule: str = "likelihood"
+    familiarity_threshold: float = DEFAULT_THRESHOLD
 
     def score(self, rule: str | None = None) -> np.ndarray:
         """(M, N) cumulative score under ``rule`` (default: the winner's rule)."""
@@ -73,6 +92,58 @@ class Recognition:
     def final_confidence(self) -> dict[str, float]:
         """Thesis-rule confidence of each model at the end."""
         return {n: float(c) for n, c in zip(self.names, self.confidence[:, -1])}
+
+    @property
+    def misfit(self) -> np.ndarray:
+        """(M,) mean squared Mahalanobis distance per scored step of each model."""
+        return misfit(self.mahalanobis, self.scored)
+
+    @property
+    def decision(self) -> Verdict:
+        """The verdict, from the best model by log-likelihood and its familiarity."""
+        return decide(self.kinds, self.log_likelihood[:, -1], self.familiarity,
+                      self.familiarity_threshold)
+
+    @property
+    def verdict(self) -> str | None:
+        """``normal``, ``abnormal`` or ``reach`` (None without calibrated models)."""
+        return self.decision.verdict
+
+    @property
+    def reference_model(self) -> str | None:
+        """The grasp model with the highest log-likelihood (None if there is none)."""
+        grasp = [i for i, k in enumerate(self.kinds) if k == "grasp"]
+        if not grasp:
+            return None
+        return self.names[grasp[int(np.argmax(self.log_likelihood[grasp, -1]))]]
+
+    def nominal(self, model: str) -> dict[str, np.ndarray]:
+        """The model's own noise-free movement at this clip's sample times.
+
+        What the model would do from its planned start (thesis Figs. 5.5-5.7
+        draw it against the demonstration), aligned on the clip's movement onset.
+
+        Parameters
+        ----------
+        model : str
+            Model name.
+
+        Returns
+        -------
+        dict of (N, 2) arrays
+            ``wrist``, ``finger``, ``thumb`` positions, m.
+        """
+        from perception.recognition.rollout import rollout
+
+        m = self.models[self.names.index(model)]
+        steps = int(np.ceil(max(self.time[-1], 0.0) / m.dt)) + 1
+        run = rollout([m], steps)
+        out = {}
+        for key in ("wrist", "finger", "thumb"):
+            xy = getattr(run, key)[0, 0]
+            out[key] = np.stack([np.interp(self.time, run.time, xy[:, 0]),
+                                 np.interp(self.time, run.time, xy[:, 1])], axis=1)
+        return out
 
     @property
     def predicted_r(self) -> np.ndarray:
@@ -103,18 +174,36 @@ class Recognition:
         })
 
     def to_dict(self) -> dict:
-        """The recognition report (``<clip>.recognition.json``)."""
+        """The recognition report (``<clip>.recognition.json``); NaN becomes None."""
+        d = self.decision
+        transport = np.cumsum(self.dC_r, axis=1)
         return {
             "clip": self.clip,
             "models": [
                 {"name": n, "kind": k, "final_confidence": float(c),
-                 "final_log_likelihood": float(ll)}
-                for n, k, c, ll in zip(self.names, self.kinds, self.confidence[:, -1],
-                                       self.log_likelihood[:, -1])
+                 "final_log_likelihood": float(ll), "misfit": _num(mf),
+                 "familiarity": _num(f)}
+                for n, k, c, ll, mf, f in zip(self.names, self.kinds, self.confidence[:, -1],
+                                              self.log_likelihood[:, -1], self.misfit,
+                                              self.familiarity)
             ],
             "winner": self.winner,
             "rule": self.rule,
+            "verdict": d.verdict,
+            "familiarity": _num(d.familiarity),
+            "margin": _num(d.margin),
+            "familiarity_threshold": float(self.familiarity_threshold),
+            "reference_model": self.reference_model,
             "time": [float(t) for t in self.time],
             "confidence": {n: [float(c) for c in row]
                            for n, row in zip(self.names, self.confidence)},
+            "transport_confidence": {n: [float(c) for c in row]
+                                     for n, row in zip(self.names, transport)},
+            "aperture": [_num(g) for g in self.observation.g],
         }
+
+
+def _num(x: float) -> float | None:
+    """A float for JSON: None where it is not finite (JSON has no NaN)."""
+    x = float(x)
+    return x if np.isfinite(x) else None

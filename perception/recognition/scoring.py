@@ -74,7 +74,7 @@ def _unit(v: np.ndarray) -> np.ndarray:
 
 def likelihood_rule(r_obs: np.ndarray, g_obs: np.ndarray, midpoint: np.ndarray,
                     opening: np.ndarray, cov_tips: np.ndarray, valid: np.ndarray,
-                    obs_sd: float) -> np.ndarray:
+                    obs_sd: float) -> tuple[np.ndarray, np.ndarray]:
     """Per-step log-likelihood of the observed ``(r, g)`` under each model's prediction.
 
     The predicted wrist, finger and thumb positions have Cartesian covariances
@@ -97,8 +97,13 @@ def likelihood_rule(r_obs: np.ndarray, g_obs: np.ndarray, midpoint: np.ndarray,
 
     Returns
     -------
-    (M, N) array
+    log_likelihood : (M, N) array
         Log-likelihood of each step (0 where not valid).
+    mahalanobis : (M, N) array
+        The squared Mahalanobis distance of each step's observation from the
+        prediction: the log-likelihood without its normalising term,
+        ``-2 (log_likelihood + log 2 pi) - log det``; about 2 on average when
+        the model's predictive distribution is right (0 where not valid).
     """
     Sw, Sf, St = cov_tips[:, :, 0], cov_tips[:, :, 1], cov_tips[:, :, 2]
     eye = np.eye(2)
@@ -117,4 +122,5 @@ def likelihood_rule(r_obs: np.ndarray, g_obs: np.ndarray, midpoint: np.ndarray,
     eg = g_obs[None] - np.linalg.norm(opening, axis=-1)
     maha = (var_g * er**2 - 2 * cov_rg * er * eg + var_r * eg**2) / det
     dll = -0.5 * (np.log(det) + maha) - np.log(2 * np.pi)
-    return np.where(valid & np.isfinite(dll), dll, 0.0)
+    ok = valid & np.isfinite(dll)
+    return np.where(ok, dll, 0.0), np.where(ok, maha, 0.0)

@@ -1,23 +1,74 @@
-"""The batch report: ``summary.csv``, condition profiles and statistics, ``report.html``."""
+"""The batch report: ``summary.csv``, the chapter 5 figures and statistics, ``report.html``.
+
+Every clip is read on one *reference* grasp model
+(:func:`~perception.report.conditions.reference_model`): the aperture
+profiles against the model's own (Fig. 5.4d), its confidence on one clip per
+condition (Fig. 5.8a) and on all clips (Fig. 5.8b), mean ± SD per condition
+(Fig. 5.8c) and the statistics of its final confidence. The page escapes
+every name it shows and quotes every link, so any clip name is safe in it.
+"""
 
 from __future__ import annotations
 
 import html
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from urllib.parse import quote
 
+import numpy as np
 import pandas as pd
 
 from perception.io.atomic import save_figure, write_csv, write_text
-from perception.report.clip import ClipSummary, clip_outputs
+from perception.report.clip import ClipSummary, clip_figures, clip_outputs
 from perception.report.conditions import (
+    aperture_profiles,
     condition_profiles,
     condition_statistics,
-    default_profile_model,
+    model_aperture,
+    reference_model,
+    typical_clips,
 )
-from perception.report.figures import condition_figure
+from perception.report.figures import (
+    aperture_figure,
+    condition_figure,
+    confidence_all_figure,
+    confidence_single_figure,
+)
 
 __all__ = ["BatchReport", "write_batch_report"]
+
+#: The chapter 5 figures of a batch: file name, thesis figure, caption.
+FIGURES = (
+    ("aperture_profiles.png", "Fig. 5.4(d)",
+     "grip aperture per condition, mean ± SD over normalised movement time, against the "
+     "reference model's own (dashed)"),
+    ("confidence_single.png", "Fig. 5.8(a)",
+     "the reference model's confidence on one clip per condition (the clip with the "
+     "condition's median final confidence)"),
+    ("confidence_all.png", "Fig. 5.8(b)", "the reference model's confidence on every clip"),
+    ("condition_profiles.png", "Fig. 5.8(c)",
+     "mean ± SD confidence per condition at select points, with its transport and grip terms"),
+)
+
+#: The figure drawn across the page (three panels).
+WIDE = "condition_profiles.png"
+
+_CSS = """
+body{font-family:system-ui,sans-serif;max-width:1240px;margin:1.5em auto;padding:0 12px;
+     line-height:1.4;color:#222}
+h1{font-size:1.6em} h2{margin-top:1.6em;border-bottom:1px solid #ccc} h3{margin-bottom:.2em}
+table.t{border-collapse:collapse;font-size:90%;margin:.5em 0}
+table.t td,table.t th{padding:3px 9px;border-bottom:1px solid #ddd;text-align:left;
+     white-space:nowrap}
+table.t td.n,table.t th.n{text-align:right}
+.scroll{max-width:100%;overflow-x:auto}
+figure{margin:0} figure img,.clip img{width:100%;height:auto;border:1px solid #eee}
+.grid{display:grid;grid-template-columns:1fr 1fr;gap:14px} .grid figure.wide{grid-column:1/-1}
+figcaption,.note{font-size:90%;color:#555}
+.v-normal{color:#1b6e20;font-weight:bold} .v-reach{color:#1f4e99;font-weight:bold}
+.v-abnormal{color:#b3261e;font-weight:bold} .v-failed{color:#777}
+"""
 
 
 @dataclass(frozen=True)
@@ -39,86 +90,234 @@ class BatchReport:
     html: Path
 
 
-def _table_html(df: pd.DataFrame) -> str:
-    return df.to_html(index=False, float_format=lambda v: f"{v:.4g}", na_rep="",
-                      classes="t", border=0, escape=True)
+def _e(value) -> str:
+    """A cell's text, escaped; empty for None and NaN."""
+    if value is None or (isinstance(value, float) and not np.isfinite(value)):
+        return ""
+    return html.escape(str(value))
+
+
+def _link(path: str, text: str) -> str:
+    return f'<a href="{html.escape(quote(path), quote=True)}">{html.escape(text)}</a>'
+
+
+def _table(headers: Sequence[str], rows: Sequence[Sequence[str]], numeric: set[int] = frozenset(),
+           cls: str = "t") -> str:
+    """An HTML table from escaped cell strings; ``numeric`` columns are right-aligned."""
+    def row(cells, tag):
+        return "<tr>" + "".join(
+            f'<{tag}{" class=n" if i in numeric else ""}>{c}</{tag}>'
+            for i, c in enumerate(cells)) + "</tr>"
+    return (f'<table class="{cls}"><thead>{row([html.escape(h) for h in headers], "th")}'
+            f'</thead><tbody>{"".join(row(r, "td") for r in rows)}</tbody></table>')
+
+
+def _num(value, fmt: str) -> str:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        return ""
+    return format(v, fmt) if np.isfinite(v) else ""
+
+
+def _verdict_cell(verdict, status: str) -> str:
+    if status != "ok":
+        return '<span class="v-failed">failed</span>'
+    v = _e(verdict) or "—"
+    return f'<span class="v-{v}">{v}</span>' if verdict else v
+
+
+def _main_table(summary: pd.DataFrame, anchors: dict[str, str], reference: str | None) -> str:
+    headers = ["clip", "condition", "verdict", "familiarity (0–1)", "margin (log-lik.)",
+               "winner", "winner log-lik.", f"C of {reference or 'reference'} (cm)", "status"]
+    rows = []
+    for r in summary.itertuples(index=False):
+        def get(name, r=r):  # a summary written by other code may lack columns
+            return getattr(r, name, None)
+
+        clip = _e(r.clip)
+        if r.clip in anchors:
+            clip = f'<a href="#{anchors[r.clip]}">{clip}</a>'
+        ref = get("reference_confidence")
+        rows.append([clip, _e(r.condition), _verdict_cell(get("verdict"), r.status),
+                     _num(get("familiarity"), ".2f"), _num(get("margin"), ".1f"), _e(r.winner),
+                     _num(get("winner_log_likelihood"), ".1f"),
+                     _num(ref * 100 if ref is not None else None, ".2f"), _e(r.status)])
+    return _table(headers, rows, numeric={3, 4, 6, 7}, cls="t main")
+
+
+def _models_table(summary: pd.DataFrame) -> str:
+    cols = [c for c in summary.columns if c.startswith("conf_")]
+    if not cols:
+        return ""
+    rows = [[_e(r["clip"])] + [_num(r[c] * 100, ".2f") for c in cols]
+            for _, r in summary[summary["status"] == "ok"].iterrows()]
+    table = _table(["clip"] + [c[len("conf_"):] for c in cols], rows,
+                   numeric=set(range(1, len(cols) + 1)))
+    return ("<details><summary>Final thesis-rule confidence C of every model (cm, "
+            f'weighted; <code>conf_&lt;model&gt;</code> in summary.csv, m)</summary>'
+            f'<div class="scroll">{table}</div></details>')
+
+
+#: summary.csv columns the main table or the per-model table shows.
+_SHOWN = {"clip", "condition", "winner", "rule", "verdict", "familiarity", "margin",
+          "winner_log_likelihood", "reference_model", "reference_confidence", "status",
+          "reused", "error"}
+
+
+def _other_columns_table(summary: pd.DataFrame) -> str:
+    """summary.csv's other columns (the tracking quality, …), folded away."""
+    cols = [c for c in summary.columns if c not in _SHOWN and not c.startswith("conf_")]
+    if not cols:
+        return ""
+    rows = [[_e(r["clip"])] + [_num(r[c], ".3g") if isinstance(r[c], int | float | np.number)
+                               else _e(r[c]) for c in cols]
+            for _, r in summary[summary["status"] == "ok"].iterrows()]
+    table = _table(["clip", *cols], rows, numeric=set(range(1, len(cols) + 1)))
+    return ("<details><summary>Tracking quality and other columns of summary.csv</summary>"
+            f'<div class="scroll">{table}</div></details>')
+
+
+def _verdict_counts(ok: pd.DataFrame) -> str:
+    if not len(ok) or "verdict" not in ok:
+        return ""
+    cond = ok["condition"].where(ok["condition"].notna(), "unlabelled")
+    counts = pd.crosstab(cond, ok["verdict"].fillna("none"))
+    rows = [[_e(c)] + [str(int(counts.loc[c, v])) for v in counts.columns] for c in counts.index]
+    return "<h2>Verdicts per condition</h2>" + _table(
+        ["condition", *[str(v) for v in counts.columns]], rows,
+        numeric=set(range(1, len(counts.columns) + 1)))
+
+
+def _clip_section(rec: ClipSummary, out: Path, anchor: str, condition) -> str:
+    files = clip_outputs(out, rec.clip)
+    links = " · ".join(_link(files[k].name, label) for k, label in
+                       (("json", "recognition.json"), ("csv", "confidence.csv")))
+    line = (f"verdict {_verdict_cell(rec.verdict, 'ok')}"
+            f" (familiarity {_num(rec.familiarity, '.2f')}, margin {_num(rec.margin, '.1f')})"
+            f"; winner {_e(rec.winner)} ({_e(rec.rule)} rule); condition "
+            f"{_e(condition) or 'unlabelled'}; files: {links}")
+    figs = "".join(f'<a href="{html.escape(quote(p.name), quote=True)}">'
+                   f'<img src="{html.escape(quote(p.name), quote=True)}" loading="lazy" '
+                   f'alt="{_e(p.name)}"></a>' for p in clip_figures(out, rec.clip))
+    return f'<div class="clip"><h3 id="{anchor}">{_e(rec.clip)}</h3><p>{line}</p>{figs}</div>'
+
+
+def _chapter5(recs: list[ClipSummary], conds: list[str], reference: str, models, out: Path
+              ) -> None:
+    """The four chapter 5 figures and their tables."""
+    model = next((m for m in models or () if m.name == reference), None)
+    own = model_aperture(model) if model is not None else None
+    ap = aperture_profiles(recs, conds)
+    if own is not None:
+        ap = pd.concat([ap, own.assign(condition=f"model:{reference}", n=1)],
+                       ignore_index=True)[["condition", "phase", "mean", "sd", "n"]]
+    write_csv(out / "aperture_profiles.csv", ap)
+    observed = ap[~ap["condition"].astype(str).str.startswith("model:")]
+    save_figure(out / "aperture_profiles.png", aperture_figure(observed, own, reference))
+    single, single_conds = typical_clips(recs, conds, reference)
+    save_figure(out / "confidence_single.png",
+                confidence_single_figure(single, single_conds, reference))
+    save_figure(out / "confidence_all.png", confidence_all_figure(recs, conds, reference))
+    prof = condition_profiles(recs, conds, reference)
+    write_csv(out / "condition_profiles.csv", prof)
+    save_figure(out / "condition_profiles.png", condition_figure(prof, reference))
+
+
+def _figures_html(reference: str) -> str:
+    """The chapter 5 figures in a grid, each a link to itself at full size."""
+    figures = "".join(
+        f'<figure{" class=wide" if name == WIDE else ""}><a href="{name}">'
+        f'<img src="{name}" alt="{fig}"></a><figcaption>{fig}: {html.escape(caption)} '
+        "(click for full size)</figcaption></figure>" for name, fig, caption in FIGURES)
+    return (f"<h2>Chapter 5, read on the reference grasp model {_e(reference)}</h2>"
+            f"<div class=grid>{figures}</div>")
+
+
+def _statistics_html(stats_df: pd.DataFrame) -> str:
+    rows = [[_e(r.test), _e(r.groups), str(int(r.n)), _e(r.statistic_type),
+             _num(r.statistic, ".3g"), _e(r.df), _num(r.p_value, ".3g"),
+             _num(r.mean_difference * 100, ".2f"), _e(r.effect_size_type),
+             _num(r.effect_size, ".2f")] for r in stats_df.itertuples(index=False)]
+    return _table(["test", "groups", "n", "statistic", "value", "df", "p", "mean difference (cm)",
+                   "effect size", "value"], rows, numeric={2, 4, 6, 7, 9})
 
 
 def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummary],
                        out: Path, *, profile_model: str | None = None,
-                       title: str = "hammer-mv recognition report") -> BatchReport:
-    """Write ``summary.csv``, condition profiles and statistics, and ``report.html``.
+                       title: str = "hammer-mv recognition report",
+                       models: Sequence | None = None) -> BatchReport:
+    """Write ``summary.csv``, the chapter 5 figures and statistics, and ``report.html``.
 
     Parameters
     ----------
     summary : pandas.DataFrame
-        One row per clip: clip, condition, winner, conf_<model>..., status, error.
+        One row per clip (:func:`perception.batch.summary_table`).
     recognitions : dict of ClipSummary
         Scored clips by name (failed clips absent).
     out : Path
         Report folder.
     profile_model : str, optional
-        Model for the per-condition profiles and statistics (default: the grasp
-        model that best explains the ``normal`` clips — highest mean
-        log-likelihood among grasp models — or all clips without labels).
+        The reference grasp model (default: the summary's ``reference_model``,
+        else the grasp model that best explains the ``normal`` clips — highest
+        mean log-likelihood among grasp models — or all clips without labels).
     title : str
         Heading of the HTML page.
+    models : sequence of MotorModel, optional
+        The repertoire's models: the reference model's own aperture is drawn
+        from it in Fig. 5.4(d).
     """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     write_csv(out / "summary.csv", summary)
-    sections = []
     ok = summary[summary["status"] == "ok"]
     recs = [recognitions[c] for c in ok["clip"] if c in recognitions]
     condition_of = ok.set_index("clip")["condition"]
+    conds = [c if isinstance(c, str) else "unlabelled" for c in condition_of.loc[
+        [r.clip for r in recs]]]
+    if profile_model is None and "reference_model" in ok and ok["reference_model"].notna().any():
+        profile_model = str(ok["reference_model"].dropna().iloc[0])
     if recs and profile_model is None:
-        normal = [r for r in recs if condition_of.get(r.clip) == "normal"]
-        profile_model = default_profile_model(normal or recs)
-    stats_df = pd.DataFrame()
+        profile_model = reference_model(recs, [condition_of.get(r.clip) for r in recs])
+    sections, stats_df = [], pd.DataFrame()
     if recs and profile_model:
-        conds = [c if isinstance(c, str) else "unlabelled"
-                 for c in condition_of.loc[[r.clip for r in recs]]]
-        prof = condition_profiles(recs, conds, profile_model)
-        write_csv(out / "condition_profiles.csv", prof)
-        save_figure(out / "condition_profiles.png", condition_figure(prof, profile_model))
+        _chapter5(recs, conds, profile_model, models, out)
         stats_df = condition_statistics(summary, profile_model)
         write_csv(out / "statistics.csv", stats_df)
-        sections.append(f"<h2>Confidence of {html.escape(profile_model)} by condition</h2>"
-                        '<img src="condition_profiles.png" alt="condition profiles">')
+        sections.append(_figures_html(profile_model))
         if len(stats_df):
-            sections.append("<h2>Statistics of final confidence</h2>" + _table_html(stats_df))
-    counts = ok.groupby(["condition", "winner"], dropna=False).size().reset_index(name="clips")
-    if len(counts):
-        sections.append("<h2>Winners (likelihood rule unless stated)</h2>" + _table_html(counts))
+            sections.append("<h2>Statistics of the reference model's final confidence</h2>"
+                            + _statistics_html(stats_df))
+    anchors = {rec.clip: f"clip-{i}" for i, rec in enumerate(recs)}
     failed = summary[summary["status"] != "ok"]
     if len(failed):
-        sections.append(f"<h2>Failed clips ({len(failed)})</h2>"
-                        + _table_html(failed[["clip", "status", "error"]]))
-    clips = []
-    for rec in recs:
-        p = clip_outputs(out, rec.clip)
-        clips.append(
-            f"<h3>{html.escape(rec.clip)} — winner {html.escape(rec.winner)} ({rec.rule})</h3>"
-            f'<img src="{p["confidence_png"].name}" width="49%">'
-            f'<img src="{p["paths_png"].name}" width="49%">'
-            + (f'<img src="{rec.clip}.tracking.png" width="98%" alt="tracked markers">'
-               if (out / f"{rec.clip}.tracking.png").exists() else ""))
+        sections.append(f"<h2>Failed clips ({len(failed)})</h2>" + _table(
+            ["clip", "error"], [[_e(r.clip), _e(r.error)] for r in failed.itertuples()]))
+    clips = [_clip_section(rec, out, anchors[rec.clip], condition_of.get(rec.clip))
+             for rec in recs]
+    tables = ['<a href="summary.csv">summary.csv</a>']
+    if len(stats_df):
+        tables.append('<a href="statistics.csv">statistics.csv</a>')
     body = "\n".join([
         f"<h1>{html.escape(title)}</h1>",
-        f"<p>{len(summary)} clips: {len(ok)} scored, {len(failed)} failed. "
-        'Tables: <a href="summary.csv">summary.csv</a>'
-        + (', <a href="statistics.csv">statistics.csv</a>' if len(stats_df) else "")
-        + ".</p>",
-        *sections,
-        "<h2>Summary</h2>", _table_html(summary),
-        "<h2>Clips</h2>", *clips,
+        f"<p>{len(summary)} clips: {len(ok)} scored, {len(failed)} failed. Tables: "
+        + ", ".join(tables) + '. <span class="note">' + _HOW_TO_READ + "</span></p>",
+        _verdict_counts(ok),
+        "<h2>Summary</h2>", _main_table(summary, anchors, profile_model), _models_table(summary),
+        _other_columns_table(summary),
+        *sections, "<h2>Clips</h2>", *clips,
     ])
     page = ("<!doctype html><html><head><meta charset='utf-8'>"
-            f"<title>{html.escape(title)}</title><style>"
-            "body{font-family:sans-serif;max-width:1200px;margin:2em auto;}"
-            "table.t{border-collapse:collapse;font-size:85%;}"
-            "table.t td,table.t th{padding:2px 8px;border-bottom:1px solid #ddd;}"
-            "img{max-width:100%;}</style></head><body>"
+            "<meta name='viewport' content='width=device-width, initial-scale=1'>"
+            f"<title>{html.escape(title)}</title><style>{_CSS}</style></head><body>"
             f"{body}</body></html>\n")
     write_text(out / "report.html", page)
     return BatchReport(folder=out, summary=out / "summary.csv", html=out / "report.html")
+
+
+_HOW_TO_READ = (
+    "How to read it: the <b>verdict</b> is <i>normal</i> or <i>reach</i> when the model that "
+    "explains a clip best (highest log-likelihood) fits it better than the worst 5 % "
+    "of its own demonstrations (<b>familiarity</b>, 0–1), and <i>abnormal</i> when it does "
+    "not; the <b>margin</b> is the winner's log-likelihood minus the runner-up's. "
+    "C is the thesis-rule confidence in cm (weighted; the files hold metres).")

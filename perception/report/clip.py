@@ -2,12 +2,15 @@
 
 :class:`ClipSummary` is what a batch keeps of a scored clip: built from the
 :class:`~perception.recognition.result.Recognition` in memory for a clip
-scored now, or from its JSON for a clip a rerun reuses.
+scored now, or from its JSON for a clip a rerun reuses. Keys a caller adds
+to the JSON (``write_clip_report(extra=...)``: the batch's fingerprint,
+condition and input, or a tracking summary) come back in
+:attr:`ClipSummary.extras`.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -15,7 +18,21 @@ import numpy as np
 from perception.io.atomic import save_figure, write_csv, write_json
 from perception.recognition.result import Recognition
 
-__all__ = ["ClipSummary", "clip_outputs", "write_clip_report"]
+__all__ = ["ClipSummary", "clip_figures", "clip_outputs", "write_clip_report"]
+
+#: Keys of ``<clip>.recognition.json`` that :meth:`Recognition.to_dict` writes;
+#: any other key is an extra (see :attr:`ClipSummary.extras`).
+RECOGNITION_KEYS = frozenset({
+    "clip", "models", "winner", "rule", "verdict", "familiarity", "margin",
+    "familiarity_threshold", "reference_model", "time", "confidence", "transport_confidence",
+    "aperture"})
+
+
+def _floats(values, n: int | None = None) -> np.ndarray:
+    """JSON numbers (None for NaN) as a float array; NaN of length ``n`` if absent."""
+    if values is None:
+        return np.full(n or 0, np.nan)
+    return np.array([np.nan if v is None else v for v in values], dtype=float)
 
 
 @dataclass(frozen=True, eq=False)
@@ -31,15 +48,30 @@ class ClipSummary:
     names, kinds : list of str
         Models and their kinds.
     confidence : (M, N) array
-        Thesis-rule confidence.
+        Thesis-rule confidence, m (weighted).
     final_log_likelihood : (M,) array
         Likelihood-rule score at the end.
     winner : str
         The winning model.
     rule : str
         Rule that picked the winner.
-    tracking : dict, optional
-        The clip's tracking quality (the JSON's ``tracking`` key).
+    verdict : str or None
+        ``normal``, ``abnormal`` or ``reach``.
+    familiarity : float
+        The best model's familiarity, 0..1.
+    margin : float
+        Log-likelihood of the best model minus the runner-up's.
+    familiarities : (M,) array
+        Every model's familiarity.
+    reference_model : str or None
+        The grasp model with the highest log-likelihood.
+    transport : (M, N) array
+        The transport term's share of the confidence (cumulative ``dC_r``), m.
+    aperture : (N,) array
+        Observed grip aperture, m.
+    extras : dict
+        The JSON's other keys (``fingerprint``, ``condition``, ``input``,
+        ``tracking``, …).
     """
 
     clip: str
@@ -50,7 +82,24 @@ class ClipSummary:
     final_log_likelihood: np.ndarray
     winner: str
     rule: str
-    tracking: dict | None = None
+    verdict: str | None = None
+    familiarity: float = float("nan")
+    margin: float = float("nan")
+    familiarities: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    reference_model: str | None = None
+    transport: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    aperture: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    extras: dict = field(default_factory=dict)
+
+    @property
+    def tracking(self) -> dict | None:
+        """The clip's tracking quality (the JSON's ``tracking`` key), if recorded."""
+        return self.extras.get("tracking")
+
+    @property
+    def grip(self) -> np.ndarray:
+        """(M, N) the grip term's share of the confidence (cumulative ``dC_g``), m."""
+        return self.confidence - self.transport
 
     @classmethod
     def from_dict(cls, d: dict) -> ClipSummary:
@@ -59,34 +108,61 @@ class ClipSummary:
         Parameters
         ----------
         d : dict
-            The parsed JSON.
+            The parsed JSON (reports written before the verdict existed lack
+            its keys; they read as NaN / None).
         """
         names = [m["name"] for m in d["models"]]
+        n = len(d["time"])
+        transport = d.get("transport_confidence") or {}
         return cls(
             clip=d["clip"],
             time=np.asarray(d["time"], dtype=float),
             names=names,
             kinds=[m["kind"] for m in d["models"]],
-            confidence=np.array([d["confidence"][n] for n in names], dtype=float),
-            final_log_likelihood=np.array([m.get("final_log_likelihood", np.nan)
-                                           for m in d["models"]], dtype=float),
+            confidence=np.array([d["confidence"][k] for k in names], dtype=float),
+            final_log_likelihood=_floats([m.get("final_log_likelihood") for m in d["models"]]),
             winner=d["winner"],
             rule=d["rule"],
-            tracking=d.get("tracking"),
+            verdict=d.get("verdict"),
+            familiarity=float(_floats([d.get("familiarity")])[0]),
+            margin=float(_floats([d.get("margin")])[0]),
+            familiarities=_floats([m.get("familiarity") for m in d["models"]]),
+            reference_model=d.get("reference_model"),
+            transport=np.array([_floats(transport.get(k), n) for k in names]).reshape(
+                len(names), n),
+            aperture=_floats(d.get("aperture"), n),
+            extras={k: v for k, v in d.items() if k not in RECOGNITION_KEYS},
         )
 
     @classmethod
-    def from_recognition(cls, rec: Recognition) -> ClipSummary:
-        """From a :class:`~perception.recognition.engine.Recognition`.
+    def from_recognition(cls, rec: Recognition, extras: dict | None = None) -> ClipSummary:
+        """From a :class:`~perception.recognition.result.Recognition`.
 
         Parameters
         ----------
         rec : Recognition
             A scored clip.
+        extras : dict, optional
+            Keys added to its JSON (see :func:`write_clip_report`).
         """
+        d = rec.decision
         return cls(clip=rec.clip, time=rec.time, names=list(rec.names), kinds=list(rec.kinds),
                    confidence=rec.confidence, final_log_likelihood=rec.log_likelihood[:, -1],
-                   winner=rec.winner, rule=rec.rule)
+                   winner=rec.winner, rule=rec.rule, verdict=d.verdict,
+                   familiarity=d.familiarity, margin=d.margin, familiarities=rec.familiarity,
+                   reference_model=rec.reference_model,
+                   transport=np.cumsum(rec.dC_r, axis=1), aperture=rec.observation.g,
+                   extras=dict(extras or {}))
+
+    def index(self, model: str) -> int:
+        """Row of ``model`` in the per-model arrays.
+
+        Parameters
+        ----------
+        model : str
+            Model name.
+        """
+        return self.names.index(model)
 
 
 def clip_outputs(out: Path, clip: str) -> dict[str, Path]:
@@ -105,6 +181,30 @@ def clip_outputs(out: Path, clip: str) -> dict[str, Path]:
         "confidence_png": out / f"{clip}.confidence.png",
         "paths_png": out / f"{clip}.paths.png",
     }
+
+
+def clip_figures(out: Path, clip: str) -> list[Path]:
+    """Every figure of ``clip`` in ``out``: its two own, then any other ``<clip>.<name>.png``.
+
+    A figure another step adds beside the clip's report (one ``<name>``, no
+    dots) is shown with the clip in ``report.html``.
+
+    Parameters
+    ----------
+    out : Path
+        Report folder.
+    clip : str
+        Clip name.
+    """
+    own = [clip_outputs(out, clip)[k] for k in ("confidence_png", "paths_png")]
+    others = []
+    if out.is_dir():
+        prefix = f"{clip}."
+        for path in sorted(out.iterdir()):
+            rest = path.name[len(prefix):] if path.name.startswith(prefix) else ""
+            if rest.endswith(".png") and rest.count(".") == 1 and path not in own:
+                others.append(path)
+    return [p for p in own if p.exists()] + others
 
 
 def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,

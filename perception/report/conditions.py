@@ -1,16 +1,35 @@
-"""Comparing stimulus conditions over a batch: mean profiles and statistics."""
+"""Comparing stimulus conditions over a batch: the reference model, profiles and statistics.
+
+The *reference* (profile) model is one grasp model for the whole batch: the
+one that explains the ``normal`` clips best (highest mean final
+log-likelihood), or all clips when none is labelled — the thesis's "normal
+grasp model" that chapter 5 reads every stimulus on.
+"""
 
 from __future__ import annotations
+
+from collections.abc import Sequence
 
 import numpy as np
 import pandas as pd
 
 from perception.report.clip import ClipSummary
 
-__all__ = ["PROFILE_POINTS", "condition_profiles", "condition_statistics", "default_profile_model"]
+__all__ = ["PROFILE_POINTS", "aperture_profiles", "condition_profiles", "condition_statistics",
+           "default_profile_model", "model_aperture", "reference_model", "typical_clips"]
 
 #: Samples of normalised movement time for per-condition mean profiles.
 PROFILE_POINTS = 101
+
+
+def _phase(rec: ClipSummary) -> np.ndarray:
+    return rec.time / rec.time[-1] if rec.time[-1] > 0 else rec.time
+
+
+def _mean_sd(curves: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    arr = np.array(curves)
+    sd = np.nanstd(arr, axis=0, ddof=1) if len(arr) > 1 else np.zeros(arr.shape[1])
+    return np.nanmean(arr, axis=0), sd
 
 
 def condition_profiles(recognitions: list[ClipSummary], conditions: list[str],
@@ -29,27 +48,85 @@ def condition_profiles(recognitions: list[ClipSummary], conditions: list[str],
     Returns
     -------
     pandas.DataFrame
-        Columns: condition, phase (0..1), mean, sd, n.
+        Columns: condition, phase (0..1), mean, sd, n (the total confidence,
+        m), and transport_mean, transport_sd, grip_mean, grip_sd (its two terms).
+    """
+    phase = np.linspace(0, 1, PROFILE_POINTS)
+    curves: dict[str, dict[str, list[np.ndarray]]] = {}
+    for rec, cond in zip(recognitions, conditions):
+        i = rec.index(model)
+        c = curves.setdefault(cond, {"": [], "transport_": [], "grip_": []})
+        t = _phase(rec)
+        c[""].append(np.interp(phase, t, rec.confidence[i]))
+        c["transport_"].append(np.interp(phase, t, rec.transport[i]) if rec.transport.size
+                               else np.full(len(phase), np.nan))
+        c["grip_"].append(c[""][-1] - c["transport_"][-1])
+    rows = []
+    for cond, parts in curves.items():
+        table = {"condition": cond, "phase": phase}
+        for prefix, cs in parts.items():
+            table[f"{prefix}mean"], table[f"{prefix}sd"] = _mean_sd(cs)
+        table["n"] = len(parts[""])
+        rows.append(pd.DataFrame(table))
+    return pd.concat(rows, ignore_index=True)[
+        ["condition", "phase", "mean", "sd", "n", "transport_mean", "transport_sd", "grip_mean",
+         "grip_sd"]]
+
+
+def aperture_profiles(recognitions: list[ClipSummary], conditions: list[str]) -> pd.DataFrame:
+    """Mean ± SD observed grip aperture per condition over normalised movement time.
+
+    Parameters
+    ----------
+    recognitions : list of ClipSummary
+        Scored clips.
+    conditions : list of str
+        Condition of each clip.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns: condition, phase (0..1), mean, sd (m), n.
     """
     phase = np.linspace(0, 1, PROFILE_POINTS)
     curves: dict[str, list[np.ndarray]] = {}
     for rec, cond in zip(recognitions, conditions):
-        i = rec.names.index(model)
-        t = rec.time / rec.time[-1] if rec.time[-1] > 0 else rec.time
-        curves.setdefault(cond, []).append(np.interp(phase, t, rec.confidence[i]))
-    rows = []
-    for cond, cs in curves.items():
-        arr = np.array(cs)
-        sd = arr.std(axis=0, ddof=1) if len(arr) > 1 else np.zeros(len(phase))
-        rows.append(pd.DataFrame({"condition": cond, "phase": phase, "mean": arr.mean(0),
-                                  "sd": sd, "n": len(arr)}))
-    return pd.concat(rows, ignore_index=True)
+        g = rec.aperture
+        ok = np.isfinite(g)
+        if ok.sum() >= 2:
+            curves.setdefault(cond, []).append(np.interp(phase, _phase(rec)[ok], g[ok]))
+    rows = [pd.DataFrame({"condition": cond, "phase": phase, "mean": _mean_sd(cs)[0],
+                          "sd": _mean_sd(cs)[1], "n": len(cs)}) for cond, cs in curves.items()]
+    return (pd.concat(rows, ignore_index=True) if rows
+            else pd.DataFrame(columns=["condition", "phase", "mean", "sd", "n"]))
+
+
+def _effect(a: np.ndarray, b: np.ndarray) -> float:
+    """Hedges' g of a - b (pooled SD, small-sample correction)."""
+    na, nb = len(a), len(b)
+    pooled = np.sqrt(((na - 1) * a.var(ddof=1) + (nb - 1) * b.var(ddof=1)) / (na + nb - 2))
+    if not pooled > 0:
+        return float("nan")
+    return float((a.mean() - b.mean()) / pooled * (1 - 3 / (4 * (na + nb) - 9)))
+
+
+def _eta_squared(groups: Sequence[np.ndarray]) -> float:
+    """Share of the variance between groups (one-way ANOVA's eta squared)."""
+    everything = np.concatenate(groups)
+    total = ((everything - everything.mean()) ** 2).sum()
+    between = sum(len(g) * (g.mean() - everything.mean()) ** 2 for g in groups)
+    return float(between / total) if total > 0 else float("nan")
+
+
+_STAT_COLUMNS = ["model", "test", "groups", "n", "statistic_type", "statistic", "df",
+                 "p_value", "mean_difference", "effect_size_type", "effect_size"]
 
 
 def condition_statistics(summary: pd.DataFrame, model: str) -> pd.DataFrame:
     """Compare final confidence of ``model`` between conditions.
 
-    One-way ANOVA across all conditions and Welch t-tests for each pair.
+    One-way ANOVA across all conditions with at least 2 scored clips and a
+    Welch t-test for each pair of them.
 
     Parameters
     ----------
@@ -61,31 +138,38 @@ def condition_statistics(summary: pd.DataFrame, model: str) -> pd.DataFrame:
     Returns
     -------
     pandas.DataFrame
-        Columns: model, test, groups, n, statistic, p_value, mean_difference.
+        Columns: model, test, groups, n, statistic_type (``F`` or ``t``),
+        statistic, df (``k-1, n-k`` for F; Welch's for t), p_value,
+        mean_difference (t-tests, m), effect_size_type (``eta^2`` or
+        ``Hedges' g``), effect_size.
     """
     from scipy import stats  # slow to import; only the batch report needs it
 
     col = f"conf_{model}"
     ok = summary[(summary["status"] == "ok") & summary["condition"].notna()]
     groups = {c: g[col].to_numpy(float) for c, g in ok.groupby("condition", sort=False)}
-    rows = []
     testable = {c: v for c, v in groups.items() if len(v) >= 2}
+    rows = []
     if len(testable) >= 2:
         f, p = stats.f_oneway(*testable.values())
-        rows.append({"test": "one-way ANOVA", "groups": " / ".join(testable),
-                     "n": sum(len(v) for v in testable.values()), "statistic": float(f),
-                     "p_value": float(p), "mean_difference": np.nan})
+        k, n = len(testable), sum(len(v) for v in testable.values())
+        rows.append({"test": "one-way ANOVA", "groups": " / ".join(testable), "n": n,
+                     "statistic_type": "F", "statistic": float(f), "df": f"{k - 1}, {n - k}",
+                     "p_value": float(p), "mean_difference": np.nan,
+                     "effect_size_type": "eta^2",
+                     "effect_size": _eta_squared(list(testable.values()))})
     names = list(testable)
     for i, a in enumerate(names):
         for b in names[i + 1:]:
-            t, p = stats.ttest_ind(testable[a], testable[b], equal_var=False)
+            res = stats.ttest_ind(testable[a], testable[b], equal_var=False)
             rows.append({"test": "Welch t-test", "groups": f"{a} vs {b}",
-                         "n": len(testable[a]) + len(testable[b]), "statistic": float(t),
-                         "p_value": float(p),
-                         "mean_difference": float(testable[a].mean() - testable[b].mean())})
-    return pd.DataFrame(rows, columns=["test", "groups", "n", "statistic", "p_value",
-                                       "mean_difference"]).assign(model=model)[
-        ["model", "test", "groups", "n", "statistic", "p_value", "mean_difference"]]
+                         "n": len(testable[a]) + len(testable[b]), "statistic_type": "t",
+                         "statistic": float(res.statistic), "df": f"{float(res.df):.1f}",
+                         "p_value": float(res.pvalue),
+                         "mean_difference": float(testable[a].mean() - testable[b].mean()),
+                         "effect_size_type": "Hedges' g",
+                         "effect_size": _effect(testable[a], testable[b])})
+    return pd.DataFrame(rows, columns=_STAT_COLUMNS[1:]).assign(model=model)[_STAT_COLUMNS]
 
 
 def default_profile_model(recs: list[ClipSummary]) -> str | None:
@@ -103,3 +187,69 @@ def default_profile_model(recs: list[ClipSummary]) -> str | None:
     ll = np.array([[r.final_log_likelihood[i] for i in grasp] for r in recs
                    if r.names == names])
     return names[grasp[int(np.argmax(np.nanmean(ll, axis=0)))]] if len(ll) else names[0]
+
+
+def reference_model(recs: list[ClipSummary], conditions: Sequence[str | None]) -> str | None:
+    """The batch's reference grasp model: the best over its ``normal`` clips, or over all.
+
+    Parameters
+    ----------
+    recs : list of ClipSummary
+        Scored clips.
+    conditions : sequence of str or None
+        Their conditions.
+    """
+    normal = [r for r, c in zip(recs, conditions) if c == "normal"]
+    return default_profile_model(normal or list(recs))
+
+
+def typical_clips(recs: list[ClipSummary], conditions: Sequence[str], model: str
+                  ) -> tuple[list[ClipSummary], list[str]]:
+    """One clip per condition: the one whose final confidence is the condition's median.
+
+    Parameters
+    ----------
+    recs : list of ClipSummary
+        Scored clips.
+    conditions : sequence of str
+        Their conditions.
+    model : str
+        The model whose final confidence ranks them.
+    """
+    chosen, conds = [], []
+    for cond in dict.fromkeys(conditions):
+        group = [r for r, c in zip(recs, conditions) if c == cond]
+        final = np.array([r.confidence[r.index(model), -1] for r in group])
+        chosen.append(group[int(np.argsort(final)[(len(final) - 1) // 2])])
+        conds.append(cond)
+    return chosen, conds
+
+
+def model_aperture(model, *, trials: int = 100, cv: float = 0.01, seed: int = 0) -> pd.DataFrame:
+    """A model's own grip aperture over its movement: mean ± SD of noisy executions.
+
+    Parameters
+    ----------
+    model : MotorModel
+        The model.
+    trials : int
+        Executions.
+    cv : float
+        Coefficient of variation of the command noise (the thesis's 1 %).
+    seed : int
+        Seed of the noise.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns: phase (0..1 of the planned movement time), mean, sd (m).
+    """
+    from perception.recognition.rollout import rollout
+
+    run = rollout([model], model.arm.horizon, trials=trials, cv=cv,
+                  rng=np.random.default_rng(seed))
+    g = run.aperture[0]
+    phase = np.linspace(0, 1, PROFILE_POINTS)
+    t = run.time / run.time[-1]
+    curves = np.array([np.interp(phase, t, trial) for trial in g])
+    return pd.DataFrame({"phase": phase, "mean": curves.mean(0), "sd": curves.std(0, ddof=1)})

@@ -1,0 +1,104 @@
+"""Every chain of every model stacked into arrays, for batched stepping.
+
+The engine (:mod:`perception.recognition.engine`) and the models' own
+executions (:mod:`perception.recognition.rollout`) both advance all leaves of
+all models at once: the stacked forward models ``(A, B)``, control gains
+``L``, Kalman gains ``K`` (position columns) and prediction covariances ``P``,
+padded to one state size, and the forward kinematics of the stacked chains.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from minvar.kinematics import TwoLinkChain
+from perception.recognition.models import MotorModel
+
+__all__ = ["Leaves", "forward_kinematics"]
+
+
+class Leaves:
+    """All chains of all models stacked (padded to one state size) for batched stepping.
+
+    Parameters
+    ----------
+    models : sequence of MotorModel
+        The models; their chains are stacked in order (arm, finger, thumb each).
+    steps : int
+        Model steps to provide gains for; beyond a plan's horizon a model
+        keeps its last gains (it holds the goal).
+    """
+
+    def __init__(self, models: Sequence[MotorModel], steps: int):
+        chains = [c for m in models for c in m.chains]
+        self.count = len(chains)
+        n = max(c.A.shape[0] for c in chains)
+        m_u = chains[0].B.shape[1]
+        L_ = len(chains)
+        self.A = np.zeros((L_, n, n))
+        self.B = np.zeros((L_, n, m_u))
+        self.Kp = np.zeros((steps, L_, n, 2))
+        self.Lg = np.zeros((steps, L_, m_u, n))
+        self.P = np.zeros((steps, L_, 2, 2))
+        self.x0 = np.zeros((L_, n))
+        for i, c in enumerate(chains):
+            k = c.A.shape[0]
+            self.A[i] = np.eye(n)  # padded constant states stay put
+            self.A[i, :k, :k] = c.A
+            self.B[i, :k] = c.B
+            t = np.minimum(np.arange(steps), c.horizon - 1)
+            self.Kp[:, i, :k] = c.K[t][:, :, :2]
+            self.Lg[:, i, :, :k] = c.L[t]
+            self.P[:, i] = c.P[np.minimum(np.arange(steps), c.horizon)]
+            self.x0[i, :k] = c.x0
+        self.l1 = np.array([c.l1 for c in chains])
+        self.l2 = np.array([c.l2 for c in chains])
+        self.base = np.array([c.base for c in chains])
+        self.chains = chains
+
+    def command(self, state: np.ndarray, s: int) -> np.ndarray:
+        """The motor command ``-L x`` of every leaf at step ``s`` for (L, ..., n) states."""
+        return -np.einsum("lmn,l...n->l...m", self.Lg[s], state)
+
+    def advance(self, state: np.ndarray, u: np.ndarray) -> np.ndarray:
+        """The forward models: ``A x + B u`` for (L, ..., n) states and (L, ..., m) commands."""
+        return (np.einsum("lij,l...j->l...i", self.A, state)
+                + np.einsum("lim,l...m->l...i", self.B, u))
+
+    def step(self, state: np.ndarray, s: int) -> np.ndarray:
+        """Every leaf one model step on: the command ``-L x`` through ``(A, B)``.
+
+        ``state`` is (L, n) or (L, k, n) for k states per leaf.
+        """
+        return self.advance(state, self.command(state, s))
+
+
+def forward_kinematics(q: np.ndarray, l1: np.ndarray, l2: np.ndarray
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """Tip positions and Jacobians of stacked leaves.
+
+    Parameters
+    ----------
+    q : (N, L, 2) array
+        Joint angles of every leaf, rad.
+    l1, l2 : (L,) arrays
+        Link lengths of every leaf, m.
+
+    Returns
+    -------
+    tip : (N, L, 2) array
+        Tip positions relative to each chain's base, m.
+    J : (N, L, 2, 2) array
+        Jacobians, m/rad.
+    """
+    tip = np.empty(q.shape)
+    J = np.empty(q.shape + (2,))
+    geometry = np.stack([l1, l2], axis=1)
+    for g in np.unique(geometry, axis=0):  # one chain per distinct geometry (a few at most)
+        cols = np.flatnonzero((geometry == g).all(axis=1))
+        chain = TwoLinkChain(*g)
+        tip[:, cols] = chain.forward(q[:, cols])
+        J[:, cols] = chain.jacobian(q[:, cols])
+    return tip, J

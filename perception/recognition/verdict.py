@@ -1,0 +1,234 @@
+"""The verdict on a clip: normal, abnormal or reach, from calibrated familiarity.
+
+The likelihood rule says which model explains a demonstration *best*; it
+does not say whether the best is any good. Familiarity does:
+
+* **misfit** — the mean, over a clip's scored steps, of the squared
+  Mahalanobis distance of the observed ``(r, g)`` from a model's prediction
+  under its own predictive distribution (the per-step log-likelihood without
+  its normalising term: ``-2 (log-likelihood + log 2 pi) - log det``);
+* **familiarity** — the share of the model's own demonstrations
+  (:mod:`perception.recognition.calibration`: its movement executed from its
+  stored gains with human-scale variability, tracked and observed like a
+  clip) that fit it worse than the clip does: 1 − F(misfit), with F the
+  log-normal distribution fitted to their misfits (centre: the median of the
+  log misfits; scale: their interquartile range / 1.349, so that a few
+  extreme demonstrations do not stretch the tail). 1 fits better than all of
+  them, 0.5 like the typical one, near 0 worse than nearly all;
+* **verdict** — take the model with the highest log-likelihood (the best
+  grasp or reach model). If its familiarity is at least the threshold
+  (``HammerParams.familiarity_threshold``, 0.05: a one-sided test at the 5 %
+  level that the clip is one of the model's own movements), the clip is
+  ``normal`` (a grasp model) or ``reach`` (a reach model); otherwise no model
+  explains it as well as 95 % of the models' own demonstrations and the
+  verdict is ``abnormal``.
+
+Misfits grow with the square of the frame period (a longer frame, a longer
+one-step prediction; measured in docs/recognition.md), so a calibration made
+at one frame rate is applied at another by rescaling the clip's misfit by
+``(calibration frame period / clip frame period)^2``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["DEFAULT_THRESHOLD", "VERDICTS", "Calibration", "CalibrationParams", "Verdict",
+           "decide", "misfit"]
+
+#: The three verdicts.
+VERDICTS = ("normal", "abnormal", "reach")
+#: Lowest familiarity called normal (or reach): fits better than the worst 5 % of the
+#: model's own demonstrations.
+DEFAULT_THRESHOLD = 0.05
+
+
+@dataclass(frozen=True)
+class CalibrationParams:
+    """How a model's own demonstrations are made for its calibration.
+
+    Each demonstration is the model's movement executed from its stored
+    gains and varied the way one person's grasps vary from one to the next
+    (ranges drawn uniformly, from the prehension literature: movement time
+    CV 5-10 %, time of maximum aperture SD 5-8 % of the movement, maximum
+    aperture SD 5-10 %, gently curved hand paths), then seen through a
+    camera with tracking noise and observed like a clip.
+
+    Parameters
+    ----------
+    demonstrations : int
+        Demonstrations per model.
+    execution_cv : float
+        Coefficient of variation of the command noise (the thesis's 1 %).
+    time_scale : float
+        Movement time scaled by a factor in ``1 ± time_scale``.
+    grip_shift : float
+        The grip runs up to this fraction of the movement ahead of or behind
+        the transport (most in mid-movement, none at the start and end).
+    aperture_scale : float
+        The opening scaled by up to ``1 ± aperture_scale`` (most in mid-movement).
+    path_bow : float
+        Sideways bow of the whole hand's path at mid-movement, up to ± m.
+    noise_px : float
+        Tracking noise, px, at ``px_per_m``.
+    px_per_m : float
+        Image scale of the demonstrations' camera, px/m.
+    rest : float
+        Stillness before and after the movement, s.
+    marker_offset : float
+        How far each digit's marker sits outside its tip, m.
+    seed : int
+        Seed of every draw: a repertoire's calibration is reproducible.
+    """
+
+    demonstrations: int = 50
+    execution_cv: float = 0.01
+    time_scale: float = 0.08
+    grip_shift: float = 0.08
+    aperture_scale: float = 0.10
+    path_bow: float = 0.015
+    noise_px: float = 0.4
+    px_per_m: float = 800.0
+    rest: float = 0.3
+    marker_offset: float = 0.0065
+    seed: int = 0
+
+    def __post_init__(self):
+        if not (isinstance(self.demonstrations, int) and self.demonstrations >= 10):
+            raise ValueError(f"demonstrations: expected an integer >= 10, got "
+                             f"{self.demonstrations!r}")
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            if f.name != "seed" and not (np.isfinite(value) and value >= 0):
+                raise ValueError(f"{f.name}: expected a finite value >= 0, got {value!r}")
+        if not (self.time_scale < 0.5 and self.grip_shift < 0.25 and self.aperture_scale < 1
+                and self.px_per_m > 0 and self.rest > 0):
+            raise ValueError("time_scale < 0.5, grip_shift < 0.25, aperture_scale < 1, "
+                             "px_per_m > 0 and rest > 0 are required")
+
+
+@dataclass(frozen=True, eq=False)
+class Calibration:
+    """The misfits of one model's own demonstrations.
+
+    Attributes
+    ----------
+    misfit : (K,) array
+        Sorted misfits of K demonstrations (mean squared Mahalanobis distance per step).
+    frame_period : float
+        Frame period of the demonstrations, s (the model's scene).
+    params : CalibrationParams
+        How they were made.
+    """
+
+    misfit: np.ndarray
+    frame_period: float
+    params: CalibrationParams = field(default_factory=CalibrationParams)
+
+    def __post_init__(self):
+        m = np.sort(np.asarray(self.misfit, dtype=float).ravel())
+        if m.size < 4 or not np.all(np.isfinite(m) & (m > 0)) or not self.frame_period > 0:
+            raise ValueError("calibration: expected at least 4 positive misfits and a positive "
+                             f"frame period, got {m.size} misfits, {self.frame_period!r} s")
+        object.__setattr__(self, "misfit", m)
+
+    @property
+    def log_centre(self) -> float:
+        """Median of the log misfits (the fitted log-normal's location)."""
+        return float(np.median(np.log(self.misfit)))
+
+    @property
+    def log_scale(self) -> float:
+        """Interquartile range of the log misfits / 1.349 (the fitted log-normal's scale)."""
+        q1, q3 = np.percentile(np.log(self.misfit), [25, 75])
+        return float(max(q3 - q1, 1e-6) / 1.349)
+
+    def familiarity(self, misfit: float, frame_period: float | None = None) -> float:
+        """Share of the model's own demonstrations that fit worse than ``misfit`` (fitted).
+
+        Parameters
+        ----------
+        misfit : float
+            A clip's misfit under this model.
+        frame_period : float, optional
+            The clip's frame period, s; its misfit is rescaled to the
+            calibration's by the squared ratio of the two.
+        """
+        if not np.isfinite(misfit):
+            return float("nan")
+        if frame_period:
+            misfit = misfit * (self.frame_period / frame_period) ** 2
+        z = (math.log(max(misfit, 1e-300)) - self.log_centre) / self.log_scale
+        return 0.5 * math.erfc(z / math.sqrt(2))  # the normal upper tail
+
+
+def misfit(mahalanobis: np.ndarray, scored: np.ndarray) -> np.ndarray:
+    """Mean squared Mahalanobis distance per scored step of each model.
+
+    Parameters
+    ----------
+    mahalanobis : (M, N) array
+        Per-step squared Mahalanobis distances.
+    scored : (M, N) bool array
+        Steps that count.
+
+    Returns
+    -------
+    (M,) array
+        NaN for a model with no scored step.
+    """
+    n = scored.sum(axis=1)
+    total = np.where(scored, mahalanobis, 0.0).sum(axis=1)
+    return np.where(n > 0, total / np.maximum(n, 1), np.nan)
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """What the calibrated likelihood says about one clip.
+
+    Attributes
+    ----------
+    verdict : str or None
+        ``normal``, ``abnormal`` or ``reach``; None if the best model has no calibration.
+    best : int
+        Index of the model with the highest log-likelihood.
+    familiarity : float
+        The best model's familiarity (NaN without calibration).
+    margin : float
+        Its log-likelihood minus the runner-up's (NaN with one model).
+    """
+
+    verdict: str | None
+    best: int
+    familiarity: float
+    margin: float
+
+
+def decide(kinds: list[str], final_log_likelihood: np.ndarray, familiarity: np.ndarray,
+           threshold: float = DEFAULT_THRESHOLD) -> Verdict:
+    """The verdict from each model's final log-likelihood and familiarity.
+
+    Parameters
+    ----------
+    kinds : list of str
+        ``grasp`` or ``reach`` per model.
+    final_log_likelihood : (M,) array
+        Likelihood-rule score of each model at the end.
+    familiarity : (M,) array
+        Each model's familiarity (NaN where it has no calibration).
+    threshold : float
+        Lowest familiarity called familiar.
+    """
+    ll = np.asarray(final_log_likelihood, dtype=float)
+    best = int(np.argmax(ll))
+    margin = float(ll[best] - np.max(np.delete(ll, best))) if ll.size > 1 else float("nan")
+    fam = float(familiarity[best])
+    if not np.isfinite(fam):
+        return Verdict(None, best, fam, margin)
+    if fam < threshold:
+        return Verdict("abnormal", best, fam, margin)
+    return Verdict("reach" if kinds[best] == "reach" else "normal", best, fam, margin)

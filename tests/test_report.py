@@ -1,0 +1,218 @@
+"""Reports: the clip summary and its JSON, the batch tables, statistics and the page."""
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+from _demos import default_repertoire, demo_tracks
+
+from perception import batch
+from perception.batch import ClipResult, summary_table
+from perception.pipeline import recognize_clip
+from perception.report import ClipSummary, write_batch_report, write_clip_report
+from perception.report.clip import clip_figures
+from perception.report.conditions import (
+    aperture_profiles,
+    condition_statistics,
+    reference_model,
+    typical_clips,
+)
+
+
+@pytest.fixture(scope="module")
+def scored(tmp_path_factory):
+    out = tmp_path_factory.mktemp("clips")
+    rep = default_repertoire()
+    recs = {}
+    for i, cond in enumerate(["normal", "normal", "delayed", "delayed", "reach"]):
+        rec = recognize_clip(demo_tracks(cond, i)[0], rep, clip=f"{cond}-{i}")
+        write_clip_report(rec, out, extra={"condition": cond, "tracking": {"lost": 0}})
+        recs[rec.clip] = (rec, cond)
+    return out, recs
+
+
+def test_the_clip_json_reads_back_as_the_summary_made_in_memory(scored):
+    out, recs = scored
+    for name, (rec, cond) in recs.items():
+        d = json.loads((out / f"{name}.recognition.json").read_text())
+        a = ClipSummary.from_recognition(rec, {"condition": cond, "tracking": {"lost": 0}})
+        b = ClipSummary.from_dict(d)
+        assert (a.verdict, a.winner, a.reference_model) == (b.verdict, b.winner,
+                                                            b.reference_model)
+        assert a.familiarity == pytest.approx(b.familiarity)
+        assert a.margin == pytest.approx(b.margin)
+        np.testing.assert_allclose(a.confidence, b.confidence)
+        np.testing.assert_allclose(a.transport, b.transport)
+        np.testing.assert_allclose(a.aperture, b.aperture)
+        assert b.extras == {"condition": cond, "tracking": {"lost": 0}}  # a later key fits in
+        # the transport and grip terms add up to the confidence
+        np.testing.assert_allclose(b.transport + b.grip, b.confidence)
+
+
+def test_a_json_from_before_the_verdict_still_reads(scored):
+    out, recs = scored
+    d = json.loads((out / "normal-0.recognition.json").read_text())
+    for key in ("verdict", "familiarity", "margin", "familiarity_threshold", "reference_model",
+                "transport_confidence", "aperture"):
+        del d[key]
+    for m in d["models"]:
+        del m["misfit"], m["familiarity"]
+    s = ClipSummary.from_dict(d)
+    assert s.verdict is None and np.isnan(s.familiarity) and np.isnan(s.margin)
+    assert np.isnan(s.aperture).all() and s.aperture.shape == s.time.shape
+
+
+def test_summary_columns_and_a_column_added_by_another_step(scored, monkeypatch):
+    _, recs = scored
+    results = [ClipResult(n, c, "ok", summary=ClipSummary.from_recognition(r))
+               for n, (r, c) in recs.items()]
+    results.append(ClipResult("bad", "normal", "failed", error="bad: not a video"))
+    monkeypatch.setattr(batch, "CLIP_COLUMNS",
+                        [*batch.CLIP_COLUMNS, ("lost_frames", lambda s: 3)])
+    table = summary_table(results)
+    assert list(table.columns[:10]) == ["clip", "condition", "winner", "rule", "verdict",
+                                        "familiarity", "margin", "winner_log_likelihood",
+                                        "lost_frames", "reference_model"]
+    assert list(table.columns[-3:]) == ["status", "reused", "error"]
+    ok = table[table["status"] == "ok"].set_index("clip")
+    assert (ok["reference_model"] == "grasp-1.0s").all()  # the model of the normal clips
+    for name, (rec, _) in recs.items():
+        assert ok.loc[name, "verdict"] == rec.verdict
+        assert ok.loc[name, "winner_log_likelihood"] == pytest.approx(
+            rec.log_likelihood[rec.names.index(rec.winner), -1])
+        assert ok.loc[name, "reference_confidence"] == pytest.approx(
+            ok.loc[name, "conf_grasp-1.0s"])
+    bad = table.set_index("clip").loc["bad"]
+    assert pd.isna(bad["verdict"]) and np.isnan(bad["reference_confidence"])
+
+
+def test_statistics_report_their_type_df_and_effect_size():
+    summary = pd.DataFrame({
+        "clip": list("abcdef"), "status": "ok",
+        "condition": ["n", "n", "n", "d", "d", "d"],
+        "conf_m": [3.0, 4.0, 5.0, 1.0, 2.0, 3.0]})
+    stats = condition_statistics(summary, "m")
+    anova, t = stats.iloc[0], stats.iloc[1]
+    assert (anova["statistic_type"], anova["df"]) == ("F", "1, 4")
+    # eta^2 = between / total = 6 / 10
+    assert anova["effect_size_type"] == "eta^2" and anova["effect_size"] == pytest.approx(0.6)
+    assert t["statistic_type"] == "t" and t["mean_difference"] == pytest.approx(2.0)
+    # Hedges' g: 2 / pooled SD 1, times 1 - 3 / (4 * 6 - 9)
+    assert t["effect_size_type"] == "Hedges' g"
+    assert t["effect_size"] == pytest.approx(2.0 * (1 - 3 / 15))
+    assert float(t["df"]) == pytest.approx(4.0)
+    assert t["statistic"] ** 2 == pytest.approx(anova["statistic"])  # equal variances here
+
+
+def test_reference_model_typical_clips_and_aperture_profiles(scored):
+    _, recs = scored
+    sums = [ClipSummary.from_recognition(r) for r, _ in recs.values()]
+    conds = [c for _, c in recs.values()]
+    assert reference_model(sums, conds) == "grasp-1.0s"
+    chosen, which = typical_clips(sums, conds, "grasp-1.0s")
+    assert which == ["normal", "delayed", "reach"] and chosen[2].clip == "reach-4"
+    ap = aperture_profiles(sums, conds).set_index("condition")
+    # normal grasps open to about object + 2 cm; reaches stay closed
+    assert 0.11 < ap.loc["normal", "mean"].max() < 0.135
+    assert ap.loc["reach", "mean"].max() < 0.01
+
+
+def test_figures_beside_a_clip_are_its_own_only(tmp_path):
+    for name in ("a.confidence.png", "a.paths.png", "a.contact.png", "a.b.confidence.png",
+                 "ab.contact.png", "a.notes.txt"):
+        (tmp_path / name).write_bytes(b"x")
+    assert [p.name for p in clip_figures(tmp_path, "a")] == ["a.confidence.png", "a.paths.png",
+                                                              "a.contact.png"]
+
+
+def test_the_batch_page_and_its_figures(scored):
+    out, recs = scored
+    results = [ClipResult(n, c, "ok", summary=ClipSummary.from_recognition(r))
+               for n, (r, c) in recs.items()]
+    summary = summary_table(results)
+    write_batch_report(summary, {r.clip: r.summary for r in results}, out,
+                       models=default_repertoire().models)
+    for name in ("aperture_profiles.png", "confidence_single.png", "confidence_all.png",
+                 "condition_profiles.png"):
+        assert (out / name).stat().st_size > 20_000, name
+    ap = pd.read_csv(out / "aperture_profiles.csv")
+    own = ap[ap["condition"] == "model:grasp-1.0s"]
+    assert len(own) == 101 and 0.11 < own["mean"].max() < 0.13  # the model's own opening
+    prof = pd.read_csv(out / "condition_profiles.csv")
+    np.testing.assert_allclose(prof["transport_mean"] + prof["grip_mean"], prof["mean"])
+    page = (out / "report.html").read_text()
+    assert "Verdicts per condition" in page and 'href="normal-0.recognition.json"' in page
+    assert 'href="#clip-0"' in page and 'id="clip-0"' in page
+
+
+#: Names from the outside world (issue 12): each would break an attribute, a tag, a link or
+#: a URL if written raw. File names cannot hold "/", so none here does.
+HOSTILE = ('a" onerror="alert(1)" x=', "50% #1?", "<b>x", "<img src=x onerror=alert(2)>",
+           "grasp é 日本 &amp;")
+
+
+@pytest.mark.filterwarnings("error::UserWarning")
+def test_hostile_clip_names_are_escaped_in_the_page_and_their_links_resolve(tmp_path):
+    from html.parser import HTMLParser
+    from urllib.parse import unquote, urlsplit
+
+    rep = default_repertoire()
+    results = []
+    for i, name in enumerate(HOSTILE):
+        cond = ("normal", "delayed")[i % 2]
+        rec = recognize_clip(demo_tracks(cond, i)[0], rep, clip=name)
+        write_clip_report(rec, tmp_path, extra={"condition": cond})
+        results.append(ClipResult(name, cond, "ok", summary=ClipSummary.from_recognition(rec)))
+    results.append(ClipResult('<i>bad" x=', "normal", "failed", error='<script>"x"</script>'))
+    summary = summary_table(results)
+    write_batch_report(summary, {r.clip: r.summary for r in results if r.summary}, tmp_path,
+                       models=rep.models)
+
+    class Page(HTMLParser):
+        def __init__(self):
+            super().__init__()
+            self.tags, self.attrs, self.text, self.h3 = [], [], [], []
+            self._in_h3 = False
+
+        def handle_starttag(self, tag, attrs):
+            self.tags.append(tag)
+            self.attrs += [(tag, k, v) for k, v in attrs]
+            self._in_h3 = tag == "h3"
+
+        def handle_endtag(self, tag):
+            self._in_h3 = False if tag == "h3" else self._in_h3
+
+        def handle_data(self, data):
+            self.text.append(data)
+            if self._in_h3:
+                self.h3.append(data)
+
+    page = Page()
+    page.feed((tmp_path / "report.html").read_text(encoding="utf-8"))
+    # no tag or attribute came from a name: only those the writer makes
+    assert set(page.tags) <= {"html", "head", "meta", "title", "style", "body", "h1", "h2", "h3",
+                              "p", "span", "b", "i", "a", "img", "table", "thead", "tbody", "tr",
+                              "th", "td", "div", "figure", "figcaption", "details", "summary",
+                              "code"}, set(page.tags)
+    assert {k for _, k, _ in page.attrs} <= {"charset", "name", "content", "class", "id",
+                                             "href", "src", "alt", "loading"}
+    assert not any(t == "img" and k == "src" and v == "x" for t, k, v in page.attrs)
+    # each name shows as itself (the parser unescapes the text)
+    assert page.h3 == list(HOSTILE)
+    text = "".join(page.text)
+    assert '<i>bad" x=' in text and '<script>"x"</script>' in text
+    # every link and image names an existing file once unquoted; in-page anchors exist
+    ids = {v for _, k, v in page.attrs if k == "id"}
+    targets = [v for _, k, v in page.attrs if k in ("href", "src")]
+    assert len(targets) > 4 * len(HOSTILE)
+    for url in targets:
+        if url.startswith("#"):
+            assert url[1:] in ids, url
+            continue
+        parts = urlsplit(url)
+        assert not (parts.scheme or parts.netloc or parts.query or parts.fragment), url
+        assert (tmp_path / unquote(parts.path)).is_file(), url
+    for name in HOSTILE:
+        for suffix in (".recognition.json", ".confidence.csv", ".confidence.png", ".paths.png"):
+            assert name + suffix in {unquote(u) for u in targets}, (name, suffix)
