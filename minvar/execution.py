@@ -68,8 +68,8 @@ def simulate(
     solution : LQGSolution
         Its gains, from :func:`minvar.lqg.solve`.
     trials : int
-        Number of repetitions (>= 1, at most :data:`minvar.limits.MAX_TRIALS`,
-        and within :data:`minvar.limits.MEMORY_BUDGET`: see
+        Number of repetitions (>= 1; their arrays within
+        :data:`minvar.limits.MEMORY_BUDGET`, see
         :func:`minvar.limits.simulation_bytes`).
     seed : int or numpy.random.Generator, optional
         Randomness; the same seed gives the same trajectories.
@@ -86,8 +86,8 @@ def simulate(
     Raises
     ------
     ValueError
-        If ``trials`` is below 1 or above the limits (checked before any
-        allocation), or the solution is for another problem.
+        If ``trials`` is below 1 or its arrays would exceed the memory budget
+        (checked before any allocation), or the solution is for another problem.
     """
     trials = int(trials)
     if trials < 1:

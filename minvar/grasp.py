@@ -63,7 +63,6 @@ from .limits import (
     check_memory,
     check_position,
     check_steps,
-    check_trials,
     simulation_bytes,
 )
 from .lqg import LQGProblem, LQGSolution, solve
@@ -789,11 +788,10 @@ _RESULT_FLOATS = 20
 
 
 def check_grasp_simulation(task: GraspTask, trials: int, what: str, *,
-                           extra_floats: int = 0) -> int:
+                           extra_floats: int = 0, max_trials: int | None = None) -> int:
     """Refuse, before planning, ``trials`` repetitions of ``task`` beyond the limits.
 
-    :data:`minvar.limits.MAX_TRIALS` bounds the repetitions, and the arrays
-    must fit :data:`minvar.limits.MEMORY_BUDGET`: each chain's states are
+    The arrays must fit :data:`minvar.limits.MEMORY_BUDGET`: each chain's states are
     kept until the result is built, while the chain being simulated also
     holds its estimates, commands and the cost's temporary
     (:func:`minvar.limits.simulation_bytes`); then the Cartesian paths are
@@ -810,6 +808,9 @@ def check_grasp_simulation(task: GraspTask, trials: int, what: str, *,
     extra_floats : int
         Floats per repetition and step that the caller adds (e.g. the
         columns of a table of the result), counted in the same budget.
+    max_trials : int, optional
+        Also refuse more repetitions than this (the command line passes
+        :data:`minvar.limits.MAX_TRIALS`).
 
     Returns
     -------
@@ -821,7 +822,9 @@ def check_grasp_simulation(task: GraspTask, trials: int, what: str, *,
     ValueError
         If the repetitions or their memory exceed the limits.
     """
-    trials = check_trials(trials, what)
+    if max_trials is not None and trials > max_trials:
+        raise ValueError(f"{what}: {trials} repetitions are more than the {max_trials} "
+                         f"allowed (MAX_TRIALS; see docs/model.md, Limits)")
     steps, plant = task.steps, task.plant
     # the arm has one positional target; each digit its goal and via-points
     states = [plant.n_states(1)] + 2 * [plant.n_states(1 + len(task.via_schedule))]
@@ -829,7 +832,7 @@ def check_grasp_simulation(task: GraspTask, trials: int, what: str, *,
     kept = sum(per_step * n for n in states)
     running = max(simulation_bytes(trials, steps, n) - per_step * n for n in states)
     check_memory(kept + running + per_step * (_RESULT_FLOATS + extra_floats), what,
-                 f"{trials} repetitions x {steps + 1} states of 3 chains")
+                 f"{trials} repetitions x {steps + 1} time points of 3 chains")
     return trials
 
 
@@ -858,9 +861,8 @@ def simulate_grasp(
     task : GraspTask
         The grasp.
     trials : int
-        Number of repetitions (>= 1; thesis 500; at most
-        :data:`minvar.limits.MAX_TRIALS`, and their arrays within
-        :data:`minvar.limits.MEMORY_BUDGET`, checked before simulating).
+        Number of repetitions (>= 1; thesis 500; their arrays within
+        :data:`minvar.limits.MEMORY_BUDGET`, checked before planning).
     seed : int, numpy.random.SeedSequence or numpy.random.Generator, optional
         Randomness; the same seed gives the same result.
     plan : GraspPlan, optional

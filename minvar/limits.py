@@ -14,17 +14,22 @@ tabulates the limits.
 The values, and why:
 
 ``MAX_STEPS = 5000``
-    Control steps of one movement: 50 s at the default 10 ms step (the
-    recognition's models step at about 8 ms: over 40 s). The thesis's
+    Control steps of one movement: 50 s at the default 10 ms step (40-55 s
+    at the 8-11 ms steps of the recognition's models). The thesis's
     movements last 0.5-1.2 s, the longest anywhere in the project 2 s; human
     reaches and grasps last about a second. Planning 5000 steps takes a few
     seconds, and the plan's arrays (``Q``, gains, per-step matrices: ``(T+1)
-    x n x n``) stay under 10 MB for one target.
+    x n x n``) take about 16 MB for one target.
 ``MAX_TRIALS = 10_000``
-    Simulated repetitions of one movement (per setting of a sweep): twenty
-    times the thesis's 500 per setting; at 10 000 the Monte Carlo error of a
-    standard deviation is under 1 %. More only lengthens the run and the
-    tables written (one CSV row per repetition and step).
+    Simulated repetitions of one movement (per setting of a sweep) that the
+    commands and the grasp experiments (:func:`minvar.grasp_experiments.check_trials`)
+    accept: twenty times the thesis's 500 per setting; at 10 000 the Monte
+    Carlo error of a standard deviation is under 1 %. More only lengthens the
+    run and the tables written (one CSV row per repetition and step). The
+    simulators themselves (:func:`minvar.execution.simulate`,
+    :func:`minvar.grasp.simulate_grasp`) are bounded by memory alone: checking
+    the Monte Carlo against the exact moments takes 20 000 repetitions of a
+    short movement, which is cheap.
 ``MEMORY_BUDGET = 2 GiB`` (2^31 bytes)
     The most memory a simulation's (or a plan's) arrays may take, estimated
     from their shapes before they are allocated: :func:`simulation_bytes` for
@@ -83,11 +88,6 @@ def _gib(nbytes: float) -> str:
     return f"{gib:.1f} GiB" if gib >= 0.1 else f"{gib:.2g} GiB"
 
 
-def steps_of(duration: float, dt: float) -> int:
-    """The number of control steps of a ``duration`` s movement at step ``dt`` s."""
-    return int(round(float(duration) / float(dt)))
-
-
 def check_steps(duration: float, dt: float, what: str) -> int:
     """Check that a movement of ``duration`` s at step ``dt`` s has at most :data:`MAX_STEPS`.
 
@@ -123,6 +123,13 @@ def check_steps(duration: float, dt: float, what: str) -> int:
 
 def check_trials(trials: int, what: str) -> int:
     """Check that ``trials`` repetitions are at most :data:`MAX_TRIALS`; return it as an int.
+
+    Parameters
+    ----------
+    trials : int
+        Repetitions (an integer >= 1: checked by the caller).
+    what : str
+        The field or flag to name in the message (e.g. ``"--trials"``).
 
     Raises
     ------
@@ -171,14 +178,25 @@ def simulation_bytes(trials: int, steps: int, n_states: int, n_controls: int = 2
     The states and the Kalman estimates (``trials x (steps+1) x n_states``
     each), the commands (``trials x steps x n_controls``) and the realised
     cost's temporary, the size of the states: float64 throughout.
+
+    Parameters
+    ----------
+    trials : int
+        Repetitions.
+    steps : int
+        Control steps of the movement.
+    n_states : int
+        State dimension.
+    n_controls : int
+        Command dimension.
     """
     per_trial = 3 * (steps + 1) * n_states + steps * n_controls
     return _FLOAT * int(trials) * per_trial
 
 
 def check_simulation(trials: int, steps: int, n_states: int, what: str,
-                     n_controls: int = 2) -> int:
-    """Check a simulation's repetitions and memory before it allocates; return ``trials``.
+                     n_controls: int = 2, *, max_trials: int | None = None) -> int:
+    """Check a simulation's memory (and repetitions) before it allocates; return ``trials``.
 
     Parameters
     ----------
@@ -192,27 +210,38 @@ def check_simulation(trials: int, steps: int, n_states: int, what: str,
         The field, flag or function to name in the message.
     n_controls : int
         Command dimension.
+    max_trials : int, optional
+        Also refuse more repetitions than this (the commands pass
+        :data:`MAX_TRIALS`).
 
     Raises
     ------
     ValueError
-        If ``trials`` exceeds :data:`MAX_TRIALS` or the arrays would exceed
+        If ``trials`` exceeds ``max_trials`` or the arrays would exceed
         :data:`MEMORY_BUDGET`; the message gives the memory needed.
     """
     need = simulation_bytes(trials, steps, n_states, n_controls)
-    if trials > MAX_TRIALS:
+    if max_trials is not None and trials > max_trials:
         raise ValueError(
-            f"{what}: {trials} repetitions are more than the {MAX_TRIALS} allowed "
+            f"{what}: {trials} repetitions are more than the {max_trials} allowed "
             f"(MAX_TRIALS; they would need about {_gib(need)} of memory; see docs/model.md, "
             f"Limits)"
         )
-    check_memory(need, what, f"{trials} repetitions x {steps + 1} states of {n_states} "
-                             f"variables")
+    check_memory(need, what, f"{trials} repetitions x {steps + 1} time points x "
+                             f"{n_states} states")
     return int(trials)
 
 
 def problem_bytes(steps: int, n_states: int) -> int:
-    """Estimated bytes of a plan: a few ``(steps+1) x n x n`` float64 arrays."""
+    """Estimated bytes of a plan: a few ``(steps+1) x n x n`` float64 arrays.
+
+    Parameters
+    ----------
+    steps : int
+        Control steps of the movement.
+    n_states : int
+        State dimension (8 plus 2 per positional target).
+    """
     return _FLOAT * _PROBLEM_ARRAYS * (steps + 1) * n_states * n_states
 
 
@@ -220,6 +249,15 @@ def check_problem(steps: int, n_states: int, what: str) -> None:
     """Check the memory of a plan of ``steps`` steps and ``n_states`` states.
 
     The estimate is :func:`problem_bytes`.
+
+    Parameters
+    ----------
+    steps : int
+        Control steps of the movement.
+    n_states : int
+        State dimension.
+    what : str
+        The task or field to name in the message.
 
     Raises
     ------

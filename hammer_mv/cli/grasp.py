@@ -15,7 +15,7 @@ from pathlib import Path
 
 from minvar.grasp import GraspTask, check_grasp_simulation
 from minvar.grasp_experiments import EXPERIMENTS, THESIS_TRIALS, check_trials
-from minvar.limits import check_position, check_steps
+from minvar.limits import MAX_TRIALS, check_position, check_steps
 from minvar.plant import PointMassPlant
 from perception.io.atomic import save_figure, write_csv, write_json
 
@@ -138,7 +138,8 @@ def run_simulate(args: argparse.Namespace) -> int:
         execution_cv=args.execution_cv, plant=PointMassPlant(dt=args.dt),
     )
     # the simulation, and the table of trajectories.csv in the same budget
-    check_grasp_simulation(task, args.trials, "--trials", extra_floats=TABLE_COLUMNS)
+    check_grasp_simulation(task, args.trials, "--trials", extra_floats=TABLE_COLUMNS,
+                           max_trials=MAX_TRIALS)
     plan = plan_grasp(task)
     result = simulate_grasp(task, args.trials, seed=args.seed, plan=plan)
     summary = summarize_grasp(result, grasp_moments(plan))

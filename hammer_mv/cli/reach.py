@@ -18,6 +18,7 @@ from minvar.analysis import (
     speed_accuracy,
 )
 from minvar.limits import (
+    MAX_TRIALS,
     check_memory,
     check_position,
     check_simulation,
@@ -106,7 +107,7 @@ def run(args: argparse.Namespace) -> int:
             steps = ReachTask(task.start, task.goal, d, vias).steps(plant.dt)
             for v in vias:
                 v.step(d, plant.dt)
-            check_simulation(trials, steps, n_states, "--trials")
+            check_simulation(trials, steps, n_states, "--trials", max_trials=MAX_TRIALS)
         sweep = speed_accuracy(task, args.durations, trials, seed=args.seed, plant=plant)
         write_csv(out / "speed_accuracy.csv", sweep.summary)
         write_csv(out / "speed_accuracy_trials.csv", sweep.trials)
@@ -119,11 +120,11 @@ def run(args: argparse.Namespace) -> int:
     if trials < 2:
         raise ValueError(f"--trials: need at least 2 repetitions, got {trials}")
     steps = task.steps(plant.dt)
-    check_simulation(trials, steps, n_states, "--trials")
+    check_simulation(trials, steps, n_states, "--trials", max_trials=MAX_TRIALS)
     # ... and the table of trajectories.csv: TABLE_COLUMNS floats per repetition and step
     check_memory(simulation_bytes(trials, steps, n_states)
                  + 8 * TABLE_COLUMNS * trials * (steps + 1),
-                 "--trials", f"{trials} repetitions x {steps + 1} states and their table")
+                 "--trials", f"{trials} repetitions x {steps + 1} time points and their table")
     result = simulate_reach(task, trials, seed=args.seed, plant=plant)
     stats = endpoint_stats(result.endpoint, task.goal)
     summary = {
