@@ -4,7 +4,8 @@ Todorov's (2005) LQG with signal-dependent noise (:mod:`minvar.lqg`), the
 point-mass/muscle plant of Todorov & Jordan 2002 (:mod:`minvar.plant`),
 reaching tasks with via-points (:mod:`minvar.task`), vectorised Monte Carlo
 execution (:mod:`minvar.execution`, :mod:`minvar.reach`), two-link kinematics
-(:mod:`minvar.kinematics`), the analyses of the thesis's chapter 3
+(:mod:`minvar.kinematics`), the limits on sizes and positions checked before
+anything is allocated (:mod:`minvar.limits`), the analyses of the thesis's chapter 3
 (:mod:`minvar.analysis`), chapter 2's comparison models
 (:mod:`minvar.baselines`), appendix A's via-point representation
 (:mod:`minvar.viapoints`, :mod:`minvar.similarity`), and reach-to-grasp
@@ -64,6 +65,7 @@ _SUBMODULES = (
     "grasp_experiments",
     "grasp_stats",
     "kinematics",
+    "limits",
     "lqg",
     "plant",
     "plotting",

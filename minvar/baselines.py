@@ -41,6 +41,7 @@ from scipy.special import beta as beta_function
 from scipy.special import betainc
 
 from .kinematics import TwoLinkChain
+from .limits import check_steps
 from .task import ViaPoint, _point
 
 __all__ = [
@@ -156,7 +157,7 @@ def _sample_times(owner: str, duration: float, dt: float) -> np.ndarray:
         raise ValueError(
             f"{owner}: dt must be positive and at most half the duration ({duration} s), got {dt}"
         )
-    steps = int(round(duration / dt))
+    steps = check_steps(duration, dt, f"{owner}: duration")  # before sampling it
     return np.linspace(0.0, duration, steps + 1)
 
 

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .limits import check_simulation
 from .lqg import LQGProblem, LQGSolution
 
 __all__ = ["Trajectories", "simulate", "as_generator"]
@@ -67,7 +68,9 @@ def simulate(
     solution : LQGSolution
         Its gains, from :func:`minvar.lqg.solve`.
     trials : int
-        Number of repetitions (>= 1).
+        Number of repetitions (>= 1; their arrays within
+        :data:`minvar.limits.MEMORY_BUDGET`, see
+        :func:`minvar.limits.simulation_bytes`).
     seed : int or numpy.random.Generator, optional
         Randomness; the same seed gives the same trajectories.
     execution : LQGProblem, optional
@@ -79,6 +82,12 @@ def simulate(
     -------
     Trajectories
         States, estimates, commands and realised cost of every repetition.
+
+    Raises
+    ------
+    ValueError
+        If ``trials`` is below 1 or its arrays would exceed the memory budget
+        (checked before any allocation), or the solution is for another problem.
     """
     trials = int(trials)
     if trials < 1:
@@ -94,6 +103,7 @@ def simulate(
                 )
     rng = as_generator(seed)
     T, n, m = p.horizon, p.n_states, p.n_controls
+    check_simulation(trials, T, n, "simulate: trials", n_controls=m)
     K, L = solution.K, solution.L
     if K.shape[0] != T or L.shape != (T, m, n):
         raise ValueError(

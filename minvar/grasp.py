@@ -59,6 +59,12 @@ import numpy as np
 from .execution import simulate
 from .grasp_stats import grip_aperture, max_grip_aperture, path_sd
 from .kinematics import TwoLinkChain
+from .limits import (
+    check_memory,
+    check_position,
+    check_steps,
+    simulation_bytes,
+)
 from .lqg import LQGProblem, LQGSolution, solve
 from .plant import POSITION, VELOCITY, PointMassPlant
 from .task import ReachTask, ViaPoint, reach_problem
@@ -77,6 +83,7 @@ __all__ = [
     "GraspResult",
     "plan_grasp",
     "simulate_grasp",
+    "check_grasp_simulation",
     "CHAINS",
 ]
 
@@ -84,8 +91,12 @@ __all__ = [
 CHAINS = ("arm", "finger", "thumb")
 
 
-def _finite(owner: str, name: str, value, *, low: float | None = None, strict: bool = False):
-    """``value`` as a float, checked finite and above ``low``; raise naming ``owner.name``."""
+def _finite(owner: str, name: str, value, *, low: float | None = None, strict: bool = False,
+            length: bool = False):
+    """``value`` as a float, checked finite and above ``low``; raise naming ``owner.name``.
+
+    A ``length`` (m) is also checked within :data:`minvar.limits.MAX_POSITION_M`.
+    """
     try:
         v = float(value)
     except (TypeError, ValueError):
@@ -95,6 +106,8 @@ def _finite(owner: str, name: str, value, *, low: float | None = None, strict: b
     if low is not None and (v <= low if strict else v < low):
         op = ">" if strict else ">="
         raise ValueError(f"{owner}.{name}: expected a value {op} {low}, got {value!r}")
+    if length:
+        check_position(v, f"{owner}.{name}")
     return v
 
 
@@ -103,6 +116,7 @@ def _pair(owner: str, name: str, value, *, positive: bool = False) -> tuple[floa
     if arr.shape != (2,) or not np.all(np.isfinite(arr)) or (positive and np.any(arr <= 0)):
         what = "2 positive lengths" if positive else "2 finite coordinates"
         raise ValueError(f"{owner}.{name}: expected {what}, got {value!r}")
+    check_position(arr, f"{owner}.{name}")
     return float(arr[0]), float(arr[1])
 
 
@@ -129,9 +143,11 @@ class GripVia:
 
     def __post_init__(self):
         object.__setattr__(
-            self, "half_aperture", _finite("GripVia", "half_aperture", self.half_aperture, low=0.0)
+            self, "half_aperture",
+            _finite("GripVia", "half_aperture", self.half_aperture, low=0.0, length=True),
         )
-        object.__setattr__(self, "height", _finite("GripVia", "height", self.height))
+        object.__setattr__(self, "height",
+                           _finite("GripVia", "height", self.height, length=True))
         f = _finite("GripVia", "fraction", self.fraction)
         if not 0.0 < f < 1.0:
             raise ValueError(f"GripVia.fraction: expected a time fraction in (0, 1), got {f}")
@@ -142,7 +158,9 @@ class GripVia:
 class GraspTask:
     """One reach-to-grasp movement (thesis 4.1.1; geometry in the module docstring).
 
-    All lengths in m, times in s unless stated.
+    All lengths in m, times in s unless stated. Every length and coordinate
+    lies within :data:`minvar.limits.MAX_POSITION_M`, and the movement has at
+    most :data:`minvar.limits.MAX_STEPS` steps (docs/model.md, Limits).
 
     Parameters
     ----------
@@ -224,12 +242,15 @@ class GraspTask:
     def __post_init__(self):
         own = "GraspTask"
         setv = object.__setattr__
-        setv(self, "object_size", _finite(own, "object_size", self.object_size, low=0.0))
-        setv(self, "distance", _finite(own, "distance", self.distance, low=0.0, strict=True))
+        setv(self, "object_size",
+             _finite(own, "object_size", self.object_size, low=0.0, length=True))
+        setv(self, "distance",
+             _finite(own, "distance", self.distance, low=0.0, strict=True, length=True))
         setv(self, "duration", _finite(own, "duration", self.duration, low=0.0, strict=True))
         setv(self, "viapoint_offset",
-             _finite(own, "viapoint_offset", self.viapoint_offset, low=0.0))
-        setv(self, "viapoint_height", _finite(own, "viapoint_height", self.viapoint_height))
+             _finite(own, "viapoint_offset", self.viapoint_offset, low=0.0, length=True))
+        setv(self, "viapoint_height",
+             _finite(own, "viapoint_height", self.viapoint_height, length=True))
         vt = _finite(own, "viapoint_time", self.viapoint_time)
         if not 0.0 < vt < 1.0:
             raise ValueError(
@@ -239,8 +260,8 @@ class GraspTask:
         for name in ("execution_cv", "execution_sigma_s", "r", "w_v", "w_f"):
             setv(self, name, _finite(own, name, getattr(self, name), low=0.0))
         setv(self, "wrist_offset",
-             _finite(own, "wrist_offset", self.wrist_offset, low=0.0, strict=True))
-        setv(self, "tip_start", _finite(own, "tip_start", self.tip_start))
+             _finite(own, "wrist_offset", self.wrist_offset, low=0.0, strict=True, length=True))
+        setv(self, "tip_start", _finite(own, "tip_start", self.tip_start, length=True))
         setv(self, "shoulder_offset", _pair(own, "shoulder_offset", self.shoulder_offset))
         setv(self, "arm_links", _pair(own, "arm_links", self.arm_links, positive=True))
         setv(self, "digit_links", _pair(own, "digit_links", self.digit_links, positive=True))
@@ -261,7 +282,7 @@ class GraspTask:
 
     def _check_timing(self) -> None:
         dt = self.plant.dt
-        T = int(round(self.duration / dt))
+        T = check_steps(self.duration, dt, "GraspTask.duration")  # before any step is counted
         if T < 2:
             raise ValueError(
                 f"GraspTask.duration: {self.duration} s is shorter than 2 steps of {dt} s"
@@ -760,6 +781,61 @@ def _result(plan: GraspPlan, q: dict, qd: dict) -> GraspResult:
     )
 
 
+#: Floats per repetition and step of a result beyond the chains' states: the
+#: wrist, finger and thumb paths and velocities (2 each) and the temporaries
+#: of their forward kinematics and Jacobians.
+_RESULT_FLOATS = 20
+
+
+def check_grasp_simulation(task: GraspTask, trials: int, what: str, *,
+                           extra_floats: int = 0, max_trials: int | None = None) -> int:
+    """Refuse, before planning, ``trials`` repetitions of ``task`` beyond the limits.
+
+    The arrays must fit :data:`minvar.limits.MEMORY_BUDGET`: each chain's states are
+    kept until the result is built, while the chain being simulated also
+    holds its estimates, commands and the cost's temporary
+    (:func:`minvar.limits.simulation_bytes`); then the Cartesian paths are
+    computed.
+
+    Parameters
+    ----------
+    task : GraspTask
+        The grasp.
+    trials : int
+        Repetitions.
+    what : str
+        The argument or flag to name in the message.
+    extra_floats : int
+        Floats per repetition and step that the caller adds (e.g. the
+        columns of a table of the result), counted in the same budget.
+    max_trials : int, optional
+        Also refuse more repetitions than this (the command line passes
+        :data:`minvar.limits.MAX_TRIALS`).
+
+    Returns
+    -------
+    int
+        ``trials``.
+
+    Raises
+    ------
+    ValueError
+        If the repetitions or their memory exceed the limits.
+    """
+    if max_trials is not None and trials > max_trials:
+        raise ValueError(f"{what}: {trials} repetitions are more than the {max_trials} "
+                         f"allowed (MAX_TRIALS; see docs/model.md, Limits)")
+    steps, plant = task.steps, task.plant
+    # the arm has one positional target; each digit its goal and via-points
+    states = [plant.n_states(1)] + 2 * [plant.n_states(1 + len(task.via_schedule))]
+    per_step = 8 * trials * (steps + 1)
+    kept = sum(per_step * n for n in states)
+    running = max(simulation_bytes(trials, steps, n) - per_step * n for n in states)
+    check_memory(kept + running + per_step * (_RESULT_FLOATS + extra_floats), what,
+                 f"{trials} repetitions x {steps + 1} time points of 3 chains")
+    return trials
+
+
 def _seeds(seed) -> list[np.random.Generator]:
     """One generator per chain from an int, SeedSequence or Generator."""
     if isinstance(seed, np.random.Generator):
@@ -785,7 +861,8 @@ def simulate_grasp(
     task : GraspTask
         The grasp.
     trials : int
-        Number of repetitions (>= 1; thesis 500).
+        Number of repetitions (>= 1; thesis 500; their arrays within
+        :data:`minvar.limits.MEMORY_BUDGET`, checked before planning).
     seed : int, numpy.random.SeedSequence or numpy.random.Generator, optional
         Randomness; the same seed gives the same result.
     plan : GraspPlan, optional
@@ -799,6 +876,7 @@ def simulate_grasp(
         raise ValueError(f"simulate_grasp: task: expected a GraspTask, got {type(task).__name__}")
     if isinstance(trials, bool) or not isinstance(trials, int | np.integer) or trials < 1:
         raise ValueError(f"simulate_grasp: trials: expected an integer >= 1, got {trials!r}")
+    check_grasp_simulation(task, int(trials), "simulate_grasp: trials")  # before planning
     if plan is None:
         plan = plan_grasp(task)
     elif not isinstance(plan, GraspPlan) or plan.task != task:

@@ -35,6 +35,7 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 import pandas as pd
 
+from . import limits
 from .grasp import GraspTask, plan_grasp, simulate_grasp
 from .grasp_stats import (
     GraspMoments,
@@ -170,9 +171,10 @@ class GraspExperiment:
 
 
 def check_trials(trials, *, name: str = "trials") -> int:
-    """Check a number of repetitions per setting: an integer of at least 2.
+    """Check a number of repetitions per setting: an integer from 2 to ``MAX_TRIALS``.
 
-    Two is the fewest from which a standard deviation can be computed.
+    Two is the fewest from which a standard deviation can be computed;
+    :data:`minvar.limits.MAX_TRIALS` (10 000) the most one setting may run.
 
     Parameters
     ----------
@@ -190,13 +192,14 @@ def check_trials(trials, *, name: str = "trials") -> int:
     Raises
     ------
     ValueError
-        If ``trials`` is not an integer >= 2 (a bool is not an integer here).
+        If ``trials`` is not an integer >= 2 (a bool is not an integer here),
+        or is more than :data:`minvar.limits.MAX_TRIALS`.
     """
     if isinstance(trials, bool) or not isinstance(trials, int | np.integer) or trials < 2:
         raise ValueError(
             f"{name}: expected an integer number of repetitions >= 2, got {trials!r}"
         )
-    return int(trials)
+    return limits.check_trials(int(trials), name)
 
 
 class SweepTables(NamedTuple):

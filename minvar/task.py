@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .limits import check_position, check_problem, check_steps
 from .lqg import LQGProblem
 from .plant import FORCE, N_BASE, POSITION, VELOCITY, PointMassPlant
 
@@ -32,6 +33,7 @@ def _point(owner: str, name: str, value) -> tuple[float, float]:
     arr = np.asarray(value, dtype=float)
     if arr.shape != (2,) or not np.all(np.isfinite(arr)):
         raise ValueError(f"{owner}.{name}: expected 2 finite coordinates, got {value!r}")
+    check_position(arr, f"{owner}.{name}")
     return float(arr[0]), float(arr[1])
 
 
@@ -45,7 +47,8 @@ class ViaPoint:
     Parameters
     ----------
     position : (2,) array_like
-        Via-point position (m, or rad in joint space).
+        Via-point position (m, or rad in joint space), each coordinate within
+        :data:`minvar.limits.MAX_POSITION_M`.
     fraction : float, optional
         Time as a fraction of the movement duration.
     seconds : float, optional
@@ -97,9 +100,11 @@ class ReachTask:
     Parameters
     ----------
     start, goal : (2,) array_like
-        Start and goal positions (m; rad for joint-space tasks).
+        Start and goal positions (m; rad for joint-space tasks), each
+        coordinate within :data:`minvar.limits.MAX_POSITION_M`.
     duration : float
-        Movement time, s. Must span at least 2 plant steps.
+        Movement time, s. Must span at least 2 plant steps and at most
+        :data:`minvar.limits.MAX_STEPS`.
     via_points : sequence of ViaPoint
         Intermediate positional targets.
     r : float
@@ -142,9 +147,10 @@ class ReachTask:
         Raises
         ------
         ValueError
-            If the movement is shorter than 2 steps.
+            If the movement is shorter than 2 steps, or longer than
+            :data:`minvar.limits.MAX_STEPS`.
         """
-        T = int(round(self.duration / dt))
+        T = check_steps(self.duration, dt, "ReachTask.duration")
         if T < 2:
             raise ValueError(
                 f"ReachTask.duration: {self.duration} s is shorter than 2 steps of {dt} s"
@@ -178,6 +184,7 @@ def reach_problem(task: ReachTask, plant: PointMassPlant | None = None) -> LQGPr
     targets = task.targets
     P = len(targets)
     n = plant.n_states(P)
+    check_problem(T, n, "ReachTask")  # before Q, (T+1) x n x n, is allocated
     A, B = plant.dynamics(P)
     H, D0 = plant.observation(P)
     # Divide by (P + 2) rather than multiply by its reciprocal: the same

@@ -13,12 +13,18 @@ import logging
 import time
 from pathlib import Path
 
-from minvar.grasp import GraspTask
+from minvar.grasp import GraspTask, check_grasp_simulation
 from minvar.grasp_experiments import EXPERIMENTS, THESIS_TRIALS, check_trials
+from minvar.limits import MAX_TRIALS, check_position, check_steps
 from minvar.plant import PointMassPlant
 from perception.io.atomic import save_figure, write_csv, write_json
 
 log = logging.getLogger(__name__)
+
+#: Columns of trajectories.csv (:meth:`minvar.grasp.GraspResult.to_pandas`).
+TABLE_COLUMNS = 17
+#: The flags of ``grasp simulate`` that are lengths, m (bounded by MAX_POSITION_M).
+LENGTH_FLAGS = ("object_size", "distance", "viapoint_offset", "viapoint_height", "tip_start")
 
 
 def register(sub) -> None:
@@ -119,6 +125,11 @@ def run_simulate(args: argparse.Namespace) -> int:
     from minvar.plotting import grasp_figure, setup_figure
 
     check_trials(args.trials, name="--trials")
+    # Sizes and lengths against minvar.limits, named by their flags, before any work.
+    for name in LENGTH_FLAGS:
+        check_position(getattr(args, name), "--" + name.replace("_", "-"))
+    if args.dt > 0:  # a bad --dt is refused by PointMassPlant
+        check_steps(args.duration, args.dt, "--duration")
     _check_output(args.output)
     task = GraspTask(
         object_size=args.object_size, distance=args.distance, duration=args.duration,
@@ -126,6 +137,9 @@ def run_simulate(args: argparse.Namespace) -> int:
         viapoint_time=args.viapoint_time, tip_start=args.tip_start, reach_only=args.reach_only,
         execution_cv=args.execution_cv, plant=PointMassPlant(dt=args.dt),
     )
+    # the simulation, and the table of trajectories.csv in the same budget
+    check_grasp_simulation(task, args.trials, "--trials", extra_floats=TABLE_COLUMNS,
+                           max_trials=MAX_TRIALS)
     plan = plan_grasp(task)
     result = simulate_grasp(task, args.trials, seed=args.seed, plan=plan)
     summary = summarize_grasp(result, grasp_moments(plan))

@@ -17,12 +17,23 @@ from minvar.analysis import (
     peak_to_mean_speed,
     speed_accuracy,
 )
+from minvar.limits import (
+    MAX_TRIALS,
+    check_memory,
+    check_position,
+    check_simulation,
+    check_steps,
+    simulation_bytes,
+)
 from minvar.plant import PointMassPlant
 from minvar.reach import simulate_reach
 from minvar.task import ReachTask, ViaPoint
 from perception.io.atomic import save_figure, write_csv, write_json
 
 log = logging.getLogger(__name__)
+
+#: Columns of trajectories.csv (:meth:`minvar.reach.ReachResult.to_pandas`).
+TABLE_COLUMNS = 10
 
 
 def register(sub) -> None:
@@ -71,12 +82,19 @@ def run(args: argparse.Namespace) -> int:
     from minvar.plotting import reach_figure, speed_accuracy_figure
 
     plant = PointMassPlant(sigma_u=args.sigma_u, sigma_s=args.sigma_s)
+    # Sizes and positions against minvar.limits, named by their flags, before any work.
+    check_position(args.start, "--start")
+    check_position(args.goal, "--goal")
+    for x, y, _ in args.via:
+        check_position((x, y), "--via")
+    check_steps(args.duration, plant.dt, "--duration")
     vias = tuple(ViaPoint((x, y), fraction=f) for x, y, f in args.via)
     task = ReachTask(tuple(args.start), tuple(args.goal), args.duration, vias,
                      r=args.r, w_v=args.w_v, w_f=args.w_f)
+    task.steps(plant.dt)
     for v in vias:
         v.step(task.duration, plant.dt)  # reject bad via-point times before any work
-    task.steps(plant.dt)
+    n_states = plant.n_states(len(task.targets))
     out: Path = args.output
     if out.exists() and not out.is_dir():
         raise ValueError(f"{out}: output exists and is not a folder")
@@ -85,9 +103,11 @@ def run(args: argparse.Namespace) -> int:
         if trials < 2:
             raise ValueError(f"--trials: need at least 2 repetitions for a sweep, got {trials}")
         for d in args.durations:
-            ReachTask(task.start, task.goal, d, vias).steps(plant.dt)
+            check_steps(d, plant.dt, "--durations")
+            steps = ReachTask(task.start, task.goal, d, vias).steps(plant.dt)
             for v in vias:
                 v.step(d, plant.dt)
+            check_simulation(trials, steps, n_states, "--trials", max_trials=MAX_TRIALS)
         sweep = speed_accuracy(task, args.durations, trials, seed=args.seed, plant=plant)
         write_csv(out / "speed_accuracy.csv", sweep.summary)
         write_csv(out / "speed_accuracy_trials.csv", sweep.trials)
@@ -99,6 +119,12 @@ def run(args: argparse.Namespace) -> int:
     trials = 100 if args.trials is None else args.trials
     if trials < 2:
         raise ValueError(f"--trials: need at least 2 repetitions, got {trials}")
+    steps = task.steps(plant.dt)
+    check_simulation(trials, steps, n_states, "--trials", max_trials=MAX_TRIALS)
+    # ... and the table of trajectories.csv: TABLE_COLUMNS floats per repetition and step
+    check_memory(simulation_bytes(trials, steps, n_states)
+                 + 8 * TABLE_COLUMNS * trials * (steps + 1),
+                 "--trials", f"{trials} repetitions x {steps + 1} time points and their table")
     result = simulate_reach(task, trials, seed=args.seed, plant=plant)
     stats = endpoint_stats(result.endpoint, task.goal)
     summary = {
