@@ -48,6 +48,8 @@ The values, and why:
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 __all__ = [
@@ -111,7 +113,9 @@ def check_steps(duration: float, dt: float, what: str) -> int:
         If the movement has more than :data:`MAX_STEPS` steps.
     """
     ratio = float(duration) / float(dt)
-    if not ratio <= MAX_STEPS + 0.5:  # also catches inf and nan
+    if not (math.isfinite(ratio) and ratio > 0):
+        raise ValueError(f"{what}: expected a finite, positive time in s, got {duration!r}")
+    if ratio > MAX_STEPS + 0.5:
         steps = f"{ratio:.0f}" if ratio < 1e9 else f"{ratio:.3g}"
         raise ValueError(
             f"{what}: {duration:g} s is {steps} steps of {dt:g} s, more than the "

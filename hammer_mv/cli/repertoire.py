@@ -51,6 +51,12 @@ def run_build(args: argparse.Namespace) -> int:
                              f"got {args.fps}")
         scene = SceneSpec(distance=args.distance, object_size=args.object_size,
                           frame_period=1.0 / args.fps)
+        from minvar.limits import check_steps
+        from perception.recognition.models import model_substeps
+
+        dt = scene.frame_period / model_substeps(scene.frame_period)
+        for duration in args.durations:  # named by the flag, before any planning
+            check_steps(duration, dt, "--durations")
         rep = Repertoire.build(default_specs(args.durations), scene)
     rep.save(args.output)
     print(f"wrote {args.output}: {len(rep)} models ({', '.join(rep.names)})")
