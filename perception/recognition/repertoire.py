@@ -13,6 +13,7 @@ stored in HDF5 (:mod:`perception.io.repertoire`).
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
 import json
 import logging
@@ -241,8 +242,32 @@ class Repertoire:
             raise InputError(f"corrupt or unreadable repertoire: {exc}", path) from None
 
 
+#: The default models' verdict calibrations at the default scene
+#: (``tools/calibrate_default.py`` makes it).
+DEFAULT_CALIBRATION = Path(__file__).with_name("default_calibration.json")
+
+
+@functools.cache
+def _shipped_calibrations() -> dict[str, Calibration]:
+    """The default models' calibrations, if the shipped file is present and readable.
+
+    Without it, the default models are calibrated when a verdict needs them
+    (the same numbers, computed: about half a second a model and scene).
+    """
+    try:
+        data = json.loads(DEFAULT_CALIBRATION.read_text())
+        params = CalibrationParams(**data["params"])
+        return {name: Calibration(misfit, float(data["frame_period"]), params)
+                for name, misfit in data["models"].items()}
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        log.warning("no shipped calibration of the default models (%s): calibrating "
+                    "them when needed", exc)
+        return {}
+
+
 class _DefaultRepertoire(Repertoire):
-    """:meth:`Repertoire.default`: the default models, planned on first use."""
+    """:meth:`Repertoire.default`: the default models, planned on first use, their verdict
+    calibrated by the shipped calibration (transferred to each clip's scene)."""
 
     def __init__(self):
         self._specs = default_specs()
@@ -256,7 +281,10 @@ class _DefaultRepertoire(Repertoire):
     @property
     def models(self) -> list[MotorModel]:  # type: ignore[override]
         if self._models is None:
-            self._models = build_models(self._specs, self._scene)  # calibrated when asked
+            shipped = _shipped_calibrations()
+            self._models = _calibrated(build_models(self._specs, self._scene),
+                                       [shipped.get(s.name) for s in self._specs],
+                                       compute=False)  # any other calibrated when asked
         return self._models
 
     @property
@@ -285,6 +313,11 @@ class _Unplanned:
     @property
     def name(self) -> str:
         return self.spec.name
+
+    @property
+    def calibration(self) -> Calibration | None:
+        """The shipped calibration, which the model planned for a clip's scene keeps."""
+        return _shipped_calibrations().get(self.spec.name)
 
 
 class PlanCache:

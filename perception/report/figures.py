@@ -18,16 +18,24 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
-from matplotlib.figure import Figure
 
-from minvar.plotting import new_figure
 from perception.recognition.result import Recognition
 
 if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
     from perception.report.clip import ClipSummary
 
 __all__ = ["aperture_figure", "condition_colour", "condition_figure", "confidence_all_figure",
            "confidence_figure", "confidence_single_figure", "paths_figure"]
+
+
+def _new_figure(*args, **kwargs):
+    # matplotlib (about a second to import) only when a figure is drawn:
+    # `recognize --no-figures` and the batch's tables never pay for it
+    from minvar.plotting import new_figure
+
+    return new_figure(*args, **kwargs)
 
 CM = 100.0
 #: Colours of the chapter 5 conditions; others take the next free colour.
@@ -70,7 +78,7 @@ def confidence_figure(rec: Recognition) -> Figure:
     rec : Recognition
         A scored clip.
     """
-    fig, ax = new_figure(1, 2, size=(12, 5))
+    fig, ax = _new_figure(1, 2, size=(12, 5))
     styles = {"grasp": "-", "reach": "--"}
     for name, kind, c, ll in zip(rec.names, rec.kinds, rec.confidence, rec.log_likelihood):
         lw = 2.6 if name == rec.winner else 1.2
@@ -108,7 +116,7 @@ def paths_figure(rec: Recognition, model: str | None = None) -> Figure:
     model = model or rec.reference_model or rec.winner
     i = rec.names.index(model)
     obs, own = rec.observation, rec.nominal(model)
-    fig, ax = new_figure(1, 2, size=(12, 5.5))
+    fig, ax = _new_figure(1, 2, size=(12, 5.5))
     a = ax[0, 0]
     for key, colour in (("finger", "g"), ("thumb", "r"), ("wrist", "b")):
         a.plot(*getattr(obs, key).T, "-", color=colour, lw=1.8, label=f"{key} observed")
@@ -161,7 +169,7 @@ def condition_figure(profiles: pd.DataFrame, model: str) -> Figure:
     parts = [("", "confidence C")]
     if "transport_mean" in profiles.columns:
         parts += [("transport_", "transport term"), ("grip_", "grip term")]
-    fig, ax = new_figure(1, len(parts), size=(5.2 * len(parts), 4.8))
+    fig, ax = _new_figure(1, len(parts), size=(5.2 * len(parts), 4.8))
     conds = list(dict.fromkeys(profiles["condition"]))
     for a, (prefix, title) in zip(ax[0], parts):
         for cond, g in profiles.groupby("condition", sort=False):
@@ -192,7 +200,7 @@ def aperture_figure(profiles: pd.DataFrame, model: pd.DataFrame | None = None,
     model_name : str
         The model's name, for the legend.
     """
-    fig, ax = new_figure(1, 1, size=(7.5, 5))
+    fig, ax = _new_figure(1, 1, size=(7.5, 5))
     a = ax[0, 0]
     conds = list(dict.fromkeys(profiles["condition"]))
     for cond, g in profiles.groupby("condition", sort=False):
@@ -233,7 +241,7 @@ def confidence_single_figure(clips: Sequence[ClipSummary], conditions: Sequence[
     model : str
         The model whose confidence is drawn.
     """
-    fig, ax = new_figure(1, 1, size=(7.5, 5))
+    fig, ax = _new_figure(1, 1, size=(7.5, 5))
     for rec, cond in zip(clips, conditions):
         ax[0, 0].plot(rec.time, rec.confidence[rec.index(model)] * CM, lw=1.8,
                       color=condition_colour(cond, conditions), label=f"{cond}: {rec.clip}")
@@ -255,7 +263,7 @@ def confidence_all_figure(clips: Sequence[ClipSummary], conditions: Sequence[str
     model : str
         The model whose confidence is drawn.
     """
-    fig, ax = new_figure(1, 1, size=(7.5, 5))
+    fig, ax = _new_figure(1, 1, size=(7.5, 5))
     labelled = set()
     for rec, cond in zip(clips, conditions):
         ax[0, 0].plot(rec.time, rec.confidence[rec.index(model)] * CM, lw=1.0, alpha=0.8,
