@@ -25,6 +25,7 @@ import numpy as np
 import pytest
 
 from perception.io.atomic import owner_tag
+from perception.io.tracks import Tracks
 from perception.io.video import write_video
 from perception.synthetic.demos import render_demo_clip
 from perception.tracking.tracker import track_video
@@ -145,6 +146,10 @@ CASES = {
     "tracks render over its video": Case(
         lambda d: ["tracks", "render", str(d / "a.tracks.h5"), str(d / "a.mp4"), "-o",
                    str(d / "a.mp4")], "is also an input", None),
+    "tracks render over the video its tracks name": Case(
+        lambda d: ["tracks", "render", str(d / "a.tracks.h5"), "-o",
+                   Tracks.load(d / "a.tracks.h5").video["path"]],
+        "is also an input", None),
     "repertoire build over its config": Case(
         _write("rep.toml", "durations = [1.0]\n",
                ["repertoire", "build", "{d}/rep.toml", "-o", "{d}/rep.toml"]),

@@ -115,7 +115,8 @@ def build_parser(command: str | None | object = _EVERY) -> argparse.ArgumentPars
     """
     parser = _Parser(prog="hammer-mv", description=DESCRIPTION)
     parser.add_argument("--version", action="version", version=f"hammer-mv {__version__}")
-    parser.add_argument("-v", "--verbose", action="store_true", help="log progress details and show library warnings")
+    parser.add_argument("-v", "--verbose", action="store_true",
+                        help="log progress details and show library warnings")
     parser.add_argument("--quiet", action="store_true", help="no progress bars or summaries")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     for name, summary in COMMANDS.items():

@@ -185,8 +185,9 @@ def run_render(args: argparse.Namespace) -> int:
 
     if args.trail < 1:
         raise InputError(f"--trail: expected >= 1 frame, got {args.trail}")
-    check_output(args.output, [p for p in (args.file, args.video) if p is not None])
     t = Tracks.load(args.file)
+    video = args.video or t.video.get("path")  # the one render_labelled will read
+    check_output(args.output, [p for p in (args.file, video) if p])
     out = render_labelled(t, args.video, args.output, trail=args.trail)
     print(f"{out}: {t.n_frames} frames labelled")
     return 0
