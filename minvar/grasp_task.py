@@ -1,0 +1,363 @@
+"""The reach-to-grasp task of thesis chapter 4: geometry, via-points, timing.
+
+Geometry (frames: docs/coordinates.md; model: docs/model.md). World frame:
+origin at the object centre, +y from the wrist's start toward the object,
+metres. The object is a disk of diameter ``object_size``.
+
+* **Arm**: a 2-link planar chain (links 0.30 m). Its shoulder sits at
+  ``shoulder_offset`` from the wrist's start position ``(0, -distance)`` —
+  by default 0.15 m to the right of and 0.25 m behind it, a right arm whose
+  elbow bends outward (to +x of the shoulder-wrist line), 122 deg at the
+  start. The wrist target is ``wrist_offset`` (6 cm) short of the object
+  centre along the approach: ``(0, -wrist_offset)`` (thesis line 724). The
+  wrist therefore travels ``distance - wrist_offset``
+  (:attr:`GraspTask.transport_distance`): 20 cm by default, the thesis's
+  "distance to be moved" (line 953; "20cm in front of the hand", line 770).
+* **Gripper**: two 2-link digits (links 0.10 m), the finger and the thumb,
+  both based at the wrist. The hand frame is the world frame translated (not
+  rotated) to the wrist. At the start the digit tips touch (line 730) at
+  ``(0, tip_start)`` in the hand frame, on the approach axis: by default
+  2 cm ahead of the wrist, 4 cm below the line of the digit targets (which
+  lies ``wrist_offset`` ahead of the wrist once it is on its target). The
+  thesis gives no value; its Fig. 4.4(a) (line 814) has the digits reach "a
+  point level with the target position" during the movement, so they start
+  below it (docs/model.md tabulates how the chapter's verdicts depend on
+  this choice). The finger's middle joint bends outward to +x, the thumb's
+  to -x (the elbow branches are fixed for each chain, so the joint angles
+  stay continuous).
+* **Targets**: the digit tips end on the object surface on the line through
+  its centre perpendicular to the approach, the finger at ``(+size/2, 0)``
+  and the thumb at ``(-size/2, 0)`` (world frame; hand frame
+  ``(+-size/2, wrist_offset)``). A digit via-point lies ``viapoint_offset``
+  outside the surface along that line, ``viapoint_height`` above it, at
+  ``viapoint_time`` of the movement; :class:`GripVia` schedules replace it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .kinematics import TwoLinkChain
+from .limits import check_position, check_steps
+from .plant import PointMassPlant
+
+__all__ = ["CHAINS", "GraspTask", "GripVia"]
+
+#: Names of the three chains, in the order they are planned and simulated.
+CHAINS = ("arm", "finger", "thumb")
+
+
+def _finite(owner: str, name: str, value, *, low: float | None = None, strict: bool = False,
+            length: bool = False):
+    """``value`` as a float, checked finite and above ``low``; raise naming ``owner.name``.
+
+    A ``length`` (m) is also checked within :data:`minvar.limits.MAX_POSITION_M`.
+    """
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{owner}.{name}: expected a number, got {value!r}") from None
+    if not np.isfinite(v):
+        raise ValueError(f"{owner}.{name}: expected a finite number, got {value!r}")
+    if low is not None and (v <= low if strict else v < low):
+        op = ">" if strict else ">="
+        raise ValueError(f"{owner}.{name}: expected a value {op} {low}, got {value!r}")
+    if length:
+        check_position(v, f"{owner}.{name}")
+    return v
+
+
+def _pair(owner: str, name: str, value, *, positive: bool = False) -> tuple[float, float]:
+    arr = np.asarray(value, dtype=float)
+    if arr.shape != (2,) or not np.all(np.isfinite(arr)) or (positive and np.any(arr <= 0)):
+        what = "2 positive lengths" if positive else "2 finite coordinates"
+        raise ValueError(f"{owner}.{name}: expected {what}, got {value!r}")
+    check_position(arr, f"{owner}.{name}")
+    return float(arr[0]), float(arr[1])
+
+
+@dataclass(frozen=True)
+class GripVia:
+    """A via-point of the grip channel, shared by both digits (mirrored).
+
+    Parameters
+    ----------
+    half_aperture : float
+        Lateral distance of each tip from the approach axis, m (>= 0): the
+        finger passes ``+half_aperture``, the thumb ``-half_aperture``; the
+        aperture there is twice this.
+    height : float
+        Height relative to the line through the digit targets, m (positive:
+        further along the approach, beyond the object's centre line).
+    fraction : float
+        Time as a fraction of the movement, strictly between 0 and 1.
+    """
+
+    half_aperture: float
+    height: float
+    fraction: float
+
+    def __post_init__(self):
+        object.__setattr__(
+            self, "half_aperture",
+            _finite("GripVia", "half_aperture", self.half_aperture, low=0.0, length=True),
+        )
+        object.__setattr__(self, "height",
+                           _finite("GripVia", "height", self.height, length=True))
+        f = _finite("GripVia", "fraction", self.fraction)
+        if not 0.0 < f < 1.0:
+            raise ValueError(f"GripVia.fraction: expected a time fraction in (0, 1), got {f}")
+        object.__setattr__(self, "fraction", f)
+
+
+@dataclass(frozen=True)
+class GraspTask:
+    """One reach-to-grasp movement (thesis 4.1.1; geometry in the module docstring).
+
+    All lengths in m, times in s unless stated. Every length and coordinate
+    lies within :data:`minvar.limits.MAX_POSITION_M`, and the movement has at
+    most :data:`minvar.limits.MAX_STEPS` steps (docs/model.md, Limits).
+
+    Parameters
+    ----------
+    object_size : float
+        Diameter of the disk to grasp (>= 0; thesis 0-8 cm).
+    distance : float
+        Distance from the wrist's start to the object centre (> 0). The wrist
+        travels ``distance - wrist_offset`` (:attr:`transport_distance`); the
+        default 0.26 m makes that the thesis's 20 cm (line 953: "the distance
+        to be moved", swept over 8-24 cm).
+    duration : float
+        Movement time (> 0; thesis 0.6-1.2 s). Must span at least 2 plant steps.
+    viapoint_offset : float
+        Distance of the default digit via-point outside the object surface,
+        along the grip axis (>= 0).
+    viapoint_height : float
+        Height of the default via-point relative to the line through the
+        digit targets (positive: further along the approach).
+    viapoint_time : float
+        Time of the default via-point, a fraction of the movement in (0, 1).
+    grip_via : tuple of GripVia, optional
+        Explicit grip via-points replacing the default one (in increasing
+        time; ``()`` for none). Used to derive abnormal grasps, e.g. delayed
+        opening or open-close-open.
+    reach_only : bool
+        Transport only: the digits' goal is their closed start posture and
+        they have no via-points.
+    plant : PointMassPlant
+        Plant of every chain, in joint coordinates; its ``dt`` sets the step
+        and its noise (``sigma_u``, ``sigma_s``) the planning noise model.
+    execution_cv : float
+        Coefficient of variation of the signal-dependent noise on each joint
+        command at execution (>= 0; thesis: 1 %).
+    execution_sigma_s : float
+        Scale of the sensory noise at execution, multiplying
+        ``plant.sensory_sd`` (>= 0; default 0: none, see the module docstring).
+    wrist_offset : float
+        Wrist target distance short of the object centre along the approach
+        (> 0; thesis 6 cm).
+    tip_start : float
+        Where the touching digit tips start, ahead of the wrist along the
+        approach axis (hand frame). Default 0.02: below the line of the digit
+        targets (``wrist_offset`` ahead of the wrist at the goal), as thesis
+        Fig. 4.4(a) implies (line 814); the thesis gives no value.
+    shoulder_offset : (2,) tuple
+        Shoulder position relative to the wrist's start position (world axes).
+    arm_links : (2,) tuple
+        Upper-arm and forearm lengths (thesis 0.30 m each).
+    digit_links : (2,) tuple
+        Lengths of the two links of each digit (thesis 0.10 m each).
+    r : float
+        Effort weight of every chain's cost (``R = r dt / T I``); the reach
+        default, not the thesis's printed 0.002 (see :mod:`minvar.task`).
+    w_v, w_f : float
+        Final velocity and force weights of every chain's goal cost (the
+        reach defaults).
+    """
+
+    object_size: float = 0.04
+    distance: float = 0.26
+    duration: float = 1.0
+    viapoint_offset: float = 0.01
+    viapoint_height: float = 0.0
+    viapoint_time: float = 0.7
+    grip_via: tuple[GripVia, ...] | None = None
+    reach_only: bool = False
+    plant: PointMassPlant = field(default_factory=PointMassPlant)
+    execution_cv: float = 0.01
+    execution_sigma_s: float = 0.0
+    wrist_offset: float = 0.06
+    tip_start: float = 0.02
+    shoulder_offset: tuple[float, float] = (0.15, -0.25)
+    arm_links: tuple[float, float] = (0.30, 0.30)
+    digit_links: tuple[float, float] = (0.10, 0.10)
+    r: float = 2e-4
+    w_v: float = 0.2
+    w_f: float = 0.01
+
+    def __post_init__(self):
+        own = "GraspTask"
+        setv = object.__setattr__
+        setv(self, "object_size",
+             _finite(own, "object_size", self.object_size, low=0.0, length=True))
+        setv(self, "distance",
+             _finite(own, "distance", self.distance, low=0.0, strict=True, length=True))
+        setv(self, "duration", _finite(own, "duration", self.duration, low=0.0, strict=True))
+        setv(self, "viapoint_offset",
+             _finite(own, "viapoint_offset", self.viapoint_offset, low=0.0, length=True))
+        setv(self, "viapoint_height",
+             _finite(own, "viapoint_height", self.viapoint_height, length=True))
+        vt = _finite(own, "viapoint_time", self.viapoint_time)
+        if not 0.0 < vt < 1.0:
+            raise ValueError(
+                f"{own}.viapoint_time: expected a fraction of the movement in (0, 1), got {vt}"
+            )
+        setv(self, "viapoint_time", vt)
+        for name in ("execution_cv", "execution_sigma_s", "r", "w_v", "w_f"):
+            setv(self, name, _finite(own, name, getattr(self, name), low=0.0))
+        setv(self, "wrist_offset",
+             _finite(own, "wrist_offset", self.wrist_offset, low=0.0, strict=True, length=True))
+        setv(self, "tip_start", _finite(own, "tip_start", self.tip_start, length=True))
+        setv(self, "shoulder_offset", _pair(own, "shoulder_offset", self.shoulder_offset))
+        setv(self, "arm_links", _pair(own, "arm_links", self.arm_links, positive=True))
+        setv(self, "digit_links", _pair(own, "digit_links", self.digit_links, positive=True))
+        if not isinstance(self.plant, PointMassPlant):
+            raise ValueError(f"{own}.plant: expected a PointMassPlant, got {self.plant!r}")
+        setv(self, "reach_only", bool(self.reach_only))
+        if self.grip_via is not None:
+            vias = tuple(self.grip_via)
+            for i, v in enumerate(vias):
+                if not isinstance(v, GripVia):
+                    raise ValueError(f"{own}.grip_via[{i}]: expected a GripVia, got {v!r}")
+            fr = [v.fraction for v in vias]
+            if any(b <= a for a, b in zip(fr, fr[1:])):
+                raise ValueError(f"{own}.grip_via: fractions must increase, got {fr}")
+            setv(self, "grip_via", vias)
+        self._check_timing()
+        self._check_reach()
+
+    def _check_timing(self) -> None:
+        dt = self.plant.dt
+        T = check_steps(self.duration, dt, "GraspTask.duration")  # before any step is counted
+        if T < 2:
+            raise ValueError(
+                f"GraspTask.duration: {self.duration} s is shorter than 2 steps of {dt} s"
+            )
+        used = self.via_schedule
+        name = "viapoint_time" if self.grip_via is None else "grip_via"
+        steps = [int(round(v.fraction * self.duration / dt)) for v in used]
+        for v, n in zip(used, steps):
+            if not 0 < n < T:
+                raise ValueError(
+                    f"GraspTask.{name}: via-point at {v.fraction:g} of {self.duration} s falls "
+                    f"on step {n}, outside the movement's steps 1..{T - 1}"
+                )
+        if len(set(steps)) != len(steps):
+            raise ValueError(f"GraspTask.grip_via: two via-points fall on the same step {steps}")
+
+    def _check_reach(self) -> None:
+        lo, hi = abs(self.arm_links[0] - self.arm_links[1]), sum(self.arm_links)
+        d_start = float(np.hypot(*self.shoulder_offset))
+        if not lo <= d_start <= hi:
+            raise ValueError(
+                f"GraspTask.shoulder_offset: the wrist's start is {d_start:.3f} m from the "
+                f"shoulder, outside the arm's reach [{lo:.3f}, {hi:.3f}] m"
+            )
+        d_goal = float(np.linalg.norm(np.subtract(self.wrist_target, self.shoulder)))
+        if not lo <= d_goal <= hi:
+            raise ValueError(
+                f"GraspTask.distance: an object {self.distance} m away puts the wrist target "
+                f"{d_goal:.3f} m from the shoulder, outside the arm's reach "
+                f"[{lo:.3f}, {hi:.3f}] m"
+            )
+        lo, hi = abs(self.digit_links[0] - self.digit_links[1]), sum(self.digit_links)
+
+        def check(point, name, what):
+            d = float(np.hypot(*point))
+            if not lo <= d <= hi:
+                raise ValueError(
+                    f"GraspTask.{name}: {what} {d:.3f} m from the wrist, outside the "
+                    f"digits' reach [{lo:.3f}, {hi:.3f}] m"
+                )
+
+        check((0.0, self.tip_start), "tip_start", "the closed digit tips lie")
+        if self.reach_only:
+            return
+        check(self.finger_goal_hand, "object_size",
+              f"an object of {self.object_size} m puts the digit targets")
+        name = "grip_via" if self.grip_via is not None else "viapoint_offset"
+        for v in self.via_schedule:
+            check((v.half_aperture, self.wrist_offset + v.height), name, "a digit via-point lies")
+
+    # --- geometry (world frame unless stated) ---------------------------------
+    @property
+    def wrist_start(self) -> tuple[float, float]:
+        """Wrist position at the start, m."""
+        return (0.0, -self.distance)
+
+    @property
+    def transport_distance(self) -> float:
+        """How far the wrist travels, start to target: ``distance - wrist_offset``, m."""
+        return self.distance - self.wrist_offset
+
+    @property
+    def wrist_target(self) -> tuple[float, float]:
+        """Wrist target, ``wrist_offset`` short of the object centre, m."""
+        return (0.0, -self.wrist_offset)
+
+    @property
+    def shoulder(self) -> tuple[float, float]:
+        """Shoulder (arm base) position, m."""
+        return (self.shoulder_offset[0], self.shoulder_offset[1] - self.distance)
+
+    @property
+    def finger_target(self) -> tuple[float, float]:
+        """Finger-tip target on the object surface, m."""
+        return (0.0, 0.0) if self.reach_only else (self.object_size / 2, 0.0)
+
+    @property
+    def thumb_target(self) -> tuple[float, float]:
+        """Thumb-tip target on the object surface, m."""
+        return (0.0, 0.0) if self.reach_only else (-self.object_size / 2, 0.0)
+
+    @property
+    def finger_goal_hand(self) -> tuple[float, float]:
+        """Finger-tip goal in the hand frame (relative to the wrist target), m."""
+        if self.reach_only:
+            return (0.0, self.tip_start)
+        return (self.object_size / 2, self.wrist_offset)
+
+    @property
+    def via_schedule(self) -> tuple[GripVia, ...]:
+        """The grip via-points in use: ``grip_via``, or the default one; none if reach_only."""
+        if self.reach_only:
+            return ()
+        if self.grip_via is not None:
+            return self.grip_via
+        return (
+            GripVia(
+                self.object_size / 2 + self.viapoint_offset,
+                self.viapoint_height,
+                self.viapoint_time,
+            ),
+        )
+
+    @property
+    def steps(self) -> int:
+        """Number of control steps T (``duration / plant.dt``, rounded)."""
+        return int(round(self.duration / self.plant.dt))
+
+    @property
+    def time(self) -> np.ndarray:
+        """(T+1,) time of each state, s."""
+        return np.arange(self.steps + 1) * self.plant.dt
+
+    def chains(self) -> dict[str, TwoLinkChain]:
+        """The arm (world frame) and the two digits (hand frame) as :class:`TwoLinkChain`."""
+        return {
+            "arm": TwoLinkChain(*self.arm_links, base=self.shoulder),
+            "finger": TwoLinkChain(*self.digit_links, base=(0.0, 0.0)),
+            "thumb": TwoLinkChain(*self.digit_links, base=(0.0, 0.0)),
+        }
