@@ -77,15 +77,21 @@ class Case:
     limit_bytes: int | None = None  # a disk that fills after this many bytes per file
 
 
-def _h5_variant(change):
-    """A tracks file with one object broken by ``change(h5py.File)``."""
+def _broken(source: str, name: str, change, argv):
+    """A copy ``name`` of the HDF5 file ``source`` with one object broken by
+    ``change(h5py.File)``; the command line ``argv`` ("{bad}" and "{d}" filled in)."""
     def prepare(d: Path) -> list[str]:
-        bad = d / "bad.tracks.h5"
-        bad.write_bytes((d / "a.tracks.h5").read_bytes())
+        bad = d / name
+        bad.write_bytes((d / source).read_bytes())
         with h5py.File(bad, "a") as fh:
             change(fh)
-        return ["tracks", "info", str(bad)]
+        return [a.format(bad=bad, d=d) for a in argv]
     return prepare
+
+
+def _h5_variant(change):
+    """A tracks file with one object broken, read by ``tracks info``."""
+    return _broken("a.tracks.h5", "bad.tracks.h5", change, ["tracks", "info", "{bad}"])
 
 
 def _soft_link(fh):
@@ -110,15 +116,10 @@ def _array_attr(fh):
 
 
 def _repertoire_variant(change):
-    """A repertoire file with one object broken by ``change(h5py.File)``, used to recognise."""
-    def prepare(d: Path) -> list[str]:
-        bad = d / "bad.h5"
-        bad.write_bytes((d / "rep.h5").read_bytes())
-        with h5py.File(bad, "a") as fh:
-            change(fh)
-        return ["recognize", str(d / "a.tracks.h5"), "--repertoire", str(bad), "-o",
-                str(d / "out"), "--no-figures"]
-    return prepare
+    """A repertoire file with one object broken, used to recognise."""
+    return _broken("rep.h5", "bad.h5", change,
+                   ["recognize", "{d}/a.tracks.h5", "--repertoire", "{bad}", "-o", "{d}/out",
+                    "--no-figures"])
 
 
 def _zero_dt(fh):

@@ -19,17 +19,16 @@ import dataclasses
 import json
 
 from perception.io.atomic import write_text
-from perception.recognition.calibration import calibrate
 from perception.recognition.models import SceneSpec
-from perception.recognition.planning import build_models, default_specs
-from perception.recognition.repertoire import DEFAULT_CALIBRATION
+from perception.recognition.planning import default_specs
+from perception.recognition.repertoire import DEFAULT_CALIBRATION, Repertoire
 
 
 def compute() -> dict:
     """The default models' calibrations at the default scene, as the shipped file holds them."""
     scene = SceneSpec()
-    models = build_models(default_specs(), scene)
-    cals = calibrate(models)
+    models = Repertoire.build(default_specs(), scene).models  # planned and calibrated
+    cals = [m.calibration for m in models]
     return {"scene": dataclasses.asdict(scene),
             "params": dataclasses.asdict(cals[0].params),
             "frame_period": cals[0].frame_period,
