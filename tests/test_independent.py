@@ -120,3 +120,9 @@ def test_bad_parameters_are_refused():
         IndependentParams(duration=0)
     with pytest.raises(ValueError, match="fps"):
         independent_paths(IndependentParams(), 0)
+
+
+def test_both_generators_name_the_same_conditions():
+    from perception.synthetic import independent, stimuli
+
+    assert independent.CONDITIONS == stimuli.CONDITIONS

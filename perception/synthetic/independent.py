@@ -58,6 +58,9 @@ from perception.tracking.markers import MARKER_NAMES
 __all__ = ["CONDITIONS", "IndependentParams", "draw_independent", "independent_aperture",
            "independent_paths", "independent_tracks", "render_independent_set"]
 
+#: The conditions of :data:`perception.synthetic.stimuli.CONDITIONS`, written
+#: out: that module imports minvar, which this generator must not (a test
+#: keeps the two equal).
 CONDITIONS = ("normal", "delayed", "open-close-open", "reach")
 
 
