@@ -216,3 +216,18 @@ def test_hostile_clip_names_are_escaped_in_the_page_and_their_links_resolve(tmp_
     for name in HOSTILE:
         for suffix in (".recognition.json", ".confidence.csv", ".confidence.png", ".paths.png"):
             assert name + suffix in {unquote(u) for u in targets}, (name, suffix)
+
+
+def test_a_clip_table_is_written_as_pandas_writes_it(tmp_path):
+    from perception.io.atomic import write_csv
+
+    rng = np.random.default_rng(0)
+    x = np.concatenate([rng.normal(size=40) * 10.0 ** rng.integers(-20, 20, 40),
+                        [np.nan, np.inf, -np.inf, -0.0, 1e-5, 0.1, 1 / 3, 1e16]])
+    cols = {"time": x, "frame": np.arange(x.size), "ok": np.arange(x.size) % 2 == 0,
+            "model": np.array(["a,b", 'say "x"', "é ü"] * 16), "C": x[::-1].copy()}
+    write_csv(tmp_path / "ours.csv", cols)
+    pd.DataFrame(cols).to_csv(tmp_path / "pandas.csv", index=False)
+    assert (tmp_path / "ours.csv").read_bytes() == (tmp_path / "pandas.csv").read_bytes()
+    back = pd.read_csv(tmp_path / "ours.csv")
+    np.testing.assert_array_equal(back["time"].to_numpy(), x)  # round trip, NaN included

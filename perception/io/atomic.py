@@ -24,6 +24,7 @@ or at interpreter exit, where they cannot be caught (and crash h5py).
 from __future__ import annotations
 
 import contextlib
+import csv
 import glob
 import hashlib
 import os
@@ -32,8 +33,10 @@ import socket
 import stat
 import tempfile
 import warnings
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Mapping
 from pathlib import Path
+
+import numpy as np
 
 from perception.errors import InputError
 
@@ -306,10 +309,35 @@ def write_json(path: str | os.PathLike, obj) -> Path:
 
 
 def write_csv(path: str | os.PathLike, frame) -> Path:
-    """Write a pandas DataFrame ``frame`` to CSV at ``path`` atomically (no index)."""
+    """Write a table to CSV at ``path`` atomically (no index).
+
+    ``frame`` is a pandas DataFrame, or a mapping of column name to 1-D
+    array, written without importing pandas (0.4 s a process) and byte for
+    byte as pandas writes the same table: floats in their shortest round-trip
+    form, NaN as an empty field, quoting only where needed.
+    """
     with atomic_path(path) as tmp:
-        frame.to_csv(tmp, index=False)
+        if isinstance(frame, Mapping):
+            _write_columns(tmp, frame)
+        else:
+            frame.to_csv(tmp, index=False)
     return Path(path)
+
+
+def _write_columns(path: Path, columns: Mapping) -> None:
+    names = list(columns)
+    cells = []
+    for values in columns.values():
+        values = np.asarray(values)
+        if values.dtype.kind == "f":
+            # numpy's str is the shortest round-trip form, as pandas writes
+            cells.append(["" if v != v else str(v) for v in values.tolist()])
+        else:
+            cells.append([str(v) for v in values.tolist()])
+    with open(path, "w", newline="", encoding="utf-8") as f:
+        out = csv.writer(f, lineterminator="\n")
+        out.writerow(names)
+        out.writerows(zip(*cells))
 
 
 def save_figure(path: str | os.PathLike, fig, *, dpi: int = 120) -> Path:

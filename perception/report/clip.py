@@ -238,7 +238,7 @@ def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,
     else:
         paths["confidence_png"].unlink(missing_ok=True)
         paths["paths_png"].unlink(missing_ok=True)
-    write_csv(paths["csv"], rec.to_pandas())
+    write_csv(paths["csv"], rec.columns())
     # the JSON last: its presence marks the clip's report complete
     write_json(paths["json"], {**rec.to_dict(), **(extra or {})})
     return paths

@@ -15,13 +15,16 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import cv2
 import numpy as np
-import pandas as pd
 
 from perception.io.atomic import atomic_path
 from perception.io.tracks import Status, Tracks
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = ["MarkerQuality", "TrackingQuality", "contact_sheet", "tracking_columns",
            "tracking_quality", "write_tracking_report"]
@@ -79,6 +82,8 @@ class TrackingQuality:
 
     def to_pandas(self) -> pd.DataFrame:
         """One row per marker."""
+        import pandas as pd  # not at the top: `recognize` never needs it
+
         return pd.DataFrame([vars(m) for m in self.markers])
 
 
