@@ -231,3 +231,27 @@ def test_a_clip_table_is_written_as_pandas_writes_it(tmp_path):
     assert (tmp_path / "ours.csv").read_bytes() == (tmp_path / "pandas.csv").read_bytes()
     back = pd.read_csv(tmp_path / "ours.csv")
     np.testing.assert_array_equal(back["time"].to_numpy(), x)  # round trip, NaN included
+
+
+def test_the_batch_statistics_are_scipy_stats_own():
+    import warnings
+
+    from scipy import stats
+
+    from perception.report.conditions import f_oneway, welch_t
+
+    rng = np.random.default_rng(1)
+    cases = [[rng.normal(m, s, n) for n, s, m in zip(rng.integers(2, 15, 3),
+                                                      rng.uniform(0.1, 3, 3), rng.normal(size=3))]
+             for _ in range(50)]
+    cases += [[np.ones(3), np.ones(4)], [np.ones(3), 2 * np.ones(4)],
+              [np.array([1.0, 2.0]), np.array([1.0, 2.0])], [np.ones(2), np.arange(3.0)]]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # scipy warns on the constant groups
+        for g in cases:
+            r = stats.f_oneway(*g)
+            np.testing.assert_allclose(f_oneway(g), (r.statistic, r.pvalue), rtol=1e-12,
+                                       equal_nan=True)
+            r = stats.ttest_ind(g[0], g[1], equal_var=False)
+            np.testing.assert_allclose(welch_t(g[0], g[1]), (r.statistic, r.pvalue, r.df),
+                                       rtol=1e-12, equal_nan=True)
