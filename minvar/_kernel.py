@@ -17,7 +17,7 @@ import numpy as np
 
 log = logging.getLogger(__name__)
 
-__all__ = ["available", "backward", "error_covariance", "forward"]
+__all__ = ["available", "backward", "error_covariance", "forward", "mean_states"]
 
 #: Flags of the C passes (minvar/_lqg_kernel.c).
 HAS_C, HAS_D, TRACK_XE, ADD_NOISE, NOISE_COST = 1, 2, 4, 8, 16
@@ -38,12 +38,17 @@ def _load():
     except OSError as exc:  # pragma: no cover - a broken build
         log.info("minvar: cannot load the compiled LQG kernel (%s); using numpy", exc)
         return None
+    if not hasattr(lib, "lqg_mean_states"):  # pragma: no cover - built from older source
+        log.info("minvar: the compiled LQG kernel is out of date (reinstall); using numpy")
+        return None
     lib.lqg_forward.argtypes = [_int] * 6 + [_ptr] * 11 + [_int, _ptr]
     lib.lqg_forward.restype = _int
     lib.lqg_backward.argtypes = [_int] * 6 + [_ptr] * 13 + [_int, _ptr, _ptr]
     lib.lqg_backward.restype = _int
     lib.lqg_error_cov.argtypes = [_int] * 6 + [_ptr] * 13
     lib.lqg_error_cov.restype = _int
+    lib.lqg_mean_states.argtypes = [_int] * 3 + [_ptr] * 5
+    lib.lqg_mean_states.restype = None
     return lib
 
 
@@ -115,3 +120,12 @@ def error_covariance(p, K: np.ndarray, L: np.ndarray) -> np.ndarray:
     if status < 0:
         raise MemoryError("minvar: the LQG kernel ran out of memory")
     return P
+
+
+def mean_states(p, L: np.ndarray) -> np.ndarray:
+    """Noise-free states ``x[t+1] = (A - B L[t]) x[t]`` from ``X1``, (T+1, n)."""
+    T, n, m = p.horizon, p.n_states, p.n_controls
+    X = np.empty((T + 1, n))
+    args = [_c(x) for x in (p.A, p.B, L, p.X1)]
+    _LIB.lqg_mean_states(T, n, m, *map(_p, args), _p(X))
+    return X

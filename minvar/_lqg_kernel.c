@@ -580,6 +580,29 @@ done:
     return status;
 }
 
+/* Noise-free mean states X (T+1 x n) under u = -L x from X1:
+ * x' = A x - B (L x), the numpy pass's (A - B L) x up to the order of summation. */
+void lqg_mean_states(int T, int n, int m, const double *A, const double *B, const double *L,
+                     const double *X1, double *X) {
+    double u[64];  /* m <= 64: the controls of a plant (checked by the caller) */
+    memcpy(X, X1, sizeof(double) * n);
+    for (int t = 0; t < T; t++) {
+        const double *x = X + (size_t)t * n, *Lt = L + (size_t)t * m * n;
+        double *y = X + (size_t)(t + 1) * n;
+        for (int c = 0; c < m; c++) {
+            double s = 0.0;
+            for (int j = 0; j < n; j++) s += Lt[c * n + j] * x[j];
+            u[c] = s;
+        }
+        for (int i = 0; i < n; i++) {
+            double s = 0.0;
+            for (int j = 0; j < n; j++) s += A[i * n + j] * x[j];
+            for (int c = 0; c < m; c++) s -= B[i * m + c] * u[c];
+            y[i] = s;
+        }
+    }
+}
+
 /* An importable (empty) module, so that setuptools builds and installs the library. */
 static struct PyModuleDef kernel_module = {
     PyModuleDef_HEAD_INIT, "_lqg_kernel",

@@ -408,6 +408,8 @@ class _Solver:
     def mean_states(self, L: np.ndarray) -> np.ndarray:
         """Noise-free trajectory under ``u = -L x`` from ``X1``."""
         p = self.p
+        if self.fast is not None and p.n_controls <= 64:
+            return _kernel.mean_states(p, L)
         X = np.empty((p.horizon + 1, p.n_states))
         X[0] = p.X1
         closed = p.A[None] - p.B[None] @ L  # (T, n, n)
