@@ -9,11 +9,13 @@ import importlib
 
 _HOMES = {
     "batch": ("BatchReport", "write_batch_report"),
+    "chart": ("Chart", "Legend", "Line", "Panel", "render_png", "to_matplotlib"),
     "clip": ("ClipSummary", "clip_figures", "clip_outputs", "write_clip_report"),
     "conditions": ("PROFILE_POINTS", "aperture_profiles", "condition_profiles",
                    "condition_statistics", "reference_model"),
     "figures": ("aperture_figure", "condition_figure", "confidence_all_figure",
-                "confidence_figure", "confidence_single_figure", "paths_figure"),
+                "confidence_chart", "confidence_figure", "confidence_single_figure",
+                "paths_chart", "paths_figure"),
 }
 _MODULE_OF = {name: module for module, names in _HOMES.items() for name in names}
 

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from perception.io.atomic import save_figure, write_csv, write_json
+from perception.io.atomic import write_bytes, write_csv, write_json
 from perception.recognition.result import Recognition
 
 __all__ = ["ClipSummary", "clip_figures", "clip_outputs", "write_clip_report"]
@@ -220,9 +220,9 @@ def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,
     extra : dict, optional
         More keys for the JSON (e.g. the batch's input fingerprint).
     figures : bool
-        Draw the figures (matplotlib is imported only then); without them,
-        figures of an earlier run are removed, since they would show another
-        result.
+        Draw the figures (with Pillow, in milliseconds: see
+        :mod:`perception.report.chart`); without them, figures of an earlier
+        run are removed, since they would show another result.
 
     Returns
     -------
@@ -231,10 +231,11 @@ def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,
     """
     paths = clip_outputs(Path(out), rec.clip)
     if figures:
-        from perception.report.figures import confidence_figure, paths_figure
+        from perception.report.chart import render_png
+        from perception.report.figures import confidence_chart, paths_chart
 
-        save_figure(paths["confidence_png"], confidence_figure(rec))
-        save_figure(paths["paths_png"], paths_figure(rec))
+        write_bytes(paths["confidence_png"], render_png(confidence_chart(rec)))
+        write_bytes(paths["paths_png"], render_png(paths_chart(rec)))
     else:
         paths["confidence_png"].unlink(missing_ok=True)
         paths["paths_png"].unlink(missing_ok=True)

@@ -1,14 +1,17 @@
 """Report figures (thesis chapter 5).
 
-Per clip: every model's confidence and log-likelihood (:func:`confidence_figure`)
+Per clip: every model's confidence and log-likelihood (:func:`confidence_chart`)
 and the demonstration against the reference grasp model's own movement
-(:func:`paths_figure`, Figs. 5.5-5.7). Per batch: grip aperture per
-condition against the model's (:func:`aperture_figure`, Fig. 5.4d), the
-reference model's confidence on one clip per condition
-(:func:`confidence_single_figure`, Fig. 5.8a) and on every clip
-(:func:`confidence_all_figure`, Fig. 5.8b), and mean ± SD per condition at
-select points (:func:`condition_figure`, Fig. 5.8c). Confidence is drawn in
-cm (weighted), ×100 of its value in the files.
+(:func:`paths_chart`, Figs. 5.5-5.7), built as :class:`~perception.report.chart.Chart`
+s: the report draws them with Pillow in milliseconds
+(:func:`~perception.report.chart.render_png`), and :func:`confidence_figure`
+and :func:`paths_figure` give the same figures in matplotlib. Per batch
+(matplotlib): grip aperture per condition against the model's
+(:func:`aperture_figure`, Fig. 5.4d), the reference model's confidence on
+one clip per condition (:func:`confidence_single_figure`, Fig. 5.8a) and on
+every clip (:func:`confidence_all_figure`, Fig. 5.8b), and mean ± SD per
+condition at select points (:func:`condition_figure`, Fig. 5.8c). Confidence
+is drawn in cm (weighted), ×100 of its value in the files.
 """
 
 from __future__ import annotations
@@ -17,22 +20,24 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from perception.recognition.result import Recognition
+from perception.report.chart import Chart, Legend, Line, Panel, to_matplotlib
 
 if TYPE_CHECKING:
+    import pandas as pd
     from matplotlib.figure import Figure
 
     from perception.report.clip import ClipSummary
 
 __all__ = ["aperture_figure", "condition_colour", "condition_figure", "confidence_all_figure",
-           "confidence_figure", "confidence_single_figure", "paths_figure"]
+           "confidence_chart", "confidence_figure", "confidence_single_figure", "paths_chart",
+           "paths_figure"]
 
 
 def _new_figure(*args, **kwargs):
-    # matplotlib (about a second to import) only when a figure is drawn:
-    # `recognize --no-figures` and the batch's tables never pay for it
+    # matplotlib (about a second to import) only when a batch figure is drawn:
+    # `recognize` draws its two with Pillow (perception.report.chart)
     from minvar.plotting import new_figure
 
     return new_figure(*args, **kwargs)
@@ -70,7 +75,10 @@ def _verdict_line(rec: Recognition) -> str:
             f"winner {rec.winner} ({rec.rule} rule)")
 
 
-def confidence_figure(rec: Recognition) -> Figure:
+TIME = "time since onset (s)"
+
+
+def confidence_chart(rec: Recognition) -> Chart:
     """Confidence profiles of every model (thesis rule) and the log-likelihood.
 
     Parameters
@@ -78,27 +86,36 @@ def confidence_figure(rec: Recognition) -> Figure:
     rec : Recognition
         A scored clip.
     """
-    fig, ax = _new_figure(1, 2, size=(12, 5))
     styles = {"grasp": "-", "reach": "--"}
-    for name, kind, c, ll in zip(rec.names, rec.kinds, rec.confidence, rec.log_likelihood):
-        lw = 2.6 if name == rec.winner else 1.2
-        ax[0, 0].plot(rec.time, c * CM, styles.get(kind, "-"), label=name, lw=lw)
-        ax[0, 1].plot(rec.time, ll, styles.get(kind, "-"), label=name, lw=lw)
-    ax[0, 0].set_title("thesis rule: confidence C (eqs. 5.6-5.8)")
-    ax[0, 0].set_ylabel("C (cm, weighted)")
-    ax[0, 1].set_title("likelihood rule: cumulative log-likelihood")
-    ax[0, 1].set_ylabel("log-likelihood")
-    for a in ax[0]:
-        a.set_xlabel("time since onset (s)")
-        a.axhline(0, color="0.7", lw=0.6)
-    fig.legend(*ax[0, 0].get_legend_handles_labels(), loc="outside lower center",
-               ncol=min(len(rec.names), 5), title="grasp models solid, reach dashed; "
-               "the winner thick", **LEGEND)
-    fig.suptitle(f"{rec.clip}: {_verdict_line(rec)}")
-    return fig
+    conf, ll = [], []
+    for k, (name, kind, c, l) in enumerate(zip(rec.names, rec.kinds, rec.confidence,
+                                               rec.log_likelihood)):
+        look = dict(colour=f"C{k % 10}", width=2.6 if name == rec.winner else 1.2,
+                    style=styles.get(kind, "-"), label=name)
+        conf.append(Line(rec.time, c * CM, **look))
+        ll.append(Line(rec.time, l, **look))
+    return Chart(
+        (Panel("thesis rule: confidence C (eqs. 5.6-5.8)", TIME, "C (cm, weighted)",
+               tuple(conf), hlines=(0.0,)),
+         Panel("likelihood rule: cumulative log-likelihood", TIME, "log-likelihood",
+               tuple(ll), hlines=(0.0,))),
+        title=f"{rec.clip}: {_verdict_line(rec)}", size=(12, 5),
+        legend=Legend(columns=min(len(rec.names), 5),
+                      title="grasp models solid, reach dashed; the winner thick"))
 
 
-def paths_figure(rec: Recognition, model: str | None = None) -> Figure:
+def confidence_figure(rec: Recognition) -> Figure:
+    """:func:`confidence_chart` as a matplotlib figure.
+
+    Parameters
+    ----------
+    rec : Recognition
+        A scored clip.
+    """
+    return to_matplotlib(confidence_chart(rec))
+
+
+def paths_chart(rec: Recognition, model: str | None = None) -> Chart:
     """The demonstration against a grasp model's own movement (thesis Figs. 5.5-5.7).
 
     Left, the observed wrist, finger and thumb paths and the model's own
@@ -116,31 +133,39 @@ def paths_figure(rec: Recognition, model: str | None = None) -> Figure:
     model = model or rec.reference_model or rec.winner
     i = rec.names.index(model)
     obs, own = rec.observation, rec.nominal(model)
-    fig, ax = _new_figure(1, 2, size=(12, 5.5))
-    a = ax[0, 0]
+    paths = []
     for key, colour in (("finger", "g"), ("thumb", "r"), ("wrist", "b")):
-        a.plot(*getattr(obs, key).T, "-", color=colour, lw=1.8, label=f"{key} observed")
-        a.plot(*own[key].T, "--", color=colour, lw=1.5, label=f"{key}, {model}")
+        seen, plan = getattr(obs, key), own[key]
+        paths.append(Line(seen[:, 0], seen[:, 1], colour, 1.8, "-", f"{key} observed"))
+        paths.append(Line(plan[:, 0], plan[:, 1], colour, 1.5, "--", f"{key}, {model}"))
     circle = np.linspace(0, 2 * np.pi, 100)
     rad = obs.object_diameter / 2
-    a.plot(rad * np.cos(circle), rad * np.sin(circle), "y-", lw=2, label="object")
-    a.set_aspect("equal", adjustable="datalim")
-    a.set_xlabel("x (m)")
-    a.set_ylabel("y (m), toward the object")
-    a.set_title(f"paths: observed (solid) and {model}'s own movement (dashed)")
-    a.legend(ncol=2, loc="lower left", **LEGEND)
-    b = ax[0, 1]
-    b.plot(rec.time, obs.g * CM, "k-", lw=2, label="observed")
+    paths.append(Line(rad * np.cos(circle), rad * np.sin(circle), "y", 2.0, "-", "object"))
     own_g = np.linalg.norm(own["finger"] - own["thumb"], axis=1)
-    b.plot(rec.time, own_g * CM, "k--", lw=1.5, label=f"{model}'s own movement")
-    b.plot(rec.time, rec.predicted_g[i] * CM, ":", color="0.45", lw=1.2,
-           label=f"{model}, one step ahead")
-    b.set_xlabel("time since onset (s)")
-    b.set_ylabel("grip aperture (cm)")
-    b.set_title("grip aperture")
-    b.legend(loc="upper left", **LEGEND)
-    fig.suptitle(f"{rec.clip}: {_verdict_line(rec)}")
-    return fig
+    aperture = (Line(rec.time, obs.g * CM, "k", 2.0, "-", "observed"),
+                Line(rec.time, own_g * CM, "k", 1.5, "--", f"{model}'s own movement"),
+                Line(rec.time, rec.predicted_g[i] * CM, "0.45", 1.2, ":",
+                     f"{model}, one step ahead"))
+    return Chart(
+        (Panel(f"paths: observed (solid) and {model}'s own movement (dashed)", "x (m)",
+               "y (m), toward the object", tuple(paths), equal_aspect=True,
+               legend=Legend("best", columns=2)),
+         Panel("grip aperture", TIME, "grip aperture (cm)", aperture,
+               legend=Legend("upper left"))),
+        title=f"{rec.clip}: {_verdict_line(rec)}", size=(12, 5.5))
+
+
+def paths_figure(rec: Recognition, model: str | None = None) -> Figure:
+    """:func:`paths_chart` as a matplotlib figure.
+
+    Parameters
+    ----------
+    rec : Recognition
+        A scored clip.
+    model : str, optional
+        Model drawn (default: the reference grasp model).
+    """
+    return to_matplotlib(paths_chart(rec, model))
 
 
 def _mean_sd_points(a, g: pd.DataFrame, colour: str, label: str, scale: float,
@@ -169,6 +194,8 @@ def condition_figure(profiles: pd.DataFrame, model: str) -> Figure:
     parts = [("", "confidence C")]
     if "transport_mean" in profiles.columns:
         parts += [("transport_", "transport term"), ("grip_", "grip term")]
+    import pandas as pd
+
     fig, ax = _new_figure(1, len(parts), size=(5.2 * len(parts), 4.8))
     conds = list(dict.fromkeys(profiles["condition"]))
     for a, (prefix, title) in zip(ax[0], parts):
