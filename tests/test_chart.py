@@ -78,10 +78,19 @@ def test_colours_are_matplotlibs():
                               (178, 178, 178)]):
         col, row = geo.pixel(0.5, k)
         np.testing.assert_allclose(img[round(float(row)), round(float(col))], want, atol=12)
-    with pytest.raises(ValueError, match="colour"):
-        Line([0], [0], "C10")
-    with pytest.raises(ValueError, match="style"):
-        Line([0], [0], style="-.")
+
+
+def test_a_chart_refuses_what_it_cannot_draw():
+    for make, match in ((lambda: Line([0], [0], "C10"), "colour"),
+                        (lambda: Line([0], [0], "purple"), "colour"),
+                        (lambda: Line([0], [0], style="-."), "style"),
+                        (lambda: Line([0, 1], [0]), "length"),
+                        (lambda: Legend("centre"), "location"),
+                        (lambda: Legend(columns=0), "column"),
+                        (lambda: Chart(()), "panel"),
+                        (lambda: Chart((Panel(),), size=(0, 3)), "size")):
+        with pytest.raises(ValueError, match=match):
+            make()
 
 
 @pytest.mark.parametrize("size, dpi", [((12, 5), 120), ((7.5, 3.2), 100), ((3, 3), 72)])

@@ -3,26 +3,27 @@
 A :class:`Chart` is a row of :class:`Panel` s holding :class:`Line` s. The
 report's per-clip figures are built once as a chart (one idea in one place)
 and drawn two ways: :func:`render_png` draws it with Pillow, in a few tens of
-milliseconds and without matplotlib (about half a second to import and a
-second or more to lay out and draw two figures: most of ``hammer-mv
-recognize``'s time on a short clip); :func:`to_matplotlib` gives the same
-figure as a matplotlib ``Figure``, for a user who wants to restyle or save it
-in another format.
+milliseconds and without matplotlib (which takes about 0.6 s to import and
+1.5 s to lay out and draw the two figures: most of ``hammer-mv recognize``'s
+time on a short clip); :func:`to_matplotlib` gives the same figure as a
+matplotlib ``Figure``, for a user who wants to restyle it or save it in
+another format.
 
 The Pillow drawing follows matplotlib's default style: tab10 colours,
 DejaVu Sans (matplotlib's own font file, read without importing matplotlib;
 Pillow's default font if it is missing), ticks at 1-2-5 steps, 5 % margins,
-dash patterns scaled by the line width. It is drawn at twice the size and
-reduced, so lines and text are anti-aliased. A character the font lacks (a
-clip name in another script) is drawn as a box, without a warning.
+dash patterns scaled by the line width. Lines are drawn at twice the size
+and reduced, so they come out anti-aliased; text (anti-aliased by FreeType)
+is drawn on the reduced image. A character the font lacks (a clip name in
+another script) is drawn as a box, without a warning.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import io
 import math
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -76,7 +77,7 @@ def _rgb(colour: str) -> tuple[int, int, int]:
                      f"{''.join(BASE_COLOURS)}, #rrggbb or a grey level '0'-'1'")
 
 
-@dataclass(frozen=True, eq=False)
+@dataclasses.dataclass(frozen=True, eq=False)
 class Line:
     """A line through points ``(x[i], y[i])``; a non-finite value breaks it.
 
@@ -92,7 +93,7 @@ class Line:
     style : str
         ``-`` solid, ``--`` dashed, ``:`` dotted.
     label : str or None
-        Legend entry (None: not in the legend).
+        Legend entry (None or empty: not in the legend).
     """
 
     x: np.ndarray
@@ -114,7 +115,7 @@ class Line:
         object.__setattr__(self, "y", y)
 
 
-@dataclass(frozen=True)
+@dataclasses.dataclass(frozen=True)
 class Legend:
     """Where and how a legend is laid out.
 
@@ -141,7 +142,7 @@ class Legend:
             raise ValueError("a legend needs at least one column")
 
 
-@dataclass(frozen=True, eq=False)
+@dataclasses.dataclass(frozen=True, eq=False)
 class Panel:
     """One set of axes.
 
@@ -168,8 +169,12 @@ class Panel:
     equal_aspect: bool = False
     legend: Legend | None = None
 
+    def __post_init__(self):
+        object.__setattr__(self, "lines", tuple(self.lines))
+        object.__setattr__(self, "hlines", tuple(float(y) for y in self.hlines))
 
-@dataclass(frozen=True, eq=False)
+
+@dataclasses.dataclass(frozen=True, eq=False)
 class Chart:
     """A figure: panels side by side, a title, and a legend below them.
 
@@ -191,12 +196,19 @@ class Chart:
     size: tuple[float, float] = (12.0, 5.0)
     legend: Legend | None = None
 
+    def __post_init__(self):
+        object.__setattr__(self, "panels", tuple(self.panels))
+        if not self.panels:
+            raise ValueError("a chart needs at least one panel")
+        if len(self.size) != 2 or not all(v > 0 for v in self.size):
+            raise ValueError(f"size must be (width, height) in inches, not {self.size!r}")
+
     def legend_lines(self) -> list[Line]:
         """The lines of the chart's legend: the first line of each label, in order."""
         seen: dict[str, Line] = {}
         for panel in self.panels:
             for line in panel.lines:
-                if line.label is not None:
+                if line.label:
                     seen.setdefault(line.label, line)
         return list(seen.values())
 
@@ -260,7 +272,7 @@ def _tick_labels(ticks: np.ndarray, minus: str) -> list[str]:
 
 
 # -- layout ----------------------------------------------------------------------
-@dataclass(frozen=True)
+@dataclasses.dataclass(frozen=True)
 class PanelLayout:
     """Where a panel's axes are drawn in the PNG, and their limits and ticks.
 
@@ -359,23 +371,19 @@ class _Fonts:
 _PAD, _WSPACE, _TITLE_PAD, _TICK, _TICK_PAD, _LABEL_PAD = 4.0, 14.0, 6.0, 3.5, 3.5, 4.0
 
 
-@dataclass
+@dataclasses.dataclass(frozen=True)
 class _Box:
-    """A panel's cell and axes, drawing pixels."""
+    """A panel's cell and its axes' frame (whole drawing pixels)."""
 
     cell: tuple[float, float, float, float]
-    axes: tuple[int, int, int, int]
-    xlim: tuple[float, float]
-    ylim: tuple[float, float]
-    xticks: np.ndarray
-    yticks: np.ndarray
+    frame: PanelLayout
 
 
 class _LegendBlock:
-    """A legend's layout: size and the place of each entry (drawing pixels)."""
+    """A legend's layout: its entries in columns, its size and spacing (drawing pixels)."""
 
     def __init__(self, lines: list[Line], legend: Legend, fonts: _Fonts):
-        self.lines, self.legend = lines, legend
+        self.legend = legend
         self.font = fonts.font(LEGEND_PT)
         em = fonts.pt(LEGEND_PT)
         self.em, self.row = em, fonts.height(self.font)
@@ -394,10 +402,10 @@ class _LegendBlock:
                        + max(self.font.getlength(ln.label or "") for ln in col)
                        for col in self.columns]
         entries_w = sum(self.widths) + self.col_gap * max(len(self.widths) - 1, 0)
-        self.title_w = self.font.getlength(legend.title) if legend.title else 0.0
+        title_w = self.font.getlength(legend.title) if legend.title else 0.0
         self.title_h = self.row + self.row_gap if legend.title else 0.0
         nrows = max((len(c) for c in self.columns), default=0)
-        self.width = max(entries_w, self.title_w) + 2 * self.border
+        self.width = max(entries_w, title_w) + 2 * self.border
         self.height = (2 * self.border + self.title_h + nrows * self.row
                        + max(nrows - 1, 0) * self.row_gap)
 
@@ -431,15 +439,15 @@ def _panel_box(panel: Panel, cell: tuple[float, float, float, float],
             ylim = (cy - per_px * h / 2, cy + per_px * h / 2)
         xticks = nice_ticks(*xlim, most=max(2, min(9, int(w / (3 * font_px)))))
         yticks = nice_ticks(*ylim, most=max(2, min(9, int(h / (2 * font_px)))))
-        return _Box(cell, axes, xlim, ylim, xticks, yticks)
+        return _Box(cell, PanelLayout(axes, xlim, ylim, xticks, yticks))
 
     # y tick labels set the left edge, the x ticks' overhang the right; the
     # ticks follow the box (and with an equal aspect, the limits): two passes
     box = fit(left + ylabel_w + fonts.pt(_TICK + _TICK_PAD), right - fonts.pt(_PAD))
     for _ in range(2):
-        ywidth = max((label.getlength(s) for s in _tick_labels(box.yticks, minus)),
+        ywidth = max((label.getlength(s) for s in _tick_labels(box.frame.yticks, minus)),
                      default=0.0)
-        xlast = _tick_labels(box.xticks, minus)[-1] if len(box.xticks) else ""
+        xlast = _tick_labels(box.frame.xticks, minus)[-1] if len(box.frame.xticks) else ""
         box = fit(left + ylabel_w + ywidth + fonts.pt(_TICK + _TICK_PAD),
                   right - max(fonts.pt(_PAD), label.getlength(xlast) / 2))
     return box
@@ -487,7 +495,7 @@ def layout(chart: Chart, dpi: float = 120) -> list[PanelLayout]:
     def png(v: float) -> float:  # a drawing pixel centre to the PNG's
         return (v + 0.5) / _SCALE - 0.5
 
-    return [PanelLayout(tuple(png(v) for v in b.axes), b.xlim, b.ylim, b.xticks, b.yticks)
+    return [dataclasses.replace(b.frame, box=tuple(png(v) for v in b.frame.box))
             for b in boxes]
 
 
@@ -587,16 +595,15 @@ def _draw_upwards(image: Image.Image, text: str, font, left: float, centre_y: fl
 
 def _draw_lines(paint: _Painter, box: _Box, panel: Panel) -> None:
     """The panel's hlines and lines, clipped to its axes."""
-    left, top, right, bottom = box.axes
-    (x0, x1), (y0, y1) = box.xlim, box.ylim
-    sx, sy = (right - left) / (x1 - x0), (bottom - top) / (y1 - y0)
+    frame = box.frame
+    left, top, right, bottom = frame.box
 
     def pixels(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-        return np.column_stack([left + (x - x0) * sx, bottom - (y - y0) * sy])
+        return np.column_stack(frame.pixel(x, y))
 
     for y in panel.hlines:
         if math.isfinite(y):
-            hline = Line([x0, x1], [y, y], HLINE_COLOUR, HLINE_WIDTH)
+            hline = Line(frame.xlim, [y, y], HLINE_COLOUR, HLINE_WIDTH)
             paint.line(pixels(hline.x, hline.y), hline)
     for line in panel.lines:
         for run in _runs(line.x, line.y):
@@ -638,7 +645,7 @@ def _draw_legend(paint: _Painter, block: _LegendBlock, left: float, top: float,
 
 def _legend_corner(block: _LegendBlock, box: _Box, panel: Panel) -> tuple[float, float]:
     """Top left of a panel's legend (drawing pixels), half a line in from its corner."""
-    left, top, right, bottom = box.axes
+    left, top, right, bottom = box.frame.box
     pad = 0.5 * block.em
     corners = {}
     for where in LOCATIONS[:4]:
@@ -647,8 +654,7 @@ def _legend_corner(block: _LegendBlock, box: _Box, panel: Panel) -> tuple[float,
                           top + pad if vertical == "upper" else bottom - pad - block.height)
     if panel.legend.location != "best":
         return corners[panel.legend.location]
-    frame = PanelLayout(box.axes, box.xlim, box.ylim, box.xticks, box.yticks)
-    x, y = frame.pixel(np.concatenate([ln.x for ln in panel.lines] or [np.zeros(0)]),
+    x, y = box.frame.pixel(np.concatenate([ln.x for ln in panel.lines] or [np.zeros(0)]),
                        np.concatenate([ln.y for ln in panel.lines] or [np.zeros(0)]))
 
     def hidden(corner: tuple[float, float]) -> int:
@@ -662,7 +668,8 @@ def _legend_corner(block: _LegendBlock, box: _Box, panel: Panel) -> tuple[float,
 def _draw_panel(paint: _Painter, box: _Box, panel: Panel) -> None:
     fonts, draw = paint.fonts, paint.draw
     _draw_lines(paint, box, panel)
-    left, top, right, bottom = box.axes
+    frame = box.frame
+    left, top, right, bottom = frame.box
     if panel.legend is not None and (labelled := [ln for ln in panel.lines if ln.label]):
         block = _LegendBlock(labelled, panel.legend, fonts)
         lx, ly = _legend_corner(block, box, panel)
@@ -671,13 +678,12 @@ def _draw_panel(paint: _Painter, box: _Box, panel: Panel) -> None:
     draw.rectangle((left, top, right, bottom), outline="black", width=thin)
     label = fonts.font(LABEL_PT)
     tick, gap = fonts.pt(_TICK), fonts.pt(_TICK + _TICK_PAD)
-    frame = PanelLayout((left, top, right, bottom), box.xlim, box.ylim, box.xticks, box.yticks)
-    cols, _ = frame.pixel(box.xticks, np.zeros(len(box.xticks)))
-    for col, text in zip(cols, _tick_labels(box.xticks, _minus())):
+    cols, _ = frame.pixel(frame.xticks, np.zeros(len(frame.xticks)))
+    for col, text in zip(cols, _tick_labels(frame.xticks, _minus())):
         draw.line([(col, bottom), (col, bottom + tick)], fill="black", width=thin)
         paint.text(col, bottom + gap, text, label, "ma")
-    _, rows = frame.pixel(np.zeros(len(box.yticks)), box.yticks)
-    for row, text in zip(rows, _tick_labels(box.yticks, _minus())):
+    _, rows = frame.pixel(np.zeros(len(frame.yticks)), frame.yticks)
+    for row, text in zip(rows, _tick_labels(frame.yticks, _minus())):
         draw.line([(left - tick, row), (left, row)], fill="black", width=thin)
         paint.text(left - gap, row, text, label, "rm")
     cell_left, cell_top, cell_right, cell_bottom = box.cell
@@ -747,8 +753,8 @@ def to_matplotlib(chart: Chart) -> Figure:
     for a, panel in zip(ax[0], chart.panels):
         for line in panel.lines:
             (h,) = a.plot(line.x, line.y, line.style, color=line.colour, lw=line.width,
-                          label="_nolegend_" if line.label is None else line.label)
-            if line.label is not None:
+                          label=line.label or "_nolegend_")
+            if line.label:
                 handles.setdefault(line.label, h)
         for y in panel.hlines:
             a.axhline(y, color=HLINE_COLOUR, lw=HLINE_WIDTH, zorder=1.5)

@@ -151,7 +151,7 @@ def paths_chart(rec: Recognition, model: str | None = None) -> Chart:
                "y (m), toward the object", tuple(paths), equal_aspect=True,
                legend=Legend("best", columns=2)),
          Panel("grip aperture", TIME, "grip aperture (cm)", aperture,
-               legend=Legend("upper left"))),
+               legend=Legend("best"))),
         title=f"{rec.clip}: {_verdict_line(rec)}", size=(12, 5.5))
 
 
