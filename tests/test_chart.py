@@ -14,7 +14,9 @@ import pytest
 from PIL import Image
 
 from perception.report.chart import (
+    Band,
     Chart,
+    ErrorBars,
     Legend,
     Line,
     Panel,
@@ -88,7 +90,13 @@ def test_a_chart_refuses_what_it_cannot_draw():
                         (lambda: Legend("centre"), "location"),
                         (lambda: Legend(columns=0), "column"),
                         (lambda: Chart(()), "panel"),
-                        (lambda: Chart((Panel(),), size=(0, 3)), "size")):
+                        (lambda: Chart((Panel(),), size=(0, 3)), "size"),
+                        (lambda: Band([0, 1], [0, 1], [1]), "length"),
+                        (lambda: Band([0], [0], [1], alpha=1.5), "alpha"),
+                        (lambda: Band([0], [0], [1], "nope"), "colour"),
+                        (lambda: ErrorBars([0, 1], [0, 1], [1, -1]), "negative"),
+                        (lambda: ErrorBars([0], [0], [1], cap=-1), "cap"),
+                        (lambda: Panel(lines=(Band([0], [0], [1]),)), "Line")):
         with pytest.raises(ValueError, match=match):
             make()
 
@@ -220,6 +228,86 @@ def test_to_matplotlib_draws_the_same_axes_and_lines():
     assert fig.get_suptitle() == "t"
 
 
+def _blend(under, colour, alpha):
+    return (1 - alpha) * np.asarray(under, dtype=float) + alpha * np.asarray(colour, dtype=float)
+
+
+def test_a_band_fills_between_its_curves_blended_over_what_is_under_it():
+    x = np.linspace(0, 10, 101)
+    low, high = np.full_like(x, 2.0), np.full_like(x, 6.0)
+    low[45:56] = np.nan  # a gap: nothing filled there
+    bands = (Band(x, low, high, "b", 0.3),  # blue 2-6, then red 4-8 over it
+             Band([0, 10], [4, 4], [8, 8], "r", 0.5))
+    chart = Chart((Panel(lines=(Line([9, 9], [0, 10], "k", 1.0),), bands=bands),),
+                  size=(6, 4))
+    img, geo = _pixels(render_png(chart, dpi=100)), layout(chart, dpi=100)[0]
+    col = round(float(geo.pixel(2, 0)[0]))
+    blue = _blend((255, 255, 255), (0, 0, 255), 0.3)
+    for y, want in ((1, (255, 255, 255)), (3, blue), (5, _blend(blue, (255, 0, 0), 0.5)),
+                    (7, _blend((255, 255, 255), (255, 0, 0), 0.5)), (9, (255, 255, 255))):
+        row = round(float(geo.pixel(0, y)[1]))
+        np.testing.assert_allclose(img[row, col], want, atol=12, err_msg=f"y = {y}")
+    # each colour spans the rows between its curves' pixels
+    _, (row_2, row_4, row_6, row_8) = geo.pixel([0] * 4, [2, 4, 6, 8])
+    for colour, (lo, hi) in ((blue, (row_4, row_2)), (_blend(blue, (255, 0, 0), 0.5),
+                                                      (row_6, row_4)),
+                             (_blend((255, 255, 255), (255, 0, 0), 0.5), (row_8, row_6))):
+        rows = np.flatnonzero(np.abs(img[:, col] - colour).max(axis=1) < 12)
+        assert rows.min() == pytest.approx(lo, abs=1.5) and rows.max() == pytest.approx(
+            hi, abs=1.5)
+    # the line is drawn over the bands, opaque; the gap leaves white
+    row, col_line = (round(float(v)) for v in geo.pixel(9, 3)[::-1])
+    assert img[row, col_line].max() < 90
+    gap = round(float(geo.pixel(5, 0)[0]))
+    np.testing.assert_allclose(img[round(float(geo.pixel(0, 3)[1])), gap], (255, 255, 255),
+                               atol=12)
+
+
+def test_error_bars_reach_y_plus_and_minus_err_with_caps_across_their_ends():
+    bars = ErrorBars([2, 5, 3.5], [5, 5, 5], [2, 1, np.nan], "r", width=1.0, cap=3.0)
+    chart = Chart((Panel(errorbars=(bars,)),), size=(6, 4))
+    img, geo = _pixels(render_png(chart, dpi=100)), layout(chart, dpi=100)[0]
+    assert geo.ylim == pytest.approx((3 - 0.2, 7 + 0.2))  # the limits hold the bars' ends
+    red = _mask(img, (255, 0, 0))
+    for x, err in ((2, 2), (5, 1)):
+        col = round(float(geo.pixel(x, 0)[0]))
+        rows = np.flatnonzero(red[:, col])
+        _, (top, bottom) = geo.pixel([x, x], [5 + err, 5 - err])
+        assert rows.min() == pytest.approx(top, abs=1.5)
+        assert rows.max() == pytest.approx(bottom, abs=1.5)
+        for cap_row in (rows.min(), rows.max()):  # a cap: 2 x 3 pt across, centred on the bar
+            cols = np.flatnonzero(red[cap_row])
+            cols = cols[np.abs(cols - col) < 20]
+            assert cols.max() - cols.min() + 1 == pytest.approx(6 / 72 * 100, abs=1.5)
+            assert (cols.min() + cols.max()) / 2 == pytest.approx(col, abs=1)
+        mid = round(float(geo.pixel(x, 5)[1]))  # between the caps: just the bar
+        assert np.flatnonzero(red[mid, col - 10:col + 11]).size <= 2
+    # a bar with a non-finite err is left out
+    assert not red[:, round(float(geo.pixel(3.5, 0)[0]))].any()
+
+
+def test_to_matplotlib_fills_bands_and_draws_error_bars():
+    from matplotlib.collections import PolyCollection
+    from matplotlib.colors import to_rgba
+
+    chart = Chart((Panel("a", lines=(Line([0, 1], [0, 1], "C1", label="one"),),
+                         bands=(Band([0, 1], [-1, 0], [1, 2], "C2", 0.25),),
+                         errorbars=(ErrorBars([0, 1], [0, 1], [0.5, 0.2], "C3", 1.5, 4.0),)),))
+    (a,) = to_matplotlib(chart).axes
+    (fill,) = [c for c in a.collections if isinstance(c, PolyCollection)]
+    assert fill.get_alpha() == 0.25
+    np.testing.assert_allclose(fill.get_facecolor()[0], to_rgba("C2", 0.25))
+    (bars,) = a.containers
+    assert bars.has_yerr and not bars.has_xerr and bars.lines[0] is None  # fmt="none"
+    caps, (segments,) = bars.lines[1], bars.lines[2]
+    assert len(caps) == 2 and all(cap in a.lines for cap in caps)
+    assert caps[0].get_markersize() == 8.0  # 2 x capsize
+    np.testing.assert_allclose(segments.get_segments()[0], [[0, -0.5], [0, 0.5]])
+    assert segments.get_linewidth()[0] == 1.5
+    np.testing.assert_allclose(segments.get_color()[0], to_rgba("C3"))
+    assert a.get_ylim()[0] <= -1 and a.get_ylim()[1] >= 2  # the band is in the limits
+
+
 # -- the report's per-clip charts ------------------------------------------------
 @pytest.fixture(scope="module")
 def rec():
@@ -272,3 +360,4 @@ def test_the_clip_report_draws_its_figures_without_matplotlib(rec, tmp_path):
     assert out.stderr == ""
     for name, size in (("c.confidence.png", (1440, 600)), ("c.paths.png", (1440, 660))):
         assert Image.open(tmp_path / name).size == size
+

@@ -9,7 +9,8 @@ import importlib
 
 _HOMES = {
     "batch": ("BatchReport", "write_batch_report"),
-    "chart": ("Chart", "Legend", "Line", "Panel", "render_png", "to_matplotlib"),
+    "chart": ("Band", "Chart", "ErrorBars", "Legend", "Line", "Panel", "render_png",
+              "to_matplotlib"),
     "clip": ("ClipSummary", "clip_figures", "clip_outputs", "write_clip_report"),
     "conditions": ("PROFILE_POINTS", "aperture_profiles", "condition_profiles",
                    "condition_statistics", "reference_model"),
