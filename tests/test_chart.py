@@ -10,6 +10,7 @@ import warnings
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 from PIL import Image
 
@@ -361,3 +362,92 @@ def test_the_clip_report_draws_its_figures_without_matplotlib(rec, tmp_path):
     for name, size in (("c.confidence.png", (1440, 600)), ("c.paths.png", (1440, 660))):
         assert Image.open(tmp_path / name).size == size
 
+
+# -- the batch report's charts ---------------------------------------------------
+def _summaries():
+    """Five scored clips of three conditions (two of them spare), in memory."""
+    from perception.report import ClipSummary
+
+    rng = np.random.default_rng(3)
+    out = []
+    for k, cond in enumerate(["normal", "normal", "delayed", "odd", "odd"]):
+        time = np.linspace(0, 1 + 0.1 * k, 30)
+        conf = np.vstack([np.sin(time + k), time * (k + 1)]) * 0.1
+        out.append(ClipSummary(f"{cond}-{k}", time, ["m", "r"], ["grasp", "reach"], conf,
+                               np.zeros(2), "m", "thesis", transport=conf / 3,
+                               aperture=0.05 + 0.01 * rng.standard_normal(time.size)))
+    return out, ["normal", "normal", "delayed", "odd", "odd"]
+
+
+def test_the_batch_charts_carry_the_figures_content():
+    from matplotlib.collections import PolyCollection
+
+    from perception.report import (
+        aperture_chart,
+        aperture_figure,
+        condition_chart,
+        condition_figure,
+        confidence_all_chart,
+        confidence_all_figure,
+        confidence_single_chart,
+        confidence_single_figure,
+    )
+    from perception.report.conditions import aperture_profiles, condition_profiles
+    from perception.report.figures import condition_colour
+
+    recs, conds = _summaries()
+    colours = {c: condition_colour(c, conds) for c in conds}
+    assert colours == {"normal": "C0", "delayed": "C1", "odd": "C4"}
+    # Fig. 5.4d: a line and a band per condition, the model dashed black on a grey band
+    prof = aperture_profiles(recs, conds)
+    own = pd.DataFrame({"phase": np.linspace(0, 1, 11), "mean": 0.06, "sd": 0.005})
+    ap = aperture_chart(prof, own, "m")
+    (panel,) = ap.panels
+    assert "Fig. 5.4d" in panel.title and panel.ylabel == "grip aperture (cm)"
+    assert [ln.label for ln in panel.lines] == ["normal (n=2)", "delayed (n=1)", "odd (n=2)",
+                                                "model m"]
+    assert [(ln.colour, ln.style) for ln in panel.lines] == [
+        ("C0", "-"), ("C1", "-"), ("C4", "-"), ("k", "--")]
+    assert [(b.colour, b.alpha) for b in panel.bands] == [
+        ("C0", 0.2), ("C1", 0.2), ("C4", 0.2), ("k", 0.12)]
+    normal = prof[prof["condition"] == "normal"]
+    np.testing.assert_allclose(panel.bands[0].upper, (normal["mean"] + normal["sd"]) * 100)
+    np.testing.assert_allclose(panel.bands[0].x, normal["phase"] * 100)
+    # Fig. 5.8a and b: one clip per condition, every clip; one legend entry per condition
+    single = confidence_single_chart(recs[1:4], conds[1:4], "m")
+    assert [ln.label for ln in single.panels[0].lines] == ["normal: normal-1",
+                                                           "delayed: delayed-2", "odd: odd-3"]
+    every = confidence_all_chart(recs, conds, "m").panels[0]
+    assert "every clip (5; Fig. 5.8b)" == every.title and every.hlines == (0.0,)
+    assert [ln.label for ln in every.lines] == ["normal", None, "delayed", "odd", None]
+    assert every.ylabel == "C of m (cm, weighted)"
+    np.testing.assert_allclose(every.lines[3].y, recs[3].confidence[0] * 100)
+    # Fig. 5.8c: the total and its two terms, SD bars at 11 points, the legend in the first
+    cp = condition_profiles(recs, conds, "m")
+    cond = condition_chart(cp, "m")
+    assert cond.title == "m's confidence by condition (Fig. 5.8c)"
+    assert cond.size == pytest.approx((15.6, 4.8))
+    assert [p.title for p in cond.panels] == ["confidence C: mean ± SD",
+                                              "transport term: mean ± SD", "grip term: mean ± SD"]
+    assert [p.legend is not None for p in cond.panels] == [True, False, False]
+    bars = cond.panels[2].errorbars[0]
+    normal = cp[cp["condition"] == "normal"]
+    assert bars.colour == "C0" and bars.x.size == 11 and bars.cap == 3.0
+    np.testing.assert_allclose(bars.err, normal["grip_sd"].to_numpy()[::10] * 100)
+    assert cond.panels[0].lines[1].label == "delayed (n=1)"
+    # the matplotlib figures draw the same charts
+    figs = {"ap": aperture_figure(prof, own, "m"),
+            "single": confidence_single_figure(recs[1:4], conds[1:4], "m"),
+            "all": confidence_all_figure(recs, conds, "m"), "cond": condition_figure(cp, "m")}
+    (a,) = figs["ap"].axes
+    assert len([c for c in a.collections if isinstance(c, PolyCollection)]) == 4
+    assert [t.get_text() for t in a.get_legend().get_texts()] == [
+        ln.label for ln in panel.lines]
+    assert [t.get_text() for t in figs["all"].axes[0].get_legend().get_texts()] == [
+        "normal", "delayed", "odd"]
+    assert figs["single"].axes[0].get_title() == "one clip per condition (Fig. 5.8a)"
+    assert [len(ax.containers) for ax in figs["cond"].axes] == [3, 3, 3]
+    assert figs["cond"].get_suptitle() == cond.title
+    # and Pillow draws them at the figures' sizes
+    for chart, size in ((ap, (900, 600)), (single, (900, 600)), (cond, (1872, 576))):
+        assert Image.open(io.BytesIO(render_png(chart))).size == size

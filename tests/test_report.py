@@ -1,11 +1,16 @@
 """Reports: the clip summary and its JSON, the batch tables, statistics and the page."""
 
 import json
+import os
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
 from _demos import default_repertoire, demo_tracks
+from PIL import Image
 
 from perception import batch
 from perception.batch import ClipResult, summary_table
@@ -126,6 +131,11 @@ def test_figures_beside_a_clip_are_its_own_only(tmp_path):
                                                               "a.contact.png"]
 
 
+#: The batch report's figures and their sizes (pixels; 120 dpi).
+FIGURES = {"aperture_profiles.png": (900, 600), "confidence_single.png": (900, 600),
+           "confidence_all.png": (900, 600), "condition_profiles.png": (1872, 576)}
+
+
 def test_the_batch_page_and_its_figures(scored):
     out, recs = scored
     results = [ClipResult(n, c, "ok", summary=ClipSummary.from_recognition(r))
@@ -133,9 +143,11 @@ def test_the_batch_page_and_its_figures(scored):
     summary = summary_table(results)
     write_batch_report(summary, {r.clip: r.summary for r in results}, out,
                        models=default_repertoire().models)
-    for name in ("aperture_profiles.png", "confidence_single.png", "confidence_all.png",
-                 "condition_profiles.png"):
-        assert (out / name).stat().st_size > 20_000, name
+    for name, size in FIGURES.items():
+        with Image.open(out / name) as png:
+            assert (png.format, png.size) == ("PNG", size), name
+            ink = (np.asarray(png.convert("L")) < 200).mean()
+            assert 0.01 < ink < 0.5, (name, ink)  # drawn, neither blank nor filled
     ap = pd.read_csv(out / "aperture_profiles.csv")
     own = ap[ap["condition"] == "model:grasp-1.0s"]
     assert len(own) == 101 and 0.11 < own["mean"].max() < 0.13  # the model's own opening
@@ -144,6 +156,32 @@ def test_the_batch_page_and_its_figures(scored):
     page = (out / "report.html").read_text()
     assert "Verdicts per condition" in page and 'href="normal-0.recognition.json"' in page
     assert 'href="#clip-0"' in page and 'id="clip-0"' in page
+
+
+def test_a_batch_draws_its_figures_without_matplotlib(tmp_path):
+    """``hammer-mv batch`` on tracks files, in a fresh process: matplotlib is never imported
+    (its import and layout were seconds of serial time at the end of every batch)."""
+    src = tmp_path / "src"
+    src.mkdir()
+    rows = []
+    for i, cond in enumerate(["normal", "normal", "delayed", "reach"]):
+        demo_tracks(cond, i)[0].save(src / f"{cond}-{i}.tracks.h5")
+        rows.append(f"{cond}-{i},{cond}-{i}.tracks.h5,{cond}\n")
+    (src / "manifest.csv").write_text("clip,video,condition\n" + "".join(rows))
+    repfile = default_repertoire().save(tmp_path / "rep.h5")
+    out = tmp_path / "out"
+    code = ("import sys\nfrom hammer_mv.cli import main\n"
+            f"rc = main(['batch', {str(src / 'manifest.csv')!r}, '-o', {str(out)!r}, "
+            f"'--repertoire', {str(repfile)!r}, '--quiet'])\n"
+            "print(rc, 'matplotlib' in sys.modules)\n")
+    root = str(Path(__file__).resolve().parents[1])
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([root, os.environ.get("PYTHONPATH", "")])}
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.split() == ["0", "False"], proc.stdout + proc.stderr
+    for name, size in FIGURES.items():
+        with Image.open(out / name) as png:
+            assert png.size == size, name
 
 
 #: Names from the outside world (issue 12): each would break an attribute, a tag, a link or

@@ -14,8 +14,9 @@ _HOMES = {
     "clip": ("ClipSummary", "clip_figures", "clip_outputs", "write_clip_report"),
     "conditions": ("PROFILE_POINTS", "aperture_profiles", "condition_profiles",
                    "condition_statistics", "reference_model"),
-    "figures": ("aperture_figure", "condition_figure", "confidence_all_figure",
-                "confidence_chart", "confidence_figure", "confidence_single_figure",
+    "figures": ("aperture_chart", "aperture_figure", "condition_chart", "condition_figure",
+                "confidence_all_chart", "confidence_all_figure", "confidence_chart",
+                "confidence_figure", "confidence_single_chart", "confidence_single_figure",
                 "paths_chart", "paths_figure"),
 }
 _MODULE_OF = {name: module for module, names in _HOMES.items() for name in names}

@@ -1,17 +1,17 @@
-"""Report figures (thesis chapter 5).
+"""Report figures (thesis chapter 5), each built as a chart and drawn by Pillow or matplotlib.
 
 Per clip: every model's confidence and log-likelihood (:func:`confidence_chart`)
 and the demonstration against the reference grasp model's own movement
-(:func:`paths_chart`, Figs. 5.5-5.7), built as :class:`~perception.report.chart.Chart`
-s: the report draws them with Pillow in milliseconds
-(:func:`~perception.report.chart.render_png`), and :func:`confidence_figure`
-and :func:`paths_figure` give the same figures in matplotlib. Per batch
-(matplotlib): grip aperture per condition against the model's
-(:func:`aperture_figure`, Fig. 5.4d), the reference model's confidence on
-one clip per condition (:func:`confidence_single_figure`, Fig. 5.8a) and on
-every clip (:func:`confidence_all_figure`, Fig. 5.8b), and mean ± SD per
-condition at select points (:func:`condition_figure`, Fig. 5.8c). Confidence
-is drawn in cm (weighted), ×100 of its value in the files.
+(:func:`paths_chart`, Figs. 5.5-5.7). Per batch: grip aperture per condition
+against the model's (:func:`aperture_chart`, Fig. 5.4d), the reference
+model's confidence on one clip per condition (:func:`confidence_single_chart`,
+Fig. 5.8a) and on every clip (:func:`confidence_all_chart`, Fig. 5.8b), and
+mean ± SD per condition at select points (:func:`condition_chart`, Fig. 5.8c).
+Each is a :class:`~perception.report.chart.Chart`: the reports draw them with
+Pillow in milliseconds (:func:`~perception.report.chart.render_png`), and each
+``*_figure`` function (:func:`confidence_figure`, :func:`aperture_figure`, …)
+gives the same figure in matplotlib. Confidence is drawn in cm (weighted),
+×100 of its value in the files.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from perception.recognition.result import Recognition
-from perception.report.chart import Chart, Legend, Line, Panel, to_matplotlib
+from perception.report.chart import Band, Chart, ErrorBars, Legend, Line, Panel, to_matplotlib
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -30,24 +30,17 @@ if TYPE_CHECKING:
 
     from perception.report.clip import ClipSummary
 
-__all__ = ["aperture_figure", "condition_colour", "condition_figure", "confidence_all_figure",
-           "confidence_chart", "confidence_figure", "confidence_single_figure", "paths_chart",
-           "paths_figure"]
+__all__ = ["aperture_chart", "aperture_figure", "condition_chart", "condition_colour",
+           "condition_figure", "confidence_all_chart", "confidence_all_figure",
+           "confidence_chart", "confidence_figure", "confidence_single_chart",
+           "confidence_single_figure", "paths_chart", "paths_figure"]
 
-
-def _new_figure(*args, **kwargs):
-    # matplotlib (about a second to import) only when a batch figure is drawn:
-    # `recognize` draws its two with Pillow (perception.report.chart)
-    from minvar.plotting import new_figure
-
-    return new_figure(*args, **kwargs)
 
 CM = 100.0
 #: Colours of the chapter 5 conditions; others take the next free colour.
 CONDITION_COLOURS = {"normal": "C0", "delayed": "C1", "open-close-open": "C3", "reach": "C2",
                      "unlabelled": "0.4"}
 _SPARE = ("C4", "C5", "C6", "C7", "C8", "C9")
-LEGEND = dict(fontsize=9, frameon=False)
 
 
 def condition_colour(condition: str, seen: Sequence[str] = ()) -> str:
@@ -168,21 +161,22 @@ def paths_figure(rec: Recognition, model: str | None = None) -> Figure:
     return to_matplotlib(paths_chart(rec, model))
 
 
-def _mean_sd_points(a, g: pd.DataFrame, colour: str, label: str, scale: float,
-                    points: int = 11) -> None:
-    """A mean curve with SD bars at ``points`` evenly spaced phases."""
-    x = g["phase"].to_numpy() * 100
-    a.plot(x, g["mean"] * scale, color=colour, lw=1.8, label=label)
-    idx = np.unique(np.round(np.linspace(0, len(g) - 1, points)).astype(int))
-    a.errorbar(x[idx], g["mean"].to_numpy()[idx] * scale, yerr=g["sd"].to_numpy()[idx] * scale,
-               fmt="none", ecolor=colour, capsize=3, lw=1)
+MOVEMENT_TIME = "movement time (%)"
+#: Error bars of Fig. 5.8c: at this many evenly spaced phases.
+SD_POINTS = 11
 
 
-def condition_figure(profiles: pd.DataFrame, model: str) -> Figure:
+def _n_label(cond: str, g: pd.DataFrame) -> str:
+    return f"{cond} (n={int(g['n'].iloc[0])})"
+
+
+def condition_chart(profiles: pd.DataFrame, model: str) -> Chart:
     """Mean ± SD confidence per condition at select points (thesis Fig. 5.8c).
 
     The total confidence, and its transport and grip terms when
-    ``profiles`` has them (``transport_mean``, ``grip_mean``, …).
+    ``profiles`` has them (``transport_mean``, ``grip_mean``, …): a mean
+    curve per condition with SD bars at :data:`SD_POINTS` evenly spaced
+    phases, the legend in the first panel.
 
     Parameters
     ----------
@@ -194,28 +188,43 @@ def condition_figure(profiles: pd.DataFrame, model: str) -> Figure:
     parts = [("", "confidence C")]
     if "transport_mean" in profiles.columns:
         parts += [("transport_", "transport term"), ("grip_", "grip term")]
-    import pandas as pd
-
-    fig, ax = _new_figure(1, len(parts), size=(5.2 * len(parts), 4.8))
     conds = list(dict.fromkeys(profiles["condition"]))
-    for a, (prefix, title) in zip(ax[0], parts):
+    panels = []
+    for k, (prefix, title) in enumerate(parts):
+        lines, bars = [], []
         for cond, g in profiles.groupby("condition", sort=False):
-            part = pd.DataFrame({"phase": g["phase"], "mean": g[f"{prefix}mean"],
-                                 "sd": g[f"{prefix}sd"]})
-            _mean_sd_points(a, part, condition_colour(cond, conds),
-                            f"{cond} (n={int(g['n'].iloc[0])})", CM)
-        a.set_xlabel("movement time (%)")
-        a.set_ylabel(f"{title} (cm, weighted)")
-        a.set_title(f"{title}: mean ± SD")
-        a.axhline(0, color="0.7", lw=0.6)
-    ax[0, 0].legend(**LEGEND)
-    fig.suptitle(f"{model}'s confidence by condition (Fig. 5.8c)")
-    return fig
+            colour = condition_colour(cond, conds)
+            x = g["phase"].to_numpy() * 100
+            mean, sd = g[f"{prefix}mean"].to_numpy() * CM, g[f"{prefix}sd"].to_numpy() * CM
+            lines.append(Line(x, mean, colour, 1.8, label=_n_label(cond, g)))
+            at = np.unique(np.round(np.linspace(0, len(g) - 1, SD_POINTS)).astype(int))
+            bars.append(ErrorBars(x[at], mean[at], sd[at], colour, 1.0, 3.0))
+        panels.append(Panel(f"{title}: mean ± SD", MOVEMENT_TIME, f"{title} (cm, weighted)",
+                            tuple(lines), hlines=(0.0,), errorbars=tuple(bars),
+                            legend=Legend("best") if k == 0 else None))
+    return Chart(tuple(panels), title=f"{model}'s confidence by condition (Fig. 5.8c)",
+                 size=(5.2 * len(parts), 4.8))
 
 
-def aperture_figure(profiles: pd.DataFrame, model: pd.DataFrame | None = None,
-                    model_name: str = "") -> Figure:
+def condition_figure(profiles: pd.DataFrame, model: str) -> Figure:
+    """:func:`condition_chart` as a matplotlib figure (thesis Fig. 5.8c).
+
+    Parameters
+    ----------
+    profiles : pandas.DataFrame
+        From :func:`~perception.report.conditions.condition_profiles`.
+    model : str
+        The model profiled (for the title).
+    """
+    return to_matplotlib(condition_chart(profiles, model))
+
+
+def aperture_chart(profiles: pd.DataFrame, model: pd.DataFrame | None = None,
+                   model_name: str = "") -> Chart:
     """Grip aperture per condition, mean ± SD, against the model's (thesis Fig. 5.4d).
+
+    A mean curve per condition over a band of ± 1 SD; the model's own
+    aperture dashed black over a grey band.
 
     Parameters
     ----------
@@ -227,36 +236,45 @@ def aperture_figure(profiles: pd.DataFrame, model: pd.DataFrame | None = None,
     model_name : str
         The model's name, for the legend.
     """
-    fig, ax = _new_figure(1, 1, size=(7.5, 5))
-    a = ax[0, 0]
     conds = list(dict.fromkeys(profiles["condition"]))
-    for cond, g in profiles.groupby("condition", sort=False):
-        colour = condition_colour(cond, conds)
-        x = g["phase"] * 100
-        a.plot(x, g["mean"] * CM, color=colour, lw=1.8, label=f"{cond} (n={int(g['n'].iloc[0])})")
-        a.fill_between(x, (g["mean"] - g["sd"]) * CM, (g["mean"] + g["sd"]) * CM,
-                       color=colour, alpha=0.2, lw=0)
+    curves = [(g, condition_colour(cond, conds), 0.2, "-", _n_label(cond, g))
+              for cond, g in profiles.groupby("condition", sort=False)]
     if model is not None and len(model):
-        x = model["phase"] * 100
-        a.plot(x, model["mean"] * CM, "k--", lw=1.8, label=f"model {model_name}")
-        a.fill_between(x, (model["mean"] - model["sd"]) * CM,
-                       (model["mean"] + model["sd"]) * CM, color="k", alpha=0.12, lw=0)
-    a.set_xlabel("movement time (%)")
-    a.set_ylabel("grip aperture (cm)")
-    a.set_title("grip aperture, mean ± SD (Fig. 5.4d)")
-    a.legend(**LEGEND)
-    return fig
+        curves.append((model, "k", 0.12, "--", f"model {model_name}"))
+    lines, bands = [], []
+    for g, colour, alpha, style, label in curves:
+        x, mean, sd = (g[c].to_numpy(dtype=float) for c in ("phase", "mean", "sd"))
+        lines.append(Line(x * 100, mean * CM, colour, 1.8, style, label))
+        bands.append(Band(x * 100, (mean - sd) * CM, (mean + sd) * CM, colour, alpha))
+    return Chart((Panel("grip aperture, mean ± SD (Fig. 5.4d)", MOVEMENT_TIME,
+                        "grip aperture (cm)", tuple(lines), bands=tuple(bands),
+                        legend=Legend("best")),), size=(7.5, 5))
 
 
-def _confidence_axes(a, model: str, title: str) -> None:
-    a.set_xlabel("time since onset (s)")
-    a.set_ylabel(f"C of {model} (cm, weighted)")
-    a.set_title(title)
-    a.axhline(0, color="0.7", lw=0.6)
+def aperture_figure(profiles: pd.DataFrame, model: pd.DataFrame | None = None,
+                    model_name: str = "") -> Figure:
+    """:func:`aperture_chart` as a matplotlib figure (thesis Fig. 5.4d).
+
+    Parameters
+    ----------
+    profiles : pandas.DataFrame
+        From :func:`~perception.report.conditions.aperture_profiles`
+        (condition, phase, mean, sd, n; m).
+    model : pandas.DataFrame, optional
+        The model's own aperture (phase, mean, sd; m), drawn dashed.
+    model_name : str
+        The model's name, for the legend.
+    """
+    return to_matplotlib(aperture_chart(profiles, model, model_name))
 
 
-def confidence_single_figure(clips: Sequence[ClipSummary], conditions: Sequence[str],
-                             model: str) -> Figure:
+def _confidence_panel(model: str, title: str, lines: list[Line]) -> Chart:
+    return Chart((Panel(title, TIME, f"C of {model} (cm, weighted)", tuple(lines),
+                        hlines=(0.0,), legend=Legend("best")),), size=(7.5, 5))
+
+
+def confidence_single_chart(clips: Sequence[ClipSummary], conditions: Sequence[str],
+                            model: str) -> Chart:
     """The model's confidence on one clip per condition (thesis Fig. 5.8a).
 
     Parameters
@@ -268,18 +286,34 @@ def confidence_single_figure(clips: Sequence[ClipSummary], conditions: Sequence[
     model : str
         The model whose confidence is drawn.
     """
-    fig, ax = _new_figure(1, 1, size=(7.5, 5))
-    for rec, cond in zip(clips, conditions):
-        ax[0, 0].plot(rec.time, rec.confidence[rec.index(model)] * CM, lw=1.8,
-                      color=condition_colour(cond, conditions), label=f"{cond}: {rec.clip}")
-    _confidence_axes(ax[0, 0], model, "one clip per condition (Fig. 5.8a)")
-    ax[0, 0].legend(**LEGEND)
-    return fig
+    return _confidence_panel(model, "one clip per condition (Fig. 5.8a)", [
+        Line(rec.time, rec.confidence[rec.index(model)] * CM,
+             condition_colour(cond, conditions), 1.8, label=f"{cond}: {rec.clip}")
+        for rec, cond in zip(clips, conditions)])
 
 
-def confidence_all_figure(clips: Sequence[ClipSummary], conditions: Sequence[str],
-                          model: str) -> Figure:
+def confidence_single_figure(clips: Sequence[ClipSummary], conditions: Sequence[str],
+                             model: str) -> Figure:
+    """:func:`confidence_single_chart` as a matplotlib figure (thesis Fig. 5.8a).
+
+    Parameters
+    ----------
+    clips : sequence of ClipSummary
+        One clip per condition.
+    conditions : sequence of str
+        Their conditions.
+    model : str
+        The model whose confidence is drawn.
+    """
+    return to_matplotlib(confidence_single_chart(clips, conditions, model))
+
+
+def confidence_all_chart(clips: Sequence[ClipSummary], conditions: Sequence[str],
+                         model: str) -> Chart:
     """The model's confidence on every clip, coloured by condition (thesis Fig. 5.8b).
+
+    One thin line a clip, in the clips' order; the legend names each
+    condition once.
 
     Parameters
     ----------
@@ -290,13 +324,26 @@ def confidence_all_figure(clips: Sequence[ClipSummary], conditions: Sequence[str
     model : str
         The model whose confidence is drawn.
     """
-    fig, ax = _new_figure(1, 1, size=(7.5, 5))
-    labelled = set()
+    lines, labelled = [], set()
     for rec, cond in zip(clips, conditions):
-        ax[0, 0].plot(rec.time, rec.confidence[rec.index(model)] * CM, lw=1.0, alpha=0.8,
-                      color=condition_colour(cond, conditions),
-                      label=None if cond in labelled else cond)
+        lines.append(Line(rec.time, rec.confidence[rec.index(model)] * CM,
+                          condition_colour(cond, conditions), 1.0,
+                          label=None if cond in labelled else cond))
         labelled.add(cond)
-    _confidence_axes(ax[0, 0], model, f"every clip ({len(clips)}; Fig. 5.8b)")
-    ax[0, 0].legend(**LEGEND)
-    return fig
+    return _confidence_panel(model, f"every clip ({len(clips)}; Fig. 5.8b)", lines)
+
+
+def confidence_all_figure(clips: Sequence[ClipSummary], conditions: Sequence[str],
+                          model: str) -> Figure:
+    """:func:`confidence_all_chart` as a matplotlib figure (thesis Fig. 5.8b).
+
+    Parameters
+    ----------
+    clips : sequence of ClipSummary
+        Scored clips.
+    conditions : sequence of str
+        Their conditions.
+    model : str
+        The model whose confidence is drawn.
+    """
+    return to_matplotlib(confidence_all_chart(clips, conditions, model))
