@@ -11,6 +11,7 @@ every name it shows and quotes every link, so any clip name is safe in it.
 from __future__ import annotations
 
 import html
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -190,7 +191,8 @@ def _verdict_counts(ok: pd.DataFrame) -> str:
         numeric=set(range(1, len(counts.columns) + 1)))
 
 
-def _clip_section(rec: ClipSummary, out: Path, anchor: str, condition) -> str:
+def _clip_section(rec: ClipSummary, out: Path, anchor: str, condition,
+                  names: list[str]) -> str:
     files = clip_outputs(out, rec.clip)
     links = " · ".join(_link(files[k].name, label) for k, label in
                        (("json", "recognition.json"), ("csv", "confidence.csv")))
@@ -200,7 +202,7 @@ def _clip_section(rec: ClipSummary, out: Path, anchor: str, condition) -> str:
             f"{_e(condition) or 'unlabelled'}; files: {links}")
     figs = "".join(f'<a href="{html.escape(quote(p.name), quote=True)}">'
                    f'<img src="{html.escape(quote(p.name), quote=True)}" loading="lazy" '
-                   f'alt="{_e(p.name)}"></a>' for p in clip_figures(out, rec.clip))
+                   f'alt="{_e(p.name)}"></a>' for p in clip_figures(out, rec.clip, names))
     return f'<div class="clip"><h3 id="{anchor}">{_e(rec.clip)}</h3><p>{line}</p>{figs}</div>'
 
 
@@ -295,7 +297,8 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
     if len(failed):
         sections.append(f"<h2>Failed clips ({len(failed)})</h2>" + _table(
             ["clip", "error"], [[_e(r.clip), _e(r.error)] for r in failed.itertuples()]))
-    clips = [_clip_section(rec, out, anchors[rec.clip], condition_of.get(rec.clip))
+    names = sorted(os.listdir(out))  # once, not once per clip
+    clips = [_clip_section(rec, out, anchors[rec.clip], condition_of.get(rec.clip), names)
              for rec in recs]
     tables = ['<a href="summary.csv">summary.csv</a>']
     if len(stats_df):

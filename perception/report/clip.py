@@ -10,6 +10,9 @@ condition and input, or a tracking summary) come back in
 
 from __future__ import annotations
 
+import bisect
+import os
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -183,7 +186,7 @@ def clip_outputs(out: Path, clip: str) -> dict[str, Path]:
     }
 
 
-def clip_figures(out: Path, clip: str) -> list[Path]:
+def clip_figures(out: Path, clip: str, names: Sequence[str] | None = None) -> list[Path]:
     """Every figure of ``clip`` in ``out``: its two own, then any other ``<clip>.<name>.png``.
 
     A figure another step adds beside the clip's report (one ``<name>``, no
@@ -195,16 +198,23 @@ def clip_figures(out: Path, clip: str) -> list[Path]:
         Report folder.
     clip : str
         Clip name.
+    names : sequence of str, optional
+        The file names in ``out``, sorted: a batch report lists its folder
+        once for all its clips, rather than once per clip (default: listed here).
     """
-    own = [clip_outputs(out, clip)[k] for k in ("confidence_png", "paths_png")]
-    others = []
-    if out.is_dir():
-        prefix = f"{clip}."
-        for path in sorted(out.iterdir()):
-            rest = path.name[len(prefix):] if path.name.startswith(prefix) else ""
-            if rest.endswith(".png") and rest.count(".") == 1 and path not in own:
-                others.append(path)
-    return [p for p in own if p.exists()] + others
+    if names is None:
+        names = sorted(os.listdir(out)) if out.is_dir() else []
+    own = [clip_outputs(out, clip)[k].name for k in ("confidence_png", "paths_png")]
+    prefix = f"{clip}."
+    mine = []
+    # the names starting with the prefix are one run of the sorted list
+    for name in names[bisect.bisect_left(names, prefix):]:
+        if not name.startswith(prefix):
+            break
+        mine.append(name)
+    others = [n for n in mine if n not in own and n.endswith(".png")
+              and n[len(prefix):].count(".") == 1]
+    return [out / n for n in own if n in mine] + [out / n for n in others]
 
 
 def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,
