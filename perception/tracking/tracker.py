@@ -534,8 +534,9 @@ def track_video(
     with contextlib.ExitStack() as stack:
         src = stack.enter_context(FrameSource(video, prefetch=prefetch,
                                               keep_truncated=keep_truncated, fps=fps))
-        w = stack.enter_context(TracksWriter(out_path, markers.names, video=src.attrs(),
-                                             tracker=tracker.attrs()))
+        # /video (with the file's SHA-256, read meanwhile) and /tracker are
+        # written when tracking is done.
+        w = stack.enter_context(TracksWriter(out_path, markers.names))
         each = None
         if labelled_video is not None:
             from perception.io.video import VideoWriter
