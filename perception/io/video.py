@@ -23,7 +23,7 @@ import queue
 import sys
 import threading
 from collections.abc import Iterable, Iterator, Mapping
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from types import MappingProxyType
 from typing import Any
@@ -54,6 +54,35 @@ def sha256_file(path: str | os.PathLike, chunk: int = 1 << 20) -> str:
         while block := fh.read(chunk):
             h.update(block)
     return h.hexdigest()
+
+
+class _Sha256Thread(threading.Thread):
+    """:func:`sha256_file` of a file in a background thread.
+
+    Reading and hashing release the GIL, so the digest costs a clip's
+    tracking no time where a core is free; :meth:`result` waits for it.
+    """
+
+    def __init__(self, path: Path):
+        super().__init__(name=f"sha256:{path.name}", daemon=True)
+        self.path = path
+        self._digest: str | None = None
+        self._error: BaseException | None = None
+        self.start()
+
+    def run(self) -> None:
+        try:
+            self._digest = sha256_file(self.path)
+        except BaseException as exc:  # raised again by result(), in the caller's thread
+            self._error = exc
+
+    def result(self) -> str:
+        """The hex digest (re-raises what reading the file raised)."""
+        self.join()
+        if self._error is not None:
+            raise self._error
+        assert self._digest is not None
+        return self._digest
 
 
 def _fourcc_str(code: float) -> str:
@@ -152,7 +181,9 @@ class FrameSource:
     prefetch : int
         Frames decoded ahead (0: decode in the caller's thread).
     hash : bool
-        Compute the file's SHA-256 (one extra sequential read of the file).
+        Compute the file's SHA-256 (one extra sequential read of the file,
+        in a background thread while frames are decoded; :attr:`info` waits
+        for it).
     keep_truncated : bool
         Keep the frames of a stream that ends well before the frame count its
         header claims (a truncated or corrupt file) instead of refusing it.
@@ -204,9 +235,10 @@ class FrameSource:
         height, width = first.shape[:2]
         n_header = cap.get(cv2.CAP_PROP_FRAME_COUNT)
         fps = cap.get(cv2.CAP_PROP_FPS)
-        self.info = VideoInfo(
+        self._sha256 = _Sha256Thread(self.path) if hash else None
+        self._info = VideoInfo(
             path=os.fspath(path),
-            sha256=sha256_file(self.path) if hash else "",
+            sha256="",
             fps_nominal=float(fps) if math.isfinite(fps) and fps > 0 else 0.0,
             n_frames_header=int(n_header) if math.isfinite(n_header) and n_header > 0 else 0,
             width=int(width),
@@ -217,7 +249,7 @@ class FrameSource:
             self._times = TimeResolver(self.fps_override, use_container=False)
         else:
             self._check_rate()
-            self._times = TimeResolver(self.info.fps_nominal)
+            self._times = TimeResolver(self._info.fps_nominal)
         self.n_decoded = 0
         self.complete = False
         self._started = False
@@ -289,7 +321,7 @@ class FrameSource:
 
     def _check_rate(self) -> None:
         """Refuse a header frame rate no camera films a hand at (it would rescale time)."""
-        fps = self.info.fps_nominal
+        fps = self._info.fps_nominal
         if fps > MAX_FPS:
             self._cap.release()
             raise InputError(f"the container claims {fps:g} frames/s, more than any camera "
@@ -297,7 +329,7 @@ class FrameSource:
                              self.path)
 
     def _check_count(self) -> None:
-        claimed = self.info.n_frames_header
+        claimed = self._info.n_frames_header
         # Header counts of some containers are estimates (duration x rate):
         # a frame or two short is not a truncated file.
         missing = claimed - self.n_decoded
@@ -316,6 +348,14 @@ class FrameSource:
                 self._times.n_fallback,
                 self.n_decoded,
             )
+
+    @property
+    def info(self) -> VideoInfo:
+        """Header metadata and the file's SHA-256 (waits for the hash to be read)."""
+        if self._sha256 is not None:
+            self._info = replace(self._info, sha256=self._sha256.result())
+            self._sha256 = None
+        return self._info
 
     @property
     def time_source(self) -> str:

@@ -52,6 +52,17 @@ class Blob:
         return Blob((self.centre[0] + dx, self.centre[1] + dy), self.area, (x + dx, y + dy, w, h))
 
 
+#: Masks with fewer pixels than this are labelled in 16 bits: every
+#: provisional label of OpenCV's scan fits, and labelling runs about twice as
+#: fast as in 32 bits (the components and their statistics are the same).
+_LABELS_16_BELOW = 65535
+
+
+def label_type(shape: tuple[int, ...]) -> int:
+    """OpenCV label type for the connected components of a mask of ``shape``."""
+    return cv2.CV_16U if shape[0] * shape[1] < _LABELS_16_BELOW else cv2.CV_32S
+
+
 def find_blobs(
     mask: np.ndarray,
     *,
@@ -77,7 +88,8 @@ def find_blobs(
     list of Blob
         In mask coordinates (scaled if ``scale``).
     """
-    n, _, stats, cents = cv2.connectedComponentsWithStats(mask, connectivity=8)
+    n, _, stats, cents = cv2.connectedComponentsWithStats(mask, connectivity=8,
+                                                          ltype=label_type(mask.shape))
     if n <= 1:
         return []
     areas = stats[1:, cv2.CC_STAT_AREA]

@@ -33,7 +33,7 @@ from dataclasses import dataclass, replace
 import cv2
 import numpy as np
 
-from perception.tracking.blobs import Blob, find_blobs, nearest_blob
+from perception.tracking.blobs import Blob, find_blobs, label_type, nearest_blob
 from perception.tracking.markers import MarkerColour
 from perception.tracking.params import TrackerParams
 
@@ -162,7 +162,8 @@ def describe(hsv: np.ndarray, colour: MarkerColour, min_area: float,
     x0, y0 = (roi[0], roi[1]) if roi is not None else (0, 0)
     region = hsv if roi is None else hsv[y0:y0 + roi[3], x0:x0 + roi[2]]
     mask = colour.backproject(region)
-    n, labels, stats, cents = cv2.connectedComponentsWithStats(mask, connectivity=8)
+    n, labels, stats, cents = cv2.connectedComponentsWithStats(
+        mask, connectivity=8, ltype=label_type(mask.shape))
     order = [k for k in np.argsort(-stats[1:, cv2.CC_STAT_AREA], kind="stable") + 1
              if stats[k, cv2.CC_STAT_AREA] >= min_area][:max_blobs]
     out = []

@@ -29,7 +29,7 @@ import numpy as np
 
 from perception.errors import InputError
 from perception.io.tracks import Status
-from perception.tracking.blobs import Blob, find_blobs
+from perception.tracking.blobs import Blob, find_blobs, label_type
 from perception.tracking.candidates import (
     Candidate,
     describe,
@@ -181,7 +181,7 @@ class FirstDetection:
         found = find_blobs(tr.colour.backproject(hsv))
         mask = tr.colour.backproject(hsv) > 0
         if found:  # only the component of the blob, not neighbours in its box
-            n, labels = cv2.connectedComponents(mask.astype(np.uint8))
+            n, labels = cv2.connectedComponents(mask.astype(np.uint8), ltype=label_type(mask.shape))
             cx, cy = int(blob.centre[0]) - x, int(blob.centre[1]) - y
             lab = labels[min(max(cy, 0), h - 1), min(max(cx, 0), w - 1)]
             if lab:

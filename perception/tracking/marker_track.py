@@ -108,7 +108,8 @@ class MarkerTrack:
             # A merged blob's centroid is unreliable: keep the velocity.
             self.x = (zx, zy)
         else:
-            (px, py), (vx, vy) = self.predicted, self.v
+            vx, vy = self.v
+            px, py = x + vx, y + vy  # the prediction
             rx, ry = zx - px, zy - py
             self.x = (px + p.alpha * rx, py + p.alpha * ry)
             self.v = (vx + p.beta * rx, vy + p.beta * ry)

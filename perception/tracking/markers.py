@@ -81,7 +81,7 @@ class MarkerColour:
                 raise ValueError(f"{where}: {name}: expected an integer 0..255, got {value!r}")
             object.__setattr__(self, name, int(value))
 
-    @property
+    @cached_property
     def hsv(self) -> tuple[int, int, int]:
         """Render colour in OpenCV HSV (hue 0..179, saturation and value 0..255)."""
         px = np.array([[self.bgr]], dtype=np.uint8)

@@ -34,7 +34,7 @@ from typing import NamedTuple
 import cv2
 import numpy as np
 
-from perception.tracking.blobs import find_blobs, nearest_blob
+from perception.tracking.blobs import find_blobs, label_type, nearest_blob
 from perception.tracking.markers import MarkerColour
 from perception.tracking.params import TrackerParams
 
@@ -159,22 +159,6 @@ def measure(
     return meas
 
 
-def _search_region(
-    shape: tuple[int, ...], centre: tuple[float, float], window: tuple[int, int], margin: float
-) -> tuple[int, int, int, int] | None:
-    """``(x0, y0, x1, y1)``: the window at ``centre`` plus the margin, within the frame."""
-    h, w = shape[:2]
-    ww, wh = window
-    cx, cy = centre
-    x0 = max(int(cx - ww / 2 - margin), 0)
-    x1 = min(int(cx + ww / 2 + margin) + 1, w)
-    y0 = max(int(cy - wh / 2 - margin), 0)
-    y1 = min(int(cy + wh / 2 + margin) + 1, h)
-    if x1 - x0 < _MIN_REGION_PX or y1 - y0 < _MIN_REGION_PX:
-        return None  # the prediction left the frame
-    return x0, y0, x1, y1
-
-
 def _measure_region(
     frame: np.ndarray,
     colour: MarkerColour,
@@ -185,63 +169,74 @@ def _measure_region(
     params: TrackerParams,
     merged_window: tuple[int, int],
 ) -> tuple[Measurement, np.ndarray, tuple[int, int, int, int]] | None:
-    """One CamShift measurement; also the region's back-projection and bounds."""
+    """One CamShift measurement; also the region's back-projection and bounds.
+
+    Run for every marker in every frame: the region and CamShift's start are
+    worked out inline, in plain ints and floats.
+    """
     cx, cy = float(centre[0]), float(centre[1])
     if not (math.isfinite(cx) and math.isfinite(cy)):
         return None
-    region = _search_region(frame.shape, (cx, cy), window, margin)
-    if region is None:
-        return None
-    x0, y0, x1, y1 = region
-    bp = colour.backproject(cv2.cvtColor(frame[y0:y1, x0:x1], cv2.COLOR_BGR2HSV))
-    rh, rw = bp.shape
+    # The region: the window at the centre plus the margin, within the frame.
+    h, w = frame.shape[:2]
     ww, wh = window
-    wx = min(max(int(round(cx - ww / 2)) - x0, 0), rw - 1)
-    wy = min(max(int(round(cy - wh / 2)) - y0, 0), rh - 1)
-    start = (wx, wy, max(min(ww, rw - wx), 1), max(min(wh, rh - wy), 1))
+    x0, y0 = int(cx - ww / 2 - margin), int(cy - wh / 2 - margin)
+    x0, y0 = (x0 if x0 > 0 else 0), (y0 if y0 > 0 else 0)
+    x1, y1 = int(cx + ww / 2 + margin) + 1, int(cy + wh / 2 + margin) + 1
+    x1, y1 = (x1 if x1 < w else w), (y1 if y1 < h else h)
+    rw, rh = x1 - x0, y1 - y0
+    if rw < _MIN_REGION_PX or rh < _MIN_REGION_PX:
+        return None  # the prediction left the frame
+    region = x0, y0, x1, y1
+    bp = colour.backproject(cv2.cvtColor(frame[y0:y1, x0:x1], cv2.COLOR_BGR2HSV))
+    wx = round(cx - ww / 2) - x0
+    wx = 0 if wx < 0 else (rw - 1 if wx >= rw else wx)
+    wy = round(cy - wh / 2) - y0
+    wy = 0 if wy < 0 else (rh - 1 if wy >= rh else wy)
+    sw = ww if ww < rw - wx else rw - wx
+    sh = wh if wh < rh - wy else rh - wy
+    start = (wx, wy, sw if sw > 1 else 1, sh if sh > 1 else 1)
     pred = (cx - x0, cy - y0)
-    converged = _camshift(bp, start, pred, ref, params)
-    if converged is None:
-        return None
-    (bcx, bcy), side = converged
-    half = _GROW * side + _GROW_PX
-    mx0, my0 = max(int(bcx - half), 0), max(int(bcy - half), 0)
-    mx1, my1 = min(int(bcx + half) + 2, rw), min(int(bcy + half) + 2, rh)
-    mo = cv2.moments(bp[my0:my1, mx0:mx1], True)
+    box, (_, _, bw, bh) = cv2.CamShift(bp, start, params.criteria)
+    if box[1][0] <= 0 or bw <= 0 or bh <= 0:
+        converged = _camshift_again(bp, pred, ref, params)
+        if converged is None:
+            return None
+        box, (_, _, bw, bh) = converged
+    bcx, bcy = box[0]
+    half = _GROW * (bw if bw > bh else bh) + _GROW_PX
+    mx0, my0 = int(bcx - half), int(bcy - half)
+    mx0, my0 = (mx0 if mx0 > 0 else 0), (my0 if my0 > 0 else 0)
+    mo = cv2.moments(bp[my0:int(bcy + half) + 2, mx0:int(bcx + half) + 2], True)
     mass = mo["m00"]
     if mass <= 0:
         return None
-    meas = Measurement(
-        (mo["m10"] / mass + x0 + mx0, mo["m01"] / mass + y0 + my0), mass, _extent(mo, mass)
-    )
+    total = cv2.countNonZero(bp)
     if ref > 0 and mass > params.split_ratio * ref:
-        meas = split_merged(bp, pred, (x0, y0), ref, params, merged_window) or meas
-    meas = meas._replace(clutter=max(cv2.countNonZero(bp) - meas.mass, 0.0))
+        meas = split_merged(bp, pred, (x0, y0), ref, params, merged_window)
+        if meas is not None:
+            return meas._replace(clutter=max(total - meas.mass, 0.0)), bp, region
+    meas = Measurement((mo["m10"] / mass + x0 + mx0, mo["m01"] / mass + y0 + my0), mass,
+                       _extent(mo, mass), False, max(total - mass, 0.0))
     return meas, bp, region
 
 
-def _camshift(
-    bp: np.ndarray,
-    start: tuple[int, int, int, int],
-    pred: tuple[float, float],
-    ref: float,
-    params: TrackerParams,
-) -> tuple[tuple[float, float], int] | None:
-    """CamShift from ``start``: the converged box's centre and larger side, px.
+def _camshift_again(
+    bp: np.ndarray, pred: tuple[float, float], ref: float, params: TrackerParams
+) -> tuple[tuple[tuple[float, float], tuple[float, float], float],
+           tuple[int, int, int, int]] | None:
+    """CamShift's second try when its start window held nothing of the colour.
 
-    Nothing of the colour in the start window: CamShift starts again on the
-    plausible blob nearest ``pred``. None if that fails too.
+    It starts again on the plausible blob nearest ``pred``; returns what
+    ``cv2.CamShift`` does, or None if there is no such blob or it fails too.
     """
-    criteria = params.criteria
-    box, (_, _, bw, bh) = cv2.CamShift(bp, start, criteria)
-    if box[1][0] <= 0 or bw <= 0 or bh <= 0:
-        blob = nearest_blob(find_blobs(bp, min_area=max(params.lost_ratio * ref, 1)), pred)
-        if blob is None:
-            return None
-        box, (_, _, bw, bh) = cv2.CamShift(bp, blob.box, criteria)
-        if box[1][0] <= 0 or bw <= 0 or bh <= 0:
-            return None
-    return box[0], max(bw, bh)
+    blob = nearest_blob(find_blobs(bp, min_area=max(params.lost_ratio * ref, 1)), pred)
+    if blob is None:
+        return None
+    box, rect = cv2.CamShift(bp, blob.box, params.criteria)
+    if box[1][0] <= 0 or rect[2] <= 0 or rect[3] <= 0:
+        return None
+    return box, rect
 
 
 def split_merged(
@@ -420,7 +415,7 @@ def soft_diameter(
     x1, y1 = min(cx + half + 1, w), min(cy + half + 1, h)
     region = frame[y0:y1, x0:x1]
     gate = colour.backproject(cv2.cvtColor(region, cv2.COLOR_BGR2HSV))
-    n, labels = cv2.connectedComponents((gate > 0).astype(np.uint8))
+    n, labels = cv2.connectedComponents((gate > 0).astype(np.uint8), ltype=label_type(gate.shape))
     lab = labels[min(cy - y0, labels.shape[0] - 1), min(cx - x0, labels.shape[1] - 1)]
     if n < 2 or lab == 0:
         return float("nan")

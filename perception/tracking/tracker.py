@@ -135,6 +135,16 @@ class Tracker:
         self._time = 0.0
         self._order = sorted(range(len(self._tracks)), key=lambda j: (
             not self._tracks[j].still, self._tracks[j].name != "wrist", j))
+        # The rest of the hand each marker is placed against (see _anchor): the
+        # digits for the wrist, the wrist for a digit; names never change.
+        self._anchors = [
+            [k for k, t in enumerate(self._tracks)
+             if k != j and t.name in (("thumb", "finger") if tr.name == "wrist" else ("wrist",))]
+            for j, tr in enumerate(self._tracks)
+        ]
+        m = len(self._tracks)
+        self._lost_row = (np.full((m, 2), np.nan), np.zeros(m, np.float32),
+                          np.full(m, Status.LOST, np.int8))
 
     # -- public -------------------------------------------------------------
     @property
@@ -222,24 +232,25 @@ class Tracker:
         """
         self._check_frame(frame)
         self._time = self.n_frames / 30.0 if time_s is None else float(time_s)
-        m = len(self._tracks)
-        position = np.full((m, 2), np.nan)
-        lik = np.zeros(m, np.float32)
-        status = np.full(m, Status.LOST, np.int8)
+        tracks = self._tracks
+        position, lik, status = (a.copy() for a in self._lost_row)
         self._small = None
-        todo = [j for j, tr in enumerate(self._tracks) if not tr.found]
-        started = self._first.detect(frame, todo, self.n_frames) if todo else {}
-        results = {}
+        todo = [j for j, tr in enumerate(tracks) if not tr.found]
+        results: list[Located | None] = [None] * len(tracks)
+        if todo:
+            for j, located in self._first.detect(frame, todo, self.n_frames).items():
+                results[j] = located
         for j in self._order:  # the object, the band, then the digits, which move relative to it
-            tr = self._tracks[j]
-            results[j] = started[j] if j in started else (self._follow(tr, frame) if not tr.lost
-                                                          else None)
+            tr = tracks[j]
+            if tr.found and not tr.lost and j not in todo:
+                results[j] = self._follow(tr, frame)
         # Lost markers are searched for once every followed one has moved on:
         # the hand's structure is then judged on this frame's positions.
-        for j, tr in enumerate(self._tracks):
+        for j, tr in enumerate(tracks):
             if results[j] is None and tr.found:
                 tr.lost = True
-        for j, tr in enumerate(self._tracks):
+        centres: list[tuple[float, float] | None] = [None] * len(tracks)
+        for j, tr in enumerate(tracks):
             result = results[j]
             if tr.found and result is None:
                 result = self._reacquire(tr, frame)
@@ -251,8 +262,12 @@ class Tracker:
             if result[2] != Status.LOST:
                 tr.seen_at = self._time
                 tr.n_lost = 0
-            (position[j, 0], position[j, 1]), lik[j], status[j] = result
-        self._record_offsets(position)
+            centre, lik[j], status[j] = result
+            position[j] = centre
+            x, y = centre
+            if math.isfinite(x) and math.isfinite(y):
+                centres[j] = (x, y)
+        self._record_offsets(centres)
         self._first.frame_done(self.n_frames)
         self.n_frames += 1
         return position, lik, status
@@ -284,33 +299,37 @@ class Tracker:
                                                 c.centre[1] + y0 - centre[1]))
         return reject_reason(c, tr.name, tr.colour, None, self.params) is None
 
-    def _anchor(self, tr: MarkerTrack, position: np.ndarray | None = None
+    def _anchor(self, tr: MarkerTrack,
+                centres: list[tuple[float, float] | None] | None = None
                 ) -> tuple[float, float] | None:
-        """Where the rest of the hand is: the wrist for a digit, the digits for the wrist."""
-        names = ("thumb", "finger") if tr.name == "wrist" else ("wrist",)
+        """Where the rest of the hand is: the wrist for a digit, the digits for the wrist.
+
+        From this frame's measured ``centres`` (None where not measured) if
+        given, else from the markers tracked now.
+        """
         xs, ys = [], []
-        for j, t in enumerate(self._tracks):
-            if t.name not in names or t is tr:
-                continue
-            if position is not None:
-                x, y = float(position[j, 0]), float(position[j, 1])
-                if math.isfinite(x) and math.isfinite(y):
-                    xs.append(x)
-                    ys.append(y)
-            elif t.found and not t.lost:
-                xs.append(t.x[0])
-                ys.append(t.x[1])
+        if centres is not None:
+            for k in self._anchors[self._tracks.index(tr)]:
+                c = centres[k]
+                if c is not None:
+                    xs.append(c[0])
+                    ys.append(c[1])
+        else:
+            for k in self._anchors[self._tracks.index(tr)]:
+                t = self._tracks[k]
+                if t.found and not t.lost:
+                    xs.append(t.x[0])
+                    ys.append(t.x[1])
         # plain floats: numpy's per-call cost would exceed the arithmetic
         return (sum(xs) / len(xs), sum(ys) / len(ys)) if xs else None
 
-    def _record_offsets(self, position: np.ndarray) -> None:
+    def _record_offsets(self, centres: list[tuple[float, float] | None]) -> None:
         """Each measured hand marker's offset from the rest of the hand, for re-acquisition."""
-        for j, tr in enumerate(self._tracks):
-            x, y = float(position[j, 0]), float(position[j, 1])
-            if tr.still or not (math.isfinite(x) and math.isfinite(y)):
+        for tr, c in zip(self._tracks, centres):
+            if tr.still or c is None:
                 continue
-            anchor = self._anchor(tr, position)
-            tr.offset = None if anchor is None else (x - anchor[0], y - anchor[1])
+            anchor = self._anchor(tr, centres)
+            tr.offset = None if anchor is None else (c[0] - anchor[0], c[1] - anchor[1])
 
     def _expected_here(self, tr: MarkerTrack) -> tuple[tuple[float, float], float]:
         """Where a lost marker should be and how far from it (px) it may be found.
@@ -327,18 +346,6 @@ class Tracker:
         drift = min(p.hand_drift * max(tr.n_lost, 1), p.max_drift) * self.px_per_m
         return (anchor[0] + tr.offset[0], anchor[1] + tr.offset[1]), drift + max(tr.win) / 2
 
-    def _with_the_hand(self, tr: MarkerTrack, centre: tuple[float, float]) -> bool:
-        """Whether a digit marker kept its place relative to the band (within ``hand_drift``)."""
-        if tr.still or tr.name == "wrist" or tr.offset is None or self.px_per_m is None:
-            return True
-        anchor = self._anchor(tr)
-        if anchor is None:
-            return True
-        p = self.params
-        allowed = p.hand_drift * self.px_per_m + max(tr.win) / 2
-        return math.hypot(centre[0] - anchor[0] - tr.offset[0],
-                          centre[1] - anchor[1] - tr.offset[1]) <= allowed
-
     def _reach_px(self, tr: MarkerTrack) -> float:
         """How far (px) a marker can have moved since it was last seen."""
         if self.px_per_m is None:
@@ -347,7 +354,13 @@ class Tracker:
         return self.params.max_speed * dt * self.px_per_m + max(tr.win)
 
     def _follow(self, tr: MarkerTrack, frame: np.ndarray) -> Located | None:
-        """Track from the prediction; None if the marker is not in its region, or jumped."""
+        """Track from the prediction; None if the marker is not in its region, or jumped.
+
+        A jump faster than a hand (:meth:`_reach_px`), or a digit leaving
+        its place relative to the band by more than ``hand_drift``, is
+        something else. Run for every marker in every frame: the tests are
+        written out in plain floats.
+        """
         p = self.params
         meas = measure_still(frame, tr.colour, tr.x, tr.win, tr.ref, p) if tr.still else None
         if meas is None:
@@ -357,10 +370,19 @@ class Tracker:
         ratio = meas.mass / tr.ref
         if ratio < p.lost_ratio or ratio > p.max_area_ratio:
             return None  # hidden, or swallowed by something of its colour: search again
-        if math.hypot(meas.centre[0] - tr.x[0], meas.centre[1] - tr.x[1]) > self._reach_px(tr):
-            return None  # faster than a hand: something else
-        if not self._with_the_hand(tr, meas.centre):
-            return None  # left the rest of the hand: something else
+        cx, cy = meas.centre
+        scale = self._first.scale
+        if scale is not None:
+            reach = p.max_speed * max(self._time - tr.seen_at, 1 / 60) * scale + max(tr.win)
+            if math.hypot(cx - tr.x[0], cy - tr.x[1]) > reach:
+                return None  # faster than a hand: something else
+            offset = tr.offset
+            if offset is not None and not tr.still and tr.name != "wrist":
+                anchor = self._anchor(tr)
+                if anchor is not None and not math.hypot(
+                        cx - anchor[0] - offset[0], cy - anchor[1] - offset[1]
+                ) <= p.hand_drift * scale + max(tr.win) / 2:
+                    return None  # left the rest of the hand: something else
         if tr.still:
             if ratio < p.hold_ratio:
                 # Partly hidden (the hand closing on the object): the visible
@@ -374,7 +396,7 @@ class Tracker:
             # Followed by prediction among its neighbour's pixels for a while:
             # where it is is no longer known, though the window stays on it.
             return (math.nan, math.nan), 0.0, Status.LOST
-        return meas.centre, tr.likelihood(meas, self.params), Status.TRACKED
+        return meas.centre, tr.likelihood(meas, p), Status.TRACKED
 
     def _plausible_here(self, tr: MarkerTrack, centre: tuple[float, float]) -> bool:
         """Whether a re-acquired hand marker lies within the hand of the others tracked."""
@@ -534,8 +556,9 @@ def track_video(
     with contextlib.ExitStack() as stack:
         src = stack.enter_context(FrameSource(video, prefetch=prefetch,
                                               keep_truncated=keep_truncated, fps=fps))
-        w = stack.enter_context(TracksWriter(out_path, markers.names, video=src.attrs(),
-                                             tracker=tracker.attrs()))
+        # /video (with the file's SHA-256, read meanwhile) and /tracker are
+        # written when tracking is done.
+        w = stack.enter_context(TracksWriter(out_path, markers.names))
         each = None
         if labelled_video is not None:
             from perception.io.video import VideoWriter
