@@ -87,8 +87,9 @@ def planning_threads() -> int:
     """Threads :func:`build_models` uses: ``$HAMMER_MV_PLAN_THREADS``, else up to 4.
 
     The solver's compiled passes (two thirds of planning) release the GIL, so
-    several models plan at once: on 2 cores a new scene's 10 models take about
-    0.6 of the time of one thread. The default is the cores this process may
+    several models plan at once (on 2 idle cores a new scene's 10 default
+    models took 144 ms, against 165-197 ms on one thread; on a busy machine
+    threads gain nothing). The default is the cores this process may
     use, at most 4 (past that the Python third, which holds the GIL, is all
     that is left). A batch's workers use one each: they already use every core.
     """
