@@ -255,6 +255,7 @@ class FrameSource:
         self._started = False
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
+        self._tokens: queue.SimpleQueue | None = None
 
     # -- iteration ---------------------------------------------------------
     def __iter__(self) -> Iterator[tuple[int, float, np.ndarray]]:
@@ -288,35 +289,37 @@ class FrameSource:
             yield frame, cap.get(cv2.CAP_PROP_POS_MSEC)
 
     def _threaded(self) -> Iterator[tuple[np.ndarray, float]]:
-        q: queue.Queue = queue.Queue(maxsize=self.prefetch)
+        # Frames come back through one queue; the decoder takes a token from
+        # another before each frame and the consumer returns one per frame
+        # taken, so at most ``prefetch`` frames wait. C-level SimpleQueues
+        # keep the per-frame handover to two calls that wait without the GIL.
+        frames: queue.SimpleQueue = queue.SimpleQueue()
+        tokens: queue.SimpleQueue = queue.SimpleQueue()
+        for _ in range(self.prefetch):
+            tokens.put(True)
+        self._tokens = tokens
         done = object()
-
-        def put(item: Any) -> bool:
-            while not self._stop.is_set():
-                try:
-                    q.put(item, timeout=0.1)
-                    return True
-                except queue.Full:
-                    continue
-            return False
 
         def run() -> None:
             try:
-                for item in self._direct():
-                    if not put(item):
+                reader = self._direct()
+                while tokens.get() and not self._stop.is_set():
+                    item = next(reader, done)
+                    frames.put(item)
+                    if item is done:
                         return
-                put(done)
             except BaseException as exc:  # surfaced in the consumer thread
-                put(exc)
+                frames.put(exc)
 
         self._thread = threading.Thread(target=run, name=f"decode:{self.path.name}", daemon=True)
         self._thread.start()
         while True:
-            item = q.get()
+            item = frames.get()
             if item is done:
                 return
             if isinstance(item, BaseException):
                 raise item
+            tokens.put(True)
             yield item
 
     def _check_rate(self) -> None:
@@ -378,6 +381,8 @@ class FrameSource:
     def close(self) -> None:
         """Stop the decoding thread and release the file."""
         self._stop.set()
+        if self._tokens is not None:
+            self._tokens.put(False)  # wakes a decoder waiting for room
         if self._thread is not None:
             self._thread.join()
             self._thread = None
