@@ -58,7 +58,8 @@ import logging
 import math
 import os
 import sys
-from collections.abc import Iterable, Mapping
+import threading
+from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any
@@ -452,6 +453,36 @@ def _roi_in_frame(name: str, roi: ROI, shape: tuple[int, ...]) -> None:
         )
 
 
+_SERIAL_LOCK = threading.Lock()
+_serial_users = 0
+_threads_before = 0
+
+
+@contextlib.contextmanager
+def _serial_opencv() -> Iterator[None]:
+    """OpenCV's own thread pool off inside the block (``cv2.setNumThreads(1)``), restored after.
+
+    Tracking converts small regions, a few thousand pixels each, which
+    OpenCV still splits over its pool: a second thread then spins for as
+    long as the first converts, on the core FFmpeg's decoding threads (not
+    OpenCV's pool) need. Nested and concurrent blocks share one setting; the
+    last to leave restores the number of threads found by the first.
+    """
+    global _serial_users, _threads_before
+    with _SERIAL_LOCK:
+        if _serial_users == 0:
+            _threads_before = cv2.getNumThreads()
+            cv2.setNumThreads(1)
+        _serial_users += 1
+    try:
+        yield
+    finally:
+        with _SERIAL_LOCK:
+            _serial_users -= 1
+            if _serial_users == 0:
+                cv2.setNumThreads(_threads_before)
+
+
 def track_frames(
     frames: Iterable[tuple[int, float, np.ndarray]],
     writer: TracksWriter,
@@ -549,11 +580,19 @@ def track_video(
         unless ``keep_truncated``, a frame rate no camera has unless ``fps``),
         a bad ROI, or a marker never found (the message says why: rejected
         candidates, or ambiguity); no output file is left behind.
+
+    Notes
+    -----
+    OpenCV's thread pool is off while tracking (``cv2.setNumThreads(1)``,
+    restored after): each frame's work is a few small regions, which the
+    pool would split at a cost of more time than it saves, on the cores
+    decoding needs.
     """
     markers = default_markers() if markers is None else markers
     out_path = tracks_path_for(video) if out is None else Path(out)
     tracker = Tracker(markers, params, rois)
     with contextlib.ExitStack() as stack:
+        stack.enter_context(_serial_opencv())
         src = stack.enter_context(FrameSource(video, prefetch=prefetch,
                                               keep_truncated=keep_truncated, fps=fps))
         # /video (with the file's SHA-256, read meanwhile) and /tracker are
