@@ -3,7 +3,7 @@
 Given where a marker should be (a centre and a window), these functions
 return where it is and how much of its colour is there, as a
 :class:`Measurement`. Only the region around the prediction is converted to
-HSV and back-projected, so decoding, not tracking, limits throughput.
+HSV and back-projected, so decoding, not tracking, takes most of the time.
 
 * :func:`measure` runs **CamShift** on the back-projection (hue range,
   saturation and value minimums) from the given window, then takes the
