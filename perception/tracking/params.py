@@ -35,7 +35,8 @@ class TrackerParams:
         Margin around the predicted window searched each frame, px.
     initial_margin_px : int
         Margin used until a marker's velocity is known (first frames and
-        after re-acquisition), px; covers fast motion from rest.
+        after re-acquisition), px, where the ``search_margin_px`` one finds
+        no marker: covers fast motion from rest.
     velocity_margin : float
         Extra margin per px/frame of predicted speed.
     alpha, beta : float

@@ -364,6 +364,13 @@ class Tracker:
         """
         p = self.params
         meas = measure_still(frame, tr.colour, tr.x, tr.win, tr.ref, p) if tr.still else None
+        if meas is None and tr.n_obs < 2 and not tr.still:
+            # Just (re)started, its velocity unknown: near where it was first,
+            # then widely (a wide region lets CamShift's window take in
+            # neighbours of the marker's colour).
+            meas = measure(frame, tr.colour, tr.predicted, tr.win, tr.ref, p.search_margin_px, p)
+            if meas is None or not p.lost_ratio <= meas.mass / tr.ref <= p.max_area_ratio:
+                meas = None
         if meas is None:
             meas = measure(frame, tr.colour, tr.predicted, tr.win, tr.ref, tr.margin(p), p)
         if meas is None:
