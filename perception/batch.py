@@ -14,6 +14,8 @@ Clips run in local processes (``jobs``) or on a dask.distributed cluster
 from __future__ import annotations
 
 import contextlib
+import ctypes
+import functools
 import json
 import logging
 import multiprocessing
@@ -26,12 +28,13 @@ from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from perception.errors import InputError
 from perception.io.atomic import owner_tag, remove_stale, write_json
+from perception.io.frame_sample import FrameSample
 from perception.pipeline import (
     TRACKS_SUFFIX,
     RecognitionSettings,
@@ -42,10 +45,11 @@ from perception.pipeline import (
 )
 from perception.recognition.planning import THREADS_VARIABLE
 from perception.recognition.repertoire import PlanCache, Repertoire
-from perception.report.batch import write_batch_report
 from perception.report.clip import ClipSummary, clip_outputs, write_clip_report
-from perception.report.conditions import reference_model
 from perception.report.tracking import tracking_columns, write_tracking_report
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = ["BatchItem", "ClipResult", "discover", "process_clip", "run_batch", "summary_table"]
 
@@ -113,6 +117,8 @@ def check_clip_name(name: str, where: str) -> str:
 
 
 def _from_manifest(source: Path) -> list[BatchItem]:
+    import pandas as pd  # not at the top: a worker process never needs pandas
+
     try:
         man = pd.read_csv(source, dtype=str, keep_default_na=False)
     except (OSError, ValueError, pd.errors.ParserError) as exc:
@@ -266,12 +272,13 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
         done = _current_report(item, out, fp)
         if done is not None:
             return ClipResult(**base, status="reused", summary=ClipSummary.from_dict(done))
+        frames = FrameSample()
         tracks = load_clip(item.path, tracks_out=out / "tracks" / f"{item.clip}{TRACKS_SUFFIX}",
                            progress=progress, setup=settings.tracking, pose=settings.pose,
-                           **settings.video_options())
+                           frames=frames, **settings.video_options())
         rec = recognize_tracks(tracks, repertoire, settings, clip=item.clip, source=item.path,
                                plan_cache=plan_cache)
-        tracking = write_tracking_report(tracks, out, item.clip)
+        tracking = write_tracking_report(tracks, out, item.clip, frames=frames)
         extra = {"fingerprint": fp, "condition": item.condition, "input": str(item.path),
                  "tracking": tracking}
         write_clip_report(rec, out, extra=extra)
@@ -319,7 +326,37 @@ def _limit_threads() -> None:
     """One thread per worker process: parallelism comes from the processes."""
     import cv2
 
+    from perception.io import video
+
     cv2.setNumThreads(1)
+    video.decoder_threads = 1
+
+
+#: glibc's ``mallopt`` parameters, and the values a plain process's dynamic
+#: thresholds grow to (``mallopt(3)``: at most 32 MiB, trim at twice that).
+_M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3
+_MMAP_THRESHOLD, _TRIM_THRESHOLD = 32 << 20, 64 << 20
+
+
+@functools.cache
+def _reuse_freed_memory() -> bool:
+    """Let glibc reuse freed frames in a worker started with ``MALLOC_TRIM_THRESHOLD_``.
+
+    dask's nanny starts its workers with ``MALLOC_TRIM_THRESHOLD_=65536``,
+    and setting any threshold also fixes glibc's mmap threshold at 128 KiB:
+    every frame-sized array (0.9 MB at 640x480) is then a fresh ``mmap``,
+    zeroed page by page. A clip took 40,000 page faults and 35 % more time
+    than in a local process. Returns whether the thresholds were changed
+    (only where the variable is set and the C library is glibc).
+    """
+    if os.environ.get("MALLOC_TRIM_THRESHOLD_") is None:
+        return False
+    try:
+        mallopt = ctypes.CDLL(None).mallopt
+    except (OSError, AttributeError):  # not glibc: its allocator is not the one tuned
+        return False
+    return bool(mallopt(_M_MMAP_THRESHOLD, _MMAP_THRESHOLD)
+                and mallopt(_M_TRIM_THRESHOLD, _TRIM_THRESHOLD))
 
 
 @contextlib.contextmanager
@@ -340,16 +377,20 @@ def _single_threaded_children():
 
 @contextlib.contextmanager
 def _one_thread():
-    """OpenCV single-threaded in this process while it works beside its workers:
-    its thread pool would otherwise take the cores the workers run on."""
+    """OpenCV and FFmpeg single-threaded in this process while it works beside its
+    workers: their thread pools would otherwise take the cores the workers run on."""
     import cv2
 
-    before = cv2.getNumThreads()
+    from perception.io import video
+
+    before = cv2.getNumThreads(), video.decoder_threads
     cv2.setNumThreads(1)
+    video.decoder_threads = 1
     try:
         yield
     finally:
-        cv2.setNumThreads(before)
+        cv2.setNumThreads(before[0])
+        video.decoder_threads = before[1]
 
 
 def _init_worker(repertoire_file: str) -> None:
@@ -360,7 +401,14 @@ def _init_worker(repertoire_file: str) -> None:
     worker has started and imported everything (about a second).
     """
     _limit_threads()
-    _WORKER["repertoire"] = Repertoire.load(repertoire_file)
+    _reuse_freed_memory()  # inherited from a process that has used dask
+    try:
+        _WORKER["repertoire"] = Repertoire.load(repertoire_file)
+    except InputError:
+        # Gone: the batch ended before this worker had started, and shuts it
+        # down without a clip (the pool does not wait for it).
+        if Path(repertoire_file).exists():
+            raise
 
 
 @dataclass(frozen=True)
@@ -384,6 +432,7 @@ class _Job:
         """:meth:`run` in a dask worker: single-threaded OpenCV, as local workers are
         (dask's nanny already starts workers with one BLAS/OpenMP thread)."""
         _limit_threads()
+        _reuse_freed_memory()
         os.environ[THREADS_VARIABLE] = "1"  # the cluster's other workers use the other cores
         return self.run(item, repertoire)
 
@@ -425,10 +474,16 @@ def _run_local(items: list[BatchItem], repertoire: Repertoire, job: _Job,
     with tempfile.TemporaryDirectory(prefix=f".repertoire-{owner_tag()}-", dir=job.out) as tmp, \
             _one_thread():
         rep_file = repertoire.save(Path(tmp) / "repertoire.h5")
-        with _single_threaded_children(), ProcessPoolExecutor(
-                max_workers=jobs - 1, initializer=_init_worker, initargs=(str(rep_file),),
-                mp_context=ctx) as pool:
-            yield from _share(pending, here, pool, job, jobs - 1)
+        # (the pool spawns its workers as clips are submitted: in the block)
+        with _single_threaded_children():
+            pool = ProcessPoolExecutor(max_workers=jobs - 1, initializer=_init_worker,
+                                       initargs=(str(rep_file),), mp_context=ctx)
+            try:
+                yield from _share(pending, here, pool, job, jobs - 1)
+            finally:
+                # The workers exit on their own (0.2 s) while this process
+                # writes the report; Python joins them before it exits.
+                pool.shutdown(wait=False, cancel_futures=True)
 
 
 def _share(pending: deque, here, pool: ProcessPoolExecutor, job: _Job,
@@ -465,10 +520,12 @@ def _share(pending: deque, here, pool: ProcessPoolExecutor, job: _Job,
 
 
 def _prepare_report() -> None:
-    """Import scipy.special (the report's statistics, 0.3 s) while the last clips
-    finish in the workers: this process would otherwise wait idle, then import it.
-    The report's own modules are imported with this one."""
+    """Import what the batch report needs (pandas, scipy.special: 0.5 s) while
+    workers finish the clips: this process would otherwise wait idle, then
+    import them. Workers never import them."""
     import scipy.special  # noqa: F401
+
+    import perception.report.batch  # noqa: F401 - pandas
 
 
 def _run_dask(items: list[BatchItem], repertoire: Repertoire, job: _Job,
@@ -480,6 +537,7 @@ def _run_dask(items: list[BatchItem], repertoire: Repertoire, job: _Job,
     with Client(scheduler) as client:
         rep = client.scatter(repertoire, broadcast=True)
         futures = [client.submit(job.run_on_cluster, it, rep, pure=False) for it in items]
+        _prepare_report()  # this process waits for the cluster anyway
         for fut in dask_completed(futures):
             yield fut.result()
 
@@ -520,6 +578,10 @@ def summary_table(results: list[ClipResult], reference: str | None = None) -> pd
         The reference grasp model (default:
         :func:`~perception.report.conditions.reference_model` of the scored clips).
     """
+    import pandas as pd
+
+    from perception.report.conditions import reference_model
+
     scored = [r for r in results if r.summary is not None]
     names = scored[0].summary.names if scored else []
     if reference is None:
@@ -584,6 +646,8 @@ def run_batch(
         The summary (see :func:`summary_table`).
     """
     from tqdm import tqdm
+
+    from perception.report.batch import write_batch_report
 
     settings = RecognitionSettings() if settings is None else settings
     if jobs < 1:

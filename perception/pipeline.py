@@ -39,6 +39,7 @@ from perception.recognition.repertoire import PlanCache, Repertoire
 from perception.recognition.result import Recognition
 
 if TYPE_CHECKING:  # the tracker (OpenCV) and movement are imported only when needed
+    from perception.io.frame_sample import FrameSample
     from perception.io.pose import PoseImport
     from perception.tracking.setup import TrackingSetup
 
@@ -178,7 +179,7 @@ def _sha256(key: tuple[Path, int, int]) -> str:
 def load_clip(source: str | os.PathLike | Tracks, *, tracks_out: str | os.PathLike | None = None,
               progress: bool = False, setup: TrackingSetup | None = None,
               pose: PoseImport | None = None, keep_truncated: bool = False,
-              fps: float | None = None) -> Tracks:
+              fps: float | None = None, frames: FrameSample | None = None) -> Tracks:
     """The tracks of a clip: tracked from a video, read from a tracks or pose file, or as given.
 
     Parameters
@@ -202,6 +203,10 @@ def load_clip(source: str | os.PathLike | Tracks, *, tracks_out: str | os.PathLi
         A video's true frame rate, frames/s, whatever its header says. With
         this or ``keep_truncated``, a video is always tracked afresh (its
         existing tracks file may have been made without them).
+    frames : FrameSample, optional
+        Keeps a few frames of a video as it is tracked, for the contact sheet
+        (:func:`~perception.report.tracking.contact_sheet`); left empty when
+        the tracks are not tracked now.
 
     Raises
     ------
@@ -230,7 +235,7 @@ def load_clip(source: str | os.PathLike | Tracks, *, tracks_out: str | os.PathLi
 
     kw = {} if setup is None else {"markers": setup.markers, "params": setup.params}
     return Tracks.load(track_video(path, out, progress=progress, keep_truncated=keep_truncated,
-                                   fps=fps, **kw))
+                                   fps=fps, frames=frames, **kw))
 
 
 #: ``/tracker`` attributes that describe what a tracker learned from the clip

@@ -330,3 +330,46 @@ def test_recognize_reports_tracking_quality_and_a_contact_sheet(tmp_path):
 
     sheet = cv2.imread(str(out / "clip.tracking.png"))
     assert sheet is not None and sheet.shape[1] == 1200
+
+
+def test_contact_sheet_from_frames_kept_while_tracking_matches_a_decoded_one(tmp_path):
+    import cv2
+
+    from perception.io.frame_sample import FrameSample
+    from perception.report.tracking import contact_sheet
+    from perception.synthetic.demos import render_demo_clip
+    from perception.synthetic.scene import Scene
+    from perception.tracking.tracker import track_video
+
+    scene = Scene.reach_to_grasp(45, 30, start=(0.0, -0.25), onset=0.3, duration=0.8)
+    clip, _ = render_demo_clip(tmp_path, "clip.mp4", n=45, angle=0.0, hand=True, scene=scene)
+    every = FrameSample(max_frames=100)  # stride 1: the very frames a decode gives
+    tracks = Tracks.load(track_video(clip.video, tmp_path / "c.tracks.h5", frames=every))
+    assert every.stride == 1 and sorted(every.frames) == list(range(45))
+    kept = contact_sheet(tracks, None, tmp_path / "kept.png", frames=every)
+    decoded = contact_sheet(tracks, None, tmp_path / "decoded.png")
+    np.testing.assert_array_equal(cv2.imread(str(kept)), cv2.imread(str(decoded)))
+
+    few = FrameSample(max_frames=8)  # every 6th frame: the nearest stand in
+    track_video(clip.video, tmp_path / "d.tracks.h5", frames=few)
+    assert few.stride == 6 and sorted(few.frames) == list(range(0, 45, 6))
+    assert few.nearest(17) == 18 and few.nearest(15) == 12 and few.nearest(44) == 42
+    (tmp_path / "moved").mkdir()
+    clip.video.rename(tmp_path / "moved" / "clip.mp4")  # the sheet can no longer decode
+    assert contact_sheet(tracks, None, tmp_path / "few.png", frames=few) is not None
+    assert contact_sheet(tracks, None, tmp_path / "none.png") is None
+
+
+def test_a_frame_sample_that_ran_out_of_budget_does_not_stand_in():
+    from perception.io.frame_sample import FrameSample
+
+    sample = FrameSample(max_frames=4, max_bytes=10 << 20)
+    sample.start(n_frames=0, frame_bytes=1 << 20)  # a header without a frame count
+    for i in range(40):
+        sample.offer(i, np.zeros(1))
+    assert sorted(sample.frames) == [0, 1, 2, 3]
+    assert sample.nearest(2) == 2 and sample.nearest(30) is None  # decode instead
+    sample.start(n_frames=100, frame_bytes=4 << 20)  # 2 frames fit in 10 MiB
+    assert sample.stride == 50 and sample.frames == {}
+    with pytest.raises(ValueError, match="positive budget"):
+        FrameSample(max_frames=0)

@@ -186,9 +186,47 @@ def test_models_planned_on_threads_are_the_same(monkeypatch):
             np.testing.assert_array_equal(ca.L, cb.L)
 
 
-def test_tracking_starts_without_pandas_scipy_or_matplotlib():
-    code = ("import sys, perception.tracking.tracker, perception.io.tracks, hammer_mv.cli.track\n"
-            "print(sorted({'pandas', 'scipy', 'matplotlib'} & set(sys.modules)))")
+@pytest.mark.parametrize("modules", [
+    "perception.tracking.tracker, perception.io.tracks, hammer_mv.cli.track",
+    # what a spawned batch worker imports before its first clip (0.35 s, not 0.85 s)
+    "perception.batch, perception.recognition.repertoire",
+])
+def test_tracking_and_batch_workers_start_without_pandas_scipy_or_matplotlib(modules):
+    code = (f"import sys, {modules}\n"
+            "print(sorted({'pandas', 'scipy', 'matplotlib', 'dask'} & set(sys.modules)))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True)
     assert out.stdout.strip() == "[]"
+
+
+_FAULTS = """
+import resource, numpy as np
+from perception.batch import _reuse_freed_memory
+
+def faults():
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+    for _ in range(50):
+        frame = np.ones((480, 640, 3), np.uint8)  # touches every page
+        del frame
+    return resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before
+
+slow = faults()
+print(_reuse_freed_memory(), slow, faults())
+"""
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's allocator")
+def test_freed_frames_are_reused_in_a_worker_started_as_dask_starts_its_workers():
+    import os
+
+    env = {**os.environ, "MALLOC_TRIM_THRESHOLD_": "65536"}  # dask's nanny sets this
+    out = subprocess.run([sys.executable, "-c", _FAULTS], capture_output=True, text=True,
+                         check=True, env=env).stdout.split()
+    changed, slow, fast = out[0], int(out[1]), int(out[2])
+    assert changed == "True"
+    assert slow > 50 * 200  # a fresh mmap per frame: every page faults
+    assert fast < slow / 20
+    env.pop("MALLOC_TRIM_THRESHOLD_")
+    plain = subprocess.run([sys.executable, "-c", _FAULTS], capture_output=True, text=True,
+                           check=True, env=env).stdout.split()
+    assert plain[0] == "False"  # glibc's own adaptive thresholds are left alone

@@ -69,6 +69,19 @@ def test_prefetch_and_direct_reading_agree_and_early_stop_is_clean(tmp_path):
         iter(src)
 
 
+@pytest.mark.parametrize("ext", [".mp4", ".mkv"])
+def test_one_decoder_thread_gives_the_same_frames(tmp_path, monkeypatch, ext):
+    from perception.io import video
+
+    path = tmp_path / f"clip{ext}"
+    write_video(_frames(20), path, 30)
+    default = list(FrameSource(path))
+    monkeypatch.setattr(video, "decoder_threads", 1)  # as a batch worker decodes
+    single = list(FrameSource(path))
+    assert [(i, t) for i, t, _ in default] == [(i, t) for i, t, _ in single]
+    assert all(np.array_equal(a[2], b[2]) for a, b in zip(default, single, strict=True))
+
+
 def test_writer_is_atomic(tmp_path):
     path = tmp_path / "clip.mp4"
     with pytest.raises(RuntimeError), VideoWriter(path, 30, (96, 64)) as vw:

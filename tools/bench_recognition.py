@@ -26,6 +26,8 @@ from bench import table, timeit  # noqa: E402
 
 #: Clips in the scaling runs (as many of each condition; the smoke recipe's look).
 CLIPS = {"normal": 14, "delayed": 13, "open-close-open": 13}
+#: Runs of each batch configuration; the best counts.
+ROUNDS = 3
 
 
 def _batch(items, out: Path, rep, **kwargs) -> float:
@@ -84,21 +86,28 @@ def main() -> None:
                      f"--jobs 1 {synth1:.1f} s", f"{synth1 / synthn:.2f}x"))
         items = discover(work / "clips")
         n = len(items)
+        workers = max(2, min(cores, 2))
         times, summaries = {}, {}
-        for jobs in sorted({1, 2, cores}):
-            times[jobs], summaries[jobs] = _batch(items, work / f"out{jobs}", rep, jobs=jobs)
+        # Best of ROUNDS, the configurations taking turns: on a shared machine
+        # a run's speed drifts by 20 % within seconds, and the best time is
+        # the one least disturbed by other work (as timeit takes).
+        for _ in range(ROUNDS):
+            for jobs in sorted({1, 2, cores}):
+                elapsed, summaries[jobs] = _batch(items, work / f"out{jobs}", rep, jobs=jobs)
+                times[jobs] = min(times.get(jobs, elapsed), elapsed)
+            elapsed, dask_summary = _dask(items, work / "dask", rep, workers)
+            times["dask"] = min(times.get("dask", elapsed), elapsed)
         base = n / times[1]
         rows.append((f"batch: track + recognise + report {n} clips, 1 process",
-                     f"{base:.1f} clips/s", "the baseline", ""))
-        for jobs in sorted(times):
+                     f"{base:.1f} clips/s", f"the baseline (best of {ROUNDS} runs each)", ""))
+        for jobs in sorted(k for k in times if k != "dask"):
             if jobs == 1:
                 continue
             eff = n / times[jobs] / (jobs * base)
             rows.append((f"  {jobs} processes", f"{n / times[jobs]:.1f} clips/s",
                          f"efficiency {eff:.0%} (target >= 85 %)",
                          "ok" if eff >= 0.85 else "MISSED"))
-        workers = max(2, min(cores, 2))
-        dask_time, dask_summary = _dask(items, work / "dask", rep, workers)
+        dask_time = times["dask"]
         ratio = times[workers] / dask_time
         rows.append((f"  dask, {workers} single-threaded workers", f"{n / dask_time:.1f} clips/s",
                      f"{ratio:.0%} of {workers} local processes (target >= 90 %)",

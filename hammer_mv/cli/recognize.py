@@ -43,6 +43,7 @@ def run(args: argparse.Namespace) -> int:
     """
     from hammer_mv.cli.options import load_repertoire, recognition_settings
     from perception.errors import InputError
+    from perception.io.frame_sample import FrameSample
     from perception.pipeline import (
         TRACKS_SUFFIX,
         clip_fingerprint,
@@ -64,15 +65,17 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("not a video, .tracks.h5 or pose file", path)
     settings = recognition_settings(args)
     rep, rep_id = load_repertoire(args)
+    frames = FrameSample()  # a few frames for the contact sheet, kept while tracking
     tracks = load_clip(path, tracks_out=args.output / "tracks" / f"{clip}{TRACKS_SUFFIX}",
                        progress=not args.quiet and sys.stderr.isatty(),
                        setup=settings.tracking, pose=settings.pose,
+                       frames=None if args.no_figures else frames,
                        **settings.video_options())
     rec = recognize_tracks(tracks, rep, settings, clip=clip, source=path)
     extra = {"fingerprint": clip_fingerprint(path, settings, rep_id), "condition": None,
              "input": str(path),
              "tracking": write_tracking_report(tracks, args.output, clip,
-                                               sheet=not args.no_figures)}
+                                               sheet=not args.no_figures, frames=frames)}
     paths = write_clip_report(rec, args.output, extra=extra, figures=not args.no_figures)
     print(f"{clip}: winner {rec.winner} ({rec.rule} rule) -> {paths['json']}")
     return 0

@@ -46,6 +46,12 @@ TIME_SOURCES = ("container", "index/fps", "mixed")
 #: frames) short of the count its header claims.
 TRUNCATION_TOLERANCE = 0.02
 
+#: Threads FFmpeg decodes a video with (0: FFmpeg's choice, about one per
+#: core). A process working beside others (a batch worker) sets 1: its
+#: parallelism is theirs, and one decoding thread spends the least CPU per
+#: frame. Read when a :class:`FrameSource` opens its file.
+decoder_threads = 0
+
 
 def sha256_file(path: str | os.PathLike, chunk: int = 1 << 20) -> str:
     """Hex SHA-256 of the file at ``path``, read in ``chunk``-byte pieces (memory stays flat)."""
@@ -221,7 +227,9 @@ class FrameSource:
             raise InputError("not a regular file", self.path)
         if self.path.stat().st_size == 0:
             raise InputError("empty file (0 bytes)", self.path)
-        cap = cv2.VideoCapture(os.fspath(self.path), cv2.CAP_FFMPEG)
+        cap = (cv2.VideoCapture(os.fspath(self.path), cv2.CAP_FFMPEG,
+                                [cv2.CAP_PROP_N_THREADS, decoder_threads])
+               if decoder_threads > 0 else cv2.VideoCapture(os.fspath(self.path), cv2.CAP_FFMPEG))
         if not cap.isOpened():
             cap.release()
             raise InputError("not a readable video (FFmpeg could not open it)", self.path)

@@ -26,6 +26,8 @@ from perception.io.tracks import Status, Tracks
 if TYPE_CHECKING:
     import pandas as pd
 
+    from perception.io.frame_sample import FrameSample
+
 __all__ = ["MarkerQuality", "TrackingQuality", "contact_sheet", "tracking_columns",
            "tracking_quality", "write_tracking_report"]
 
@@ -157,7 +159,8 @@ def _pick_frames(tracks: Tracks, n: int) -> list[int]:
 
 
 def contact_sheet(tracks: Tracks, video: str | os.PathLike | None, out: str | os.PathLike, *,
-                  n: int = 6, width: int = 1200) -> Path | None:
+                  n: int = 6, width: int = 1200,
+                  frames: FrameSample | None = None) -> Path | None:
     """Write a contact sheet PNG: frames with their markers drawn, in one row or two.
 
     Parameters
@@ -173,36 +176,35 @@ def contact_sheet(tracks: Tracks, video: str | os.PathLike | None, out: str | os
         the movement.
     width : int
         Width of the sheet, px.
+    frames : FrameSample, optional
+        Frames kept while the video was tracked: when they cover the clip,
+        the sheet shows the kept frame nearest each chosen one instead of
+        decoding the video again.
 
     Returns
     -------
     Path or None
         None when the video cannot be read (the sheet needs its frames).
     """
-    from perception.io.video import FrameSource
     from perception.tracking.overlay import Labeller, _colours
 
-    video = video or tracks.video.get("path")
-    if not video or not Path(video).is_file():
-        return None
     wanted = _pick_frames(tracks, n)
     row = {int(f): i for i, f in enumerate(tracks.frame)}
     labeller = Labeller(tracks.markers, _colours(tracks), trail=1)
-    tiles = []
-    try:
-        with FrameSource(video, hash=False) as src:
-            for index, time_s, frame in src:
-                if index in wanted and index in row:
-                    i = row[index]
-                    img = labeller.draw(frame, tracks.position[i], tracks.likelihood[i],
-                                        tracks.status[i])
-                    cv2.putText(img, f"frame {index}  {time_s:.2f} s", (8, img.shape[0] - 10),
-                                cv2.FONT_HERSHEY_SIMPLEX, 0.6, (255, 255, 255), 1, cv2.LINE_AA)
-                    tiles.append(img)
-                if index >= wanted[-1]:
-                    break
-    except (ValueError, OSError):
-        return None
+
+    def tile(index: int, time_s: float, frame: np.ndarray) -> np.ndarray:
+        i = row[index]
+        img = labeller.draw(frame, tracks.position[i], tracks.likelihood[i], tracks.status[i])
+        cv2.putText(img, f"frame {index}  {time_s:.2f} s", (8, img.shape[0] - 10),
+                    cv2.FONT_HERSHEY_SIMPLEX, 0.6, (255, 255, 255), 1, cv2.LINE_AA)
+        return img
+
+    kept = [frames.nearest(w) for w in wanted] if frames is not None else [None]
+    if None not in kept and all(k in row for k in kept):
+        tiles = [tile(k, float(tracks.time[row[k]]), frames.frames[k])
+                 for k in sorted(set(kept))]
+    else:
+        tiles = _decoded_tiles(video or tracks.video.get("path"), wanted, row, tile)
     if not tiles:
         return None
     cols = min(len(tiles), 3)
@@ -218,8 +220,28 @@ def contact_sheet(tracks: Tracks, video: str | os.PathLike | None, out: str | os
     return Path(out)
 
 
+def _decoded_tiles(video, wanted: list[int], row: dict, tile) -> list[np.ndarray]:
+    """``tile`` of each ``wanted`` frame of ``video``, decoded (none if it cannot be read)."""
+    from perception.io.video import FrameSource
+
+    if not video or not Path(video).is_file():
+        return []
+    tiles = []
+    try:
+        with FrameSource(video, hash=False) as src:
+            for index, time_s, frame in src:
+                if index in wanted and index in row:
+                    tiles.append(tile(index, time_s, frame))
+                if index >= wanted[-1]:
+                    break
+    except (ValueError, OSError):
+        return []
+    return tiles
+
+
 def write_tracking_report(tracks: Tracks | str | os.PathLike, out: str | os.PathLike,
-                          clip: str, *, sheet: bool = True) -> dict:
+                          clip: str, *, sheet: bool = True,
+                          frames: FrameSample | None = None) -> dict:
     """The clip's tracking quality (JSON-ready) and its contact sheet ``<clip>.tracking.png``.
 
     The one call the clip and batch reports make: it returns the value of the
@@ -236,10 +258,14 @@ def write_tracking_report(tracks: Tracks | str | os.PathLike, out: str | os.Path
         Clip name.
     sheet : bool
         Draw the contact sheet (reads frames of the video).
+    frames : FrameSample, optional
+        Frames kept while the clip was tracked, which spare the sheet a
+        second decode (:func:`contact_sheet`).
     """
     if not isinstance(tracks, Tracks):
         tracks = Tracks.load(tracks)
     quality = tracking_quality(tracks).to_dict()
-    drawn = contact_sheet(tracks, None, Path(out) / f"{clip}.tracking.png") if sheet else None
+    drawn = (contact_sheet(tracks, None, Path(out) / f"{clip}.tracking.png", frames=frames)
+             if sheet else None)
     quality["contact_sheet"] = drawn.name if drawn is not None else None
     return quality

@@ -62,7 +62,7 @@ import threading
 from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import asdict
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import cv2
 import numpy as np
@@ -77,6 +77,9 @@ from perception.tracking.markers import MarkerSet, default_markers
 from perception.tracking.measurement import Measurement, likelihood, measure, measure_still
 from perception.tracking.params import TrackerParams
 from perception.tracking.reacquisition import ROI, downscaled_hsv, reacquire, search_scale
+
+if TYPE_CHECKING:
+    from perception.io.frame_sample import FrameSample
 
 __all__ = ["ROI", "Measurement", "Tracker", "TrackerParams", "track_frames", "track_video"]
 
@@ -549,6 +552,7 @@ def track_video(
     labelled_video: str | os.PathLike | None = None,
     keep_truncated: bool = False,
     fps: float | None = None,
+    frames: FrameSample | None = None,
 ) -> Path:
     """Track a video file into a tracks file (``<stem>.tracks.h5`` beside it by default).
 
@@ -574,6 +578,8 @@ def track_video(
         The true frame rate, frames/s, for a container whose rate or times
         are wrong: frame times become ``index / fps`` (the labelled video
         is written at this rate too).
+    frames : FrameSample, optional
+        Keeps a few of the frames as they are decoded (for the contact sheet).
 
     Returns
     -------
@@ -617,6 +623,14 @@ def track_video(
 
             def each(index, time_s, frame, position, likelihood, status):
                 vw.write(labeller.draw(frame, position, likelihood, status))
+        if frames is not None:
+            frames.start(src.info.n_frames_header, src.info.width * src.info.height * 3)
+            label = each
+
+            def each(index, time_s, frame, *marks):
+                frames.offer(index, frame)
+                if label is not None:
+                    label(index, time_s, frame, *marks)
 
         bar = None
         if progress:
