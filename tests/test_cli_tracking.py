@@ -371,5 +371,8 @@ def test_a_frame_sample_that_ran_out_of_budget_does_not_stand_in():
     assert sample.nearest(2) == 2 and sample.nearest(30) is None  # decode instead
     sample.start(n_frames=100, frame_bytes=4 << 20)  # 2 frames fit in 10 MiB
     assert sample.stride == 50 and sample.frames == {}
+    for i in range(0, 400, 50):  # the header undercounted: the budget still holds
+        sample.offer(i, np.zeros(1))
+    assert sorted(sample.frames) == [0, 50]
     with pytest.raises(ValueError, match="positive budget"):
         FrameSample(max_frames=0)

@@ -39,13 +39,14 @@ class FrameSample:
         self.max_frames = int(max_frames)
         self.max_bytes = int(max_bytes)
         self.stride = 1
+        self._room = self.max_frames  # frames the budget holds, set by start()
         self.frames: dict[int, np.ndarray] = {}
 
     def start(self, n_frames: int, frame_bytes: int) -> None:
         """Choose the stride for a video of ``n_frames`` (0: unknown) frames of
         ``frame_bytes`` each, and forget frames kept before."""
-        fit = max(1, min(self.max_frames, self.max_bytes // max(frame_bytes, 1)))
-        self.stride = max(1, math.ceil(n_frames / fit)) if n_frames > 0 else 1
+        self._room = max(1, min(self.max_frames, self.max_bytes // max(frame_bytes, 1)))
+        self.stride = max(1, math.ceil(n_frames / self._room)) if n_frames > 0 else 1
         self.frames = {}
 
     def offer(self, index: int, frame: np.ndarray) -> None:
@@ -54,7 +55,7 @@ class FrameSample:
         The array itself is kept, not a copy: a decoder yields a new array
         per frame and nothing writes into it.
         """
-        if index % self.stride == 0 and len(self.frames) < self.max_frames:
+        if index % self.stride == 0 and len(self.frames) < self._room:
             self.frames[int(index)] = frame
 
     def nearest(self, index: int) -> int | None:
