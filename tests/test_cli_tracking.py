@@ -376,3 +376,32 @@ def test_a_frame_sample_that_ran_out_of_budget_does_not_stand_in():
     assert sorted(sample.frames) == [0, 50]
     with pytest.raises(ValueError, match="positive budget"):
         FrameSample(max_frames=0)
+
+
+def test_tracking_does_not_wait_for_the_videos_hash(tmp_path, monkeypatch):
+    import threading
+
+    from perception.io import video
+    from perception.io.frame_sample import FrameSample
+    from perception.synthetic.demos import render_demo_clip
+    from perception.synthetic.scene import Scene
+    from perception.tracking.tracker import track_video
+
+    scene = Scene.reach_to_grasp(20, 30, start=(0.0, -0.25), onset=0.2, duration=0.4)
+    clip, _ = render_demo_clip(tmp_path, "clip.mp4", n=20, angle=0.0, hand=True, scene=scene)
+    tracked = threading.Event()
+    digest = video.sha256_file(clip.video)
+
+    def slow_sha256(path):
+        assert tracked.wait(20), "the hash was waited for before the frames were tracked"
+        return digest
+
+    class LastFrame(FrameSample):
+        def offer(self, index, frame):
+            super().offer(index, frame)
+            if index == 19:
+                tracked.set()
+
+    monkeypatch.setattr(video, "sha256_file", slow_sha256)
+    out = track_video(clip.video, tmp_path / "c.tracks.h5", frames=LastFrame())
+    assert Tracks.load(out).video["sha256"] == digest

@@ -1,6 +1,7 @@
 import hashlib
 import logging
 
+import cv2
 import numpy as np
 import pytest
 
@@ -77,9 +78,32 @@ def test_one_decoder_thread_gives_the_same_frames(tmp_path, monkeypatch, ext):
     write_video(_frames(20), path, 30)
     default = list(FrameSource(path))
     monkeypatch.setattr(video, "decoder_threads", 1)  # as a batch worker decodes
-    single = list(FrameSource(path))
+    src = FrameSource(path)
+    assert src._cap.get(cv2.CAP_PROP_N_THREADS) == 1  # FFmpeg was told
+    single = list(src)
     assert [(i, t) for i, t, _ in default] == [(i, t) for i, t, _ in single]
     assert all(np.array_equal(a[2], b[2]) for a, b in zip(default, single, strict=True))
+
+
+def test_header_is_there_at_once_and_info_waits_for_the_hash(tmp_path, monkeypatch):
+    import threading
+
+    from perception.io import video
+
+    path = tmp_path / "clip.mkv"
+    write_video(_frames(4), path, 30)
+    release = threading.Event()
+
+    def slow_sha256(p):
+        assert release.wait(10)
+        return "digest"
+
+    monkeypatch.setattr(video, "sha256_file", slow_sha256)
+    src = FrameSource(path)
+    assert (src.header.width, src.header.n_frames_header, src.header.sha256) == (96, 4, "")
+    assert [i for i, _, _ in src] == [0, 1, 2, 3]  # frames flow while the hash is read
+    release.set()
+    assert src.info.sha256 == "digest" and src.info.width == 96
 
 
 def test_writer_is_atomic(tmp_path):

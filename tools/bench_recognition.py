@@ -29,8 +29,6 @@ from bench import table, timeit  # noqa: E402
 CLIPS = {"normal": 14, "delayed": 13, "open-close-open": 13}
 #: Runs of each batch configuration; the best counts.
 ROUNDS = 3
-#: CPU time of this process in the last batch run with each ``jobs``, s.
-CPU: dict[int, float] = {}
 
 
 def _cpu_s() -> float:
@@ -39,16 +37,17 @@ def _cpu_s() -> float:
     return use.ru_utime + use.ru_stime
 
 
-def _batch(items, out: Path, rep, **kwargs) -> float:
+def _batch(items, out: Path, rep, **kwargs):
+    """Wall time (s), summary and this process's CPU time (s; its workers' not
+    included) of one batch run."""
     from perception.batch import run_batch
 
     shutil.rmtree(out, ignore_errors=True)
     t0, c0 = time.perf_counter(), _cpu_s()
     summary = run_batch(items, out, rep, quiet=True, **kwargs)
     elapsed = time.perf_counter() - t0
-    CPU[kwargs.get("jobs", 0)] = _cpu_s() - c0  # the workers' own not included
     assert (summary["status"] == "ok").all(), summary[summary["status"] != "ok"]
-    return elapsed, summary
+    return elapsed, summary, _cpu_s() - c0
 
 
 def _dask(items, out: Path, rep, workers: int):
@@ -104,11 +103,12 @@ def main() -> None:
         cores_used = []  # by the one process: it decodes on other threads
         for _ in range(ROUNDS):
             for jobs in sorted({1, 2, cores}):
-                elapsed, summaries[jobs] = _batch(items, work / f"out{jobs}", rep, jobs=jobs)
+                elapsed, summaries[jobs], cpu = _batch(items, work / f"out{jobs}", rep,
+                                                       jobs=jobs)
                 times[jobs] = min(times.get(jobs, elapsed), elapsed)
                 if jobs == 1:
-                    cores_used.append(CPU[1] / elapsed)
-            elapsed, dask_summary = _dask(items, work / "dask", rep, workers)
+                    cores_used.append(cpu / elapsed)
+            elapsed, dask_summary, _ = _dask(items, work / "dask", rep, workers)
             times["dask"] = min(times.get("dask", elapsed), elapsed)
         base = n / times[1]
         used = sorted(cores_used)[len(cores_used) // 2]

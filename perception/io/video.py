@@ -205,7 +205,9 @@ class FrameSource:
     Attributes
     ----------
     info : VideoInfo
-        Header metadata.
+        Header metadata and the file's SHA-256 (waits for the hash).
+    header : VideoInfo
+        Header metadata without waiting (``sha256`` empty until ``info`` is read).
     n_decoded : int
         Frames yielded so far; the true frame count once iteration has ended.
     complete : bool
@@ -359,6 +361,11 @@ class FrameSource:
                 self._times.n_fallback,
                 self.n_decoded,
             )
+
+    @property
+    def header(self) -> VideoInfo:
+        """Header metadata at once: ``sha256`` stays empty until :attr:`info` has waited for it."""
+        return self._info
 
     @property
     def info(self) -> VideoInfo:

@@ -189,6 +189,8 @@ def contact_sheet(tracks: Tracks, video: str | os.PathLike | None, out: str | os
     from perception.tracking.overlay import Labeller, _colours
 
     wanted = _pick_frames(tracks, n)
+    if not wanted:  # no frames tracked
+        return None
     row = {int(f): i for i, f in enumerate(tracks.frame)}
     labeller = Labeller(tracks.markers, _colours(tracks), trail=1)
 
@@ -199,8 +201,8 @@ def contact_sheet(tracks: Tracks, video: str | os.PathLike | None, out: str | os
                     cv2.FONT_HERSHEY_SIMPLEX, 0.6, (255, 255, 255), 1, cv2.LINE_AA)
         return img
 
-    kept = [frames.nearest(w) for w in wanted] if frames is not None else [None]
-    if None not in kept and all(k in row for k in kept):
+    kept = [frames.nearest(w) for w in wanted] if frames is not None else None
+    if kept is not None and all(k is not None and k in row for k in kept):
         tiles = [tile(k, float(tracks.time[row[k]]), frames.frames[k])
                  for k in sorted(set(kept))]
     else:

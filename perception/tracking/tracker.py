@@ -312,18 +312,15 @@ class Tracker:
         given, else from the markers tracked now.
         """
         xs, ys = [], []
-        if centres is not None:
-            for k in self._anchors[self._tracks.index(tr)]:
+        for k in self._anchors[self._tracks.index(tr)]:
+            if centres is not None:
                 c = centres[k]
-                if c is not None:
-                    xs.append(c[0])
-                    ys.append(c[1])
-        else:
-            for k in self._anchors[self._tracks.index(tr)]:
+            else:
                 t = self._tracks[k]
-                if t.found and not t.lost:
-                    xs.append(t.x[0])
-                    ys.append(t.x[1])
+                c = t.x if t.found and not t.lost else None
+            if c is not None:
+                xs.append(c[0])
+                ys.append(c[1])
         # plain floats: numpy's per-call cost would exceed the arithmetic
         return (sum(xs) / len(xs), sum(ys) / len(ys)) if xs else None
 
@@ -609,22 +606,22 @@ def track_video(
         src = stack.enter_context(FrameSource(video, prefetch=prefetch,
                                               keep_truncated=keep_truncated, fps=fps))
         # /video (with the file's SHA-256, read meanwhile) and /tracker are
-        # written when tracking is done.
+        # written when tracking is done; until then only src.header is read.
         w = stack.enter_context(TracksWriter(out_path, markers.names))
         each = None
         if labelled_video is not None:
             from perception.io.video import VideoWriter
             from perception.tracking.overlay import Labeller
 
-            rate = fps or src.info.fps_nominal or 30.0
+            rate = fps or src.header.fps_nominal or 30.0
             vw = stack.enter_context(VideoWriter(labelled_video, rate,
-                                                 (src.info.width, src.info.height)))
+                                                 (src.header.width, src.header.height)))
             labeller = Labeller(markers.names, [m.bgr for m in markers])
 
             def each(index, time_s, frame, position, likelihood, status):
                 vw.write(labeller.draw(frame, position, likelihood, status))
         if frames is not None:
-            frames.start(src.info.n_frames_header, src.info.width * src.info.height * 3)
+            frames.start(src.header.n_frames_header, src.header.width * src.header.height * 3)
             label = each
 
             def each(index, time_s, frame, *marks):
@@ -636,7 +633,7 @@ def track_video(
         if progress:
             from tqdm import tqdm
 
-            bar = stack.enter_context(tqdm(total=src.info.n_frames_header or None, unit="frame",
+            bar = stack.enter_context(tqdm(total=src.header.n_frames_header or None, unit="frame",
                                            file=sys.stderr, desc=Path(video).name,
                                            leave=False))
         try:
