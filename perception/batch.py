@@ -13,28 +13,21 @@ Clips run in local processes (``jobs``) or on a dask.distributed cluster
 
 from __future__ import annotations
 
-import contextlib
-import ctypes
-import functools
 import json
 import logging
-import multiprocessing
 import os
-import pickle
 import re
 import sys
-import tempfile
-from collections import deque
 from collections.abc import Callable, Iterable, Iterator
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
+import perception.workers as workers
 from perception.errors import InputError
-from perception.io.atomic import owner_tag, remove_stale, write_json
+from perception.io.atomic import write_json
 from perception.io.frame_sample import FrameSample
 from perception.pipeline import (
     TRACKS_SUFFIX,
@@ -316,101 +309,6 @@ def _guarded(item: BatchItem, out: Path, **kwargs) -> ClipResult:
                           kwargs["settings"].hammer.rule)
 
 
-#: Thread pools of the numerical libraries, one thread each in a worker: set in
-#: the environment a worker is spawned with, because they are read when numpy
-#: (its BLAS) and OpenCV load, before any code of the worker runs.
-THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
-                    "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS")
-
-
-def _limit_threads() -> None:
-    """One thread per worker process: parallelism comes from the processes."""
-    import cv2
-
-    from perception.io import video
-
-    cv2.setNumThreads(1)
-    video.decoder_threads = 1
-
-
-#: glibc's ``mallopt`` parameters, and the values a plain process's dynamic
-#: thresholds grow to (``mallopt(3)``: at most 32 MiB, trim at twice that).
-_M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3
-_MMAP_THRESHOLD, _TRIM_THRESHOLD = 32 << 20, 64 << 20
-
-
-@functools.cache
-def _reuse_freed_memory() -> bool:
-    """Let glibc reuse freed frames in a worker started with ``MALLOC_TRIM_THRESHOLD_``.
-
-    dask's nanny starts its workers with ``MALLOC_TRIM_THRESHOLD_=65536``,
-    and setting any threshold also fixes glibc's mmap threshold at 128 KiB:
-    every frame-sized array (0.9 MB at 640x480) is then a fresh ``mmap``,
-    zeroed page by page. A clip took 40,000 page faults and 35 % more time
-    than in a local process. Returns whether the thresholds were changed
-    (only where the variable is set and the C library is glibc).
-    """
-    if os.environ.get("MALLOC_TRIM_THRESHOLD_") is None:
-        return False
-    try:
-        mallopt = ctypes.CDLL(None).mallopt
-    except (OSError, AttributeError):  # not glibc: its allocator is not the one tuned
-        return False
-    return bool(mallopt(_M_MMAP_THRESHOLD, _MMAP_THRESHOLD)
-                and mallopt(_M_TRIM_THRESHOLD, _TRIM_THRESHOLD))
-
-
-@contextlib.contextmanager
-def _single_threaded_children():
-    """Processes spawned inside get one BLAS/OpenMP thread (the environment they inherit)."""
-    names = (*THREAD_VARIABLES, THREADS_VARIABLE)
-    before = {k: os.environ.get(k) for k in names}
-    os.environ.update({k: "1" for k in names})
-    try:
-        yield
-    finally:
-        for k, v in before.items():
-            if v is None:
-                os.environ.pop(k, None)
-            else:
-                os.environ[k] = v
-
-
-@contextlib.contextmanager
-def _one_thread():
-    """OpenCV and FFmpeg single-threaded in this process while it works beside its
-    workers: their thread pools would otherwise take the cores the workers run on."""
-    import cv2
-
-    from perception.io import video
-
-    before = cv2.getNumThreads(), video.decoder_threads
-    cv2.setNumThreads(1)
-    video.decoder_threads = 1
-    try:
-        yield
-    finally:
-        cv2.setNumThreads(before[0])
-        video.decoder_threads = before[1]
-
-
-def _init_worker(repertoire_file: str) -> None:
-    """Worker setup: one thread, and the repertoire read once per process.
-
-    The repertoire comes as a file, not pickled in the start-up arguments: a
-    spawning parent blocks writing those into the worker's pipe until the
-    worker has started and imported everything (about a second).
-    """
-    _limit_threads()
-    _reuse_freed_memory()  # inherited from a process that has used dask
-    try:
-        _WORKER["repertoire"] = pickle.loads(Path(repertoire_file).read_bytes())
-    except FileNotFoundError:
-        # The batch ended before this worker had started, and shuts it down
-        # without a clip (the pool does not wait for it).
-        pass
-
-
 @dataclass(frozen=True)
 class _Job:
     """What every clip of one batch shares (sent to each worker with its clip)."""
@@ -431,8 +329,8 @@ class _Job:
     def run_on_cluster(self, item: BatchItem, repertoire: Repertoire) -> ClipResult:
         """:meth:`run` in a dask worker: single-threaded OpenCV, as local workers are
         (dask's nanny already starts workers with one BLAS/OpenMP thread)."""
-        _limit_threads()
-        _reuse_freed_memory()
+        workers.limit_threads()
+        workers.reuse_freed_memory()
         os.environ[THREADS_VARIABLE] = "1"  # the cluster's other workers use the other cores
         return self.run(item, repertoire)
 
@@ -441,86 +339,28 @@ class _Job:
 PLANS_FOLDER = ".plans"
 
 
-def _work_in_worker(item: BatchItem, job: _Job) -> ClipResult:
-    # the worker's own repertoire keeps its re-planned models between clips
-    return job.run(item, _WORKER["repertoire"])
-
-
-#: State of a worker process (set by its initializer; empty in the main process).
-_WORKER: dict = {}
+def _file_size(item: BatchItem) -> int:
+    """A clip's expected cost, for handing out the largest first (0 if unreadable: a
+    missing file fails at once)."""
+    try:
+        return item.path.stat().st_size
+    except OSError:
+        return 0
 
 
 def _run_local(items: list[BatchItem], repertoire: Repertoire, job: _Job,
                jobs: int) -> Iterator[ClipResult]:
     """Every item in this process and ``jobs - 1`` worker processes.
 
-    The calling process takes items from the same queue as its workers: it is
-    warm (modules imported) while a worker spends about a second starting, so
-    a short batch gains from the second process too.
+    This process works on clips too: it is warm (modules imported) while a
+    worker spends about half a second starting, so a short batch gains from
+    the second process too.
     """
-    pending = deque(items)
-
-    def here(item: BatchItem) -> ClipResult:
-        return job.run(item, repertoire)
-
-    if jobs == 1 or len(items) <= 1:
-        while pending:
-            yield here(pending.popleft())
-        return
-    # spawn, not fork: a parent that has already rendered or planned holds
-    # OpenCV/BLAS thread pools, and forking those deadlocks the workers
-    ctx = multiprocessing.get_context("spawn")
-    remove_stale(job.out, ".repertoire-h*p*")  # left by a batch that was killed
-    with tempfile.TemporaryDirectory(prefix=f".repertoire-{owner_tag()}-", dir=job.out) as tmp, \
-            _one_thread():
-        # Pickled, not HDF5 (0.1 s to write here, 0.1 s to read in each worker,
-        # against milliseconds): the folder is this process's own (mode 0700)
-        # and lives while the batch runs.
-        rep_file = Path(tmp) / "repertoire.pickle"
-        rep_file.write_bytes(pickle.dumps(repertoire, protocol=pickle.HIGHEST_PROTOCOL))
-        # (the pool spawns its workers as clips are submitted: in the block)
-        with _single_threaded_children():
-            pool = ProcessPoolExecutor(max_workers=jobs - 1, initializer=_init_worker,
-                                       initargs=(str(rep_file),), mp_context=ctx)
-            try:
-                yield from _share(pending, here, pool, job, jobs - 1)
-            finally:
-                # The workers exit on their own (0.2 s) while this process
-                # writes the report; Python joins them before it exits.
-                pool.shutdown(wait=False, cancel_futures=True)
-
-
-def _share(pending: deque, here, pool: ProcessPoolExecutor, job: _Job,
-           workers: int) -> Iterator[ClipResult]:
-    """The caller's share of the clips and the workers', until all are done."""
-    running: dict = {}
-
-    def feed():
-        # a few clips queued per worker, so it never waits for this process
-        while pending and len(running) < 4 * workers:
-            item = pending.popleft()
-            running[pool.submit(_work_in_worker, item, job)] = item
-
-    def collect():
-        for f in [f for f in running if f.done()]:
-            del running[f]
-            yield f.result()
-
-    feed()
-    while pending:
-        yield here(pending.popleft())
-        yield from collect()
-        feed()
-    # The queue is empty: take back clips no worker has started, rather than
-    # wait for them.
-    for f in list(running):
-        if f.cancel():
-            yield here(running.pop(f))
-        yield from collect()
-    if running:
-        _prepare_report()
-    for f in as_completed(list(running)):
-        yield f.result()
+    if jobs > 1:
+        items = workers.largest_first(items, jobs - 1, _file_size)
+    # (workers keep the models they re-plan between clips, in their own repertoire)
+    return workers.run_shared(items, job, jobs, shared=repertoire, folder=job.out,
+                              name="repertoire", while_waiting=_prepare_report)
 
 
 def _prepare_report() -> None:
@@ -540,6 +380,8 @@ def _run_dask(items: list[BatchItem], repertoire: Repertoire, job: _Job,
 
     with Client(scheduler) as client:
         rep = client.scatter(repertoire, broadcast=True)
+        # largest first: the cluster's last clips are its shortest
+        items = sorted(items, key=_file_size, reverse=True)
         futures = [client.submit(job.run_on_cluster, it, rep, pure=False) for it in items]
         _prepare_report()  # this process waits for the cluster anyway
         for fut in dask_completed(futures):

@@ -120,7 +120,8 @@ def test_libraries_never_import_the_application(graph, library, forbidden):
 def test_io_knows_nothing_of_what_it_stores(graph):
     """perception.io reads and writes files; recognition, tracking and reports sit above it."""
     above = ("perception.recognition", "perception.tracking", "perception.report",
-             "perception.batch", "perception.pipeline", "perception.synthetic")
+             "perception.batch", "perception.pipeline", "perception.synthetic",
+             "perception.workers")
     bad = {(m, dep) for m, deps in graph.items() if m.startswith("perception.io")
            for dep in deps if dep.startswith(above)}
     assert not bad, sorted(bad)

@@ -190,6 +190,8 @@ def test_models_planned_on_threads_are_the_same(monkeypatch):
     "perception.tracking.tracker, perception.io.tracks, hammer_mv.cli.track",
     # what a spawned batch worker imports before its first clip (0.35 s, not 0.85 s)
     "perception.batch, perception.recognition.repertoire",
+    # what the fork server imports for the workers forked from it
+    "importlib, perception.workers as w; [importlib.import_module(m) for m in w.PRELOAD]",
 ])
 def test_tracking_and_batch_workers_start_without_pandas_scipy_or_matplotlib(modules):
     code = (f"import sys, {modules}\n"
@@ -201,7 +203,7 @@ def test_tracking_and_batch_workers_start_without_pandas_scipy_or_matplotlib(mod
 
 _FAULTS = """
 import resource, numpy as np
-from perception.batch import _reuse_freed_memory
+from perception.workers import reuse_freed_memory
 
 def faults():
     before = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
@@ -211,7 +213,7 @@ def faults():
     return resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before
 
 slow = faults()
-print(_reuse_freed_memory(), slow, faults())
+print(reuse_freed_memory(), slow, faults())
 """
 
 

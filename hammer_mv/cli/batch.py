@@ -8,6 +8,7 @@ from pathlib import Path
 
 from hammer_mv.cli.options import add_recognition_options, load_repertoire, recognition_settings
 from perception.batch import discover, run_batch
+from perception.workers import start_early
 
 
 def register(sub) -> None:
@@ -49,6 +50,8 @@ def run(args: argparse.Namespace) -> int:
     items = discover(args.input)
     if not items:
         raise ValueError(f"{args.input}: no clips found")
+    if args.jobs > 1 and len(items) > 1 and not args.scheduler:
+        start_early()  # the workers' fork server imports while the repertoire loads
     rep, rep_id = load_repertoire(args)
     summary = run_batch(items, args.output, rep, recognition_settings(args), jobs=args.jobs,
                         scheduler=args.scheduler, repertoire_id=rep_id, quiet=args.quiet)

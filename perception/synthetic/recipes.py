@@ -254,13 +254,7 @@ def synthesize(recipe: Recipe, out: str | os.PathLike, *, seed: int = 0,
     work = [(recipe, out, plan) for plan in plans]
     bar = tqdm(total=len(plans), desc=f"synth {recipe.name}", unit="clip", disable=not progress)
     with bar:
-        if int(jobs) == 1 or len(plans) <= 1:
-            rows = []
-            for w in work:
-                rows.append(_render_one(w))
-                bar.update()
-        else:
-            rows = _render_parallel(work, int(jobs), bar)
+        rows = _render_all(work, int(jobs), bar)
     manifest = pd.DataFrame(rows)
     write_csv(out / "manifest.csv", manifest)
     return manifest
@@ -284,32 +278,22 @@ def _render_one(work: tuple) -> dict:
             "parameters": json.dumps(meta)}
 
 
-def _render_parallel(work: list, jobs: int, bar) -> list[dict]:
-    """:func:`_render_one` of every item in ``jobs - 1`` spawned workers and this process."""
-    import multiprocessing
-    from collections import deque
-    from concurrent.futures import ProcessPoolExecutor
+class _Render:
+    """:func:`_render_one` of item ``(index, work)`` as a :mod:`perception.workers` job."""
 
-    from perception.batch import _one_thread, _single_threaded_children
+    def run(self, item: tuple[int, tuple], shared: None) -> tuple[int, dict]:
+        return item[0], _render_one(item[1])
+
+
+def _render_all(work: list, jobs: int, bar) -> list[dict]:
+    """:func:`_render_one` of every item, in this process and ``jobs - 1`` spawned workers
+    (one BLAS/OpenCV thread each)."""
+    from perception.workers import run_shared
 
     rows: list[dict | None] = [None] * len(work)
-    pending = deque(range(len(work)))
-    # spawn, not fork (OpenCV/BLAS thread pools do not survive a fork), one
-    # thread per process; this process renders too, from the end of the list
-    with _one_thread(), _single_threaded_children(), ProcessPoolExecutor(
-            max_workers=jobs - 1, mp_context=multiprocessing.get_context("spawn")) as pool:
-        running = {}
-        while pending or running:
-            while pending and len(running) < 2 * (jobs - 1):
-                i = pending.popleft()
-                running[pool.submit(_render_one, work[i])] = i
-            if pending:
-                i = pending.pop()
-                rows[i] = _render_one(work[i])
-                bar.update()
-            for f in [f for f in running if f.done() or not pending]:
-                rows[running.pop(f)] = f.result()
-                bar.update()
+    for i, row in run_shared(list(enumerate(work)), _Render(), jobs):
+        rows[i] = row
+        bar.update()
     return rows
 
 
