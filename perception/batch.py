@@ -326,6 +326,13 @@ class _Job:
         return _guarded(item, self.out, repertoire=repertoire, settings=self.settings,
                         repertoire_id=self.repertoire_id, plan_cache=self.plan_cache)
 
+    def lost(self, item: BatchItem, message: str) -> ClipResult:
+        """A clip whose worker process died while on it: failed, its outputs removed."""
+        log.error("%s: %s", item.clip, message)
+        _remove_outputs(item, self.out)
+        return ClipResult(item.clip, item.condition, "failed", f"{item.path}: {message}",
+                          self.settings.hammer.rule)
+
     def run_on_cluster(self, item: BatchItem, repertoire: Repertoire) -> ClipResult:
         """:meth:`run` in a dask worker: single-threaded OpenCV, as local workers are
         (dask's nanny already starts workers with one BLAS/OpenMP thread)."""

@@ -24,6 +24,7 @@ import tempfile
 import threading
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 from typing import Any, Protocol, TypeVar
 
@@ -129,17 +130,29 @@ class Claims:
     def __init__(self, n: int, context=None):
         self._taken = (context or multiprocessing).Array("B", int(n))
 
-    def take(self, index: int) -> bool:
-        """Claim item ``index``; whether it was free (then the caller must do it)."""
+    #: Who claimed an item: nobody, the process that started the workers, a worker.
+    FREE, CALLER, WORKER = 0, 1, 2
+
+    def take(self, index: int, by: int = CALLER) -> bool:
+        """Claim item ``index`` for ``by``; whether it was free (then the caller must do it)."""
         with self._taken.get_lock():
             if self._taken[index]:
                 return False
-            self._taken[index] = 1
+            self._taken[index] = by
             return True
+
+    def owner(self, index: int) -> int:
+        """Who claimed item ``index`` (:data:`FREE` if nobody has)."""
+        return self._taken[index]
 
 
 class Job(Protocol):
-    """What :func:`run_shared` runs: picklable, its ``run`` importable in a worker."""
+    """What :func:`run_shared` runs: picklable, its ``run`` importable in a worker.
+
+    A job may also have ``lost(item, message)``: the result of an item whose
+    worker died while running it (a crash in a library, or the kernel's
+    out-of-memory killer). Without it, such a death ends the run.
+    """
 
     def run(self, item: Any, shared: Any) -> Any: ...
 
@@ -195,7 +208,7 @@ def _init_worker(claims: Claims, shared_file: str | None) -> None:
 
 def _claimed(index: int, item: Any, job: Job) -> tuple[bool, Any]:
     """``job.run`` in a worker, unless another process has claimed the item."""
-    if not _WORKER["claims"].take(index):
+    if not _WORKER["claims"].take(index, Claims.WORKER):
         return False, None
     return True, job.run(item, _WORKER.get("shared"))
 
@@ -289,16 +302,28 @@ def run_shared(items: Sequence, job: Job, jobs: int, *, shared: Any = None,
         stack.enter_context(one_thread())
         pool = ProcessPoolExecutor(max_workers=jobs - 1, initializer=_init_worker,
                                    initargs=(claims, shared_file), mp_context=ctx)
+        broken: list[BrokenProcessPool] = []  # a worker died: the pool takes nothing more
         try:
-            yield from _share(items, job, shared, claims, pool, jobs - 1, while_waiting)
+            yield from _share(items, job, shared, claims, pool, jobs - 1, while_waiting, broken)
         finally:
             # The workers exit on their own (0.2 s) while this process goes
             # on (a batch writes its report); Python joins them before it exits.
-            pool.shutdown(wait=False, cancel_futures=True)
+            # (A broken pool's futures are failed by its own thread: cancelling
+            # them too raises InvalidStateError there, in Python 3.11.)
+            pool.shutdown(wait=False, cancel_futures=not broken)
+
+
+def _lost(job: Job, item: Any, exc: BaseException) -> Any:
+    """The result of an item whose worker died while running it, or the error."""
+    if not hasattr(job, "lost"):
+        raise exc
+    return job.lost(item, "the worker process running it ended abruptly (a crash in a "
+                          "library, or out of memory); rerun to retry it")
 
 
 def _share(items: Sequence, job: Job, shared: Any, claims: Claims, pool: ProcessPoolExecutor,
-           workers: int, while_waiting: Callable[[], None] | None) -> Iterator[Any]:
+           workers: int, while_waiting: Callable[[], None] | None,
+           broken: list[BrokenProcessPool]) -> Iterator[Any]:
     """This process's share of the items and the workers', until all are done."""
     running: dict = {}
     front, back = 0, len(items)  # next item submitted to the workers; one past this process's
@@ -306,14 +331,27 @@ def _share(items: Sequence, job: Job, shared: Any, claims: Claims, pool: Process
     def feed():
         # a few items queued per worker, so that it never waits for this process
         nonlocal front
-        while front < back and len(running) < 4 * workers:
-            running[pool.submit(_claimed, front, items[front], job)] = front
+        while front < back and len(running) < 4 * workers and not broken:
+            try:
+                running[pool.submit(_claimed, front, items[front], job)] = front
+            except BrokenProcessPool as exc:
+                broken.append(exc)
+                return
             front += 1
 
     def collect(futures):
         for f in futures:
-            del running[f]
-            done, result = f.result()
+            index = running.pop(f)
+            try:
+                done, result = f.result()
+            except BrokenProcessPool as exc:
+                # Every item the pool had is lost. One nobody claimed is this
+                # process's to do (it claims down to the first); one a worker
+                # had claimed may be what killed it, and is not run again here.
+                broken.append(exc)
+                if claims.owner(index) == Claims.WORKER:
+                    yield _lost(job, items[index], exc)
+                continue
             if done:
                 yield result
 
@@ -342,10 +380,10 @@ def _share(items: Sequence, job: Job, shared: Any, claims: Claims, pool: Process
             feed()
     finally:
         starter.join()
-    # Every item is claimed: what is left is what the workers are doing.
-    for f in running:
-        f.cancel()  # a queued item a worker would only find claimed
-    running = {f: i for f, i in running.items() if not f.cancelled()}
+    # Every item is claimed: what is left is what the workers are doing, and
+    # queued items a worker will find claimed (milliseconds each; not
+    # cancelled: in Python 3.11 a pool that breaks after a future was
+    # cancelled raises InvalidStateError in its own thread).
     if running and while_waiting is not None:
         while_waiting()
     yield from collect(as_completed(list(running)))

@@ -99,3 +99,32 @@ def test_workers_start_with_the_preloaded_modules_imported(tmp_path):
     # this test module imports none of them: a spawned worker would not have them
     results = list(run_shared([0, 1], _Modules(tmp_path), 2))
     assert [r for r in results if r is not None] == [list(PRELOAD)]
+
+
+class _Dies:
+    """A worker dies on item 0; this process's first item waits until one has taken it."""
+
+    def __init__(self, folder: Path, parent: int):
+        self.folder, self.parent = folder, parent
+
+    def run(self, item: int, shared: None) -> int:
+        if item == 0 and os.getpid() != self.parent:
+            (self.folder / "took-0").touch()
+            os._exit(3)  # as a crash in a library would
+        if item == 3:
+            deadline = time.monotonic() + 30
+            while not (self.folder / "took-0").exists():
+                if time.monotonic() > deadline:
+                    raise TimeoutError("no worker took item 0")
+                time.sleep(0.01)
+        return item
+
+    def lost(self, item: int, message: str) -> tuple[str, int]:
+        return message, item
+
+
+def test_a_dead_workers_item_is_reported_lost_and_the_rest_are_done(tmp_path):
+    results = list(run_shared(list(range(4)), _Dies(tmp_path, os.getpid()), 2))
+    lost = [r for r in results if isinstance(r, tuple)]
+    assert sorted(r for r in results if isinstance(r, int)) == [1, 2, 3]
+    assert [r[1] for r in lost] == [0] and "ended abruptly" in lost[0][0]
