@@ -1,8 +1,9 @@
 """Worker processes: one thread each, and work shared with the process that starts them.
 
 A batch (and ``synth --jobs``) runs in this process and ``jobs - 1``
-spawned workers. Every process is single-threaded (OpenCV, FFmpeg, BLAS):
-the parallelism is the processes'.
+worker processes, forked from a fork server where there is one (see
+:func:`run_shared`). Every process is single-threaded (OpenCV, FFmpeg,
+BLAS): the parallelism is the processes'.
 
 Workers take items from the front of the queue and this process from the
 back. Each item is claimed once, in a table the processes share, by
@@ -151,7 +152,8 @@ class Job(Protocol):
 
     A job may also have ``lost(item, message)``: the result of an item whose
     worker died while running it (a crash in a library, or the kernel's
-    out-of-memory killer). Without it, such a death ends the run.
+    out-of-memory killer). Without it, such a death ends the run with a
+    :class:`ChildProcessError` (an ``OSError``).
     """
 
     def run(self, item: Any, shared: Any) -> Any: ...
@@ -190,8 +192,8 @@ def _init_worker(claims: Claims, shared_file: str | None) -> None:
     """Worker set-up: one thread, glibc's thresholds, the claims table and the shared object.
 
     The shared object comes as a file, not pickled in the start-up
-    arguments: a spawning parent blocks writing those into the worker's pipe
-    until the worker has started and imported everything (about a second).
+    arguments: the parent blocks writing those to a new worker until the
+    worker has started (and, spawned, imported everything: about a second).
     """
     limit_threads()
     reuse_freed_memory()  # inherited from a process that has used dask
@@ -221,6 +223,7 @@ PRELOAD = ("perception.batch", "perception.tracking.tracker", "perception.tracki
                                                 ("Bmp", "Gif", "Jpeg", "Png", "Ppm")))
 
 
+@functools.cache
 def _context():
     """Workers are forked from a fork server where there is one (POSIX), else spawned.
 
@@ -279,6 +282,8 @@ def run_shared(items: Sequence, job: Job, jobs: int, *, shared: Any = None,
     object
         Each item's result, in the order they finish.
     """
+    if shared is not None and folder is None:
+        raise ValueError("run_shared: a shared object needs a folder for its pickle")
     if jobs <= 1 or len(items) <= 1:
         for item in items:
             yield job.run(item, shared)
@@ -314,11 +319,12 @@ def run_shared(items: Sequence, job: Job, jobs: int, *, shared: Any = None,
 
 
 def _lost(job: Job, item: Any, exc: BaseException) -> Any:
-    """The result of an item whose worker died while running it, or the error."""
+    """The result of an item whose worker died while running it, or (a job without
+    ``lost``) an error a command reports in one line."""
+    why = "ended abruptly (a crash in a library, or out of memory)"
     if not hasattr(job, "lost"):
-        raise exc
-    return job.lost(item, "the worker process running it ended abruptly (a crash in a "
-                          "library, or out of memory); rerun to retry it")
+        raise ChildProcessError(f"a worker process {why}") from exc
+    return job.lost(item, f"the worker process running it {why}; rerun to retry it")
 
 
 def _share(items: Sequence, job: Job, shared: Any, claims: Claims, pool: ProcessPoolExecutor,

@@ -34,6 +34,15 @@ def test_an_item_is_claimed_once():
     assert claims.take(0) and claims.take(2)
 
 
+def _wait_until(ready, what: str, seconds: float = 30) -> None:
+    """Poll ``ready()`` until true; a TimeoutError naming ``what`` after ``seconds``."""
+    deadline = time.monotonic() + seconds
+    while not ready():
+        if time.monotonic() > deadline:
+            raise TimeoutError(what)
+        time.sleep(0.01)
+
+
 class _Record:
     """Sleeps for an item, then leaves a file naming the item and the process."""
 
@@ -44,11 +53,8 @@ class _Record:
         if item == 0:
             # The first item waits until every other item is done: a process
             # that left a queued item undone while it waits never sees that.
-            deadline = time.monotonic() + 20
-            while len(list(self.folder.glob("done-*"))) < 5:
-                if time.monotonic() > deadline:
-                    raise TimeoutError("the other items were not done")
-                time.sleep(0.01)
+            _wait_until(lambda: len(list(self.folder.glob("done-*"))) >= 5,
+                        "the other items were not done", seconds=20)
         else:
             time.sleep(0.2)
         (self.folder / f"done-{item}-{os.getpid()}").touch()
@@ -83,11 +89,7 @@ class _Modules:
 
     def run(self, item: int, shared: None) -> list[str] | None:
         if item == 1:
-            deadline = time.monotonic() + 30
-            while not (self.folder / "0").exists():
-                if time.monotonic() > deadline:
-                    raise TimeoutError("no worker ran item 0")
-                time.sleep(0.01)
+            _wait_until((self.folder / "0").exists, "no worker ran item 0")
             return None
         loaded = [m for m in PRELOAD if m in sys.modules]
         (self.folder / "0").touch()
@@ -112,19 +114,28 @@ class _Dies:
             (self.folder / "took-0").touch()
             os._exit(3)  # as a crash in a library would
         if item == 3:
-            deadline = time.monotonic() + 30
-            while not (self.folder / "took-0").exists():
-                if time.monotonic() > deadline:
-                    raise TimeoutError("no worker took item 0")
-                time.sleep(0.01)
+            _wait_until((self.folder / "took-0").exists, "no worker took item 0")
         return item
 
+
+class _DiesReported(_Dies):
     def lost(self, item: int, message: str) -> tuple[str, int]:
         return message, item
 
 
 def test_a_dead_workers_item_is_reported_lost_and_the_rest_are_done(tmp_path):
-    results = list(run_shared(list(range(4)), _Dies(tmp_path, os.getpid()), 2))
+    results = list(run_shared(list(range(4)), _DiesReported(tmp_path, os.getpid()), 2))
     lost = [r for r in results if isinstance(r, tuple)]
     assert sorted(r for r in results if isinstance(r, int)) == [1, 2, 3]
     assert [r[1] for r in lost] == [0] and "ended abruptly" in lost[0][0]
+
+
+def test_a_dead_worker_ends_a_job_without_lost_with_an_oserror(tmp_path):
+    # an OSError: a command reports it in one line (not BrokenProcessPool's traceback)
+    with pytest.raises(ChildProcessError, match="worker process ended abruptly"):
+        list(run_shared(list(range(4)), _Dies(tmp_path, os.getpid()), 2))
+
+
+def test_a_shared_object_needs_a_folder():
+    with pytest.raises(ValueError, match="needs a folder"):
+        list(run_shared([1, 2], _Record(Path(".")), 2, shared="s"))

@@ -103,7 +103,7 @@ def main() -> None:
                      f"--jobs 1 {synth1:.1f} s", f"{synth1 / synthn:.2f}x"))
         items = discover(work / "clips")
         n = len(items)
-        workers = max(2, min(cores, 2))
+        workers = 2  # dask's, against as many local processes
         times, summaries = {}, {}
         # Best of ROUNDS, the configurations taking turns: on a shared machine
         # a run's speed drifts by 20 % within seconds, and the best time is

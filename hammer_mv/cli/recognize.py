@@ -65,11 +65,12 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("not a video, .tracks.h5 or pose file", path)
     settings = recognition_settings(args)
     rep, rep_id = load_repertoire(args)
-    frames = FrameSample()  # a few frames for the contact sheet, kept while tracking
+    # a few frames for the contact sheet, kept while tracking
+    frames = None if args.no_figures else FrameSample()
     tracks = load_clip(path, tracks_out=args.output / "tracks" / f"{clip}{TRACKS_SUFFIX}",
                        progress=not args.quiet and sys.stderr.isatty(),
                        setup=settings.tracking, pose=settings.pose,
-                       frames=None if args.no_figures else frames,
+                       frames=frames,
                        **settings.video_options())
     rec = recognize_tracks(tracks, rep, settings, clip=clip, source=path)
     extra = {"fingerprint": clip_fingerprint(path, settings, rep_id), "condition": None,
