@@ -1,0 +1,46 @@
+"""tools/bench_recognition.py's scaling harness: the process counts it times, the
+clips it makes, and its measure of what the machine itself allows."""
+
+import dataclasses
+import sys
+from pathlib import Path
+
+import pandas as pd
+import pytest
+from _demos import default_repertoire
+
+from perception.batch import discover
+from perception.synthetic.recipes import load_recipe, synthesize
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tools"))
+
+import bench_recognition  # noqa: E402
+
+
+@pytest.mark.parametrize("cores, expected", [(1, [1]), (2, [1, 2]), (6, [1, 2, 4, 6]),
+                                             (16, [1, 2, 4, 8, 16])])
+def test_process_counts_double_up_to_every_core(cores, expected):
+    assert bench_recognition._worker_counts(cores) == expected
+
+
+@pytest.mark.parametrize("cores", [1, 2, 5, 16])
+def test_clip_counts_give_every_process_several_clips(cores):
+    counts = bench_recognition._counts(cores)
+    total = sum(counts.values())
+    assert total == max(40, bench_recognition.CLIPS_PER_CORE * cores)
+    assert max(counts.values()) - min(counts.values()) <= 1
+    assert set(counts) == {"normal", "delayed", "open-close-open"}
+
+
+@pytest.mark.slow
+def test_side_by_side_batches_share_every_clip_once(tmp_path):
+    recipe = dataclasses.replace(load_recipe(ROOT / "datasets" / "smoke.toml"),
+                                 counts={"normal": 2, "delayed": 1})
+    synthesize(recipe, tmp_path / "clips", seed=0)
+    items = discover(tmp_path / "clips")
+    wall = bench_recognition._side_by_side(items, tmp_path / "out", default_repertoire(), 2)
+    assert 0 < wall < 120
+    done = [pd.read_csv(f)["clip"] for f in sorted((tmp_path / "out").glob("alone*/summary.csv"))]
+    assert len(done) == 2 and len(done[0]) == 2 and len(done[1]) == 1  # largest first, dealt
+    assert sorted(pd.concat(done)) == sorted(i.clip for i in items)
