@@ -41,6 +41,19 @@ def test_side_by_side_batches_share_every_clip_once(tmp_path):
     items = discover(tmp_path / "clips")
     wall = bench_recognition._side_by_side(items, tmp_path / "out", default_repertoire(), 2)
     assert 0 < wall < 120
-    done = [pd.read_csv(f)["clip"] for f in sorted((tmp_path / "out").glob("alone*/summary.csv"))]
-    assert len(done) == 2 and len(done[0]) == 2 and len(done[1]) == 1  # largest first, dealt
-    assert sorted(pd.concat(done)) == sorted(i.clip for i in items)
+    done = [list(pd.read_csv(f)["clip"])
+            for f in sorted((tmp_path / "out").glob("alone*/summary.csv"))]
+    ranked = [i.clip for i in sorted(items, key=lambda i: i.path.stat().st_size, reverse=True)]
+    # largest first, dealt in turn: the first and third largest to one, the second to the other
+    assert sorted(done[0]) == sorted(ranked[0::2]) and done[1] == ranked[1:2]
+
+
+@pytest.mark.slow
+def test_side_by_side_reports_a_failed_batch_instead_of_waiting(tmp_path):
+    recipe = dataclasses.replace(load_recipe(ROOT / "datasets" / "smoke.toml"),
+                                 counts={"normal": 2})
+    synthesize(recipe, tmp_path / "clips", seed=0)
+    items = discover(tmp_path / "clips")
+    items[1] = dataclasses.replace(items[1], path=tmp_path / "gone.mp4")  # fails its batch
+    with pytest.raises(RuntimeError, match="failed"):
+        bench_recognition._side_by_side(items, tmp_path / "out", default_repertoire(), 2)

@@ -7,8 +7,8 @@ parallel efficiency (throughput with N processes / N x throughput with 1)
 workers within 10 % of N local processes; ``synth --jobs N`` against one
 process. The same-run baselines are the one-process figures, and for each N
 the throughput of N independent one-process batches side by side: how far
-the machine itself (memory, caches, clock) lets N single-threaded processes
-scale, which no scheduling can beat.
+the machine itself lets N single-threaded processes scale, which no way of
+sharing the clips can beat.
 """
 
 from __future__ import annotations
@@ -79,7 +79,7 @@ def _alone(items, out: Path, rep, ready, results) -> None:
     from perception import workers
 
     workers.limit_threads()
-    ready.wait()
+    ready.wait(timeout=300)  # a sibling that died before it would otherwise hang us
     t0 = time.perf_counter()
     _batch(items, out, rep)
     results.put((t0, time.perf_counter()))
@@ -96,20 +96,24 @@ def _side_by_side(items, out: Path, rep, processes: int) -> float:
     import multiprocessing
 
     from perception import workers
+    from perception.batch import _file_size
 
     ctx = multiprocessing.get_context("spawn")
     ready, results = ctx.Barrier(processes), ctx.Queue()
     # largest first, dealt in turn, so that each gets as much work
-    ranked = sorted(items, key=lambda i: i.path.stat().st_size, reverse=True)
+    ranked = sorted(items, key=_file_size, reverse=True)
     with workers.single_threaded_children():
         procs = [ctx.Process(target=_alone, args=(ranked[k::processes], out / f"alone{k}",
                                                   rep, ready, results))
                  for k in range(processes)]
         for proc in procs:
             proc.start()
-    spans = [results.get(timeout=600) for _ in procs]
-    for proc in procs:
+    for proc in procs:  # each puts two floats: the pipe holds them while it exits
         proc.join()
+    failed = [k for k, proc in enumerate(procs) if proc.exitcode != 0]
+    if failed:
+        raise RuntimeError(f"one-process batches {failed} failed (their tracebacks above)")
+    spans = [results.get(timeout=10) for _ in procs]
     return max(end for _, end in spans) - min(start for start, _ in spans)
 
 
