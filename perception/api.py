@@ -17,7 +17,7 @@ modules hold the rest.
 """
 
 from perception.batch import BatchItem, discover, run_batch
-from perception.errors import InputError
+from perception.errors import HammerMVError, InputError, PlanningError, TrackingError
 from perception.geometry import DEFAULT_OBJECT_DIAMETER, SimilarityTransform
 from perception.io.tracks import Status, Tracks, TracksWriter
 from perception.io.video import FrameSource, open_video, write_video
@@ -46,7 +46,10 @@ __all__ = [
     "DEFAULT_OBJECT_DIAMETER",
     "FrameSource",
     "HammerParams",
+    "HammerMVError",
     "InputError",
+    "PlanningError",
+    "TrackingError",
     "MarkerSet",
     "ModelSpec",
     "MotorModel",

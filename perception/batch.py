@@ -18,6 +18,7 @@ import logging
 import os
 import re
 import sys
+import traceback
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -26,9 +27,11 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 import perception.workers as workers
-from perception.errors import InputError
-from perception.io.atomic import write_json
+from perception.errors import HammerMVError, InputError
+from perception.io.atomic import write_json, write_text
+from perception.io.files import input_file, is_regular_file
 from perception.io.frame_sample import FrameSample
+from perception.io.names import output_folder, output_stem
 from perception.pipeline import (
     TRACKS_SUFFIX,
     RecognitionSettings,
@@ -37,15 +40,17 @@ from perception.pipeline import (
     load_clip,
     recognize_tracks,
 )
+from perception.provenance import code_digest
 from perception.recognition.planning import THREADS_VARIABLE
 from perception.recognition.repertoire import PlanCache, Repertoire
-from perception.report.clip import ClipSummary, clip_outputs, write_clip_report
+from perception.report.clip import ClipSummary, clip_outputs, remove_output, write_clip_report
 from perception.report.tracking import tracking_columns, write_tracking_report
 
 if TYPE_CHECKING:
     import pandas as pd
 
-__all__ = ["BatchItem", "ClipResult", "discover", "process_clip", "run_batch", "summary_table"]
+__all__ = ["BatchItem", "ClipResult", "Discovery", "discover", "find_clips", "process_clip",
+           "run_batch", "summary_table"]
 
 log = logging.getLogger(__name__)
 
@@ -53,13 +58,18 @@ log = logging.getLogger(__name__)
 #: manifest, and what a batch writes (so a report folder can be its own input).
 COMPANION_SUFFIXES = (".truth.h5", ".recognition.json", ".confidence.csv", ".confidence.png",
                       ".paths.png", ".tracking.png", ".status.csv")
-#: Which file stands for a clip found more than once (a tracks file spares
-#: tracking; a pose file beside its video is what the lab tracked it with).
-_PREFERENCE = {"tracks": 3, "pose": 2, "video": 1, "unknown": 0}
+#: Which file stands for a clip found more than once: a pose file beside its
+#: video is what the lab tracked it with; a tracks file beside a video stands
+#: for it only when it is current (checked when the video is loaded), so the
+#: video is the clip.
+_PREFERENCE = {"pose": 3, "video": 2, "tracks": 1, "unknown": 0}
 COMPANION_NAMES = ("manifest.csv", "README.md", "recipe.toml", "summary.csv", "statistics.csv",
                    "condition_profiles.csv", "condition_profiles.png", "report.html",
                    "batch.json", "repertoire.h5", "aperture_profiles.csv",
-                   "aperture_profiles.png", "confidence_single.png", "confidence_all.png")
+                   "aperture_profiles.png", "confidence_single.png", "confidence_all.png",
+                   "errors.log")
+#: Tracebacks of the clips that failed through a bug (not their input).
+ERRORS_LOG = "errors.log"
 #: A clip name becomes file names in the report folder: no separators, no
 #: leading dot, nothing that is not printable.
 _CLIP_NAME = re.compile(r"[^/\\\x00-\x1f\x7f]+")
@@ -76,7 +86,8 @@ class BatchItem:
     path : Path
         Video, tracks or pose file.
     kind : str
-        ``video``, ``tracks``, ``pose`` or ``unknown`` (recorded as a failure).
+        ``video``, ``tracks`` or ``pose`` (a manifest row may name a file of
+        another kind: ``unknown``, recorded as a failure).
     condition : str or None
         Stimulus condition, when a manifest gives it.
     """
@@ -133,8 +144,35 @@ def _from_manifest(source: Path) -> list[BatchItem]:
     return sorted(items, key=lambda i: i.clip)
 
 
+@dataclass(frozen=True)
+class Discovery:
+    """What a batch input holds.
+
+    Attributes
+    ----------
+    items : list of BatchItem
+        The clips, sorted by name.
+    skipped : list of (str, str)
+        Files of a folder that are not clips, with why: ``(file name, reason)``.
+    """
+
+    items: list[BatchItem]
+    skipped: list[tuple[str, str]]
+
+
 def discover(source: str | os.PathLike) -> list[BatchItem]:
-    """List the clips of a batch input.
+    """List the clips of a batch input (:func:`find_clips`, without the skipped files).
+
+    Parameters
+    ----------
+    source : str or os.PathLike
+        A folder or a ``manifest.csv``.
+    """
+    return find_clips(source).items
+
+
+def find_clips(source: str | os.PathLike) -> Discovery:
+    """List the clips of a batch input, and the files of a folder that are not clips.
 
     Parameters
     ----------
@@ -144,12 +182,16 @@ def discover(source: str | os.PathLike) -> list[BatchItem]:
 
     Returns
     -------
-    list of BatchItem
-        Sorted by clip name. A clip found as several files uses, in order of
-        preference, its tracks file, pose file or video; two files of equal
-        standing with one stem (``dup.avi``, ``dup.mp4``) are both clips, named
-        by their file names. Other files become ``unknown`` items (reported as
-        failed).
+    Discovery
+        Clips sorted by name. A clip found as several files uses its pose
+        file before its video (what the lab tracked it with), and its video
+        before a tracks file of the same name: such tracks are reused only
+        if they are current for that very video and these settings
+        (:func:`~perception.pipeline.current_tracks`), as ``recognize`` does.
+        Two files of equal standing with one stem (``dup.avi``, ``dup.mp4``)
+        are both clips, named by their file names. Files that are not clips
+        (notes, setups, FIFOs, devices or links to them) are skipped, never
+        opened.
 
     Raises
     ------
@@ -160,22 +202,29 @@ def discover(source: str | os.PathLike) -> list[BatchItem]:
     source = Path(source)
     if not source.exists():
         raise InputError("batch input not found", source)
-    if source.is_file():
+    if not source.is_dir():
         if source.suffix.lower() != ".csv":
             raise InputError("batch input must be a folder or a manifest.csv", source)
-        return _from_manifest(source)
+        return Discovery(_from_manifest(input_file(source, "manifest")), [])
     conditions = {}
     manifest = source / "manifest.csv"
-    if manifest.is_file():
+    if is_regular_file(manifest):
         conditions = {i.clip: i.condition for i in _from_manifest(manifest)}
     by_stem: dict[str, list[BatchItem]] = {}
+    skipped = []
     for path in sorted(source.iterdir()):
-        if path.name.startswith(".") or path.is_dir() or path.name in COMPANION_NAMES:
+        if path.name.startswith(".") or path.name in COMPANION_NAMES:
             continue
-        if path.name.endswith(COMPANION_SUFFIXES):
+        if path.name.endswith(COMPANION_SUFFIXES) or path.is_dir():
             continue
         clip, kind = clip_name(path)
-        by_stem.setdefault(clip, []).append(BatchItem(clip, path, kind, conditions.get(clip)))
+        if kind == "unknown":
+            skipped.append((path.name, "not a video, tracks or pose file"))
+        elif not is_regular_file(path):
+            skipped.append((path.name, "not a regular file (a FIFO, device, socket or a "
+                                       "broken link)"))
+        else:
+            by_stem.setdefault(clip, []).append(BatchItem(clip, path, kind, conditions.get(clip)))
     items = []
     for found in by_stem.values():
         best = max(_PREFERENCE[i.kind] for i in found)
@@ -183,7 +232,9 @@ def discover(source: str | os.PathLike) -> list[BatchItem]:
         if len(chosen) > 1:  # the stem alone would not tell them apart
             chosen = [BatchItem(i.path.name, i.path, i.kind, i.condition) for i in chosen]
         items += chosen
-    return sorted(items, key=lambda i: i.clip)
+    for name, why in skipped:
+        log.info("%s: skipped: %s", source / name, why)
+    return Discovery(sorted(items, key=lambda i: i.clip), skipped)
 
 
 def _current_report(item: BatchItem, out: Path, fingerprint: str) -> dict | None:
@@ -216,6 +267,8 @@ class ClipResult:
         Rule that picks the winner.
     summary : ClipSummary or None
         The scored clip (None if it failed).
+    traceback : str
+        The traceback of a failure that is a bug, not bad input (empty otherwise).
     """
 
     clip: str
@@ -224,6 +277,7 @@ class ClipResult:
     error: str = ""
     rule: str = "likelihood"
     summary: ClipSummary | None = None
+    traceback: str = ""
 
     @property
     def winner(self) -> str | None:
@@ -262,12 +316,14 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
     """
     base = dict(clip=item.clip, condition=item.condition, rule=settings.hammer.rule)
     try:
+        input_file(item.path, "clip")  # before hashing: a FIFO or device would never end
         fp = clip_fingerprint(item.path, settings, repertoire_id)
         done = _current_report(item, out, fp)
         if done is not None:
             return ClipResult(**base, status="reused", summary=ClipSummary.from_dict(done))
         frames = FrameSample()
-        tracks = load_clip(item.path, tracks_out=out / "tracks" / f"{item.clip}{TRACKS_SUFFIX}",
+        tracks_out = output_folder(out, "tracks") / f"{output_stem(item.clip)}{TRACKS_SUFFIX}"
+        tracks = load_clip(item.path, tracks_out=tracks_out,
                            progress=progress, setup=settings.tracking, pose=settings.pose,
                            frames=frames, **settings.video_options())
         rec = recognize_tracks(tracks, repertoire, settings, clip=item.clip, source=item.path,
@@ -277,36 +333,54 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
                  "tracking": tracking}
         write_clip_report(rec, out, extra=extra)
         return ClipResult(**base, status="ok", summary=ClipSummary.from_recognition(rec, extra))
-    except (InputError, ValueError, OSError) as exc:
-        msg = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        if isinstance(exc, OSError) and not isinstance(exc, InputError):
+    except (HammerMVError, OSError) as exc:  # the clip's fault; anything else is a bug
+        msg = _first_line(exc)
+        if isinstance(exc, OSError) and item.path.name not in msg:
             msg = f"{item.path}: {msg}"
         log.info("%s failed: %s", item.clip, msg)
         _remove_outputs(item, out)
         return ClipResult(**base, status="failed", error=msg)
 
 
+def _first_line(exc: BaseException) -> str:
+    text = str(exc).strip()
+    return text.splitlines()[0] if text else type(exc).__name__
+
+
 def _remove_outputs(item: BatchItem, out: Path) -> None:
-    """A clip that fails now must not keep a report from an earlier run."""
-    for path in clip_outputs(out, item.clip).values():
-        path.unlink(missing_ok=True)
+    """A clip that fails now must not keep a report from an earlier run.
+
+    Never raises: it runs while a failure is being recorded (a name too long
+    for the file system, a read-only folder) and must not end the batch.
+    """
+    try:
+        paths = list(clip_outputs(out, item.clip).values())
+    except (OSError, ValueError) as exc:
+        log.warning("%s: cannot list its outputs to remove them: %s", item.clip, exc)
+        return
+    for path in paths:
+        try:
+            remove_output(path)
+        except OSError as exc:
+            log.warning("%s: %s", item.clip, exc)
 
 
 def _guarded(item: BatchItem, out: Path, **kwargs) -> ClipResult:
     """:func:`process_clip` that records an unexpected error instead of raising it.
 
     A batch goes on past any clip; the error (a bug, not bad input) is logged
-    with its traceback and reported with its type.
+    with its traceback, reported with its type and kept with its traceback
+    (``errors.log`` in the report folder).
     """
     try:
         return process_clip(item, out, **kwargs)
     except Exception as exc:  # noqa: BLE001 - one clip must not end the batch
-        log.exception("%s: unexpected error", item.clip)
+        log.exception("%s: unexpected error (a bug in hammer-mv)", item.clip)
         _remove_outputs(item, out)
-        first = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
         return ClipResult(item.clip, item.condition, "failed",
-                          f"{item.path}: unexpected {type(exc).__name__}: {first}",
-                          kwargs["settings"].hammer.rule)
+                          f"{item.path}: unexpected {type(exc).__name__} (a bug in hammer-mv; "
+                          f"see errors.log): {_first_line(exc)}",
+                          kwargs["settings"].hammer.rule, traceback=traceback.format_exc())
 
 
 @dataclass(frozen=True)
@@ -379,13 +453,54 @@ def _prepare_report() -> None:
     import perception.report.batch  # noqa: F401 - pandas
 
 
+#: Seconds to wait for a dask scheduler to answer before giving up.
+SCHEDULER_TIMEOUT_S = 10.0
+
+
+def _check_scheduler(address: str) -> None:
+    """Refuse ``address`` unless a dask scheduler answers there within the time limit.
+
+    ``Client(address, timeout=...)`` waits for ever on a port that accepts
+    and says nothing (its connection handshake is not bounded): ask the
+    scheduler for its identity first, under an overall limit, on a loop of
+    our own in another thread (the caller may be running one).
+    """
+    import asyncio
+    from concurrent.futures import ThreadPoolExecutor
+
+    from distributed.comm import connect
+
+    async def identity():
+        comm = await connect(address, timeout=SCHEDULER_TIMEOUT_S)
+        try:
+            await comm.write({"op": "identity", "reply": True})
+            return await comm.read()
+        finally:
+            comm.abort()
+
+    async def bounded():
+        return await asyncio.wait_for(identity(), SCHEDULER_TIMEOUT_S)
+
+    with ThreadPoolExecutor(1) as pool:
+        try:
+            answer = pool.submit(asyncio.run, bounded()).result()
+        except (OSError, ValueError, TypeError) as exc:  # TimeoutError is an OSError
+            raise InputError(f"no dask scheduler answered at {address!r} within "
+                             f"{SCHEDULER_TIMEOUT_S:g} s ({type(exc).__name__}: "
+                             f"{_first_line(exc)})", field="--scheduler") from None
+    if not isinstance(answer, dict) or answer.get("type") != "Scheduler":
+        raise InputError(f"{address!r} answered, but not as a dask scheduler",
+                         field="--scheduler")
+
+
 def _run_dask(items: list[BatchItem], repertoire: Repertoire, job: _Job,
               scheduler: str) -> Iterator[ClipResult]:
     """Every item on a dask.distributed cluster."""
     from dask.distributed import Client
     from dask.distributed import as_completed as dask_completed
 
-    with Client(scheduler) as client:
+    _check_scheduler(scheduler)
+    with Client(scheduler, timeout=SCHEDULER_TIMEOUT_S) as client:
         rep = client.scatter(repertoire, broadcast=True)
         # largest first: the cluster's last clips are its shortest
         items = sorted(items, key=_file_size, reverse=True)
@@ -469,6 +584,7 @@ def run_batch(
     scheduler: str | None = None,
     repertoire_id: str = "",
     quiet: bool = False,
+    skipped: Iterable[tuple[str, str]] = (),
 ) -> pd.DataFrame:
     """Process every clip and write the batch report.
 
@@ -492,6 +608,9 @@ def run_batch(
         Identity of the repertoire for the resume fingerprints.
     quiet : bool
         No progress bar (there is none anyway when stderr is not a terminal).
+    skipped : iterable of (str, str)
+        Files of the input that are not clips, with why (:attr:`Discovery.skipped`),
+        listed in ``batch.json``.
 
     Returns
     -------
@@ -504,10 +623,12 @@ def run_batch(
 
     settings = RecognitionSettings() if settings is None else settings
     if jobs < 1:
-        raise ValueError(f"--jobs: expected at least 1, got {jobs}")
+        raise InputError(f"expected at least 1, got {jobs}", field="--jobs")
     items = list(items)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
+    for sub in ("tracks", PLANS_FOLDER):  # a link leading out of the report: refused now
+        output_folder(out, sub)
     job = _Job(out, settings, repertoire_id)
     results = (_run_dask(items, repertoire, job, scheduler) if scheduler
                else _run_local(items, repertoire, job, jobs))
@@ -521,9 +642,16 @@ def run_batch(
     summary = summary_table(done)
     write_batch_report(summary, {r.clip: r.summary for r in done if r.summary is not None}, out,
                        models=repertoire.models)
+    bugs = [f"== {r.clip} ({r.error})\n{r.traceback}" for r in done if r.traceback]
+    if bugs:
+        write_text(out / ERRORS_LOG, "\n".join(bugs))
+    else:
+        (out / ERRORS_LOG).unlink(missing_ok=True)
     write_json(out / "batch.json", {"clips": len(done),
                                     "ok": int((summary["status"] == "ok").sum()),
                                     "failed": int((summary["status"] != "ok").sum()),
+                                    "skipped": [{"file": n, "reason": why} for n, why in skipped],
                                     "settings": settings.fingerprint(),
-                                    "repertoire": repertoire_id})
+                                    "repertoire": repertoire_id,
+                                    "code": code_digest()})
     return summary

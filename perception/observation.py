@@ -151,29 +151,29 @@ class ObserveParams:
                      "max_rest_aperture", "onset_displacement", "onset_noise_factor",
                      "end_speed", "end_noise_factor"):
             if not _positive(getattr(self, name)):
-                raise ValueError(f"ObserveParams.{name}: expected a positive number, "
-                                 f"got {getattr(self, name)!r}")
+                raise InputError(f"expected a positive number, got {getattr(self, name)!r}",
+                                 field=f"ObserveParams.{name}")
         if self.px_per_m is not None and not _positive(self.px_per_m):
-            raise ValueError(f"ObserveParams.px_per_m: expected a positive scale, "
-                             f"got {self.px_per_m!r}")
+            raise InputError(f"expected a positive scale, got {self.px_per_m!r}",
+                             field="ObserveParams.px_per_m")
         for name in ("hand_size_range", "frame_period_range"):
             if not _range(getattr(self, name)):
-                raise ValueError(f"ObserveParams.{name}: expected (low, high) with "
-                                 f"0 < low < high, got {getattr(self, name)!r}")
+                raise InputError(f"expected (low, high) with 0 < low < high, got "
+                                 f"{getattr(self, name)!r}", field=f"ObserveParams.{name}")
         for name, least in (("rest_frames", 2), ("onset_hold_frames", 1),
                             ("end_pad_frames", 0), ("min_frames", 3)):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < least:
-                raise ValueError(f"ObserveParams.{name}: expected a whole number of frames "
-                                 f">= {least}, got {value!r}")
+                raise InputError(f"expected a whole number of frames >= {least}, got {value!r}",
+                                 field=f"ObserveParams.{name}")
         if not (0 < self.alpha <= 1 and 0 <= self.beta < 2):
-            raise ValueError(f"ObserveParams.alpha/beta: expected 0 < alpha <= 1, "
-                             f"0 <= beta < 2, got {self.alpha}, {self.beta}")
+            raise InputError(f"expected 0 < alpha <= 1, 0 <= beta < 2, got {self.alpha}, "
+                             f"{self.beta}", field="ObserveParams.alpha/beta")
         prof = np.asarray(self.onset_profile, dtype=float)
         if not (prof.ndim == 2 and prof.shape[1] == 2 and len(prof) >= 2
                 and np.all(np.diff(prof, axis=0) > 0)):
-            raise ValueError("ObserveParams.onset_profile: expected increasing "
-                             "(displacement m, time s) pairs")
+            raise InputError("expected increasing (displacement m, time s) pairs",
+                             field="ObserveParams.onset_profile")
 
     def onset_latency(self, displacement: float) -> float:
         """Time after the command onset at which the wrist has moved ``displacement`` m.
@@ -361,6 +361,12 @@ def _clip_name(tracks, clip: str | None) -> str:
     return clip or getattr(tracks, "name", None) or "clip"
 
 
+def _source(tracks, name: str) -> str:
+    """What an error names: the tracks file the clip was loaded from, else the clip."""
+    path = getattr(tracks, "path", None)
+    return str(path) if path is not None else name
+
+
 def _marker_pixels(tracks, params: ObserveParams, name: str) -> dict[str, np.ndarray]:
     """(T, 2) px of every needed marker; refuses tracks that cannot be scored."""
     markers = list(tracks.markers)
@@ -370,12 +376,12 @@ def _marker_pixels(tracks, params: ObserveParams, name: str) -> dict[str, np.nda
         what = "object" if m == "object" else f"marker '{m}'"
         if m not in markers:
             raise InputError(f"marker '{m}' is not in the tracks (have {', '.join(markers)})",
-                             name)
+                             name, field=m)
         px[m] = pos[:, markers.index(m)]
         if not np.isfinite(px[m]).all(axis=1).any():
-            raise InputError(f"{what} is never seen in the clip", name)
+            raise InputError(f"{what} is never seen in the clip", name, field=m)
         if np.isinf(px[m]).any():
-            raise InputError(f"marker '{m}' has infinite positions", name)
+            raise InputError(f"marker '{m}' has infinite positions", name, field=m)
     if len(pos) < params.min_frames:
         raise InputError(f"clip too short to score: {len(pos)} frames "
                          f"(need at least {params.min_frames})", name)
@@ -406,10 +412,17 @@ def _scene_transform(px: dict[str, np.ndarray], tracks, params: ObserveParams,
         if not np.isfinite(px[m][rest]).all():
             what = "object" if m == "object" else f"marker '{m}'"
             raise InputError(f"the clip must start with the hand at rest and visible: the "
-                             f"{what} is lost in its first {params.rest_frames} frames", name)
+                             f"{what} is lost in its first {params.rest_frames} frames", name,
+                             field=m)
     # The object stays put while the hand is away: twice the rest frames
-    # average its centre better and are still long before the hand arrives.
-    origin = np.median(px["object"][: 2 * params.rest_frames], axis=0)
+    # average its centre better and are still long before the hand arrives;
+    # the median is over the frames in which it is seen (the hand may hide it).
+    early = px["object"][: 2 * params.rest_frames]
+    seen = early[np.isfinite(early).all(axis=1)]
+    if not len(seen):
+        raise InputError("the object is never seen in the first "
+                         f"{2 * params.rest_frames} frames", name, field="object")
+    origin = np.median(seen, axis=0)
     scale = params.px_per_m
     if scale is None:
         dpx = tracks.object_diameter_px()
@@ -484,19 +497,20 @@ def _end_row(filtered: np.ndarray, time: np.ndarray, noise: float, dt: float,
 
 def _prepare(tracks, params: ObserveParams, name: str) -> _Prepared:
     """Scene, smoothed model-frame positions and the movement span of some tracks."""
-    px = _marker_pixels(tracks, params, name)
-    time, dts = _frame_times(tracks, params, name)
+    where = _source(tracks, name)  # errors name the tracks file where there is one
+    px = _marker_pixels(tracks, params, where)
+    time, dts = _frame_times(tracks, params, where)
     dt = float(np.median(dts))
-    transform = _scene_transform(px, tracks, params, name)
+    transform = _scene_transform(px, tracks, params, where)
     raw = np.stack([transform.to_model(px[m]) for m in DIGIT_MARKERS], axis=1)
-    noise, rest_mean = _rest_noise(raw, params, name)
+    noise, rest_mean = _rest_noise(raw, params, where)
     filtered = alpha_beta(raw, np.concatenate([[dt], dts]), params.alpha, params.beta)
-    onset_time = _onset_time(filtered, time, noise, params, name)
+    onset_time = _onset_time(filtered, time, noise, params, where)
     start = int(np.searchsorted(time, onset_time))
     end = _end_row(filtered, time, noise, dt, params)
     if end - start + 1 < params.min_frames:
         raise InputError(f"movement too short to score: {end - start + 1} frames "
-                         f"(need at least {params.min_frames})", name)
+                         f"(need at least {params.min_frames})", where)
     frames = np.asarray(getattr(tracks, "frame", np.arange(len(time))))
     span = MovementSpan(start, end + 1, int(frames[start]), int(frames[end]), onset_time)
     return _Prepared(name, frames, time, dt, transform, raw, filtered, rest_mean, noise, span)
@@ -566,7 +580,7 @@ def observe(tracks, params: ObserveParams | None = None, *, clip: str | None = N
     """
     params = ObserveParams() if params is None else params
     p = _prepare(tracks, params, _clip_name(tracks, clip))
-    _check_hand(p.rest_mean, params, p.name)
+    _check_hand(p.rest_mean, params, _source(tracks, p.name))
     start, finger0, thumb0 = p.rest_mean
     # The digits touch at rest (as in the model), so the markers' separation
     # then is where they sit on the digits, outside the tips: take it off.

@@ -29,10 +29,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from perception import __version__
 from perception.errors import InputError
 from perception.io.tracks import Tracks, tracks_path_for
 from perception.observation import ObserveParams, observe
+from perception.provenance import code_digest
 from perception.recognition.engine import HammerParams, recognize
 from perception.recognition.models import SceneSpec
 from perception.recognition.repertoire import PlanCache, Repertoire
@@ -138,6 +138,9 @@ def clip_fingerprint(path: str | os.PathLike, settings: RecognitionSettings,
     different video of the same size is a different clip), the settings,
     the repertoire's identity and the software version: a report carrying
     the same fingerprint is current and need not be made again.
+    The code is :func:`~perception.provenance.code_digest`: any change to
+    scoring, tracking, planning or the shipped calibration makes every
+    report stale.
 
     Parameters
     ----------
@@ -150,7 +153,7 @@ def clip_fingerprint(path: str | os.PathLike, settings: RecognitionSettings,
     """
     source = {"sha256": file_sha256(path)}
     payload = json.dumps({"input": source, "settings": settings.fingerprint(),
-                          "repertoire": repertoire_id, "software": __version__},
+                          "repertoire": repertoire_id, "code": code_digest()},
                          sort_keys=True)
     return hashlib.sha256(payload.encode()).hexdigest()[:16]
 
@@ -254,7 +257,8 @@ def current_tracks(video: str | os.PathLike, candidates,
                    setup: TrackingSetup | None = None) -> Tracks | None:
     """The first of ``candidates`` that is a current tracks file of ``video``, loaded.
 
-    Current means: written by this software version, of this very video
+    Current means: written by this very code (:func:`~perception.provenance.code_digest`),
+    of this very video
     (``/video`` attribute ``sha256``: hashing reads the file once, far
     cheaper than decoding and tracking it) and with the tracker settings a
     tracker of ``setup`` (default: the default colour models and parameters)
@@ -278,12 +282,12 @@ def current_tracks(video: str | os.PathLike, candidates,
             continue
         try:
             with h5py.File(cand, "r") as fh:
-                version = fh.attrs.get("software_version")
+                digest = fh.attrs.get("software_digest")
             tracks = Tracks.load(cand)
         except (InputError, OSError, ValueError):
             continue
-        version = version.decode() if isinstance(version, bytes) else version
-        if version != __version__ or tracks.video.get("sha256") != file_sha256(video):
+        digest = digest.decode() if isinstance(digest, bytes) else digest
+        if digest != code_digest() or tracks.video.get("sha256") != file_sha256(video):
             continue
         expected = expected or _settings(_tracker_attrs(setup))
         if _settings(tracks.tracker) == expected:
@@ -325,21 +329,25 @@ def recognize_tracks(tracks: Tracks, repertoire: Repertoire,
     Raises
     ------
     InputError
-        The tracks cannot be observed, or their scene cannot be planned.
+        The tracks cannot be observed.
+    PlanningError
+        Their scene cannot be planned (out of the models' reach: often a wrong scale).
     """
+    from perception.errors import PlanningError
+
     settings = RecognitionSettings() if settings is None else settings
     try:
         obs = observe(tracks, settings.observe, clip=clip)
     except InputError as exc:
         if source is None:
             raise
-        raise InputError(exc.problem, source) from None  # name the file the user gave
+        # name the file the user gave; keep the kind (TrackingError) and the field
+        raise type(exc)(exc.problem, source, field=exc.field) from None
     try:
         models = repertoire.for_scene(SceneSpec.of(obs), cache=plan_cache)
-    except ValueError as exc:
-        raise InputError(f"cannot plan the models for this clip's scene (distance "
-                         f"{obs.start_distance:.3f} m; check the scale: --px-per-m, "
-                         f"--object-diameter): {exc}", source or obs.clip) from None
+    except PlanningError as exc:  # the scene, not the software: name the clip and the scale
+        raise PlanningError(f"{exc.problem} (check the scale: --px-per-m, --object-diameter)",
+                            source or obs.clip, field=exc.field) from None
     rec = recognize(obs, models, settings.hammer)
     if rec.verdict is None:  # the default repertoire calibrates only the models it needs
         rec = recognize(obs, repertoire.calibrated(models, rec.decision.best), settings.hammer)

@@ -80,10 +80,12 @@ def test_batch_goes_on_past_bad_files(clips, repfile, tmp_path):
     (src / "notes.txt").write_text("not a video")
     (src / "empty.mp4").write_bytes(b"")
     proc = _batch(src, tmp_path / "out", repfile)
-    assert proc.returncode == 1 and "2 clip(s) failed" in proc.stderr
+    assert proc.returncode == 1 and "1 clip(s) failed" in proc.stderr
     s = pd.read_csv(tmp_path / "out" / "summary.csv").set_index("clip")
     assert s.loc["normal-01", "status"] == "ok"
-    assert s.loc["notes", "status"] == "failed" and "not a video" in s.loc["notes", "error"]
+    assert "notes" not in s.index  # not a clip: skipped, and listed as such
+    skipped = json.loads((tmp_path / "out" / "batch.json").read_text())["skipped"]
+    assert skipped == [{"file": "notes.txt", "reason": "not a video, tracks or pose file"}]
     assert s.loc["empty", "status"] == "failed" and "empty.mp4" in s.loc["empty", "error"]
     assert not list((tmp_path / "out").glob("empty.*")) and not list(
         (tmp_path / "out").glob(".*part*"))
@@ -196,6 +198,7 @@ def test_an_unexpected_error_is_recorded_and_the_batch_goes_on(clips, tmp_path):
     summary = run_batch(items, tmp_path / "out", bad_rep, quiet=True)
     assert (summary["status"] == "failed").all()
     assert summary["error"].str.contains("unexpected IndexError").all()
+    assert "IndexError" in (tmp_path / "out" / "errors.log").read_text()
     assert (tmp_path / "out" / "summary.csv").exists()
     assert (tmp_path / "out" / "report.html").exists()
 

@@ -50,9 +50,11 @@ def test_a_manifest_clip_name_that_looks_like_a_number_stays_text(tmp_path):
 
 
 def test_stem_collisions_are_both_processed_under_their_file_names(tmp_path):
-    for name in ("dup.avi", "dup.mp4", "solo.mp4", "t.mp4", "t.tracks.h5", "p.csv", "p.mp4"):
+    for name in ("dup.avi", "dup.mp4", "solo.mp4", "t.mp4", "t.tracks.h5", "p.csv", "p.mp4",
+                 "u.tracks.h5"):
         (tmp_path / name).write_bytes(b"")
     items = {i.clip: (i.path.name, i.kind) for i in discover(tmp_path)}
     assert items == {"dup.avi": ("dup.avi", "video"), "dup.mp4": ("dup.mp4", "video"),
-                     "solo": ("solo.mp4", "video"), "t": ("t.tracks.h5", "tracks"),
+                     "solo": ("solo.mp4", "video"), "t": ("t.mp4", "video"),
+                     "u": ("u.tracks.h5", "tracks"),
                      "p": ("p.csv", "pose")}

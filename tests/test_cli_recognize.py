@@ -62,8 +62,9 @@ def test_corrupt_repertoire(tmp_path):
 
 
 @pytest.mark.parametrize("extra, message", [(["--rule", "vote"], "invalid choice"),
-                                            (["--filter-gain", "3"], "filter_gain"),
-                                            (["--object-diameter", "-1"], "object_diameter")])
+                                            (["--filter-gain", "3"], "--filter-gain: "),
+                                            (["--object-diameter", "-1"],
+                                             "--object-diameter: ")])
 def test_bad_options(tmp_path, repfile, extra, message):
     path = _save(demo_tracks("normal", 0)[0], tmp_path / "n.tracks.h5")
     proc = _recognize(path, tmp_path / "out", repfile, *extra)

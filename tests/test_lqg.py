@@ -193,4 +193,8 @@ def test_a_cost_bouncing_on_its_rounding_floor_stops_the_iteration():
     plan = plan_grasp(GraspTask(object_size=0.10, distance=0.25, duration=0.98, grip_via=vias))
     sol = plan.thumb.solution
     assert sol.converged and sol.iterations < 100
-    np.testing.assert_allclose(sol.cost, plan.finger.solution.cost, rtol=1e-8)  # its mirror
+    # its mirror, to the solver's own tolerance: a cost on its rounding floor is
+    # known no better than the bounce it stopped on (2e-8 with numpy 2.4's BLAS)
+    from minvar.lqg import _FLOOR_RTOL
+
+    np.testing.assert_allclose(sol.cost, plan.finger.solution.cost, rtol=_FLOOR_RTOL)

@@ -68,8 +68,8 @@ def test_synth_cli_is_reproducible_and_labels_truth(tmp_path):
 
 
 @pytest.mark.parametrize("text, message", [
-    ("conditions = 3\n", "must be a table"),
-    ("[conditions]\nnormal = 1.7\n", "whole, non-negative"),
+    ("conditions = 3\n", r"\[conditions\]: expected a table"),
+    ("[conditions]\nnormal = 1.7\n", r"\[conditions\] normal: expected an integer"),
     ("[conditions]\nnormal = 1\n[scene]\nmarker_offset = -0.5\n", "marker_offset"),
     ("[conditions]\nnormal = 1\n[variation]\nduration_sd = -0.1\n", "duration_sd"),
     ("[conditions]\nnormal = 3\n[scene]\nduration = 0.15\n[variation]\nduration_sd = 0.3\n",

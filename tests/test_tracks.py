@@ -126,7 +126,7 @@ def test_not_hdf5_and_missing_dataset(tmp_path):
     path = _tracks().save(tmp_path / "c.tracks.h5")
     with h5py.File(path, "a") as fh:
         del fh["tracks/status"]
-    with pytest.raises(InputError, match="missing dataset /tracks/status"):
+    with pytest.raises(InputError, match="/tracks/status: missing dataset"):
         Tracks.load(path)
     with pytest.raises(InputError, match="no such file"):
         Tracks.load(tmp_path / "none.h5")

@@ -6,9 +6,12 @@ taking the parsed ``argparse.Namespace`` and returning an exit status). Every
 parser shows its defaults, and every command takes ``-v/--verbose`` and
 ``--quiet`` before or after its name.
 
-A user's mistake (``InputError``, ``ValueError``, ``OSError``) is printed as one
-line on stderr and exits with status 2; anything else is a bug and shows a
-traceback.
+A user's mistake (a :class:`~perception.errors.HammerMVError`, or an
+``OSError`` from the user's files) is printed as one line on stderr and exits
+with status 2; anything else (a bare ``ValueError`` included) is a bug: it shows
+its traceback, a line saying so, and exits with status 1. Library warnings
+(numpy's RuntimeWarnings and the like) are shown with ``-v``; otherwise they
+are counted and summarised in one line at the end (nothing with ``--quiet``).
 """
 
 from __future__ import annotations
@@ -18,9 +21,11 @@ import importlib
 import logging
 import os
 import sys
+import traceback
 import warnings
 
 from minvar import __version__
+from perception.errors import HammerMVError
 
 #: Subcommands, in the order ``--help`` lists them, and their one-line help. A
 #: command's module (``hammer_mv.cli.<name>``) is imported only when that
@@ -138,8 +143,52 @@ def _command(argv: list[str]) -> str | None:
     return None
 
 
+def _first_line(text: str) -> str:
+    text = text.strip()
+    return text.splitlines()[0] if text else ""
+
+
+def _user_error(exc: BaseException) -> str:
+    """The one line that tells a user's mistake: the file (and field) and the problem."""
+    if isinstance(exc, OSError) and not isinstance(exc, HammerMVError):
+        names = [str(f) for f in (exc.filename, exc.filename2) if f is not None]
+        reason = _first_line(exc.strerror or str(exc)) or type(exc).__name__
+        return f"{' -> '.join(names)}: {reason}" if names else reason
+    return _first_line(str(exc)) or type(exc).__name__
+
+
+def _warnings_line(command: str, caught: list[warnings.WarningMessage]) -> str:
+    """One line that counts the library warnings a command raised, naming the first."""
+    first = caught[0]
+    return (f"hammer-mv {command}: {len(caught)} library warning(s) hidden (first: "
+            f"{first.category.__name__}: {_first_line(str(first.message))}); -v shows them")
+
+
+def _run(args: argparse.Namespace) -> int:
+    """Run the command; library warnings shown with -v, else counted in one line at the end.
+
+    Without ``-v`` the warnings the filters let through (the user's own
+    ``-W``/``PYTHONWARNINGS`` included) are recorded instead of printed: a
+    long run is not buried in numpy's RuntimeWarnings, yet none goes unseen.
+    A command that fails prints its one line only. Our own warnings go
+    through ``logging`` and show as always.
+    """
+    if args.verbose:
+        return int(args.func(args) or 0)
+    with warnings.catch_warnings(record=True) as caught:
+        status = int(args.func(args) or 0)
+    if caught and not args.quiet:
+        print(_warnings_line(args.command, caught), file=sys.stderr)
+    return status
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Run ``hammer-mv`` with ``argv`` (default ``sys.argv[1:]``); return the exit status."""
+    """Run ``hammer-mv`` with ``argv`` (default ``sys.argv[1:]``); return the exit status.
+
+    0 on success; 1 if some of the work failed (a batch's clips) or on a bug
+    (its traceback shown); 2 for a user's mistake (one line on stderr); 130
+    when interrupted.
+    """
     # FFmpeg and OpenCV print their own warnings about broken files on stderr;
     # we report those files in one line ourselves. Set before any video opens.
     os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "-8")
@@ -156,22 +205,22 @@ def main(argv: list[str] | None = None) -> int:
         level=logging.INFO if args.verbose else logging.WARNING,
         format="%(levelname)s %(name)s: %(message)s",
     )
-    if not args.verbose:
-        # numpy's RuntimeWarnings and the like are for developers: a user's
-        # error is one line (below), and our own warnings go through logging.
-        warnings.simplefilter("ignore")
     if not getattr(args, "func", None):
         parser.print_help(sys.stderr)
         return 2
     try:
-        return int(args.func(args) or 0)
-    except (ValueError, OSError) as exc:  # InputError is a ValueError
-        msg = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        print(f"hammer-mv {args.command}: error: {msg}", file=sys.stderr)
+        return _run(args)
+    except (HammerMVError, OSError) as exc:  # the user's to fix: one line
+        print(f"hammer-mv {args.command}: error: {_user_error(exc)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("hammer-mv: interrupted", file=sys.stderr)
         return 130
+    except Exception:  # noqa: BLE001 - a bug: its traceback, and who to tell
+        traceback.print_exc()
+        print(f"hammer-mv {args.command}: this is a bug in hammer-mv (not in your input); "
+              "please report it with the traceback above", file=sys.stderr)
+        return 1
 
 
 if __name__ == "__main__":  # python -m hammer_mv.cli

@@ -6,8 +6,9 @@ import argparse
 import sys
 from pathlib import Path
 
+from hammer_mv.cli.checks import cap_jobs, output_folder
 from hammer_mv.cli.options import add_recognition_options, load_repertoire, recognition_settings
-from perception.batch import discover, run_batch
+from perception.batch import find_clips, run_batch
 from perception.workers import start_early
 
 
@@ -45,16 +46,27 @@ def run(args: argparse.Namespace) -> int:
     args : argparse.Namespace
         Parsed arguments.
     """
-    if args.jobs < 1:
-        raise ValueError(f"--jobs: expected at least 1, got {args.jobs}")
-    items = discover(args.input)
+    from perception.errors import InputError
+
+    # local processes only: a scheduler's workers are its own
+    jobs = (args.jobs if args.scheduler and args.jobs >= 1
+            else cap_jobs(args.jobs, "batch", quiet=args.quiet))
+    output_folder(args.output)
+    found = find_clips(args.input)
+    items = found.items
+    if found.skipped and not args.quiet:
+        names = ", ".join(f"{name} ({why})" for name, why in found.skipped[:3])
+        more = f" and {len(found.skipped) - 3} more" if len(found.skipped) > 3 else ""
+        print(f"hammer-mv batch: skipped {len(found.skipped)} file(s) that are not clips: "
+              f"{names}{more}", file=sys.stderr)
     if not items:
-        raise ValueError(f"{args.input}: no clips found")
-    if args.jobs > 1 and len(items) > 1 and not args.scheduler:
+        raise InputError("no clips found", args.input)
+    if jobs > 1 and len(items) > 1 and not args.scheduler:
         start_early()  # the workers' fork server imports while the repertoire loads
     rep, rep_id = load_repertoire(args)
-    summary = run_batch(items, args.output, rep, recognition_settings(args), jobs=args.jobs,
-                        scheduler=args.scheduler, repertoire_id=rep_id, quiet=args.quiet)
+    summary = run_batch(items, args.output, rep, recognition_settings(args), jobs=jobs,
+                        scheduler=args.scheduler, repertoire_id=rep_id, quiet=args.quiet,
+                        skipped=found.skipped)
     failed = int((summary["status"] != "ok").sum())
     reused = int(summary["reused"].sum())
     if not args.quiet:
@@ -62,6 +74,37 @@ def run(args: argparse.Namespace) -> int:
               f"{reused} reused (their reports were current), {failed} failed -> "
               f"{args.output / 'report.html'}")
     if failed:
-        print(f"hammer-mv batch: {failed} clip(s) failed; see the report", file=sys.stderr)
+        print(f"hammer-mv batch: {failed} clip(s) failed ({failure_reasons(summary, items)}); "
+              f"see {args.output / 'summary.csv'}", file=sys.stderr)
         return 1
     return 0
+
+
+def failure_reasons(summary, items) -> str:
+    """The most common reason clips failed, with its count: ``"3: <reason>, 1 other"``.
+
+    A clip's error begins with its file's name, which is left out so that
+    clips failing for the same reason count together.
+
+    Parameters
+    ----------
+    summary : pandas.DataFrame
+        The batch summary (``clip``, ``status``, ``error``).
+    items : list of BatchItem
+        The clips (their paths).
+    """
+    from collections import Counter
+
+    paths = {item.clip: str(item.path) for item in items}
+    reasons = Counter()
+    for clip, status, error in zip(summary["clip"], summary["status"], summary["error"]):
+        if status == "ok":
+            continue
+        reason = str(error or "").strip() or "unknown error"
+        prefix = f"{paths.get(clip, '')}: "
+        if prefix != ": " and reason.startswith(prefix):
+            reason = reason[len(prefix):]
+        reasons[reason.splitlines()[0]] += 1
+    reason, count = reasons.most_common(1)[0]
+    others = sum(reasons.values()) - count
+    return f"{count}: {reason}" + (f"; {others} other" if others else "")

@@ -13,6 +13,7 @@ import logging
 import time
 from pathlib import Path
 
+from hammer_mv.cli.checks import check_seed, option, options, output_folder
 from minvar.grasp import GraspTask, check_grasp_simulation
 from minvar.grasp_experiments import EXPERIMENTS, THESIS_TRIALS, check_trials
 from minvar.limits import MAX_TRIALS, check_position, check_steps
@@ -113,9 +114,11 @@ def _usage(parser: argparse.ArgumentParser) -> int:
     return 2
 
 
-def _check_output(out: Path) -> None:
-    if out.exists() and not out.is_dir():
-        raise ValueError(f"{out}: output exists and is not a folder")
+#: GraspTask fields -> the ``grasp simulate`` options that set them.
+TASK_FIELDS = {"object_size": "--object-size", "distance": "--distance",
+               "duration": "--duration", "viapoint_offset": "--viapoint-offset",
+               "viapoint_height": "--viapoint-height", "viapoint_time": "--viapoint-time",
+               "tip_start": "--tip-start", "execution_cv": "--execution-cv", "dt": "--dt"}
 
 
 def run_simulate(args: argparse.Namespace) -> int:
@@ -124,22 +127,30 @@ def run_simulate(args: argparse.Namespace) -> int:
     from minvar.grasp_stats import grasp_moments, summarize_grasp
     from minvar.plotting import grasp_figure, setup_figure
 
-    check_trials(args.trials, name="--trials")
+    with option("--trials"):
+        check_trials(args.trials, name="--trials")
+    check_seed(args.seed)
     # Sizes and lengths against minvar.limits, named by their flags, before any work.
     for name in LENGTH_FLAGS:
-        check_position(getattr(args, name), "--" + name.replace("_", "-"))
-    if args.dt > 0:  # a bad --dt is refused by PointMassPlant
+        flag = "--" + name.replace("_", "-")
+        with option(flag):
+            check_position(getattr(args, name), flag)
+    with options({"dt": "--dt"}):
+        plant = PointMassPlant(dt=args.dt)
+    with option("--duration"):
         check_steps(args.duration, args.dt, "--duration")
-    _check_output(args.output)
-    task = GraspTask(
-        object_size=args.object_size, distance=args.distance, duration=args.duration,
-        viapoint_offset=args.viapoint_offset, viapoint_height=args.viapoint_height,
-        viapoint_time=args.viapoint_time, tip_start=args.tip_start, reach_only=args.reach_only,
-        execution_cv=args.execution_cv, plant=PointMassPlant(dt=args.dt),
-    )
+    output_folder(args.output)
+    with options(TASK_FIELDS):
+        task = GraspTask(
+            object_size=args.object_size, distance=args.distance, duration=args.duration,
+            viapoint_offset=args.viapoint_offset, viapoint_height=args.viapoint_height,
+            viapoint_time=args.viapoint_time, tip_start=args.tip_start,
+            reach_only=args.reach_only, execution_cv=args.execution_cv, plant=plant,
+        )
     # the simulation, and the table of trajectories.csv in the same budget
-    check_grasp_simulation(task, args.trials, "--trials", extra_floats=TABLE_COLUMNS,
-                           max_trials=MAX_TRIALS)
+    with option("--trials"):
+        check_grasp_simulation(task, args.trials, "--trials", extra_floats=TABLE_COLUMNS,
+                               max_trials=MAX_TRIALS)
     plan = plan_grasp(task)
     result = simulate_grasp(task, args.trials, seed=args.seed, plan=plan)
     summary = summarize_grasp(result, grasp_moments(plan))
@@ -175,8 +186,10 @@ def run_simulate(args: argparse.Namespace) -> int:
 
 def run_experiment(args: argparse.Namespace) -> int:
     """Execute ``hammer-mv grasp experiment`` with parsed ``args``; return the exit status."""
-    check_trials(args.trials, name="--trials")
-    _check_output(args.output)
+    with option("--trials"):
+        check_trials(args.trials, name="--trials")
+    check_seed(args.seed)
+    output_folder(args.output)
     names = list(EXPERIMENTS) if args.name == "all" else [args.name]
     out: Path = args.output
     for name in names:

@@ -9,9 +9,12 @@ from __future__ import annotations
 import argparse
 import hashlib
 import json
+import math
 from pathlib import Path
 
+from hammer_mv.cli.checks import options
 from hammer_mv.cli.flags import FPS_HELP, add_video_options
+from perception.errors import InputError
 from perception.observation import ObserveParams
 from perception.pipeline import RecognitionSettings
 from perception.recognition.engine import RULES, HammerParams
@@ -19,6 +22,9 @@ from perception.recognition.repertoire import Repertoire
 
 _OBSERVE = ObserveParams()
 _HAMMER = HammerParams()
+#: The pose options, by the PoseImport fields they set (its messages name the flag).
+POSE_FIELDS = {"keypoints": "--keypoints", "pcutoff": "--pcutoff", "fps": "--fps",
+               "object_diameter_px": "--object-diameter-px", "individual": "--individual"}
 
 
 def add_recognition_options(p: argparse.ArgumentParser) -> None:
@@ -91,7 +97,8 @@ def _mapping(pairs: list[str]) -> dict[str, str]:
     for pair in pairs:
         marker, sep, name = pair.partition("=")
         if not sep or not marker or not name:
-            raise ValueError(f"--keypoints {pair}: expected MARKER=NAME, e.g. thumb=Thumb_tip")
+            raise InputError(f"{pair}: expected MARKER=NAME, e.g. thumb=Thumb_tip",
+                             field="--keypoints")
         out[marker] = name
     return out
 
@@ -119,7 +126,8 @@ def pose_import(args: argparse.Namespace):
     base = load_pose_config(config) if config is not None else PoseImport()
     if "keypoints" in given:
         given["keypoints"] = {**base.keypoints, **given["keypoints"]}
-    return dataclasses.replace(base, **given)
+    with options(POSE_FIELDS):  # PoseImport names the flag in its messages
+        return dataclasses.replace(base, **given)
 
 
 def recognition_settings(args: argparse.Namespace) -> RecognitionSettings:
@@ -130,10 +138,15 @@ def recognition_settings(args: argparse.Namespace) -> RecognitionSettings:
     args : argparse.Namespace
         Parsed arguments of :func:`add_recognition_options`.
     """
-    observe = ObserveParams(object_diameter=args.object_diameter, px_per_m=args.px_per_m,
-                            mirror=args.mirror)
-    hammer = HammerParams(rule=args.rule, w_r=args.w_r, w_g=args.w_g,
-                          filter_gain=args.filter_gain)
+    with options({"object_diameter": "--object-diameter", "px_per_m": "--px-per-m"}):
+        observe = ObserveParams(object_diameter=args.object_diameter, px_per_m=args.px_per_m,
+                                mirror=args.mirror)
+    for flag, value in (("--w-r", args.w_r), ("--w-g", args.w_g)):
+        if not (math.isfinite(value) and value >= 0):  # HammerParams names both at once
+            raise InputError(f"expected a finite weight >= 0, got {value}", field=flag)
+    with options({"rule": "--rule", "filter_gain": "--filter-gain"}):
+        hammer = HammerParams(rule=args.rule, w_r=args.w_r, w_g=args.w_g,
+                              filter_gain=args.filter_gain)
     tracking = None
     if getattr(args, "setup", None) is not None:
         from perception.tracking.setup import load_setup

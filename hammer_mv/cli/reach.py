@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from hammer_mv.cli.checks import check_seed, option, options, output_folder
 from minvar.analysis import (
     THESIS_DURATIONS,
     closest_approach,
@@ -28,6 +29,7 @@ from minvar.limits import (
 from minvar.plant import PointMassPlant
 from minvar.reach import simulate_reach
 from minvar.task import ReachTask, ViaPoint
+from perception.errors import InputError
 from perception.io.atomic import save_figure, write_csv, write_json
 
 log = logging.getLogger(__name__)
@@ -81,33 +83,44 @@ def run(args: argparse.Namespace) -> int:
     """Execute ``hammer-mv reach`` with parsed ``args``; return the exit status."""
     from minvar.plotting import reach_figure, speed_accuracy_figure
 
-    plant = PointMassPlant(sigma_u=args.sigma_u, sigma_s=args.sigma_s)
+    check_seed(args.seed)
+    with options({"sigma_u": "--sigma-u", "sigma_s": "--sigma-s"}):
+        plant = PointMassPlant(sigma_u=args.sigma_u, sigma_s=args.sigma_s)
     # Sizes and positions against minvar.limits, named by their flags, before any work.
-    check_position(args.start, "--start")
-    check_position(args.goal, "--goal")
-    for x, y, _ in args.via:
-        check_position((x, y), "--via")
-    check_steps(args.duration, plant.dt, "--duration")
-    vias = tuple(ViaPoint((x, y), fraction=f) for x, y, f in args.via)
-    task = ReachTask(tuple(args.start), tuple(args.goal), args.duration, vias,
-                     r=args.r, w_v=args.w_v, w_f=args.w_f)
-    task.steps(plant.dt)
-    for v in vias:
-        v.step(task.duration, plant.dt)  # reject bad via-point times before any work
+    with option("--start"):
+        check_position(args.start, "--start")
+    with option("--goal"):
+        check_position(args.goal, "--goal")
+    with option("--via"):
+        for x, y, _ in args.via:
+            check_position((x, y), "--via")
+    with option("--duration"):
+        check_steps(args.duration, plant.dt, "--duration")
+    with option("--via"):
+        vias = tuple(ViaPoint((x, y), fraction=f) for x, y, f in args.via)
+    with options({"start": "--start", "goal": "--goal", "duration": "--duration",
+                  "r": "--r", "w_v": "--w-v", "w_f": "--w-f"}):
+        task = ReachTask(tuple(args.start), tuple(args.goal), args.duration, vias,
+                         r=args.r, w_v=args.w_v, w_f=args.w_f)
+        task.steps(plant.dt)
+    with option("--via"):
+        for v in vias:
+            v.step(task.duration, plant.dt)  # reject bad via-point times before any work
     n_states = plant.n_states(len(task.targets))
-    out: Path = args.output
-    if out.exists() and not out.is_dir():
-        raise ValueError(f"{out}: output exists and is not a folder")
+    out: Path = output_folder(args.output)
     if args.sweep:
         trials = 200 if args.trials is None else args.trials
         if trials < 2:
-            raise ValueError(f"--trials: need at least 2 repetitions for a sweep, got {trials}")
+            raise InputError(f"need at least 2 repetitions for a sweep, got {trials}",
+                             field="--trials")
         for d in args.durations:
-            check_steps(d, plant.dt, "--durations")
-            steps = ReachTask(task.start, task.goal, d, vias).steps(plant.dt)
-            for v in vias:
-                v.step(d, plant.dt)
-            check_simulation(trials, steps, n_states, "--trials", max_trials=MAX_TRIALS)
+            with option("--durations"):
+                check_steps(d, plant.dt, "--durations")
+                steps = ReachTask(task.start, task.goal, d, vias).steps(plant.dt)
+                for v in vias:
+                    v.step(d, plant.dt)
+            with option("--trials"):
+                check_simulation(trials, steps, n_states, "--trials", max_trials=MAX_TRIALS)
         sweep = speed_accuracy(task, args.durations, trials, seed=args.seed, plant=plant)
         write_csv(out / "speed_accuracy.csv", sweep.summary)
         write_csv(out / "speed_accuracy_trials.csv", sweep.trials)
@@ -118,13 +131,15 @@ def run(args: argparse.Namespace) -> int:
 
     trials = 100 if args.trials is None else args.trials
     if trials < 2:
-        raise ValueError(f"--trials: need at least 2 repetitions, got {trials}")
+        raise InputError(f"need at least 2 repetitions, got {trials}", field="--trials")
     steps = task.steps(plant.dt)
-    check_simulation(trials, steps, n_states, "--trials", max_trials=MAX_TRIALS)
-    # ... and the table of trajectories.csv: TABLE_COLUMNS floats per repetition and step
-    check_memory(simulation_bytes(trials, steps, n_states)
-                 + 8 * TABLE_COLUMNS * trials * (steps + 1),
-                 "--trials", f"{trials} repetitions x {steps + 1} time points and their table")
+    with option("--trials"):
+        check_simulation(trials, steps, n_states, "--trials", max_trials=MAX_TRIALS)
+        # ... and the table of trajectories.csv: TABLE_COLUMNS floats per repetition and step
+        check_memory(simulation_bytes(trials, steps, n_states)
+                     + 8 * TABLE_COLUMNS * trials * (steps + 1),
+                     "--trials", f"{trials} repetitions x {steps + 1} time points and their "
+                     "table")
     result = simulate_reach(task, trials, seed=args.seed, plant=plant)
     stats = endpoint_stats(result.endpoint, task.goal)
     summary = {

@@ -36,14 +36,19 @@ def register(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     """Execute ``hammer-mv recognize`` with parsed ``args``; return the exit status.
 
+    Prints one line (the clip, its verdict and winner, the report) unless ``--quiet``.
+
     Parameters
     ----------
     args : argparse.Namespace
         Parsed arguments.
     """
+    from hammer_mv.cli.checks import output_folder
     from hammer_mv.cli.options import load_repertoire, recognition_settings
     from perception.errors import InputError
     from perception.io.frame_sample import FrameSample
+    from perception.io.names import output_folder as subfolder
+    from perception.io.names import output_stem
     from perception.pipeline import (
         TRACKS_SUFFIX,
         clip_fingerprint,
@@ -55,6 +60,7 @@ def run(args: argparse.Namespace) -> int:
     from perception.report.tracking import write_tracking_report
 
     path: Path = args.input
+    output_folder(args.output)  # before any tracking
     if not path.exists():
         raise InputError("input not found", path)
     if path.is_dir():
@@ -67,7 +73,8 @@ def run(args: argparse.Namespace) -> int:
     rep, rep_id = load_repertoire(args)
     # a few frames for the contact sheet, kept while tracking
     frames = None if args.no_figures else FrameSample()
-    tracks = load_clip(path, tracks_out=args.output / "tracks" / f"{clip}{TRACKS_SUFFIX}",
+    tracks_out = subfolder(args.output, "tracks") / f"{output_stem(clip)}{TRACKS_SUFFIX}"
+    tracks = load_clip(path, tracks_out=tracks_out,
                        progress=not args.quiet and sys.stderr.isatty(),
                        setup=settings.tracking, pose=settings.pose,
                        frames=frames,
@@ -78,5 +85,7 @@ def run(args: argparse.Namespace) -> int:
              "tracking": write_tracking_report(tracks, args.output, clip,
                                                sheet=not args.no_figures, frames=frames)}
     paths = write_clip_report(rec, args.output, extra=extra, figures=not args.no_figures)
-    print(f"{clip}: winner {rec.winner} ({rec.rule} rule) -> {paths['json']}")
+    if not args.quiet:
+        print(f"{clip}: {rec.verdict or 'no verdict'}, winner {rec.winner} ({rec.rule} rule) "
+              f"-> {paths['json']}")
     return 0

@@ -3,8 +3,12 @@
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 
+from hammer_mv.cli.checks import option
+from minvar.limits import check_position, check_steps
+from perception.errors import InputError, PlanningError
 from perception.limits import MAX_FPS
 from perception.recognition.models import SceneSpec
 from perception.recognition.planning import DEFAULT_DURATIONS, default_specs
@@ -47,20 +51,39 @@ def run_build(args: argparse.Namespace) -> int:
         rep = Repertoire.from_config(args.config)
     else:
         if not 0 < args.fps <= MAX_FPS:
-            raise ValueError(f"--fps: expected a frame rate in (0, {MAX_FPS:g}] frames/s, "
-                             f"got {args.fps}")
+            raise InputError(f"expected a frame rate in (0, {MAX_FPS:g}] frames/s, "
+                             f"got {args.fps}", field="--fps")
+        for flag, value in (("--distance", args.distance), ("--object-size", args.object_size)):
+            if not (math.isfinite(value) and value > 0):  # what SceneSpec asks
+                raise InputError(f"expected a positive length in m, got {value}", field=flag)
+            with option(flag):
+                check_position(value, flag)
         scene = SceneSpec(distance=args.distance, object_size=args.object_size,
                           frame_period=1.0 / args.fps)
-        from minvar.limits import check_steps
         from perception.recognition.models import model_substeps
 
         dt = scene.frame_period / model_substeps(scene.frame_period)
         for duration in args.durations:  # named by the flag, before any planning
-            check_steps(duration, dt, "--durations")
-        rep = Repertoire.build(default_specs(args.durations), scene)
+            with option("--durations"):
+                check_steps(duration, dt, "--durations")
+        # a scene the arm cannot reach is a PlanningError, named by its option here
+        try:
+            rep = Repertoire.build(default_specs(args.durations), scene)
+        except PlanningError as exc:
+            raise PlanningError(exc.problem, field=exc.field or _scene_flag(exc.problem)) \
+                from None
     rep.save(args.output)
     print(f"wrote {args.output}: {len(rep)} models ({', '.join(rep.names)})")
     return 0
+
+
+def _scene_flag(problem: str) -> str | None:
+    """The ``repertoire build`` option a planning problem is about, if one is named."""
+    for attribute, flag in (("distance", "--distance"), ("object_size", "--object-size"),
+                            ("duration", "--durations")):
+        if f"GraspTask.{attribute}" in problem:
+            return flag
+    return None
 
 
 def run_info(args: argparse.Namespace) -> int:

@@ -6,6 +6,8 @@ import argparse
 import sys
 from pathlib import Path
 
+from hammer_mv.cli.checks import cap_jobs, check_seed, output_folder
+
 
 def register(sub) -> None:
     """Add the ``synth`` subcommand to ``sub`` (an argparse subparsers action)."""
@@ -28,13 +30,15 @@ def run(args: argparse.Namespace) -> int:
     """Execute ``hammer-mv synth`` with parsed ``args``; return the exit status."""
     from perception.synthetic.recipes import load_recipe, synthesize
 
-    if args.jobs < 1:
-        raise ValueError(f"--jobs: expected at least 1, got {args.jobs}")
+    jobs = cap_jobs(args.jobs, "synth", quiet=args.quiet)
+    check_seed(args.seed)
+    output_folder(args.output)
     recipe = load_recipe(args.recipe)
-    manifest = synthesize(recipe, args.output, seed=args.seed, jobs=args.jobs,
+    manifest = synthesize(recipe, args.output, seed=args.seed, jobs=jobs,
                           progress=not args.quiet and sys.stderr.isatty())
-    counts = manifest["condition"].value_counts().to_dict()
-    print(f"wrote {len(manifest)} clips to {args.output} "
-          f"({', '.join(f'{k}: {v}' for k, v in counts.items())}); "
-          f"manifest {args.output / 'manifest.csv'}")
+    if not args.quiet:
+        counts = manifest["condition"].value_counts().to_dict()
+        print(f"wrote {len(manifest)} clips to {args.output} "
+              f"({', '.join(f'{k}: {v}' for k, v in counts.items())}); "
+              f"manifest {args.output / 'manifest.csv'}")
     return 0

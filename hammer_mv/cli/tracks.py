@@ -152,14 +152,14 @@ def run_export(args: argparse.Namespace) -> int:
     for out in outputs:
         check_output(out, inputs=[args.file])
     if args.max_gap < 0:
-        raise InputError(f"--max-gap: expected >= 0 frames, got {args.max_gap}")
+        raise InputError(f"expected >= 0 frames, got {args.max_gap}", field="--max-gap")
     t = Tracks.load(args.file)
     span = None
     if args.trim:  # on the tracks as recorded, as recognition sees them
         try:
             span = movement_span(t)
         except InputError as exc:
-            raise InputError(f"--trim: {exc.problem}", args.file) from None
+            raise InputError(exc.problem, args.file, field="--trim") from None
     if args.max_gap:
         t = t.interpolate(args.max_gap)
     if span is not None:
@@ -184,10 +184,13 @@ def run_render(args: argparse.Namespace) -> int:
     from perception.tracking.overlay import render_labelled
 
     if args.trail < 1:
-        raise InputError(f"--trail: expected >= 1 frame, got {args.trail}")
+        raise InputError(f"--trail: expected >= 1 frame, got {args.trail}", field="--trail")
     t = Tracks.load(args.file)
-    video = args.video or t.video.get("path")  # the one render_labelled will read
-    check_output(args.output, [p for p in (args.file, video) if p])
+    stored = t.video.get("path")
+    if args.video is None and stored and not Path(stored).is_absolute():
+        stored = Path(args.file).parent / stored  # where render_labelled will look
+    check_output(args.output, [p for p in (args.file, args.video or stored) if p])
+    # render_labelled checks the video is the tracked one (its SHA-256)
     out = render_labelled(t, args.video, args.output, trail=args.trail)
     print(f"{out}: {t.n_frames} frames labelled")
     return 0

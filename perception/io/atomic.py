@@ -10,6 +10,9 @@ is one of the command's inputs. A write that fails for want of space or
 permission ends in one :class:`OSError` naming the file, with the temporary
 file removed.
 
+A temporary name is ``.<stem>.<owner>.<random>.part<suffix>``, or for a long
+final name ``.<hash>.<owner>.<random>.part<suffix>`` (a hash of the final
+name): never longer than a long final name, so it fits wherever that fits.
 Temporary names carry their writer's host and process (:func:`owner_tag`):
 a write killed by SIGKILL or a power cut leaves its temporary file behind,
 and the next write of the same output removes it once that process is gone
@@ -160,6 +163,28 @@ def check_output(path: str | os.PathLike, inputs: Iterable[str | os.PathLike] = 
     return final
 
 
+#: Final names up to this long (bytes) keep their stem in their temporary name;
+#: a longer one is written under a hash of it, which is shorter than it.
+_LONG_NAME = 128
+
+
+def _temporary_key(final: Path, suffix: str) -> tuple[str, str]:
+    """What a temporary name of ``final`` starts with (after the dot), and its suffix.
+
+    ``.<stem>.<owner>.<random>.part<suffix>`` while that is short; for a long
+    final name, ``.<hash12>.<owner>.<random>.part<suffix>`` instead, so the
+    temporary name fits in a file name (255 bytes) whenever the final one
+    does, and is no longer than it. The key is the same for every write of
+    one output, so :func:`remove_stale` finds what a killed writer left.
+    """
+    name = os.fsencode(final.name)
+    if len(name) <= _LONG_NAME:
+        return final.stem, suffix
+    if len(os.fsencode(suffix)) > 16:  # not a format's suffix: not needed by a writer
+        suffix = ""
+    return hashlib.sha1(name).hexdigest()[:12], suffix
+
+
 @contextlib.contextmanager
 def atomic_path(path: str | os.PathLike, *, suffix: str | None = None) -> Iterator[Path]:
     """Yield a temporary path beside ``path``; rename it to ``path`` on success.
@@ -180,10 +205,11 @@ def atomic_path(path: str | os.PathLike, *, suffix: str | None = None) -> Iterat
     final = Path(path)
     _refuse_non_regular(final)
     suffix = final.suffix if suffix is None else suffix
+    key, suffix = _temporary_key(final, suffix)
     try:
         final.parent.mkdir(parents=True, exist_ok=True)
-        remove_stale(final.parent, f".{glob.escape(final.stem)}.h*p*.part*")
-        fd, tmp = tempfile.mkstemp(prefix=f".{final.stem}.{owner_tag()}.",
+        remove_stale(final.parent, f".{glob.escape(key)}.h*p*.part*")
+        fd, tmp = tempfile.mkstemp(prefix=f".{key}.{owner_tag()}.",
                                    suffix=f".part{suffix}", dir=final.parent)
     except OSError as exc:
         raise OSError(exc.errno, f"cannot write {final}: {exc.strerror or exc}") from None
@@ -320,7 +346,8 @@ def write_csv(path: str | os.PathLike, frame) -> Path:
         if isinstance(frame, Mapping):
             _write_columns(tmp, frame)
         else:
-            frame.to_csv(tmp, index=False)
+            # a name Python could not decode (a surrogate) is written escaped, not lost
+            frame.to_csv(tmp, index=False, errors="backslashreplace")
     return Path(path)
 
 
@@ -334,7 +361,7 @@ def _write_columns(path: Path, columns: Mapping) -> None:
             cells.append(["" if v != v else str(v) for v in values.tolist()])
         else:
             cells.append([str(v) for v in values.tolist()])
-    with open(path, "w", newline="", encoding="utf-8") as f:
+    with open(path, "w", newline="", encoding="utf-8", errors="backslashreplace") as f:
         out = csv.writer(f, lineterminator="\n")
         out.writerow(names)
         out.writerows(zip(*cells))

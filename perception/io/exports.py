@@ -19,13 +19,15 @@ docs/tracks-format.md gives every column.
 
 from __future__ import annotations
 
+import contextlib
 import os
 from pathlib import Path
 
 from perception.errors import InputError
-from perception.io.atomic import atomic_path
+from perception.io.atomic import write_text
 from perception.io.pose import write_dlc, write_movement
 from perception.io.tracks import Tracks
+from perception.limits import MAX_MARKERS
 
 __all__ = ["EXPORT_FORMATS", "export_tracks", "status_path_for"]
 
@@ -46,8 +48,9 @@ def status_path_for(path: str | os.PathLike) -> Path:
 
 
 def _write_csv(table, path: Path, *, index: bool = False) -> None:
-    with atomic_path(path) as tmp:
-        table.to_csv(tmp, index=index, na_rep="NaN")
+    # the whole text in memory, written and synced under a temporary name and
+    # renamed: a full disk is an OSError and leaves nothing behind
+    write_text(path, table.to_csv(index=index, na_rep="NaN"))
 
 
 def export_tracks(tracks: Tracks, path: str | os.PathLike, format: str) -> list[Path]:
@@ -69,10 +72,22 @@ def export_tracks(tracks: Tracks, path: str | os.PathLike, format: str) -> list[
         An unknown format, or an ending the format cannot write.
     """
     path = Path(path)
+    if format not in EXPORT_FORMATS:
+        raise InputError(f"expected one of {', '.join(EXPORT_FORMATS)}, got {format!r}",
+                         field="--format")
+    if len(tracks.markers) > MAX_MARKERS:
+        raise InputError(f"the tracks hold {len(tracks.markers)} markers, more than the "
+                         f"{MAX_MARKERS} an export may hold", tracks.path, field="markers")
     if format == "dlc":
         write_dlc(tracks, path)
         status = status_path_for(path)
-        _write_csv(tracks.to_status(), status)
+        try:
+            _write_csv(tracks.to_status(), status)
+        except BaseException:
+            # both files or neither: a table without its status codes is not the export
+            with contextlib.suppress(OSError):
+                path.unlink()
+            raise
         return [path, status]
     if format == "movement":
         if path.suffix.lower() != ".nc":

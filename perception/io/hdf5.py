@@ -18,8 +18,10 @@ from typing import Any
 import numpy as np
 
 from perception.errors import InputError
+from perception.io.files import input_file
+from perception.limits import MAX_HDF5_VALUES
 
-__all__ = ["decode_attrs", "open_hdf5", "read_dataset", "scalar_attr"]
+__all__ = ["check_dataset", "decode_attrs", "open_hdf5", "read_dataset", "scalar_attr"]
 
 #: dtype kinds by what a reader expects.
 _KINDS = {"number": "biuf", "integer": "iu", "string": "SOU"}
@@ -43,18 +45,21 @@ def open_hdf5(path: str | os.PathLike, what: str):
     import h5py
 
     p = Path(path)
-    if not p.exists():
+    if not os.path.lexists(p) or not p.exists():
         raise InputError("no such file", p)
-    if not p.is_file():
-        raise InputError(f"not a regular file (expected a {what})", p)
+    input_file(p, what)  # a FIFO or device would block or never end
     try:
         return h5py.File(p, "r")
     except OSError:
         raise InputError(f"not an HDF5 file (or unreadable; expected a {what})", p) from None
 
 
-def read_dataset(fh, name: str, kind: str, ndim: int, path: str | os.PathLike) -> np.ndarray:
-    """The whole of dataset ``name``, checked to be a hard-linked array of ``kind`` and ``ndim``.
+def check_dataset(fh, name: str, kind: str, ndim: int, path: str | os.PathLike, *,
+                  max_values: int = MAX_HDF5_VALUES):
+    """Dataset ``name``, checked to be a hard-linked array of ``kind`` and ``ndim``; not read.
+
+    Its shape is what the file *claims*: checked against ``max_values``
+    before anything is read, so a file claiming a billion rows costs nothing.
 
     Parameters
     ----------
@@ -68,25 +73,66 @@ def read_dataset(fh, name: str, kind: str, ndim: int, path: str | os.PathLike) -
         Its number of dimensions.
     path : str or os.PathLike
         The file, for messages.
+    max_values : int
+        Most elements it may hold.
+
+    Returns
+    -------
+    h5py.Dataset
     """
     import h5py
 
     where = f"/{fh.name.strip('/')}/{name}".replace("//", "/")
     link = fh.get(name, getlink=True)
     if link is None:
-        raise InputError(f"missing dataset {where}", path)
+        raise InputError("missing dataset", path, field=where)
     if not isinstance(link, h5py.HardLink):
-        raise InputError(f"{where} is a {type(link).__name__}, not a dataset stored in the file",
-                         path)
+        raise InputError(f"is a {type(link).__name__}, not a dataset stored in the file", path,
+                         field=where)
     obj = fh[name]
     if not isinstance(obj, h5py.Dataset):
-        raise InputError(f"{where} is a group, not a dataset", path)
+        raise InputError("is a group, not a dataset", path, field=where)
     dtype = obj.dtype
     if dtype.fields is not None or dtype.kind not in _KINDS[kind]:
-        raise InputError(f"{where} has dtype {dtype}, expected {kind}s", path)
+        raise InputError(f"has dtype {dtype}, expected {kind}s", path, field=where)
     if obj.ndim != ndim:
-        raise InputError(f"{where} has {obj.ndim} dimensions, expected {ndim}", path)
-    return obj[()]
+        raise InputError(f"has {obj.ndim} dimensions, expected {ndim}", path,
+                         field=where)
+    size = math.prod(int(n) for n in obj.shape)
+    if size > max_values:
+        raise InputError(f"claims shape {tuple(obj.shape)} ({size:.3g} values), more "
+                         f"than the {max_values:.3g} a file of this kind may hold", path,
+                         field=where)
+    return obj
+
+
+def read_dataset(fh, name: str, kind: str, ndim: int, path: str | os.PathLike, *,
+                 max_values: int = MAX_HDF5_VALUES) -> np.ndarray:
+    """The whole of dataset ``name``, checked by :func:`check_dataset` before it is read.
+
+    Parameters
+    ----------
+    fh : h5py.File or h5py.Group
+        Where to look.
+    name : str
+        Path of the dataset below ``fh``.
+    kind : {"number", "integer", "string"}
+        What its elements must be.
+    ndim : int
+        Its number of dimensions.
+    path : str or os.PathLike
+        The file, for messages.
+    max_values : int
+        Most elements it may hold.
+    """
+    obj = check_dataset(fh, name, kind, ndim, path, max_values=max_values)
+    where = obj.name
+    try:
+        return obj[()]
+    except (OSError, ValueError, TypeError) as exc:  # corrupt chunks, a bad filter
+        raise InputError(f"cannot be read: {exc}", path, field=where) from None
+    except MemoryError:
+        raise InputError("too large to read", path, field=where) from None
 
 
 def _plain(value: Any, key: str, where: str, path: str | os.PathLike) -> Any:
@@ -94,12 +140,12 @@ def _plain(value: Any, key: str, where: str, path: str | os.PathLike) -> Any:
         try:
             return value.decode("utf-8")
         except UnicodeDecodeError:
-            raise InputError(f"attribute {where}.{key} is not UTF-8 text", path) from None
+            raise InputError("not UTF-8 text", path, field=f"{where}.{key}") from None
     if isinstance(value, np.generic):
         return value.item()
     if isinstance(value, np.ndarray):
         if value.dtype.fields is not None or value.dtype.kind not in "biufSOU":
-            raise InputError(f"attribute {where}.{key} has dtype {value.dtype}", path)
+            raise InputError(f"has dtype {value.dtype}", path, field=f"{where}.{key}")
         if value.dtype.kind in "SO":
             return np.array([v.decode("utf-8", "replace") if isinstance(v, bytes) else v
                              for v in value.ravel()], dtype=object).reshape(value.shape)
@@ -121,7 +167,7 @@ def decode_attrs(attrs, where: str, path: str | os.PathLike) -> dict[str, Any]:
     try:
         items = list(attrs.items())
     except (OSError, TypeError, ValueError) as exc:
-        raise InputError(f"unreadable attributes of {where}: {exc}", path) from None
+        raise InputError(f"unreadable attributes: {exc}", path, field=where) from None
     return {key: _plain(value, key, where, path) for key, value in items}
 
 
@@ -155,5 +201,5 @@ def scalar_attr(values: dict[str, Any], key: str, kind: str, where: str,
           and math.isfinite(value)}[kind]
     if not ok:
         shown = f"an array of shape {value.shape}" if isinstance(value, np.ndarray) else repr(value)
-        raise InputError(f"attribute {where}.{key} is {shown}, expected one {kind}", path)
+        raise InputError(f"is {shown}, expected one {kind}", path, field=f"{where}.{key}")
     return value

@@ -16,9 +16,12 @@ docs/pose-files.md describes the mapping, the scale and every format.
 
 from __future__ import annotations
 
+import importlib.abc
 import json
 import math
 import os
+import sys
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -28,8 +31,10 @@ from typing import Any
 import numpy as np
 
 from perception.errors import InputError
-from perception.io.atomic import atomic_path
-from perception.io.tracks import Status, Tracks
+from perception.io.atomic import write_bytes, write_text
+from perception.io.files import input_file
+from perception.io.tracks import Status, Tracks, position_bounds
+from perception.limits import MAX_FPS, MAX_FRAMES, MAX_KEYPOINTS, MAX_MARKERS, MAX_POSE_POINTS
 
 __all__ = [
     "DLC_KEY",
@@ -54,13 +59,109 @@ _SOURCES = {"dlc": "DeepLabCut", "sleap": "SLEAP", "lp": "LightningPose", "nwb":
 _EXTRA = "reading and writing pose files needs the optional extra: pip install 'hammer-mv[pose]'"
 
 
-def _movement():
-    """The ``movement`` package's loaders and savers, or a one-line error naming the extra."""
+class _QuietMovementLogging(importlib.abc.MetaPathFinder):
+    """Import hook: ``movement.utils.logging`` loads with a ``configure`` that does nothing.
+
+    Importing ``movement`` calls ``logger.configure()``, which creates
+    ``~/.movement/movement.log`` (failing with a read-only or missing HOME),
+    adds a stderr handler and redirects every warning of the process into its
+    log. Only while :func:`_import_movement` imports the package, the module
+    is loaded as usual and its ``MovementLogger.configure`` replaced before
+    ``movement/__init__`` calls it; the original is put back afterwards, so a
+    user calling it on purpose gets movement's logging as documented.
+    """
+
+    def __init__(self):
+        self.original = None
+
+    def find_spec(self, name, path=None, target=None):
+        if name != "movement.utils.logging":
+            return None
+        for finder in sys.meta_path:
+            if finder is self or not hasattr(finder, "find_spec"):
+                continue
+            spec = finder.find_spec(name, path, target)
+            if spec is not None and spec.loader is not None:
+                break
+        else:
+            return None
+        hook, loader = self, spec.loader
+        real_exec = loader.exec_module
+
+        def exec_module(module):
+            real_exec(module)
+            hook.original = module.MovementLogger.configure
+            module.MovementLogger.configure = lambda self, *args, **kwargs: None
+
+        spec.loader = _ExecWrapper(loader, exec_module)
+        return spec
+
+
+class _ExecWrapper(importlib.abc.Loader):
+    """A loader like ``loader`` whose ``exec_module`` is ``exec_module``."""
+
+    def __init__(self, loader, exec_module):
+        self._loader, self._exec = loader, exec_module
+
+    def create_module(self, spec):
+        return self._loader.create_module(spec)
+
+    def exec_module(self, module):
+        self._exec(module)
+
+    def __getattr__(self, name):
+        return getattr(self._loader, name)
+
+
+def _import_movement() -> None:
+    """Import ``movement`` without writing under HOME (see :class:`_QuietMovementLogging`).
+
+    Its own messages are disabled in ``loguru`` (the package's loaders log
+    every file they read); a user enables them with
+    ``loguru.logger.enable("movement")``.
+    """
+    if "movement.io" in sys.modules:
+        return
+    hook = _QuietMovementLogging()
+    sys.meta_path.insert(0, hook)
+    dirs = None
+    if "pynwb" not in sys.modules:
+        # pynwb (imported by movement.io) creates ~/.cache/pynwb-hdmf/<version>
+        # at import for a cache of its schema: while it is imported, its
+        # folders are not created (its cache is then skipped if absent)
+        import platformdirs
+
+        dirs = platformdirs.PlatformDirs
+
+        class _NoCreate(dirs):
+            def __init__(self, *args, **kwargs):
+                kwargs["ensure_exists"] = False
+                super().__init__(*args, **kwargs)
+
+        platformdirs.PlatformDirs = _NoCreate
     try:
-        from movement.io import load_poses, save_poses
+        import movement.io  # noqa: F401
+    finally:
+        sys.meta_path.remove(hook)
+        if hook.original is not None:
+            sys.modules["movement.utils.logging"].MovementLogger.configure = hook.original
+        if dirs is not None:
+            import platformdirs
+
+            platformdirs.PlatformDirs = dirs
+    from loguru import logger
+
+    logger.disable("movement")
+
+
+def _movement():
+    """``movement``'s ``load_dataset`` and ``load_poses``, or a one-line error naming the extra."""
+    try:
+        _import_movement()
+        from movement.io import load_dataset, load_poses
     except ImportError:
         raise InputError(_EXTRA) from None
-    return load_poses, save_poses
+    return load_dataset, load_poses
 
 
 @dataclass(frozen=True)
@@ -97,17 +198,39 @@ class PoseImport:
         mapping = dict(self.keypoints)
         unknown = sorted(set(mapping) - set(MARKERS))
         if unknown:
-            raise ValueError(f"--keypoints: unknown marker {unknown[0]!r} "
-                             f"(expected {', '.join(MARKERS)})")
+            raise InputError(f"unknown marker {unknown[0]!r} (expected {', '.join(MARKERS)})",
+                             field="--keypoints")
+        if not all(isinstance(v, str) and v for v in mapping.values()):
+            raise InputError("expected marker=KEYPOINT with a keypoint name", field="--keypoints")
+        resolved = {m: mapping.get(m, m) for m in MARKERS}
+        for i, m in enumerate(MARKERS):
+            other = [o for o in MARKERS[:i] if resolved[o] == resolved[m]]
+            if other:
+                raise InputError(f"{other[0]} and {m} both map to keypoint {resolved[m]!r}: "
+                                 "each marker needs its own keypoint (markers left out map "
+                                 "to a keypoint of their own name)", field="--keypoints")
         object.__setattr__(self, "keypoints", MappingProxyType(mapping))
-        if not (isinstance(self.pcutoff, int | float) and 0 <= self.pcutoff <= 1):
-            raise ValueError(f"--pcutoff: expected a likelihood between 0 and 1, "
-                             f"got {self.pcutoff!r}")
+        if not (isinstance(self.pcutoff, int | float) and not isinstance(self.pcutoff, bool)
+                and 0 <= self.pcutoff <= 1):
+            raise InputError(f"expected a likelihood between 0 and 1, got {self.pcutoff!r}",
+                             field="--pcutoff")
+        if self.individual is not None and not isinstance(self.individual, str):
+            raise InputError(f"expected a name, got {self.individual!r}", field="--individual")
         for name in ("fps", "object_diameter_px"):
             value = getattr(self, name)
-            if value is not None and not (math.isfinite(value) and value > 0):
-                raise ValueError(f"--{name.replace('_', '-')}: expected a positive number, "
-                                 f"got {value!r}")
+            flag = f"--{name.replace('_', '-')}"
+            if value is not None and not (isinstance(value, int | float)
+                                          and not isinstance(value, bool)
+                                          and math.isfinite(value) and value > 0):
+                raise InputError(f"expected a positive number, got {value!r}", field=flag)
+        if self.fps is not None and self.fps > MAX_FPS:
+            raise InputError(f"expected a frame rate up to {MAX_FPS:g} frames/s, got "
+                             f"{self.fps!r}", field="--fps")
+
+    def __reduce__(self):
+        # MappingProxyType does not pickle: batch workers get the options sent
+        return PoseImport, (dict(self.keypoints), self.individual, self.pcutoff, self.fps,
+                            self.object_diameter_px)
 
     def to_dict(self) -> dict[str, Any]:
         """The options as JSON-able data (for reports and resume fingerprints)."""
@@ -167,6 +290,10 @@ def load_pose_config(path: str | os.PathLike) -> PoseImport:
         check_keys(mapping, MARKERS, "[keypoints]")
         return PoseImport(keypoints={k: str(v) for k, v in mapping.items()},
                           **{k: cfg[k] for k in _CONFIG_KEYS if k in cfg})
+    except InputError as exc:
+        key = (exc.field or "").lstrip("-").replace("-", "_")
+        where = "[keypoints]" if key == "keypoints" else key or None
+        raise InputError(f"bad pose config: {exc.problem}", path, field=where) from None
     except (TypeError, ValueError) as exc:
         raise InputError(f"bad pose config: {exc}", path) from None
 
@@ -214,24 +341,146 @@ def _source(path: Path) -> str:
                      f"(key {DLC_KEY!r}) nor a SLEAP analysis file", path)
 
 
-def _load_dataset(path: Path, source: str, fps: float | None):
-    """The file as a ``movement`` poses dataset."""
-    load_poses, _ = _movement()
-    try:
-        if source == "movement":
-            import xarray as xr
+def _check_hdf5_sizes(path: Path, source: str) -> None:
+    """What an HDF5 pose file's datasets claim, checked before anything is read."""
+    import h5py
 
-            ds = xr.load_dataset(path)
-            if "position" not in ds or ds.attrs.get("ds_type", "poses") != "poses":
-                raise InputError("a netCDF file that is not a movement poses dataset", path)
-            return ds
-        return load_poses.from_file(path, source_software=_SOURCES[source], fps=fps)
+    found: list[tuple[str, tuple[int, ...], int]] = []
+
+    def visit(name, obj):
+        if isinstance(obj, h5py.Dataset):
+            fields = len(obj.dtype.fields) if obj.dtype.fields else 1
+            sub = max(1, obj.dtype.itemsize // 8) if obj.dtype.fields else 1
+            found.append((f"/{name}", tuple(int(n) for n in obj.shape or ()), max(fields, sub)))
+
+    try:
+        with h5py.File(path, "r") as fh:
+            fh.visititems(visit)
+    except OSError:
+        raise InputError("not an HDF5 file (or unreadable)", path) from None
+    for name, shape, width in found:
+        values = math.prod(shape) * width
+        if values > 3 * MAX_POSE_POINTS:
+            raise InputError(f"claims shape {shape} ({values:.3g} values), more than a pose "
+                             f"file may hold ({MAX_POSE_POINTS:.3g} points)", path, field=name)
+        rows = shape[-1] if source == "sleap" and name == "/tracks" and shape else (
+            shape[0] if source == "dlc" and name.startswith(f"/{DLC_KEY}") and shape else 0)
+        if rows > MAX_FRAMES:
+            raise InputError(f"claims {rows} frames, more than the {MAX_FRAMES} a pose file may "
+                             "hold", path, field=name)
+        if source == "sleap" and name == "/tracks" and len(shape) == 4 and (
+                shape[2] > MAX_KEYPOINTS):
+            raise InputError(f"claims {shape[2]} keypoints, more than {MAX_KEYPOINTS}", path,
+                             field=name)
+
+
+#: Largest text table read, bytes (x, y and likelihood of MAX_POSE_POINTS).
+_MAX_TABLE_BYTES = 24 * MAX_POSE_POINTS
+
+
+def _dlc_table(path: Path):
+    """A DeepLabCut table as DeepLabCut writes it: its own frame index, MultiIndex columns."""
+    import pandas as pd
+
+    if path.suffix.lower() == ".csv":
+        with open(path, encoding="utf-8", errors="replace") as fh:
+            second = fh.readline() and fh.readline()
+        levels = (["scorer", "individuals", "bodyparts", "coords"]
+                  if second.lower().startswith("individuals") else
+                  ["scorer", "bodyparts", "coords"])
+        df = pd.read_csv(path, header=list(range(len(levels))))
+        df = df.set_index(df.columns[0])
+        df.index.name = None
+        df.columns = pd.MultiIndex.from_tuples(df.columns, names=levels)
+        return df
+    try:
+        import tables  # noqa: F401 - pandas' HDF reader needs PyTables
+    except ImportError:
+        raise InputError(_EXTRA, path) from None
+    return pd.DataFrame(pd.read_hdf(path, key=DLC_KEY))
+
+
+def _own_frames(index, n: int) -> np.ndarray | None:
+    """A table's row index as frame numbers, if it is one (integers, >= 0, increasing)."""
+    try:
+        values = np.asarray(index, dtype=float)
+    except (TypeError, ValueError):
+        return None  # labelled-image paths, not frame numbers
+    if (values.shape != (n,) or not np.all(np.isfinite(values))
+            or not np.all(values == np.round(values)) or (n and values.min() < 0)
+            or np.any(np.diff(values) <= 0) or (n and values.max() > 2 ** 53)):
+        return None
+    return values.astype(np.int64)
+
+
+def _load_dataset(path: Path, source: str, fps: float | None):
+    """The file as a ``movement`` poses dataset, and the file's own frame numbers (or None)."""
+    load_dataset, load_poses = _movement()
+    suffix = path.suffix.lower()
+    if suffix in (".h5", ".slp", ".nwb", ".nc"):
+        try:
+            _check_hdf5_sizes(path, source)
+        except InputError:
+            if suffix == ".nc":  # a netCDF3 file is not HDF5: xarray checks it lazily below
+                pass
+            else:
+                raise
+    elif path.stat().st_size > _MAX_TABLE_BYTES:
+        raise InputError(f"a table of {path.stat().st_size / 1e9:.3g} GB holds more than the "
+                         f"{MAX_POSE_POINTS:.3g} points a pose file may hold", path)
+    try:
+        with warnings.catch_warnings():
+            # movement's own notes (a file without individuals, say) are not the user's business
+            warnings.simplefilter("ignore")
+            if source == "movement":
+                import xarray as xr
+
+                with xr.open_dataset(path) as lazy:
+                    _check_sizes(lazy, path)
+                    ds = lazy.load()
+                if "position" not in ds or ds.attrs.get("ds_type", "poses") != "poses":
+                    raise InputError("a netCDF file that is not a movement poses dataset", path)
+                return ds, None
+            if source == "dlc":
+                df = _dlc_table(path)
+                _check_sizes_table(df, path)
+                ds = load_poses.from_dlc_style_df(df, fps=fps, source_software="DeepLabCut")
+                return ds, _own_frames(df.index, len(df))
+            return load_dataset(path, source_software=_SOURCES[source], fps=fps), None
     except InputError:
         raise
-    except (OSError, ValueError, KeyError, TypeError, AttributeError) as exc:
+    except MemoryError:
+        raise InputError("too large to read", path) from None
+    except (OSError, ValueError, KeyError, TypeError, AttributeError, IndexError) as exc:
         first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         raise InputError(f"not a readable {_SOURCES.get(source, source)} pose file: {first}",
                          path) from None
+
+
+def _check_sizes(ds, path: Path) -> None:
+    """A dataset's frames, keypoints and points, within the limits."""
+    sizes = dict(ds.sizes)
+    frames, keypoints = sizes.get("time", 0), sizes.get("keypoints", 0)
+    points = frames * keypoints * sizes.get("individuals", 1)
+    if frames > MAX_FRAMES:
+        raise InputError(f"claims {frames} frames, more than the {MAX_FRAMES} a pose file may "
+                         "hold", path, field="time")
+    if keypoints > MAX_KEYPOINTS:
+        raise InputError(f"claims {keypoints} keypoints, more than {MAX_KEYPOINTS}", path,
+                         field="keypoints")
+    if points > MAX_POSE_POINTS:
+        raise InputError(f"claims {points:.3g} points (frames x keypoints x individuals), more "
+                         f"than the {MAX_POSE_POINTS:.3g} a pose file may hold", path,
+                         field="position")
+
+
+def _check_sizes_table(df, path: Path) -> None:
+    if len(df) > MAX_FRAMES:
+        raise InputError(f"holds {len(df)} frames, more than the {MAX_FRAMES} a pose file may "
+                         "hold", path)
+    if len(df.columns) > 3 * MAX_KEYPOINTS * 16 or len(df) * len(df.columns) > 3 * MAX_POSE_POINTS:
+        raise InputError(f"holds {len(df.columns)} columns of {len(df)} frames, more than a pose "
+                         "file may hold", path)
 
 
 def _pick_individual(ds, options: PoseImport, path: Path):
@@ -247,19 +496,36 @@ def _pick_individual(ds, options: PoseImport, path: Path):
     return ds.isel(individuals=0) if names else ds
 
 
-def _frame_times(ds, options: PoseImport, path: Path) -> tuple[np.ndarray, np.ndarray, float]:
-    """Frame indices, times (s) and the frame rate of a dataset."""
+def _frame_times(ds, options: PoseImport, path: Path,
+                 own: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, float]:
+    """Frame indices, times (s) and the frame rate of a dataset.
+
+    ``own``: the file's own frame numbers (a DeepLabCut table's index), kept
+    as the tracks' frame indices; times are then ``frame / fps``.
+    """
     n = ds.sizes["time"]
     coords = np.asarray(ds["time"].values, dtype=float)
     unit = ds.attrs.get("time_unit", "frames")
     fps = ds.attrs.get("fps")
-    fps = float(fps) if fps is not None and np.isfinite(float(fps)) and float(fps) > 0 else None
-    if unit == "seconds" and fps:
+    try:
+        fps = float(fps) if fps is not None else None
+    except (TypeError, ValueError):
+        fps = None
+    fps = fps if fps is not None and math.isfinite(fps) and 0 < fps <= MAX_FPS else None
+    if own is None and unit == "seconds" and fps:
+        if not np.all(np.isfinite(coords)):
+            raise InputError("time stamps are not finite", path, field="time")
         return np.rint(coords * fps).astype(np.int64), coords, fps
     fps = fps or options.fps
     if fps is None:
-        raise InputError("the pose file has no frame rate: give it with --fps", path)
-    frames = coords.astype(np.int64) if len(coords) == n else np.arange(n)
+        raise InputError("the pose file has no frame rate: give it with --fps", path,
+                         field="--fps")
+    if own is not None:
+        frames = own
+    elif len(coords) == n and np.all(np.isfinite(coords)) and np.all(np.abs(coords) < 2 ** 53):
+        frames = coords.astype(np.int64)
+    else:
+        frames = np.arange(n)
     return frames, frames / fps, fps
 
 
@@ -284,6 +550,18 @@ def _marker_arrays(ds, options: PoseImport, path: Path) -> tuple[np.ndarray, np.
     else:  # a file without scores: every seen point is as good as the file says
         conf = np.isfinite(xy).all(axis=-1).astype(np.float64)
     return xy, np.clip(conf, 0.0, 1.0)
+
+
+def _check_positions(xy: np.ndarray, options: PoseImport, path: Path) -> None:
+    """Positions NaN (not found) or within a believable distance of any frame, px."""
+    lo, hi = position_bounds({})
+    with np.errstate(invalid="ignore"):
+        bad = np.isinf(xy) | (xy < lo) | (xy > hi)
+    if bad.any():
+        t, j, _ = np.argwhere(bad)[0]
+        raise InputError(f"keypoint {options.keypoint(MARKERS[j])!r} at row {t} lies at "
+                         f"({xy[t, j, 0]:.6g}, {xy[t, j, 1]:.6g}) px, beyond any frame "
+                         f"(at most {hi[0]:g} px)", path, field="position")
 
 
 def read_pose(path: str | os.PathLike, options: PoseImport | None = None) -> Tracks:
@@ -311,12 +589,16 @@ def read_pose(path: str | os.PathLike, options: PoseImport | None = None) -> Tra
     """
     options = PoseImport() if options is None else options
     path = Path(path)
-    if not path.is_file():
+    if not os.path.exists(path):
         raise InputError("no such file", path)
+    input_file(path, "pose file")  # a FIFO or device would block or never end
     source = _source(path)
-    ds = _pick_individual(_load_dataset(path, source, options.fps), options, path)
-    frames, time, fps = _frame_times(ds, options, path)
+    ds, own = _load_dataset(path, source, options.fps)
+    _check_sizes(ds, path)
+    ds = _pick_individual(ds, options, path)
+    frames, time, fps = _frame_times(ds, options, path, own)
     xy, conf = _marker_arrays(ds, options, path)
+    _check_positions(xy, options, path)
     seen = np.isfinite(xy).all(axis=-1) & (conf >= options.pcutoff)
     position = np.where(seen[..., None], xy, np.nan)
     diameter = [options.object_diameter_px if m == "object" and options.object_diameter_px
@@ -350,21 +632,42 @@ def write_dlc(tracks: Tracks, path: str | os.PathLike, *, scorer: str = "hammer-
         The ``scorer`` level of the columns.
     """
     path = Path(path)
-    table = tracks.to_dlc(scorer).rename_axis(None)
+    _check_markers(tracks, path)
     suffix = path.suffix.lower()
-    if suffix == ".csv":
-        with atomic_path(path) as tmp:
-            table.to_csv(tmp, na_rep="NaN")
-        return path
-    if suffix != ".h5":
+    if suffix not in (".csv", ".h5"):
         raise InputError("a DeepLabCut file ends in .h5 or .csv", path)
+    table = tracks.to_dlc(scorer).rename_axis(None)
+    if suffix == ".csv":
+        write_text(path, table.to_csv(na_rep="NaN"))
+        return path
     try:
         import tables  # noqa: F401 - pandas' HDF writer needs PyTables
     except ImportError:
         raise InputError(_EXTRA, path) from None
-    with atomic_path(path) as tmp:
-        table.to_hdf(tmp, key=DLC_KEY, mode="w", format="table")
+    write_bytes(path, _hdf_image(table))
     return path
+
+
+def _hdf_image(table) -> bytes:
+    """A DataFrame as the bytes of a pandas HDF file (key ``df_with_missing``), built in memory.
+
+    PyTables' own writes to a full disk fail late or not at all (leaving a
+    table of zeros); the image is written with :func:`write_bytes` instead,
+    whose failure is an :class:`OSError` and leaves nothing behind.
+    """
+    import pandas as pd
+
+    with pd.HDFStore(f"hammer-mv-{id(table)}.h5", mode="w", driver="H5FD_CORE",
+                     driver_core_backing_store=0) as store:
+        store.put(DLC_KEY, table, format="table", track_times=False)
+        store.flush()
+        return bytes(store._handle.get_file_image())
+
+
+def _check_markers(tracks: Tracks, path: Path) -> None:
+    if len(tracks.markers) > MAX_MARKERS:
+        raise InputError(f"the tracks hold {len(tracks.markers)} markers, more than the "
+                         f"{MAX_MARKERS} an export may hold", path, field="markers")
 
 
 def write_movement(tracks: Tracks, path: str | os.PathLike) -> Path:
@@ -381,8 +684,9 @@ def write_movement(tracks: Tracks, path: str | os.PathLike) -> Path:
     path : str or os.PathLike
         Output file (``.nc``).
     """
-    load_poses, _ = _movement()
+    _, load_poses = _movement()
     path = Path(path)
+    _check_markers(tracks, path)
     fps = _fps(tracks)
     pos = np.transpose(tracks.position, (0, 2, 1))[..., None]  # (time, space, keypoints, ind)
     ds = load_poses.from_numpy(pos, tracks.likelihood.astype(np.float64)[..., None],
@@ -392,8 +696,13 @@ def write_movement(tracks: Tracks, path: str | os.PathLike) -> Path:
     ds = ds.assign_coords(time=tracks.time)  # the real time stamps, not index / fps
     ds["status"] = (("time", "keypoints", "individuals"), tracks.status[..., None])
     ds.attrs["frame_offset"] = int(tracks.frame[0]) if tracks.n_frames else 0
-    with atomic_path(path) as tmp:
-        ds.to_netcdf(tmp)
+    # Built in memory and written whole: netCDF's own writes onto a full disk
+    # fail late (or crash the process) and leave a partial file.
+    try:
+        image = ds.to_netcdf(engine="h5netcdf")
+    except (ImportError, ValueError):
+        image = ds.to_netcdf()
+    write_bytes(path, bytes(image))
     return path
 
 

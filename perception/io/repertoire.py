@@ -29,6 +29,7 @@ from perception import __version__
 from perception.errors import InputError
 from perception.io.atomic import atomic_hdf5
 from perception.io.hdf5 import decode_attrs, open_hdf5, read_dataset, scalar_attr
+from perception.limits import MAX_FPS, MAX_GAIN, MAX_SUBSTEPS
 
 __all__ = ["SCHEMA", "SCHEMA_VERSION", "StoredCalibration", "StoredChain", "StoredModel",
            "read_repertoire", "write_repertoire"]
@@ -153,16 +154,57 @@ def write_repertoire(path: str | os.PathLike, config: Mapping[str, Any],
     return path
 
 
+#: Largest link length or base offset of a chain, m (an arm is under a metre).
+_MAX_LENGTH_M = 10.0
+
+
 def _read_chain(cg, path: Path) -> StoredChain:
     arrays = {k: np.asarray(read_dataset(cg, k, "number", _NDIM[k], path), dtype=float)
               for k in ARRAYS}
+    for key, value in arrays.items():
+        where = f"{cg.name}/{key}"
+        if not np.all(np.isfinite(value)):
+            raise InputError("has non-finite values", path, field=where)
+        if value.size and np.abs(value).max() > MAX_GAIN:
+            raise InputError(f"has values up to {np.abs(value).max():.3g}, beyond the "
+                             f"{MAX_GAIN:.0e} of any planned model: a corrupt repertoire "
+                             "(rebuild it)", path, field=where)
+    _check_covariance(arrays["P"], f"{cg.name}/P", path)
     attrs = decode_attrs(cg.attrs, cg.name, path)
     base = np.asarray(attrs.get("base"), dtype=float) if "base" in attrs else None
-    if base is None or base.shape != (2,):
-        raise InputError(f"attribute {cg.name}.base must be 2 numbers", path)
-    return StoredChain(arrays=arrays, l1=scalar_attr(attrs, "l1", "number", cg.name, path),
-                       l2=scalar_attr(attrs, "l2", "number", cg.name, path), base=base,
-                       elbow=scalar_attr(attrs, "elbow", "integer", cg.name, path))
+    if (base is None or base.shape != (2,) or not np.all(np.isfinite(base))
+            or np.abs(base).max() > _MAX_LENGTH_M):
+        raise InputError(f"must be 2 finite numbers within {_MAX_LENGTH_M:g} m", path,
+                         field=f"{cg.name}.base")
+    lengths = {}
+    for key in ("l1", "l2"):
+        value = scalar_attr(attrs, key, "number", cg.name, path)
+        if value is None or not 0 < value <= _MAX_LENGTH_M:
+            raise InputError(f"must be a link length in (0, {_MAX_LENGTH_M:g}] m, got {value!r}",
+                             path, field=f"{cg.name}.{key}")
+        lengths[key] = value
+    elbow = scalar_attr(attrs, "elbow", "integer", cg.name, path)
+    if elbow not in (1, -1):
+        raise InputError(f"must be +1 or -1, got {elbow!r}", path, field=f"{cg.name}.elbow")
+    return StoredChain(arrays=arrays, l1=lengths["l1"], l2=lengths["l2"], base=base,
+                       elbow=elbow)
+
+
+def _check_covariance(P: np.ndarray, where: str, path: Path) -> None:
+    """``P`` (T+1, 2, 2): symmetric positive semi-definite covariances, not all zero."""
+    if P.ndim != 3 or P.shape[1:] != (2, 2):
+        return  # the shape is ChainModel's to report, with the others
+    scale = float(np.abs(P).max()) if P.size else 0.0
+    # a reach model's grip is planned without noise: its digits' covariances are
+    # rounding noise around zero (1e-17 rad^2), of either sign
+    tol = 1e-9 * scale + 1e-15
+    if np.abs(P - np.swapaxes(P, 1, 2)).max() > tol:
+        raise InputError("covariances are not symmetric: a corrupt repertoire (rebuild it)",
+                         path, field=where)
+    diagonal = np.diagonal(P, axis1=1, axis2=2)
+    if diagonal.min() < -tol or np.linalg.eigvalsh(0.5 * (P + np.swapaxes(P, 1, 2))).min() < -tol:
+        raise InputError("covariances are not positive semi-definite (a negative variance): "
+                         "a corrupt repertoire (rebuild it)", path, field=where)
 
 
 def _read_calibration(mg, path: Path) -> StoredCalibration | None:
@@ -173,16 +215,19 @@ def _read_calibration(mg, path: Path) -> StoredCalibration | None:
         return None
     cal = mg["calibration"]
     if not isinstance(cal, h5py.Group):
-        raise InputError(f"{cal.name} is not a group", path)
+        raise InputError("is not a group", path, field=cal.name)
     misfit = np.asarray(read_dataset(cal, "misfit", "number", 1, path), dtype=float)
+    if np.isinf(misfit).any() or (misfit[np.isfinite(misfit)] < 0).any():
+        raise InputError("misfits must be non-negative numbers", path,
+                         field=f"{cal.name}/misfit")
     attrs = decode_attrs(cal.attrs, cal.name, path)
     period = scalar_attr(attrs, "frame_period", "number", cal.name, path)
-    if period is None or not period > 0:
-        raise InputError(f"attribute {cal.name}.frame_period must be a positive time, "
-                         f"got {period!r}", path)
+    if period is None or not 1 / MAX_FPS <= period <= 1:
+        raise InputError(f"must be a frame period of {1 / MAX_FPS:g} to 1 s, got {period!r}",
+                         path, field=f"{cal.name}.frame_period")
     params = _json_attr(attrs, "params", cal.name, path)
     if not isinstance(params, dict):
-        raise InputError(f"attribute {cal.name}.params must be a JSON object", path)
+        raise InputError("must be a JSON object", path, field=f"{cal.name}.params")
     return StoredCalibration(misfit=misfit, frame_period=period, params=params)
 
 
@@ -190,28 +235,38 @@ def _json_attr(attrs: dict, key: str, where: str, path: Path):
     text = scalar_attr(attrs, key, "string", where, path)
     try:
         return json.loads(text)
-    except (TypeError, ValueError):
-        raise InputError(f"attribute {where}.{key} is not JSON", path) from None
+    except (TypeError, ValueError, RecursionError):
+        raise InputError("is not JSON", path, field=f"{where}.{key}") from None
 
 
 def _read_model(name: str, mg, path: Path) -> StoredModel:
     import h5py
 
     if not isinstance(mg, h5py.Group):
-        raise InputError(f"/models/{name} is not a group", path)
+        raise InputError("is not a group", path, field=f"/models/{name}")
     a = decode_attrs(mg.attrs, mg.name, path)
     for role in ROLES:
         if role not in mg or not isinstance(mg.get(role, getlink=True), h5py.HardLink):
-            raise InputError(f"missing group {mg.name}/{role}", path)
+            raise InputError("missing group", path, field=f"{mg.name}/{role}")
     dt = scalar_attr(a, "dt", "number", mg.name, path)
-    if dt is None or dt <= 0:
-        raise InputError(f"attribute {mg.name}.dt must be a positive time step, got {dt!r}",
-                         path)
+    if dt is None or not 0 < dt <= 1:
+        raise InputError(f"must be a positive time step of at most 1 s, got {dt!r}", path,
+                         field=f"{mg.name}.dt")
+    substeps = scalar_attr(a, "substeps", "integer", mg.name, path)
+    if substeps is None or not 1 <= substeps <= MAX_SUBSTEPS:
+        raise InputError(f"must be a whole number of model steps per frame, 1 to "
+                         f"{MAX_SUBSTEPS}, got {substeps!r}", path, field=f"{mg.name}.substeps")
+    task = _json_attr(a, "task", mg.name, path)
+    scene = _json_attr(a, "scene", mg.name, path)
+    for key, value in (("task", task), ("scene", scene)):
+        if not isinstance(value, dict):
+            raise InputError("must be a JSON object", path, field=f"{mg.name}.{key}")
+    chains = {role: _read_chain(mg[role], path) for role in ROLES}
+    if not np.any(chains["arm"].arrays["P"]):
+        raise InputError("every covariance of the transport is zero: a corrupt repertoire "
+                         "(rebuild it)", path, field=f"{mg.name}/arm/P")
     return StoredModel(name=name, kind=scalar_attr(a, "kind", "string", mg.name, path),
-                       task=_json_attr(a, "task", mg.name, path),
-                       scene=_json_attr(a, "scene", mg.name, path),
-                       substeps=scalar_attr(a, "substeps", "integer", mg.name, path), dt=dt,
-                       chains={role: _read_chain(mg[role], path) for role in ROLES},
+                       task=task, scene=scene, substeps=substeps, dt=dt, chains=chains,
                        calibration=_read_calibration(mg, path))
 
 

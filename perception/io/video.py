@@ -33,7 +33,8 @@ import numpy as np
 
 from perception.errors import InputError
 from perception.io.atomic import atomic_path
-from perception.limits import MAX_FPS
+from perception.io.files import input_file
+from perception.limits import MAX_FPS, MAX_FRAMES, MAX_VIDEO_PIXELS, MAX_VIDEO_SIDE, MIN_FPS
 
 logger = logging.getLogger(__name__)
 
@@ -225,8 +226,7 @@ class FrameSource:
         self.fps_override = fps
         if not self.path.exists():
             raise InputError("no such file", self.path)
-        if not self.path.is_file():
-            raise InputError("not a regular file", self.path)
+        input_file(self.path, "video")  # a FIFO or device would block or never end
         if self.path.stat().st_size == 0:
             raise InputError("empty file (0 bytes)", self.path)
         cap = (cv2.VideoCapture(os.fspath(self.path), cv2.CAP_FFMPEG,
@@ -235,6 +235,20 @@ class FrameSource:
         if not cap.isOpened():
             cap.release()
             raise InputError("not a readable video (FFmpeg could not open it)", self.path)
+        width, height = (cap.get(p) for p in (cv2.CAP_PROP_FRAME_WIDTH,
+                                              cv2.CAP_PROP_FRAME_HEIGHT))
+        if (not (math.isfinite(width) and math.isfinite(height))
+                or max(width, height) > MAX_VIDEO_SIDE or width * height > MAX_VIDEO_PIXELS):
+            cap.release()  # before a frame of it is decoded: one of 16000 x 16000 is 768 MB
+            raise InputError(f"frames of {width:g} x {height:g} px are larger than this reads "
+                             f"(at most {MAX_VIDEO_SIDE} px a side, {MAX_VIDEO_PIXELS} px in "
+                             "all)", self.path, field="frame size")
+        claimed = cap.get(cv2.CAP_PROP_FRAME_COUNT)
+        if math.isfinite(claimed) and claimed > MAX_FRAMES:
+            cap.release()  # its tracks could not be read back
+            raise InputError(f"the container claims {claimed:.0f} frames, more than the "
+                             f"{MAX_FRAMES} a tracks file may hold", self.path,
+                             field="frame count")
         ok, first = cap.read()
         if not ok or first is None:
             cap.release()
@@ -333,13 +347,30 @@ class FrameSource:
             yield item
 
     def _check_rate(self) -> None:
-        """Refuse a header frame rate no camera films a hand at (it would rescale time)."""
+        """Refuse a header frame rate no camera films a hand at (it would rescale time).
+
+        The rate must lie in ``[MIN_FPS, MAX_FPS)`` (:mod:`perception.limits`):
+        1000 is what a millisecond time base reports for a stream stating no
+        rate, and FFmpeg reads an AVI header's rate of 0 as 25, so an AVI's
+        own header is read to tell.
+        """
         fps = self._info.fps_nominal
-        if fps > MAX_FPS:
+        stated = _avi_header_rate(self.path)
+        if stated is not None and not stated > 0:
+            fps = 0.0
+        if fps >= MAX_FPS or fps < MIN_FPS:
             self._cap.release()
-            raise InputError(f"the container claims {fps:g} frames/s, more than any camera "
-                             f"filming a hand ({MAX_FPS:g}); give the true rate with --fps",
-                             self.path)
+            self._cap = None
+            if fps <= 0:
+                problem = "the container states no frame rate (0 frames/s)"
+            elif fps < MIN_FPS:
+                problem = (f"the container claims {fps:g} frames/s, fewer than any camera "
+                           f"filming a hand ({MIN_FPS:g})")
+            else:
+                problem = (f"the container claims {fps:g} frames/s, more than this believes "
+                           f"of a header (below {MAX_FPS:g})")
+            raise InputError(f"{problem}; give the true rate with --fps", self.path,
+                             field="frame rate")
 
     def _check_count(self) -> None:
         claimed = self._info.n_frames_header
@@ -414,6 +445,36 @@ class FrameSource:
     def __del__(self) -> None:
         with contextlib.suppress(Exception):
             self.close()
+
+
+def _avi_header_rate(path: Path) -> float | None:
+    """The frame rate an AVI's own header states (0 if none), or None if not an AVI.
+
+    The rate of the first video stream header (``strh``: ``dwRate / dwScale``),
+    else ``1e6 / dwMicroSecPerFrame`` of the main header, as FFmpeg reads it.
+    """
+    import struct
+
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(1 << 16)
+    except OSError:
+        return None
+    if len(head) < 12 or head[:4] != b"RIFF" or head[8:12] != b"AVI ":
+        return None
+    usec = 0
+    i = head.find(b"avih")
+    if 0 <= i <= len(head) - 12:
+        usec = struct.unpack_from("<I", head, i + 8)[0]
+    i = head.find(b"strh")
+    while 0 <= i <= len(head) - 36:
+        if head[i + 8:i + 12] == b"vids":
+            scale, rate = struct.unpack_from("<II", head, i + 28)
+            if scale and rate:
+                return rate / scale
+            break
+        i = head.find(b"strh", i + 4)
+    return 1e6 / usec if usec else 0.0
 
 
 def open_video(path: str | os.PathLike, **kwargs: Any) -> FrameSource:

@@ -29,6 +29,7 @@ from typing import NamedTuple
 import numpy as np
 
 from minvar.kinematics import TwoLinkChain
+from perception.errors import InputError
 from perception.observation import Observation
 from perception.recognition.leaves import Leaves, forward_kinematics
 from perception.recognition.models import ChainModel, MotorModel
@@ -207,6 +208,35 @@ def _to_cartesian(leaves: Leaves, q_pred: np.ndarray, P_pred: np.ndarray,
                       to_mn(cov))
 
 
+def _refuse_broken_models(models: Sequence[MotorModel], observable: np.ndarray,
+                          valid: np.ndarray) -> None:
+    """A model that predicts nothing finite where the hand was seen has unusable gains.
+
+    Left alone it would score 0.0 at every frame, its familiarity NaN and the
+    verdict null, reported as a normal result.
+    """
+    if not observable.any():
+        return
+    dead = ~valid[:, observable].any(axis=1)
+    if dead.any():
+        names = [m.name for m, d in zip(models, dead) if d]
+        raise InputError(f"model{'s' if len(names) > 1 else ''} {', '.join(names)} predict"
+                         f"{'' if len(names) > 1 else 's'} no finite hand position at any of the "
+                         f"{int(observable.sum())} frames where the hand was seen: the stored "
+                         "gains or dynamics are unusable (rebuild the repertoire)",
+                         field="repertoire")
+
+
+def _refuse_non_finite(models: Sequence[MotorModel], scores: dict[str, np.ndarray]) -> None:
+    """Scores that are not finite would turn into 0.0 or null in every report."""
+    for what, values in scores.items():
+        bad = ~np.isfinite(values).all(axis=1)
+        if bad.any():
+            names = [m.name for m, b in zip(models, bad) if b]
+            raise InputError(f"the {what} of model {', '.join(names)} is not finite: its "
+                             "predictions overflow (rebuild the repertoire)", field="repertoire")
+
+
 def recognize(
     observation: Observation,
     models: Sequence[MotorModel],
@@ -251,9 +281,11 @@ def recognize(
     observed = np.concatenate([[False], seen[:-1]]) & np.isfinite(r_obs) & np.isfinite(g_obs)
     prev_ok = np.concatenate([[False], np.isfinite(r_obs[:-1]) & np.isfinite(g_obs[:-1])])
     valid = (observed & prev_ok)[None] & np.isfinite(r_pred) & np.isfinite(g_pred)
+    _refuse_broken_models(models, observed & prev_ok, valid)
     grasp = np.array([m.kind == "grasp" for m in models])
     dC_r, dC_g = thesis_rule(r_obs, g_obs, r_pred, g_pred, grasp, valid, params.w_r, params.w_g)
     dll, maha = likelihood_rule(r_obs, g_obs, midpoint, opening, pred.cov, valid, params.obs_sd)
+    _refuse_non_finite(models, {"confidence": dC_r + dC_g, "log-likelihood": dll})
     mis = misfit(maha, valid)
     familiarity = np.array([np.nan if m.calibration is None
                             else m.calibration.familiarity(float(x), obs.dt)

@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from minvar import GraspTask, GripVia, PointMassPlant
+from perception.errors import PlanningError
 from perception.geometry import DEFAULT_OBJECT_DIAMETER, DEFAULT_TIP_START
 
 if TYPE_CHECKING:
@@ -161,7 +162,8 @@ class SceneSpec:
         for name in ("distance", "object_size", "frame_period", "tip_start"):
             value = getattr(self, name)
             if not (isinstance(value, int | float) and np.isfinite(value) and value > 0):
-                raise ValueError(f"scene {name}: expected a positive number, got {value!r}")
+                raise PlanningError(f"expected a positive number, got {value!r}",
+                                    field=f"scene {name}")
 
     @classmethod
     def of(cls, observation: Observation) -> SceneSpec:
@@ -285,6 +287,16 @@ class MotorModel:
     finger: ChainModel = field(repr=False)
     thumb: ChainModel = field(repr=False)
     calibration: Calibration | None = field(default=None, repr=False)
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.substeps, int | np.integer) and not isinstance(self.substeps, bool)
+                and self.substeps >= 1):
+            raise ValueError(f"model '{self.spec.name}': substeps: expected a whole number of "
+                             f"model steps per frame >= 1, got {self.substeps!r}")
+        if not (isinstance(self.dt, int | float | np.floating) and np.isfinite(self.dt)
+                and self.dt > 0):
+            raise ValueError(f"model '{self.spec.name}': dt: expected a positive time step, "
+                             f"got {self.dt!r}")
 
     @property
     def name(self) -> str:

@@ -10,6 +10,7 @@ import numpy as np
 
 from minvar import plan_grasp
 from minvar.lqg import estimation_error_covariance
+from perception.errors import PlanningError
 from perception.recognition.models import (
     KINDS,
     ChainModel,
@@ -65,8 +66,22 @@ def build_model(spec: ModelSpec, scene: SceneSpec) -> MotorModel:
         The movement.
     scene : SceneSpec
         Distance, object size and frame period.
+
+    Raises
+    ------
+    PlanningError
+        The movement cannot be planned in this scene (the object out of
+        reach, a duration shorter than two of its steps, ...).
     """
-    task = spec.grasp_task(scene)
+    try:
+        # the task's own checks: an object out of the arm's or the digits' reach,
+        # a movement too short for the frame period (a wrong scale puts a clip's
+        # object metres away). What the solver raises after them is a bug.
+        task = spec.grasp_task(scene)
+    except ValueError as exc:
+        raise PlanningError(f"cannot plan model '{spec.name}' for a scene with the object "
+                            f"{scene.distance:.3f} m away, {scene.object_size:.3f} m wide, "
+                            f"at {1 / scene.frame_period:.4g} frames/s: {exc}") from None
     plan = plan_grasp(task)
     return MotorModel(
         spec=spec,

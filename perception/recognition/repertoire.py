@@ -22,7 +22,7 @@ import time
 from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 
-from perception.errors import InputError
+from perception.errors import InputError, PlanningError
 from perception.io.atomic import owner_gone, owner_tag
 from perception.io.repertoire import (
     StoredCalibration,
@@ -101,6 +101,11 @@ class Repertoire:
             Models to plan (default: :func:`default_specs`).
         scene : SceneSpec, optional
             The scene (default: 0.25 m to a 0.10 m ball at 30 frames/s).
+
+        Raises
+        ------
+        PlanningError
+            A model cannot be planned in ``scene`` (out of reach, too short).
         """
         specs = default_specs() if specs is None else list(specs)
         scene = SceneSpec() if scene is None else scene
@@ -116,6 +121,13 @@ class Repertoire:
         ----------
         path : str or Path
             The configuration file.
+
+        Raises
+        ------
+        InputError
+            The file is unreadable or its tables, keys or values are wrong.
+        PlanningError
+            A model cannot be planned in the file's scene (named with the file).
         """
         from perception.io.config import check_keys, read_toml
 
@@ -135,11 +147,19 @@ class Repertoire:
                          for e in entries]
             else:
                 specs = default_specs(cfg.get("durations", DEFAULT_DURATIONS))
-            return cls.build(specs, scene)
+            names = [s.name for s in specs]
+            if not names:
+                raise ValueError("no models: give [[model]] entries or durations")
+            if len(set(names)) != len(names):
+                raise ValueError(f"duplicate model names in {names}")
         except (TypeError, KeyError) as exc:
             raise InputError(f"bad repertoire config: {exc}", path) from None
         except ValueError as exc:
             raise InputError(str(exc), path) from None
+        try:
+            return cls.build(specs, scene)
+        except PlanningError as exc:  # a model the config's scene cannot hold
+            raise PlanningError(exc.problem, path, field=exc.field) from None
 
     def for_scene(self, scene: SceneSpec, cache: PlanCache | None = None) -> list[MotorModel]:
         """The models, re-planned for ``scene`` where their stored scene differs.
@@ -351,11 +371,11 @@ class PlanCache:
 
     def key(self, scene: SceneSpec, specs: list[ModelSpec]) -> str:
         """The file key of ``specs`` planned for ``scene`` (already on the grid)."""
-        from perception import __version__
+        from perception.provenance import code_digest
 
         payload = json.dumps({"scene": dataclasses.asdict(scene),
                               "models": [dataclasses.asdict(s) for s in specs],
-                              "software": __version__}, sort_keys=True, default=str)
+                              "code": code_digest()}, sort_keys=True, default=str)
         return hashlib.sha256(payload.encode()).hexdigest()[:24]
 
     def get(self, scene: SceneSpec, specs: list[ModelSpec],

@@ -5,7 +5,10 @@ Every clip is read on one *reference* grasp model
 profiles against the model's own (Fig. 5.4d), its confidence on one clip per
 condition (Fig. 5.8a) and on all clips (Fig. 5.8b), mean ± SD per condition
 (Fig. 5.8c) and the statistics of its final confidence. The page escapes
-every name it shows and quotes every link, so any clip name is safe in it.
+every name it shows and quotes every link, so any clip name is safe in it;
+a name with bytes that are not UTF-8 (or control characters) is shown, in
+the page and in ``summary.csv``, with them escaped
+(:func:`~perception.io.names.printable`).
 """
 
 from __future__ import annotations
@@ -21,6 +24,7 @@ import numpy as np
 import pandas as pd
 
 from perception.io.atomic import write_bytes, write_csv, write_text
+from perception.io.names import printable
 from perception.report.chart import render_png
 from perception.report.clip import ClipSummary, clip_figures, clip_outputs
 from perception.report.conditions import (
@@ -96,11 +100,11 @@ def _e(value) -> str:
     """A cell's text, escaped; empty for None and NaN."""
     if value is None or (isinstance(value, float) and not np.isfinite(value)):
         return ""
-    return html.escape(str(value))
+    return html.escape(printable(str(value)))
 
 
 def _link(path: str, text: str) -> str:
-    return f'<a href="{html.escape(quote(path), quote=True)}">{html.escape(text)}</a>'
+    return f'<a href="{html.escape(quote(path), quote=True)}">{_e(text)}</a>'
 
 
 def _table(headers: Sequence[str], rows: Sequence[Sequence[str]], numeric: set[int] = frozenset(),
@@ -112,6 +116,18 @@ def _table(headers: Sequence[str], rows: Sequence[Sequence[str]], numeric: set[i
             for i, c in enumerate(cells)) + "</tr>"
     return (f'<table class="{cls}"><thead>{row([html.escape(h) for h in headers], "th")}'
             f'</thead><tbody>{"".join(row(r, "td") for r in rows)}</tbody></table>')
+
+
+def _printable_table(table: pd.DataFrame) -> pd.DataFrame:
+    """``table`` with its text cells :func:`~perception.io.names.printable` (valid UTF-8)."""
+    def cell(v):
+        return printable(v) if isinstance(v, str) else v
+
+    shown = table.copy()
+    for c in table.columns:
+        if not (pd.api.types.is_numeric_dtype(table[c]) or pd.api.types.is_bool_dtype(table[c])):
+            shown[c] = table[c].map(cell)
+    return shown
 
 
 def _num(value, fmt: str) -> str:
@@ -273,7 +289,7 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
     """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    write_csv(out / "summary.csv", summary)
+    write_csv(out / "summary.csv", _printable_table(summary))
     ok = summary[summary["status"] == "ok"]
     recs = [recognitions[c] for c in ok["clip"] if c in recognitions]
     condition_of = ok.set_index("clip")["condition"]
@@ -304,7 +320,7 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
     if len(stats_df):
         tables.append('<a href="statistics.csv">statistics.csv</a>')
     body = "\n".join([
-        f"<h1>{html.escape(title)}</h1>",
+        f"<h1>{_e(title)}</h1>",
         f"<p>{len(summary)} clips: {len(ok)} scored, {len(failed)} failed. Tables: "
         + ", ".join(tables) + '. <span class="note">' + _HOW_TO_READ + "</span></p>",
         _verdict_counts(ok),
@@ -314,7 +330,7 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
     ])
     page = ("<!doctype html><html><head><meta charset='utf-8'>"
             "<meta name='viewport' content='width=device-width, initial-scale=1'>"
-            f"<title>{html.escape(title)}</title><style>{_CSS}</style></head><body>"
+            f"<title>{_e(title)}</title><style>{_CSS}</style></head><body>"
             f"{body}</body></html>\n")
     write_text(out / "report.html", page)
     return BatchReport(folder=out, summary=out / "summary.csv", html=out / "report.html")

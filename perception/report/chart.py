@@ -46,6 +46,10 @@ def to_matplotlib(chart: Chart) -> Figure:
     """
     from minvar.plotting import new_figure
 
+    def text(s: str | None) -> str | None:
+        # a ``$`` in a clip name is text, not mathtext (``$\\x$`` would fail to draw)
+        return None if s is None else s.replace("$", r"\$")
+
     fig, ax = new_figure(1, len(chart.panels), size=chart.size)
     handles = {}
     for a, panel in zip(ax[0], chart.panels):
@@ -54,9 +58,9 @@ def to_matplotlib(chart: Chart) -> Figure:
                            lw=0)
         for line in panel.lines:
             (h,) = a.plot(line.x, line.y, line.style, color=line.colour, lw=line.width,
-                          label=line.label or "_nolegend_")
+                          label=text(line.label) or "_nolegend_")
             if line.label:
-                handles.setdefault(line.label, h)
+                handles.setdefault(text(line.label), h)
         for bars in panel.errorbars:
             a.errorbar(bars.x, bars.y, yerr=bars.err, fmt="none", ecolor=bars.colour,
                        elinewidth=bars.width, capsize=bars.cap, capthick=bars.width)
@@ -64,16 +68,16 @@ def to_matplotlib(chart: Chart) -> Figure:
             a.axhline(y, color=HLINE_COLOUR, lw=HLINE_WIDTH, zorder=1.5)
         if panel.equal_aspect:
             a.set_aspect("equal", adjustable="datalim")
-        a.set_title(panel.title)
-        a.set_xlabel(panel.xlabel)
-        a.set_ylabel(panel.ylabel)
+        a.set_title(text(panel.title))
+        a.set_xlabel(text(panel.xlabel))
+        a.set_ylabel(text(panel.ylabel))
         if panel.legend is not None and any(ln.label for ln in panel.lines):
             a.legend(loc=panel.legend.location, ncol=panel.legend.columns,
-                     title=panel.legend.title, fontsize=LEGEND_PT, title_fontsize=LEGEND_PT)
+                     title=text(panel.legend.title), fontsize=LEGEND_PT, title_fontsize=LEGEND_PT)
     if chart.legend is not None and handles:
         fig.legend(list(handles.values()), list(handles), loc="outside lower center",
-                   ncol=chart.legend.columns, title=chart.legend.title, fontsize=LEGEND_PT,
+                   ncol=chart.legend.columns, title=text(chart.legend.title), fontsize=LEGEND_PT,
                    title_fontsize=LEGEND_PT, frameon=False)
     if chart.title:
-        fig.suptitle(chart.title)
+        fig.suptitle(text(chart.title))
     return fig

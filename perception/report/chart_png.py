@@ -163,10 +163,70 @@ def _font(px: int) -> ImageFont.FreeTypeFont:
     path = _font_file()
     if path is not None:
         try:
-            return ImageFont.truetype(path, px)
+            return _safe_font_class()(path, px)
         except OSError:
             pass
     return ImageFont.load_default(size=px)
+
+
+#: What Pillow raises where it cannot lay out a text (``raqm_layout() failed`` is a
+#: RuntimeError; a character it cannot encode, a UnicodeError).
+_LAYOUT_ERRORS = (OSError, RuntimeError, ValueError)
+
+
+def _escaped(text: str) -> str:
+    """``text`` in ASCII, every other character as a backslash escape."""
+    return text.encode("ascii", "backslashreplace").decode("ascii")
+
+
+@functools.cache
+def _safe_font_class() -> type:
+    """A FreeType font whose text always lays out.
+
+    Complex layout (libraqm: right-to-left and combining scripts) fails on
+    some texts and builds (``RuntimeError: raqm_layout() failed``): such a
+    text is laid out again without it (``Layout.BASIC``: each character's
+    glyph in order), and, should that fail too, drawn escaped in ASCII. A
+    figure never fails for a clip's name.
+    """
+    from PIL import ImageFont
+
+    class SafeFont(ImageFont.FreeTypeFont):
+        _basic: ImageFont.FreeTypeFont | None = None
+
+        def _fallback(self) -> ImageFont.FreeTypeFont:
+            if self._basic is None:
+                self._basic = ImageFont.FreeTypeFont(self.path, self.size, self.index,
+                                                     self.encoding,
+                                                     layout_engine=ImageFont.Layout.BASIC)
+            return self._basic
+
+        def _safe(self, method: str, text, *args, **kwargs):
+            try:
+                return getattr(super(), method)(text, *args, **kwargs)
+            except _LAYOUT_ERRORS:
+                pass
+            basic = getattr(self._fallback(), method)
+            try:
+                return basic(text, *args, **kwargs)
+            except _LAYOUT_ERRORS:
+                if not isinstance(text, str):
+                    raise
+                return basic(_escaped(text), *args, **kwargs)
+
+        def getlength(self, text, *args, **kwargs):
+            return self._safe("getlength", text, *args, **kwargs)
+
+        def getbbox(self, text, *args, **kwargs):
+            return self._safe("getbbox", text, *args, **kwargs)
+
+        def getmask(self, text, *args, **kwargs):
+            return self._safe("getmask", text, *args, **kwargs)
+
+        def getmask2(self, text, *args, **kwargs):
+            return self._safe("getmask2", text, *args, **kwargs)
+
+    return SafeFont
 
 
 def _minus() -> str:

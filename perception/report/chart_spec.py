@@ -4,7 +4,10 @@ What is drawn, not how: :mod:`perception.report.chart_png` draws a chart
 with Pillow, :func:`perception.report.chart.to_matplotlib` with matplotlib.
 Colours, line styles and font sizes are matplotlib's defaults, so the two
 look alike. Every array is checked and stored as a flat float array when a
-part is made; a non-finite value is a gap (nothing is drawn there).
+part is made; a non-finite value is a gap (nothing is drawn there). Every
+text (a title, a label: often a clip's name) is stored as it can be drawn:
+bytes that were not UTF-8 and control characters escaped
+(:func:`~perception.io.names.printable`).
 """
 
 from __future__ import annotations
@@ -12,6 +15,8 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
+
+from perception.io.names import printable
 
 __all__ = ["Band", "Chart", "ErrorBars", "Legend", "Line", "Panel"]
 
@@ -81,6 +86,7 @@ class Line:
 
     def __post_init__(self):
         _store_arrays(self, "x", "y")
+        _store_texts(self, "label")
         if self.style not in STYLES:
             raise ValueError(f"unknown line style {self.style!r}: use one of {STYLES}")
         rgb(self.colour)
@@ -150,6 +156,14 @@ class ErrorBars:
             raise ValueError(f"width must be > 0 and cap >= 0, not {self.width!r}, {self.cap!r}")
 
 
+def _store_texts(part, *names: str) -> None:
+    """Store a frozen part's text fields ``names`` as they can be drawn (None kept)."""
+    for name in names:
+        value = getattr(part, name)
+        if value is not None:
+            object.__setattr__(part, name, printable(str(value)))
+
+
 def _store_arrays(part, *names: str) -> None:
     """Store a frozen part's fields ``names`` as flat float arrays of one length."""
     arrays = [np.asarray(getattr(part, name), dtype=float).ravel() for name in names]
@@ -180,6 +194,7 @@ class Legend:
     title: str | None = None
 
     def __post_init__(self):
+        _store_texts(self, "title")
         if self.location not in LOCATIONS:
             raise ValueError(f"unknown legend location {self.location!r}: use one of "
                              f"{LOCATIONS}")
@@ -221,6 +236,7 @@ class Panel:
     errorbars: tuple[ErrorBars, ...] = ()
 
     def __post_init__(self):
+        _store_texts(self, "title", "xlabel", "ylabel")
         for name, kind in (("lines", Line), ("bands", Band), ("errorbars", ErrorBars)):
             parts = tuple(getattr(self, name))
             if not all(isinstance(p, kind) for p in parts):
@@ -273,6 +289,7 @@ class Chart:
     legend: Legend | None = None
 
     def __post_init__(self):
+        _store_texts(self, "title")
         object.__setattr__(self, "panels", tuple(self.panels))
         if not self.panels:
             raise ValueError("a chart needs at least one panel")

@@ -19,9 +19,11 @@ from pathlib import Path
 import numpy as np
 
 from perception.io.atomic import write_bytes, write_csv, write_json
+from perception.io.names import output_stem, printable
 from perception.recognition.result import Recognition
 
-__all__ = ["ClipSummary", "clip_figures", "clip_outputs", "write_clip_report"]
+__all__ = ["ClipSummary", "clip_figures", "clip_outputs", "remove_output",
+           "write_clip_report"]
 
 #: Keys of ``<clip>.recognition.json`` that :meth:`Recognition.to_dict` writes;
 #: any other key is an extra (see :attr:`ClipSummary.extras`).
@@ -171,6 +173,10 @@ class ClipSummary:
 def clip_outputs(out: Path, clip: str) -> dict[str, Path]:
     """Paths of the files :func:`write_clip_report` writes for ``clip`` in ``out``.
 
+    They are named by the clip's :func:`~perception.io.names.output_stem`:
+    the clip name itself unless it holds bytes that are not UTF-8, a
+    separator or a control character, or is too long for a file name.
+
     Parameters
     ----------
     out : Path
@@ -178,11 +184,12 @@ def clip_outputs(out: Path, clip: str) -> dict[str, Path]:
     clip : str
         Clip name.
     """
+    stem = output_stem(clip)
     return {
-        "json": out / f"{clip}.recognition.json",
-        "csv": out / f"{clip}.confidence.csv",
-        "confidence_png": out / f"{clip}.confidence.png",
-        "paths_png": out / f"{clip}.paths.png",
+        "json": out / f"{stem}.recognition.json",
+        "csv": out / f"{stem}.confidence.csv",
+        "confidence_png": out / f"{stem}.confidence.png",
+        "paths_png": out / f"{stem}.paths.png",
     }
 
 
@@ -205,7 +212,7 @@ def clip_figures(out: Path, clip: str, names: Sequence[str] | None = None) -> li
     if names is None:
         names = sorted(os.listdir(out)) if out.is_dir() else []
     own = [clip_outputs(out, clip)[k].name for k in ("confidence_png", "paths_png")]
-    prefix = f"{clip}."
+    prefix = f"{output_stem(clip)}."
     mine = []
     # the names starting with the prefix are one run of the sorted list
     for name in names[bisect.bisect_left(names, prefix):]:
@@ -213,8 +220,31 @@ def clip_figures(out: Path, clip: str, names: Sequence[str] | None = None) -> li
             break
         mine.append(name)
     others = [n for n in mine if n not in own and n.endswith(".png")
-              and n[len(prefix):].count(".") == 1]
+              and n[len(prefix):].count(".") == 1
+              and printable(n) == n]  # not a file name that is not UTF-8 text
     return [out / n for n in own if n in mine] + [out / n for n in others]
+
+
+def remove_output(path: Path) -> None:
+    """Remove an output that would be stale, if there is one.
+
+    A read-only folder refuses even to remove a file that is not there
+    (``EROFS``): only an existing file is removed, and a failure is one
+    :class:`OSError` naming it.
+
+    Parameters
+    ----------
+    path : Path
+        The output.
+    """
+    if not os.path.lexists(path):
+        return
+    try:
+        path.unlink()
+    except FileNotFoundError:
+        pass
+    except OSError as exc:
+        raise OSError(exc.errno, f"cannot remove {path}: {exc.strerror or exc}") from None
 
 
 def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,
@@ -247,8 +277,8 @@ def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,
         write_bytes(paths["confidence_png"], render_png(confidence_chart(rec)))
         write_bytes(paths["paths_png"], render_png(paths_chart(rec)))
     else:
-        paths["confidence_png"].unlink(missing_ok=True)
-        paths["paths_png"].unlink(missing_ok=True)
+        remove_output(paths["confidence_png"])
+        remove_output(paths["paths_png"])
     write_csv(paths["csv"], rec.columns())
     # the JSON last: its presence marks the clip's report complete
     write_json(paths["json"], {**rec.to_dict(), **(extra or {})})

@@ -20,7 +20,8 @@ from typing import TYPE_CHECKING
 import cv2
 import numpy as np
 
-from perception.io.atomic import atomic_path
+from perception.io.atomic import write_bytes
+from perception.io.names import output_stem
 from perception.io.tracks import Status, Tracks
 
 if TYPE_CHECKING:
@@ -216,10 +217,12 @@ def contact_sheet(tracks: Tracks, video: str | os.PathLike | None, out: str | os
     small = [cv2.resize(t, (tw, th), interpolation=cv2.INTER_AREA) for t in tiles]
     small += [np.zeros_like(small[0])] * (-len(small) % cols)
     sheet = np.vstack([np.hstack(small[r:r + cols]) for r in range(0, len(small), cols)])
-    with atomic_path(out) as tmp:
-        if not cv2.imwrite(os.fspath(tmp), sheet):
-            raise OSError(f"{out}: cannot write the contact sheet")
-    return Path(out)
+    # encoded here and written by us: OpenCV is never handed a path (a name that
+    # is not UTF-8 crashes its writer)
+    ok, png = cv2.imencode(".png", sheet)
+    if not ok:
+        raise OSError(f"{out}: cannot encode the contact sheet")
+    return write_bytes(out, png.tobytes())
 
 
 def _decoded_tiles(video, wanted: list[int], row: dict, tile) -> list[np.ndarray]:
@@ -267,7 +270,8 @@ def write_tracking_report(tracks: Tracks | str | os.PathLike, out: str | os.Path
     if not isinstance(tracks, Tracks):
         tracks = Tracks.load(tracks)
     quality = tracking_quality(tracks).to_dict()
-    drawn = (contact_sheet(tracks, None, Path(out) / f"{clip}.tracking.png", frames=frames)
+    sheet_path = Path(out) / f"{output_stem(clip)}.tracking.png"
+    drawn = (contact_sheet(tracks, None, sheet_path, frames=frames)
              if sheet else None)
     quality["contact_sheet"] = drawn.name if drawn is not None else None
     return quality

@@ -13,20 +13,39 @@ import dataclasses
 import json
 import logging
 import os
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
 
 from perception.errors import InputError
 from perception.io.atomic import write_csv
+from perception.io.config import Spec, check_keys, check_table, read_toml, sub_table
 from perception.io.video import CODECS
 from perception.limits import MAX_CLIPS
 from perception.synthetic.footage import load_background
 from perception.synthetic.render import render_clip
-from perception.synthetic.scene import Camera, Distractor, Occlusion, RenderStyle, Scene
-from perception.synthetic.stimuli import CONDITIONS, StimulusParams, stimulus_paths, stimulus_task
+from perception.synthetic.scene import (
+    DISTRACTOR_LIMITS,
+    OCCLUSION_LIMITS,
+    RENDER_LIMITS,
+    Camera,
+    Distractor,
+    Occlusion,
+    RenderStyle,
+    Scene,
+)
+from perception.synthetic.stimuli import (
+    CONDITIONS,
+    SCENE_LIMITS,
+    StimulusParams,
+    stimulus_paths,
+    stimulus_task,
+)
+from perception.tracking.markers import MARKER_NAMES
 
 __all__ = ["Recipe", "load_recipe", "render_style", "clip_plans", "synthesize"]
 
@@ -72,8 +91,30 @@ class Recipe:
 RECIPE_TABLES = ("conditions", "scene", "variation", "render")
 
 
+#: Type and range of each ``[variation]`` value.
+VARIATION_LIMITS: dict[str, Spec] = {
+    "duration_sd": Spec(float, 0, 10, note="s"),
+    "distance_sd": Spec(float, 0, 1, note="m"),
+    "camera_angle_deg": Spec(float, -180, 180, size=2, note="degrees, [low, high]"),
+}
+#: Of each ``[conditions]`` value (clips of that condition).
+CONDITION_LIMITS: dict[str, Spec] = {
+    c: Spec(int, 0, MAX_CLIPS, note=f"at most {MAX_CLIPS} clips per recipe") for c in CONDITIONS}
+#: Of each ``[[render.occlusions]]`` value: an occlusion hides one of the markers.
+_OCCLUSION_TABLE = {**OCCLUSION_LIMITS, "marker": Spec(str, choices=MARKER_NAMES)}
+#: A distractor's, and a sleeve's, colour names a marker.
+_DISTRACTOR_TABLE = {**DISTRACTOR_LIMITS, "colour": Spec("colour", choices=MARKER_NAMES)}
+_RENDER_TABLE = {**RENDER_LIMITS, "sleeve": Spec("colour", choices=MARKER_NAMES)}
+_REQUIRED = {"distractors": ("colour", "start"), "occlusions": ("marker", "start", "stop")}
+
+
 def load_recipe(path: str | os.PathLike) -> Recipe:
     """Read a recipe TOML file.
+
+    Every value is checked for its type and range before anything is built
+    (:data:`CONDITION_LIMITS`, :data:`VARIATION_LIMITS`,
+    :data:`perception.synthetic.stimuli.SCENE_LIMITS`,
+    :data:`perception.synthetic.scene.RENDER_LIMITS`, ...).
 
     Parameters
     ----------
@@ -83,100 +124,88 @@ def load_recipe(path: str | os.PathLike) -> Recipe:
     Raises
     ------
     InputError
-        If the file is missing, not TOML, or has unknown or bad fields.
+        If the file is missing, not a regular file, not TOML, or has unknown
+        or bad fields; the message names the file and the field.
     """
-    from perception.io.config import check_keys, read_toml
-
     path = Path(path)
     cfg = read_toml(path, "recipe")
     try:
-        check_keys(cfg, RECIPE_TABLES, "the top level")
-        for name in RECIPE_TABLES:
-            if not isinstance(cfg.get(name, {}), dict):
-                raise ValueError(f"[{name}] must be a table")
-        check_keys(cfg.get("scene", {}),
-                   [f.name for f in dataclasses.fields(StimulusParams) if f.name != "condition"],
-                   "[scene]")
-        table = cfg.get("conditions", {})
-        if not isinstance(table, dict):
-            raise ValueError("[conditions] must be a table of clip counts, e.g. normal = 2")
-        bad = set(table) - set(CONDITIONS)
-        if bad:
-            raise ValueError(f"[conditions]: unknown {sorted(bad)} (expected {CONDITIONS})")
-        if not all(isinstance(v, int) and not isinstance(v, bool) and v >= 0
-                   for v in table.values()) or sum(table.values()) == 0:
-            raise ValueError("[conditions]: give a whole, non-negative clip count per "
-                             "condition, and at least one clip")
-        counts = {str(k): int(v) for k, v in table.items()}
-        if sum(counts.values()) > MAX_CLIPS:
-            raise ValueError(f"[conditions]: at most {MAX_CLIPS} clips per recipe, got "
-                             f"{sum(counts.values())}")
-        stim = StimulusParams(**cfg.get("scene", {}))
-        var = dict(cfg.get("variation", {}))
-        angle = tuple(float(a) for a in var.pop("camera_angle_deg", (0.0, 0.0)))
-        if len(angle) != 2:
-            raise ValueError("[variation] camera_angle_deg: expected [low, high]")
+        check_keys(cfg, RECIPE_TABLES, "the top level", path)
+        tables = {name: sub_table(cfg, name, f"[{name}]", path) for name in RECIPE_TABLES}
+        check_table(tables["conditions"], CONDITION_LIMITS, "[conditions]", path)
+        counts = {str(k): int(v) for k, v in tables["conditions"].items()}
+        if not 0 < sum(counts.values()) <= MAX_CLIPS:
+            raise InputError(f"expected at least 1 and at most {MAX_CLIPS} clips in all, got "
+                             f"{sum(counts.values())}", path, field="[conditions]")
+        check_table(tables["scene"], SCENE_LIMITS, "[scene]", path)
+        check_table(tables["variation"], VARIATION_LIMITS, "[variation]", path)
+        stim = StimulusParams(**tables["scene"])
+        var = tables["variation"]
+        angle = tuple(float(a) for a in var.get("camera_angle_deg", (0.0, 0.0)))
         recipe = Recipe(name=path.stem, counts=counts, stimulus=stim,
-                        duration_sd=float(var.pop("duration_sd", 0.0)),
-                        distance_sd=float(var.pop("distance_sd", 0.0)),
-                        camera_angle_deg=angle, style=dict(cfg.get("render", {})))
-        if var:
-            raise ValueError(f"[variation]: unknown fields {sorted(var)}")
-        if not (recipe.duration_sd >= 0 and recipe.distance_sd >= 0):
-            raise ValueError("[variation]: duration_sd and distance_sd must be >= 0")
-        render_style(recipe.style)  # validate now, not after rendering half the set
+                        duration_sd=float(var.get("duration_sd", 0.0)),
+                        distance_sd=float(var.get("distance_sd", 0.0)),
+                        camera_angle_deg=angle, style=dict(tables["render"]))
+        render_style(recipe.style, path)  # validate now, not after rendering half the set
         clip_plans(recipe, seed=0)  # every clip's movement must be plannable
+    except InputError as exc:
+        if exc.path is None:
+            raise InputError(exc.problem, path, field=exc.field) from None
+        raise
     except (TypeError, ValueError, KeyError) as exc:
         raise InputError(f"bad recipe: {exc}", path) from None
     return recipe
 
 
-def _refuse_unknown(table: dict, valid, where: str) -> None:
-    """Refuse a key that is not in ``valid``, naming the nearest valid one."""
-    import difflib
-
-    for key in table:
-        if key not in valid:
-            near = difflib.get_close_matches(str(key), list(valid), n=1)
-            hint = f"did you mean {near[0]!r}?" if near else f"expected one of {sorted(valid)}"
-            raise ValueError(f"{where}: unknown key {key!r} ({hint})")
-
-
-def render_style(table: dict) -> RenderStyle:
+def render_style(table: Mapping[str, Any], path: str | os.PathLike | None = None) -> RenderStyle:
     """A :class:`~perception.synthetic.render.RenderStyle` from a recipe's ``[render]`` table.
 
     Parameters
     ----------
-    table : dict
+    table : mapping
         RenderStyle fields; ``distractors`` and ``occlusions`` as lists of tables
         (``{colour, start, end, diameter, frames, shape, aspect, angle_deg}``,
         ``{marker, start, stop}``); ``background = "photo:NAME"`` or
-        ``"video:PATH"``. An unknown key is refused, naming the nearest valid one.
+        ``"video:PATH"``. An unknown key is refused, naming the nearest valid
+        one; every value is checked against :data:`RENDER_LIMITS` (and
+        :data:`DISTRACTOR_LIMITS`, :data:`OCCLUSION_LIMITS`).
+    path : str or os.PathLike, optional
+        The recipe, for messages.
+
+    Raises
+    ------
+    InputError
+        A bad key or value, naming the field (``[render] fps``).
     """
+    check_table(table, _RENDER_TABLE, "[render]", path)
     fields = dict(table)
-    _refuse_unknown(fields, {f.name for f in dataclasses.fields(RenderStyle)}, "[render]")
-
-    def tup(v):
-        return None if v is None else tuple(v)
-
-    if "distractors" in fields:
-        valid = {f.name for f in dataclasses.fields(Distractor)}
-        for d in fields["distractors"]:
-            _refuse_unknown(d, valid, "[[render.distractors]]")
-        fields["distractors"] = tuple(
-            Distractor(colour=d["colour"] if isinstance(d["colour"], str) else tuple(d["colour"]),
-                       start=tuple(d["start"]), end=tup(d.get("end")),
-                       diameter=float(d.get("diameter", 0.02)), frames=tup(d.get("frames")),
-                       shape=str(d.get("shape", "disc")), aspect=float(d.get("aspect", 1.0)),
-                       angle_deg=float(d.get("angle_deg", 0.0)))
-            for d in fields["distractors"])
-    if "occlusions" in fields:
-        for o in fields["occlusions"]:
-            _refuse_unknown(o, {"marker", "start", "stop"}, "[[render.occlusions]]")
-        fields["occlusions"] = tuple(Occlusion(**o) for o in fields["occlusions"])
-    if "band_size" in fields:
-        fields["band_size"] = tuple(fields["band_size"])
-    style = RenderStyle(**fields)
+    for key, limits, cls in (("distractors", _DISTRACTOR_TABLE, Distractor),
+                             ("occlusions", _OCCLUSION_TABLE, Occlusion)):
+        if key not in fields:
+            continue
+        items = fields[key]
+        if not isinstance(items, list | tuple) or not all(isinstance(i, Mapping) for i in items):
+            raise InputError(f"expected a list of tables ([[render.{key}]]), got "
+                             f"{items!r}"[:120], path, field=f"[render] {key}")
+        built = []
+        for i, item in enumerate(items):
+            where = f"[[render.{key}]] #{i + 1}"
+            check_table(item, limits, where, path)
+            missing = [k for k in _REQUIRED[key] if k not in item]
+            if missing:
+                raise InputError(f"missing; give {', '.join(_REQUIRED[key])}", path,
+                                 field=f"{where} {missing[0]}")
+            try:
+                built.append(cls(**item))
+            except InputError as exc:  # between fields: frames = [first, stop]
+                name = (exc.field or "").rpartition(".")[2]
+                raise InputError(exc.problem, path, field=f"{where} {name}") from None
+        fields[key] = tuple(built)
+    try:
+        style = RenderStyle(**fields)
+    except InputError as exc:  # between fields: exposure within a frame period
+        name = (exc.field or "").rpartition(".")[2]
+        raise InputError(exc.problem, path, field=f"[render] {name}") from None
     if style.background:  # a missing photograph or package: refused before rendering
         next(load_background(style.background, 16, 16))
     return style
@@ -197,7 +226,7 @@ def clip_plans(recipe: Recipe, seed: int) -> list[tuple]:
 
     Raises
     ------
-    ValueError
+    InputError
         If a clip's drawn movement is impossible (e.g. a negative duration).
     """
     plans = []
@@ -212,8 +241,11 @@ def clip_plans(recipe: Recipe, seed: int) -> list[tuple]:
                     duration=float(base.duration + recipe.duration_sd * rng.standard_normal()),
                     distance=float(base.distance + recipe.distance_sd * rng.standard_normal()))
                 stimulus_task(params)
-            except ValueError as exc:
-                raise ValueError(f"clip {clip} (seed {seed}): {exc}") from None
+            except ValueError as exc:  # too large a variation: a negative duration
+                varied = recipe.duration_sd > 0 or recipe.distance_sd > 0
+                raise InputError(f"clip {clip} (seed {seed}) draws an impossible movement: "
+                                 f"{exc}", field="[variation]" if varied else "[scene]") \
+                    from None
             plans.append((clip, cond, params, float(rng.uniform(*recipe.camera_angle_deg)), rng))
     return plans
 
@@ -246,7 +278,7 @@ def synthesize(recipe: Recipe, out: str | os.PathLike, *, seed: int = 0,
     from tqdm import tqdm
 
     if int(jobs) < 1:
-        raise ValueError(f"--jobs: expected at least 1, got {jobs}")
+        raise InputError(f"expected at least 1, got {jobs}", field="--jobs")
     render_style(recipe.style)
     plans = clip_plans(recipe, seed)  # all of them first: a bad draw renders nothing
     out = Path(out)

@@ -22,11 +22,61 @@ from typing import Any
 
 import numpy as np
 
+from perception.errors import InputError
 from perception.geometry import DEFAULT_OBJECT_DIAMETER, SimilarityTransform
+from perception.io.config import Spec, check_fields, document_ranges
 from perception.limits import MAX_FPS, MAX_FRAME_SIDE
 from perception.synthetic.footage import check_background
 
-__all__ = ["Camera", "Distractor", "Occlusion", "RenderStyle", "Scene", "visibility"]
+__all__ = ["DISTRACTOR_LIMITS", "OCCLUSION_LIMITS", "RENDER_LIMITS", "Camera", "Distractor",
+           "Occlusion", "RenderStyle", "Scene", "visibility"]
+
+#: Largest frame index, and largest distance from the object, m, of a distractor.
+_MAX_FRAME = 10_000_000
+_MAX_M = 10.0
+
+#: Type and range of each :class:`Distractor` field (a recipe's ``[[render.distractors]]``).
+DISTRACTOR_LIMITS: dict[str, Spec] = {
+    "colour": Spec("colour"),
+    "start": Spec(float, -_MAX_M, _MAX_M, size=2, note="m"),
+    "end": Spec(float, -_MAX_M, _MAX_M, size=2, note="m"),
+    "diameter": Spec(float, 0, 1, lo_open=True, note="m"),
+    "frames": Spec(int, 0, _MAX_FRAME, size=2),
+    "shape": Spec(str, choices=("disc", "bar")),
+    "aspect": Spec(float, 0, 1, lo_open=True),
+    "angle_deg": Spec(float, -360, 360, note="degrees"),
+}
+#: Of each :class:`Occlusion` field (a recipe's ``[[render.occlusions]]``).
+OCCLUSION_LIMITS: dict[str, Spec] = {
+    "marker": Spec(str),
+    "start": Spec(int, 0, _MAX_FRAME),
+    "stop": Spec(int, 0, _MAX_FRAME),
+}
+#: Of each :class:`RenderStyle` field (a recipe's ``[render]``); ``distractors``
+#: and ``occlusions`` are checked by their own classes.
+RENDER_LIMITS: dict[str, Spec] = {
+    # below MAX_FPS: a header claiming MAX_FPS is read as "no rate stated"
+    "fps": Spec(float, 0, MAX_FPS, lo_open=True, hi_open=True, note="a frame rate, frames/s"),
+    "width": Spec(int, 16, MAX_FRAME_SIDE, note="width and height in px"),
+    "height": Spec(int, 16, MAX_FRAME_SIDE, note="width and height in px"),
+    "codec": Spec(str),
+    "texture": Spec(bool),
+    "hand": Spec(bool),
+    "marker_diameter": Spec(float, 0, 0.5, note="m"),
+    "band_size": Spec(float, 0, 1, lo_open=True, size=2, note="m"),
+    "noise_sd": Spec(float, 0, 255, note="grey levels"),
+    "blur_sigma": Spec(float, 0, 100, note="px"),
+    "lighting": Spec(float, 0, 1, hi_open=True),
+    "lighting_angle_deg": Spec(float, -360, 360, note="degrees"),
+    "distractors": Spec("any"),
+    "occlusions": Spec("any"),
+    "background": Spec(str),
+    "exposure": Spec(float, 0, 1, note="s, at most one frame period"),
+    "motion_samples": Spec(int, 1, 100),
+    "flicker": Spec(float, 0, 1),
+    "shading": Spec(float, 0, 1),
+    "sleeve": Spec("colour"),
+}
 
 
 @dataclass(frozen=True)
@@ -144,12 +194,10 @@ class Distractor:
     angle_deg: float = 0.0
 
     def __post_init__(self) -> None:
-        if self.shape not in ("disc", "bar"):
-            raise ValueError(f"Distractor.shape: expected 'disc' or 'bar', got {self.shape!r}")
-        if not 0 < self.aspect <= 1:
-            raise ValueError(f"Distractor.aspect: expected 0 < aspect <= 1, got {self.aspect!r}")
-        if not self.diameter > 0:
-            raise ValueError(f"Distractor.diameter: expected > 0 m, got {self.diameter!r}")
+        check_fields(self, DISTRACTOR_LIMITS, "Distractor")
+        if self.frames is not None and self.frames[0] > self.frames[1]:
+            raise InputError(f"expected [first, stop], got {list(self.frames)}",
+                             field="Distractor.frames")
 
     def position(self, index: int, n_frames: int) -> np.ndarray | None:
         """World position (2,) m at frame ``index``, or None when not visible."""
@@ -170,6 +218,9 @@ class Occlusion:
     marker: str
     start: int
     stop: int
+
+    def __post_init__(self) -> None:
+        check_fields(self, OCCLUSION_LIMITS, "Occlusion")
 
 
 @dataclass(frozen=True)
@@ -250,31 +301,17 @@ class RenderStyle:
     sleeve: str | tuple[int, int, int] | None = None
 
     def __post_init__(self) -> None:
-        if not (math.isfinite(self.fps) and 0 < self.fps <= MAX_FPS):
-            raise ValueError(f"RenderStyle.fps: expected a frame rate in (0, {MAX_FPS:g}] "
-                             f"frames/s, got {self.fps!r}")
-        if not all(16 <= int(side) <= MAX_FRAME_SIDE for side in (self.width, self.height)):
-            raise ValueError(f"RenderStyle: expected width and height of 16 to {MAX_FRAME_SIDE} "
-                             f"px, got {self.width} x {self.height}")
-        for name in ("noise_sd", "blur_sigma", "marker_diameter", "exposure", "flicker"):
-            if not getattr(self, name) >= 0:
-                raise ValueError(f"RenderStyle.{name}: expected >= 0, got {getattr(self, name)!r}")
-        if not 0 <= self.lighting < 1:
-            raise ValueError(
-                f"RenderStyle.lighting: expected 0 <= lighting < 1, got {self.lighting!r}"
-            )
-        if not 0 <= self.shading <= 1:
-            raise ValueError(f"RenderStyle.shading: expected 0 <= shading <= 1, "
-                             f"got {self.shading!r}")
+        check_fields(self, RENDER_LIMITS, "RenderStyle")
         if self.exposure > 1 / self.fps:
-            raise ValueError(f"RenderStyle.exposure: expected at most one frame period "
-                             f"({1 / self.fps:.4f} s), got {self.exposure!r}")
-        if int(self.motion_samples) < 1:
-            raise ValueError(f"RenderStyle.motion_samples: expected >= 1, got "
-                             f"{self.motion_samples!r}")
+            raise InputError(f"expected at most one frame period ({1 / self.fps:.4f} s), "
+                             f"got {self.exposure!r}", field="RenderStyle.exposure")
+        for name, kind in (("distractors", Distractor), ("occlusions", Occlusion)):
+            items = getattr(self, name)
+            if not isinstance(items, list | tuple) or not all(isinstance(i, kind)
+                                                              for i in items):
+                raise InputError(f"expected {kind.__name__}s, got {items!r}"[:120],
+                                 field=f"RenderStyle.{name}")
         check_background(self.background)
-        if isinstance(self.sleeve, (list, tuple)):
-            object.__setattr__(self, "sleeve", tuple(int(c) for c in self.sleeve))
         object.__setattr__(self, "distractors", tuple(self.distractors))
         object.__setattr__(self, "occlusions", tuple(self.occlusions))
 
@@ -388,6 +425,11 @@ class Scene:
         ahead = wrist + np.array([0.0, wrist_offset])
         lateral = np.stack([ap / 2, np.zeros_like(ap)], axis=1)
         return cls(wrist, ahead + lateral, ahead - lateral, object_diameter=object_diameter)
+
+
+document_ranges(Distractor, DISTRACTOR_LIMITS)
+document_ranges(Occlusion, OCCLUSION_LIMITS)
+document_ranges(RenderStyle, RENDER_LIMITS)
 
 
 def _min_jerk(tau: np.ndarray) -> np.ndarray:

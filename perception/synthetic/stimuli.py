@@ -24,12 +24,26 @@ from dataclasses import dataclass
 import numpy as np
 
 from minvar import GraspTask, GripVia, simulate_grasp
+from perception.errors import InputError
 from perception.geometry import DEFAULT_OBJECT_DIAMETER, DEFAULT_TIP_START
+from perception.io.config import Spec, check_fields, document_ranges
 from perception.limits import MAX_REST_S
 
-__all__ = ["CONDITIONS", "StimulusParams", "stimulus_task", "stimulus_paths"]
+__all__ = ["CONDITIONS", "SCENE_LIMITS", "StimulusParams", "stimulus_task", "stimulus_paths"]
 
 CONDITIONS = ("normal", "delayed", "open-close-open", "reach")
+
+#: Type and range of each :class:`StimulusParams` field but ``condition``
+#: (a recipe's ``[scene]``).
+SCENE_LIMITS: dict[str, Spec] = {
+    "object_size": Spec(float, 0, 0.5, lo_open=True, note="m"),
+    "distance": Spec(float, 0, 2, lo_open=True, note="m"),
+    "duration": Spec(float, 0, 10, lo_open=True, note="s"),
+    "execution_cv": Spec(float, 0, 1),
+    "rest_before": Spec(float, 0, MAX_REST_S, note="s"),
+    "rest_after": Spec(float, 0, MAX_REST_S, note="s"),
+    "marker_offset": Spec(float, 0, 0.1, note="m"),
+}
 
 
 @dataclass(frozen=True)
@@ -66,19 +80,12 @@ class StimulusParams:
 
     def __post_init__(self):
         if self.condition not in CONDITIONS:
-            raise ValueError(f"condition: expected one of {CONDITIONS}, got {self.condition!r}")
-        for name, positive in (("object_size", True), ("distance", True), ("duration", True),
-                               ("execution_cv", False), ("rest_before", False),
-                               ("rest_after", False), ("marker_offset", False)):
-            value = getattr(self, name)
-            if not (isinstance(value, int | float) and np.isfinite(value)
-                    and (value > 0 if positive else value >= 0)):
-                raise ValueError(f"[scene] {name}: expected a finite value "
-                                 f"{'> 0' if positive else '>= 0'}, got {value!r}")
-        for name in ("rest_before", "rest_after"):
-            if getattr(self, name) > MAX_REST_S:
-                raise ValueError(f"[scene] {name}: at most {MAX_REST_S:g} s of rest, got "
-                                 f"{getattr(self, name)!r}")
+            raise InputError(f"expected one of {', '.join(CONDITIONS)}, got {self.condition!r}",
+                             field="StimulusParams.condition")
+        check_fields(self, SCENE_LIMITS, "StimulusParams")
+
+
+document_ranges(StimulusParams, SCENE_LIMITS)
 
 
 def stimulus_task(p: StimulusParams) -> GraspTask:

@@ -24,14 +24,14 @@ import os
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field, fields, replace
 from functools import cached_property
-from pathlib import Path
 from typing import Any
 
 import cv2
 import numpy as np
 
 from perception.errors import InputError
-from perception.io.config import check_keys, read_toml
+from perception.io.config import Spec, check_keys, check_value, read_toml, suggest
+from perception.io.files import input_file
 
 #: Marker names in file order (``/tracks/markers``).
 MARKER_NAMES: tuple[str, ...] = ("thumb", "finger", "wrist", "object")
@@ -64,21 +64,20 @@ class MarkerColour:
     val_min: int = 50
 
     def __post_init__(self) -> None:
-        where = f"marker {self.name!r}"
-        bgr = tuple(int(c) for c in np.asarray(self.bgr).ravel())
-        if len(bgr) != 3 or not all(0 <= c <= 255 for c in bgr):
-            raise ValueError(f"{where}: bgr: expected 3 integers 0..255, got {self.bgr!r}")
-        object.__setattr__(self, "bgr", bgr)
-        hue = _normalise_hue(self.hue, where)
+        bgr = self.bgr
+        if isinstance(bgr, np.ndarray):
+            bgr = bgr.ravel().tolist()
+        if check_value(bgr, Spec(int, 0, 255, size=3)):
+            raise InputError(f"expected 3 integers 0..255, got {self.bgr!r}",
+                             field=f"{self.name}.bgr")
+        object.__setattr__(self, "bgr", tuple(int(c) for c in bgr))
+        hue = _normalise_hue(self.hue, f"{self.name}.hue")
         object.__setattr__(self, "hue", hue)
         for name in ("sat_min", "val_min"):
             value = getattr(self, name)
-            if (
-                isinstance(value, bool)
-                or not isinstance(value, (int, np.integer))
-                or not (0 <= value <= 255)
-            ):
-                raise ValueError(f"{where}: {name}: expected an integer 0..255, got {value!r}")
+            problem = check_value(value, Spec(int, 0, 255))
+            if problem:
+                raise InputError(problem, field=f"{self.name}.{name}")
             object.__setattr__(self, name, int(value))
 
     @cached_property
@@ -136,16 +135,19 @@ class MarkerColour:
         }
 
 
-def _normalise_hue(hue: Any, where: str) -> tuple[tuple[int, int], ...]:
+def _normalise_hue(hue: Any, field: str) -> tuple[tuple[int, int], ...]:
     """Accept ``[lo, hi]`` or ``[[lo, hi], ...]``; return a tuple of int pairs."""
-    bad = ValueError(
-        f"{where}: hue: expected [lo, hi] or a list of [lo, hi] ranges with "
-        f"integers 0..179 (lo > hi wraps through 0), got {hue!r}"
+    shown = repr(hue) if len(repr(hue)) <= 60 else repr(hue)[:57] + "..."
+    bad = InputError(
+        "expected [lo, hi] or a list of [lo, hi] ranges with "
+        f"integers 0..179 (lo > hi wraps through 0), got {shown}", field=field
     )
     try:
         arr = np.asarray(hue)
     except (TypeError, ValueError):
         raise bad from None
+    if arr.dtype == object or arr.size > 2 * 180:
+        raise bad
     if arr.ndim == 1:
         arr = arr[None, :]
     if arr.ndim != 2 or arr.shape[1] != 2 or arr.shape[0] == 0:
@@ -203,7 +205,7 @@ class MarkerSet:
         """JSON of :meth:`to_dict` (stored in ``/tracker`` attrs)."""
         return json.dumps(self.to_dict())
 
-    def with_overrides(self, overrides: Mapping[str, Any], source: str = "colours") -> MarkerSet:
+    def with_overrides(self, overrides: Mapping[str, Any], source: str = "") -> MarkerSet:
         """Return a copy with fields replaced from ``{marker: {field: value}}``.
 
         Parameters
@@ -212,42 +214,47 @@ class MarkerSet:
             Marker name -> mapping of :class:`MarkerColour` fields (``bgr`` or
             ``rgb``, ``hue``, ``sat_min``, ``val_min``).
         source : str
-            Where the overrides come from, for error messages.
+            Where the overrides come from (``"[markers]"``), put before the
+            field an error names.
 
         Raises
         ------
-        ValueError
-            Unknown marker or field, or an invalid value; the message names
-            ``marker.field``.
+        InputError
+            Unknown marker or field, or an invalid value; its field is
+            ``marker.field`` (after ``source``).
         """
+        def where(field: str | None = None) -> str | None:
+            return " ".join(p for p in (source, field) if p) or None
+
         if not isinstance(overrides, Mapping):
-            raise ValueError(
-                f"{source}: expected a table of markers, got {type(overrides).__name__}"
-            )
+            raise InputError(f"expected a table of markers, got {type(overrides).__name__}",
+                             field=where())
         by_name = {m.name: m for m in self.markers}
         for name, table in overrides.items():
             if name not in by_name:
-                raise ValueError(
-                    f"{source}: unknown marker {name!r} (expected one of {', '.join(self.names)})"
-                )
+                raise InputError(f"unknown marker {name!r}{suggest(str(name), self.names)} "
+                                 f"(expected one of {', '.join(self.names)})", field=where())
             if not isinstance(table, Mapping):
-                raise ValueError(f"{source}: {name}: expected a table of fields, got {table!r}")
+                raise InputError(f"expected a table of fields, got {table!r}"[:120],
+                                 field=where(str(name)))
             unknown = sorted(set(table) - set(_FIELDS))
             if unknown:
-                raise ValueError(
-                    f"{source}: {name}.{unknown[0]}: unknown field (expected {', '.join(_FIELDS)})"
-                )
+                raise InputError(f"unknown field{suggest(unknown[0], _FIELDS)} "
+                                 f"(expected {', '.join(_FIELDS)})",
+                                 field=where(f"{name}.{unknown[0]}"))
             if "bgr" in table and "rgb" in table:
-                raise ValueError(f"{source}: {name}: give bgr or rgb, not both")
+                raise InputError("give bgr or rgb, not both", field=where(str(name)))
             changes = {k: v for k, v in table.items() if k != "rgb"}
             if "rgb" in table:
                 rgb = table["rgb"]
                 changes["bgr"] = list(rgb)[::-1] if isinstance(rgb, (list, tuple)) else rgb
             try:
                 by_name[name] = replace(by_name[name], **changes)
-            except (ValueError, TypeError) as exc:
-                # Re-point the message at the file's field name.
-                raise ValueError(f"{source}: {name}.{_field_in(str(exc))}") from None
+            except InputError as exc:
+                field = exc.field or ""
+                if "rgb" in table:
+                    field = field.replace(".bgr", ".rgb")
+                raise InputError(exc.problem, field=where(field)) from None
         return MarkerSet(tuple(by_name[n] for n in self.names))
 
     @classmethod
@@ -261,13 +268,8 @@ class MarkerSet:
             try:
                 markers.append(MarkerColour(name=name, **kwargs))
             except (ValueError, TypeError) as exc:
-                raise ValueError(f"{source}: {name}.{_field_in(str(exc))}") from None
+                raise ValueError(f"{source}: {exc}") from None
         return cls(tuple(markers))
-
-
-def _field_in(message: str) -> str:
-    """``"marker 'thumb': hue: expected ..."`` -> ``"hue: expected ..."``."""
-    return message.split(": ", 1)[1] if message.startswith("marker ") else message
 
 
 def default_markers() -> MarkerSet:
@@ -292,32 +294,30 @@ def load_markers(path: str | os.PathLike, base: MarkerSet | None = None) -> Mark
         valid name is suggested); an invalid value (the message names
         ``marker.field``). The message names the file.
     """
-    p = Path(path)
+    p = input_file(path, "colours file")
     base = default_markers() if base is None else base
     if p.suffix.lower() == ".json":
         try:
             raw = p.read_bytes()
-        except FileNotFoundError:
-            raise InputError("colours file not found", p) from None
         except OSError as exc:
             raise InputError(f"cannot read colours file ({exc.strerror})", p) from None
         try:
             data = json.loads(raw.decode("utf-8"))
-        except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        except (UnicodeDecodeError, json.JSONDecodeError, RecursionError) as exc:
             raise InputError(f"not valid JSON: {exc}", p) from None
     else:
         data = read_toml(p, "colours file")
+    # Here rather than in with_overrides: a hand-written file's usual
+    # mistake is a misspelling, and the nearest valid name fixes it.
+    if isinstance(data, Mapping):
+        check_keys(data, base.names, "the top level", p)
+        for name, table in data.items():
+            if isinstance(table, Mapping):
+                check_keys(table, _FIELDS, f"marker {name!r}", p)
     try:
-        # Here rather than in with_overrides: a hand-written file's usual
-        # mistake is a misspelling, and the nearest valid name fixes it.
-        if isinstance(data, Mapping):
-            check_keys(data, base.names, "the top level")
-            for name, table in data.items():
-                if isinstance(table, Mapping):
-                    check_keys(table, _FIELDS, f"marker {name!r}")
-        return base.with_overrides(data, source="colours")
-    except ValueError as exc:
-        raise InputError(str(exc).removeprefix("colours: "), p) from None
+        return base.with_overrides(data)
+    except InputError as exc:
+        raise InputError(exc.problem, p, field=exc.field) from None
 
 
 # Saturations sit well above skin's (~110) so a skin-coloured hand never

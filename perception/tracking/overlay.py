@@ -20,7 +20,7 @@ from perception.errors import InputError
 from perception.io.tracks import Status, Tracks
 from perception.io.video import FrameSource, VideoWriter
 
-__all__ = ["Labeller", "render_labelled"]
+__all__ = ["Labeller", "render_labelled", "tracked_video"]
 
 _GREY = (160, 160, 160)
 _FONT = cv2.FONT_HERSHEY_SIMPLEX
@@ -109,9 +109,63 @@ def _colours(tracks: Tracks) -> list[tuple[int, int, int]]:
         models = json.loads(tracks.tracker.get("colour_models", "{}"))
     except (TypeError, ValueError):
         pass
+    if not isinstance(models, dict):
+        models = {}
     palette = [(60, 60, 230), (60, 200, 60), (230, 120, 40), (40, 210, 230), (200, 60, 200)]
-    return [tuple(models.get(m, {}).get("bgr", palette[j % len(palette)]))
-            for j, m in enumerate(tracks.markers)]
+    colours = []
+    for j, m in enumerate(tracks.markers):
+        model = models.get(m)
+        bgr = model.get("bgr") if isinstance(model, dict) else None
+        ok = (isinstance(bgr, list | tuple) and len(bgr) == 3
+              and all(isinstance(c, int) and 0 <= c <= 255 for c in bgr))
+        colours.append(tuple(bgr) if ok else palette[j % len(palette)])
+    return colours
+
+
+def tracked_video(tracks: Tracks, video: str | os.PathLike | None = None) -> Path:
+    """The video ``tracks`` were tracked from, checked to be that very file.
+
+    Parameters
+    ----------
+    tracks : Tracks
+        The tracks; their ``/video`` ``path`` is the default (a relative
+        one is looked for beside the tracks file, then in the working
+        folder), and their ``sha256``, if recorded, must match the video's.
+    video : str or os.PathLike, optional
+        The video the user named instead.
+
+    Raises
+    ------
+    InputError
+        No video given or recorded, not a regular file, or a file whose
+        SHA-256 differs from the one the tracks record.
+    """
+    from perception.io.files import input_file
+    from perception.io.video import sha256_file
+
+    field = "VIDEO" if video is not None else "/video.path"
+    if video is None:
+        stored = tracks.video.get("path")
+        if not stored:
+            raise InputError("the tracks name no video: give the VIDEO", tracks.path)
+        video = Path(stored)
+        if not video.is_absolute() and tracks.path is not None:
+            # written relative to the folder the tracker ran in, which may be
+            # this one; the SHA-256 below tells whether it is the right file
+            beside = Path(tracks.path).parent / video
+            video = beside if beside.exists() or not video.exists() else video
+    video = input_file(video, "video")
+    sha = tracks.video.get("sha256")
+    if sha:
+        try:
+            digest = sha256_file(video)
+        except OSError as exc:
+            raise InputError(f"cannot read the video: {exc.strerror or exc}", video) from None
+        if digest != str(sha).lower():
+            raise InputError(f"not the tracked video: its SHA-256 is {digest[:12]}..., the "
+                             f"tracks ({tracks.path}) record {str(sha)[:12]}...; give the "
+                             "video they were tracked from", video, field=field)
+    return video
 
 
 def render_labelled(tracks: Tracks, video: str | os.PathLike | None,
@@ -132,11 +186,10 @@ def render_labelled(tracks: Tracks, video: str | os.PathLike | None,
     Raises
     ------
     InputError
-        No video given or recorded, or a video with fewer frames than the tracks.
+        No video given or recorded, a video other than the tracked one (its
+        SHA-256 differs), or a video with fewer frames than the tracks.
     """
-    video = video or tracks.video.get("path")
-    if not video:
-        raise InputError("the tracks name no video: give the VIDEO", tracks.path)
+    video = tracked_video(tracks, video)
     row = {int(f): i for i, f in enumerate(tracks.frame)}
     labeller = Labeller(tracks.markers, _colours(tracks), trail)
     nan = np.full((len(tracks.markers), 2), np.nan)

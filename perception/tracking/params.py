@@ -11,6 +11,11 @@ Masses and areas are pixel counts of a marker's colour; ratios are taken
 against the marker's *reference mass*, the pixel count of the whole marker,
 measured when it is first found and then followed slowly
 (``ref_update``).
+
+Every field has a type and a range (:data:`LIMITS`, listed at the end of
+the :class:`TrackerParams` docstring): a setup file's ``[tracker]`` and
+``[sizes]`` values are checked against it, naming the file and field, and
+so is every ``TrackerParams`` built in Python.
 """
 
 from __future__ import annotations
@@ -20,7 +25,69 @@ from functools import cached_property
 
 import cv2
 
+from perception.errors import InputError
 from perception.geometry import DEFAULT_OBJECT_DIAMETER
+from perception.io.config import Spec, check_fields, document_ranges
+
+_PX = 4096  # px: a distance or window side no larger than the largest frame side
+
+#: Type and range of every :class:`TrackerParams` field (inclusive bounds
+#: unless open; integers are C ints for OpenCV, floats finite).
+LIMITS: dict[str, Spec] = {
+    "min_window_px": Spec(int, 3, _PX),
+    "search_margin_px": Spec(int, 0, _PX),
+    "initial_margin_px": Spec(int, 0, _PX),
+    "velocity_margin": Spec(float, 0, 100),
+    "alpha": Spec(float, 0, 1, lo_open=True),
+    "beta": Spec(float, 0, 2, hi_open=True),
+    "lost_ratio": Spec(float, 0, 1, lo_open=True),
+    "reacquire_ratio": Spec(float, 0, 1, lo_open=True),
+    "split_ratio": Spec(float, 1, 1000),
+    "merge_ratio": Spec(float, 1, 1000),
+    "max_area_ratio": Spec(float, 1, 1000),
+    "hold_ratio": Spec(float, 0, 1),
+    "still_jump_px": Spec(float, 0, _PX),
+    "still_markers": Spec(str, size=0),
+    "term_eps_px": Spec(float, 0, 100, lo_open=True),
+    "term_max_iter": Spec(int, 1, 1000),
+    "min_area_px": Spec(int, 1, 10_000_000),
+    "search_scale": Spec(int, 0, 64),
+    "ref_update": Spec(float, 0, 1),
+    "lost_velocity_decay": Spec(float, 0, 1),
+    "init_candidates": Spec(int, 1, 20),
+    "search_min_ratio": Spec(float, 0, 1),
+    "search_tries": Spec(int, 1, 100),
+    "search_marker_px": Spec(float, 0, _PX, lo_open=True),
+    "search_max_scale": Spec(int, 1, 64),
+    "ref_update_band": Spec(float, 1, 100),
+    "still_min_rate": Spec(float, 0, 1, lo_open=True),
+    "still_shift_px": Spec(float, 0, _PX),
+    "max_window_ratio": Spec(float, 1, 100),
+    "object_diameter": Spec(float, 0, 10, lo_open=True),
+    "marker_diameter": Spec(float, 0, 1, lo_open=True),
+    "band_size": Spec(float, 0, 1, lo_open=True, size=2),
+    "size_tolerance": Spec(float, 1, 100),
+    "min_roundness": Spec(float, 0, 1, lo_open=True),
+    "band_elongation": Spec(float, 0, 100, lo_open=True, size=2),
+    "min_saturation_ratio": Spec(float, 0, 1),
+    "min_value_ratio": Spec(float, 0, 1),
+    "strict_saturation_ratio": Spec(float, 0, 1),
+    "strict_value_ratio": Spec(float, 0, 1),
+    "own_saturation_margin": Spec(int, 0, 255),
+    "own_value_ratio": Spec(float, 0, 1),
+    "rest_motion_px": Spec(float, 0, _PX, lo_open=True),
+    "init_frames": Spec(int, 1, 1000),
+    "digit_gap": Spec(float, 0, 1, lo_open=True),
+    "hand_span": Spec(float, 0, 2, lo_open=True),
+    "min_band_distance": Spec(float, 0, 1),
+    "ambiguity_margin": Spec(float, 0, 1000),
+    "max_speed": Spec(float, 0, 100, lo_open=True),
+    "merged_likelihood": Spec(float, 0, 0.5, hi_open=True),
+    "clutter_ratio": Spec(float, 0, 1000),
+    "max_merged_frames": Spec(int, 0, 100_000),
+    "hand_drift": Spec(float, 0, 1),
+    "max_drift": Spec(float, 0, 2),
+}
 
 
 @dataclass(frozen=True)
@@ -229,45 +296,18 @@ class TrackerParams:
     max_drift: float = 0.06
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "still_markers", tuple(self.still_markers))
-        for name in ("band_size", "band_elongation"):
-            value = tuple(float(v) for v in getattr(self, name))
-            if len(value) != 2 or not all(v > 0 for v in value):
-                raise ValueError(f"TrackerParams.{name}: expected two positive numbers, "
-                                 f"got {getattr(self, name)!r}")
-            object.__setattr__(self, name, value)
-        for name in ("object_diameter", "marker_diameter", "digit_gap", "hand_span",
-                     "max_speed", "rest_motion_px"):
-            if not getattr(self, name) > 0:
-                raise ValueError(f"TrackerParams.{name}: expected > 0, got "
-                                 f"{getattr(self, name)!r}")
-        if self.size_tolerance < 1 or not 0 < self.min_roundness <= 1:
-            raise ValueError("TrackerParams: expected size_tolerance >= 1 and "
-                             "0 < min_roundness <= 1")
-        if self.init_frames < 1 or not 0 <= self.merged_likelihood < 0.5:
-            raise ValueError("TrackerParams: expected init_frames >= 1 and "
-                             "0 <= merged_likelihood < 0.5")
-        if not 0 < self.lost_ratio <= self.reacquire_ratio <= 1:
-            raise ValueError(
-                "TrackerParams: expected 0 < lost_ratio <= reacquire_ratio <= 1, got "
-                f"{self.lost_ratio}, {self.reacquire_ratio}"
-            )
-        if not 1 <= self.split_ratio <= self.merge_ratio <= self.max_area_ratio:
-            raise ValueError(
-                "TrackerParams: expected 1 <= split_ratio <= merge_ratio <= max_area_ratio"
-            )
-        if self.min_window_px < 3 or self.term_max_iter < 1 or self.term_eps_px <= 0:
-            raise ValueError(
-                "TrackerParams: expected min_window_px >= 3, term_max_iter >= 1, term_eps_px > 0"
-            )
-        if min(self.init_candidates, self.search_tries, self.search_max_scale) < 1:
-            raise ValueError(
-                "TrackerParams: expected init_candidates, search_tries, search_max_scale >= 1"
-            )
-        if self.ref_update_band < 1 or not 0 < self.still_min_rate <= 1:
-            raise ValueError(
-                "TrackerParams: expected ref_update_band >= 1 and 0 < still_min_rate <= 1"
-            )
+        check_fields(self, LIMITS, "TrackerParams")
+        # what the ranges alone cannot say
+        for names in (("lost_ratio", "reacquire_ratio"),
+                      ("split_ratio", "merge_ratio", "max_area_ratio")):
+            values = [getattr(self, n) for n in names]
+            if values != sorted(values):
+                raise InputError(f"expected {' <= '.join(names)}, got "
+                                 f"{', '.join(map(repr, values))}",
+                                 field=f"TrackerParams.{names[0]}")
+        if self.band_elongation[0] > self.band_elongation[1]:
+            raise InputError(f"expected [low, high], got {list(self.band_elongation)}",
+                             field="TrackerParams.band_elongation")
 
     @cached_property
     def criteria(self) -> tuple[int, int, float]:
@@ -277,3 +317,6 @@ class TrackerParams:
             int(self.term_max_iter),
             float(self.term_eps_px),
         )
+
+
+document_ranges(TrackerParams, LIMITS)

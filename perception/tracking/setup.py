@@ -31,10 +31,8 @@ Unknown tables and keys are refused, naming the nearest valid one.
 from __future__ import annotations
 
 import dataclasses
-import difflib
 import math
 import os
-import tomllib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -45,15 +43,16 @@ import numpy as np
 
 from perception.errors import InputError
 from perception.io.atomic import write_text
+from perception.io.config import Spec, check_keys, check_table, read_toml, sub_table
+from perception.io.files import input_file
 from perception.tracking.markers import MarkerColour, MarkerSet, default_markers
 from perception.tracking.measurement import soft_diameter
-from perception.tracking.params import TrackerParams
+from perception.tracking.params import LIMITS, TrackerParams
 
 __all__ = ["TrackingSetup", "calibrate", "load_setup", "write_setup"]
 
 _TABLES = ("setup", "sizes", "markers", "tracker")
 _SIZES = ("object_diameter", "marker_diameter", "band_size")
-_MARKER_KEYS = ("bgr", "rgb", "hue", "sat_min", "val_min")
 #: Hue units (0..179) added to each side of the hue range a marker shows.
 _HUE_PAD = 4
 #: Saturation units below the 5th percentile a marker shows that still count.
@@ -142,16 +141,21 @@ def write_setup(path: str | os.PathLike, setup: TrackingSetup) -> Path:
     return write_text(path, "\n".join(lines))
 
 
-def _refuse(keys, valid: Sequence[str], where: str) -> None:
-    for key in keys:
-        if key not in valid:
-            near = difflib.get_close_matches(str(key), list(valid), n=1)
-            hint = f"did you mean {near[0]!r}?" if near else f"expected one of {', '.join(valid)}"
-            raise ValueError(f"{where}: unknown key {key!r} ({hint})")
+#: Type and range of each ``[setup]`` value.
+SETUP_SPECS = {"source": Spec(str), "frames": Spec(int, 0, 1_000_000)}
+#: Of each ``[markers.NAME]`` value (``hue`` is checked by :class:`MarkerColour`).
+MARKER_SPECS = {"bgr": Spec(int, 0, 255, size=3), "rgb": Spec(int, 0, 255, size=3),
+                "hue": Spec("any"), "sat_min": Spec(int, 0, 255),
+                "val_min": Spec(int, 0, 255)}
 
 
 def load_setup(path: str | os.PathLike) -> TrackingSetup:
     """Read a setup file.
+
+    Every value is checked for its type and range (:data:`SETUP_SPECS`,
+    :data:`MARKER_SPECS` and :data:`perception.tracking.params.LIMITS`, the
+    ranges listed in the :class:`TrackerParams` docstring) before anything
+    is built from it.
 
     Parameters
     ----------
@@ -161,35 +165,38 @@ def load_setup(path: str | os.PathLike) -> TrackingSetup:
     Raises
     ------
     InputError
-        Missing or unparsable file, an unknown table or key (the nearest
-        valid one is named), or a bad value; the message names the file.
+        Missing, not a regular file (a FIFO) or unparsable file, a table that
+        is not a table, an unknown table or key (the nearest valid one is
+        named), or a value of the wrong type or out of range; the message
+        names the file and the field (``[tracker] search_scale``).
     """
-    p = Path(path)
+    p = input_file(path, "setup file")
+    data = read_toml(p, "setup file")
+    check_keys(data, _TABLES, "the top level", p)
+    meta = sub_table(data, "setup", "[setup]", p)
+    check_table(meta, SETUP_SPECS, "[setup]", p)
+    sizes = sub_table(data, "sizes", "[sizes]", p)
+    check_table(sizes, {k: LIMITS[k] for k in _SIZES}, "[sizes]", p)
+    tracker = sub_table(data, "tracker", "[tracker]", p)
+    check_table(tracker, {k: v for k, v in LIMITS.items() if k not in _SIZES}, "[tracker]", p)
+    markers = sub_table(data, "markers", "[markers]", p)
+    for name in markers:
+        check_keys({name: None}, default_markers().names, "[markers]", p)
+        where = f"[markers.{name}]"
+        check_table(sub_table(markers, name, where, p), MARKER_SPECS, where, p)
     try:
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise InputError("setup file not found", p) from None
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
-        raise InputError(f"not a readable TOML setup file: {exc}", p) from None
-    try:
-        _refuse(data, _TABLES, "setup file")
-        meta = data.get("setup", {})
-        _refuse(meta, ("source", "frames"), "[setup]")
-        sizes = data.get("sizes", {})
-        _refuse(sizes, _SIZES, "[sizes]")
-        tracker = data.get("tracker", {})
-        _refuse(tracker, [f.name for f in dataclasses.fields(TrackerParams)
-                          if f.name not in _SIZES], "[tracker]")
-        markers = data.get("markers", {})
-        for name, table in markers.items():
-            _refuse([name], default_markers().names, "[markers]")
-            _refuse(table, _MARKER_KEYS, f"[markers.{name}]")
         params = TrackerParams(**{**tracker, **sizes})
-        colours = default_markers().with_overrides(markers, source="[markers]")
-        return TrackingSetup(colours, params, str(meta.get("source", "")),
-                             int(meta.get("frames", 0)))
-    except (TypeError, ValueError) as exc:
-        raise InputError(str(exc), p) from None
+    except InputError as exc:  # a relation between fields (lost_ratio <= reacquire_ratio)
+        name = (exc.field or "").removeprefix("TrackerParams.")
+        table = "[sizes]" if name in _SIZES else "[tracker]"
+        raise InputError(exc.problem, p, field=f"{table} {name}".strip()) from None
+    try:
+        colours = default_markers().with_overrides(markers)
+    except InputError as exc:  # the hue, and bgr with rgb; exc.field: "thumb.hue"
+        name, _, key = (exc.field or "").partition(".")
+        field = f"[markers.{name}] {key}".strip() if name else "[markers]"
+        raise InputError(exc.problem, p, field=field) from None
+    return TrackingSetup(colours, params, meta.get("source", ""), meta.get("frames", 0))
 
 
 # -- calibration ------------------------------------------------------------------

@@ -1,0 +1,243 @@
+"""Batches never hang, never reuse a stale result, and never end on one bad clip.
+
+Every case here was once measured broken: a FIFO or a link to /dev/zero in a
+batch folder hung it (the clip was hashed before it was checked), a tracks
+file of another clip beside a video was trusted, a change to the code reused
+every old report, a silent scheduler hung the command, and a failure while
+recording a failure ended the batch without its summary.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import socket
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+from _demos import default_repertoire, demo_tracks
+
+from perception.batch import discover, find_clips, run_batch
+from perception.provenance import code_digest
+from perception.synthetic.recipes import Recipe, StimulusParams, synthesize
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _batch(src, out, *extra, env=None, timeout=120, cwd=None):
+    return subprocess.run([sys.executable, "-m", "hammer_mv", "batch", str(src), "-o", str(out),
+                           "--quiet", *extra], capture_output=True, text=True, timeout=timeout,
+                          env=env, cwd=cwd)
+
+
+@pytest.fixture(scope="module")
+def repfile(tmp_path_factory):
+    return default_repertoire().save(tmp_path_factory.mktemp("rep") / "rep.h5")
+
+
+@pytest.fixture(scope="module")
+def clips(tmp_path_factory):
+    out = tmp_path_factory.mktemp("clips")
+    recipe = Recipe(name="f", counts={"normal": 1, "delayed": 1},
+                    stimulus=StimulusParams(rest_before=0.3, rest_after=0.2))
+    synthesize(recipe, out, seed=5)
+    return out
+
+
+@pytest.fixture()
+def tracks_folder(tmp_path):
+    """Two demonstrations as tracks files (no video: fast)."""
+    src = tmp_path / "src"
+    src.mkdir()
+    for cond in ("normal", "delayed"):
+        demo_tracks(cond, 0)[0].save(src / f"{cond}.tracks.h5")
+    return src
+
+
+def test_fifos_devices_and_notes_in_a_folder_are_skipped_not_opened(tracks_folder, repfile,
+                                                                     tmp_path):
+    os.mkfifo(tracks_folder / "x.mp4")
+    (tracks_folder / "z.mp4").symlink_to("/dev/zero")
+    (tracks_folder / "notes.txt").write_text("not a clip")
+    (tracks_folder / "setup.toml").write_text("[tracker]\n")
+    found = find_clips(tracks_folder)
+    assert [i.clip for i in found.items] == ["delayed", "normal"]
+    assert dict(found.skipped).keys() == {"x.mp4", "z.mp4", "notes.txt", "setup.toml"}
+    assert "regular file" in dict(found.skipped)["x.mp4"]
+    out = tmp_path / "out"
+    proc = _batch(tracks_folder, out, "--repertoire", str(repfile), timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    summary = pd.read_csv(out / "summary.csv")
+    assert list(summary["clip"]) == ["delayed", "normal"] and (summary["status"] == "ok").all()
+    skipped = json.loads((out / "batch.json").read_text())["skipped"]
+    assert {s["file"] for s in skipped} == {"x.mp4", "z.mp4", "notes.txt", "setup.toml"}
+
+
+def test_a_manifest_row_naming_a_device_fails_that_clip_at_once(tracks_folder, repfile,
+                                                                 tmp_path):
+    manifest = tracks_folder / "manifest.csv"
+    manifest.write_text("clip,condition,video\nnormal,normal,normal.tracks.h5\n"
+                        "noise,normal,/dev/urandom\n")
+    start = time.monotonic()
+    proc = _batch(manifest, tmp_path / "out", "--repertoire", str(repfile), timeout=60)
+    assert time.monotonic() - start < 30
+    assert proc.returncode == 1, proc.stderr
+    s = pd.read_csv(tmp_path / "out" / "summary.csv").set_index("clip")
+    assert s.loc["normal", "status"] == "ok"
+    assert s.loc["noise", "status"] == "failed"
+    assert "/dev/urandom" in s.loc["noise", "error"] and "regular file" in s.loc["noise", "error"]
+
+
+def test_tracks_of_another_clip_beside_a_video_are_not_trusted(clips, repfile, tmp_path):
+    alone = tmp_path / "alone"
+    alone.mkdir()
+    shutil.copy(clips / "normal-01.mp4", alone)
+    assert _batch(alone, tmp_path / "ref", "--repertoire", str(repfile)).returncode == 0
+    ref = json.loads((tmp_path / "ref" / "normal-01.recognition.json").read_text())
+
+    src = tmp_path / "src"
+    src.mkdir()
+    shutil.copy(clips / "normal-01.mp4", src)
+    # the delayed grasp's tracks, under the normal clip's name
+    shutil.copy(tmp_path / "ref" / "tracks" / "normal-01.tracks.h5", tmp_path / "keep.h5")
+    proc = subprocess.run([sys.executable, "-m", "hammer_mv", "track",
+                           str(clips / "delayed-01.mp4"), "-o", str(src / "normal-01.tracks.h5"),
+                           "--quiet"], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    out = tmp_path / "out"
+    assert _batch(src, out, "--repertoire", str(repfile)).returncode == 0
+    got = json.loads((out / "normal-01.recognition.json").read_text())
+    for key in ("verdict", "winner", "familiarity", "margin"):
+        assert got[key] == ref[key], key
+    assert (out / "tracks" / "normal-01.tracks.h5").exists()  # tracked afresh
+
+    # its own current tracks beside it are reused, not tracked again
+    shutil.copy(tmp_path / "keep.h5", src / "normal-01.tracks.h5")
+    out2 = tmp_path / "out2"
+    assert _batch(src, out2, "--repertoire", str(repfile)).returncode == 0
+    assert not (out2 / "tracks" / "normal-01.tracks.h5").exists()
+    got = json.loads((out2 / "normal-01.recognition.json").read_text())
+    assert got["verdict"] == ref["verdict"] and got["familiarity"] == ref["familiarity"]
+
+
+def _code_copy(root: Path, change: str | None) -> Path:
+    """The packages copied to ``root``; ``change`` appended to the scoring module."""
+    for pkg in ("minvar", "perception", "hammer_mv"):
+        shutil.copytree(ROOT / pkg, root / pkg, ignore=shutil.ignore_patterns("__pycache__"))
+    if change:
+        with open(root / "perception" / "recognition" / "scoring.py", "a") as fh:
+            fh.write(change)
+    return root
+
+
+def test_a_change_to_the_scoring_code_recomputes_every_report(tracks_folder, repfile, tmp_path):
+    out = tmp_path / "out"
+    same = _code_copy(tmp_path / "same", None)
+    changed = _code_copy(tmp_path / "changed", "\n_UNUSED_SCORING_CONSTANT = 1.0\n")
+    # run from tmp_path: "python -m" puts the working folder (the checkout) first
+    env = {**os.environ, "PYTHONPATH": str(same)}
+    for _ in range(2):
+        assert _batch(tracks_folder, out, "--repertoire", str(repfile), env=env,
+                      cwd=tmp_path).returncode == 0
+    assert pd.read_csv(out / "summary.csv")["reused"].all()
+    env = {**os.environ, "PYTHONPATH": str(changed)}
+    proc = _batch(tracks_folder, out, "--repertoire", str(repfile), env=env, cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert not pd.read_csv(out / "summary.csv")["reused"].any()
+    code = "from perception.provenance import code_digest; print(code_digest())"
+    digests = [subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                              env={**os.environ, "PYTHONPATH": str(p)}, cwd=tmp_path).stdout.strip()
+               for p in (same, changed)]
+    assert digests[0] == code_digest() != digests[1]
+
+
+def test_a_silent_scheduler_fails_in_bounded_time(tracks_folder, repfile, tmp_path):
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen(4)
+    held = []
+    stop = threading.Event()
+
+    def accept():  # accepts and says nothing
+        server.settimeout(0.2)
+        while not stop.is_set():
+            try:
+                held.append(server.accept()[0])
+            except OSError:
+                continue
+
+    threading.Thread(target=accept, daemon=True).start()
+    try:
+        start = time.monotonic()
+        proc = _batch(tracks_folder, tmp_path / "out", "--repertoire", str(repfile),
+                      "--scheduler", f"tcp://127.0.0.1:{server.getsockname()[1]}", timeout=60)
+        elapsed = time.monotonic() - start
+    finally:
+        stop.set()
+        for c in held:
+            c.close()
+        server.close()
+    assert proc.returncode == 2 and elapsed < 30
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and "--scheduler" in lines[0], proc.stderr
+
+
+def test_a_failure_while_recording_a_failure_does_not_end_the_batch(tracks_folder, tmp_path,
+                                                                     monkeypatch):
+    import perception.batch as batch
+
+    def broken(out, clip):
+        raise OSError(36, "File name too long")
+
+    (tracks_folder / "empty.tracks.h5").write_bytes(b"")  # fails: its error handler runs
+    monkeypatch.setattr(batch, "clip_outputs", broken)
+    items = discover(tracks_folder)
+    summary = batch.summary_table([batch._guarded(i, tmp_path / "out",
+                                                  repertoire=default_repertoire(),
+                                                  settings=batch.RecognitionSettings(),
+                                                  repertoire_id="")
+                                   for i in items if i.clip == "empty"])
+    assert summary.loc[0, "status"] == "failed"
+
+
+def test_a_bug_in_one_clip_is_kept_with_its_traceback(tracks_folder, tmp_path, monkeypatch):
+    import perception.batch as batch
+
+    real = batch.recognize_tracks
+
+    def buggy(tracks, *args, clip=None, **kwargs):
+        if clip == "delayed":
+            raise ZeroDivisionError("a bug")
+        return real(tracks, *args, clip=clip, **kwargs)
+
+    monkeypatch.setattr(batch, "recognize_tracks", buggy)
+    out = tmp_path / "out"
+    summary = run_batch(discover(tracks_folder), out, default_repertoire(), quiet=True)
+    s = summary.set_index("clip")
+    assert s.loc["normal", "status"] == "ok" and s.loc["delayed", "status"] == "failed"
+    assert "unexpected ZeroDivisionError" in s.loc["delayed", "error"]
+    log = (out / "errors.log").read_text()
+    assert "Traceback" in log and "ZeroDivisionError: a bug" in log and "== delayed" in log
+    # a later clean run removes the stale log
+    monkeypatch.setattr(batch, "recognize_tracks", real)
+    run_batch(discover(tracks_folder), out, default_repertoire(), quiet=True)
+    assert not (out / "errors.log").exists()
+
+
+def test_a_tracks_subfolder_linked_outside_the_report_is_refused(tracks_folder, repfile,
+                                                                  tmp_path):
+    out, elsewhere = tmp_path / "out", tmp_path / "elsewhere"
+    out.mkdir()
+    elsewhere.mkdir()
+    (out / "tracks").symlink_to(elsewhere)
+    proc = _batch(tracks_folder, out, "--repertoire", str(repfile))
+    assert proc.returncode == 2
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and "outside the output folder" in lines[0], proc.stderr
+    assert not any(elsewhere.iterdir())
