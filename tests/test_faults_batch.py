@@ -241,3 +241,19 @@ def test_a_tracks_subfolder_linked_outside_the_report_is_refused(tracks_folder, 
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and "outside the output folder" in lines[0], proc.stderr
     assert not any(elsewhere.iterdir())
+
+
+def test_a_video_whose_name_is_not_utf8_is_tracked_and_reported(clips, repfile, tmp_path):
+    # OpenCV crashed the whole process (a segfault) opening such a name
+    src = tmp_path / "src"
+    src.mkdir()
+    name = os.fsdecode(b"grasp\xff.mp4")
+    shutil.copy(clips / "normal-01.mp4", src / name)
+    out = tmp_path / "out"
+    for _ in range(2):
+        proc = _batch(src, out, "--repertoire", str(repfile))
+        assert proc.returncode == 0, proc.stderr
+    summary = pd.read_csv(out / "summary.csv")
+    assert (summary["status"] == "ok").all() and summary["reused"].all()
+    for path in [*out.iterdir(), *(out / "tracks").iterdir()]:
+        os.fsencode(path.name).decode("utf-8")  # every output name is valid UTF-8

@@ -401,3 +401,16 @@ def test_recognize_tracks_leaves_a_bug_a_bug(monkeypatch):
     with pytest.raises(ValueError) as info:
         pipeline.recognize_tracks(None, Broken(), source="clip.mp4")
     assert not isinstance(info.value, InputError | PlanningError)
+
+
+@pytest.mark.parametrize("argv", [
+    ["reach", "--trials", "5"],
+    ["grasp", "simulate", "--trials", "2"],
+    ["repertoire", "build", "--durations", "1.0"],
+], ids=["reach", "grasp", "repertoire"])
+def test_quiet_commands_print_nothing_on_success(argv, tmp_path, capsys):
+    out = tmp_path / ("rep.h5" if argv[0] == "repertoire" else "out")
+    assert main([*argv, "-o", str(out), "--quiet"]) == 0
+    captured = capsys.readouterr()
+    assert captured.out == "" and captured.err == ""
+    assert out.exists()

@@ -61,7 +61,8 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(exc.problem, args.video) from None
     write_setup(args.output, setup)
     p = setup.params
-    print(f"{args.output}: markers {', '.join(setup.markers.names)}; marker diameter "
-          f"{p.marker_diameter * 1000:.1f} mm, band {p.band_size[0] * 1000:.0f} x "
-          f"{p.band_size[1] * 1000:.0f} mm (object {p.object_diameter * 1000:.0f} mm)")
+    if not args.quiet:
+        print(f"{args.output}: markers {', '.join(setup.markers.names)}; marker diameter "
+              f"{p.marker_diameter * 1000:.1f} mm, band {p.band_size[0] * 1000:.0f} x "
+              f"{p.band_size[1] * 1000:.0f} mm (object {p.object_diameter * 1000:.0f} mm)")
     return 0

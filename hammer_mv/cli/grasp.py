@@ -178,9 +178,10 @@ def run_simulate(args: argparse.Namespace) -> int:
     write_json(out / "summary.json", info)
     save_figure(out / "grasp.png", grasp_figure(result))
     save_figure(out / "setup.png", setup_figure(plan=plan))
-    print(f"wrote {out / 'grasp.png'}, setup.png, trajectories.csv and summary.json "
-          f"({args.trials} repetitions; MGA {summary.mga_mean * 100:.2f} cm at "
-          f"{summary.mga_time_mean * 100:.0f} % of the movement)")
+    if not args.quiet:
+        print(f"wrote {out / 'grasp.png'}, setup.png, trajectories.csv and summary.json "
+              f"({args.trials} repetitions; MGA {summary.mga_mean * 100:.2f} cm at "
+              f"{summary.mga_time_mean * 100:.0f} % of the movement)")
     return 0
 
 
@@ -196,9 +197,10 @@ def run_experiment(args: argparse.Namespace) -> int:
         t0 = time.perf_counter()
         exp = EXPERIMENTS[name](trials=args.trials, seed=args.seed)
         written = write_experiment(exp, out)
-        print(f"{name}: {len(exp.summary)} settings x {args.trials} repetitions in "
-              f"{time.perf_counter() - t0:.1f} s -> {out / (name + '.csv')}, "
-              + ", ".join(p.name for p in written if p.suffix == ".png"))
+        if not args.quiet:
+            print(f"{name}: {len(exp.summary)} settings x {args.trials} repetitions in "
+                  f"{time.perf_counter() - t0:.1f} s -> {out / (name + '.csv')}, "
+                  + ", ".join(p.name for p in written if p.suffix == ".png"))
     return 0
 
 

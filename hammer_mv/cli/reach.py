@@ -125,8 +125,9 @@ def run(args: argparse.Namespace) -> int:
         write_csv(out / "speed_accuracy.csv", sweep.summary)
         write_csv(out / "speed_accuracy_trials.csv", sweep.trials)
         save_figure(out / "speed_accuracy.png", speed_accuracy_figure(sweep))
-        print(f"wrote {out / 'speed_accuracy.png'} and speed_accuracy.csv "
-              f"({len(args.durations)} durations x {trials} repetitions)")
+        if not args.quiet:
+            print(f"wrote {out / 'speed_accuracy.png'} and speed_accuracy.csv "
+                  f"({len(args.durations)} durations x {trials} repetitions)")
         return 0
 
     trials = 100 if args.trials is None else args.trials
@@ -165,7 +166,8 @@ def run(args: argparse.Namespace) -> int:
     write_csv(out / "trajectories.csv", result.to_pandas())
     write_json(out / "summary.json", summary)
     save_figure(out / "reach.png", reach_figure(result))
-    print(f"wrote {out / 'reach.png'}, trajectories.csv and summary.json "
-          f"({trials} repetitions; end-point SD {stats.sd_total * 1000:.2f} mm)")
+    if not args.quiet:
+        print(f"wrote {out / 'reach.png'}, trajectories.csv and summary.json "
+              f"({trials} repetitions; end-point SD {stats.sd_total * 1000:.2f} mm)")
     return 0
 

@@ -73,7 +73,8 @@ def run_build(args: argparse.Namespace) -> int:
             raise PlanningError(exc.problem, field=exc.field or _scene_flag(exc.problem)) \
                 from None
     rep.save(args.output)
-    print(f"wrote {args.output}: {len(rep)} models ({', '.join(rep.names)})")
+    if not args.quiet:
+        print(f"wrote {args.output}: {len(rep)} models ({', '.join(rep.names)})")
     return 0
 
 

@@ -283,9 +283,10 @@ def write_text(path: str | os.PathLike, text: str) -> Path:
     path : str or os.PathLike
         Output file.
     text : str
-        Its content (written as UTF-8).
+        Its content (written as UTF-8; a file name's undecodable bytes,
+        which Python holds as lone surrogates, as ``\\udcff`` escapes).
     """
-    return write_bytes(path, text.encode("utf-8"))
+    return write_bytes(path, text.encode("utf-8", "backslashreplace"))
 
 
 def jsonable(value):

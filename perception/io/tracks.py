@@ -74,10 +74,14 @@ def _attr_value(value: Any) -> Any:
     """Make a value storable as an HDF5 attribute (JSON for anything structured)."""
     if isinstance(value, (bool, np.bool_)):
         return bool(value)
-    if isinstance(value, (int, float, str, np.integer, np.floating)):
-        return value
     if isinstance(value, Path):
-        return os.fspath(value)
+        value = os.fspath(value)
+    if isinstance(value, str):
+        # HDF5 strings are UTF-8: a file name's undecodable bytes (lone
+        # surrogates in Python) are stored as visible escapes
+        return value.encode("utf-8", "backslashreplace").decode("utf-8")
+    if isinstance(value, (int, float, np.integer, np.floating)):
+        return value
     if isinstance(value, np.ndarray) and value.dtype.kind in "biuf":
         return value  # numeric arrays as read back from a file: store them as they are
     if (

@@ -21,6 +21,7 @@ import math
 import os
 import queue
 import sys
+import tempfile
 import threading
 from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import asdict, dataclass, replace
@@ -172,6 +173,33 @@ class TimeResolver:
         return "index/fps" if self.n_container <= 1 else "mixed"
 
 
+
+def _utf8(path: str | os.PathLike) -> bool:
+    try:
+        os.fspath(path).encode("utf-8")
+    except UnicodeEncodeError:  # undecodable bytes of the file system, as surrogates
+        return False
+    return True
+
+
+@contextlib.contextmanager
+def opencv_name(path: str | os.PathLike) -> Iterator[str]:
+    """A name OpenCV can open ``path`` by, valid while the block runs.
+
+    OpenCV converts a path to UTF-8 and crashes the process (a segfault,
+    not an exception) on a file name that is not valid UTF-8 — such names
+    are legal on Linux. Those files are opened through a link with a plain
+    name in a private temporary folder; FFmpeg keeps the file itself open
+    once the capture is made, so the link can go when the block ends.
+    """
+    if _utf8(path):
+        yield os.fspath(path)
+        return
+    with tempfile.TemporaryDirectory(prefix="hammer-mv-") as tmp:
+        link = Path(tmp) / f"video{Path(os.fsencode(path).decode('utf-8', 'replace')).suffix}"
+        link.symlink_to(Path(path).resolve())
+        yield os.fspath(link)
+
 class FrameSource:
     """Lazy, sequential frames of one video file.
 
@@ -229,9 +257,10 @@ class FrameSource:
         input_file(self.path, "video")  # a FIFO or device would block or never end
         if self.path.stat().st_size == 0:
             raise InputError("empty file (0 bytes)", self.path)
-        cap = (cv2.VideoCapture(os.fspath(self.path), cv2.CAP_FFMPEG,
-                                [cv2.CAP_PROP_N_THREADS, decoder_threads])
-               if decoder_threads > 0 else cv2.VideoCapture(os.fspath(self.path), cv2.CAP_FFMPEG))
+        with opencv_name(self.path) as name:
+            cap = (cv2.VideoCapture(name, cv2.CAP_FFMPEG,
+                                    [cv2.CAP_PROP_N_THREADS, decoder_threads])
+                   if decoder_threads > 0 else cv2.VideoCapture(name, cv2.CAP_FFMPEG))
         if not cap.isOpened():
             cap.release()
             raise InputError("not a readable video (FFmpeg could not open it)", self.path)
@@ -577,6 +606,9 @@ class VideoWriter:
         stack = contextlib.ExitStack()
         try:
             self.tmp_path = stack.enter_context(atomic_path(self.path))
+            if not _utf8(self.tmp_path):
+                raise InputError("OpenCV cannot write a video whose name is not valid UTF-8; "
+                                 "choose another name", self.path)
             with quiet_native_stderr():
                 vw = cv2.VideoWriter(
                     os.fspath(self.tmp_path), cv2.VideoWriter_fourcc(*self.codec), self.fps,
@@ -623,8 +655,8 @@ class VideoWriter:
 
 def _readable(path: Path, n_frames: int) -> bool:
     """Whether FFmpeg opens a just-written clip and its header counts ``n_frames``."""
-    with quiet_native_stderr():
-        cap = cv2.VideoCapture(os.fspath(path), cv2.CAP_FFMPEG)
+    with quiet_native_stderr(), opencv_name(path) as name:
+        cap = cv2.VideoCapture(name, cv2.CAP_FFMPEG)
     try:
         if not cap.isOpened():
             return False
