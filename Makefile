@@ -12,7 +12,7 @@ CONSTRAINTS := requirements/constraints.txt
 PIN := PIP_CONSTRAINT=$(CURDIR)/$(CONSTRAINTS)
 LATEST := .venv-latest
 
-.PHONY: demo test test-fast test-latest lock lint bench reproduce clean bytecode
+.PHONY: demo test test-fast test-latest lock lint bench reproduce evaluate clean bytecode
 
 $(STAMP): pyproject.toml setup.py minvar/_lqg_kernel.c $(CONSTRAINTS)
 	$(PYTHON) -c 'import sys; assert sys.version_info >= (3, 11), "hammer-mv needs Python >= 3.11"'
@@ -76,6 +76,11 @@ bytecode:
 
 reproduce: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/python tools/reproduce_thesis.py -o out/thesis
+
+# The verdict on the held-out healthy-adult population (seeds 9000 + k), from
+# video; `tools/evaluate_verdict.py --set dev` is the set to tune on.
+evaluate: $(STAMP)
+	MPLBACKEND=Agg $(BIN)/python tools/evaluate_verdict.py --set heldout -o out/eval/heldout
 
 clean:
 	rm -rf $(VENV) $(LATEST) .venv-lock out .pytest_cache

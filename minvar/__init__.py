@@ -35,6 +35,7 @@ _NAMES = {
     'GraspResult': 'grasp',
     'GraspTask': 'grasp_task',
     'GripVia': 'grasp_task',
+    'shoulder_for': 'grasp_task',
     'plan_grasp': 'grasp',
     'simulate_grasp': 'grasp',
     'GraspMoments': 'grasp_stats',

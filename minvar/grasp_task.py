@@ -43,7 +43,7 @@ from .kinematics import TwoLinkChain
 from .limits import check_position, check_steps
 from .plant import PointMassPlant
 
-__all__ = ["CHAINS", "GraspTask", "GripVia"]
+__all__ = ["CHAINS", "DEFAULT_SHOULDER", "GraspTask", "GripVia", "shoulder_for"]
 
 #: Names of the three chains, in the order they are planned and simulated.
 CHAINS = ("arm", "finger", "thumb")
@@ -110,6 +110,43 @@ class GripVia:
         if not 0.0 < f < 1.0:
             raise ValueError(f"GripVia.fraction: expected a time fraction in (0, 1), got {f}")
         object.__setattr__(self, "fraction", f)
+
+
+#: The shoulder relative to the wrist's start for reaches up to about 0.33 m
+#: (:class:`GraspTask`'s default, the thesis's posture).
+DEFAULT_SHOULDER = (0.15, -0.25)
+#: Farthest the wrist's goal may lie from the shoulder, as a share of the arm's length.
+MAX_REACH_SHARE = 0.9
+
+
+def shoulder_for(distance: float, wrist_offset: float = 0.06,
+                 arm_links: tuple[float, float] = (0.30, 0.30)) -> tuple[float, float]:
+    """Where the shoulder sits, relative to the wrist's start, for a reach of ``distance`` m.
+
+    A person reaching farther starts with the hand nearer the body: the
+    thesis's posture (:data:`DEFAULT_SHOULDER`) up to where the wrist's
+    goal would lie beyond :data:`MAX_REACH_SHARE` of the arm's length; for
+    longer reaches the start moves toward the shoulder, so the goal stays at
+    that share (an object 0.5 m away is reached, not refused).
+
+    Parameters
+    ----------
+    distance : float
+        Wrist start to object centre, m.
+    wrist_offset : float
+        How far short of the object centre the wrist stops, m.
+    arm_links : (float, float)
+        Upper arm and forearm lengths, m.
+    """
+    side, back = DEFAULT_SHOULDER[0], -DEFAULT_SHOULDER[1]
+    reach = MAX_REACH_SHARE * sum(arm_links)
+    longest = float(np.sqrt(max(reach**2 - side**2, 0.0)))  # shoulder to goal, along the approach
+    back = min(back, longest - (distance - wrist_offset))
+    if back < -side:
+        # the hand would start well ahead of the shoulder: no arm makes this
+        # reach; the thesis's posture lets GraspTask say so, naming the distance
+        return DEFAULT_SHOULDER
+    return (side, -back)
 
 
 @dataclass(frozen=True)
@@ -190,7 +227,7 @@ class GraspTask:
     execution_sigma_s: float = 0.0
     wrist_offset: float = 0.06
     tip_start: float = 0.02
-    shoulder_offset: tuple[float, float] = (0.15, -0.25)
+    shoulder_offset: tuple[float, float] = DEFAULT_SHOULDER
     arm_links: tuple[float, float] = (0.30, 0.30)
     digit_links: tuple[float, float] = (0.10, 0.10)
     r: float = 2e-4

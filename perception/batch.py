@@ -532,8 +532,12 @@ def summary_table(results: list[ClipResult], reference: str | None = None) -> pd
     Columns: ``clip, condition, winner, rule``, the :data:`CLIP_COLUMNS`
     (``verdict, familiarity, margin, winner_log_likelihood``),
     ``reference_model`` and ``reference_confidence`` (its final thesis-rule
-    confidence, m), ``conf_<model>`` (final thesis-rule confidence of each
-    model of the first scored clip, m), the tracking quality
+    confidence, m), ``verdict_detail`` (the kind of an ``abnormal`` verdict),
+    the observed landmarks (``movement_time`` s, ``peak_speed`` m/s,
+    ``peak_speed_time``, ``mga`` m, ``mga_time``, ``aperture_peaks``:
+    :data:`~perception.report.clip.KINEMATICS_COLUMNS`), ``conf_<model>``
+    (final thesis-rule confidence of each model of the first scored clip,
+    m), the tracking quality
     (``track_<marker>``, ``minlik_<marker>``, ``reacquisitions``,
     ``ambiguous_frames``), ``status`` (``ok`` or ``failed``), ``reused`` (the
     report was already current), ``error``.
@@ -548,6 +552,7 @@ def summary_table(results: list[ClipResult], reference: str | None = None) -> pd
     """
     import pandas as pd
 
+    from perception.report.clip import KINEMATICS_COLUMNS
     from perception.report.conditions import reference_model
 
     scored = [r for r in results if r.summary is not None]
@@ -563,6 +568,9 @@ def summary_table(results: list[ClipResult], reference: str | None = None) -> pd
         entry["reference_model"] = reference if s is not None else None
         entry["reference_confidence"] = (_model_value(s, reference, s.confidence[:, -1])
                                          if s is not None and reference else float("nan"))
+        entry["verdict_detail"] = s.verdict_detail if s is not None else None
+        for column in KINEMATICS_COLUMNS:
+            entry[column] = s.landmark(column) if s is not None else float("nan")
         for n in names:
             entry[f"conf_{n}"] = (_model_value(s, n, s.confidence[:, -1]) if s is not None
                                   else float("nan"))
@@ -571,7 +579,10 @@ def summary_table(results: list[ClipResult], reference: str | None = None) -> pd
         entry["reused"] = r.status == "reused"
         entry["error"] = r.error
         table.append(entry)
-    return pd.DataFrame(table)
+    table = pd.DataFrame(table)
+    if "aperture_peaks" in table:  # a count: 1, not 1.0 (empty where unknown)
+        table["aperture_peaks"] = table["aperture_peaks"].astype("Int64")
+    return table
 
 
 def run_batch(

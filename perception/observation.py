@@ -117,6 +117,10 @@ class ObserveParams:
         Gains of the causal alpha-beta filter applied to every marker.
     min_frames : int
         Fewest frames of movement that can be scored.
+    min_movement : float
+        Least distance the wrist must get from its rest position during the
+        movement, m: less is no reach (a still hand drifting a few mm, a
+        tremor), and the clip is refused rather than scored as a movement.
     """
 
     object_diameter: float = DEFAULT_OBJECT_DIAMETER
@@ -141,6 +145,7 @@ class ObserveParams:
     alpha: float = 0.5
     beta: float = 0.15
     min_frames: int = 8
+    min_movement: float = 0.02
 
     def __post_init__(self):
         object.__setattr__(self, "hand_size_range", tuple(self.hand_size_range))
@@ -149,7 +154,7 @@ class ObserveParams:
                            tuple(tuple(float(v) for v in row) for row in self.onset_profile))
         for name in ("object_diameter", "max_rest_noise", "max_rest_drift", "rest_noise_factor",
                      "max_rest_aperture", "onset_displacement", "onset_noise_factor",
-                     "end_speed", "end_noise_factor"):
+                     "end_speed", "end_noise_factor", "min_movement"):
             if not _positive(getattr(self, name)):
                 raise InputError(f"expected a positive number, got {getattr(self, name)!r}",
                                  field=f"ObserveParams.{name}")
@@ -484,15 +489,29 @@ def _onset_time(filtered: np.ndarray, time: np.ndarray, noise: float, params: Ob
     return float(crossing - params.onset_latency(threshold))
 
 
+#: The time over which the end of a movement reads speeds, s (a frame at 30 frames/s).
+END_SPEED_WINDOW = 1 / 30
+
+
 def _end_row(filtered: np.ndarray, time: np.ndarray, noise: float, dt: float,
              params: ObserveParams) -> int:
-    """The last row of the movement: a few frames after any hand marker last moved."""
-    speed = np.linalg.norm(np.diff(filtered, axis=0), axis=-1) / np.diff(time)[:, None]
-    floor = max(params.end_speed, params.end_noise_factor * noise / dt)
+    """The last row of the movement: a few frames after any hand marker last moved.
+
+    Speeds are measured over :data:`END_SPEED_WINDOW` (``k`` frames, one at
+    30 frames/s or less): over one frame of a 120 frames/s clip the noise
+    floor would be four times as high, and a slow movement's approach would
+    count as stopped long before it ends.
+    """
+    k = max(1, int(round(END_SPEED_WINDOW / dt)))
+    if len(time) <= k:
+        return len(time) - 1
+    speed = (np.linalg.norm(filtered[k:] - filtered[:-k], axis=-1)
+             / (time[k:] - time[:-k])[:, None])
+    floor = max(params.end_speed, params.end_noise_factor * noise / (k * dt))
     moving = np.nanmax(np.where(np.isfinite(speed), speed, 0), axis=1) > floor
     active = np.flatnonzero(moving)
     last = len(time) - 1
-    return int(min(last, active[-1] + params.end_pad_frames)) if len(active) else last
+    return int(min(last, active[-1] + k * params.end_pad_frames)) if len(active) else last
 
 
 def _prepare(tracks, params: ObserveParams, name: str) -> _Prepared:
@@ -589,6 +608,11 @@ def observe(tracks, params: ObserveParams | None = None, *, clip: str | None = N
     filt[:, 1] -= half
     filt[:, 2] += half
     sl = p.span.rows
+    moved = float(np.nanmax(np.linalg.norm(filt[sl, 0] - start, axis=-1), initial=0.0))
+    if moved < params.min_movement:
+        raise InputError(f"no movement: the wrist moves {moved * 1000:.0f} mm (a reach moves at "
+                         f"least {params.min_movement * 1000:.0f} mm)", _source(tracks, p.name),
+                         field="wrist")
     log.info("%s: onset at frame %d, %d frames scored, start distance %.3f m",
              p.name, p.span.onset_frame, p.span.n_frames, np.linalg.norm(start))
     return Observation(

@@ -29,6 +29,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from perception.errors import InputError
 from perception.io.tracks import Tracks, tracks_path_for
 from perception.observation import ObserveParams, observe
@@ -334,15 +336,24 @@ def recognize_tracks(tracks: Tracks, repertoire: Repertoire,
         Their scene cannot be planned (out of the models' reach: often a wrong scale).
     """
     from perception.errors import PlanningError
+    from perception.recognition.shape import is_mirrored
 
     settings = RecognitionSettings() if settings is None else settings
     try:
         obs = observe(tracks, settings.observe, clip=clip)
+        mirrored = is_mirrored(obs)
+        if mirrored:  # the other hand, or the camera on the other side: score its mirror image
+            obs = observe(tracks, dataclasses.replace(settings.observe,
+                                                      mirror=not settings.observe.mirror),
+                          clip=clip)
     except InputError as exc:
         if source is None:
             raise
         # name the file the user gave; keep the kind (TrackingError) and the field
         raise type(exc)(exc.problem, source, field=exc.field) from None
+    # brought to the reference scale first: a clip that cannot be judged is
+    # refused before its scene is planned
+    shape_obs, norm = _canonical(obs, repertoire, source)
     try:
         models = repertoire.for_scene(SceneSpec.of(obs), cache=plan_cache)
     except PlanningError as exc:  # the scene, not the software: name the clip and the scale
@@ -351,7 +362,59 @@ def recognize_tracks(tracks: Tracks, repertoire: Repertoire,
     rec = recognize(obs, models, settings.hammer)
     if rec.verdict is None:  # the default repertoire calibrates only the models it needs
         rec = recognize(obs, repertoire.calibrated(models, rec.decision.best), settings.hammer)
-    return rec
+    shape, transport = _shape_pass(shape_obs, repertoire, settings, plan_cache)
+    return dataclasses.replace(rec, shape=shape, normalisation=norm,
+                               transport_familiarity=transport, mirrored=mirrored)
+
+
+def _canonical(obs, repertoire: Repertoire, source):
+    """``obs`` at the repertoire's reference scale (see :mod:`perception.recognition.shape`).
+
+    The reference scene keeps the clip's object size (the grip's targets
+    are on the object).
+    """
+    from perception.recognition.shape import canonical
+
+    scene, durations = repertoire.reference()
+    scene = dataclasses.replace(scene, object_size=obs.object_diameter)
+    try:
+        return canonical(obs, scene, durations)
+    except InputError as exc:
+        raise type(exc)(exc.problem, source or obs.clip, field=exc.field) from None
+
+
+def _shape_pass(shape_obs, repertoire: Repertoire, settings: RecognitionSettings,
+                plan_cache: PlanCache | None) -> tuple[Recognition, float]:
+    """The demonstration at the reference scale, scored there: the verdict.
+
+    See :mod:`perception.recognition.shape`. It is scored against the
+    repertoire's grasp models if its grip opens as a grasp's must
+    (:func:`~perception.recognition.shape.opens`), else against its reach
+    models. Also the familiarity of its transport alone (digits held
+    closed) to the best reach model: NaN without reach models.
+    """
+    from perception.recognition.shape import closed_hand, opens
+
+    scene = SceneSpec.of(shape_obs)
+    every = repertoire.for_scene(scene, cache=plan_cache)
+    kind = "grasp" if opens(shape_obs) else "reach"
+    models = [m for m in every if m.kind == kind] or every
+    # the clip's own tracking noise, where it exceeds what the rule assumes
+    hammer = dataclasses.replace(settings.hammer,
+                                 obs_sd=max(settings.hammer.obs_sd, shape_obs.noise))
+    shape = recognize(shape_obs, models, hammer)
+    if shape.verdict is None:
+        shape = recognize(shape_obs, repertoire.calibrated(models, shape.decision.best),
+                          hammer)
+    reach = [m for m in every if m.kind == "reach"]
+    if not reach:
+        return shape, float("nan")
+    closed = recognize(closed_hand(shape_obs), reach, hammer)
+    best = int(np.argmax(closed.log_likelihood[:, -1]))
+    if not np.isfinite(closed.familiarity[best]):
+        closed = recognize(closed_hand(shape_obs), repertoire.calibrated(reach, best),
+                           hammer)
+    return shape, float(closed.familiarity[best])
 
 
 def recognize_clip(source: str | os.PathLike | Tracks, repertoire: Repertoire,

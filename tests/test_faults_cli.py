@@ -11,7 +11,6 @@ is silent on success.
 from __future__ import annotations
 
 import sys
-import types
 import warnings
 from pathlib import Path
 
@@ -369,11 +368,17 @@ def test_an_unreachable_scene_is_a_planning_error():
         build_model(default_specs([1.0])[0], SceneSpec(distance=2.0))
 
 
+def _reference(self):
+    from perception.recognition.models import SceneSpec
+
+    return SceneSpec(), (0.6, 1.2)
+
+
 def _scene_observation(monkeypatch):
     import perception.pipeline as pipeline
+    from perception.synthetic.demos import demo_tracks
 
-    obs = types.SimpleNamespace(start_distance=0.25, object_diameter=0.1, dt=1 / 30,
-                                hand_offset=(0.0, 0.1), clip="c")
+    obs = pipeline.observe(demo_tracks("normal", 0)[0], clip="c")
     monkeypatch.setattr(pipeline, "observe", lambda tracks, params, clip=None: obs)
     return pipeline
 
@@ -382,6 +387,8 @@ def test_recognize_tracks_names_the_clip_of_a_planning_error(monkeypatch):
     pipeline = _scene_observation(monkeypatch)
 
     class Unreachable:
+        reference = _reference
+
         def for_scene(self, scene, cache=None):
             raise PlanningError("out of the arm's reach", field="distance")
 
@@ -395,6 +402,8 @@ def test_recognize_tracks_leaves_a_bug_a_bug(monkeypatch):
     pipeline = _scene_observation(monkeypatch)
 
     class Broken:
+        reference = _reference
+
         def for_scene(self, scene, cache=None):
             raise ValueError("operands could not be broadcast together")
 

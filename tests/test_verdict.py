@@ -104,9 +104,11 @@ def test_the_calibration_is_stored_and_old_files_still_load(small, tmp_path):
     fresh, built = recognize_clip(tracks, old), recognize_clip(tracks, small)
     assert fresh.verdict == built.verdict == "normal"
     assert fresh.decision.familiarity == pytest.approx(built.decision.familiarity)
-    again = old.for_scene(SceneSpec.of(fresh.observation))
+    again = old.for_scene(SceneSpec.of(fresh.shape.observation))
     assert again[fresh.decision.best].calibration is not None  # kept for the next clip
-    assert sum(m.calibration is not None for m in again) == 1  # and only that one
+    # and only those the verdict rests on: the best model at the reference
+    # scale and the best reach model of the transport alone
+    assert sum(m.calibration is not None for m in again) <= 2
 
 
 def test_replanned_models_keep_their_calibration(small):
@@ -182,10 +184,14 @@ def test_recognition_json_keeps_every_key_and_adds_the_verdict():
             "aperture", "familiarity_threshold"} <= set(d)
     assert {"name", "kind", "final_confidence", "final_log_likelihood", "misfit",
             "familiarity"} == set(d["models"][0])
-    best = int(np.argmax(rec.log_likelihood[:, -1]))
-    assert d["familiarity"] == pytest.approx(rec.familiarity[best])
-    second = np.sort(rec.log_likelihood[:, -1])[-2]
-    assert d["margin"] == pytest.approx(rec.log_likelihood[best, -1] - second)
+    # the verdict is read at the repertoire's reference scale (the shape pass),
+    # among the models of the clip's kind (it opens its grip: the grasp models)
+    shape = rec.shape
+    best = int(np.argmax(shape.log_likelihood[:, -1]))
+    assert d["familiarity"] == pytest.approx(shape.familiarity[best])
+    assert set(shape.kinds) == {"grasp"} and d["shape"]["model"] == shape.names[best]
+    second = np.sort(shape.log_likelihood[:, -1])[-2]
+    assert d["margin"] == pytest.approx(shape.log_likelihood[best, -1] - second)
     thesis = dataclasses.replace(HammerParams(), rule="thesis")
     from perception.pipeline import RecognitionSettings
 

@@ -302,6 +302,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--skip-ch4", action="store_true", help="do not run chapter 4")
     parser.add_argument("--skip-ch5", action="store_true",
                         help="do not run chapter 5 (--quick skips it too: it renders video)")
+    parser.add_argument("--skip-verdict", action="store_true",
+                        help="do not evaluate the verdict on the held-out population "
+                             "(--quick skips it too: it renders and tracks 60 clips)")
     parser.add_argument("--jobs", type=int, default=2, metavar="N",
                         help="chapters run at once, each in its own process (default 2; "
                              "results do not depend on it)")
@@ -339,7 +342,17 @@ def main(argv: list[str] | None = None) -> int:
     ]
     rows = [dict(as_claim(r), chapter=r["chapter"]) for r in claims if not is_sensitivity(r)]
     write_csv(out / "numbers.csv", pd.DataFrame(rows, columns=["chapter", *CLAIM_KEYS]))
-    write_text(out / "numbers.md", numbers_markdown(claims, notes, header))
+    text = numbers_markdown(claims, notes, header)
+    if not (args.skip_verdict or args.quick):
+        # not a thesis claim: how the verdict does on movements our models did not
+        # make, a population held out from every choice of a parameter
+        import evaluate_verdict
+
+        _, result = evaluate_verdict.run("heldout", out / "verdict",
+                                         evaluate_verdict.DEFAULT_COUNTS, jobs=args.jobs,
+                                         quiet=True)
+        text += "\n" + result["markdown"]
+    write_text(out / "numbers.md", text)
     figures = sorted(p.name for p in out.glob("fig*.png"))
     print(f"{len(figures)} figures, {len(rows)} claims ({verdict_counts(rows)}) in {out} "
           f"({total:.0f} s)")

@@ -86,6 +86,10 @@ def run(args: argparse.Namespace) -> int:
                                                sheet=not args.no_figures, frames=frames)}
     paths = write_clip_report(rec, args.output, extra=extra, figures=not args.no_figures)
     if not args.quiet:
-        print(f"{clip}: {rec.verdict or 'no verdict'}, winner {rec.winner} ({rec.rule} rule) "
-              f"-> {paths['json']}")
+        detail = f" ({rec.verdict_detail})" if rec.verdict_detail else ""
+        mirror = ("; the scene is mirrored: scored as with --mirror"
+                  if rec.mirrored and not args.mirror else
+                  "; the scene is not mirrored: scored without --mirror" if rec.mirrored else "")
+        print(f"{clip}: {rec.verdict or 'no verdict'}{detail}, winner {rec.winner} "
+              f"({rec.rule} rule){mirror} -> {paths['json']}")
     return 0

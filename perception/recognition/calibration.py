@@ -38,6 +38,13 @@ def _bump(tau: np.ndarray) -> np.ndarray:
     return np.sin(np.pi * np.clip(tau, 0.0, 1.0))
 
 
+def _skewed(tau: np.ndarray, skew: float) -> np.ndarray:
+    """A monotone warp of the movement's clock, 0 -> 0 and 1 -> 1: ``skew`` > 0 runs
+    ahead early (the speed peaks earlier, a longer deceleration), < 0 behind."""
+    tau = np.clip(tau, 0.0, 1.0)
+    return tau + skew * np.sin(np.pi * tau) / np.pi
+
+
 def _interp(t: np.ndarray, ref: np.ndarray, xy: np.ndarray) -> np.ndarray:
     return np.stack([np.interp(t, ref, xy[:, 0]), np.interp(t, ref, xy[:, 1])], axis=1)
 
@@ -65,9 +72,11 @@ def own_demonstration(model: MotorModel, run: Rollout, index: int, params: Calib
     shift, scale = rng.uniform(-p.grip_shift, p.grip_shift), rng.uniform(-p.aperture_scale,
                                                                           p.aperture_scale)
     bow = rng.uniform(-p.path_bow, p.path_bow)
+    skew = rng.uniform(0.0, p.transport_skew)
+    noise_px = p.noise_px * rng.uniform(1 - p.noise_spread, 1 + p.noise_spread)
     t = np.arange(int(round((2 * p.rest + k * D) / period)) + 1) * period
     tau = (t - p.rest) / (k * D)
-    tm = np.clip(tau * D, 0.0, run.time[-1])
+    tm = np.clip(_skewed(tau, skew) * D, 0.0, run.time[-1])
     tg = np.clip(tm + shift * D * _bump(tau), 0.0, run.time[-1])  # the grip's own clock
     wrist = _interp(tm, run.time, run.wrist[0, index])
     finger = _interp(tg, run.time, run.finger[0, index] - run.wrist[0, index])
@@ -80,7 +89,7 @@ def own_demonstration(model: MotorModel, run: Rollout, index: int, params: Calib
              "thumb": wrist + mid - half - across, "object": np.zeros_like(wrist)}
     camera = SimilarityTransform((320.0, 144.0), p.px_per_m, math.pi / 2)
     pos = np.stack([camera.to_pixels(world[m]) for m in _MARKERS], axis=1)
-    pos = pos + p.noise_px * rng.standard_normal(pos.shape)
+    pos = pos + noise_px * rng.standard_normal(pos.shape)
     diameter = [model.scene.object_size * p.px_per_m if m == "object" else math.nan
                 for m in _MARKERS]
     return Tracks(frame=np.arange(len(t)), time=t, markers=_MARKERS, position=pos,

@@ -35,7 +35,7 @@ from perception.recognition.leaves import Leaves, forward_kinematics
 from perception.recognition.models import ChainModel, MotorModel
 from perception.recognition.result import Recognition
 from perception.recognition.scoring import RULES, likelihood_rule, thesis_rule
-from perception.recognition.verdict import DEFAULT_THRESHOLD, misfit
+from perception.recognition.verdict import DEFAULT_THRESHOLD, UNFAMILIAR_THRESHOLD, misfit
 
 __all__ = ["HammerParams", "RULES", "recognize"]
 
@@ -56,6 +56,11 @@ class HammerParams:
         Lowest familiarity (0..1) of the best model for the verdict ``normal``
         (or ``reach``); below it the verdict is ``abnormal``
         (:mod:`perception.recognition.verdict`).
+    unfamiliar_threshold : float
+        Lowest familiarity (0..1) of the movement's transport alone (digits
+        held closed) to the best reach model; below it nothing in the
+        repertoire explains the movement as a human reach or grasp and the
+        verdict is ``unfamiliar``.
     filter_gain : float
         How strongly observed positions correct each model's own estimate of
         velocity and force: 1 applies the plan's Kalman gains as designed, 0
@@ -75,6 +80,7 @@ class HammerParams:
     obs_sd: float = 0.001
     filter_gain: float = 0.3
     familiarity_threshold: float = DEFAULT_THRESHOLD
+    unfamiliar_threshold: float = UNFAMILIAR_THRESHOLD
 
     def __post_init__(self):
         if self.rule not in RULES:
@@ -90,6 +96,9 @@ class HammerParams:
         if not 0 <= self.familiarity_threshold <= 1:
             raise ValueError("familiarity_threshold: expected a value in [0, 1], got "
                              f"{self.familiarity_threshold}")
+        if not 0 <= self.unfamiliar_threshold <= 1:
+            raise ValueError("unfamiliar_threshold: expected a value in [0, 1], got "
+                             f"{self.unfamiliar_threshold}")
 
 
 def _clamp_reach(p: np.ndarray, l1: float, l2: float) -> np.ndarray:
@@ -308,4 +317,5 @@ def recognize(
         models=models,
         rule=params.rule,
         familiarity_threshold=params.familiarity_threshold,
+        unfamiliar_threshold=params.unfamiliar_threshold,
     )

@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from minvar import GraspTask, GripVia, PointMassPlant
+from minvar import GraspTask, GripVia, PointMassPlant, shoulder_for
 from perception.errors import PlanningError
 from perception.geometry import DEFAULT_OBJECT_DIAMETER, DEFAULT_TIP_START
 
@@ -251,9 +251,12 @@ class ModelSpec:
         if "grip_via" in params and params["grip_via"] is not None:
             params["grip_via"] = tuple(GripVia(**g) if isinstance(g, dict) else g
                                        for g in params["grip_via"])
+        params.setdefault("shoulder_offset", shoulder_for(scene.distance, **{
+            k: params[k] for k in ("wrist_offset", "arm_links") if k in params}))
         return GraspTask(object_size=scene.object_size, distance=scene.distance,
                          tip_start=scene.tip_start, reach_only=self.kind == "reach",
                          plant=plant, **params)
+
 
 
 @dataclass(frozen=True, eq=False)

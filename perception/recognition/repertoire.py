@@ -90,6 +90,19 @@ class Repertoire:
         """Model names in order."""
         return [m.name for m in self.models]
 
+    def reference(self) -> tuple[SceneSpec, tuple[float, float]]:
+        """Where the verdict judges a movement's shape (:mod:`perception.recognition.shape`).
+
+        The scene most of the models were planned (and calibrated) for, and
+        the shortest and longest movement time of the grasp models (of all
+        models if none grasps), s.
+        """
+        scenes = [m.scene for m in self.models]
+        scene = max(scenes, key=scenes.count)
+        times = [m.duration for m in self.models if m.kind == "grasp"]
+        times = times or [m.duration for m in self.models]
+        return scene, (float(min(times)), float(max(times)))
+
     @classmethod
     def build(cls, specs: Iterable[ModelSpec] | None = None,
               scene: SceneSpec | None = None) -> Repertoire:
@@ -311,6 +324,11 @@ class _DefaultRepertoire(Repertoire):
     def names(self) -> list[str]:
         return [s.name for s in self._specs]
 
+    def reference(self) -> tuple[SceneSpec, tuple[float, float]]:
+        # without planning the default scene's models
+        times = [float(s.task["duration"]) for s in self._specs if s.kind == "grasp"]
+        return self._scene, (min(times), max(times))
+
     def __len__(self) -> int:
         return len(self._specs)
 
@@ -478,7 +496,9 @@ def _model(s: StoredModel) -> MotorModel:
     except ValueError as exc:
         raise ValueError(f"model '{s.name}': {exc}") from None
     cal = s.calibration
+    # files written before these variations existed were made without them
+    made = {"transport_skew": 0.0, "noise_spread": 0.0, **(cal.params if cal else {})}
     calibration = None if cal is None else Calibration(
-        cal.misfit, cal.frame_period, CalibrationParams(**cal.params))
+        cal.misfit, cal.frame_period, CalibrationParams(**made))
     return MotorModel(spec=spec, scene=SceneSpec(**s.scene), substeps=s.substeps, dt=s.dt,
                       calibration=calibration, **chains)

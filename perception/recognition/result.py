@@ -3,17 +3,32 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from perception.recognition.verdict import DEFAULT_THRESHOLD, Verdict, decide, misfit
+from perception.landmarks import (
+    Landmarks,
+    grip_departs,
+    model_landmarks,
+    observed_landmarks,
+    verdict_detail,
+)
+from perception.recognition.verdict import (
+    DEFAULT_THRESHOLD,
+    UNFAMILIAR_THRESHOLD,
+    Verdict,
+    decide,
+    misfit,
+)
 
 if TYPE_CHECKING:
     import pandas as pd
 
     from perception.observation import Observation
     from perception.recognition.models import MotorModel
+    from perception.recognition.shape import Normalisation
 
 __all__ = ["Recognition"]
 
@@ -55,6 +70,20 @@ class Recognition:
         The rule that picks the winner.
     familiarity_threshold : float
         Lowest familiarity of the best model called familiar (the verdict).
+    shape : Recognition or None
+        The same demonstration brought to the repertoire's reference scale
+        and scored against its models there (:mod:`perception.recognition.shape`):
+        when present, the verdict, familiarity and margin are its.
+    normalisation : Normalisation or None
+        How it was brought to that scale.
+    transport_familiarity : float
+        Familiarity of the movement's transport alone (digits held closed, at
+        the reference scale) to the best reach model; NaN if not measured.
+    unfamiliar_threshold : float
+        Below this transport familiarity the verdict is ``unfamiliar``.
+    mirrored : bool
+        The scene was found mirrored (the finger opening on the model's -x
+        side) and its mirror image was scored: the opposite of ``--mirror``.
     """
 
     clip: str
@@ -74,6 +103,11 @@ class Recognition:
     models: list[MotorModel] = field(repr=False)
     rule: str = "likelihood"
     familiarity_threshold: float = DEFAULT_THRESHOLD
+    shape: Recognition | None = field(default=None, repr=False)
+    normalisation: Normalisation | None = None
+    transport_familiarity: float = float("nan")
+    unfamiliar_threshold: float = UNFAMILIAR_THRESHOLD
+    mirrored: bool = False
 
     def score(self, rule: str | None = None) -> np.ndarray:
         """(M, N) cumulative score under ``rule`` (default: the winner's rule)."""
@@ -101,7 +135,23 @@ class Recognition:
 
     @property
     def decision(self) -> Verdict:
-        """The verdict, from the best model by log-likelihood and its familiarity."""
+        """The verdict, from the best model by log-likelihood and its familiarity.
+
+        With a :attr:`shape` pass, the verdict is that pass's: the movement's
+        coordination judged at the repertoire's reference scale, not its speed,
+        size or camera; ``unfamiliar`` when even its transport is no human
+        reach; and a grasp the models find familiar is still ``abnormal`` if
+        its grip departs from the transport in the field's own measures
+        (:func:`perception.landmarks.grip_departs`: opening late, or
+        re-opening).
+        """
+        if self.shape is not None:
+            d = self.shape.decision
+            if d.verdict is not None and self.transport_familiarity < self.unfamiliar_threshold:
+                return Verdict("unfamiliar", d.best, d.familiarity, d.margin)
+            if d.verdict == "normal" and grip_departs(self.landmarks[0]):
+                return Verdict("abnormal", d.best, d.familiarity, d.margin)
+            return d
         return decide(self.kinds, self.log_likelihood[:, -1], self.familiarity,
                       self.familiarity_threshold)
 
@@ -145,6 +195,50 @@ class Recognition:
             out[key] = np.stack([np.interp(self.time, run.time, xy[:, 0]),
                                  np.interp(self.time, run.time, xy[:, 1])], axis=1)
         return out
+
+    def own_landmarks(self, model: str) -> Landmarks:
+        """The landmarks of a model's own noise-free movement (:func:`nominal`'s).
+
+        Its movement from its planned start, run until half its planned
+        duration past its end, ends when no hand point moves faster than
+        0.02 m/s (the observation's end rule, without tracking noise).
+
+        Parameters
+        ----------
+        model : str
+            Model name.
+        """
+        from perception.recognition.rollout import rollout
+
+        m = self.models[self.names.index(model)]
+        run = rollout([m], int(np.ceil(1.5 * m.duration / m.dt)) + 1)
+        return model_landmarks(run.time, run.wrist[0, 0], run.finger[0, 0], run.thumb[0, 0],
+                               duration=m.duration)
+
+    @cached_property
+    def landmarks(self) -> tuple[Landmarks, Landmarks | None]:
+        """The demonstration's landmarks and the reference grasp model's own (None without one)."""
+        ref = self.reference_model
+        return (observed_landmarks(self.observation),
+                self.own_landmarks(ref) if ref is not None else None)
+
+    @property
+    def kinematics(self) -> dict:
+        """The ``kinematics`` of the report: ``observed``, ``reference``, ``reference_model``."""
+        observed, reference = self.landmarks
+        return {"observed": observed.to_dict(),
+                "reference": reference.to_dict() if reference is not None else None,
+                "reference_model": self.reference_model}
+
+    @property
+    def verdict_detail(self) -> str | None:
+        """The kind of an ``abnormal`` verdict (:func:`perception.landmarks.verdict_detail`).
+
+        None for any other verdict.
+        """
+        if self.verdict != "abnormal":
+            return None
+        return verdict_detail(*self.landmarks)
 
     @property
     def predicted_r(self) -> np.ndarray:
@@ -199,17 +293,32 @@ class Recognition:
             "winner": self.winner,
             "rule": self.rule,
             "verdict": d.verdict,
+            "verdict_detail": self.verdict_detail,
             "familiarity": _num(d.familiarity),
             "margin": _num(d.margin),
             "familiarity_threshold": float(self.familiarity_threshold),
             "reference_model": self.reference_model,
+            "shape": _shape_summary(self),
+            "mirrored": bool(self.mirrored),
             "time": [float(t) for t in self.time],
             "confidence": {n: [float(c) for c in row]
                            for n, row in zip(self.names, self.confidence)},
             "transport_confidence": {n: [float(c) for c in row]
                                      for n, row in zip(self.names, transport)},
             "aperture": [_num(g) for g in self.observation.g],
+            "kinematics": self.kinematics,
         }
+
+
+def _shape_summary(rec: Recognition) -> dict | None:
+    if rec.shape is None:
+        return None
+    d = rec.shape.decision
+    out = {"model": rec.shape.names[d.best], "familiarity": _num(d.familiarity),
+           "margin": _num(d.margin), "transport_familiarity": _num(rec.transport_familiarity)}
+    if rec.normalisation is not None:
+        out.update({k: _num(v) for k, v in rec.normalisation.to_dict().items()})
+    return out
 
 
 def _num(x: float) -> float | None:

@@ -37,14 +37,18 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["DEFAULT_THRESHOLD", "VERDICTS", "Calibration", "CalibrationParams", "Verdict",
-           "decide", "misfit"]
+__all__ = ["DEFAULT_THRESHOLD", "UNFAMILIAR_THRESHOLD", "VERDICTS", "Calibration",
+           "CalibrationParams", "Verdict", "decide", "misfit"]
 
-#: The three verdicts.
-VERDICTS = ("normal", "abnormal", "reach")
+#: The four verdicts.
+VERDICTS = ("normal", "abnormal", "reach", "unfamiliar")
 #: Lowest familiarity called normal (or reach): fits better than the worst 5 % of the
 #: model's own demonstrations.
 DEFAULT_THRESHOLD = 0.05
+#: Lowest familiarity of a movement's transport (digits held closed) to the
+#: best reach model that still counts as a human reach: below it the movement
+#: is ``unfamiliar`` (worse than 99 % of the reach models' own reaches).
+UNFAMILIAR_THRESHOLD = 0.01
 
 
 @dataclass(frozen=True)
@@ -73,8 +77,14 @@ class CalibrationParams:
         The opening scaled by up to ``1 ± aperture_scale`` (most in mid-movement).
     path_bow : float
         Sideways bow of the whole hand's path at mid-movement, up to ± m.
+    transport_skew : float
+        The movement's clock runs ahead early by up to this (0..1): the wrist's
+        speed peaks earlier than the model's (at 36-50 % of the movement in
+        healthy adults, against the model's 48 %).
     noise_px : float
         Tracking noise, px, at ``px_per_m``.
+    noise_spread : float
+        Each demonstration's tracking noise is ``noise_px`` × (1 ± this).
     px_per_m : float
         Image scale of the demonstrations' camera, px/m.
     rest : float
@@ -90,8 +100,10 @@ class CalibrationParams:
     time_scale: float = 0.08
     grip_shift: float = 0.08
     aperture_scale: float = 0.10
-    path_bow: float = 0.015
+    path_bow: float = 0.03
+    transport_skew: float = 0.5
     noise_px: float = 0.4
+    noise_spread: float = 0.5
     px_per_m: float = 800.0
     rest: float = 0.3
     marker_offset: float = 0.0065
@@ -106,9 +118,11 @@ class CalibrationParams:
             if f.name != "seed" and not (np.isfinite(value) and value >= 0):
                 raise ValueError(f"{f.name}: expected a finite value >= 0, got {value!r}")
         if not (self.time_scale < 0.5 and self.grip_shift < 0.25 and self.aperture_scale < 1
+                and self.transport_skew < 1 and self.noise_spread < 1
                 and self.px_per_m > 0 and self.rest > 0):
             raise ValueError("time_scale < 0.5, grip_shift < 0.25, aperture_scale < 1, "
-                             "px_per_m > 0 and rest > 0 are required")
+                             "transport_skew < 1, noise_spread < 1, px_per_m > 0 and rest > 0 "
+                             "are required")
 
 
 @dataclass(frozen=True, eq=False)

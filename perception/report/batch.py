@@ -138,11 +138,14 @@ def _num(value, fmt: str) -> str:
     return format(v, fmt) if np.isfinite(v) else ""
 
 
-def _verdict_cell(verdict, status: str) -> str:
+def _verdict_cell(verdict, status: str, detail=None) -> str:
     if status != "ok":
         return '<span class="v-failed">failed</span>'
     v = _e(verdict) or "—"
-    return f'<span class="v-{v}">{v}</span>' if verdict else v
+    # the kind of an abnormal verdict (a float NaN where summary.csv has none)
+    # on a line of its own: the main table must fit a 1280 px window
+    kind = f"<br><small>{_e(detail)}</small>" if isinstance(detail, str) and detail else ""
+    return f'<span class="v-{v}">{v}</span>{kind}' if verdict else v
 
 
 def _main_table(summary: pd.DataFrame, anchors: dict[str, str], reference: str | None) -> str:
@@ -157,7 +160,8 @@ def _main_table(summary: pd.DataFrame, anchors: dict[str, str], reference: str |
         if r.clip in anchors:
             clip = f'<a href="#{anchors[r.clip]}">{clip}</a>'
         ref = get("reference_confidence")
-        rows.append([clip, _e(r.condition), _verdict_cell(get("verdict"), r.status),
+        rows.append([clip, _e(r.condition),
+                     _verdict_cell(get("verdict"), r.status, get("verdict_detail")),
                      _num(get("familiarity"), ".2f"), _num(get("margin"), ".1f"), _e(r.winner),
                      _num(get("winner_log_likelihood"), ".1f"),
                      _num(ref * 100 if ref is not None else None, ".2f"), _e(r.status)])
@@ -178,8 +182,8 @@ def _models_table(summary: pd.DataFrame) -> str:
 
 
 #: summary.csv columns the main table or the per-model table shows.
-_SHOWN = {"clip", "condition", "winner", "rule", "verdict", "familiarity", "margin",
-          "winner_log_likelihood", "reference_model", "reference_confidence", "status",
+_SHOWN = {"clip", "condition", "winner", "rule", "verdict", "verdict_detail", "familiarity",
+          "margin", "winner_log_likelihood", "reference_model", "reference_confidence", "status",
           "reused", "error"}
 
 
@@ -212,7 +216,7 @@ def _clip_section(rec: ClipSummary, out: Path, anchor: str, condition,
     files = clip_outputs(out, rec.clip)
     links = " · ".join(_link(files[k].name, label) for k, label in
                        (("json", "recognition.json"), ("csv", "confidence.csv")))
-    line = (f"verdict {_verdict_cell(rec.verdict, 'ok')}"
+    line = (f"verdict {_verdict_cell(rec.verdict, 'ok', rec.verdict_detail)}"
             f" (familiarity {_num(rec.familiarity, '.2f')}, margin {_num(rec.margin, '.1f')})"
             f"; winner {_e(rec.winner)} ({_e(rec.rule)} rule); condition "
             f"{_e(condition) or 'unlabelled'}; files: {links}")

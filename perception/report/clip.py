@@ -22,7 +22,7 @@ from perception.io.atomic import write_bytes, write_csv, write_json
 from perception.io.names import output_stem, printable
 from perception.recognition.result import Recognition
 
-__all__ = ["ClipSummary", "clip_figures", "clip_outputs", "remove_output",
+__all__ = ["KINEMATICS_COLUMNS", "ClipSummary", "clip_figures", "clip_outputs", "remove_output",
            "write_clip_report"]
 
 #: Keys of ``<clip>.recognition.json`` that :meth:`Recognition.to_dict` writes;
@@ -30,7 +30,12 @@ __all__ = ["ClipSummary", "clip_figures", "clip_outputs", "remove_output",
 RECOGNITION_KEYS = frozenset({
     "clip", "models", "winner", "rule", "verdict", "familiarity", "margin",
     "familiarity_threshold", "reference_model", "time", "confidence", "transport_confidence",
-    "aperture"})
+    "aperture", "verdict_detail", "kinematics", "shape", "mirrored"})
+
+#: The observed landmarks a batch's ``summary.csv`` shows, one column each
+#: (:attr:`ClipSummary.kinematics`; units in docs/recognition.md §9).
+KINEMATICS_COLUMNS = ("movement_time", "peak_speed", "peak_speed_time", "mga", "mga_time",
+                      "aperture_peaks")
 
 
 def _floats(values, n: int | None = None) -> np.ndarray:
@@ -62,6 +67,9 @@ class ClipSummary:
         Rule that picked the winner.
     verdict : str or None
         ``normal``, ``abnormal`` or ``reach``.
+    verdict_detail : str or None
+        The kind of an ``abnormal`` verdict (``delayed-opening``,
+        ``re-opening``, ``no-opening``, ``other``); None for any other.
     familiarity : float
         The best model's familiarity, 0..1.
     margin : float
@@ -74,6 +82,10 @@ class ClipSummary:
         The transport term's share of the confidence (cumulative ``dC_r``), m.
     aperture : (N,) array
         Observed grip aperture, m.
+    kinematics : dict or None
+        The JSON's ``kinematics``: the ``observed`` landmarks, the
+        ``reference`` model's own and its name (None in reports written
+        before they existed).
     extras : dict
         The JSON's other keys (``fingerprint``, ``condition``, ``input``,
         ``tracking``, …).
@@ -95,11 +107,28 @@ class ClipSummary:
     transport: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     aperture: np.ndarray = field(default_factory=lambda: np.zeros(0))
     extras: dict = field(default_factory=dict)
+    verdict_detail: str | None = None
+    kinematics: dict | None = None
 
     @property
     def tracking(self) -> dict | None:
         """The clip's tracking quality (the JSON's ``tracking`` key), if recorded."""
         return self.extras.get("tracking")
+
+    def landmark(self, name: str) -> float | int | None:
+        """One observed landmark (the JSON's ``kinematics.observed``): NaN if unknown.
+
+        ``aperture_peaks`` is None where it is not known.
+
+        Parameters
+        ----------
+        name : str
+            A landmark, e.g. ``mga`` (see :class:`perception.landmarks.Landmarks`).
+        """
+        value = ((self.kinematics or {}).get("observed") or {}).get(name)
+        if name == "aperture_peaks":
+            return None if value is None else int(value)
+        return float("nan") if value is None else float(value)
 
     @property
     def grip(self) -> np.ndarray:
@@ -137,6 +166,8 @@ class ClipSummary:
                 len(names), n),
             aperture=_floats(d.get("aperture"), n),
             extras={k: v for k, v in d.items() if k not in RECOGNITION_KEYS},
+            verdict_detail=d.get("verdict_detail"),
+            kinematics=d.get("kinematics"),
         )
 
     @classmethod
@@ -157,7 +188,8 @@ class ClipSummary:
                    familiarity=d.familiarity, margin=d.margin, familiarities=rec.familiarity,
                    reference_model=rec.reference_model,
                    transport=np.cumsum(rec.dC_r, axis=1), aperture=rec.observation.g,
-                   extras=dict(extras or {}))
+                   extras=dict(extras or {}), verdict_detail=rec.verdict_detail,
+                   kinematics=rec.kinematics)
 
     def index(self, model: str) -> int:
         """Row of ``model`` in the per-model arrays.

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from minvar import GraspTask, GripVia, simulate_grasp
+from minvar import GraspTask, GripVia, shoulder_for, simulate_grasp
 from perception.errors import InputError
 from perception.geometry import DEFAULT_OBJECT_DIAMETER, DEFAULT_TIP_START
 from perception.io.config import Spec, check_fields, document_ranges
@@ -98,7 +98,8 @@ def stimulus_task(p: StimulusParams) -> GraspTask:
     """
     radius = p.object_size / 2
     common = dict(object_size=p.object_size, distance=p.distance, duration=p.duration,
-                  execution_cv=p.execution_cv, tip_start=DEFAULT_TIP_START)
+                  execution_cv=p.execution_cv, tip_start=DEFAULT_TIP_START,
+                  shoulder_offset=shoulder_for(p.distance))
     if p.condition == "normal":
         return GraspTask(**common)
     if p.condition == "reach":

@@ -1,0 +1,211 @@
+"""The movement's shape: a demonstration brought to the repertoire's own scale.
+
+A person may reach slower or faster, farther or nearer, and be filmed at
+another frame rate and scale than the repertoire's models were planned and
+calibrated for — and still grasp normally. The verdict asks whether the
+*coordination* is one of the models' own (does the grip follow the
+transport as the model's does?), so before it is judged a demonstration is
+brought to the repertoire's reference scale (:func:`canonical`):
+
+* **time**: a movement time (:func:`movement_time`) outside the range of
+  the repertoire's grasp models is scaled to the nearest end of that range
+  (a 0.6 s grasp to 0.8 s, a 1.5 s one to 1.2 s: within the range the
+  models of several durations already judge it as it is), then the
+  movement is resampled at the reference frame period. Not every movement
+  is scaled to one duration: the model's own 0.6 s grasp, stretched to
+  1 s, fits its 1 s grasp worse than a 1 s person's does — the muscles'
+  lag does not scale with speed;
+* **transport**: the wrist's path scaled about its goal (``wrist_offset``
+  short of the object centre, where the models' wrists stop) so that it
+  starts at the reference distance; the digits keep their places relative
+  to the wrist, so the grip is not rescaled;
+* **hand**: the digit tips' rest position ahead of the wrist moved to the
+  reference hand's.
+
+The grip aperture and its timing relative to the transport — what tells a
+normal grasp from a delayed or an open-close-open one — are left as they
+were. The verdict (:mod:`perception.recognition.verdict`) is then read off
+the repertoire's models at the reference scene, whose calibrations were
+made there.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+
+from perception.errors import InputError
+from perception.landmarks import movement_time
+from perception.observation import Observation
+from perception.recognition.models import SceneSpec
+
+__all__ = ["GRASP_OPENING", "Normalisation", "canonical", "closed_hand", "is_mirrored", "opens"]
+
+#: Where the models' wrists stop: this far short of the object centre, m
+#: (:class:`minvar.GraspTask` ``wrist_offset``).
+WRIST_GOAL_OFFSET = 0.06
+#: Least transport (start to goal) a demonstration must show to be scaled, m.
+MIN_TRANSPORT = 0.02
+
+
+@dataclass(frozen=True)
+class Normalisation:
+    """How a demonstration was brought to the reference scale.
+
+    Attributes
+    ----------
+    movement_time : float
+        Its estimated movement time, s.
+    time_scale : float
+        Its times were multiplied by this (> 1: it was faster than the
+        repertoire's fastest model; 1 within the repertoire's range).
+    distance_scale : float
+        Reference transport / its transport.
+    """
+
+    movement_time: float
+    time_scale: float
+    distance_scale: float
+
+    def to_dict(self) -> dict:
+        """JSON-able fields."""
+        return dataclasses.asdict(self)
+
+
+def _resample(t_new: np.ndarray, t: np.ndarray, xy: np.ndarray) -> np.ndarray:
+    """``xy`` (N, 2) at ``t_new``, linearly; NaN where either neighbour is lost."""
+    out = np.empty((len(t_new), 2))
+    for k in range(2):
+        out[:, k] = np.interp(t_new, t, np.nan_to_num(xy[:, k]))
+    lost = ~np.isfinite(xy).all(axis=1)
+    i = np.clip(np.searchsorted(t, t_new), 1, len(t) - 1)
+    gone = lost[i] | lost[i - 1]
+    out[gone] = np.nan
+    return out
+
+
+def canonical(obs: Observation, scene: SceneSpec, durations: tuple[float, float]
+              ) -> tuple[Observation, Normalisation]:
+    """``obs`` brought to ``scene`` and ``duration`` (see the module docstring).
+
+    Parameters
+    ----------
+    obs : Observation
+        The demonstration, in its own scene.
+    scene : SceneSpec
+        The reference scene: its distance, hand (``tip_start``) and frame period.
+    durations : (float, float)
+        The shortest and longest reference movement time, s.
+
+    Returns
+    -------
+    Observation
+        The demonstration at the reference scale (``clip`` kept).
+    Normalisation
+        What was done.
+
+    Raises
+    ------
+    InputError
+        Too little of the movement is seen to measure its time, or the wrist
+        travels less than :data:`MIN_TRANSPORT`.
+    """
+    mt = movement_time(obs)
+    if not (np.isfinite(mt) and mt > 0):
+        raise InputError("the wrist is seen too little to measure the movement time",
+                         obs.clip, field="wrist")
+    alpha = float(np.clip(mt, *durations)) / mt
+    transport = obs.start_distance - WRIST_GOAL_OFFSET
+    if transport < MIN_TRANSPORT:
+        raise InputError(f"starts {obs.start_distance * 1000:.0f} mm from the object: too near "
+                         "to judge a reach", obs.clip, field="wrist")
+    s = (scene.distance - WRIST_GOAL_OFFSET) / transport
+    goal = np.array([0.0, -WRIST_GOAL_OFFSET])
+    tip = np.array([0.0, scene.tip_start]) - np.asarray(obs.hand_offset, dtype=float)
+    wrist = goal + (obs.wrist - goal) * s
+    finger = obs.finger - obs.wrist + wrist + tip
+    thumb = obs.thumb - obs.wrist + wrist + tip
+    t_scaled = obs.time * alpha
+    step = scene.frame_period
+    t_new = np.arange(np.ceil(t_scaled[0] / step), np.floor(t_scaled[-1] / step) + 1) * step
+    frames = np.interp(t_new, t_scaled, obs.frame.astype(float)).round().astype(int)
+    out = dataclasses.replace(
+        obs, time=t_new, frame=frames,
+        wrist=_resample(t_new, t_scaled, wrist), finger=_resample(t_new, t_scaled, finger),
+        thumb=_resample(t_new, t_scaled, thumb), raw={}, dt=step,
+        start_distance=scene.distance,
+        hand_offset=np.asarray(obs.hand_offset, dtype=float) + tip,
+        noise=obs.noise * s)
+    return out, Normalisation(float(mt), float(alpha), float(s))
+
+
+def closed_hand(obs: Observation) -> Observation:
+    """``obs`` with the digits kept closed at their rest place ahead of the wrist.
+
+    The transport alone, as a reach-only model makes it: scored against the
+    reach models, it says whether the wrist moves like a human reach
+    whatever the grip does (the verdict ``unfamiliar`` when it does not).
+
+    Parameters
+    ----------
+    obs : Observation
+        A demonstration (at the reference scale).
+    """
+    tips = obs.wrist + np.asarray(obs.hand_offset, dtype=float)
+    return dataclasses.replace(obs, finger=tips.copy(), thumb=tips.copy())
+
+
+#: Least grip opening, m, at which the side the finger is on is read.
+MIRROR_OPENING = 0.02
+
+
+def is_mirrored(obs: Observation) -> bool:
+    """Whether the finger opens on the model's -x side: a mirrored scene.
+
+    The models put the finger at +x of the approach (a right hand filmed
+    from its thumb's side, or a left hand from the other side, is the
+    mirror image). Read over the frames where the grip is open by at least
+    :data:`MIRROR_OPENING`: mirrored if in most of them the finger is on
+    -x. A movement that never opens (a reach) is never mirrored.
+
+    Parameters
+    ----------
+    obs : Observation
+        The demonstration.
+    """
+    opening = obs.finger - obs.thumb
+    wide = np.linalg.norm(opening, axis=1) >= MIRROR_OPENING
+    if not wide.any():
+        return False
+    return bool(np.mean(opening[wide, 0] < 0) > 0.5)
+
+
+#: A hand that grasps an object opens its grip by at least this share of the
+#: object's diameter beyond its closed rest aperture (it must pass around
+#: the object: healthy adults open 1.5-3.5 cm *beyond* it, Jeannerod 1984).
+GRASP_OPENING = 0.5
+
+
+def opens(obs: Observation) -> bool:
+    """Whether the grip opens as a grasp of the object must: a grasp, not a reach.
+
+    The observed aperture must exceed its rest value (the first frames)
+    by :data:`GRASP_OPENING` × the object's diameter at some frame. The
+    verdict is then judged against the repertoire's grasp models, otherwise
+    against its reach models: whether the hand opens is what tells the two
+    kinds apart, and the one-step likelihood weighs it weakly (a grasp
+    model's predicted opening is uncertain, its signal-dependent noise large).
+
+    Parameters
+    ----------
+    obs : Observation
+        The demonstration.
+    """
+    g = obs.g
+    seen = np.isfinite(g)
+    if not seen.any():
+        return False
+    rest = float(g[seen][: max(1, min(5, int(seen.sum())))].mean())
+    return bool(np.nanmax(g) - rest >= GRASP_OPENING * obs.object_diameter)

@@ -1,0 +1,231 @@
+"""Reach-to-grasp landmarks against known answers, and the kind of an abnormal verdict.
+
+Known answers: the independent generator (docs/recognition.md §10) builds
+movements with a known duration, peak-speed time, MGA and MGA time; the
+demos are the grasp model's own movement, whose landmarks the reference
+model's own must match.
+"""
+
+import json
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pandas as pd
+import pytest
+from _demos import default_repertoire, demo_tracks
+from scipy.special import beta as beta_fn
+
+from perception.batch import ClipResult, summary_table
+from perception.landmarks import (
+    DETAILS,
+    Landmarks,
+    count_peaks,
+    movement_landmarks,
+    observed_landmarks,
+    verdict_detail,
+)
+from perception.observation import observe
+from perception.pipeline import recognize_clip
+from perception.report import ClipSummary, write_clip_report
+from perception.synthetic.independent import IndependentParams, independent_tracks
+
+CONTRACT = ["movement_time", "peak_speed", "peak_speed_time", "mga", "mga_time",
+            "aperture_peaks"]
+
+
+def _mga_time(p: IndependentParams) -> float:
+    return {"normal": p.mga_time, "delayed": p.delayed_mga_time,
+            "open-close-open": p.oco_reopen_time}[p.condition]
+
+
+def _peak_speed(p: IndependentParams) -> float:
+    """The generator's peak wrist speed: its path over its beta(3, b) speed profile."""
+    b, tau = 2 / p.peak_velocity_time - 1, p.peak_velocity_time
+    return (p.distance - p.hand_size) * tau**2 * (1 - tau)**(b - 1) / beta_fn(3, b) / p.duration
+
+
+# -- the peak count ---------------------------------------------------------------------
+def test_peaks_count_by_prominence_not_by_the_aperture_at_contact():
+    t = np.linspace(0, 1, 101)
+    # opens to 12 cm at 0.7, closes on a 10 cm object: one peak though it stands only
+    # 2 cm above the contact aperture (scipy's prominence would be 2 cm)
+    normal = np.interp(t, [0, 0.1, 0.7, 1], [0, 0, 0.12, 0.10])
+    assert count_peaks(normal, 0.25 * 0.12) == 1
+    oco = np.interp(t, [0, 0.1, 0.38, 0.58, 0.82, 1], [0, 0, 0.096, 0.043, 0.12, 0.10])
+    assert count_peaks(oco, 0.25 * 0.12) == 2
+    # a dip shallower than the least prominence is one peak
+    shallow = np.interp(t, [0, 0.1, 0.38, 0.58, 0.82, 1], [0, 0, 0.10, 0.095, 0.12, 0.10])
+    assert count_peaks(shallow, 0.25 * 0.12) == 1
+    # still opening at the end: the last sample is the peak; a flat line has none
+    assert count_peaks(np.interp(t, [0, 1], [0, 0.1]), 0.005) == 1
+    assert count_peaks(np.zeros(10), 0.005) == 0
+    assert count_peaks(np.array([0.0, 0.1, 0.1, 0.1, 0.0]), 0.005) == 1  # a plateau is one
+
+
+# -- landmarks against the generator's parameters --------------------------------------
+@pytest.mark.parametrize("condition", ["normal", "delayed", "open-close-open"])
+@pytest.mark.parametrize("seed", [0, 2])
+def test_landmarks_recover_the_independent_generators_kinematics(condition, seed):
+    p = IndependentParams(condition=condition)
+    obs = observe(independent_tracks(p, seed)[0])
+    got = observed_landmarks(obs)
+    T = got.movement_time
+    # the movement span ends when no marker moves faster than the tracking noise allows
+    # (about 0.09 m/s here): a slow final approach is cut short, a late closing is not
+    assert -0.25 < T - p.duration < 0.1
+    if condition != "normal":
+        assert abs(T - p.duration) < 0.1
+    # the landmarks' times, s since onset, within 0.05 / 0.06 of the 1 s movement
+    assert got.mga_time * T == pytest.approx(_mga_time(p) * p.duration, abs=0.05)
+    assert got.peak_speed_time * T == pytest.approx(p.peak_velocity_time * p.duration,
+                                                    abs=0.06)
+    # as fractions of the measured movement time: off by as much as its end
+    assert got.mga_time == pytest.approx(_mga_time(p), abs=0.1)
+    assert got.mga == pytest.approx(p.mga, abs=0.004)
+    assert got.peak_speed == pytest.approx(_peak_speed(p), rel=0.12)
+    assert got.rest_aperture == pytest.approx(0.0, abs=0.003)
+    assert got.contact_aperture == pytest.approx(p.object_size, abs=0.012)
+    assert got.aperture_peaks == (2 if condition == "open-close-open" else 1)
+    if condition == "delayed":
+        assert got.opening_time > 0.45
+    else:
+        assert got.opening_time < 0.3
+
+
+def test_the_models_own_movement_matches_the_reference_models_own_landmarks():
+    rep = default_repertoire()
+    rec = recognize_clip(demo_tracks("normal", 0)[0], rep, clip="n")
+    assert rec.reference_model == "grasp-1.0s"
+    observed, reference = rec.landmarks
+    assert reference.movement_time == 1.0  # the planned movement time
+    assert observed.movement_time == pytest.approx(reference.movement_time, abs=0.1)
+    assert observed.mga == pytest.approx(reference.mga, abs=0.004)
+    assert observed.mga_time == pytest.approx(reference.mga_time, abs=0.06)
+    assert observed.peak_speed == pytest.approx(reference.peak_speed, rel=0.1)
+    assert observed.peak_speed_time == pytest.approx(reference.peak_speed_time, abs=0.08)
+    assert observed.aperture_peaks == reference.aperture_peaks == 1
+    assert rec.verdict == "normal" and rec.verdict_detail is None
+
+
+# -- the detail rule -------------------------------------------------------------------
+def _lm(**kw):
+    base = dict(movement_time=1.0, peak_speed=0.5, peak_speed_time=0.4, mga=0.12,
+                mga_time=0.7, contact_aperture=0.1, aperture_peaks=1, rest_aperture=0.0,
+                opening_time=0.2)
+    return Landmarks(**{**base, **kw})
+
+
+def test_the_detail_rule_in_the_fields_terms():
+    ref = _lm()
+    assert verdict_detail(_lm(), ref) == "other"
+    assert verdict_detail(_lm(mga=0.03), ref) == "no-opening"  # 25 % of the reference's
+    assert verdict_detail(_lm(mga=0.03, aperture_peaks=2), ref) == "no-opening"
+    assert verdict_detail(_lm(aperture_peaks=2), ref) == "re-opening"
+    assert verdict_detail(_lm(opening_time=0.5), ref) == "delayed-opening"
+    assert verdict_detail(_lm(mga_time=0.9), ref) == "delayed-opening"
+    # a late MGA is no delay when the reference's own is as late
+    assert verdict_detail(_lm(mga_time=0.9), _lm(mga_time=0.9)) == "other"
+    # scale-free: the same grasp at twice the size
+    big = _lm(mga=0.06, rest_aperture=0.0)
+    assert verdict_detail(big, _lm(mga=0.24)) == "no-opening"
+    assert verdict_detail(big, _lm(mga=0.12)) == "other"
+    assert verdict_detail(Landmarks(), None) == "other"
+    assert verdict_detail(Landmarks(), ref) in DETAILS
+
+
+@pytest.mark.parametrize("condition, detail", [("delayed", "delayed-opening"),
+                                               ("open-close-open", "re-opening")])
+def test_abnormal_independent_grasps_get_their_kind(condition, detail):
+    rep = default_repertoire()
+    verdicts = []
+    for seed in range(3):
+        rec = recognize_clip(independent_tracks(IndependentParams(condition=condition),
+                                                seed)[0], rep, clip=f"{condition}-{seed}")
+        verdicts.append(rec.verdict)
+        if rec.verdict == "abnormal":
+            assert rec.verdict_detail == detail
+            assert rec.to_dict()["verdict_detail"] == detail
+        else:
+            assert rec.verdict_detail is None
+    assert "abnormal" in verdicts
+
+
+# -- missing markers -------------------------------------------------------------------
+def test_landmarks_survive_missing_markers():
+    assert all(v is None for v in Landmarks().to_dict().values())
+    t = np.linspace(0, 1, 31)
+    wrist = np.c_[np.zeros(31), np.linspace(-0.2, 0, 31)]
+    empty = movement_landmarks(t, wrist, np.full(31, np.nan))
+    assert math.isnan(empty.mga) and empty.aperture_peaks is None
+    assert empty.peak_speed == pytest.approx(0.2)
+    lost = movement_landmarks(t, np.full((31, 2), np.nan), np.full(31, np.nan))
+    assert math.isnan(lost.peak_speed) and lost.movement_time == 1.0
+    # the finger lost for 0.2 s in mid-movement: a dip could hide there, so no peak count
+    tracks, _ = demo_tracks("normal", 0, lost={"finger": slice(20, 26)})
+    got = observed_landmarks(observe(tracks))
+    assert got.aperture_peaks is None
+    assert got.mga == pytest.approx(0.119, abs=0.01) and math.isfinite(got.peak_speed)
+    d = json.loads(json.dumps(got.to_dict()))
+    assert d["aperture_peaks"] is None and Landmarks.from_dict(d).mga == pytest.approx(got.mga)
+
+
+# -- the reports -----------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def reports(tmp_path_factory):
+    out = tmp_path_factory.mktemp("reports")
+    rep = default_repertoire()
+    recs = [recognize_clip(demo_tracks("normal", 0)[0], rep, clip="normal-0"),
+            recognize_clip(demo_tracks("delayed", 0)[0], rep, clip="delayed-0")]
+    for rec in recs:
+        write_clip_report(rec, out, figures=False)
+    return out, recs
+
+
+def test_the_json_and_its_summary_keep_the_kinematics(reports):
+    out, recs = reports
+    for rec in recs:
+        d = json.loads((out / f"{rec.clip}.recognition.json").read_text())
+        k = d["kinematics"]
+        assert k["reference_model"] == d["reference_model"] == rec.reference_model
+        assert set(CONTRACT) <= set(k["observed"]) and set(CONTRACT) <= set(k["reference"])
+        assert d["verdict_detail"] == (rec.verdict_detail if d["verdict"] == "abnormal"
+                                       else None)
+        a, b = ClipSummary.from_recognition(rec), ClipSummary.from_dict(d)
+        assert a.verdict_detail == b.verdict_detail and "kinematics" not in b.extras
+        for name in CONTRACT:
+            assert a.landmark(name) == pytest.approx(b.landmark(name))
+    assert recs[1].verdict == "abnormal" and recs[1].verdict_detail == "delayed-opening"
+
+
+def test_summary_csv_has_the_landmark_columns(reports, tmp_path):
+    out, recs = reports
+    results = [ClipResult(r.clip, None, "ok", summary=ClipSummary.from_dict(
+        json.loads((out / f"{r.clip}.recognition.json").read_text()))) for r in recs]
+    results.append(ClipResult("bad", None, "failed", error="bad: not a video"))
+    table = summary_table(results).set_index("clip")
+    assert {*CONTRACT, "verdict_detail"} <= set(table.columns)
+    for rec in recs:
+        observed = rec.kinematics["observed"]
+        for name in CONTRACT:
+            assert table.loc[rec.clip, name] == pytest.approx(observed[name])
+    assert table.loc["delayed-0", "verdict_detail"] == "delayed-opening"
+    assert pd.isna(table.loc["normal-0", "verdict_detail"])
+    assert np.isnan(table.loc["bad", "mga"])
+    table.reset_index().to_csv(tmp_path / "summary.csv", index=False)
+    lines = (tmp_path / "summary.csv").read_text().splitlines()
+    header = lines[0].split(",")
+    row = dict(zip(header, next(x for x in lines if x.startswith("delayed-0")).split(",")))
+    assert row["aperture_peaks"] == "1" and row["verdict_detail"] == "delayed-opening"
+
+
+def test_recognize_prints_the_kind_of_an_abnormal_verdict(tmp_path):
+    rep = default_repertoire().save(tmp_path / "rep.h5")
+    demo_tracks("delayed", 0)[0].save(tmp_path / "d.tracks.h5")
+    proc = subprocess.run([sys.executable, "-m", "hammer_mv", "recognize",
+                           str(tmp_path / "d.tracks.h5"), "-o", str(tmp_path / "out"),
+                           "--repertoire", str(rep), "--no-figures"],
+                          capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.startswith("d: abnormal (delayed-opening), winner grasp-")

@@ -1,0 +1,119 @@
+"""The verdict judges coordination, not speed, size or camera; and says when it cannot judge.
+
+Known answers: the model's own movements at other speeds, distances and
+frame rates are its own (normal / reach); a mirrored camera is the same
+grasp; a hand that does not move is no reach; a hand that scrabbles sideways
+is no human reach.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import numpy as np
+import pytest
+from _demos import default_repertoire, demo_tracks
+
+from hammer_mv.cli import main
+from minvar import GraspTask, shoulder_for
+from perception.errors import InputError
+from perception.landmarks import movement_time
+from perception.observation import observe
+from perception.pipeline import recognize_tracks
+from perception.recognition.models import SceneSpec
+from perception.recognition.shape import canonical, is_mirrored, opens
+
+
+@pytest.mark.parametrize("duration", [0.6, 1.0, 1.4])
+def test_movement_time_is_measured_from_the_wrist(duration):
+    obs = observe(demo_tracks("normal", 1, duration=duration)[0])
+    assert movement_time(obs) == pytest.approx(duration, rel=0.1)
+
+
+@pytest.mark.parametrize("condition, verdict", [("normal", "normal"), ("reach", "reach")])
+@pytest.mark.parametrize("duration, distance, fps", [(0.6, 0.25, 30), (1.6, 0.25, 120),
+                                                     (1.0, 0.45, 30), (1.0, 0.5, 60),
+                                                     (0.8, 0.15, 25)])
+def test_the_models_own_movements_at_other_speeds_distances_and_rates_are_familiar(
+        condition, verdict, duration, distance, fps):
+    tracks = demo_tracks(condition, 0, duration=duration, distance=distance, fps=fps)[0]
+    rec = recognize_tracks(tracks, default_repertoire())
+    assert rec.verdict == verdict, (rec.decision, rec.normalisation)
+    assert rec.decision.familiarity > 0.05
+    assert rec.to_dict()["shape"]["movement_time"] == pytest.approx(duration, rel=0.15)
+
+
+def test_delayed_and_open_close_open_stay_abnormal_at_other_speeds():
+    for condition, detail in (("delayed", "delayed-opening"), ("open-close-open", "re-opening")):
+        for duration in (0.7, 1.4):
+            rec = recognize_tracks(demo_tracks(condition, 0, duration=duration)[0],
+                                   default_repertoire())
+            assert rec.verdict == "abnormal" and rec.verdict_detail == detail, (condition,
+                                                                               duration)
+
+
+def test_canonical_scales_time_and_transport_but_not_the_grip():
+    obs = observe(demo_tracks("normal", 0, duration=1.5, distance=0.35)[0])
+    scene = SceneSpec()
+    out, norm = canonical(obs, scene, (0.6, 1.2))
+    assert norm.time_scale == pytest.approx(1.2 / movement_time(obs))
+    assert norm.distance_scale == pytest.approx((0.25 - 0.06) / (obs.start_distance - 0.06))
+    assert out.start_distance == scene.distance and out.dt == scene.frame_period
+    assert np.nanmax(out.g) == pytest.approx(np.nanmax(obs.g), abs=0.002)
+    assert movement_time(out) == pytest.approx(1.2, rel=0.05)
+    # within the repertoire's range the time is left as it is
+    same, norm = canonical(observe(demo_tracks("normal", 0)[0]), scene, (0.6, 1.2))
+    assert norm.time_scale == 1.0
+
+
+def test_a_mirrored_scene_is_found_and_scored_as_its_mirror_image(tmp_path, capsys):
+    tracks = demo_tracks("normal", 0)[0]
+    flipped = dataclasses.replace(tracks, position=tracks.position * [-1, 1] + [640, 0])
+    assert not is_mirrored(observe(tracks))
+    assert is_mirrored(observe(flipped))
+    rec = recognize_tracks(flipped, default_repertoire())
+    assert rec.mirrored and rec.verdict == "normal"
+    path = flipped.save(tmp_path / "left.tracks.h5")
+    assert main(["recognize", str(path), "-o", str(tmp_path / "o"), "--no-figures"]) == 0
+    line = capsys.readouterr().out.strip()
+    assert "normal" in line and "--mirror" in line
+    assert json.loads((tmp_path / "o" / "left.recognition.json").read_text())["mirrored"]
+
+
+def test_a_still_hand_is_refused_naming_the_movement():
+    tracks = demo_tracks("normal", 0)[0]
+    rest = tracks.position[:5].mean(axis=0)
+    rng = np.random.default_rng(0)
+    drift = np.linspace(0, 1, tracks.n_frames)[:, None, None] * [1.6, 1.6]  # ~2 mm at 800 px/m
+    still = rest + drift * np.array([1, 1, 1, 0])[None, :, None]
+    still = still + 0.3 * rng.standard_normal(still.shape)
+    with pytest.raises(InputError, match="no movement: the wrist moves") as info:
+        recognize_tracks(dataclasses.replace(tracks, position=still), default_repertoire())
+    assert info.value.field == "wrist"
+
+
+def test_a_hand_that_scrabbles_sideways_is_unfamiliar():
+    tracks, truth = demo_tracks("reach", 0)
+    t = np.arange(tracks.n_frames)
+    wobble = 40 * np.sin(2 * np.pi * t / 12) * (t > truth["onset_frame"])
+    pos = tracks.position.copy()
+    pos[:, :3, 0] += wobble[:, None]
+    rec = recognize_tracks(dataclasses.replace(tracks, position=pos), default_repertoire())
+    assert rec.verdict == "unfamiliar" and rec.transport_familiarity < 0.01
+    assert rec.to_dict()["verdict"] == "unfamiliar" and rec.verdict_detail is None
+
+
+def test_a_grasp_opens_a_reach_does_not():
+    assert opens(observe(demo_tracks("normal", 0)[0]))
+    assert not opens(observe(demo_tracks("reach", 0)[0]))
+
+
+@pytest.mark.parametrize("distance", [0.15, 0.25, 0.33, 0.4, 0.5])
+def test_the_start_posture_follows_the_reach(distance):
+    task = GraspTask(distance=distance, shoulder_offset=shoulder_for(distance))
+    goal = np.linalg.norm(np.subtract(task.wrist_target, task.shoulder))
+    assert goal <= 0.9 * sum(task.arm_links) + 1e-9
+    if distance <= 0.3:
+        assert shoulder_for(distance) == (0.15, -0.25)  # the thesis's posture
+    assert shoulder_for(2.0) == (0.15, -0.25)  # no arm reaches 2 m: GraspTask says so
