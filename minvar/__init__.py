@@ -15,88 +15,16 @@ Figures of all of these are drawn on request by :mod:`minvar.plotting`.
 numpy/scipy only: no video, no files. The model and its parameters are
 described in docs/model.md.
 
-Every name below and every submodule above is an attribute of the package
-(``minvar.solve``, ``minvar.grasp_experiments``), imported the first time it
-is used: ``import minvar`` itself loads nothing heavy (no scipy, pandas or
-matplotlib), so a command that only asks for the version starts at once.
+Every public name (``minvar.solve``) and every submodule above
+(``minvar.grasp_experiments``) is an attribute of the package, imported the
+first time it is used (``lazy_loader``, from the names ``__init__.pyi``
+lists, which IDEs, type checkers and ``help(minvar)`` read too): ``import
+minvar`` itself loads nothing heavy (no scipy, pandas or matplotlib), so a
+command that only asks for the version starts at once.
 """
 
-from importlib import import_module as _import_module
+import lazy_loader as _lazy
 
-from minvar._version import __version__
+from minvar._version import __version__ as __version__
 
-#: Public names and the submodule each comes from (imported on first use).
-_NAMES = {
-    'endpoint_stats': 'analysis',
-    'peak_to_mean_speed': 'analysis',
-    'speed_accuracy': 'analysis',
-    'ChainPlan': 'grasp',
-    'GraspPlan': 'grasp',
-    'GraspResult': 'grasp',
-    'GraspTask': 'grasp_task',
-    'GripVia': 'grasp_task',
-    'shoulder_for': 'grasp_task',
-    'plan_grasp': 'grasp',
-    'simulate_grasp': 'grasp',
-    'GraspMoments': 'grasp_stats',
-    'GraspSummary': 'grasp_stats',
-    'grasp_moments': 'grasp_stats',
-    'summarize_grasp': 'grasp_stats',
-    'LQGProblem': 'lqg',
-    'LQGSolution': 'lqg',
-    'expected_cost': 'lqg',
-    'solve': 'lqg',
-    'state_moments': 'lqg',
-    'PointMassPlant': 'plant',
-    'ReachResult': 'reach',
-    'simulate_reach': 'reach',
-    'Trajectories': 'execution',
-    'simulate': 'execution',
-    'ReachTask': 'task',
-    'ViaPoint': 'task',
-    'reach_problem': 'task',
-}
-
-# Submodules reachable as attributes of the package, imported on first use.
-_SUBMODULES = (
-    "analysis",
-    "baselines",
-    "execution",
-    "grasp",
-    "grasp_experiments",
-    "grasp_task",
-    "grasp_stats",
-    "kinematics",
-    "limits",
-    "lqg",
-    "plant",
-    "plotting",
-    "reach",
-    "similarity",
-    "task",
-    "viapoints",
-)
-
-__all__ = ["__version__", *sorted(_NAMES)]
-
-
-def __getattr__(name: str):
-    """``minvar.<name>`` and ``minvar.<submodule>`` without importing them first (PEP 562).
-
-    Parameters
-    ----------
-    name : str
-        The attribute asked for.
-    """
-    if name in _NAMES:
-        value = getattr(_import_module(f"{__name__}.{_NAMES[name]}"), name)
-        globals()[name] = value  # found once, then an ordinary attribute
-        return value
-    if name in _SUBMODULES:
-        return _import_module(f"{__name__}.{name}")
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    """The package's names, its lazily imported names and submodules included."""
-    return sorted({*globals(), *_NAMES, *_SUBMODULES})
+__getattr__, __dir__, __all__ = _lazy.attach_stub(__name__, __file__)

@@ -1,9 +1,12 @@
 """The compiled passes of :mod:`minvar.lqg` (``minvar/_lqg_kernel.c``), loaded with ctypes.
 
 The library is built by ``pip install`` (``setup.py``; a C compiler is all it
-needs) and is optional: without it, or with ``MINVAR_KERNEL=numpy`` in the
-environment, the solver runs its numpy passes, which give the same results to
-rounding, five to ten times slower.
+needs) and is optional: the solver's ``engine`` argument picks the compiled
+passes (``"c"``), its numpy passes (``"numpy"``), which give the same results to
+rounding, five to ten times slower, or the compiled passes where they are built
+(``"auto"``, the default; ``MINVAR_KERNEL=numpy`` or ``=c`` in the environment
+sets what ``"auto"`` means). An ``"auto"`` solve that falls back to numpy because
+the library is missing says so once per process, as a warning.
 """
 
 from __future__ import annotations
@@ -12,12 +15,22 @@ import ctypes
 import importlib.util
 import logging
 import os
+import threading
 
 import numpy as np
 
-log = logging.getLogger(__name__)
+__all__ = ["ENGINES", "KernelUnavailableError", "available", "backward", "check_engine",
+           "error_covariance", "forward", "loaded", "mean_states", "use_compiled"]
 
-__all__ = ["available", "backward", "error_covariance", "forward", "mean_states"]
+#: The values of the solver's ``engine`` argument.
+ENGINES = ("auto", "c", "numpy")
+
+#: Values of ``MINVAR_KERNEL`` and the engine each makes ``"auto"`` mean.
+_ENV_ENGINES = {"": "auto", "auto": "auto", "c": "c", "compiled": "c", "numpy": "numpy"}
+
+
+class KernelUnavailableError(ImportError):
+    """``engine="c"`` was asked for but the compiled kernel is not built or cannot be loaded."""
 
 #: Flags of the C passes (minvar/_lqg_kernel.c).
 HAS_C, HAS_D, TRACK_XE, ADD_NOISE, NOISE_COST = 1, 2, 4, 8, 16
@@ -26,20 +39,24 @@ _int = ctypes.c_int
 _ptr = ctypes.c_void_p
 
 
+#: Why the library is not loaded (None when it is).
+_WHY: str | None = None
+
+
 def _load():
-    if os.environ.get("MINVAR_KERNEL", "").lower() == "numpy":
-        return None
+    """The library, or None with the reason in ``_WHY`` (said when a solve needs it)."""
+    global _WHY
     spec = importlib.util.find_spec("minvar._lqg_kernel")
     if spec is None or not spec.origin:
-        log.info("minvar: compiled LQG kernel not built; using the numpy passes")
+        _WHY = "it was not built: no C compiler when minvar was installed"
         return None
     try:
         lib = ctypes.CDLL(spec.origin)
     except OSError as exc:  # pragma: no cover - a broken build
-        log.info("minvar: cannot load the compiled LQG kernel (%s); using numpy", exc)
+        _WHY = f"it cannot be loaded ({exc})"
         return None
     if not hasattr(lib, "lqg_mean_states"):  # pragma: no cover - built from older source
-        log.info("minvar: the compiled LQG kernel is out of date (reinstall); using numpy")
+        _WHY = "it is out of date (reinstall minvar)"
         return None
     lib.lqg_forward.argtypes = [_int] * 6 + [_ptr] * 11 + [_int, _ptr]
     lib.lqg_forward.restype = _int
@@ -55,9 +72,64 @@ def _load():
 _LIB = _load()
 
 
-def available() -> bool:
-    """Whether the compiled passes are in use."""
+def loaded() -> bool:
+    """Whether the compiled library is built and loaded (``engine="c"`` can run)."""
     return _LIB is not None
+
+
+def available() -> bool:
+    """Whether the default engine (``"auto"``) uses the compiled passes.
+
+    True when the library is loaded and ``MINVAR_KERNEL`` does not ask for numpy.
+    """
+    return _LIB is not None and os.environ.get("MINVAR_KERNEL", "").strip().lower() != "numpy"
+
+
+def check_engine(engine, where: str) -> str:
+    """``engine`` if it is one of :data:`ENGINES`, else a ValueError naming it (at ``where``)."""
+    if not isinstance(engine, str) or engine not in ENGINES:
+        raise ValueError(f"{where}: engine must be one of {', '.join(map(repr, ENGINES))}, "
+                         f"got {engine!r}")
+    return engine
+
+
+#: Whether an "auto" fallback to numpy has been announced in this process.
+_WARNED = False
+_WARN_LOCK = threading.Lock()
+
+
+def use_compiled(engine: str) -> bool:
+    """Whether a solve with ``engine`` (checked by :func:`check_engine`) runs the compiled passes.
+
+    ``"auto"`` takes its meaning from ``MINVAR_KERNEL`` when that is set, and
+    otherwise uses the compiled passes where they are loaded, announcing the
+    numpy fallback once per process (a warning on the ``minvar`` logger).
+    ``"c"`` without the library raises :class:`KernelUnavailableError`.
+    """
+    global _WARNED
+    if engine == "auto":
+        env = os.environ.get("MINVAR_KERNEL", "")
+        engine = _ENV_ENGINES.get(env.strip().lower())
+        if engine is None:
+            raise ValueError(f"MINVAR_KERNEL must be one of 'auto', 'c' (or 'compiled') or "
+                             f"'numpy', got {env!r}")
+    if engine == "numpy":
+        return False
+    if _LIB is not None:
+        return True
+    why = _WHY or "it is not loaded"
+    if engine == "c":
+        raise KernelUnavailableError(
+            f"minvar: engine='c' needs the compiled LQG kernel (minvar/_lqg_kernel.c), but "
+            f"{why}; reinstall minvar with a C compiler, or use engine='auto' or 'numpy'")
+    with _WARN_LOCK:
+        warn, _WARNED = not _WARNED, True
+    if warn:
+        logging.getLogger("minvar").warning(
+            "minvar: the compiled LQG kernel is not available (%s); solving with the numpy "
+            "passes, the same results five to ten times slower (engine='numpy' or "
+            "MINVAR_KERNEL=numpy chooses them without this warning)", why)
+    return False
 
 
 def _p(a: np.ndarray | None):

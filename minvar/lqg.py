@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import _kernel
+from ._kernel import KernelUnavailableError
 
 log = logging.getLogger(__name__)
 
@@ -37,7 +38,7 @@ log = logging.getLogger(__name__)
 _FLOOR_RTOL = 1e-6
 
 __all__ = ["LQGProblem", "LQGSolution", "solve", "expected_cost", "state_moments",
-           "estimation_error_covariance"]
+           "estimation_error_covariance", "KernelUnavailableError"]
 
 
 def _as_matrix(name: str, value, shape: tuple[int | None, ...]) -> np.ndarray:
@@ -259,7 +260,7 @@ class _Solver:
     be singular.
     """
 
-    def __init__(self, p: LQGProblem):
+    def __init__(self, p: LQGProblem, compiled: bool = True):
         self.p = p
         A, B = p.A, p.B
         self.At = np.ascontiguousarray(A.T)
@@ -282,7 +283,7 @@ class _Solver:
         # The compiled passes cover the Cholesky case (every planning problem
         # of this project); the pseudo-inverse case runs in numpy.
         self.fast = None
-        if _kernel.available() and self.filter_pd and self.control_pd:
+        if compiled and self.filter_pd and self.control_pd:
             flags = ((_kernel.HAS_C if self.has_C else 0) | (_kernel.HAS_D if self.has_D else 0)
                      | (_kernel.TRACK_XE if self.has_E0 else 0)
                      | (_kernel.ADD_NOISE if self.has_C0 or self.has_E0 else 0)
@@ -425,6 +426,7 @@ def solve(
     tol: float = 0.0,
     max_iter: int = 500,
     initial_L: np.ndarray | None = None,
+    engine: str = "auto",
 ) -> LQGSolution:
     """Find the filter ``K`` and controller ``L`` that are optimal for each other.
 
@@ -451,6 +453,17 @@ def solve(
         Control gains for the first forward pass (default zeros, as the thesis
         and Todorov's code; thesis line 481: any start converges to the same
         answer).
+    engine : {"auto", "c", "numpy"}, optional
+        Which implementation runs the forward and backward passes. ``"c"``:
+        the compiled kernel (``minvar/_lqg_kernel.c``, built by ``pip install``);
+        ``"numpy"``: the numpy passes, the same results to rounding (gains to
+        about 1e-12 relative), five to ten times slower. ``"auto"`` (default):
+        what the environment variable ``MINVAR_KERNEL`` says (``c`` or
+        ``numpy``) if it is set, else the compiled kernel where it is built,
+        falling back to numpy with one warning per process (logger
+        ``minvar``) where it is not. Problems whose filter or control system
+        may be singular (``D0 D0'`` or ``R`` not positive definite) run the
+        numpy passes' pseudo-inverse whatever the engine.
 
     Returns
     -------
@@ -462,10 +475,14 @@ def solve(
     Raises
     ------
     ValueError
-        If ``tol``, ``atol``, ``max_iter`` or ``initial_L`` are out of range, or the
-        recursions break down: non-finite moments or gains (e.g. dynamics so
-        unstable that the moments overflow), or a singular observation noise
-        whose filter system cannot be solved. The message names the cause.
+        If ``tol``, ``atol``, ``max_iter``, ``initial_L`` or ``engine`` are out of
+        range, or the recursions break down: non-finite moments or gains (e.g.
+        dynamics so unstable that the moments overflow), or a singular
+        observation noise whose filter system cannot be solved. The message
+        names the cause.
+    KernelUnavailableError
+        If ``engine="c"`` (or ``"auto"`` with ``MINVAR_KERNEL=c``) and the
+        compiled kernel is not built or cannot be loaded (an ``ImportError``).
     """
     if not isinstance(problem, LQGProblem):
         raise ValueError(f"solve: expected an LQGProblem, got {type(problem).__name__}")
@@ -473,7 +490,8 @@ def solve(
         raise ValueError(f"solve: tol and atol must be >= 0, got tol={tol}, atol={atol}")
     if int(max_iter) < 1:
         raise ValueError(f"solve: max_iter must be >= 1, got {max_iter}")
-    solver = _Solver(problem)
+    compiled = _kernel.use_compiled(_kernel.check_engine(engine, "solve"))
+    solver = _Solver(problem, compiled)
     T, m, n = problem.horizon, problem.n_controls, problem.n_states
     L = np.zeros((T, m, n)) if initial_L is None else np.array(initial_L, dtype=float)
     if L.shape != (T, m, n) or not np.all(np.isfinite(L)):
@@ -628,7 +646,8 @@ def state_moments(
     return np.array(means), np.array(covs)
 
 
-def estimation_error_covariance(problem: LQGProblem, K: np.ndarray, L: np.ndarray) -> np.ndarray:
+def estimation_error_covariance(problem: LQGProblem, K: np.ndarray, L: np.ndarray, *,
+                                engine: str = "auto") -> np.ndarray:
     """Exact covariance of the filter's error ``x[t] - xhat[t]`` under gains ``K``, ``L``.
 
     ``xhat[t]`` uses observations up to ``t - 1``, so this is the spread of the
@@ -643,6 +662,9 @@ def estimation_error_covariance(problem: LQGProblem, K: np.ndarray, L: np.ndarra
         Filter gains.
     L : (T, m, n) array
         Control gains.
+    engine : {"auto", "c", "numpy"}, optional
+        The compiled recursion or the numpy one (:func:`_joint_moments`, as
+        :func:`state_moments` and :func:`expected_cost`); as in :func:`solve`.
 
     Returns
     -------
@@ -653,7 +675,8 @@ def estimation_error_covariance(problem: LQGProblem, K: np.ndarray, L: np.ndarra
     T, n, m, k = p.horizon, p.n_states, p.n_controls, p.n_outputs
     K = np.asarray(K, dtype=float)
     L = np.asarray(L, dtype=float)
-    if _kernel.available() and K.shape == (T, n, k) and L.shape == (T, m, n):
+    compiled = _kernel.use_compiled(_kernel.check_engine(engine, "estimation_error_covariance"))
+    if compiled and K.shape == (T, n, k) and L.shape == (T, m, n):
         return _kernel.error_covariance(p, K, L)  # the same recursion, compiled
     out = []
     for _, _, S in _joint_moments(problem, K, L):

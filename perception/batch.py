@@ -41,7 +41,6 @@ from perception.pipeline import (
     recognize_tracks,
 )
 from perception.provenance import code_digest
-from perception.recognition.planning import THREADS_VARIABLE
 from perception.recognition.repertoire import PlanCache, Repertoire
 from perception.report.clip import ClipSummary, clip_outputs, remove_output, write_clip_report
 from perception.report.tracking import tracking_columns, write_tracking_report
@@ -407,14 +406,6 @@ class _Job:
         return ClipResult(item.clip, item.condition, "failed", f"{item.path}: {message}",
                           self.settings.hammer.rule)
 
-    def run_on_cluster(self, item: BatchItem, repertoire: Repertoire) -> ClipResult:
-        """:meth:`run` in a dask worker: single-threaded OpenCV, as local workers are
-        (dask's nanny already starts workers with one BLAS/OpenMP thread)."""
-        workers.limit_threads()
-        workers.reuse_freed_memory()
-        os.environ[THREADS_VARIABLE] = "1"  # the cluster's other workers use the other cores
-        return self.run(item, repertoire)
-
 
 #: Folder of the plan cache inside a report folder.
 PLANS_FOLDER = ".plans"
@@ -453,61 +444,17 @@ def _prepare_report() -> None:
     import perception.report.batch  # noqa: F401 - pandas
 
 
-#: Seconds to wait for a dask scheduler to answer before giving up.
-SCHEDULER_TIMEOUT_S = 10.0
-
-
-def _check_scheduler(address: str) -> None:
-    """Refuse ``address`` unless a dask scheduler answers there within the time limit.
-
-    ``Client(address, timeout=...)`` waits for ever on a port that accepts
-    and says nothing (its connection handshake is not bounded): ask the
-    scheduler for its identity first, under an overall limit, on a loop of
-    our own in another thread (the caller may be running one).
-    """
-    import asyncio
-    from concurrent.futures import ThreadPoolExecutor
-
-    from distributed.comm import connect
-
-    async def identity():
-        comm = await connect(address, timeout=SCHEDULER_TIMEOUT_S)
-        try:
-            await comm.write({"op": "identity", "reply": True})
-            return await comm.read()
-        finally:
-            comm.abort()
-
-    async def bounded():
-        return await asyncio.wait_for(identity(), SCHEDULER_TIMEOUT_S)
-
-    with ThreadPoolExecutor(1) as pool:
-        try:
-            answer = pool.submit(asyncio.run, bounded()).result()
-        except (OSError, ValueError, TypeError) as exc:  # TimeoutError is an OSError
-            raise InputError(f"no dask scheduler answered at {address!r} within "
-                             f"{SCHEDULER_TIMEOUT_S:g} s ({type(exc).__name__}: "
-                             f"{_first_line(exc)})", field="--scheduler") from None
-    if not isinstance(answer, dict) or answer.get("type") != "Scheduler":
-        raise InputError(f"{address!r} answered, but not as a dask scheduler",
-                         field="--scheduler")
-
-
 def _run_dask(items: list[BatchItem], repertoire: Repertoire, job: _Job,
               scheduler: str) -> Iterator[ClipResult]:
-    """Every item on a dask.distributed cluster."""
-    from dask.distributed import Client
-    from dask.distributed import as_completed as dask_completed
-
-    _check_scheduler(scheduler)
-    with Client(scheduler, timeout=SCHEDULER_TIMEOUT_S) as client:
-        rep = client.scatter(repertoire, broadcast=True)
-        # largest first: the cluster's last clips are its shortest
-        items = sorted(items, key=_file_size, reverse=True)
-        futures = [client.submit(job.run_on_cluster, it, rep, pure=False) for it in items]
-        _prepare_report()  # this process waits for the cluster anyway
-        for fut in dask_completed(futures):
-            yield fut.result()
+    """Every item on a dask.distributed cluster (:mod:`perception.cluster`)."""
+    try:
+        from perception.cluster import run_on_cluster
+    except ImportError as exc:  # dask is the optional "cluster" extra
+        raise InputError(f"needs dask.distributed ({exc}): pip install 'hammer-mv[cluster]'",
+                         field="--scheduler") from None
+    # largest first: the cluster's last clips are its shortest
+    return run_on_cluster(sorted(items, key=_file_size, reverse=True), job.run, repertoire,
+                          scheduler, while_waiting=_prepare_report)
 
 
 def _model_value(s: ClipSummary, name: str, values: np.ndarray) -> float:

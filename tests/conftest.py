@@ -20,3 +20,13 @@ def reference_problem(todorov):
     from minvar import LQGProblem
 
     return LQGProblem(**{k: np.array(v, dtype=float) for k, v in todorov["inputs"].items()})
+
+
+@pytest.fixture(params=["c", "numpy"])
+def engine(request):
+    """Each of the solver's engines (``solve(..., engine=engine)``); "c" only where it is built."""
+    from minvar import _kernel
+
+    if request.param == "c" and not _kernel.loaded():
+        pytest.skip(f"the compiled LQG kernel is not available: {_kernel._WHY}")
+    return request.param

@@ -405,3 +405,22 @@ def test_tracking_does_not_wait_for_the_videos_hash(tmp_path, monkeypatch):
     monkeypatch.setattr(video, "sha256_file", slow_sha256)
     out = track_video(clip.video, tmp_path / "c.tracks.h5", frames=LastFrame())
     assert Tracks.load(out).video["sha256"] == digest
+
+
+def test_opencv_threads_are_set_by_the_commands_that_track_not_by_the_library(clips, tmp_path,
+                                                                            monkeypatch):
+    import cv2
+
+    from hammer_mv.cli import main
+    from perception.tracking.tracker import track_video
+
+    calls = []
+    monkeypatch.setattr(cv2, "setNumThreads", calls.append)
+    track_video(clips["good"].video, tmp_path / "lib.tracks.h5")
+    assert calls == []  # a library leaves process-wide state alone
+    assert main(["track", str(clips["good"].video), "-o", str(tmp_path / "cli.h5"),
+                 "--quiet"]) == 0
+    assert calls == [1]
+    calls.clear()
+    assert main(["tracks", "info", str(tmp_path / "cli.h5")]) == 0
+    assert calls == []  # a command that does not track leaves it too

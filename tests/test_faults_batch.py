@@ -257,3 +257,26 @@ def test_a_video_whose_name_is_not_utf8_is_tracked_and_reported(clips, repfile, 
     assert (summary["status"] == "ok").all() and summary["reused"].all()
     for path in [*out.iterdir(), *(out / "tracks").iterdir()]:
         os.fsencode(path.name).decode("utf-8")  # every output name is valid UTF-8
+
+
+def test_a_cluster_batch_leaves_the_workers_as_it_found_them(tracks_folder, tmp_path):
+    import cv2
+    from dask.distributed import LocalCluster
+
+    from perception.recognition.planning import THREADS_VARIABLE
+
+    before = cv2.getNumThreads()
+    cv2.setNumThreads(3)
+    env = os.environ.pop(THREADS_VARIABLE, None)
+    try:
+        # workers in this very process: what the batch's plugin changes, we can see
+        with LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                          dashboard_address=None) as cluster:
+            summary = run_batch(discover(tracks_folder), tmp_path / "out", default_repertoire(),
+                                quiet=True, scheduler=cluster.scheduler_address)
+        assert (summary["status"] == "ok").all()
+        assert cv2.getNumThreads() == 3 and THREADS_VARIABLE not in os.environ
+    finally:
+        cv2.setNumThreads(before)
+        if env is not None:
+            os.environ[THREADS_VARIABLE] = env

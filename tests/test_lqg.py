@@ -1,6 +1,7 @@
 """The solver against Todorov's own code, exact moments and Monte Carlo."""
 
 import dataclasses
+import logging
 
 import numpy as np
 import pytest
@@ -8,9 +9,9 @@ import pytest
 from minvar import expected_cost, simulate, solve, state_moments
 
 
-def test_matches_todorov_reference(todorov, reference_problem):
+def test_matches_todorov_reference(todorov, reference_problem, engine):
     out = todorov["outputs"]
-    sol = solve(reference_problem)
+    sol = solve(reference_problem, engine=engine)
     np.testing.assert_allclose(sol.K, np.array(out["K"]), rtol=0, atol=1e-8)
     np.testing.assert_allclose(sol.L, np.array(out["L"]), rtol=0, atol=1e-8)
     np.testing.assert_allclose(sol.mean_states, np.array(out["Xa"]), rtol=0, atol=1e-8)
@@ -21,9 +22,9 @@ def test_matches_todorov_reference(todorov, reference_problem):
     np.testing.assert_allclose(sol.cost_history[:n], out["Cost"][:n], rtol=0, atol=1e-10)
 
 
-def test_two_iterations_match_reference_exactly(todorov, reference_problem):
+def test_two_iterations_match_reference_exactly(todorov, reference_problem, engine):
     out = todorov["outputs_niter2"]
-    sol = solve(reference_problem, max_iter=2)
+    sol = solve(reference_problem, max_iter=2, engine=engine)
     assert sol.iterations == 2
     np.testing.assert_allclose(sol.K, np.array(out["K"]), rtol=0, atol=1e-8)
     np.testing.assert_allclose(sol.L, np.array(out["L"]), rtol=0, atol=1e-8)
@@ -57,10 +58,12 @@ def noisy(reference_problem):
     return p, solve(p)
 
 
-def test_reported_cost_is_exact_expected_cost(reference_problem, noisy):
-    sol = solve(reference_problem)
+def test_reported_cost_is_exact_expected_cost(reference_problem, noisy, engine):
+    # the passes' moments (specialised to the optimal K) against _joint_moments (any gains)
+    sol = solve(reference_problem, engine=engine)
     assert expected_cost(reference_problem, sol.K, sol.L) == pytest.approx(sol.cost, rel=1e-9)
-    p, s = noisy
+    p, _ = noisy
+    s = solve(p, engine=engine)
     assert s.converged
     assert expected_cost(p, s.K, s.L) == pytest.approx(s.cost, rel=1e-9)
 
@@ -176,17 +179,23 @@ def test_costs_and_initial_covariance_must_be_psd(reference_problem, field, valu
         dataclasses.replace(reference_problem, **{field: value})
 
 
-def test_unconverged_solve_is_reported(reference_problem, caplog, monkeypatch):
+def test_unconverged_solve_is_reported(reference_problem, caplog, monkeypatch, engine):
     import minvar.lqg
 
     monkeypatch.setattr(minvar.lqg, "_REPORTED", set())  # reported once per process
-    solve(reference_problem, max_iter=2)
+    solve(reference_problem, max_iter=2, engine=engine)
     assert "did not converge" in caplog.text
 
 
-def test_a_cost_bouncing_on_its_rounding_floor_stops_the_iteration():
-    from minvar import GraspTask, GripVia, plan_grasp
+def test_a_cost_bouncing_on_its_rounding_floor_stops_the_iteration(engine, monkeypatch):
+    from collections import OrderedDict
 
+    from minvar import GraspTask, GripVia, grasp, plan_grasp
+
+    # plan_grasp solves with engine "auto", which MINVAR_KERNEL sets; a fresh
+    # cache of chain solutions, or the other engine's would be reused
+    monkeypatch.setenv("MINVAR_KERNEL", engine)
+    monkeypatch.setattr(grasp, "_SOLVED", OrderedDict())
     # an open-close-open grip schedule; the thumb's targets near pi rad make its
     # cost a small difference of large terms
     vias = (GripVia(0.062, 0.0, 0.40), GripVia(0.015, 0.0, 0.60), GripVia(0.065, 0.0, 0.82))
@@ -198,3 +207,114 @@ def test_a_cost_bouncing_on_its_rounding_floor_stops_the_iteration():
     from minvar.lqg import _FLOOR_RTOL
 
     np.testing.assert_allclose(sol.cost, plan.finger.solution.cost, rtol=_FLOOR_RTOL)
+
+
+def _count_compiled_calls(monkeypatch):
+    """A list that grows by one per call of the compiled forward pass."""
+    from minvar import _kernel
+
+    calls = []
+    forward = _kernel.forward
+    monkeypatch.setattr(_kernel, "forward", lambda *a: calls.append(1) or forward(*a))
+    return calls
+
+
+def test_grasp_plans_are_the_same_with_each_engine(engine, monkeypatch):
+    from collections import OrderedDict
+
+    import minvar.lqg
+    from minvar import GraspTask, _kernel, grasp, plan_grasp
+
+    monkeypatch.setenv("MINVAR_KERNEL", engine)  # what plan_grasp's solves ("auto") use
+    monkeypatch.setattr(grasp, "_SOLVED", OrderedDict())
+    monkeypatch.setattr(minvar.lqg, "_REPORTED", set())  # the fixed-length solves below
+    calls = _count_compiled_calls(monkeypatch)
+    plan = plan_grasp(GraspTask(object_size=0.07, distance=0.3, duration=0.9))
+    assert bool(calls) == (engine == "c")  # the engine asked for is the one that ran
+    other = "numpy" if engine == "c" else "c" if _kernel.loaded() else "numpy"
+    for chain in (plan.arm, plan.finger, plan.thumb):
+        ours = chain.solution
+        assert ours.converged
+        # the same number of iterations: the 1e-15 stopping test is at the
+        # cost's rounding level, so the engines may stop one apart, and the
+        # gains of consecutive iterations differ by ~1e-6 of their size
+        ref = solve(chain.problem, engine=other, atol=0.0, max_iter=ours.iterations)
+        assert ref.iterations == ours.iterations
+        for name in ("K", "L"):
+            a, b = getattr(ours, name), getattr(ref, name)
+            np.testing.assert_allclose(a, b, rtol=0, atol=1e-9 * np.abs(b).max(), err_msg=name)
+        np.testing.assert_allclose(ours.mean_states, ref.mean_states, rtol=0, atol=1e-9)
+        assert ours.cost == pytest.approx(ref.cost, rel=1e-9)
+
+
+def test_engine_argument_is_checked(reference_problem):
+    from minvar.lqg import estimation_error_covariance
+
+    for bad in ("bogus", "C", None):
+        with pytest.raises(ValueError, match=r"solve: engine must be one of 'auto', 'c', "):
+            solve(reference_problem, engine=bad)
+    s = solve(reference_problem, max_iter=1)
+    with pytest.raises(ValueError, match=r"estimation_error_covariance: engine"):
+        estimation_error_covariance(reference_problem, s.K, s.L, engine="bogus")
+
+
+def test_engine_parameter_wins_over_the_environment(reference_problem, engine, monkeypatch):
+    other = {"c": "numpy", "numpy": "c"}[engine]
+    monkeypatch.setenv("MINVAR_KERNEL", other)
+    calls = _count_compiled_calls(monkeypatch)
+    solve(reference_problem, max_iter=2, engine=engine)
+    assert bool(calls) == (engine == "c")
+
+
+def test_unknown_environment_engine_is_named(reference_problem, monkeypatch):
+    monkeypatch.setenv("MINVAR_KERNEL", "fortran")
+    with pytest.raises(ValueError, match=r"MINVAR_KERNEL must be .* got 'fortran'"):
+        solve(reference_problem, max_iter=1)
+    solve(reference_problem, max_iter=1, engine="numpy")  # an explicit engine needs no variable
+
+
+def _without_kernel(monkeypatch):
+    """The process as an install without a C compiler sees it."""
+    from minvar import _kernel
+
+    monkeypatch.setattr(_kernel, "_LIB", None)
+    monkeypatch.setattr(_kernel, "_WHY", "it was not built: no C compiler (test)")
+    monkeypatch.setattr(_kernel, "_WARNED", False)
+    monkeypatch.delenv("MINVAR_KERNEL", raising=False)
+
+
+def test_c_engine_without_the_kernel_raises(reference_problem, monkeypatch):
+    from minvar.lqg import KernelUnavailableError, estimation_error_covariance
+
+    _without_kernel(monkeypatch)
+    with pytest.raises(KernelUnavailableError, match=r"engine='c' needs the compiled.*no C "):
+        solve(reference_problem, engine="c")
+    assert issubclass(KernelUnavailableError, ImportError)
+    monkeypatch.setenv("MINVAR_KERNEL", "c")  # "auto" told by the environment to use it
+    with pytest.raises(KernelUnavailableError):
+        solve(reference_problem)
+    s = solve(reference_problem, engine="numpy")
+    with pytest.raises(KernelUnavailableError):
+        estimation_error_covariance(reference_problem, s.K, s.L, engine="c")
+
+
+def test_auto_engine_without_the_kernel_warns_once(reference_problem, monkeypatch, caplog,
+                                                   todorov):
+    _without_kernel(monkeypatch)
+    with caplog.at_level(logging.WARNING, logger="minvar"):
+        first = solve(reference_problem)
+        second = solve(reference_problem, engine="auto")
+    warned = [r for r in caplog.records if "compiled LQG kernel is not available" in r.message]
+    assert len(warned) == 1 and warned[0].levelno == logging.WARNING
+    assert warned[0].name == "minvar" and "no C compiler" in warned[0].message
+    assert first.cost == second.cost  # and the numpy passes did the work
+    assert abs(first.cost - todorov["outputs"]["Cost_final"]) < 1e-10
+
+
+def test_numpy_engine_without_the_kernel_is_silent(reference_problem, monkeypatch, caplog):
+    _without_kernel(monkeypatch)
+    monkeypatch.setenv("MINVAR_KERNEL", "numpy")
+    with caplog.at_level(logging.WARNING, logger="minvar"):
+        solve(reference_problem, max_iter=2)
+        solve(reference_problem, max_iter=2, engine="numpy")
+    assert not caplog.records

@@ -108,6 +108,7 @@ def test_statistics_report_their_type_df_and_effect_size():
     assert t["effect_size"] == pytest.approx(2.0 * (1 - 3 / 15))
     assert float(t["df"]) == pytest.approx(4.0)
     assert t["statistic"] ** 2 == pytest.approx(anova["statistic"])  # equal variances here
+    assert (anova["n_per_group"], anova["note"]) == ("n=3, d=3", "")
 
 
 def test_reference_model_typical_clips_and_aperture_profiles(scored):
@@ -256,7 +257,7 @@ def test_hostile_clip_names_are_escaped_in_the_page_and_their_links_resolve(tmp_
             assert name + suffix in {unquote(u) for u in targets}, (name, suffix)
 
 
-def test_a_clip_table_is_written_as_pandas_writes_it(tmp_path):
+def test_a_clip_table_written_without_pandas_reads_back_in_pandas(tmp_path):
     from perception.io.atomic import write_csv
 
     rng = np.random.default_rng(0)
@@ -266,30 +267,66 @@ def test_a_clip_table_is_written_as_pandas_writes_it(tmp_path):
             "model": np.array(["a,b", 'say "x"', "é ü"] * 16), "C": x[::-1].copy()}
     write_csv(tmp_path / "ours.csv", cols)
     pd.DataFrame(cols).to_csv(tmp_path / "pandas.csv", index=False)
-    assert (tmp_path / "ours.csv").read_bytes() == (tmp_path / "pandas.csv").read_bytes()
     back = pd.read_csv(tmp_path / "ours.csv")
-    np.testing.assert_array_equal(back["time"].to_numpy(), x)  # round trip, NaN included
+    pd.testing.assert_frame_equal(back, pd.read_csv(tmp_path / "pandas.csv"))
+    pd.testing.assert_frame_equal(back, pd.DataFrame(cols))  # round trip, NaN and -0.0 included
+    np.testing.assert_array_equal(np.signbit(back["time"]), np.signbit(x))
 
 
-def test_the_batch_statistics_are_scipy_stats_own():
+def _old_f_oneway(groups):
+    """The batch's ANOVA before it called scipy.stats (on scipy.special)."""
+    from scipy.special import fdtrc
+
+    everything = np.concatenate(groups)
+    k, n, grand = len(groups), everything.size, everything.mean()
+    between = sum(len(g) * (g.mean() - grand) ** 2 for g in groups) / (k - 1)
+    within = sum(((g - g.mean()) ** 2).sum() for g in groups) / (n - k)
+    if within == 0:
+        return (np.nan, np.nan) if between == 0 else (np.inf, 0.0)
+    return between / within, fdtrc(k - 1, n - k, between / within)
+
+
+def _old_welch_t(a, b):
+    """The batch's Welch t-test before it called scipy.stats (on scipy.special)."""
+    from scipy.special import stdtr
+
+    va, vb = a.var(ddof=1) / len(a), b.var(ddof=1) / len(b)
+    df = (va + vb) ** 2 / (va ** 2 / (len(a) - 1) + vb ** 2 / (len(b) - 1))
+    t = (a.mean() - b.mean()) / np.sqrt(va + vb)
+    return t, 2 * stdtr(df, -np.abs(t)), df
+
+
+def test_the_batch_statistics_equal_the_former_ones():
+    rng = np.random.default_rng(1)
+    for _ in range(30):
+        sizes = rng.integers(2, 15, 3)
+        conf = [rng.normal(m, s, n) for n, s, m in zip(sizes, rng.uniform(0.1, 3, 3),
+                                                      rng.normal(size=3))]
+        summary = pd.DataFrame({"status": "ok", "condition": np.repeat(list("abc"), sizes),
+                                "conf_m": np.concatenate(conf)})
+        stats = condition_statistics(summary, "m")
+        assert list(stats["test"]) == ["one-way ANOVA", *["Welch t-test"] * 3]
+        np.testing.assert_allclose(stats.iloc[0][["statistic", "p_value"]].to_numpy(float),
+                                   _old_f_oneway(conf), rtol=1e-9)
+        for row, (i, j) in zip(stats.iloc[1:].itertuples(), [(0, 1), (0, 2), (1, 2)]):
+            t, p, df = _old_welch_t(conf[i], conf[j])
+            np.testing.assert_allclose([row.statistic, row.p_value], [t, p], rtol=1e-9)
+            assert row.df == f"{df:.1f}"
+        assert stats.iloc[0]["n_per_group"] == ", ".join(
+            f"{c}={n}" for c, n in zip("abc", sizes))
+        assert (stats["note"] == "a group has fewer than 3 clips").tolist() == [
+            min(sizes) < 3, *[min(sizes[i], sizes[j]) < 3 for i, j in [(0, 1), (0, 2), (1, 2)]]]
+
+
+def test_statistics_of_constant_groups_are_nan_or_inf_silently():
     import warnings
 
-    from scipy import stats
-
-    from perception.report.conditions import f_oneway, welch_t
-
-    rng = np.random.default_rng(1)
-    cases = [[rng.normal(m, s, n) for n, s, m in zip(rng.integers(2, 15, 3),
-                                                      rng.uniform(0.1, 3, 3), rng.normal(size=3))]
-             for _ in range(50)]
-    cases += [[np.ones(3), np.ones(4)], [np.ones(3), 2 * np.ones(4)],
-              [np.array([1.0, 2.0]), np.array([1.0, 2.0])], [np.ones(2), np.arange(3.0)]]
+    summary = pd.DataFrame({"status": "ok", "condition": list("aaabbbbcc"),
+                            "conf_m": [1.0] * 3 + [2.0] * 4 + [1.0] * 2})
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # scipy warns on the constant groups
-        for g in cases:
-            r = stats.f_oneway(*g)
-            np.testing.assert_allclose(f_oneway(g), (r.statistic, r.pvalue), rtol=1e-12,
-                                       equal_nan=True)
-            r = stats.ttest_ind(g[0], g[1], equal_var=False)
-            np.testing.assert_allclose(welch_t(g[0], g[1]), (r.statistic, r.pvalue, r.df),
-                                       rtol=1e-12, equal_nan=True)
+        warnings.simplefilter("error")
+        stats = condition_statistics(summary, "m").set_index("groups")
+    assert stats.loc["a / b / c", "statistic"] == np.inf
+    assert stats.loc["a / b / c", "p_value"] == 0.0
+    assert np.isnan(stats.loc["a vs c", "statistic"]) and np.isnan(stats.loc["a vs c", "p_value"])
+    assert stats.loc["a vs c", "n_per_group"] == "a=3, c=2"

@@ -210,3 +210,31 @@ def test_truncated_video_is_refused_unless_kept_and_fps_overrides_the_container(
     assert (tracks.status[0] == Status.TRACKED).all()
     slow = Tracks.load(track_video(clip.video, tmp_path / "slow.h5", fps=25.0))
     np.testing.assert_allclose(slow.time, np.arange(30) / 25.0)
+
+
+#: Tunables that were module constants before they were :class:`TrackerParams`
+#: fields, each with another value in its range.
+MOVED = {"default_fps": 25.0, "table_height_m": 0.5, "object_rival_ratio": 0.6,
+         "max_blobs": 32, "rest_area_ratio": 3.0, "typical_reach": 0.09,
+         "colour_weight": 1.0, "max_band_cos": 0.7, "rival_separation_px": 5.0, "rim_px": 5,
+         "still_pad_px": 5, "min_region_px": 4, "min_soft_contrast": 12.0}
+
+
+def test_every_tunable_is_saved_and_a_change_stops_tracks_being_reused(tmp_path):
+    from perception.pipeline import current_tracks
+    from perception.tracking.setup import TrackingSetup
+
+    clip, _ = render(tmp_path, n=6, width=320, height=240)
+    base = track_video(clip.video, tmp_path / "base.tracks.h5")
+    saved = Tracks.load(base).tracker
+    assert {k: saved[k] for k in MOVED} == {k: getattr(TrackerParams(), k) for k in MOVED}
+    assert current_tracks(clip.video, [base], TrackingSetup()) is not None
+    for name, value in MOVED.items():
+        changed = TrackingSetup(params=TrackerParams(**{name: value}))
+        assert current_tracks(clip.video, [base], changed) is None, name
+    other = track_video(clip.video, tmp_path / "other.tracks.h5",
+                        params=TrackerParams(max_band_cos=0.7))
+    assert Tracks.load(other).tracker["max_band_cos"] == 0.7
+    assert current_tracks(clip.video, [other], TrackingSetup()) is None
+    assert current_tracks(clip.video, [other], TrackingSetup(
+        params=TrackerParams(max_band_cos=0.7))) is not None

@@ -122,15 +122,21 @@ S_TASK = ReachTask(
 
 
 def _numpy_passes(fn: Callable[[], object]) -> Callable[[], object]:
-    """``fn`` with the solver's numpy passes instead of the compiled ones."""
-    from minvar import _kernel
+    """``fn`` with the solver's numpy passes instead of the compiled ones
+    (``MINVAR_KERNEL=numpy``: what ``engine="auto"`` then picks; set by this
+    tool, an application, around the timed call only)."""
+    import os
 
     def run():
-        lib, _kernel._LIB = _kernel._LIB, None
+        before = os.environ.get("MINVAR_KERNEL")
+        os.environ["MINVAR_KERNEL"] = "numpy"
         try:
             return fn()
         finally:
-            _kernel._LIB = lib
+            if before is None:
+                os.environ.pop("MINVAR_KERNEL")
+            else:
+                os.environ["MINVAR_KERNEL"] = before
 
     return run
 

@@ -48,6 +48,26 @@ _EVERY = object()
 #: Thread-pool sizes of numpy's BLAS and OpenMP, read when they load.
 THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
+#: The commands that track video: OpenCV's own thread pool is off while they
+#: run (:func:`serial_opencv`).
+TRACKING_COMMANDS = frozenset({"calibrate", "track", "recognize", "batch"})
+
+
+def serial_opencv() -> None:
+    """Turn OpenCV's own thread pool off in this process (``cv2.setNumThreads(1)``).
+
+    Tracking converts small regions, a few thousand pixels each, which
+    OpenCV still splits over its pool: a second thread then spins for as
+    long as the first converts, on the core FFmpeg's decoding threads (not
+    OpenCV's pool) need; the split costs more time than it saves. The
+    library leaves the process-wide setting alone; the commands that track
+    (:data:`TRACKING_COMMANDS`) set it here, when they run, so that
+    ``--version`` and ``--help`` never load OpenCV.
+    """
+    import cv2
+
+    cv2.setNumThreads(1)
+
 
 #: What ``hammer-mv --help`` says before the commands.
 DESCRIPTION = """\
@@ -171,8 +191,11 @@ def _run(args: argparse.Namespace) -> int:
     ``-W``/``PYTHONWARNINGS`` included) are recorded instead of printed: a
     long run is not buried in numpy's RuntimeWarnings, yet none goes unseen.
     A command that fails prints its one line only. Our own warnings go
-    through ``logging`` and show as always.
+    through ``logging`` and show as always. The commands that track run
+    with OpenCV's thread pool off (:func:`serial_opencv`).
     """
+    if args.command in TRACKING_COMMANDS:
+        serial_opencv()
     if args.verbose:
         return int(args.func(args) or 0)
     with warnings.catch_warnings(record=True) as caught:

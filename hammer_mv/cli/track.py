@@ -96,7 +96,11 @@ def parse_rois(specs: list[list[str]], names: tuple[str, ...]) -> dict[str, tupl
 
 
 def run(args: argparse.Namespace) -> int:
-    """Track ``args.video``; print a one-line summary unless ``--quiet``."""
+    """Track ``args.video``; print a one-line summary unless ``--quiet``.
+
+    OpenCV's thread pool is off by then: :func:`hammer_mv.cli.serial_opencv`
+    (run by the command line for every command that tracks) says why.
+    """
     from perception.io.atomic import check_output
     from perception.io.tracks import Status, Tracks, tracks_path_for
     from perception.tracking.markers import load_markers

@@ -259,7 +259,13 @@ def _figures_html(reference: str) -> str:
 
 
 def _statistics_html(stats_df: pd.DataFrame) -> str:
-    rows = [[_e(r.test), _e(r.groups), str(int(r.n)), _e(r.statistic_type),
+    def n(r):  # clips per group, and a warning where a group is too small
+        per = getattr(r, "n_per_group", None)
+        note = getattr(r, "note", None)
+        text = _e(per) if isinstance(per, str) and per else str(int(r.n))
+        return text + (f"<br><small>{_e(note)}</small>" if isinstance(note, str) and note else "")
+
+    rows = [[_e(r.test), _e(r.groups), n(r), _e(r.statistic_type),
              _num(r.statistic, ".3g"), _e(r.df), _num(r.p_value, ".3g"),
              _num(r.mean_difference * 100, ".2f"), _e(r.effect_size_type),
              _num(r.effect_size, ".2f")] for r in stats_df.itertuples(index=False)]

@@ -101,8 +101,8 @@ def aperture_profiles(recognitions: list[ClipSummary], conditions: list[str]) ->
             else pd.DataFrame(columns=["condition", "phase", "mean", "sd", "n"]))
 
 
-def _effect(a: np.ndarray, b: np.ndarray) -> float:
-    """Hedges' g of a - b (pooled SD, small-sample correction)."""
+def _hedges_g(a: np.ndarray, b: np.ndarray) -> float:
+    """Hedges' g of a - b (pooled SD, small-sample correction); scipy.stats has none."""
     na, nb = len(a), len(b)
     pooled = np.sqrt(((na - 1) * a.var(ddof=1) + (nb - 1) * b.var(ddof=1)) / (na + nb - 2))
     if not pooled > 0:
@@ -118,51 +118,27 @@ def _eta_squared(groups: Sequence[np.ndarray]) -> float:
     return float(between / total) if total > 0 else float("nan")
 
 
-def f_oneway(groups: Sequence[np.ndarray]) -> tuple[float, float]:
-    """One-way ANOVA: F and its p-value, as ``scipy.stats.f_oneway`` gives them.
-
-    Written on ``scipy.special``: ``scipy.stats`` takes a second to import,
-    serial time at the end of every batch (tests compare the two).
-    """
-    from scipy.special import fdtrc
-
-    everything = np.concatenate(groups)
-    k, n, grand = len(groups), everything.size, everything.mean()
-    between = sum(len(g) * (g.mean() - grand) ** 2 for g in groups) / (k - 1)
-    within = sum(((g - g.mean()) ** 2).sum() for g in groups) / (n - k)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        f = np.float64(between) / np.float64(within)
-    if within == 0:  # no spread within groups: scipy's convention
-        return (float("nan"), float("nan")) if between == 0 else (float("inf"), 0.0)
-    return float(f), float(fdtrc(k - 1, n - k, f))
-
-
-def welch_t(a: np.ndarray, b: np.ndarray) -> tuple[float, float, float]:
-    """Welch's t-test of ``a`` against ``b``: t, its two-sided p-value and df.
-
-    The values of ``scipy.stats.ttest_ind(a, b, equal_var=False)``, on
-    ``scipy.special`` (see :func:`f_oneway`).
-    """
-    from scipy.special import stdtr
-
-    va, vb = a.var(ddof=1) / len(a), b.var(ddof=1) / len(b)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        df = np.float64(va + vb) ** 2 / (va ** 2 / (len(a) - 1) + vb ** 2 / (len(b) - 1))
-        t = np.float64(a.mean() - b.mean()) / np.sqrt(va + vb)
-    if np.isnan(df):  # both groups constant: scipy's convention
-        df = np.float64(1.0)
-    return float(t), float(2 * stdtr(df, -np.abs(t))), float(df)
-
+#: Fewer clips than this in a group: its test is flagged in ``note``.
+_FEW_CLIPS = 3
 
 _STAT_COLUMNS = ["model", "test", "groups", "n", "statistic_type", "statistic", "df",
-                 "p_value", "mean_difference", "effect_size_type", "effect_size"]
+                 "p_value", "mean_difference", "effect_size_type", "effect_size",
+                 "n_per_group", "note"]
+
+
+def _sizes(groups: dict[str, np.ndarray]) -> dict:
+    """The ``n_per_group`` and ``note`` cells of a test of ``groups``."""
+    few = min(len(v) for v in groups.values()) < _FEW_CLIPS
+    return {"n_per_group": ", ".join(f"{c}={len(v)}" for c, v in groups.items()),
+            "note": f"a group has fewer than {_FEW_CLIPS} clips" if few else ""}
 
 
 def condition_statistics(summary: pd.DataFrame, model: str) -> pd.DataFrame:
     """Compare final confidence of ``model`` between conditions.
 
-    One-way ANOVA across all conditions with at least 2 scored clips and a
-    Welch t-test for each pair of them.
+    One-way ANOVA (``scipy.stats.f_oneway``) across all conditions with at
+    least 2 scored clips and a Welch t-test (``scipy.stats.ttest_ind`` with
+    ``equal_var=False``) for each pair of them.
 
     Parameters
     ----------
@@ -177,31 +153,42 @@ def condition_statistics(summary: pd.DataFrame, model: str) -> pd.DataFrame:
         Columns: model, test, groups, n, statistic_type (``F`` or ``t``),
         statistic, df (``k-1, n-k`` for F; Welch's for t), p_value,
         mean_difference (t-tests, m), effect_size_type (``eta^2`` or
-        ``Hedges' g``), effect_size.
+        ``Hedges' g``), effect_size, n_per_group (``a=10, b=3``) and note
+        (``a group has fewer than 3 clips``, or empty).
     """
+    import warnings
+
+    from scipy import stats  # here: a second of import, only for batches with conditions
+
     col = f"conf_{model}"
     ok = summary[(summary["status"] == "ok") & summary["condition"].notna()]
     groups = {c: g[col].to_numpy(float) for c, g in ok.groupby("condition", sort=False)}
     testable = {c: v for c, v in groups.items() if len(v) >= 2}
     rows = []
-    if len(testable) >= 2:
-        f, p = f_oneway(list(testable.values()))
-        k, n = len(testable), sum(len(v) for v in testable.values())
-        rows.append({"test": "one-way ANOVA", "groups": " / ".join(testable), "n": n,
-                     "statistic_type": "F", "statistic": float(f), "df": f"{k - 1}, {n - k}",
-                     "p_value": float(p), "mean_difference": np.nan,
-                     "effect_size_type": "eta^2",
-                     "effect_size": _eta_squared(list(testable.values()))})
-    names = list(testable)
-    for i, a in enumerate(names):
-        for b in names[i + 1:]:
-            t, p, df = welch_t(testable[a], testable[b])
-            rows.append({"test": "Welch t-test", "groups": f"{a} vs {b}",
-                         "n": len(testable[a]) + len(testable[b]), "statistic_type": "t",
-                         "statistic": t, "df": f"{df:.1f}", "p_value": p,
-                         "mean_difference": float(testable[a].mean() - testable[b].mean()),
-                         "effect_size_type": "Hedges' g",
-                         "effect_size": _effect(testable[a], testable[b])})
+    with warnings.catch_warnings():
+        # a constant group gives NaN or inf, as the table shows; no warning on stderr
+        warnings.simplefilter("ignore", RuntimeWarning)
+        if len(testable) >= 2:
+            r = stats.f_oneway(*testable.values())
+            k, n = len(testable), sum(len(v) for v in testable.values())
+            rows.append({"test": "one-way ANOVA", "groups": " / ".join(testable), "n": n,
+                         "statistic_type": "F", "statistic": float(r.statistic),
+                         "df": f"{k - 1}, {n - k}", "p_value": float(r.pvalue),
+                         "mean_difference": np.nan, "effect_size_type": "eta^2",
+                         "effect_size": _eta_squared(list(testable.values())),
+                         **_sizes(testable)})
+        names = list(testable)
+        for i, a in enumerate(names):
+            for b in names[i + 1:]:
+                x, y = testable[a], testable[b]
+                r = stats.ttest_ind(x, y, equal_var=False)
+                rows.append({"test": "Welch t-test", "groups": f"{a} vs {b}",
+                             "n": len(x) + len(y), "statistic_type": "t",
+                             "statistic": float(r.statistic), "df": f"{r.df:.1f}",
+                             "p_value": float(r.pvalue),
+                             "mean_difference": float(x.mean() - y.mean()),
+                             "effect_size_type": "Hedges' g", "effect_size": _hedges_g(x, y),
+                             **_sizes({a: x, b: y})})
     return pd.DataFrame(rows, columns=_STAT_COLUMNS[1:]).assign(model=model)[_STAT_COLUMNS]
 
 

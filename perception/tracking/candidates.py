@@ -97,11 +97,12 @@ def _shape(mask: np.ndarray) -> tuple[float, tuple[float, float]]:
                                                                        math.sin(angle))
 
 
-def _moved(later: np.ndarray, colour: MarkerColour, blob: Blob) -> float:
+def _moved(later: np.ndarray, colour: MarkerColour, blob: Blob, size_change: float) -> float:
     """How far a blob moved in a later HSV frame, px (inf: gone or changed size).
 
     The later blob is the component of the colour nearest the blob's centre
-    in its padded box: neighbours of the same colour do not count.
+    in its padded box: neighbours of the same colour do not count; one
+    larger or smaller than ``size_change`` x the blob is not the blob.
     """
     x, y, w, h = blob.box
     pad = max(4, (w + h) // 4)
@@ -109,7 +110,7 @@ def _moved(later: np.ndarray, colour: MarkerColour, blob: Blob) -> float:
     x0, y0, x1, y1 = max(x - pad, 0), max(y - pad, 0), min(x + w + pad, W), min(y + h + pad, H)
     found = nearest_blob(find_blobs(colour.backproject(later[y0:y1, x0:x1])),
                          (blob.centre[0] - x0, blob.centre[1] - y0))
-    if found is None or not 0.5 * blob.area <= found.area <= 2.0 * blob.area:
+    if found is None or not blob.area / size_change <= found.area <= size_change * blob.area:
         return math.inf
     return math.hypot(found.centre[0] + x0 - blob.centre[0], found.centre[1] + y0 - blob.centre[1])
 
@@ -136,7 +137,8 @@ def strict(colour: MarkerColour, params: TrackerParams) -> MarkerColour:
 
 def describe(hsv: np.ndarray, colour: MarkerColour, min_area: float,
              roi: tuple[int, int, int, int] | None = None,
-             later: np.ndarray | None = None, max_blobs: int = 64) -> list[Candidate]:
+             later: np.ndarray | None = None, max_blobs: int = 64,
+             size_change: float = 2.0) -> list[Candidate]:
     """The blobs of a marker's colour with their shape, purity and stillness, largest first.
 
     Parameters
@@ -152,7 +154,11 @@ def describe(hsv: np.ndarray, colour: MarkerColour, min_area: float,
     later : (H, W, 3) uint8, optional
         A later frame of the clip's rest, in HSV, for the stillness test.
     max_blobs : int
-        At most this many blobs (the largest) are described.
+        At most this many blobs (the largest) are described
+        (``TrackerParams.max_blobs``).
+    size_change : float
+        Stillness test: a blob whose later area differs from its own by more
+        than this factor, either way, has gone (``TrackerParams.rest_area_ratio``).
 
     Returns
     -------
@@ -175,7 +181,7 @@ def describe(hsv: np.ndarray, colour: MarkerColour, min_area: float,
         roundness, axis = _shape(sub.astype(np.uint8))
         blob = Blob((float(cents[k][0]) + x0, float(cents[k][1]) + y0), float(area),
                     (x + x0, y + y0, w, h))
-        moved = _moved(later, colour, blob) if later is not None else math.nan
+        moved = _moved(later, colour, blob, size_change) if later is not None else math.nan
         sat, val = float(np.median(pix[:, 1])), float(np.median(pix[:, 2]))
         purity = (min(sat / max(ref_s, 1), 1.0) + min(val / max(ref_v, 1), 1.0)) / 2
         out.append(Candidate(blob, roundness, axis, sat, val, moved, purity))

@@ -130,17 +130,18 @@ class FirstDetection:
         return self._hsv
 
     def _scale_or_guess(self) -> float:
-        """px/m: from the object, or a frame height spanning 0.6 m of table."""
+        """px/m: from the object, or a frame height spanning ``table_height_m`` of table."""
         if self.scale is not None:
             return self.scale
-        return self._height / 0.6
+        return self._height / self.params.table_height_m
 
     def _candidates(self, tr: MarkerTrack, frame: np.ndarray, later: bool) -> list[Candidate]:
         # A ROI says where the marker is on the first frame only.
         if tr.roi is not None and self._index > 0:
             return []
-        cands = describe(self._full_hsv(frame), tr.colour, self.params.min_area_px, tr.roi,
-                         self._later if later else None)
+        p = self.params
+        cands = describe(self._full_hsv(frame), tr.colour, p.min_area_px, tr.roi,
+                         self._later if later else None, p.max_blobs, p.rest_area_ratio)
         if tr.roi is not None and not cands:
             raise InputError(f"{tr.name}: nothing of its colour in the ROI {list(tr.roi)} "
                              "on the first frame")
@@ -168,7 +169,7 @@ class FirstDetection:
             return keep
         narrow = strict(tr.colour, p)
         pure = describe(self._full_hsv(frame), narrow, p.min_area_px, None,
-                        self._later if later else None)
+                        self._later if later else None, p.max_blobs, p.rest_area_ratio)
         keep = [c for c in pure if reject_reason(c, tr.name, narrow, expected, p) is None]
         if keep:
             tr.colour = narrow
@@ -196,7 +197,7 @@ class FirstDetection:
         if not keep:
             return None
         best = keep[0]
-        rivals = [c for c in keep[1:] if c.area >= 0.5 * best.area]
+        rivals = [c for c in keep[1:] if c.area >= self.params.object_rival_ratio * best.area]
         if rivals and tr.roi is None:
             return self._ambiguous(tr, [best, *rivals])
         located = self._start(tr, frame, best.blob)
@@ -306,7 +307,7 @@ class FirstDetection:
         tr.ref = meas.mass
         tr.n_obs = 0
         if tr.still and not np.isfinite(tr.diameter):
-            tr.diameter = soft_diameter(frame, tr.colour, meas.centre, meas.window)
+            tr.diameter = soft_diameter(frame, tr.colour, meas.centre, meas.window, p)
         tr.observe(meas, p)
         logger.info(
             "%s found at (%.1f, %.1f) px on frame %d, %d px of its colour",

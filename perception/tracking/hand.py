@@ -11,9 +11,11 @@ required. Markers already tracked take part as fixed anchors.
 
 Every combination of one candidate per marker is scored (:func:`hand_cost`,
 plus how far each candidate's colour lies from its marker's own);
-the cheapest plausible one wins. Where another plausible combination costs
-less than ``ambiguity_margin`` more and puts a marker on a different blob,
-that marker is **ambiguous**: the tracker reports it so, and does not guess.
+the cheapest plausible one wins (the weights and limits are
+:class:`~perception.tracking.params.TrackerParams` fields). Where another
+plausible combination costs less than ``ambiguity_margin`` more and puts a
+marker on a different blob, that marker is **ambiguous**: the tracker
+reports it so, and does not guess.
 """
 
 from __future__ import annotations
@@ -27,14 +29,6 @@ from perception.tracking.candidates import Candidate
 from perception.tracking.params import TrackerParams
 
 __all__ = ["HandChoice", "choose_hand", "hand_cost"]
-
-#: Digit markers' usual distance from the band at rest, m (the cost's reference).
-_TYPICAL_REACH = 0.08
-#: Weight of a candidate's colour impurity (1 - purity) in a placement's cost.
-_COLOUR_WEIGHT = 2.0
-#: |cos| of the angle between the band's long axis and the band -> digits line
-#: above which the band does not lie across the forearm.
-_MAX_BAND_COS = 0.6
 
 
 @dataclass(frozen=True)
@@ -79,7 +73,8 @@ def hand_cost(points: Mapping[str, Sequence[float]], band_axis: Sequence[float] 
     px_per_m : float
         Image scale, px/m.
     params : TrackerParams
-        ``digit_gap``, ``hand_span``, ``min_band_distance``.
+        ``digit_gap``, ``hand_span``, ``min_band_distance``, ``typical_reach``
+        and ``max_band_cos``.
     at_rest : bool
         The clip's first frames: digits close together, band across the forearm.
 
@@ -103,13 +98,13 @@ def hand_cost(points: Mapping[str, Sequence[float]], band_axis: Sequence[float] 
         reach = _dist(d, wrist) / px_per_m
         if not params.min_band_distance <= reach <= params.hand_span:
             return None
-        cost += abs(reach - _TYPICAL_REACH) / _TYPICAL_REACH / len(digits)
+        cost += abs(reach - params.typical_reach) / params.typical_reach / len(digits)
     if at_rest and band_axis is not None:
         mx = sum(d[0] for d in digits) / len(digits) - wrist[0]
         my = sum(d[1] for d in digits) / len(digits) - wrist[1]
         norm = math.hypot(mx, my)
         cos = abs(mx * band_axis[0] + my * band_axis[1]) / norm if norm > 0 else 1.0
-        if cos > _MAX_BAND_COS:
+        if cos > params.max_band_cos:
             return None
         cost += cos
     return cost
@@ -118,7 +113,7 @@ def hand_cost(points: Mapping[str, Sequence[float]], band_axis: Sequence[float] 
 def choose_hand(candidates: Mapping[str, Sequence[Candidate]],
                 anchors: Mapping[str, Sequence[float]], px_per_m: float,
                 params: TrackerParams, *, at_rest: bool,
-                separation_px: float = 4.0) -> HandChoice:
+                separation_px: float | None = None) -> HandChoice:
     """One candidate per hand marker: the plausible combination that looks most like a hand.
 
     Parameters
@@ -130,11 +125,12 @@ def choose_hand(candidates: Mapping[str, Sequence[Candidate]],
     px_per_m : float
         Image scale, px/m.
     params : TrackerParams
-        The hand's limits and ``ambiguity_margin``.
+        The hand's limits, ``colour_weight`` and ``ambiguity_margin``.
     at_rest : bool
         See :func:`hand_cost`.
-    separation_px : float
-        Rival blobs closer than this are the same blob.
+    separation_px : float, optional
+        Rival blobs closer than this (px) are the same blob (default
+        ``params.rival_separation_px``).
 
     Returns
     -------
@@ -144,6 +140,8 @@ def choose_hand(candidates: Mapping[str, Sequence[Candidate]],
     names = [n for n, cands in candidates.items() if cands]
     if not names:
         return HandChoice()
+    if separation_px is None:
+        separation_px = params.rival_separation_px
     scored = []
     for combo in itertools.product(*(range(len(candidates[n])) for n in names)):
         picked = {n: candidates[n][k] for n, k in zip(names, combo)}
@@ -151,7 +149,7 @@ def choose_hand(candidates: Mapping[str, Sequence[Candidate]],
         axis = picked["wrist"].axis if "wrist" in picked else None
         cost = hand_cost(points, axis, px_per_m, params, at_rest=at_rest)
         if cost is not None:
-            cost += _COLOUR_WEIGHT * sum(1 - c.purity for c in picked.values())
+            cost += params.colour_weight * sum(1 - c.purity for c in picked.values())
             scored.append((cost, picked))
     if not scored:
         # No combination of all: the most markers that do make a hand (one of

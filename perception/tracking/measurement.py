@@ -38,22 +38,14 @@ from perception.tracking.blobs import find_blobs, label_type, nearest_blob
 from perception.tracking.markers import MarkerColour
 from perception.tracking.params import TrackerParams
 
-#: A blob's window is its extent, 4 standard deviations per axis (a disc's
-#: diameter), plus this many px so that its blurred rim lies inside.
-_RIM_PX = 4
 #: CamShift's window of a round blob can be as small as 0.71 x its diameter
 #: (it boxes the rotated ellipse axis by axis): mass and centroid are taken in
 #: a square of half-side ``_GROW x`` the window's larger side ``+ _GROW_PX``
 #: (1.5 x larger) around its centre, so the whole blob counts.
 _GROW, _GROW_PX = 0.75, 2
-#: A still marker's window is padded by this many px each side: room to see
-#: that the blob moved or that something of its colour came near.
-_STILL_PAD_PX = 4
 #: :func:`soft_diameter` looks this far around the blob: ``_SOFT_GROW x`` its
 #: window plus ``_SOFT_PAD_PX`` px, enough for the background ring below.
 _SOFT_GROW, _SOFT_PAD_PX = 0.75, 12
-#: Regions narrower than this (px) hold no measurable marker.
-_MIN_REGION_PX = 3
 
 
 class Measurement(NamedTuple):
@@ -77,9 +69,17 @@ def likelihood(ratio: float) -> float:
     return float(min(ratio, 1.0 / ratio)) if ratio > 0 else 0.0
 
 
-def ref_side(ref: float) -> int:
-    """Side (px) of a square window about the size of a blob of ``ref`` px."""
-    return max(int(round(2 * math.sqrt(ref / math.pi))) + _RIM_PX, 3)
+def ref_side(ref: float, params: TrackerParams) -> int:
+    """Side (px) of a square window about the size of a blob of ``ref`` px.
+
+    Parameters
+    ----------
+    ref : float
+        The blob's mass (area), px.
+    params : TrackerParams
+        ``rim_px``: added to the disc's diameter for its blurred rim.
+    """
+    return max(int(round(2 * math.sqrt(ref / math.pi))) + params.rim_px, 3)
 
 
 def clamp_window(win: tuple[int, int], ref: float, params: TrackerParams) -> tuple[int, int]:
@@ -96,17 +96,17 @@ def clamp_window(win: tuple[int, int], ref: float, params: TrackerParams) -> tup
     """
     min_side = params.min_window_px
     if ref > 0:
-        cap = max(int(params.max_window_ratio * ref_side(ref)), min_side)
+        cap = max(int(params.max_window_ratio * ref_side(ref, params)), min_side)
     else:
         cap = 10**6
     return (min(max(int(win[0]), min_side), cap), min(max(int(win[1]), min_side), cap))
 
 
-def _extent(mo: dict[str, float], mass: float) -> tuple[int, int]:
-    """A blob's window from its central moments: 2r for a disc, plus the rim."""
+def _extent(mo: dict[str, float], mass: float, rim_px: int) -> tuple[int, int]:
+    """A blob's window from its central moments: 2r for a disc, plus ``rim_px`` for the rim."""
     return (
-        int(4 * math.sqrt(mo["mu20"] / mass)) + _RIM_PX,
-        int(4 * math.sqrt(mo["mu02"] / mass)) + _RIM_PX,
+        int(4 * math.sqrt(mo["mu20"] / mass)) + rim_px,
+        int(4 * math.sqrt(mo["mu02"] / mass)) + rim_px,
     )
 
 
@@ -185,7 +185,7 @@ def _measure_region(
     x1, y1 = int(cx + ww / 2 + margin) + 1, int(cy + wh / 2 + margin) + 1
     x1, y1 = (x1 if x1 < w else w), (y1 if y1 < h else h)
     rw, rh = x1 - x0, y1 - y0
-    if rw < _MIN_REGION_PX or rh < _MIN_REGION_PX:
+    if rw < params.min_region_px or rh < params.min_region_px:
         return None  # the prediction left the frame
     region = x0, y0, x1, y1
     bp = colour.backproject(cv2.cvtColor(frame[y0:y1, x0:x1], cv2.COLOR_BGR2HSV))
@@ -217,7 +217,7 @@ def _measure_region(
         if meas is not None:
             return meas._replace(clutter=max(total - meas.mass, 0.0)), bp, region
     meas = Measurement((mo["m10"] / mass + x0 + mx0, mo["m01"] / mass + y0 + my0), mass,
-                       _extent(mo, mass), False, max(total - mass, 0.0))
+                       _extent(mo, mass, params.rim_px), False, max(total - mass, 0.0))
     return meas, bp, region
 
 
@@ -278,7 +278,7 @@ def split_merged(
     if blob.area <= params.merge_ratio * ref:
         c = blob.centre
         return Measurement((c[0] + offset[0], c[1] + offset[1]), blob.area, blob.size)
-    side = ref_side(ref)
+    side = ref_side(ref, params)
     x0 = max(int(round(pred[0] - side / 2)), 0)
     y0 = max(int(round(pred[1] - side / 2)), 0)
     mo = cv2.moments(bp[y0 : y0 + side, x0 : x0 + side], True)
@@ -337,14 +337,15 @@ def measure_still(
     ref : float
         Reference mass, px.
     params : TrackerParams
-        ``split_ratio``, ``hold_ratio`` and ``still_shift_px``.
+        ``split_ratio``, ``hold_ratio``, ``still_shift_px``, ``still_pad_px``
+        (the region: the window plus this each side) and ``rim_px``.
     """
     h, w = frame.shape[:2]
-    half = 0.5 * max(window) + _STILL_PAD_PX
+    half = 0.5 * max(window) + params.still_pad_px
     cx, cy = float(centre[0]), float(centre[1])
     x0, y0 = max(int(cx - half), 0), max(int(cy - half), 0)
     x1, y1 = min(int(cx + half) + 2, w), min(int(cy + half) + 2, h)
-    if x1 - x0 < _MIN_REGION_PX or y1 - y0 < _MIN_REGION_PX:
+    if x1 - x0 < params.min_region_px or y1 - y0 < params.min_region_px:
         return None
     bp = colour.backproject(cv2.cvtColor(frame[y0:y1, x0:x1], cv2.COLOR_BGR2HSV))
     mo = cv2.moments(bp, True)
@@ -359,7 +360,7 @@ def measure_still(
         return None  # whole but off-centre: it is moving
     if _touches_edge(bp, (x0, y0, x1, y1), (h, w)):
         return None  # the blob may extend beyond the region: search properly
-    return Measurement(found, mass, _extent(mo, mass))
+    return Measurement(found, mass, _extent(mo, mass, params.rim_px))
 
 
 def _touches_edge(
@@ -382,6 +383,7 @@ def soft_diameter(
     colour: MarkerColour,
     centre: np.ndarray | tuple[float, float],
     window: tuple[int, int],
+    params: TrackerParams | None = None,
 ) -> float:
     """Apparent diameter (px) of a round blob, from its colour-unmixed area.
 
@@ -401,6 +403,8 @@ def soft_diameter(
         A point inside the blob (x, y), px.
     window : (int, int)
         The blob's window (width, height), px.
+    params : TrackerParams, optional
+        ``min_soft_contrast`` (default: the default parameters').
 
     Returns
     -------
@@ -427,7 +431,8 @@ def soft_diameter(
     obj, bg = np.median(pix[inner], axis=0), np.median(pix[ring], axis=0)
     axis = obj - bg
     norm = float(axis @ axis)
-    if norm < 100.0:  # the blob hardly differs from its surroundings
+    contrast = (TrackerParams() if params is None else params).min_soft_contrast
+    if norm < contrast * contrast:  # the blob hardly differs from its surroundings
         return float("nan")
     alpha = np.clip((pix[near] - bg) @ axis / norm, 0.0, 1.0)
     return float(2.0 * np.sqrt(alpha.sum() / np.pi))

@@ -87,6 +87,19 @@ LIMITS: dict[str, Spec] = {
     "max_merged_frames": Spec(int, 0, 100_000),
     "hand_drift": Spec(float, 0, 1),
     "max_drift": Spec(float, 0, 2),
+    "default_fps": Spec(float, 0, 1000, lo_open=True),
+    "table_height_m": Spec(float, 0, 100, lo_open=True),
+    "object_rival_ratio": Spec(float, 0, 1),
+    "max_blobs": Spec(int, 1, 100_000),
+    "rest_area_ratio": Spec(float, 1, 100),
+    "typical_reach": Spec(float, 0, 2, lo_open=True),
+    "colour_weight": Spec(float, 0, 100),
+    "max_band_cos": Spec(float, 0, 1),
+    "rival_separation_px": Spec(float, 0, _PX),
+    "rim_px": Spec(int, 0, _PX),
+    "still_pad_px": Spec(int, 0, _PX),
+    "min_region_px": Spec(int, 1, _PX),
+    "min_soft_contrast": Spec(float, 0, 1000),
 }
 
 
@@ -239,6 +252,50 @@ class TrackerParams:
         markers still tracked put it.
     max_drift : float
         The most a hand marker moves relative to the rest of the hand, m.
+    default_fps : float
+        Frame rate assumed where :meth:`Tracker.update` is given no frame
+        time (time = index / ``default_fps``), frames/s; it bounds how far a
+        marker can move between frames (``max_speed``).
+    table_height_m : float
+        Until the object has set the scale, the frame's height is taken to
+        span this much of the table, m (the expected sizes of hand markers
+        found before the object).
+    object_rival_ratio : float
+        Another round, pure, still blob of the object's colour at least this
+        fraction of the largest one's area makes the object ambiguous.
+    max_blobs : int
+        At most this many blobs of a colour (the largest) are described as
+        candidates when a marker is first looked for.
+    rest_area_ratio : float
+        Stillness test: a candidate whose blob in the later rest frame is
+        larger or smaller than this factor of its area has gone or changed
+        (it counts as moving).
+    typical_reach : float
+        A digit marker's usual distance from the band at rest, m: a hand
+        placement costs more the further its reaches are from it.
+    colour_weight : float
+        Weight of a candidate's colour impurity (1 - purity) in a hand
+        placement's cost.
+    max_band_cos : float
+        At rest, the band lies across the forearm: |cos| of the angle between
+        its long axis and the band -> digits line above this is not a hand.
+    rival_separation_px : float
+        Rival blobs of an ambiguous marker closer than this (px) are the
+        same blob.
+    rim_px : int
+        A blob's window is 4 standard deviations per axis (a disc's
+        diameter) plus this many px, so that its blurred rim lies inside.
+    still_pad_px : int
+        A still marker's measured region is its window padded by this many
+        px each side: room to see that the blob moved or that something of
+        its colour came near.
+    min_region_px : int
+        A search region narrower than this (px; the prediction left the
+        frame) holds no measurable marker.
+    min_soft_contrast : float
+        A round marker whose colour lies closer than this (BGR distance) to
+        its surroundings' has no colour-unmixed diameter (``diameter_px``
+        NaN; its gated area sets the scale).
     """
 
     min_window_px: int = 8
@@ -294,6 +351,19 @@ class TrackerParams:
     max_merged_frames: int = 3
     hand_drift: float = 0.01
     max_drift: float = 0.06
+    default_fps: float = 30.0
+    table_height_m: float = 0.6
+    object_rival_ratio: float = 0.5
+    max_blobs: int = 64
+    rest_area_ratio: float = 2.0
+    typical_reach: float = 0.08
+    colour_weight: float = 2.0
+    max_band_cos: float = 0.6
+    rival_separation_px: float = 4.0
+    rim_px: int = 4
+    still_pad_px: int = 4
+    min_region_px: int = 3
+    min_soft_contrast: float = 10.0
 
     def __post_init__(self) -> None:
         check_fields(self, LIMITS, "TrackerParams")

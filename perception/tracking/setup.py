@@ -315,7 +315,7 @@ def calibrate(frames: Sequence[np.ndarray], *, rois: Mapping[str, tuple[int, int
         if name in ("thumb", "finger"):
             # unbiased by the partly coloured rim, which is large on small discs
             d = soft_diameter(frames[0], tracker.markers[name], position[j],
-                              tracker._tracks[j].win)
+                              tracker._tracks[j].win, tracker.params)
             digits.append((d if np.isfinite(d) else 2 * math.sqrt(masks[name].sum() / math.pi))
                           / scale)
     if digits:

@@ -58,8 +58,7 @@ import logging
 import math
 import os
 import sys
-import threading
-from collections.abc import Iterable, Iterator, Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import asdict
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -222,7 +221,7 @@ class Tracker:
         frame : (H, W, 3) uint8
             BGR image; frames must come in order.
         time_s : float, optional
-            The frame's time, s (default: index / 30 frames/s); bounds how
+            The frame's time, s (default: index / ``params.default_fps``); bounds how
             far a marker can have moved since it was last seen.
 
         Returns
@@ -235,7 +234,8 @@ class Tracker:
             :class:`~perception.io.tracks.Status` codes.
         """
         self._check_frame(frame)
-        self._time = self.n_frames / 30.0 if time_s is None else float(time_s)
+        self._time = (self.n_frames / self.params.default_fps if time_s is None
+                      else float(time_s))
         tracks = self._tracks
         position, lik, status = (a.copy() for a in self._lost_row)
         self._small = None
@@ -460,36 +460,6 @@ def _roi_in_frame(name: str, roi: ROI, shape: tuple[int, ...]) -> None:
         )
 
 
-_SERIAL_LOCK = threading.Lock()
-_serial_users = 0
-_threads_before = 0
-
-
-@contextlib.contextmanager
-def _serial_opencv() -> Iterator[None]:
-    """OpenCV's own thread pool off inside the block (``cv2.setNumThreads(1)``), restored after.
-
-    Tracking converts small regions, a few thousand pixels each, which
-    OpenCV still splits over its pool: a second thread then spins for as
-    long as the first converts, on the core FFmpeg's decoding threads (not
-    OpenCV's pool) need. Nested and concurrent blocks share one setting; the
-    last to leave restores the number of threads found by the first.
-    """
-    global _serial_users, _threads_before
-    with _SERIAL_LOCK:
-        if _serial_users == 0:
-            _threads_before = cv2.getNumThreads()
-            cv2.setNumThreads(1)
-        _serial_users += 1
-    try:
-        yield
-    finally:
-        with _SERIAL_LOCK:
-            _serial_users -= 1
-            if _serial_users == 0:
-                cv2.setNumThreads(_threads_before)
-
-
 def track_frames(
     frames: Iterable[tuple[int, float, np.ndarray]],
     writer: TracksWriter,
@@ -593,16 +563,15 @@ def track_video(
 
     Notes
     -----
-    OpenCV's thread pool is off while tracking (``cv2.setNumThreads(1)``,
-    restored after): each frame's work is a few small regions, which the
-    pool would split at a cost of more time than it saves, on the cores
-    decoding needs.
+    OpenCV's thread pool is left as the caller set it: the ``hammer-mv``
+    commands that track turn it off (:func:`hammer_mv.cli.serial_opencv`
+    says why); a Python caller tracking many clips may do the same with
+    ``cv2.setNumThreads(1)``.
     """
     markers = default_markers() if markers is None else markers
     out_path = tracks_path_for(video) if out is None else Path(out)
     tracker = Tracker(markers, params, rois)
     with contextlib.ExitStack() as stack:
-        stack.enter_context(_serial_opencv())
         src = stack.enter_context(FrameSource(video, prefetch=prefetch,
                                               keep_truncated=keep_truncated, fps=fps))
         # /video (with the file's SHA-256, read meanwhile) and /tracker are

@@ -1,0 +1,47 @@
+"""Static view of :mod:`perception`'s public names (lazy_loader reads it at run time)."""
+
+__version__: str
+from .api import DEFAULT_OBJECT_DIAMETER as DEFAULT_OBJECT_DIAMETER
+from .api import BatchItem as BatchItem
+from .api import Camera as Camera
+from .api import FrameSource as FrameSource
+from .api import HammerMVError as HammerMVError
+from .api import HammerParams as HammerParams
+from .api import InputError as InputError
+from .api import MarkerSet as MarkerSet
+from .api import ModelSpec as ModelSpec
+from .api import MotorModel as MotorModel
+from .api import MovementSpan as MovementSpan
+from .api import Observation as Observation
+from .api import ObserveParams as ObserveParams
+from .api import PlanningError as PlanningError
+from .api import Recognition as Recognition
+from .api import RecognitionSettings as RecognitionSettings
+from .api import RenderStyle as RenderStyle
+from .api import Repertoire as Repertoire
+from .api import Scene as Scene
+from .api import SceneSpec as SceneSpec
+from .api import SimilarityTransform as SimilarityTransform
+from .api import Status as Status
+from .api import Tracker as Tracker
+from .api import TrackerParams as TrackerParams
+from .api import TrackingError as TrackingError
+from .api import Tracks as Tracks
+from .api import TracksWriter as TracksWriter
+from .api import default_markers as default_markers
+from .api import demo_tracks as demo_tracks
+from .api import discover as discover
+from .api import load_clip as load_clip
+from .api import load_recipe as load_recipe
+from .api import movement_span as movement_span
+from .api import observe as observe
+from .api import open_video as open_video
+from .api import recognize as recognize
+from .api import recognize_clip as recognize_clip
+from .api import render_clip as render_clip
+from .api import run_batch as run_batch
+from .api import synthesize as synthesize
+from .api import track_video as track_video
+from .api import write_batch_report as write_batch_report
+from .api import write_clip_report as write_clip_report
+from .api import write_video as write_video
