@@ -28,6 +28,9 @@ import numpy as np  # noqa: E402
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tools"))
+# the sections' `from bench import table` must reach this very module (run as a
+# script it is __main__), so that every table is kept for the markdown file
+sys.modules.setdefault("bench", sys.modules[__name__])
 
 from minvar import (  # noqa: E402
     LQGProblem,
@@ -64,55 +67,23 @@ def timeit(fn: Callable[[], object], *, repeat: int = 7, min_time: float = 0.2) 
     return statistics.median(runs)
 
 
+#: Every table printed in this run, as markdown (``make bench`` writes them to a file).
+TABLES: list[str] = []
+
+
 def table(title: str, rows: list[tuple[str, str, str, str]]) -> None:
-    """Print rows of (what, measured, baseline/target, verdict)."""
+    """Print rows of (what, measured, baseline/target, verdict); keep them as markdown too."""
+    cells = [("what", "measured", "target / baseline", ""), *rows]
+    TABLES.append("\n".join([f"## {title}", "", *(
+        "| " + " | ".join(c.replace("|", "\\|") for c in r) + " |"
+        for r in cells[:1]), "|---|---|---|---|", *(
+        "| " + " | ".join(c.replace("|", "\\|") for c in r) + " |" for r in rows), ""]))
     print(f"\n## {title}")
     w = [max(len(r[i]) for r in rows + [("what", "measured", "target / baseline", "")])
          for i in range(4)]
     print(f"{'what':<{w[0]}}  {'measured':>{w[1]}}  {'target / baseline':<{w[2]}}  ")
     for r in rows:
         print(f"{r[0]:<{w[0]}}  {r[1]:>{w[1]}}  {r[2]:<{w[2]}}  {r[3]}")
-
-
-def _literal_kalman_lqg(p: LQGProblem, tol: float = 1e-15, max_iter: int = 500):
-    """Baseline: kalman_lqg.m transcribed call for call (pinv, @, explicit loops)."""
-    T, n, m = p.horizon, p.n_states, p.n_controls
-    L = np.zeros((T, m, n))
-    K = np.zeros((T, n, p.n_outputs))
-    costs = []
-    for _ in range(max_iter):
-        SiE, SiX, SiXE = p.S1.copy(), np.outer(p.X1, p.X1), np.zeros((n, n))
-        for k in range(T):
-            temp = SiE + SiX + SiXE + SiXE.T
-            DSiD = sum((D @ temp @ D.T for D in p.D), np.zeros((p.n_outputs,) * 2))
-            K[k] = p.A @ SiE @ p.H.T @ np.linalg.pinv(p.H @ SiE @ p.H.T + p.D0 @ p.D0.T + DSiD)
-            newE = p.E0 @ p.E0.T + p.C0 @ p.C0.T + (p.A - K[k] @ p.H) @ SiE @ p.A.T
-            LSiL = L[k] @ SiX @ L[k].T
-            for C in p.C:
-                newE = newE + p.B @ C @ LSiL @ C.T @ p.B.T
-            ABL = p.A - p.B @ L[k]
-            SiX = (p.E0 @ p.E0.T + K[k] @ p.H @ SiE @ p.A.T + ABL @ SiX @ ABL.T
-                   + ABL @ SiXE @ p.H.T @ K[k].T + K[k] @ p.H @ SiXE.T @ ABL.T)
-            SiE = newE
-            SiXE = ABL @ SiXE @ (p.A - K[k] @ p.H).T - p.E0 @ p.E0.T
-        Sx, Se, cost = p.Q[T].copy(), np.zeros((n, n)), 0.0
-        for k in range(T - 1, -1, -1):
-            cost += np.trace(Sx @ p.C0 @ p.C0.T) + np.trace(
-                Se @ (K[k] @ p.D0 @ p.D0.T @ K[k].T + p.E0 @ p.E0.T + p.C0 @ p.C0.T))
-            temp = p.R + p.B.T @ Sx @ p.B
-            BSxeB = p.B.T @ (Sx + Se) @ p.B
-            for C in p.C:
-                temp = temp + C.T @ BSxeB @ C
-            L[k] = np.linalg.pinv(temp) @ p.B.T @ Sx @ p.A
-            newE = p.A.T @ Sx @ p.B @ L[k] + (p.A - K[k] @ p.H).T @ Se @ (p.A - K[k] @ p.H)
-            Sx = p.Q[k] + p.A.T @ Sx @ (p.A - p.B @ L[k])
-            for D in p.D:
-                Sx = Sx + D.T @ K[k].T @ Se @ K[k] @ D
-            Se = newE
-        costs.append(cost + p.X1 @ Sx @ p.X1 + np.trace((Se + Sx) @ p.S1))
-        if len(costs) > 1 and abs(costs[-2] - costs[-1]) < tol:
-            break
-    return K, L, costs
 
 
 S_TASK = ReachTask(
@@ -156,12 +127,11 @@ def section_solver() -> None:
         ours = timeit(lambda p=problem: solve(p))
         best = BEST["last"]
         numpy_passes = timeit(_numpy_passes(lambda p=problem: solve(p)), repeat=3)
-        literal = timeit(lambda p=problem: _literal_kalman_lqg(p), repeat=3)
         sol = solve(problem)
         rows.append((f"{label}, {sol.iterations} it",
                      f"{ours * 1e3:.1f} ms (best {best * 1e3:.1f})",
-                     f"numpy passes {numpy_passes * 1e3:.0f} ms; literal numpy port "
-                     f"{literal * 1e3:.0f} ms", f"{numpy_passes / ours:.1f}x faster"))
+                     f"numpy passes {numpy_passes * 1e3:.0f} ms",
+                     f"{numpy_passes / ours:.1f}x faster"))
     rows[0] = (*rows[0][:3], rows[0][3] + ("; target <= 10 ms " + (
         "ok" if float(rows[0][1].split()[0]) <= 10 else "MISSED (median)")))
     sol = solve(LQGProblem(**{k: np.array(v, float) for k, v in ref["inputs"].items()}))
@@ -213,13 +183,21 @@ def main(argv: list[str] | None = None) -> int:
     sections = _discover()
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", nargs="+", choices=sorted(sections), help="sections to run")
+    parser.add_argument("-o", "--output", type=Path, default=ROOT / "out" / "bench.md",
+                        help="markdown file the tables are written to (default: out/bench.md)")
     args = parser.parse_args(argv)
     load = ", ".join(f"{x:.1f}" for x in os.getloadavg())
-    print(f"hammer-mv benchmarks  (python {sys.version.split()[0]}, numpy {np.__version__}; "
-          f"{os.cpu_count()} cores, load average {load} at the start: other work on the "
-          "machine slows every figure)")
+    header = (f"hammer-mv benchmarks, {time.strftime('%Y-%m-%d %H:%M')} (python "
+              f"{sys.version.split()[0]}, numpy {np.__version__}; {os.cpu_count()} cores, load "
+              f"average {load} at the start: other work on the machine slows every figure)")
+    print(header)
     for name in args.only or list(sections):
         sections[name]()
+    from perception.io.atomic import write_text
+
+    args.output.parent.mkdir(parents=True, exist_ok=True)
+    write_text(args.output, "# " + header + "\n\n" + "\n".join(TABLES))
+    print(f"\nwrote {args.output}")
     return 0
 
 

@@ -157,7 +157,7 @@ class Recognition:
 
     @property
     def verdict(self) -> str | None:
-        """``normal``, ``abnormal`` or ``reach`` (None without calibrated models)."""
+        """``normal``, ``abnormal``, ``reach`` or ``unfamiliar`` (None without calibrations)."""
         return self.decision.verdict
 
     @property

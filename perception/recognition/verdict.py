@@ -1,5 +1,8 @@
 """The verdict on a clip: normal, abnormal or reach, from calibrated familiarity.
 
+(``unfamiliar``, the fourth, is decided beside it:
+:attr:`perception.recognition.result.Recognition.decision`.)
+
 The likelihood rule says which model explains a demonstration *best*; it
 does not say whether the best is any good. Familiarity does:
 

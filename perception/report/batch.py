@@ -74,6 +74,7 @@ figure{margin:0} figure img,.clip img{width:100%;height:auto;border:1px solid #e
 figcaption,.note{font-size:90%;color:#555}
 .v-normal{color:#1b6e20;font-weight:bold} .v-reach{color:#1f4e99;font-weight:bold}
 .v-abnormal{color:#b3261e;font-weight:bold} .v-failed{color:#777}
+.v-unfamiliar{color:#8a5a00;font-weight:bold}
 """
 
 

@@ -66,7 +66,7 @@ class ClipSummary:
     rule : str
         Rule that picked the winner.
     verdict : str or None
-        ``normal``, ``abnormal`` or ``reach``.
+        ``normal``, ``abnormal``, ``reach`` or ``unfamiliar``.
     verdict_detail : str or None
         The kind of an ``abnormal`` verdict (``delayed-opening``,
         ``re-opening``, ``no-opening``, ``other``); None for any other.
