@@ -88,7 +88,7 @@ def _resample(t_new: np.ndarray, t: np.ndarray, xy: np.ndarray) -> np.ndarray:
 
 def canonical(obs: Observation, scene: SceneSpec, durations: tuple[float, float]
               ) -> tuple[Observation, Normalisation]:
-    """``obs`` brought to ``scene`` and ``duration`` (see the module docstring).
+    """``obs`` brought to ``scene`` and the range of ``durations`` (see the module docstring).
 
     Parameters
     ----------
