@@ -348,8 +348,11 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
 
 
 _HOW_TO_READ = (
-    "How to read it: the <b>verdict</b> is <i>normal</i> or <i>reach</i> when the model that "
-    "explains a clip best (highest log-likelihood) fits it better than the worst 5 % "
-    "of its own demonstrations (<b>familiarity</b>, 0–1), and <i>abnormal</i> when it does "
-    "not; the <b>margin</b> is the winner's log-likelihood minus the runner-up's. "
-    "C is the thesis-rule confidence in cm (weighted; the files hold metres).")
+    "How to read it: the <b>verdict</b> judges the movement's coordination, brought to the "
+    "repertoire's speed, distance and frame rate: <i>normal</i> or <i>reach</i> when the "
+    "model that explains it best (highest log-likelihood) fits it better than the worst 5 % "
+    "of its own demonstrations (<b>familiarity</b>, 0–1); <i>abnormal</i> when it does not, "
+    "or when the grip opens late or twice (the kind is given below it); <i>unfamiliar</i> "
+    "when even its transport is no human reach. The <b>margin</b> is the best model's "
+    "log-likelihood minus the runner-up's. C is the thesis-rule confidence in cm "
+    "(weighted; the files hold metres).")
