@@ -1,12 +1,12 @@
 # `make demo` and `make test` each build .venv from this project's own files,
-# with the versions pinned in requirements/constraints.txt (`make lock` renews
+# with the versions pinned in constraints.txt (`make lock` renews
 # them; `make test-latest` tries the newest versions the registry serves).
 PYTHON ?= $(shell command -v python3.11 2>/dev/null || command -v python3)
 VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-stamp
 JOBS ?= 2
-CONSTRAINTS := requirements/constraints.txt
+CONSTRAINTS := constraints.txt
 # PIP_CONSTRAINT, not -c: pip applies it to the isolated build environment
 # too, so setuptools (the build backend) is pinned as well
 PIN := PIP_CONSTRAINT=$(CURDIR)/$(CONSTRAINTS)
@@ -29,7 +29,6 @@ lock:
 	$(PYTHON) -m venv .venv-lock
 	.venv-lock/bin/python -m pip install --quiet --upgrade pip setuptools wheel
 	.venv-lock/bin/python -m pip install --quiet '.[dev,pose]'
-	mkdir -p requirements
 	{ echo "# Versions make demo, make test and CI install (make lock renews them)."; \
 	  echo "# Resolved $$(date -u +%Y-%m-%d) for Python $$(.venv-lock/bin/python -c 'import platform; print(platform.python_version())')."; \
 	  .venv-lock/bin/python -m pip freeze --all --exclude hammer-mv; } > $(CONSTRAINTS).part

@@ -10,6 +10,7 @@ from . import grasp_task as grasp_task
 from . import kinematics as kinematics
 from . import limits as limits
 from . import lqg as lqg
+from . import moments as moments
 from . import plant as plant
 from . import plotting as plotting
 from . import reach as reach
@@ -36,9 +37,9 @@ from .grasp_task import GripVia as GripVia
 from .grasp_task import shoulder_for as shoulder_for
 from .lqg import LQGProblem as LQGProblem
 from .lqg import LQGSolution as LQGSolution
-from .lqg import expected_cost as expected_cost
 from .lqg import solve as solve
-from .lqg import state_moments as state_moments
+from .moments import expected_cost as expected_cost
+from .moments import state_moments as state_moments
 from .plant import PointMassPlant as PointMassPlant
 from .reach import ReachResult as ReachResult
 from .reach import simulate_reach as simulate_reach

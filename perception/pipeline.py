@@ -29,9 +29,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-import numpy as np
-
-from perception.errors import InputError
+from perception.errors import InputError, PlanningError
 from perception.io.tracks import Tracks, tracks_path_for
 from perception.observation import ObserveParams, observe
 from perception.provenance import code_digest
@@ -138,9 +136,9 @@ def clip_fingerprint(path: str | os.PathLike, settings: RecognitionSettings,
 
     The input file's content (its SHA-256, not its size and time: a
     different video of the same size is a different clip), the settings,
-    the repertoire's identity and the software version: a report carrying
-    the same fingerprint is current and need not be made again.
-    The code is :func:`~perception.provenance.code_digest`: any change to
+    the repertoire's identity and the code: a report carrying the same
+    fingerprint is current and need not be made again. The code is
+    :func:`~perception.provenance.code_digest`: any change to
     scoring, tracking, planning or the shipped calibration makes every
     report stale.
 
@@ -335,7 +333,6 @@ def recognize_tracks(tracks: Tracks, repertoire: Repertoire,
     PlanningError
         Their scene cannot be planned (out of the models' reach: often a wrong scale).
     """
-    from perception.errors import PlanningError
     from perception.recognition.shape import is_mirrored
 
     settings = RecognitionSettings() if settings is None else settings
@@ -359,9 +356,7 @@ def recognize_tracks(tracks: Tracks, repertoire: Repertoire,
     except PlanningError as exc:  # the scene, not the software: name the clip and the scale
         raise PlanningError(f"{exc.problem} (check the scale: --px-per-m, --object-diameter)",
                             source or obs.clip, field=exc.field) from None
-    rec = recognize(obs, models, settings.hammer)
-    if rec.verdict is None:  # the default repertoire calibrates only the models it needs
-        rec = recognize(obs, repertoire.calibrated(models, rec.decision.best), settings.hammer)
+    rec = _scored(obs, models, repertoire, settings.hammer)
     shape, transport = _shape_pass(shape_obs, repertoire, settings, plan_cache)
     return dataclasses.replace(rec, shape=shape, normalisation=norm,
                                transport_familiarity=transport, mirrored=mirrored)
@@ -402,19 +397,20 @@ def _shape_pass(shape_obs, repertoire: Repertoire, settings: RecognitionSettings
     # the clip's own tracking noise, where it exceeds what the rule assumes
     hammer = dataclasses.replace(settings.hammer,
                                  obs_sd=max(settings.hammer.obs_sd, shape_obs.noise))
-    shape = recognize(shape_obs, models, hammer)
-    if shape.verdict is None:
-        shape = recognize(shape_obs, repertoire.calibrated(models, shape.decision.best),
-                          hammer)
+    shape = _scored(shape_obs, models, repertoire, hammer)
     reach = [m for m in every if m.kind == "reach"]
     if not reach:
         return shape, float("nan")
-    closed = recognize(closed_hand(shape_obs), reach, hammer)
-    best = int(np.argmax(closed.log_likelihood[:, -1]))
-    if not np.isfinite(closed.familiarity[best]):
-        closed = recognize(closed_hand(shape_obs), repertoire.calibrated(reach, best),
-                           hammer)
-    return shape, float(closed.familiarity[best])
+    return shape, _scored(closed_hand(shape_obs), reach, repertoire, hammer).decision.familiarity
+
+
+def _scored(obs, models: list, repertoire: Repertoire, params: HammerParams) -> Recognition:
+    """:func:`recognize`, with the best model calibrated first if it has no calibration yet
+    (the default repertoire calibrates only the models a verdict rests on)."""
+    rec = recognize(obs, models, params)
+    if rec.verdict is None:
+        rec = recognize(obs, repertoire.calibrated(models, rec.decision.best), params)
+    return rec
 
 
 def recognize_clip(source: str | os.PathLike | Tracks, repertoire: Repertoire,

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from minvar import _kernel, reach_problem, solve
-from minvar.lqg import _joint_moments, estimation_error_covariance
+from minvar.moments import _joint_moments, estimation_error_covariance
 from minvar.task import ReachTask, ViaPoint
 
 S_TASK = ReachTask((-0.2, 0.5), (-0.4, 0.2), 1.0,

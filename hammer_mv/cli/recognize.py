@@ -87,9 +87,10 @@ def run(args: argparse.Namespace) -> int:
     paths = write_clip_report(rec, args.output, extra=extra, figures=not args.no_figures)
     if not args.quiet:
         detail = f" ({rec.verdict_detail})" if rec.verdict_detail else ""
-        mirror = ("; the scene is mirrored: scored as with --mirror"
-                  if rec.mirrored and not args.mirror else
-                  "; the scene is not mirrored: scored without --mirror" if rec.mirrored else "")
+        mirror = ""
+        if rec.mirrored:  # the scene was found the other way round from what was asked
+            mirror = ("; the scene is not mirrored: scored without --mirror" if args.mirror
+                      else "; the scene is mirrored: scored as with --mirror")
         print(f"{clip}: {rec.verdict or 'no verdict'}{detail}, winner {rec.winner} "
               f"({rec.rule} rule){mirror} -> {paths['json']}")
     return 0

@@ -11,16 +11,16 @@ count as lost. :func:`write_dlc` and :func:`write_movement` go the other way.
 
 ``movement`` pulls in many packages (xarray, netCDF4, PyTables, pynwb,
 sleap-io), so it is an optional extra: ``pip install 'hammer-mv[pose]'``.
+It is imported through :mod:`perception.io.movement_import`, which keeps its
+import from writing under HOME.
 docs/pose-files.md describes the mapping, the scale and every format.
 """
 
 from __future__ import annotations
 
-import importlib.abc
 import json
 import math
 import os
-import sys
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -33,6 +33,8 @@ import numpy as np
 from perception.errors import InputError
 from perception.io.atomic import write_bytes, write_text
 from perception.io.files import input_file
+from perception.io.movement_import import POSE_EXTRA as _EXTRA
+from perception.io.movement_import import movement_loaders as _movement
 from perception.io.tracks import Status, Tracks, position_bounds
 from perception.limits import MAX_FPS, MAX_FRAMES, MAX_KEYPOINTS, MAX_MARKERS, MAX_POSE_POINTS
 
@@ -56,112 +58,6 @@ POSE_SUFFIXES = (".h5", ".csv", ".slp", ".nc", ".nwb")
 DLC_KEY = "df_with_missing"
 #: ``movement``'s name for each source, by how the file is recognised.
 _SOURCES = {"dlc": "DeepLabCut", "sleap": "SLEAP", "lp": "LightningPose", "nwb": "NWB"}
-_EXTRA = "reading and writing pose files needs the optional extra: pip install 'hammer-mv[pose]'"
-
-
-class _QuietMovementLogging(importlib.abc.MetaPathFinder):
-    """Import hook: ``movement.utils.logging`` loads with a ``configure`` that does nothing.
-
-    Importing ``movement`` calls ``logger.configure()``, which creates
-    ``~/.movement/movement.log`` (failing with a read-only or missing HOME),
-    adds a stderr handler and redirects every warning of the process into its
-    log. Only while :func:`_import_movement` imports the package, the module
-    is loaded as usual and its ``MovementLogger.configure`` replaced before
-    ``movement/__init__`` calls it; the original is put back afterwards, so a
-    user calling it on purpose gets movement's logging as documented.
-    """
-
-    def __init__(self):
-        self.original = None
-
-    def find_spec(self, name, path=None, target=None):
-        if name != "movement.utils.logging":
-            return None
-        for finder in sys.meta_path:
-            if finder is self or not hasattr(finder, "find_spec"):
-                continue
-            spec = finder.find_spec(name, path, target)
-            if spec is not None and spec.loader is not None:
-                break
-        else:
-            return None
-        hook, loader = self, spec.loader
-        real_exec = loader.exec_module
-
-        def exec_module(module):
-            real_exec(module)
-            hook.original = module.MovementLogger.configure
-            module.MovementLogger.configure = lambda self, *args, **kwargs: None
-
-        spec.loader = _ExecWrapper(loader, exec_module)
-        return spec
-
-
-class _ExecWrapper(importlib.abc.Loader):
-    """A loader like ``loader`` whose ``exec_module`` is ``exec_module``."""
-
-    def __init__(self, loader, exec_module):
-        self._loader, self._exec = loader, exec_module
-
-    def create_module(self, spec):
-        return self._loader.create_module(spec)
-
-    def exec_module(self, module):
-        self._exec(module)
-
-    def __getattr__(self, name):
-        return getattr(self._loader, name)
-
-
-def _import_movement() -> None:
-    """Import ``movement`` without writing under HOME (see :class:`_QuietMovementLogging`).
-
-    Its own messages are disabled in ``loguru`` (the package's loaders log
-    every file they read); a user enables them with
-    ``loguru.logger.enable("movement")``.
-    """
-    if "movement.io" in sys.modules:
-        return
-    hook = _QuietMovementLogging()
-    sys.meta_path.insert(0, hook)
-    dirs = None
-    if "pynwb" not in sys.modules:
-        # pynwb (imported by movement.io) creates ~/.cache/pynwb-hdmf/<version>
-        # at import for a cache of its schema: while it is imported, its
-        # folders are not created (its cache is then skipped if absent)
-        import platformdirs
-
-        dirs = platformdirs.PlatformDirs
-
-        class _NoCreate(dirs):
-            def __init__(self, *args, **kwargs):
-                kwargs["ensure_exists"] = False
-                super().__init__(*args, **kwargs)
-
-        platformdirs.PlatformDirs = _NoCreate
-    try:
-        import movement.io  # noqa: F401
-    finally:
-        sys.meta_path.remove(hook)
-        if hook.original is not None:
-            sys.modules["movement.utils.logging"].MovementLogger.configure = hook.original
-        if dirs is not None:
-            import platformdirs
-
-            platformdirs.PlatformDirs = dirs
-    from loguru import logger
-
-    logger.disable("movement")
-
-
-def _movement():
-    """``movement``'s ``load_dataset`` and ``load_poses``, or a one-line error naming the extra."""
-    try:
-        _import_movement()
-        from movement.io import load_dataset, load_poses
-    except ImportError:
-        raise InputError(_EXTRA) from None
-    return load_dataset, load_poses
 
 
 @dataclass(frozen=True)

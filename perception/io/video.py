@@ -10,6 +10,10 @@ frame count its header claims is kept with a warning and the true count.
 
 :class:`VideoWriter` writes a clip atomically: mp4v ``.mp4`` (default), MJPG
 ``.avi`` or FFV1 ``.mkv`` (lossless).
+
+What a file's container says before decoding, and how OpenCV is handed a
+file (:func:`opencv_name`, :func:`quiet_native_stderr`), live in
+:mod:`perception.io.video_files`; both names are importable from here too.
 """
 
 from __future__ import annotations
@@ -21,7 +25,6 @@ import math
 import os
 import queue
 import sys
-import tempfile
 import threading
 from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import asdict, dataclass, replace
@@ -35,6 +38,13 @@ import numpy as np
 from perception.errors import InputError
 from perception.io.atomic import atomic_path
 from perception.io.files import input_file
+from perception.io.video_files import (
+    avi_header_rate,
+    fourcc_str,
+    opencv_name,
+    quiet_native_stderr,
+    utf8_name,
+)
 from perception.limits import MAX_FPS, MAX_FRAMES, MAX_VIDEO_PIXELS, MAX_VIDEO_SIDE, MIN_FPS
 
 logger = logging.getLogger(__name__)
@@ -91,12 +101,6 @@ class _Sha256Thread(threading.Thread):
             raise self._error
         assert self._digest is not None
         return self._digest
-
-
-def _fourcc_str(code: float) -> str:
-    n = int(code)
-    text = "".join(chr((n >> (8 * i)) & 0xFF) for i in range(4))
-    return text if text.isprintable() and n else ""
 
 
 @dataclass(frozen=True)
@@ -172,33 +176,6 @@ class TimeResolver:
         # A lone first frame at t=0 says nothing about the container.
         return "index/fps" if self.n_container <= 1 else "mixed"
 
-
-
-def _utf8(path: str | os.PathLike) -> bool:
-    try:
-        os.fspath(path).encode("utf-8")
-    except UnicodeEncodeError:  # undecodable bytes of the file system, as surrogates
-        return False
-    return True
-
-
-@contextlib.contextmanager
-def opencv_name(path: str | os.PathLike) -> Iterator[str]:
-    """A name OpenCV can open ``path`` by, valid while the block runs.
-
-    OpenCV converts a path to UTF-8 and crashes the process (a segfault,
-    not an exception) on a file name that is not valid UTF-8 — such names
-    are legal on Linux. Those files are opened through a link with a plain
-    name in a private temporary folder; FFmpeg keeps the file itself open
-    once the capture is made, so the link can go when the block ends.
-    """
-    if _utf8(path):
-        yield os.fspath(path)
-        return
-    with tempfile.TemporaryDirectory(prefix="hammer-mv-") as tmp:
-        link = Path(tmp) / f"video{Path(os.fsencode(path).decode('utf-8', 'replace')).suffix}"
-        link.symlink_to(Path(path).resolve())
-        yield os.fspath(link)
 
 class FrameSource:
     """Lazy, sequential frames of one video file.
@@ -296,7 +273,7 @@ class FrameSource:
             n_frames_header=int(n_header) if math.isfinite(n_header) and n_header > 0 else 0,
             width=int(width),
             height=int(height),
-            fourcc=_fourcc_str(cap.get(cv2.CAP_PROP_FOURCC)),
+            fourcc=fourcc_str(cap.get(cv2.CAP_PROP_FOURCC)),
         )
         if self.fps_override is not None:
             self._times = TimeResolver(self.fps_override, use_container=False)
@@ -384,7 +361,7 @@ class FrameSource:
         own header is read to tell.
         """
         fps = self._info.fps_nominal
-        stated = _avi_header_rate(self.path)
+        stated = avi_header_rate(self.path)
         if stated is not None and not stated > 0:
             fps = 0.0
         if fps >= MAX_FPS or fps < MIN_FPS:
@@ -476,36 +453,6 @@ class FrameSource:
             self.close()
 
 
-def _avi_header_rate(path: Path) -> float | None:
-    """The frame rate an AVI's own header states (0 if none), or None if not an AVI.
-
-    The rate of the first video stream header (``strh``: ``dwRate / dwScale``),
-    else ``1e6 / dwMicroSecPerFrame`` of the main header, as FFmpeg reads it.
-    """
-    import struct
-
-    try:
-        with open(path, "rb") as fh:
-            head = fh.read(1 << 16)
-    except OSError:
-        return None
-    if len(head) < 12 or head[:4] != b"RIFF" or head[8:12] != b"AVI ":
-        return None
-    usec = 0
-    i = head.find(b"avih")
-    if 0 <= i <= len(head) - 12:
-        usec = struct.unpack_from("<I", head, i + 8)[0]
-    i = head.find(b"strh")
-    while 0 <= i <= len(head) - 36:
-        if head[i + 8:i + 12] == b"vids":
-            scale, rate = struct.unpack_from("<II", head, i + 28)
-            if scale and rate:
-                return rate / scale
-            break
-        i = head.find(b"strh", i + 4)
-    return 1e6 / usec if usec else 0.0
-
-
 def open_video(path: str | os.PathLike, **kwargs: Any) -> FrameSource:
     """Open the video at ``path`` for sequential reading; see :class:`FrameSource`.
 
@@ -517,30 +464,6 @@ def open_video(path: str | os.PathLike, **kwargs: Any) -> FrameSource:
         Passed to :class:`FrameSource` (``prefetch``, ``hash``).
     """
     return FrameSource(path, **kwargs)
-
-
-@contextlib.contextmanager
-def quiet_native_stderr() -> Iterator[None]:
-    """Silence what OpenCV and FFmpeg print straight to the process's stderr.
-
-    Their messages about a file we then report ourselves ("tag ... is not
-    found", "Could not open codec") would make a one-line error three lines.
-    Only file descriptor 2 is redirected, and only for the block.
-    """
-    try:
-        fd = sys.stderr.fileno()
-    except (AttributeError, OSError, ValueError):  # no real stderr (e.g. captured)
-        yield
-        return
-    sys.stderr.flush()
-    saved = os.dup(fd)
-    try:
-        with open(os.devnull, "w") as null:
-            os.dup2(null.fileno(), fd)
-            yield
-    finally:
-        os.dup2(saved, fd)
-        os.close(saved)
 
 
 def codec_for(path: str | os.PathLike, codec: str | None = None) -> str:
@@ -606,7 +529,7 @@ class VideoWriter:
         stack = contextlib.ExitStack()
         try:
             self.tmp_path = stack.enter_context(atomic_path(self.path))
-            if not _utf8(self.tmp_path):
+            if not utf8_name(self.tmp_path):
                 raise InputError("OpenCV cannot write a video whose name is not valid UTF-8; "
                                  "choose another name", self.path)
             with quiet_native_stderr():
