@@ -37,6 +37,7 @@ from .grasp_task import GripVia as GripVia
 from .grasp_task import shoulder_for as shoulder_for
 from .lqg import LQGProblem as LQGProblem
 from .lqg import LQGSolution as LQGSolution
+from .lqg import kernel_engine as kernel_engine
 from .lqg import solve as solve
 from .moments import expected_cost as expected_cost
 from .moments import state_moments as state_moments

@@ -1,20 +1,27 @@
-/* The forward and backward passes of minvar.lqg's solver, compiled.
+/* The forward and backward passes of minvar.lqg's solver, compiled: the
+ * extension module minvar._lqg_kernel, called by minvar/_kernel.py.
  *
- * The same recursions as minvar.lqg._Solver.forward/backward (Todorov's
- * kalman_lqg.m), for the case every planning problem of this project is in:
- * the filter and controller systems are positive definite (Cholesky), so no
- * pseudo-inverse is needed. The products exploit the structure of the
- * problems (A, B and H are mostly zeros: a plant of a few chained
- * integrators, constant states, observations of a few states) by keeping
- * those matrices in compressed-row form; every other product is dense. The
- * arithmetic is that of the numpy passes up to the order of summation, so the
- * results agree to rounding (tests/test_lqg.py compares them).
+ * Each function here is the compiled twin of a Python function that it must
+ * match to rounding (tests/test_speed_solver.py compares the two engines):
+ *   lqg_forward     minvar.lqg._Solver.forward (its moments: minvar.moments.Moments.step
+ *                   with the optimal filter's shortcut)
+ *   lqg_backward    minvar.lqg._Solver.backward
+ *   lqg_error_cov   minvar.moments.Moments.step under any gains (the Mee it returns)
+ *   lqg_mean_states minvar.moments.mean_states
+ * The passes are those of Todorov's kalman_lqg.m, for the case every planning
+ * problem of this project is in: the filter and controller systems are
+ * positive definite (Cholesky), so no pseudo-inverse is needed. The products
+ * exploit the structure of the problems (A, B and H are mostly zeros: a plant
+ * of a few chained integrators, constant states, observations of a few states)
+ * by keeping those matrices in compressed-row form; every other product is
+ * dense. The arithmetic is that of the numpy code up to the order of
+ * summation, so the results agree to rounding.
  *
- * The library is loaded with ctypes (minvar/_kernel.py); it is built as a
- * Python extension module only so that setuptools compiles and installs it.
- * Matrices are row-major doubles. Every function returns 0, or a positive
- * code when a Cholesky factorisation fails (the caller then uses numpy) or a
- * negative one when memory runs out.
+ * Matrices are row-major doubles. The recursions return 0, or a positive code
+ * when a Cholesky factorisation fails (the caller then uses numpy) or a
+ * negative one when memory runs out. The module functions at the end check
+ * every buffer against the problem's sizes and run the recursions without the
+ * GIL.
  */
 
 #define PY_SSIZE_T_CLEAN
@@ -211,12 +218,15 @@ static void add(double *out, const double *X, int size) {
     for (int i = 0; i < size; i++) out[i] += X[i];
 }
 
-/* Filter gains K (T x n x k) optimal for control gains L (T x m x n).
- * BC: nc matrices B C_i (n x m); D: nd matrices (k x n). */
-int lqg_forward(int T, int n, int m, int k, int nc, int nd, const double *A, const double *B,
-                const double *H, const double *BC, const double *D, const double *DD0,
-                const double *CC0, const double *EE0, const double *S1, const double *X1,
-                const double *L, int flags, double *K) {
+/* Filter gains K (T x n x k) optimal for control gains L (T x m x n), with the
+ * moments SiX, SiXE, SiE (Mhh, Mhe, Mee of minvar.moments.Moments) stepped
+ * with the optimal filter's shortcut. BC: nc matrices B C_i (n x m); D: nd
+ * matrices (k x n). */
+static int lqg_forward(int T, int n, int m, int k, int nc, int nd, const double *A,
+                       const double *B, const double *H, const double *BC, const double *D,
+                       const double *DD0, const double *CC0, const double *EE0,
+                       const double *S1, const double *X1, const double *L, int flags,
+                       double *K) {
     const size_t nn = (size_t)n * n, nk = (size_t)n * k;
     csr sA = {0}, sAt = {0}, sB = {0}, sH = {0}, sHt = {0};
     const size_t blk = block_size(n, m, k);
@@ -330,11 +340,11 @@ done:
 
 /* Control gains L (T x m x n) optimal for filter gains K (T x n x k), and the
  * expected cost. C: nc matrices (m x m); D: nd matrices (k x n); Q (T+1 x n x n). */
-int lqg_backward(int T, int n, int m, int k, int nc, int nd, const double *A, const double *B,
-                 const double *H, const double *C, const double *D, const double *DD0,
-                 const double *CC0, const double *EE0, const double *Q, const double *R,
-                 const double *X1, const double *S1, const double *K, int flags, double *L,
-                 double *cost_out) {
+static int lqg_backward(int T, int n, int m, int k, int nc, int nd, const double *A,
+                        const double *B, const double *H, const double *C, const double *D,
+                        const double *DD0, const double *CC0, const double *EE0,
+                        const double *Q, const double *R, const double *X1, const double *S1,
+                        const double *K, int flags, double *L, double *cost_out) {
     const size_t nn = (size_t)n * n, nm = (size_t)n * m;
     csr sA = {0}, sAt = {0}, sB = {0}, sBt = {0}, sH = {0}, sHt = {0};
     const size_t blk = block_size(n, m, k);
@@ -464,17 +474,19 @@ done:
 }
 
 /* Exact second moments of the estimation error e = x - xhat under arbitrary
- * gains K, L (the covariance minvar.lqg.estimation_error_covariance returns),
- * propagated in (xhat, e) coordinates: E[e] = 0, and with Y = A - B L,
+ * gains K, L (the covariance minvar.lqg.estimation_error_covariance returns):
+ * the recursion of minvar.moments.Moments.step, in the same (xhat, e)
+ * coordinates: E[e] = 0, and with Y = A - B L,
  * Z = K H, akh = A - K H, W = K (sum_j D_j Mxx D_j' + D0 D0') K' + E0 E0':
  *   Mhh' = Y Mhh Y' + Y Mhe Z' + Z Meh Y' + Z Mee Z' + W
  *   Mhe' = (Y Mhe + Z Mee) akh' - W
  *   Mee' = akh Mee akh' + sum_i B C_i L Mhh L' C_i' B' + W + C0 C0'
  * with Mxx = Mhh + Mhe + Meh + Mee. P receives Mee for t = 0..T. */
-int lqg_error_cov(int T, int n, int m, int k, int nc, int nd, const double *A, const double *B,
-                  const double *H, const double *BC, const double *D, const double *DD0,
-                  const double *CC0, const double *EE0, const double *S1, const double *X1,
-                  const double *K, const double *L, double *P) {
+static int lqg_error_cov(int T, int n, int m, int k, int nc, int nd, const double *A,
+                         const double *B, const double *H, const double *BC, const double *D,
+                         const double *DD0, const double *CC0, const double *EE0,
+                         const double *S1, const double *X1, const double *K, const double *L,
+                         double *P) {
     const size_t nn = (size_t)n * n;
     csr sA = {0}, sAt = {0}, sB = {0}, sH = {0}, sHt = {0};
     const size_t blk = block_size(n, m, k);
@@ -581,10 +593,12 @@ done:
 }
 
 /* Noise-free mean states X (T+1 x n) under u = -L x from X1:
- * x' = A x - B (L x), the numpy pass's (A - B L) x up to the order of summation. */
-void lqg_mean_states(int T, int n, int m, const double *A, const double *B, const double *L,
-                     const double *X1, double *X) {
-    double u[64];  /* m <= 64: the controls of a plant (checked by the caller) */
+ * x' = A x - B (L x), numpy's (A - B L) x up to the order of summation.
+ * Returns 0, or -1 when memory runs out. */
+static int lqg_mean_states(int T, int n, int m, const double *A, const double *B,
+                           const double *L, const double *X1, double *X) {
+    double *u = malloc(sizeof(double) * (m ? m : 1));
+    if (!u) return -1;
     memcpy(X, X1, sizeof(double) * n);
     for (int t = 0; t < T; t++) {
         const double *x = X + (size_t)t * n, *Lt = L + (size_t)t * m * n;
@@ -601,12 +615,250 @@ void lqg_mean_states(int T, int n, int m, const double *A, const double *B, cons
             y[i] = s;
         }
     }
+    free(u);
+    return 0;
 }
 
-/* An importable (empty) module, so that setuptools builds and installs the library. */
+/* ---- The module: Python's buffers in, checked against the problem's sizes ---- */
+
+/* Largest n, m, k, nc, nd: products of two fit an int, as the recursions index;
+ * every buffer's size fits a Py_ssize_t (checked too). */
+#define MAX_SIZE 10000
+#define MAX_STEPS 100000000
+
+typedef struct {
+    int T, n, m, k, nc, nd;
+} dims_t;
+
+/* One buffer argument: its name, object, the doubles it must hold, and its view. */
+typedef struct {
+    const char *name;
+    PyObject *obj;
+    Py_ssize_t count;
+    int writable;
+    Py_buffer view;
+} arg_t;
+
+static int parse_dims(const char *func, PyObject *obj, dims_t *d) {
+    if (!PyArg_ParseTuple(obj, "iiiiii;dims must be six ints (T, n, m, k, nc, nd)", &d->T,
+                          &d->n, &d->m, &d->k, &d->nc, &d->nd))
+        return -1;
+    if (d->T < 0 || d->T > MAX_STEPS || d->n < 0 || d->n > MAX_SIZE || d->m < 0
+        || d->m > MAX_SIZE || d->k < 0 || d->k > MAX_SIZE || d->nc < 0 || d->nc > MAX_SIZE
+        || d->nd < 0 || d->nd > MAX_SIZE
+        || (double)(d->T + 1) * (d->n + 1) * (d->n + d->m + d->k + d->nc + d->nd + 1)
+               > (double)PY_SSIZE_T_MAX / sizeof(double)) {
+        PyErr_Format(PyExc_ValueError,
+                     "_lqg_kernel.%s: sizes (T, n, m, k, nc, nd) = (%d, %d, %d, %d, %d, %d) out "
+                     "of range (0 to %d steps, 0 to %d otherwise)",
+                     func, d->T, d->n, d->m, d->k, d->nc, d->nd, MAX_STEPS, MAX_SIZE);
+        return -1;
+    }
+    return 0;
+}
+
+/* Whether a buffer's struct format is a native double. */
+static int is_double(const char *format) {
+    if (format == NULL) return 0; /* unsigned bytes */
+#if PY_LITTLE_ENDIAN
+    if (*format == '@' || *format == '=' || *format == '<') format++;
+#else
+    if (*format == '@' || *format == '=' || *format == '>' || *format == '!') format++;
+#endif
+    return format[0] == 'd' && format[1] == '\0';
+}
+
+static void release(arg_t *args, int count) {
+    for (int i = 0; i < count; i++) PyBuffer_Release(&args[i].view);
+}
+
+/* Take the views of args[0..count): each C-contiguous float64 values, as many as
+ * its count, writable where asked. 0, or -1 with a ValueError or TypeError
+ * naming the function and argument, and no view held. */
+static int take(const char *func, arg_t *args, int count) {
+    for (int i = 0; i < count; i++) {
+        arg_t *a = &args[i];
+        const char *want = a->writable ? "writable C-contiguous float64" : "C-contiguous float64";
+        if (!PyObject_CheckBuffer(a->obj)) {
+            PyErr_Format(PyExc_TypeError, "_lqg_kernel.%s: %s: expected %zd %s values, got %.200s",
+                         func, a->name, a->count, want, Py_TYPE(a->obj)->tp_name);
+            release(args, i);
+            return -1;
+        }
+        int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (a->writable ? PyBUF_WRITABLE : 0);
+        if (PyObject_GetBuffer(a->obj, &a->view, flags) < 0) {
+            PyErr_Clear(); /* numpy's reason (not contiguous, read-only) is in ours */
+            PyErr_Format(PyExc_ValueError, "_lqg_kernel.%s: %s: expected %zd %s values",
+                         func, a->name, a->count, want);
+            release(args, i);
+            return -1;
+        }
+        if (!is_double(a->view.format) || a->view.itemsize != (Py_ssize_t)sizeof(double)
+            || a->view.len != a->count * (Py_ssize_t)sizeof(double)) {
+            PyErr_Format(PyExc_ValueError,
+                         "_lqg_kernel.%s: %s: expected %zd %s values, got %zd bytes of '%s'",
+                         func, a->name, a->count, want, a->view.len,
+                         a->view.format ? a->view.format : "B");
+            release(args, i + 1);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+#define BUF(i) ((double *)args[i].view.buf)
+
+PyDoc_STRVAR(forward_doc,
+"forward(dims, flags, A, B, H, BC, D, DD0, CC0, EE0, S1, X1, L, K) -> bool\n\n"
+"Filter gains K (T, n, k), written in place, optimal for control gains L (T, m, n);\n"
+"dims = (T, n, m, k, nc, nd), BC = B C_i (nc, n, m), D (nd, k, n). False when a\n"
+"filter system is not positive definite (K is then incomplete).");
+
+static PyObject *py_forward(PyObject *self, PyObject *py_args) {
+    PyObject *dims, *o[12];
+    dims_t d;
+    int flags, status;
+    (void)self;
+    if (!PyArg_ParseTuple(py_args, "OiOOOOOOOOOOOO:forward", &dims, &flags, &o[0], &o[1],
+                          &o[2], &o[3], &o[4], &o[5], &o[6], &o[7], &o[8], &o[9], &o[10], &o[11])
+        || parse_dims("forward", dims, &d) < 0)
+        return NULL;
+    const Py_ssize_t T = d.T, n = d.n, m = d.m, k = d.k;
+    arg_t args[] = {
+        {"A", o[0], n * n, 0},         {"B", o[1], n * m, 0},
+        {"H", o[2], k * n, 0},         {"BC", o[3], d.nc * n * m, 0},
+        {"D", o[4], d.nd * k * n, 0},  {"DD0", o[5], k * k, 0},
+        {"CC0", o[6], n * n, 0},       {"EE0", o[7], n * n, 0},
+        {"S1", o[8], n * n, 0},        {"X1", o[9], n, 0},
+        {"L", o[10], T * m * n, 0},    {"K", o[11], T * n * k, 1},
+    };
+    if (take("forward", args, 12) < 0) return NULL;
+    Py_BEGIN_ALLOW_THREADS
+    status = lqg_forward(d.T, d.n, d.m, d.k, d.nc, d.nd, BUF(0), BUF(1), BUF(2), BUF(3), BUF(4),
+                         BUF(5), BUF(6), BUF(7), BUF(8), BUF(9), BUF(10), flags, BUF(11));
+    Py_END_ALLOW_THREADS
+    release(args, 12);
+    if (status < 0) return PyErr_NoMemory();
+    return PyBool_FromLong(status == 0);
+}
+
+PyDoc_STRVAR(backward_doc,
+"backward(dims, flags, A, B, H, C, D, DD0, CC0, EE0, Q, R, X1, S1, K, L) -> float | None\n\n"
+"Control gains L (T, m, n), written in place, optimal for filter gains K (T, n, k),\n"
+"and their expected cost; C (nc, m, m), Q (T+1, n, n). None when a control system\n"
+"is not positive definite (L is then incomplete).");
+
+static PyObject *py_backward(PyObject *self, PyObject *py_args) {
+    PyObject *dims, *o[14];
+    dims_t d;
+    int flags, status;
+    double cost = 0.0;
+    (void)self;
+    if (!PyArg_ParseTuple(py_args, "OiOOOOOOOOOOOOOO:backward", &dims, &flags, &o[0], &o[1],
+                          &o[2], &o[3], &o[4], &o[5], &o[6], &o[7], &o[8], &o[9], &o[10], &o[11],
+                          &o[12], &o[13])
+        || parse_dims("backward", dims, &d) < 0)
+        return NULL;
+    const Py_ssize_t T = d.T, n = d.n, m = d.m, k = d.k;
+    arg_t args[] = {
+        {"A", o[0], n * n, 0},          {"B", o[1], n * m, 0},
+        {"H", o[2], k * n, 0},          {"C", o[3], d.nc * m * m, 0},
+        {"D", o[4], d.nd * k * n, 0},   {"DD0", o[5], k * k, 0},
+        {"CC0", o[6], n * n, 0},        {"EE0", o[7], n * n, 0},
+        {"Q", o[8], (T + 1) * n * n, 0}, {"R", o[9], m * m, 0},
+        {"X1", o[10], n, 0},            {"S1", o[11], n * n, 0},
+        {"K", o[12], T * n * k, 0},     {"L", o[13], T * m * n, 1},
+    };
+    if (take("backward", args, 14) < 0) return NULL;
+    Py_BEGIN_ALLOW_THREADS
+    status = lqg_backward(d.T, d.n, d.m, d.k, d.nc, d.nd, BUF(0), BUF(1), BUF(2), BUF(3),
+                          BUF(4), BUF(5), BUF(6), BUF(7), BUF(8), BUF(9), BUF(10), BUF(11),
+                          BUF(12), flags, BUF(13), &cost);
+    Py_END_ALLOW_THREADS
+    release(args, 14);
+    if (status < 0) return PyErr_NoMemory();
+    if (status > 0) Py_RETURN_NONE;
+    return PyFloat_FromDouble(cost);
+}
+
+PyDoc_STRVAR(error_cov_doc,
+"error_cov(dims, A, B, H, BC, D, DD0, CC0, EE0, S1, X1, K, L, P) -> None\n\n"
+"Cov[x - xhat] for t = 0..T under any gains K, L, written into P (T+1, n, n).");
+
+static PyObject *py_error_cov(PyObject *self, PyObject *py_args) {
+    PyObject *dims, *o[13];
+    dims_t d;
+    int status;
+    (void)self;
+    if (!PyArg_ParseTuple(py_args, "OOOOOOOOOOOOOO:error_cov", &dims, &o[0], &o[1], &o[2],
+                          &o[3], &o[4], &o[5], &o[6], &o[7], &o[8], &o[9], &o[10], &o[11], &o[12])
+        || parse_dims("error_cov", dims, &d) < 0)
+        return NULL;
+    const Py_ssize_t T = d.T, n = d.n, m = d.m, k = d.k;
+    arg_t args[] = {
+        {"A", o[0], n * n, 0},          {"B", o[1], n * m, 0},
+        {"H", o[2], k * n, 0},          {"BC", o[3], d.nc * n * m, 0},
+        {"D", o[4], d.nd * k * n, 0},   {"DD0", o[5], k * k, 0},
+        {"CC0", o[6], n * n, 0},        {"EE0", o[7], n * n, 0},
+        {"S1", o[8], n * n, 0},         {"X1", o[9], n, 0},
+        {"K", o[10], T * n * k, 0},     {"L", o[11], T * m * n, 0},
+        {"P", o[12], (T + 1) * n * n, 1},
+    };
+    if (take("error_cov", args, 13) < 0) return NULL;
+    Py_BEGIN_ALLOW_THREADS
+    status = lqg_error_cov(d.T, d.n, d.m, d.k, d.nc, d.nd, BUF(0), BUF(1), BUF(2), BUF(3),
+                           BUF(4), BUF(5), BUF(6), BUF(7), BUF(8), BUF(9), BUF(10), BUF(11),
+                           BUF(12));
+    Py_END_ALLOW_THREADS
+    release(args, 13);
+    if (status < 0) return PyErr_NoMemory();
+    Py_RETURN_NONE;
+}
+
+PyDoc_STRVAR(mean_states_doc,
+"mean_states(dims, A, B, L, X1, X) -> None\n\n"
+"Noise-free states x[t+1] = (A - B L[t]) x[t] from X1, written into X (T+1, n).");
+
+static PyObject *py_mean_states(PyObject *self, PyObject *py_args) {
+    PyObject *dims, *o[5];
+    dims_t d;
+    int status;
+    (void)self;
+    if (!PyArg_ParseTuple(py_args, "OOOOOO:mean_states", &dims, &o[0], &o[1], &o[2], &o[3],
+                          &o[4])
+        || parse_dims("mean_states", dims, &d) < 0)
+        return NULL;
+    const Py_ssize_t T = d.T, n = d.n, m = d.m;
+    arg_t args[] = {
+        {"A", o[0], n * n, 0}, {"B", o[1], n * m, 0}, {"L", o[2], T * m * n, 0},
+        {"X1", o[3], n, 0},    {"X", o[4], (T + 1) * n, 1},
+    };
+    if (take("mean_states", args, 5) < 0) return NULL;
+    Py_BEGIN_ALLOW_THREADS
+    status = lqg_mean_states(d.T, d.n, d.m, BUF(0), BUF(1), BUF(2), BUF(3), BUF(4));
+    Py_END_ALLOW_THREADS
+    release(args, 5);
+    if (status < 0) return PyErr_NoMemory();
+    Py_RETURN_NONE;
+}
+
+static PyMethodDef kernel_methods[] = {
+    {"forward", py_forward, METH_VARARGS, forward_doc},
+    {"backward", py_backward, METH_VARARGS, backward_doc},
+    {"error_cov", py_error_cov, METH_VARARGS, error_cov_doc},
+    {"mean_states", py_mean_states, METH_VARARGS, mean_states_doc},
+    {NULL, NULL, 0, NULL},
+};
+
 static struct PyModuleDef kernel_module = {
-    PyModuleDef_HEAD_INIT, "_lqg_kernel",
-    "Compiled passes of minvar.lqg's solver (loaded with ctypes by minvar._kernel).", -1, NULL,
+    PyModuleDef_HEAD_INIT,
+    "_lqg_kernel",
+    "The compiled passes of minvar.lqg's solver (called by minvar._kernel).\n\n"
+    "Matrices are C-contiguous float64 buffers (numpy arrays), checked against the\n"
+    "problem's sizes dims = (T, n, m, k, nc, nd); outputs are written in place, and\n"
+    "the recursions run without the GIL.",
+    0,
+    kernel_methods,
 };
 
 PyMODINIT_FUNC PyInit__lqg_kernel(void) { return PyModule_Create(&kernel_module); }

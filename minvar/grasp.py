@@ -35,7 +35,7 @@ from .limits import (
     check_memory,
     simulation_bytes,
 )
-from .lqg import LQGProblem, LQGSolution, solve
+from .lqg import LQGProblem, LQGSolution, kernel_engine, solve
 from .plant import POSITION, VELOCITY
 from .task import ReachTask, ViaPoint, reach_problem
 
@@ -217,6 +217,7 @@ def _solve(problem: LQGProblem) -> LQGSolution:
     same (it is read-only, so it is shared as it is).
     """
     h = hashlib.blake2b(digest_size=20)
+    h.update(kernel_engine().encode())  # each engine's own solutions
     for name in ("A", "B", "C", "C0", "H", "D", "D0", "E0", "Q", "R", "X1", "S1"):
         a = getattr(problem, name)
         h.update(repr(a.shape).encode())

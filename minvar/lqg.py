@@ -34,7 +34,8 @@ import numpy as np
 
 from . import _kernel
 from ._kernel import KernelUnavailableError
-from .moments import estimation_error_covariance, expected_cost, state_moments
+from .moments import Moments, estimation_error_covariance, expected_cost, state_moments
+from .moments import mean_states as _mean_states
 
 log = logging.getLogger(__name__)
 
@@ -42,7 +43,7 @@ log = logging.getLogger(__name__)
 _FLOOR_RTOL = 1e-6
 
 __all__ = ["LQGProblem", "LQGSolution", "solve", "expected_cost", "state_moments",
-           "estimation_error_covariance", "KernelUnavailableError"]
+           "estimation_error_covariance", "KernelUnavailableError", "kernel_engine"]
 
 
 def _as_matrix(name: str, value, shape: tuple[int | None, ...]) -> np.ndarray:
@@ -261,29 +262,23 @@ class _Solver:
     Linear systems are solved by Cholesky when the matrix is bounded below by a
     positive definite constant (``D0 D0'`` for the filter, ``R`` for the
     controller) and with the pseudo-inverse, as in Todorov's code, when it may
-    be singular.
+    be singular. The forward pass's moments are stepped by
+    :class:`minvar.moments.Moments`, the recursion the exact moments of any
+    gains use too.
     """
 
     def __init__(self, p: LQGProblem, compiled: bool = True):
         self.p = p
-        A, B = p.A, p.B
-        self.At = np.ascontiguousarray(A.T)
-        self.Bt = np.ascontiguousarray(B.T)
-        self.Ht = np.ascontiguousarray(p.H.T)
-        self.BC = np.einsum("ij,cjk->cik", B, p.C)  # (c, n, m): thesis C_i
-        self.DD0 = p.D0 @ p.D0.T
-        self.CC0 = p.C0 @ p.C0.T
-        self.EE0 = p.E0 @ p.E0.T
-        self.Dt = np.ascontiguousarray(np.transpose(p.D, (0, 2, 1)))
-        self.has_C = bool(np.any(p.C))
-        self.has_D = bool(np.any(p.D))
-        self.has_E0 = bool(np.any(self.EE0))
-        self.has_C0 = bool(np.any(self.CC0))
+        self.moments = mom = Moments(p)
+        self.At, self.Ht, self.BC, self.Dt = mom.At, mom.Ht, mom.BC, mom.Dt
+        self.Bt = np.ascontiguousarray(p.B.T)
+        self.DD0, self.CC0, self.EE0 = mom.DD0, mom.CC0, mom.EE0
+        self.has_C, self.has_D, self.has_E0, self.has_C0 = (mom.has_C, mom.has_D, mom.has_E0,
+                                                            mom.has_C0)
         # additive noise terms of the cost (zero for the thesis problems)
         self.has_noise_cost = self.has_C0 or self.has_E0 or bool(np.any(self.DD0))
         self.filter_pd = _is_positive_definite(self.DD0)
         self.control_pd = _is_positive_definite(p.R)
-        self.XX1 = np.outer(p.X1, p.X1)
         # The compiled passes cover the Cholesky case (every planning problem
         # of this project); the pseudo-inverse case runs in numpy.
         self.fast = None
@@ -305,13 +300,6 @@ class _Solver:
         K, AKH = self.forward(L)
         L, cost = self.backward(K, AKH)
         return K, L, cost
-
-    @functools.cached_property
-    def noise_fwd(self) -> np.ndarray:
-        """sum_i X_i M X_i' as one product on vec(M), X_i = B C_i (row-major:
-        vec(X M Y) = (X kron Y') vec(M)); the numpy passes only."""
-        n, m = self.p.n_states, self.p.n_controls
-        return sum((np.kron(BCi, BCi) for BCi in self.BC), np.zeros((n * n, m * m)))
 
     @functools.cached_property
     def noise_bwd(self) -> np.ndarray:
@@ -337,40 +325,19 @@ class _Solver:
     # cost at this size.
     def forward(self, L: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Filter gains ``K`` optimal for control gains ``L``; also ``A - K H`` per step."""
-        p = self.p
-        A, B, H, At, Ht = p.A, p.B, p.H, self.At, self.Ht
+        p, mom = self.p, self.moments
+        A, H, Ht = p.A, p.H, self.Ht
         T, n, k = p.horizon, p.n_states, p.n_outputs
         K = np.empty((T, n, k))
         AKH = np.empty((T, n, n))
-        SiE = p.S1.copy()
-        SiX = self.XX1.copy()
-        SiXE = np.zeros((n, n))
-        track_xe = self.has_E0  # SiXE stays exactly zero without internal noise
+        SiX, SiXE, SiE = mom.start()  # E[xhat xhat'], E[xhat e'], E[e e'], e = x - xhat
         for t in range(T):
-            Lt = L[t]
             SiEHt = SiE.dot(Ht)
-            M = H.dot(SiEHt) + self.DD0
-            if self.has_D:
-                temp = SiE + SiX + SiXE + SiXE.T
-                M += (p.D @ temp @ self.Dt).sum(axis=0)
+            M = mom.add_sensor_noise(H.dot(SiEHt), SiX, SiXE, SiE)  # the filter's system
             ASH = A.dot(SiEHt)  # A SiE H'
             Kt = self._solve(M, ASH.T, self.filter_pd).T  # A SiE H' M^-1
             K[t] = Kt
-            akh = AKH[t]
-            np.subtract(A, Kt.dot(H), out=akh)
-            newE = akh.dot(SiE).dot(At)
-            if self.has_C:
-                LSiL = Lt.dot(SiX).dot(Lt.T)
-                newE += self.noise_fwd.dot(LSiL.ravel()).reshape(n, n)
-            if self.has_C0 or self.has_E0:
-                newE += self.EE0 + self.CC0
-            abl = A - B.dot(Lt)
-            SiX = Kt.dot(ASH.T) + abl.dot(SiX).dot(abl.T)
-            if track_xe:
-                cross = abl.dot(SiXE).dot(Ht).dot(Kt.T)
-                SiX += self.EE0 + cross + cross.T
-                SiXE = abl.dot(SiXE).dot(akh.T) - self.EE0
-            SiE = newE
+            SiX, SiXE, SiE = mom.step(SiX, SiXE, SiE, Kt, L[t], KMK=Kt.dot(ASH.T), akh=AKH[t])
         return K, AKH
 
     def backward(self, K: np.ndarray, AKH: np.ndarray) -> tuple[np.ndarray, float]:
@@ -413,14 +380,9 @@ class _Solver:
     def mean_states(self, L: np.ndarray) -> np.ndarray:
         """Noise-free trajectory under ``u = -L x`` from ``X1``."""
         p = self.p
-        if self.fast is not None and p.n_controls <= 64:
+        if self.fast is not None:
             return _kernel.mean_states(p, L)
-        X = np.empty((p.horizon + 1, p.n_states))
-        X[0] = p.X1
-        closed = p.A[None] - p.B[None] @ L  # (T, n, n)
-        for t in range(p.horizon):
-            X[t + 1] = closed[t] @ X[t]
-        return X
+        return _mean_states(p, L)
 
 
 def solve(
@@ -465,9 +427,10 @@ def solve(
         what the environment variable ``MINVAR_KERNEL`` says (``c`` or
         ``numpy``) if it is set, else the compiled kernel where it is built,
         falling back to numpy with one warning per process (logger
-        ``minvar``) where it is not. Problems whose filter or control system
-        may be singular (``D0 D0'`` or ``R`` not positive definite) run the
-        numpy passes' pseudo-inverse whatever the engine.
+        ``minvar``) where it is not (:func:`kernel_engine` says which runs).
+        Problems whose filter or control system may be singular (``D0 D0'``
+        or ``R`` not positive definite) run the numpy passes' pseudo-inverse
+        whatever the engine.
 
     Returns
     -------
@@ -538,6 +501,28 @@ def solve(
         converged=converged,
         mean_states=solver.mean_states(L),
     )
+
+
+def kernel_engine(engine: str = "auto") -> str:
+    """Which passes a :func:`solve` with ``engine`` runs: ``"c"`` or ``"numpy"``.
+
+    ``python -c "import minvar; print(minvar.kernel_engine())"`` tells whether
+    this install solves with the compiled kernel. It warns and raises nothing
+    about a missing kernel (``"c"``, asked for or by ``MINVAR_KERNEL``, is then
+    a solve's :class:`KernelUnavailableError`), and problems that need the
+    pseudo-inverse run the numpy passes whatever it says.
+
+    Parameters
+    ----------
+    engine : {"auto", "c", "numpy"}, optional
+        The ``engine`` argument of :func:`solve`.
+
+    Returns
+    -------
+    str
+        ``"c"`` or ``"numpy"``.
+    """
+    return _kernel.resolve(engine, "kernel_engine")
 
 
 def _first_bad(K: np.ndarray, L: np.ndarray) -> str:

@@ -22,11 +22,20 @@ def reference_problem(todorov):
     return LQGProblem(**{k: np.array(v, dtype=float) for k, v in todorov["inputs"].items()})
 
 
-@pytest.fixture(params=["c", "numpy"])
+@pytest.fixture(scope="module", params=["c", "numpy"])
 def engine(request):
-    """Each of the solver's engines (``solve(..., engine=engine)``); "c" only where it is built."""
+    """Each of the solver's engines in turn, as trackpy runs its tests once per engine.
+
+    The value is for ``solve(..., engine=engine)``; while a module's tests run
+    with it, ``MINVAR_KERNEL`` makes the library's own solves (``engine="auto"``:
+    planning, recognition) use it too, so a module-scoped fixture that plans
+    and uses ``engine`` is planned once per engine. "c" is skipped where the
+    kernel is not built.
+    """
     from minvar import _kernel
 
     if request.param == "c" and not _kernel.loaded():
         pytest.skip(f"the compiled LQG kernel is not available: {_kernel._WHY}")
-    return request.param
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("MINVAR_KERNEL", request.param)
+        yield request.param

@@ -18,10 +18,12 @@ from minvar.grasp_stats import (
 )
 from minvar.lqg import state_moments
 
+pytestmark = pytest.mark.usefixtures("engine")  # plans and simulations once per solver engine
+
 
 @pytest.fixture(scope="module")
-def plan():
-    return plan_grasp(GraspTask())
+def plan(engine):
+    return plan_grasp(GraspTask())  # by `engine` (MINVAR_KERNEL)
 
 
 @pytest.fixture(scope="module")

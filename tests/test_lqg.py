@@ -1,7 +1,11 @@
-"""The solver against Todorov's own code, exact moments and Monte Carlo."""
+"""The solver against Todorov's own code, exact moments and Monte Carlo, with each engine."""
 
 import dataclasses
 import logging
+import os
+import subprocess
+import sys
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -32,8 +36,8 @@ def test_two_iterations_match_reference_exactly(todorov, reference_problem, engi
     np.testing.assert_allclose(sol.cost_history, out["Cost"], rtol=0, atol=1e-10)
 
 
-def test_gains_are_read_only(reference_problem):
-    sol = solve(reference_problem)
+def test_gains_are_read_only(reference_problem, engine):
+    sol = solve(reference_problem, engine=engine)
     with pytest.raises(ValueError):
         sol.K[0, 0, 0] = 1.0
 
@@ -53,24 +57,42 @@ def _all_noise(problem, seed=1):
 
 
 @pytest.fixture(scope="module")
-def noisy(reference_problem):
+def noisy(reference_problem, engine):
+    """The noisy problem and its plan by ``engine``."""
     p = _all_noise(reference_problem)
-    return p, solve(p)
+    return p, solve(p, engine=engine)
+
+
+@pytest.fixture(scope="module")
+def noisy_mc(reference_problem):
+    """Monte Carlo runs (20000 trials each) of the noisy problem's plan by the
+    numpy passes, summarised: what each engine's exact numbers are compared
+    with. The engines' gains agree to ~1e-9 of their size (test_speed_solver.py),
+    far below what 20000 trials resolve, so one sample serves both."""
+    p = _all_noise(reference_problem)
+    s = solve(p, engine="numpy")
+    cost = simulate(p, s, 20000, seed=7).cost
+    end = simulate(p, s, 20000, seed=11).states[:, -1, :2].copy()
+    tr = simulate(p, s, 20000, seed=13)
+    err = tr.states - tr.estimates
+    return SimpleNamespace(solution=s, cost=cost, end=end,
+                           error={t: err[:, t, :4].copy() for t in (10, 30, 50)})
 
 
 def test_reported_cost_is_exact_expected_cost(reference_problem, noisy, engine):
-    # the passes' moments (specialised to the optimal K) against _joint_moments (any gains)
+    # the passes' moments (specialised to the optimal K) against Moments.step (any gains)
     sol = solve(reference_problem, engine=engine)
     assert expected_cost(reference_problem, sol.K, sol.L) == pytest.approx(sol.cost, rel=1e-9)
-    p, _ = noisy
-    s = solve(p, engine=engine)
+    p, s = noisy
     assert s.converged
     assert expected_cost(p, s.K, s.L) == pytest.approx(s.cost, rel=1e-9)
 
 
-def test_monte_carlo_cost_within_sampling_error(noisy):
-    p, s = noisy
-    cost = simulate(p, s, 20000, seed=7).cost
+def test_monte_carlo_cost_within_sampling_error(noisy, noisy_mc):
+    _, s = noisy  # this engine's cost, against the sample of the numpy passes' gains
+    np.testing.assert_allclose(s.L, noisy_mc.solution.L, rtol=0,
+                               atol=1e-8 * np.abs(s.L).max())
+    cost = noisy_mc.cost
     stderr = cost.std(ddof=1) / np.sqrt(cost.size)
     assert abs(cost.mean() - s.cost) < 4 * stderr
     assert stderr < 0.01 * s.cost  # the check has teeth
@@ -89,30 +111,29 @@ def test_perturbing_gains_raises_cost(noisy, which):
             assert expected_cost(p, trial["K"], trial["L"]) > s.cost
 
 
-def test_exact_moments_match_monte_carlo(noisy):
-    p, s = noisy
+def test_exact_moments_match_monte_carlo(reference_problem, noisy_mc):
+    p, s = _all_noise(reference_problem), noisy_mc.solution
     mean, cov = state_moments(p, s.K, s.L)
-    X = simulate(p, s, 20000, seed=11).states
-    end = X[:, -1, :2]
+    end = noisy_mc.end
     np.testing.assert_allclose(end.mean(0), mean[-1, :2], atol=4 * np.sqrt(cov[-1, 0, 0] / 2e4))
     np.testing.assert_allclose(np.cov(end.T), cov[-1, :2, :2], rtol=0.06)
 
 
-def test_singular_filter_falls_back_to_pseudo_inverse(reference_problem):
+def test_singular_filter_falls_back_to_pseudo_inverse(reference_problem, engine):
     # No sensory noise and a known start: H S H' + D0 D0' is exactly zero at
     # t = 0; additive process noise makes it positive definite from t = 1.
     n = reference_problem.n_states
     C0 = np.zeros((n, 8))
     C0[:8, :8] = 1e-3 * np.eye(8)
     p = dataclasses.replace(reference_problem, D0=np.zeros((6, 1)), C0=C0)
-    s = solve(p)
+    s = solve(p, engine=engine)
     assert np.all(np.isfinite(s.K)) and np.all(np.isfinite(s.L))
     assert np.allclose(s.K[0], 0.0)
     assert expected_cost(p, s.K, s.L) == pytest.approx(s.cost, rel=1e-8)
 
 
-def test_simulation_is_reproducible(reference_problem):
-    s = solve(reference_problem)
+def test_simulation_is_reproducible(reference_problem, engine):
+    s = solve(reference_problem, engine=engine)
     a = simulate(reference_problem, s, 50, seed=5).states
     b = simulate(reference_problem, s, 50, seed=5).states
     c = simulate(reference_problem, s, 50, seed=6).states
@@ -120,8 +141,8 @@ def test_simulation_is_reproducible(reference_problem):
     assert not np.array_equal(a, c)
 
 
-def test_execution_noise_can_differ_from_planning(reference_problem):
-    s = solve(reference_problem)
+def test_execution_noise_can_differ_from_planning(reference_problem, engine):
+    s = solve(reference_problem, engine=engine)
     quiet = dataclasses.replace(reference_problem, C=[0.01 * np.eye(2)])
     loud = simulate(reference_problem, s, 400, seed=1).states[:, -1, :2].std(0)
     soft = simulate(reference_problem, s, 400, seed=1, execution=quiet).states[:, -1, :2].std(0)
@@ -153,20 +174,18 @@ def test_bad_solver_options(reference_problem):
         simulate(reference_problem, solve(reference_problem, max_iter=1), 0)
 
 
-def test_estimation_error_covariance_matches_monte_carlo(noisy):
+def test_estimation_error_covariance_matches_monte_carlo(reference_problem, noisy_mc, engine):
     from minvar.lqg import estimation_error_covariance
 
-    p, s = noisy
-    P = estimation_error_covariance(p, s.K, s.L)
-    tr = simulate(p, s, 20000, seed=13)
-    err = tr.states - tr.estimates
+    p, s = _all_noise(reference_problem), noisy_mc.solution
+    P = estimation_error_covariance(p, s.K, s.L, engine=engine)  # of the gains sampled
     assert np.allclose(P[0], p.S1)
-    for t in (10, 30, 50):
+    for t, err in noisy_mc.error.items():
         exact = P[t, :4, :4]
         # standard error of each sample covariance element of a Gaussian
         d = np.diag(exact)
         se = np.sqrt((np.outer(d, d) + exact**2) / err.shape[0])
-        assert np.all(np.abs(np.cov(err[:, t, :4].T) - exact) < 4 * se)
+        assert np.all(np.abs(np.cov(err.T) - exact) < 4 * se)
 
 
 @pytest.mark.parametrize("field, value, message", [
@@ -273,11 +292,25 @@ def test_unknown_environment_engine_is_named(reference_problem, monkeypatch):
     solve(reference_problem, max_iter=1, engine="numpy")  # an explicit engine needs no variable
 
 
+def test_kernel_engine_says_which_passes_run(reference_problem, engine, monkeypatch):
+    from minvar import _kernel, kernel_engine
+
+    assert kernel_engine() == engine  # "auto", told by MINVAR_KERNEL (the fixture)
+    calls = _count_compiled_calls(monkeypatch)
+    solve(reference_problem, max_iter=2)
+    assert bool(calls) == (engine == "c")
+    assert kernel_engine("numpy") == "numpy"
+    monkeypatch.delenv("MINVAR_KERNEL")
+    assert kernel_engine() == ("c" if _kernel.loaded() else "numpy")
+    with pytest.raises(ValueError, match=r"kernel_engine: engine must be one of 'auto'"):
+        kernel_engine("fortran")
+
+
 def _without_kernel(monkeypatch):
     """The process as an install without a C compiler sees it."""
     from minvar import _kernel
 
-    monkeypatch.setattr(_kernel, "_LIB", None)
+    monkeypatch.setattr(_kernel, "_KERNEL", None)
     monkeypatch.setattr(_kernel, "_WHY", "it was not built: no C compiler (test)")
     monkeypatch.setattr(_kernel, "_WARNED", False)
     monkeypatch.delenv("MINVAR_KERNEL", raising=False)
@@ -300,7 +333,10 @@ def test_c_engine_without_the_kernel_raises(reference_problem, monkeypatch):
 
 def test_auto_engine_without_the_kernel_warns_once(reference_problem, monkeypatch, caplog,
                                                    todorov):
+    from minvar import kernel_engine
+
     _without_kernel(monkeypatch)
+    assert kernel_engine() == "numpy" and kernel_engine("c") == "c"  # silently
     with caplog.at_level(logging.WARNING, logger="minvar"):
         first = solve(reference_problem)
         second = solve(reference_problem, engine="auto")
@@ -318,3 +354,21 @@ def test_numpy_engine_without_the_kernel_is_silent(reference_problem, monkeypatc
         solve(reference_problem, max_iter=2)
         solve(reference_problem, max_iter=2, engine="numpy")
     assert not caplog.records
+
+
+def test_an_install_without_the_kernel_solves_and_says_so_once():
+    # what a user sees where no C compiler built minvar._lqg_kernel: the numpy
+    # passes, and one warning on stderr (logging's default), not a silent slow-down
+    code = ("import sys; sys.modules['minvar._lqg_kernel'] = None  # as if never built\n"
+            "import minvar\n"
+            "p = minvar.reach_problem(minvar.ReachTask((0.2, 0.2), (0.4, 0.5), 0.5))\n"
+            "a, b = minvar.solve(p), minvar.solve(p, engine='auto')\n"
+            "print(minvar.kernel_engine(), a.converged, a.cost == b.cost)\n")
+    env = {k: v for k, v in os.environ.items() if k != "MINVAR_KERNEL"}
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
+                         check=True)
+    assert out.stdout.split() == ["numpy", "True", "True"]
+    warnings = [line for line in out.stderr.splitlines() if line.strip()]
+    assert len(warnings) == 1, out.stderr
+    assert warnings[0].startswith("minvar: the compiled LQG kernel is not available (it was "
+                                  "not built: no C compiler")

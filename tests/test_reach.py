@@ -14,6 +14,8 @@ from minvar.analysis import (
 )
 from minvar.plant import POSITION, VELOCITY
 
+pytestmark = pytest.mark.usefixtures("engine")  # every test plans: once per solver engine
+
 THESIS_REACH = ReachTask((0.2, 0.2), (0.4, 0.5), 0.5)
 S_TASK = ReachTask(
     (-0.2, 0.5), (-0.4, 0.2), 1.0,

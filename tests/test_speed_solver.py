@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from minvar import _kernel, reach_problem, solve
-from minvar.moments import _joint_moments, estimation_error_covariance
+from minvar.moments import Moments, estimation_error_covariance, mean_states
 from minvar.task import ReachTask, ViaPoint
 
 S_TASK = ReachTask((-0.2, 0.5), (-0.4, 0.2), 1.0,
@@ -50,18 +50,42 @@ def test_compiled_passes_match_numpy_passes(reference_problem, which):
     assert fast.cost == pytest.approx(slow.cost, rel=1e-9)
 
 
-def test_error_covariance_matches_joint_moments(reference_problem):
+def test_compiled_moments_match_numpy_moments(reference_problem):
+    # lqg_error_cov and lqg_mean_states are the compiled twins of
+    # minvar.moments.Moments.step and minvar.moments.mean_states
     rng = np.random.default_rng(4)
     for p in (reference_problem, _noisy(reference_problem)):
         s = solve(p)
         K = s.K + 0.01 * rng.standard_normal(s.K.shape)  # any gains, not only optimal ones
         L = s.L * (1 + 0.01 * rng.standard_normal(s.L.shape))
-        n = p.n_states
-        slow = np.array([S[:n, :n] - S[:n, n:] - S[n:, :n] + S[n:, n:]
-                         for _, _, S in _joint_moments(p, K, L)])
-        for engine in ("c", "numpy"):  # numpy: _joint_moments itself
-            np.testing.assert_allclose(estimation_error_covariance(p, K, L, engine=engine),
-                                       slow, rtol=0, atol=1e-12 * np.abs(slow).max())
+        slow = estimation_error_covariance(p, K, L, engine="numpy")
+        fast = estimation_error_covariance(p, K, L, engine="c")
+        np.testing.assert_allclose(fast, slow, rtol=0, atol=1e-12 * np.abs(slow).max())
+        optimal = estimation_error_covariance(p, s.K, s.L, engine="numpy")
+        assert np.abs(optimal - slow).max() > 1e-6 * np.abs(slow).max()  # the gains matter
+        np.testing.assert_allclose(_kernel.mean_states(p, L), mean_states(p, L), rtol=0,
+                                   atol=1e-12)
+
+
+def test_optimal_filter_step_is_the_general_step(reference_problem):
+    # the forward pass steps the moments with Todorov's shortcut for the
+    # optimal filter gain; with that gain the general step gives the same
+    p = _noisy(reference_problem)
+    L = solve(p, engine="numpy").L
+    moments = Moments(p)
+    A, H = p.A, p.H
+    fast = general = moments.start()
+    for t in range(p.horizon):
+        Mhh, Mhe, Mee = fast
+        M = moments.add_sensor_noise(H @ Mee @ H.T, Mhh, Mhe, Mee)
+        ASH = A @ Mee @ H.T
+        K = np.linalg.solve(M, ASH.T).T  # optimal for these moments
+        fast = moments.step(*fast, K, L[t], KMK=K @ ASH.T)
+        general = moments.step(*general, K, L[t])
+        for name, a, b in zip(("Mhh", "Mhe", "Mee"), fast, general):
+            np.testing.assert_allclose(a, b, rtol=0, atol=1e-11 * np.abs(b).max() + 1e-300,
+                                       err_msg=f"{name} at step {t + 1}")
+    assert np.abs(fast[1]).max() > 0  # internal noise: the estimate-error moment is tracked
 
 
 def test_stopping_rule_is_todorovs_absolute_test(todorov, reference_problem, engine):
@@ -72,7 +96,7 @@ def test_stopping_rule_is_todorovs_absolute_test(todorov, reference_problem, eng
     assert abs(h[-1] - h[-2]) < 1e-15 and abs(h[-2] - h[-3]) >= 1e-15
 
 
-def test_routine_plans_converge_without_warnings(caplog):
+def test_routine_plans_converge_without_warnings(caplog, engine):
     from perception.recognition.repertoire import Repertoire
 
     with caplog.at_level(logging.WARNING):
@@ -91,10 +115,10 @@ def test_unconverged_plan_is_reported_once(reference_problem, caplog, monkeypatc
     assert len([r for r in caplog.records if "did not converge" in r.getMessage()]) == 1
 
 
-def test_overflowing_dynamics_raise_naming_the_cause(reference_problem):
+def test_overflowing_dynamics_raise_naming_the_cause(reference_problem, engine):
     p = dataclasses.replace(reference_problem, A=reference_problem.A * 1e8)
     with pytest.raises(ValueError, match=r"not finite.*dynamics A grow by 1e\+08"):
-        solve(p)
+        solve(p, engine=engine)
 
 
 def test_singular_sensor_noise_raises_naming_the_cause(reference_problem, engine):
@@ -103,12 +127,31 @@ def test_singular_sensor_noise_raises_naming_the_cause(reference_problem, engine
         solve(p, engine=engine)
 
 
-def test_identical_chain_problems_are_solved_once():
+def test_identical_chain_problems_are_solved_once(engine):
     from minvar.grasp import GraspTask, plan_grasp
 
     grasp = plan_grasp(GraspTask(duration=0.9))
     reach = plan_grasp(GraspTask(duration=0.9, reach_only=True))
     assert reach.arm.solution is grasp.arm.solution  # one transport, one solve
+
+
+def test_plans_shared_between_solves_are_those_of_the_engine(monkeypatch):
+    # the process-wide cache of chain solutions holds each engine's own
+    from collections import OrderedDict
+
+    from minvar import grasp
+    from minvar.grasp import GraspTask, plan_grasp
+
+    monkeypatch.setattr(grasp, "_SOLVED", OrderedDict())
+    task = GraspTask(duration=0.8)
+    plans = {}
+    for engine in ("c", "numpy", "c"):
+        monkeypatch.setenv("MINVAR_KERNEL", engine)
+        plans.setdefault(engine, []).append(plan_grasp(task).arm.solution)
+    assert plans["c"][0] is plans["c"][1]  # shared within an engine
+    assert plans["numpy"][0] is not plans["c"][0]
+    by_numpy = solve(plan_grasp(task).arm.problem, engine="numpy")
+    assert plans["numpy"][0].cost_history.tobytes() == by_numpy.cost_history.tobytes()
 
 
 def test_numpy_fallback_by_environment(tmp_path):
@@ -120,3 +163,30 @@ def test_numpy_fallback_by_environment(tmp_path):
                          check=True)
     assert out.stdout.strip() == "False True False True"
     assert not out.stderr
+
+
+def test_kernel_checks_the_buffers_it_is_given(reference_problem):
+    if not _kernel.loaded():
+        pytest.skip(f"the compiled LQG kernel is not available: {_kernel._WHY}")
+    from minvar import _lqg_kernel
+
+    p = reference_problem
+    T, n, m = p.horizon, p.n_states, p.n_controls
+    dims = (T, n, m, p.n_outputs, 0, 0)
+    L = np.random.default_rng(0).standard_normal((T, m, n))
+    X = np.empty((T + 1, n))
+    _lqg_kernel.mean_states(dims, p.A, p.B, L, p.X1, X)  # read-only inputs are fine
+    np.testing.assert_allclose(X, mean_states(p, L), rtol=0, atol=1e-12 * np.abs(X).max())
+    frozen = np.empty_like(X)
+    frozen.setflags(write=False)
+    bad = [({"X": frozen}, ValueError, rf"X: expected {(T + 1) * n} writable C-contiguous"),
+           ({"X": X[:-1]}, ValueError, rf"X: expected {(T + 1) * n} .* got {T * n * 8} bytes"),
+           ({"L": np.asfortranarray(L)}, ValueError, r"L: expected \d+ C-contiguous float64"),
+           ({"L": L.astype(np.float32)}, ValueError, r"L: .* of 'f'"),
+           ({"X1": list(p.X1)}, TypeError, r"X1: expected 10 C-contiguous float64 .* got list")]
+    for change, error, message in bad:
+        args = {"A": p.A, "B": p.B, "L": L, "X1": p.X1, "X": X, **change}
+        with pytest.raises(error, match=rf"_lqg_kernel\.mean_states: {message}"):
+            _lqg_kernel.mean_states(dims, *args.values())
+    with pytest.raises(ValueError, match=r"sizes \(T, n, m, k, nc, nd\) = \(-1, "):
+        _lqg_kernel.mean_states((-1, n, m, 6, 0, 0), p.A, p.B, L, p.X1, X)

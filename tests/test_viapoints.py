@@ -50,6 +50,7 @@ def test_curvature_of_accelerating_line_is_its_acceleration_over_speed_term():
                                rtol=1e-9)
 
 
+@pytest.mark.usefixtures("engine")  # plans: once per solver engine
 def test_curvature_unit_is_the_length_unit_of_eq_a1():
     # the same circle in centimetres: R -> 100 R in the formula
     R, w = 0.1, 2 * np.pi
@@ -108,6 +109,7 @@ def test_msd_zero_for_identical_and_grows_with_shift():
         msd(np.zeros((3, 2)), np.zeros((3, 3)))
 
 
+@pytest.mark.usefixtures("engine")  # plans: once per solver engine
 def test_joint_msd_compensates_for_arm_length():
     t, p = expected_path(CURVED)
     _, other = expected_path(ReachTask(CURVED.start, CURVED.goal, 1.0))
@@ -157,6 +159,7 @@ def test_transform_maps_points_by_eqs_a4_a5():
     assert new.via_fractions == m.via_fractions and new.duration == m.duration
 
 
+@pytest.mark.usefixtures("engine")  # plans: once per solver engine
 def test_replayed_generalised_path_is_the_transformed_path():
     m = letter_a(duration=1.5)
     _, p = replay(m)
@@ -184,6 +187,7 @@ def test_movement_validation_names_the_argument():
 
 # --- the letter 'a' ----------------------------------------------------------------------
 
+@pytest.mark.usefixtures("engine")  # plans: once per solver engine
 def test_letter_a_reverses_with_near_zero_speed_near_70_percent():
     m = letter_a(duration=1.5)
     t, p = replay(m)
@@ -199,6 +203,7 @@ def test_letter_a_reverses_with_near_zero_speed_near_70_percent():
 
 # --- criteria and timing -----------------------------------------------------------------------
 
+@pytest.mark.usefixtures("engine")  # plans: once per solver engine
 def test_compare_criteria_replays_and_scores():
     r = simulate_reach(CURVED, 2, seed=7)
     trajs = [(r.time, r.position[k]) for k in range(2)]
@@ -217,6 +222,7 @@ def test_compare_criteria_replays_and_scores():
         compare_criteria([(r.time * 2, r.position[0])])
 
 
+@pytest.mark.usefixtures("engine")  # plans: once per solver engine
 def test_viapoint_timing_is_zero_at_reference_and_grows():
     df = viapoint_timing(CURVED, [-0.2, -0.1, 0.0, 0.1, 0.2])
     assert df.loc[2, "msd"] == 0 and df.loc[2, "path_distance"] == 0
