@@ -384,7 +384,7 @@ def _guarded(item: BatchItem, out: Path, **kwargs) -> ClipResult:
 
 @dataclass(frozen=True)
 class _Job:
-    """What every clip of one batch shares (sent to each worker with its clip)."""
+    """What every clip of one batch shares (sent to each worker once, when it starts)."""
 
     out: Path
     settings: RecognitionSettings
@@ -400,7 +400,8 @@ class _Job:
                         repertoire_id=self.repertoire_id, plan_cache=self.plan_cache)
 
     def lost(self, item: BatchItem, message: str) -> ClipResult:
-        """A clip whose worker process died while on it: failed, its outputs removed."""
+        """A clip lost to a worker process that died (it, or another clip, crashed the
+        pool): failed, its outputs removed."""
         log.error("%s: %s", item.clip, message)
         _remove_outputs(item, self.out)
         return ClipResult(item.clip, item.condition, "failed", f"{item.path}: {message}",
@@ -422,23 +423,25 @@ def _file_size(item: BatchItem) -> int:
 
 def _run_local(items: list[BatchItem], repertoire: Repertoire, job: _Job,
                jobs: int) -> Iterator[ClipResult]:
-    """Every item in this process and ``jobs - 1`` worker processes.
+    """Every item here (``jobs`` 1) or in ``jobs`` worker processes (largest first).
 
-    This process works on clips too: it is warm (modules imported) while a
-    worker spends about half a second starting, so a short batch gains from
-    the second process too.
+    Each worker gets the repertoire once, when it starts (and keeps the
+    models it re-plans for a scene between clips).
     """
-    if jobs > 1:
-        items = workers.largest_first(items, jobs - 1, _file_size)
-    # (workers keep the models they re-plan between clips, in their own repertoire)
-    return workers.run_shared(items, job, jobs, shared=repertoire, folder=job.out,
-                              name="repertoire", while_waiting=_prepare_report)
+    left, used = len(items), min(jobs, len(items))
+    size = _file_size if jobs > 1 else None  # one process: in name order
+    for result in workers.run_pool(items, job, jobs, shared=repertoire, size=size):
+        yield result
+        left -= 1
+        if used > 1 and left == used - 1:  # a worker has nothing more to do
+            _prepare_report()
 
 
 def _prepare_report() -> None:
-    """Import what the batch report needs (pandas, scipy.special: 0.5 s) while
-    workers finish the clips: this process would otherwise wait idle, then
-    import them. Workers never import them."""
+    """Import what the batch report needs (pandas, scipy.special: 0.5 s) on the core
+    a worker has left while the others finish the last clips: this process would
+    otherwise wait idle, then import them. Workers never import them."""
+    import matplotlib.figure  # noqa: F401 - the chapter 5 figures' (0.4 s)
     import scipy.special  # noqa: F401
 
     import perception.report.batch  # noqa: F401 - pandas
@@ -557,9 +560,12 @@ def run_batch(
     settings : RecognitionSettings, optional
         Observation and engine settings.
     jobs : int
-        Local processes working on clips: this one and ``jobs - 1`` spawned
-        workers (ignored with ``scheduler``). Scripts that use ``jobs > 1``
-        need the usual ``if __name__ == "__main__":`` guard of multiprocessing.
+        Worker processes working on clips, one OpenCV/FFmpeg thread each
+        (:mod:`perception.workers`; 1: in this process; ignored with
+        ``scheduler``). Scripts that use ``jobs > 1`` need the usual
+        ``if __name__ == "__main__":`` guard of multiprocessing, and should set
+        ``OMP_NUM_THREADS=1`` (and OpenBLAS's, MKL's) before numpy loads, as
+        ``hammer-mv`` does: the workers inherit it.
     scheduler : str, optional
         Address of a dask.distributed scheduler (``tcp://host:8786``) to run on.
     repertoire_id : str

@@ -22,7 +22,6 @@ from distributed import as_completed as dask_completed
 from distributed.comm import connect
 
 from perception.errors import InputError
-from perception.recognition.planning import THREADS_VARIABLE
 
 __all__ = ["SCHEDULER_TIMEOUT_S", "OneThreadPerWorker", "check_scheduler", "run_on_cluster"]
 
@@ -58,35 +57,31 @@ class OneThreadPerWorker(WorkerPlugin):
 
     name = "hammer-mv-one-thread-per-worker"
 
-    def setup(self, worker) -> None:  # noqa: D102 - dask's API
+    def setup(self, **_) -> None:  # noqa: D102 - dask's API (it passes worker=, not needed)
         import cv2
 
         from perception.io import video
+        from perception.recognition import planning
 
-        self._before = (cv2.getNumThreads(), video.decoder_threads,
-                        os.environ.get(THREADS_VARIABLE))
+        self._before = cv2.getNumThreads(), video.decoder_threads, planning.threads
         cv2.setNumThreads(1)
         video.decoder_threads = 1
-        os.environ[THREADS_VARIABLE] = "1"
+        planning.threads = 1
         trim = os.environ.get("MALLOC_TRIM_THRESHOLD_")
         mallopt = _mallopt() if trim is not None else None
         self._trim = trim if mallopt and mallopt(_M_MMAP_THRESHOLD, _MMAP_THRESHOLD) and \
             mallopt(_M_TRIM_THRESHOLD, _TRIM_THRESHOLD) else None
 
-    def teardown(self, worker) -> None:  # noqa: D102 - dask's API
+    def teardown(self, **_) -> None:  # noqa: D102 - dask's API
         import cv2
 
         from perception.io import video
+        from perception.recognition import planning
 
-        threads, decoders, plan = self._before
-        cv2.setNumThreads(threads)
-        video.decoder_threads = decoders
-        if plan is None:
-            os.environ.pop(THREADS_VARIABLE, None)
-        else:
-            os.environ[THREADS_VARIABLE] = plan
+        cv2.setNumThreads(self._before[0])
+        video.decoder_threads, planning.threads = self._before[1:]
         mallopt = _mallopt() if self._trim is not None else None
-        if mallopt:
+        if mallopt:  # what the variable had set (it fixes the mmap threshold at glibc's default)
             mallopt(_M_TRIM_THRESHOLD, int(self._trim))
             mallopt(_M_MMAP_THRESHOLD, _DEFAULT_MMAP_THRESHOLD)
 

@@ -121,7 +121,7 @@ def test_io_knows_nothing_of_what_it_stores(graph):
     """perception.io reads and writes files; recognition, tracking and reports sit above it."""
     above = ("perception.recognition", "perception.tracking", "perception.report",
              "perception.batch", "perception.pipeline", "perception.synthetic",
-             "perception.workers")
+             "perception.workers", "perception.cluster")
     bad = {(m, dep) for m, deps in graph.items() if m.startswith("perception.io")
            for dep in deps if dep.startswith(above)}
     assert not bad, sorted(bad)
@@ -147,3 +147,86 @@ def test_importing_a_topic_module_stays_light():
             "heavy = [m for m in ('cv2', 'matplotlib', 'scipy', 'dask') if m in sys.modules]\n"
             "assert not heavy, heavy\n")
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+#: Worker initialisers: the only library code that may set process-wide state,
+#: in a worker process that the library itself started (or, on a dask worker,
+#: for as long as the batch's plugin is registered, which puts it back).
+WORKER_INITIALISERS = {"perception.workers.init_worker",
+                       "perception.cluster.OneThreadPerWorker.setup",
+                       "perception.cluster.OneThreadPerWorker.teardown"}
+#: Calls that change a whole process: thread pools, the allocator, the environment,
+#: how multiprocessing starts its children.
+_PROCESS_WIDE = {"setNumThreads", "mallopt", "putenv", "unsetenv", "set_start_method",
+                 "set_forkserver_preload"}
+_ENVIRON_WRITES = {"update", "pop", "popitem", "setdefault", "clear", "__setitem__",
+                   "__delitem__"}
+
+
+def _is_environ(node: ast.AST) -> bool:
+    return (isinstance(node, ast.Attribute) and node.attr == "environ") or (
+        isinstance(node, ast.Name) and node.id == "environ")
+
+
+def _process_wide_changes(module: str, source: str) -> list[str]:
+    """``module.function: call`` of each change to process-wide state outside
+    :data:`WORKER_INITIALISERS`."""
+    found = []
+
+    def visit(node: ast.AST, where: str) -> None:
+        for child in ast.iter_child_nodes(node):
+            inner = where
+            if isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+                inner = f"{where}.{child.name}"
+            bad = None
+            if isinstance(child, ast.Call):
+                func = child.func
+                name = func.attr if isinstance(func, ast.Attribute) else getattr(func, "id", "")
+                if name in _PROCESS_WIDE:
+                    bad = name
+                elif (isinstance(func, ast.Attribute) and name in _ENVIRON_WRITES
+                      and _is_environ(func.value)):
+                    bad = f"os.environ.{name}"
+            elif isinstance(child, (ast.Assign, ast.AugAssign, ast.Delete)):
+                targets = child.targets if isinstance(child, (ast.Assign, ast.Delete)) \
+                    else [child.target]
+                if any(isinstance(t, ast.Subscript) and _is_environ(t.value) for t in targets):
+                    bad = "os.environ[...]"
+            if bad and inner not in WORKER_INITIALISERS:
+                found.append(f"{inner}: {bad}")
+            visit(child, inner)
+
+    visit(ast.parse(source), module)
+    return found
+
+
+def test_libraries_leave_process_wide_state_to_the_application():
+    """No library code sets thread counts, the allocator or the environment behind its
+    caller's back: only hammer_mv's entry points and worker initialisers do."""
+    bad = [change for name, path in _modules().items() if name.split(".")[0] != "hammer_mv"
+           for change in _process_wide_changes(name, path.read_text())]
+    assert not bad, bad
+
+
+def test_the_process_wide_check_finds_each_kind_of_change():
+    source = """
+import os, cv2, ctypes
+def a():
+    cv2.setNumThreads(1)
+def b():
+    os.environ["X"] = "1"
+def c():
+    os.environ.update(X="1")
+class D:
+    def e(self):
+        ctypes.CDLL(None).mallopt(-1, 0)
+def f():
+    del os.environ["X"]
+def g():
+    return os.environ.get("X"), cv2.getNumThreads()  # reading is fine
+"""
+    assert _process_wide_changes("m", source) == [
+        "m.a: setNumThreads", "m.b: os.environ[...]", "m.c: os.environ.update",
+        "m.D.e: mallopt", "m.f: os.environ[...]"]
+    assert _process_wide_changes("perception.workers",
+                                 "def init_worker():\n    cv2.setNumThreads(1)\n") == []

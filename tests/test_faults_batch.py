@@ -25,6 +25,7 @@ from _demos import default_repertoire, demo_tracks
 
 from perception.batch import discover, find_clips, run_batch
 from perception.provenance import code_digest
+from perception.recognition.repertoire import Repertoire
 from perception.synthetic.recipes import Recipe, StimulusParams, synthesize
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -263,11 +264,12 @@ def test_a_cluster_batch_leaves_the_workers_as_it_found_them(tracks_folder, tmp_
     import cv2
     from dask.distributed import LocalCluster
 
-    from perception.recognition.planning import THREADS_VARIABLE
+    from perception.io import video
+    from perception.recognition import planning
 
     before = cv2.getNumThreads()
     cv2.setNumThreads(3)
-    env = os.environ.pop(THREADS_VARIABLE, None)
+    env = dict(os.environ)
     try:
         # workers in this very process: what the batch's plugin changes, we can see
         with LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
@@ -275,8 +277,27 @@ def test_a_cluster_batch_leaves_the_workers_as_it_found_them(tracks_folder, tmp_
             summary = run_batch(discover(tracks_folder), tmp_path / "out", default_repertoire(),
                                 quiet=True, scheduler=cluster.scheduler_address)
         assert (summary["status"] == "ok").all()
-        assert cv2.getNumThreads() == 3 and THREADS_VARIABLE not in os.environ
+        assert cv2.getNumThreads() == 3
+        assert video.decoder_threads == 0 and planning.threads is None
+        assert dict(os.environ) == env
     finally:
         cv2.setNumThreads(before)
-        if env is not None:
-            os.environ[THREADS_VARIABLE] = env
+
+class _CrashesInAWorker(Repertoire):
+    """Kills the worker process that plans a clip's models (as a crash in a library would)."""
+
+    def for_scene(self, scene, cache=None):
+        os._exit(3)
+
+
+def test_a_killed_worker_fails_its_clips_in_one_clear_line_and_the_batch_ends(tracks_folder,
+                                                                              tmp_path):
+    rep = _CrashesInAWorker(default_repertoire().models)
+    out = tmp_path / "out"
+    summary = run_batch(discover(tracks_folder), out, rep, quiet=True, jobs=2)
+    assert (summary["status"] == "failed").all()
+    for clip, error in zip(summary["clip"], summary["error"]):
+        assert error.startswith(str(tracks_folder / f"{clip}.tracks.h5"))
+        assert "worker process ended abruptly" in error and "rerun" in error
+    assert json.loads((out / "batch.json").read_text())["failed"] == 2
+    assert not list(out.glob("*.recognition.json"))

@@ -245,7 +245,6 @@ def test_batch_caps_jobs_and_names_the_commonest_failure(machine, monkeypatch, t
 
     monkeypatch.setattr(batch_cli, "run_batch", run_batch)
     monkeypatch.setattr(batch_cli, "load_repertoire", lambda args: (None, "rep"))
-    monkeypatch.setattr(batch_cli, "start_early", lambda: None)
     out = tmp_path / "report"
     assert main(["batch", str(clips), "-o", str(out), "--jobs", "64"]) == 1
     assert seen["jobs"] == 2

@@ -190,8 +190,8 @@ def test_models_planned_on_threads_are_the_same(monkeypatch):
     "perception.tracking.tracker, perception.io.tracks, hammer_mv.cli.track",
     # what a spawned batch worker imports before its first clip (0.35 s, not 0.85 s)
     "perception.batch, perception.recognition.repertoire",
-    # what the fork server imports for the workers forked from it
-    "importlib, perception.workers as w; [importlib.import_module(m) for m in w.PRELOAD]",
+    # what a worker process imports to start (its initialiser's module)
+    "perception.workers",
 ])
 def test_tracking_and_batch_workers_start_without_pandas_scipy_or_matplotlib(modules):
     code = (f"import sys, {modules}\n"
@@ -203,7 +203,7 @@ def test_tracking_and_batch_workers_start_without_pandas_scipy_or_matplotlib(mod
 
 _FAULTS = """
 import resource, numpy as np
-from perception.workers import reuse_freed_memory
+from perception.cluster import OneThreadPerWorker
 
 def faults():
     before = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
@@ -212,22 +212,27 @@ def faults():
         del frame
     return resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before
 
+plugin = OneThreadPerWorker()
 slow = faults()
-print(reuse_freed_memory(), slow, faults())
+plugin.setup(worker=None)
+fast = faults()
+plugin.teardown(worker=None)
+print(plugin._trim is not None, slow, fast, faults())
 """
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's allocator")
-def test_freed_frames_are_reused_in_a_worker_started_as_dask_starts_its_workers():
+def test_a_cluster_worker_reuses_freed_frames_while_a_batch_runs_and_then_is_put_back():
     import os
 
     env = {**os.environ, "MALLOC_TRIM_THRESHOLD_": "65536"}  # dask's nanny sets this
     out = subprocess.run([sys.executable, "-c", _FAULTS], capture_output=True, text=True,
                          check=True, env=env).stdout.split()
-    changed, slow, fast = out[0], int(out[1]), int(out[2])
+    changed, slow, fast, after = out[0], int(out[1]), int(out[2]), int(out[3])
     assert changed == "True"
     assert slow > 50 * 200  # a fresh mmap per frame: every page faults
     assert fast < slow / 20
+    assert after > 50 * 200  # teardown put the worker's own thresholds back
     env.pop("MALLOC_TRIM_THRESHOLD_")
     plain = subprocess.run([sys.executable, "-c", _FAULTS], capture_output=True, text=True,
                            check=True, env=env).stdout.split()

@@ -1,120 +1,70 @@
-"""Work shared between a process and its spawned workers (perception.workers)."""
+"""Worker processes for ``--jobs`` (perception.workers): a standard pool, one thread each."""
 
 from __future__ import annotations
 
 import os
-import sys
 import time
 from pathlib import Path
 
 import pytest
 
-from perception.workers import PRELOAD, Claims, largest_first, run_shared
+from perception.workers import run_pool
 
 
-def test_largest_first_gives_both_ends_the_largest_and_the_middle_the_smallest():
-    sizes = [5, 9, 1, 7, 3, 8, 2, 6, 4]
-    order = largest_first(sizes, workers=2, size=lambda s: s)
-    assert sorted(order) == sorted(sizes)
-    # ranked 9 8 7 6 5 4 3 2 1: every third (7, 4, 1) goes to the back
-    assert order == [9, 8, 6, 5, 3, 2, 1, 4, 7]
-    front, back = order[:6], order[6:][::-1]
-    assert front == sorted(front, reverse=True) and back == sorted(back, reverse=True)
+class _Where:
+    """Where an item ran: the item, the process, which shared object and the worker's threads."""
+
+    def run(self, item: int, shared: dict) -> tuple:
+        import cv2
+
+        from perception.io import video
+        from perception.recognition import planning
+
+        time.sleep(0.05)  # long enough that both workers get items
+        return (item, os.getpid(), id(shared), shared["name"], cv2.getNumThreads(),
+                video.decoder_threads, planning.threads)
 
 
-def test_largest_first_keeps_the_order_of_equal_sizes():
-    items = ["a", "b", "c", "d"]
-    assert largest_first(items, workers=1, size=lambda _: 0) == ["a", "c", "d", "b"]
+def test_items_run_once_in_workers_each_getting_the_shared_object_once():
+    results = list(run_pool(range(8), _Where(), 2, shared={"name": "rep"}))
+    assert sorted(r[0] for r in results) == list(range(8))
+    pids = {r[1] for r in results}
+    assert os.getpid() not in pids and 1 <= len(pids) <= 2
+    for pid in pids:  # one copy per worker, unpickled when it started, not one per item
+        assert len({r[2] for r in results if r[1] == pid}) == 1
+    assert {r[3] for r in results} == {"rep"}
+    assert {r[4:] for r in results} == {(1, 1, 1)}  # one OpenCV, FFmpeg and planning thread
 
 
-def test_an_item_is_claimed_once():
-    claims = Claims(3)
-    assert claims.take(1)
-    assert not claims.take(1)
-    assert claims.take(0) and claims.take(2)
+def test_the_calling_process_is_left_as_it_was():
+    import cv2
+
+    from perception.io import video
+    from perception.recognition import planning
+
+    before = (cv2.getNumThreads(), video.decoder_threads, planning.threads, dict(os.environ))
+    list(run_pool(range(3), _Where(), 2, shared={"name": "s"}))
+    assert (cv2.getNumThreads(), video.decoder_threads, planning.threads,
+            dict(os.environ)) == before
 
 
-def _wait_until(ready, what: str, seconds: float = 30) -> None:
-    """Poll ``ready()`` until true; a TimeoutError naming ``what`` after ``seconds``."""
-    deadline = time.monotonic() + seconds
-    while not ready():
-        if time.monotonic() > deadline:
-            raise TimeoutError(what)
-        time.sleep(0.01)
-
-
-class _Record:
-    """Sleeps for an item, then leaves a file naming the item and the process."""
-
-    def __init__(self, folder: Path):
-        self.folder = folder
-
-    def run(self, item: int, shared: str) -> tuple[int, int, str]:
-        if item == 0:
-            # The first item waits until every other item is done: a process
-            # that left a queued item undone while it waits never sees that.
-            _wait_until(lambda: len(list(self.folder.glob("done-*"))) >= 5,
-                        "the other items were not done", seconds=20)
-        else:
-            time.sleep(0.2)
-        (self.folder / f"done-{item}-{os.getpid()}").touch()
-        return item, os.getpid(), shared
-
-
-def test_every_item_runs_once_and_nothing_queued_waits_behind_a_long_one(tmp_path):
-    # Item 0 (the front: a worker's first) ends only when items 1-5 are done.
-    # Without claims, the worker's next item sits queued behind it, and item
-    # 0 times out waiting for it.
-    results = list(run_shared(list(range(6)), _Record(tmp_path), 2, shared="rep",
-                              folder=tmp_path, name="test"))
-    assert sorted(r[0] for r in results) == list(range(6))
-    assert {r[2] for r in results} == {"rep"}  # the shared object reached the worker
-    assert len(list(tmp_path.glob("done-*"))) == 6  # none ran twice
-    assert not list(tmp_path.glob(".test-*"))  # the shared pickle's folder is gone
-
-
-@pytest.mark.parametrize("jobs", [1, 3])
-def test_results_come_from_every_process_that_took_part(tmp_path, jobs):
-    results = list(run_shared(list(range(1, 9)), _Record(tmp_path), jobs, shared="s",
-                              folder=tmp_path))
-    assert sorted(r[0] for r in results) == list(range(1, 9))
-    assert (os.getpid() in {r[1] for r in results}) and len({r[1] for r in results}) <= jobs
-
-
-class _Modules:
-    """Item 1 (this process's first) waits for item 0, which a worker must therefore run."""
-
-    def __init__(self, folder: Path):
-        self.folder = folder
-
-    def run(self, item: int, shared: None) -> list[str] | None:
-        if item == 1:
-            _wait_until((self.folder / "0").exists, "no worker ran item 0")
-            return None
-        loaded = [m for m in PRELOAD if m in sys.modules]
-        (self.folder / "0").touch()
-        return loaded
-
-
-@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="a fork server")
-def test_workers_start_with_the_preloaded_modules_imported(tmp_path):
-    # this test module imports none of them: a spawned worker would not have them
-    results = list(run_shared([0, 1], _Modules(tmp_path), 2))
-    assert [r for r in results if r is not None] == [list(PRELOAD)]
+def test_one_job_runs_here_largest_first():
+    results = list(run_pool([3, 9, 1, 7], _Where(), 1, shared={"name": "s"},
+                            size=lambda i: i))
+    assert [r[0] for r in results] == [9, 7, 3, 1]
+    assert {r[1] for r in results} == {os.getpid()}
 
 
 class _Dies:
-    """A worker dies on item 0; this process's first item waits until one has taken it."""
+    """A worker dies on item 0 (after the others have had time to finish)."""
 
-    def __init__(self, folder: Path, parent: int):
-        self.folder, self.parent = folder, parent
+    def __init__(self, parent: int):
+        self.parent = parent
 
     def run(self, item: int, shared: None) -> int:
         if item == 0 and os.getpid() != self.parent:
-            (self.folder / "took-0").touch()
-            os._exit(3)  # as a crash in a library would
-        if item == 3:
-            _wait_until((self.folder / "took-0").exists, "no worker took item 0")
+            time.sleep(1.0)
+            os._exit(3)  # as a crash in a library, or the out-of-memory killer, would
         return item
 
 
@@ -123,19 +73,33 @@ class _DiesReported(_Dies):
         return message, item
 
 
-def test_a_dead_workers_item_is_reported_lost_and_the_rest_are_done(tmp_path):
-    results = list(run_shared(list(range(4)), _DiesReported(tmp_path, os.getpid()), 2))
+def test_a_dead_worker_loses_the_unfinished_items_and_nothing_hangs():
+    # item 0 goes last (smallest): the others are done before its worker dies
+    results = list(run_pool(range(4), _DiesReported(os.getpid()), 2, size=lambda i: i))
     lost = [r for r in results if isinstance(r, tuple)]
     assert sorted(r for r in results if isinstance(r, int)) == [1, 2, 3]
-    assert [r[1] for r in lost] == [0] and "ended abruptly" in lost[0][0]
+    assert [r[1] for r in lost] == [0]
+    assert "worker process ended abruptly" in lost[0][0] and "rerun" in lost[0][0]
 
 
-def test_a_dead_worker_ends_a_job_without_lost_with_an_oserror(tmp_path):
+def test_a_dead_worker_ends_a_job_without_lost_with_an_oserror():
     # an OSError: a command reports it in one line (not BrokenProcessPool's traceback)
     with pytest.raises(ChildProcessError, match="worker process ended abruptly"):
-        list(run_shared(list(range(4)), _Dies(tmp_path, os.getpid()), 2))
+        list(run_pool(range(4), _Dies(os.getpid()), 2))
 
 
-def test_a_shared_object_needs_a_folder():
-    with pytest.raises(ValueError, match="needs a folder"):
-        list(run_shared([1, 2], _Record(Path(".")), 2, shared="s"))
+class _Touch:
+    def __init__(self, folder: Path):
+        self.folder = folder
+
+    def run(self, item: int, shared: None) -> int:
+        time.sleep(0.1)
+        (self.folder / str(item)).touch()
+        return item
+
+
+def test_stopping_early_drops_the_items_not_started(tmp_path):
+    results = run_pool(range(40), _Touch(tmp_path), 2)
+    next(results)
+    results.close()  # as an interrupted batch does: the pool is shut down at once
+    assert len(list(tmp_path.iterdir())) < 40

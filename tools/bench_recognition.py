@@ -73,12 +73,16 @@ def _batch(items, out: Path, rep, **kwargs):
 
 def _alone(items, out: Path, rep, ready, results) -> None:
     """One of :func:`_side_by_side`'s processes: a one-process batch, as a worker runs."""
+    import cv2
     import pandas  # noqa: F401  (the report's imports: a batch's main process has them)
     import scipy.special  # noqa: F401
 
-    from perception import workers
+    from perception.io import video
+    from perception.recognition import planning
 
-    workers.limit_threads()
+    # as a batch's worker process runs (perception.workers.init_worker)
+    cv2.setNumThreads(1)
+    video.decoder_threads = planning.threads = 1
     ready.wait(timeout=300)  # a sibling that died before it would otherwise hang us
     t0 = time.perf_counter()
     _batch(items, out, rep)
@@ -95,19 +99,17 @@ def _side_by_side(items, out: Path, rep, processes: int) -> float:
     """
     import multiprocessing
 
-    from perception import workers
     from perception.batch import _file_size
 
-    ctx = multiprocessing.get_context("spawn")
+    ctx = multiprocessing.get_context("spawn")  # one BLAS thread: bench.py's environment
     ready, results = ctx.Barrier(processes), ctx.Queue()
     # largest first, dealt in turn, so that each gets as much work
     ranked = sorted(items, key=_file_size, reverse=True)
-    with workers.single_threaded_children():
-        procs = [ctx.Process(target=_alone, args=(ranked[k::processes], out / f"alone{k}",
-                                                  rep, ready, results))
-                 for k in range(processes)]
-        for proc in procs:
-            proc.start()
+    procs = [ctx.Process(target=_alone, args=(ranked[k::processes], out / f"alone{k}",
+                                              rep, ready, results))
+             for k in range(processes)]
+    for proc in procs:
+        proc.start()
     for proc in procs:  # each puts two floats: the pipe holds them while it exits
         proc.join()
     failed = [k for k, proc in enumerate(procs) if proc.exitcode != 0]

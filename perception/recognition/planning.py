@@ -94,12 +94,16 @@ def build_model(spec: ModelSpec, scene: SceneSpec) -> MotorModel:
     )
 
 
-#: Environment variable: threads that plan a repertoire's models (default 1).
+#: Environment variable: threads that plan a repertoire's models (see :func:`planning_threads`).
 THREADS_VARIABLE = "HAMMER_MV_PLAN_THREADS"
+#: Threads that plan in this process, where set (before the variable): a worker
+#: process's initialiser sets 1, as its siblings already use every core.
+threads: int | None = None
 
 
 def planning_threads() -> int:
-    """Threads :func:`build_models` uses: ``$HAMMER_MV_PLAN_THREADS``, else up to 4.
+    """Threads :func:`build_models` uses: :data:`threads` if set, else
+    ``$HAMMER_MV_PLAN_THREADS``, else up to 4.
 
     The solver's compiled passes (two thirds of planning) release the GIL, so
     several models plan at once (on 2 idle cores a new scene's 10 default
@@ -108,6 +112,8 @@ def planning_threads() -> int:
     use, at most 4 (past that the Python third, which holds the GIL, is all
     that is left). A batch's workers use one each: they already use every core.
     """
+    if threads is not None:
+        return threads
     value = os.environ.get(THREADS_VARIABLE, "")
     if value.strip().isdigit() and int(value) >= 1:
         return int(value)

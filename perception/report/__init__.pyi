@@ -2,14 +2,6 @@
 
 from .batch import BatchReport as BatchReport
 from .batch import write_batch_report as write_batch_report
-from .chart import Band as Band
-from .chart import Chart as Chart
-from .chart import ErrorBars as ErrorBars
-from .chart import Legend as Legend
-from .chart import Line as Line
-from .chart import Panel as Panel
-from .chart import render_png as render_png
-from .chart import to_matplotlib as to_matplotlib
 from .clip import ClipSummary as ClipSummary
 from .clip import clip_figures as clip_figures
 from .clip import clip_outputs as clip_outputs
@@ -19,15 +11,9 @@ from .conditions import aperture_profiles as aperture_profiles
 from .conditions import condition_profiles as condition_profiles
 from .conditions import condition_statistics as condition_statistics
 from .conditions import reference_model as reference_model
-from .figures import aperture_chart as aperture_chart
 from .figures import aperture_figure as aperture_figure
-from .figures import condition_chart as condition_chart
 from .figures import condition_figure as condition_figure
-from .figures import confidence_all_chart as confidence_all_chart
 from .figures import confidence_all_figure as confidence_all_figure
-from .figures import confidence_chart as confidence_chart
 from .figures import confidence_figure as confidence_figure
-from .figures import confidence_single_chart as confidence_single_chart
 from .figures import confidence_single_figure as confidence_single_figure
-from .figures import paths_chart as paths_chart
 from .figures import paths_figure as paths_figure

@@ -23,9 +23,8 @@ from urllib.parse import quote
 import numpy as np
 import pandas as pd
 
-from perception.io.atomic import write_bytes, write_csv, write_text
+from perception.io.atomic import save_figure, write_csv, write_text
 from perception.io.names import printable
-from perception.report.chart import render_png
 from perception.report.clip import ClipSummary, clip_figures, clip_outputs
 from perception.report.conditions import (
     aperture_profiles,
@@ -36,10 +35,10 @@ from perception.report.conditions import (
     typical_clips,
 )
 from perception.report.figures import (
-    aperture_chart,
-    condition_chart,
-    confidence_all_chart,
-    confidence_single_chart,
+    aperture_figure,
+    condition_figure,
+    confidence_all_figure,
+    confidence_single_figure,
 )
 
 __all__ = ["BatchReport", "write_batch_report"]
@@ -229,7 +228,7 @@ def _clip_section(rec: ClipSummary, out: Path, anchor: str, condition,
 
 def _chapter5(recs: list[ClipSummary], conds: list[str], reference: str, models, out: Path
               ) -> None:
-    """The four chapter 5 figures (drawn with Pillow, no matplotlib) and their tables."""
+    """The four chapter 5 figures (matplotlib) and their tables."""
     model = next((m for m in models or () if m.name == reference), None)
     own = model_aperture(model) if model is not None else None
     ap = aperture_profiles(recs, conds)
@@ -238,15 +237,14 @@ def _chapter5(recs: list[ClipSummary], conds: list[str], reference: str, models,
                        ignore_index=True)[["condition", "phase", "mean", "sd", "n"]]
     write_csv(out / "aperture_profiles.csv", ap)
     observed = ap[~ap["condition"].astype(str).str.startswith("model:")]
-    write_bytes(out / "aperture_profiles.png", render_png(aperture_chart(observed, own, reference)))
+    save_figure(out / "aperture_profiles.png", aperture_figure(observed, own, reference))
     single, single_conds = typical_clips(recs, conds, reference)
-    write_bytes(out / "confidence_single.png",
-                render_png(confidence_single_chart(single, single_conds, reference)))
-    write_bytes(out / "confidence_all.png",
-                render_png(confidence_all_chart(recs, conds, reference)))
+    save_figure(out / "confidence_single.png",
+                confidence_single_figure(single, single_conds, reference))
+    save_figure(out / "confidence_all.png", confidence_all_figure(recs, conds, reference))
     prof = condition_profiles(recs, conds, reference)
     write_csv(out / "condition_profiles.csv", prof)
-    write_bytes(out / "condition_profiles.png", render_png(condition_chart(prof, reference)))
+    save_figure(out / "condition_profiles.png", condition_figure(prof, reference))
 
 
 def _figures_html(reference: str) -> str:

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from perception.io.atomic import write_bytes, write_csv, write_json
+from perception.io.atomic import save_figure, write_csv, write_json
 from perception.io.names import output_stem, printable
 from perception.recognition.result import Recognition
 
@@ -292,8 +292,8 @@ def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,
     extra : dict, optional
         More keys for the JSON (e.g. the batch's input fingerprint).
     figures : bool
-        Draw the figures (with Pillow, in milliseconds: see
-        :mod:`perception.report.chart`); without them, figures of an earlier
+        Draw the figures (matplotlib, imported here: see
+        :mod:`perception.report.figures`); without them, figures of an earlier
         run are removed, since they would show another result.
 
     Returns
@@ -303,11 +303,10 @@ def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,
     """
     paths = clip_outputs(Path(out), rec.clip)
     if figures:
-        from perception.report.chart import render_png
-        from perception.report.figures import confidence_chart, paths_chart
+        from perception.report.figures import confidence_figure, paths_figure
 
-        write_bytes(paths["confidence_png"], render_png(confidence_chart(rec)))
-        write_bytes(paths["paths_png"], render_png(paths_chart(rec)))
+        save_figure(paths["confidence_png"], confidence_figure(rec))
+        save_figure(paths["paths_png"], paths_figure(rec))
     else:
         remove_output(paths["confidence_png"])
         remove_output(paths["paths_png"])

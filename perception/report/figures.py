@@ -1,17 +1,23 @@
-"""Report figures (thesis chapter 5), each built as a chart and drawn by Pillow or matplotlib.
+"""Report figures (thesis chapter 5) as matplotlib ``Figure`` s, built on request.
 
-Per clip: every model's confidence and log-likelihood (:func:`confidence_chart`)
-and the demonstration against the reference grasp model's own movement
-(:func:`paths_chart`, Figs. 5.5-5.7). Per batch: grip aperture per condition
-against the model's (:func:`aperture_chart`, Fig. 5.4d), the reference
-model's confidence on one clip per condition (:func:`confidence_single_chart`,
-Fig. 5.8a) and on every clip (:func:`confidence_all_chart`, Fig. 5.8b), and
-mean ± SD per condition at select points (:func:`condition_chart`, Fig. 5.8c).
-Each is a :class:`~perception.report.chart.Chart`: the reports draw them with
-Pillow in milliseconds (:func:`~perception.report.chart.render_png`), and each
-``*_figure`` function (:func:`confidence_figure`, :func:`aperture_figure`, …)
-gives the same figure in matplotlib. Confidence is drawn in cm (weighted),
-×100 of its value in the files.
+Per clip: every model's confidence and log-likelihood
+(:func:`confidence_figure`, also :meth:`Recognition.plot()
+<perception.recognition.result.Recognition.plot>`) and the demonstration
+against the reference grasp model's own movement (:func:`paths_figure`,
+Figs. 5.5-5.7). Per batch: grip aperture per condition against the model's
+(:func:`aperture_figure`, Fig. 5.4d), the reference model's confidence on one
+clip per condition (:func:`confidence_single_figure`, Fig. 5.8a) and on
+every clip (:func:`confidence_all_figure`, Fig. 5.8b), and mean ± SD per
+condition at select points (:func:`condition_figure`, Fig. 5.8c).
+
+Each is a :class:`matplotlib.figure.Figure` on an Agg canvas, never through
+pyplot (no global figure registry; safe in worker processes); save one with
+:func:`perception.io.atomic.save_figure`. matplotlib is imported when the
+first figure is drawn, not with this module: it costs about 0.4 s, which
+``import perception`` and ``recognize --no-figures`` do not pay. Texts from
+the outside world (clip, model and condition names) are drawn as they are: a
+``$`` is a dollar, not mathtext, and undecodable bytes show as ``\\xNN``.
+Confidence is drawn in cm (weighted), ×100 of its value in the files.
 """
 
 from __future__ import annotations
@@ -21,19 +27,18 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from perception.recognition.result import Recognition
-from perception.report.chart import Band, Chart, ErrorBars, Legend, Line, Panel, to_matplotlib
+from perception.io.names import printable
 
 if TYPE_CHECKING:
     import pandas as pd
+    from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
+    from perception.recognition.result import Recognition
     from perception.report.clip import ClipSummary
 
-__all__ = ["aperture_chart", "aperture_figure", "condition_chart", "condition_colour",
-           "condition_figure", "confidence_all_chart", "confidence_all_figure",
-           "confidence_chart", "confidence_figure", "confidence_single_chart",
-           "confidence_single_figure", "paths_chart", "paths_figure"]
+__all__ = ["aperture_figure", "condition_colour", "condition_figure", "confidence_all_figure",
+           "confidence_figure", "confidence_single_figure", "paths_figure"]
 
 
 CM = 100.0
@@ -41,6 +46,12 @@ CM = 100.0
 CONDITION_COLOURS = {"normal": "C0", "delayed": "C1", "open-close-open": "C3", "reach": "C2",
                      "unlabelled": "0.4"}
 _SPARE = ("C4", "C5", "C6", "C7", "C8", "C9")
+#: Legend font size, points.
+LEGEND_PT = 9.0
+TIME = "time since onset (s)"
+MOVEMENT_TIME = "movement time (%)"
+#: Error bars of Fig. 5.8c: at this many evenly spaced phases.
+SD_POINTS = 11
 
 
 def condition_colour(condition: str, seen: Sequence[str] = ()) -> str:
@@ -60,6 +71,64 @@ def condition_colour(condition: str, seen: Sequence[str] = ()) -> str:
     return _SPARE[i % len(_SPARE)]
 
 
+# -- the canvas ---------------------------------------------------------------------
+#: Margins around the panels, inches: left of the first (tick labels and the y
+#: label), between two (the next one's), right, below (x ticks and label) and
+#: above (a panel's title; with the figure's title).
+LEFT, GAP, RIGHT, BOTTOM, TOP, TOP_TITLED = 0.85, 0.85, 0.2, 0.55, 0.35, 0.7
+#: Height of one row of a legend below the panels (9 pt text and its spacing), inches.
+LEGEND_ROW = 0.21
+
+
+def _figure(size: tuple[float, float], panels: int = 1, *, titled: bool = False,
+            legend_rows: int = 0) -> tuple[Figure, np.ndarray]:
+    """A figure on an Agg canvas with ``panels`` axes side by side.
+
+    The margins are fixed (:data:`LEFT`, ...) rather than found by
+    matplotlib's constrained layout, which measures every text once more
+    before drawing: a third of a figure's drawing time, 0.1 s a figure. A
+    titled figure leaves room for its title; ``legend_rows`` rows of a legend
+    below the panels (its title one of them) get room there.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    width, height = size
+    fig = Figure(figsize=size)
+    FigureCanvasAgg(fig)
+    panel = (width - LEFT - RIGHT - GAP * (panels - 1)) / panels
+    bottom = BOTTOM + (legend_rows * LEGEND_ROW + 0.1 if legend_rows else 0.0)
+    axes = fig.subplots(1, panels, squeeze=False, gridspec_kw=dict(
+        left=LEFT / width, right=1 - RIGHT / width, wspace=GAP / panel,
+        bottom=bottom / height, top=1 - (TOP_TITLED if titled else TOP) / height))
+    return fig, axes[0]
+
+
+def _panel(ax: Axes, title: str, xlabel: str, ylabel: str, *, zero: bool = False) -> None:
+    if zero:  # under the lines, over any band
+        ax.axhline(0.0, color="0.7", lw=0.6, zorder=1.5)
+    # names hold "$" (text, not mathtext) and undecodable bytes (escaped)
+    ax.set_title(printable(title), parse_math=False)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(printable(ylabel), parse_math=False)
+
+
+def _legend(where: Axes | Figure, handles: list, loc: str = "best", **kwargs) -> None:
+    """A legend of ``handles`` (lines), each labelled with its label as text.
+
+    The lines are named rather than found by their labels: matplotlib leaves
+    out a label starting with ``_``, and a clip's name may.
+    """
+    legend = where.legend(handles=handles, labels=[printable(h.get_label()) for h in handles],
+                          loc=loc, fontsize=LEGEND_PT, title_fontsize=LEGEND_PT, **kwargs)
+    for text in (*legend.get_texts(), legend.get_title()):
+        text.set_parse_math(False)
+
+
+def _title(fig: Figure, title: str) -> None:
+    fig.suptitle(printable(title), parse_math=False)
+
+
 def _verdict_line(rec: Recognition) -> str:
     d = rec.decision
     if d.verdict is None:
@@ -68,47 +137,40 @@ def _verdict_line(rec: Recognition) -> str:
             f"winner {rec.winner} ({rec.rule} rule)")
 
 
-TIME = "time since onset (s)"
-
-
-def confidence_chart(rec: Recognition) -> Chart:
+# -- one clip ---------------------------------------------------------------------
+def confidence_figure(rec: Recognition) -> Figure:
     """Confidence profiles of every model (thesis rule) and the log-likelihood.
 
+    Left, the thesis rule's confidence C; right, the cumulative
+    log-likelihood; a line per model in both (grasp models solid, reach
+    dashed, the winner thick) and one legend below them.
+
     Parameters
     ----------
     rec : Recognition
         A scored clip.
     """
+    columns = min(len(rec.names), 5)
+    fig, (conf, ll) = _figure((12, 5), 2, titled=True,
+                              legend_rows=1 - (-len(rec.names) // columns))
     styles = {"grasp": "-", "reach": "--"}
-    conf, ll = [], []
+    handles = []
     for k, (name, kind, c, l) in enumerate(zip(rec.names, rec.kinds, rec.confidence,
                                                rec.log_likelihood)):
-        look = dict(colour=f"C{k % 10}", width=2.6 if name == rec.winner else 1.2,
-                    style=styles.get(kind, "-"), label=name)
-        conf.append(Line(rec.time, c * CM, **look))
-        ll.append(Line(rec.time, l, **look))
-    return Chart(
-        (Panel("thesis rule: confidence C (eqs. 5.6-5.8)", TIME, "C (cm, weighted)",
-               tuple(conf), hlines=(0.0,)),
-         Panel("likelihood rule: cumulative log-likelihood", TIME, "log-likelihood",
-               tuple(ll), hlines=(0.0,))),
-        title=f"{rec.clip}: {_verdict_line(rec)}", size=(12, 5),
-        legend=Legend(columns=min(len(rec.names), 5),
-                      title="grasp models solid, reach dashed; the winner thick"))
+        look = dict(color=f"C{k % 10}", lw=2.6 if name == rec.winner else 1.2,
+                    ls=styles.get(kind, "-"), label=name)
+        handles += conf.plot(rec.time, c * CM, **look)
+        ll.plot(rec.time, l, **look)
+    _panel(conf, "thesis rule: confidence C (eqs. 5.6-5.8)", TIME, "C (cm, weighted)",
+           zero=True)
+    _panel(ll, "likelihood rule: cumulative log-likelihood", TIME, "log-likelihood", zero=True)
+    _legend(fig, handles, "lower center", ncols=columns,
+            title="grasp models solid, reach dashed; the winner thick", frameon=False)
+    _title(fig, f"{rec.clip}: {_verdict_line(rec)}")
+    return fig
 
 
-def confidence_figure(rec: Recognition) -> Figure:
-    """:func:`confidence_chart` as a matplotlib figure.
-
-    Parameters
-    ----------
-    rec : Recognition
-        A scored clip.
-    """
-    return to_matplotlib(confidence_chart(rec))
-
-
-def paths_chart(rec: Recognition, model: str | None = None) -> Chart:
+def paths_figure(rec: Recognition, model: str | None = None) -> Figure:
     """The demonstration against a grasp model's own movement (thesis Figs. 5.5-5.7).
 
     Left, the observed wrist, finger and thumb paths and the model's own
@@ -126,51 +188,36 @@ def paths_chart(rec: Recognition, model: str | None = None) -> Chart:
     model = model or rec.reference_model or rec.winner
     i = rec.names.index(model)
     obs, own = rec.observation, rec.nominal(model)
-    paths = []
+    fig, (paths, grip) = _figure((12, 5.5), 2, titled=True)
     for key, colour in (("finger", "g"), ("thumb", "r"), ("wrist", "b")):
         seen, plan = getattr(obs, key), own[key]
-        paths.append(Line(seen[:, 0], seen[:, 1], colour, 1.8, "-", f"{key} observed"))
-        paths.append(Line(plan[:, 0], plan[:, 1], colour, 1.5, "--", f"{key}, {model}"))
+        paths.plot(seen[:, 0], seen[:, 1], "-", color=colour, lw=1.8, label=f"{key} observed")
+        paths.plot(plan[:, 0], plan[:, 1], "--", color=colour, lw=1.5, label=f"{key}, {model}")
     circle = np.linspace(0, 2 * np.pi, 100)
     rad = obs.object_diameter / 2
-    paths.append(Line(rad * np.cos(circle), rad * np.sin(circle), "y", 2.0, "-", "object"))
+    paths.plot(rad * np.cos(circle), rad * np.sin(circle), "-", color="y", lw=2.0,
+               label="object")
+    paths.set_aspect("equal", adjustable="datalim")
+    _panel(paths, f"paths: observed (solid) and {model}'s own movement (dashed)", "x (m)",
+           "y (m), toward the object")
+    _legend(paths, paths.get_lines(), ncols=2)
     own_g = np.linalg.norm(own["finger"] - own["thumb"], axis=1)
-    aperture = (Line(rec.time, obs.g * CM, "k", 2.0, "-", "observed"),
-                Line(rec.time, own_g * CM, "k", 1.5, "--", f"{model}'s own movement"),
-                Line(rec.time, rec.predicted_g[i] * CM, "0.45", 1.2, ":",
-                     f"{model}, one step ahead"))
-    return Chart(
-        (Panel(f"paths: observed (solid) and {model}'s own movement (dashed)", "x (m)",
-               "y (m), toward the object", tuple(paths), equal_aspect=True,
-               legend=Legend("best", columns=2)),
-         Panel("grip aperture", TIME, "grip aperture (cm)", aperture,
-               legend=Legend("best"))),
-        title=f"{rec.clip}: {_verdict_line(rec)}", size=(12, 5.5))
+    grip.plot(rec.time, obs.g * CM, "-", color="k", lw=2.0, label="observed")
+    grip.plot(rec.time, own_g * CM, "--", color="k", lw=1.5, label=f"{model}'s own movement")
+    grip.plot(rec.time, rec.predicted_g[i] * CM, ":", color="0.45", lw=1.2,
+              label=f"{model}, one step ahead")
+    _panel(grip, "grip aperture", TIME, "grip aperture (cm)")
+    _legend(grip, grip.get_lines())
+    _title(fig, f"{rec.clip}: {_verdict_line(rec)}")
+    return fig
 
 
-def paths_figure(rec: Recognition, model: str | None = None) -> Figure:
-    """:func:`paths_chart` as a matplotlib figure.
-
-    Parameters
-    ----------
-    rec : Recognition
-        A scored clip.
-    model : str, optional
-        Model drawn (default: the reference grasp model).
-    """
-    return to_matplotlib(paths_chart(rec, model))
-
-
-MOVEMENT_TIME = "movement time (%)"
-#: Error bars of Fig. 5.8c: at this many evenly spaced phases.
-SD_POINTS = 11
-
-
+# -- a batch ----------------------------------------------------------------------
 def _n_label(cond: str, g: pd.DataFrame) -> str:
     return f"{cond} (n={int(g['n'].iloc[0])})"
 
 
-def condition_chart(profiles: pd.DataFrame, model: str) -> Chart:
+def condition_figure(profiles: pd.DataFrame, model: str) -> Figure:
     """Mean ± SD confidence per condition at select points (thesis Fig. 5.8c).
 
     The total confidence, and its transport and grip terms when
@@ -189,38 +236,26 @@ def condition_chart(profiles: pd.DataFrame, model: str) -> Chart:
     if "transport_mean" in profiles.columns:
         parts += [("transport_", "transport term"), ("grip_", "grip term")]
     conds = list(dict.fromkeys(profiles["condition"]))
-    panels = []
-    for k, (prefix, title) in enumerate(parts):
-        lines, bars = [], []
+    fig, axes = _figure((5.2 * len(parts), 4.8), len(parts), titled=True)
+    for ax, (prefix, title) in zip(axes, parts):
+        means = []
         for cond, g in profiles.groupby("condition", sort=False):
             colour = condition_colour(cond, conds)
             x = g["phase"].to_numpy() * 100
             mean, sd = g[f"{prefix}mean"].to_numpy() * CM, g[f"{prefix}sd"].to_numpy() * CM
-            lines.append(Line(x, mean, colour, 1.8, label=_n_label(cond, g)))
+            means += ax.plot(x, mean, color=colour, lw=1.8, label=_n_label(cond, g))
             at = np.unique(np.round(np.linspace(0, len(g) - 1, SD_POINTS)).astype(int))
-            bars.append(ErrorBars(x[at], mean[at], sd[at], colour, 1.0, 3.0))
-        panels.append(Panel(f"{title}: mean ± SD", MOVEMENT_TIME, f"{title} (cm, weighted)",
-                            tuple(lines), hlines=(0.0,), errorbars=tuple(bars),
-                            legend=Legend("best") if k == 0 else None))
-    return Chart(tuple(panels), title=f"{model}'s confidence by condition (Fig. 5.8c)",
-                 size=(5.2 * len(parts), 4.8))
+            ax.errorbar(x[at], mean[at], yerr=sd[at], fmt="none", ecolor=colour, elinewidth=1.0,
+                        capsize=3.0, capthick=1.0)
+        _panel(ax, f"{title}: mean ± SD", MOVEMENT_TIME, f"{title} (cm, weighted)", zero=True)
+        if ax is axes[0]:
+            _legend(ax, means)
+    _title(fig, f"{model}'s confidence by condition (Fig. 5.8c)")
+    return fig
 
 
-def condition_figure(profiles: pd.DataFrame, model: str) -> Figure:
-    """:func:`condition_chart` as a matplotlib figure (thesis Fig. 5.8c).
-
-    Parameters
-    ----------
-    profiles : pandas.DataFrame
-        From :func:`~perception.report.conditions.condition_profiles`.
-    model : str
-        The model profiled (for the title).
-    """
-    return to_matplotlib(condition_chart(profiles, model))
-
-
-def aperture_chart(profiles: pd.DataFrame, model: pd.DataFrame | None = None,
-                   model_name: str = "") -> Chart:
+def aperture_figure(profiles: pd.DataFrame, model: pd.DataFrame | None = None,
+                    model_name: str = "") -> Figure:
     """Grip aperture per condition, mean ± SD, against the model's (thesis Fig. 5.4d).
 
     A mean curve per condition over a band of ± 1 SD; the model's own
@@ -241,40 +276,33 @@ def aperture_chart(profiles: pd.DataFrame, model: pd.DataFrame | None = None,
               for cond, g in profiles.groupby("condition", sort=False)]
     if model is not None and len(model):
         curves.append((model, "k", 0.12, "--", f"model {model_name}"))
-    lines, bands = [], []
+    fig, (ax,) = _figure((7.5, 5))
     for g, colour, alpha, style, label in curves:
-        x, mean, sd = (g[c].to_numpy(dtype=float) for c in ("phase", "mean", "sd"))
-        lines.append(Line(x * 100, mean * CM, colour, 1.8, style, label))
-        bands.append(Band(x * 100, (mean - sd) * CM, (mean + sd) * CM, colour, alpha))
-    return Chart((Panel("grip aperture, mean ± SD (Fig. 5.4d)", MOVEMENT_TIME,
-                        "grip aperture (cm)", tuple(lines), bands=tuple(bands),
-                        legend=Legend("best")),), size=(7.5, 5))
+        x, mean, sd = (g[c].to_numpy(dtype=float) * 100 for c in ("phase", "mean", "sd"))
+        ax.fill_between(x, mean - sd, mean + sd, color=colour, alpha=alpha, lw=0)
+        ax.plot(x, mean, style, color=colour, lw=1.8, label=label)
+    _panel(ax, "grip aperture, mean ± SD (Fig. 5.4d)", MOVEMENT_TIME, "grip aperture (cm)")
+    _legend(ax, ax.get_lines())
+    return fig
 
 
-def aperture_figure(profiles: pd.DataFrame, model: pd.DataFrame | None = None,
-                    model_name: str = "") -> Figure:
-    """:func:`aperture_chart` as a matplotlib figure (thesis Fig. 5.4d).
-
-    Parameters
-    ----------
-    profiles : pandas.DataFrame
-        From :func:`~perception.report.conditions.aperture_profiles`
-        (condition, phase, mean, sd, n; m).
-    model : pandas.DataFrame, optional
-        The model's own aperture (phase, mean, sd; m), drawn dashed.
-    model_name : str
-        The model's name, for the legend.
-    """
-    return to_matplotlib(aperture_chart(profiles, model, model_name))
+def _confidence_panel(model: str, title: str,
+                      lines: Sequence[tuple[ClipSummary, str, float, str | None]]) -> Figure:
+    """One panel of ``model``'s confidence: a line per (clip, colour, width, label)."""
+    fig, (ax,) = _figure((7.5, 5))
+    labelled = []
+    for rec, colour, width, label in lines:
+        (line,) = ax.plot(rec.time, rec.confidence[rec.index(model)] * CM, color=colour,
+                          lw=width, label=label)
+        if label is not None:
+            labelled.append(line)
+    _panel(ax, title, TIME, f"C of {model} (cm, weighted)", zero=True)
+    _legend(ax, labelled)
+    return fig
 
 
-def _confidence_panel(model: str, title: str, lines: list[Line]) -> Chart:
-    return Chart((Panel(title, TIME, f"C of {model} (cm, weighted)", tuple(lines),
-                        hlines=(0.0,), legend=Legend("best")),), size=(7.5, 5))
-
-
-def confidence_single_chart(clips: Sequence[ClipSummary], conditions: Sequence[str],
-                            model: str) -> Chart:
+def confidence_single_figure(clips: Sequence[ClipSummary], conditions: Sequence[str],
+                             model: str) -> Figure:
     """The model's confidence on one clip per condition (thesis Fig. 5.8a).
 
     Parameters
@@ -287,29 +315,12 @@ def confidence_single_chart(clips: Sequence[ClipSummary], conditions: Sequence[s
         The model whose confidence is drawn.
     """
     return _confidence_panel(model, "one clip per condition (Fig. 5.8a)", [
-        Line(rec.time, rec.confidence[rec.index(model)] * CM,
-             condition_colour(cond, conditions), 1.8, label=f"{cond}: {rec.clip}")
+        (rec, condition_colour(cond, conditions), 1.8, f"{cond}: {rec.clip}")
         for rec, cond in zip(clips, conditions)])
 
 
-def confidence_single_figure(clips: Sequence[ClipSummary], conditions: Sequence[str],
-                             model: str) -> Figure:
-    """:func:`confidence_single_chart` as a matplotlib figure (thesis Fig. 5.8a).
-
-    Parameters
-    ----------
-    clips : sequence of ClipSummary
-        One clip per condition.
-    conditions : sequence of str
-        Their conditions.
-    model : str
-        The model whose confidence is drawn.
-    """
-    return to_matplotlib(confidence_single_chart(clips, conditions, model))
-
-
-def confidence_all_chart(clips: Sequence[ClipSummary], conditions: Sequence[str],
-                         model: str) -> Chart:
+def confidence_all_figure(clips: Sequence[ClipSummary], conditions: Sequence[str],
+                          model: str) -> Figure:
     """The model's confidence on every clip, coloured by condition (thesis Fig. 5.8b).
 
     One thin line a clip, in the clips' order; the legend names each
@@ -326,24 +337,7 @@ def confidence_all_chart(clips: Sequence[ClipSummary], conditions: Sequence[str]
     """
     lines, labelled = [], set()
     for rec, cond in zip(clips, conditions):
-        lines.append(Line(rec.time, rec.confidence[rec.index(model)] * CM,
-                          condition_colour(cond, conditions), 1.0,
-                          label=None if cond in labelled else cond))
+        lines.append((rec, condition_colour(cond, conditions), 1.0,
+                      None if cond in labelled else cond))
         labelled.add(cond)
     return _confidence_panel(model, f"every clip ({len(clips)}; Fig. 5.8b)", lines)
-
-
-def confidence_all_figure(clips: Sequence[ClipSummary], conditions: Sequence[str],
-                          model: str) -> Figure:
-    """:func:`confidence_all_chart` as a matplotlib figure (thesis Fig. 5.8b).
-
-    Parameters
-    ----------
-    clips : sequence of ClipSummary
-        Scored clips.
-    conditions : sequence of str
-        Their conditions.
-    model : str
-        The model whose confidence is drawn.
-    """
-    return to_matplotlib(confidence_all_chart(clips, conditions, model))

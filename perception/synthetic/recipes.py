@@ -266,9 +266,9 @@ def synthesize(recipe: Recipe, out: str | os.PathLike, *, seed: int = 0,
     progress : bool
         Show a progress bar.
     jobs : int
-        Processes rendering clips (this one and ``jobs - 1`` spawned workers,
-        one BLAS/OpenCV thread each). Each clip comes from its own stream, so
-        the clips do not depend on ``jobs``.
+        Worker processes rendering clips, one OpenCV thread each (1: in this
+        process). Each clip comes from its own stream, so the clips do not
+        depend on ``jobs``.
 
     Returns
     -------
@@ -318,12 +318,12 @@ class _Render:
 
 
 def _render_all(work: list, jobs: int, bar) -> list[dict]:
-    """:func:`_render_one` of every item, in this process and ``jobs - 1`` spawned workers
-    (one BLAS/OpenCV thread each)."""
-    from perception.workers import run_shared
+    """:func:`_render_one` of every item, here (``jobs`` 1) or in ``jobs`` worker
+    processes (one OpenCV thread each)."""
+    from perception.workers import run_pool
 
     rows: list[dict | None] = [None] * len(work)
-    for i, row in run_shared(list(enumerate(work)), _Render(), jobs):
+    for i, row in run_pool(enumerate(work), _Render(), jobs):
         rows[i] = row
         bar.update()
     return rows
