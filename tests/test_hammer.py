@@ -197,3 +197,71 @@ def test_independent_open_close_open_falls_after_its_closing_then_recovers(indep
     bottom = mean[top: low + 26].min()
     assert bottom < mean[top] * 0.97  # falls by more than 3 %
     assert mean[-1] > bottom  # and recovers
+
+
+# -- the two readings of the thesis rule's sign (issue 25) ---------------------------------
+def test_thesis_sign_readings_on_known_steps():
+    from perception.recognition.scoring import thesis_rule
+
+    # observed: the hand approaches (r falls) and the digits close (g falls)
+    r_obs, g_obs = np.array([0.30, 0.29]), np.array([0.06, 0.05])
+    valid, grasp = np.ones((1, 2), bool), np.array([True])
+
+    def both(r_next, g_next):
+        # predictions are taken from the observed state at n-1 (0.30, 0.06)
+        args = (r_obs, g_obs, np.array([[np.nan, r_next]]), np.array([[np.nan, g_next]]),
+                grasp, valid, 1.0, 2.0)
+        text = [x[0, 1] for x in thesis_rule(*args)]
+        printed = [x[0, 1] for x in thesis_rule(*args, sign="printed")]
+        return text, printed
+
+    # the prediction recedes (+0.02) and opens (+0.01): the text lowers confidence for
+    # both; printed, the observed approach (positive, line 1070) raises it and the
+    # observed closing lowers it, whatever was predicted
+    text, printed = both(0.32, 0.07)
+    assert text == pytest.approx([-0.02, -0.02]) and printed == pytest.approx([0.02, -0.02])
+    # the prediction approaches (-0.02) and closes (-0.01), as observed: the text raises
+    # confidence for both; printed, the closing still lowers it
+    text, printed = both(0.28, 0.05)
+    assert text == pytest.approx([0.02, 0.02]) and printed == pytest.approx([0.02, -0.02])
+    with pytest.raises(ValueError, match="sign"):
+        thesis_rule(r_obs, g_obs, np.zeros((1, 2)), np.zeros((1, 2)), grasp, valid, 1.0, 2.0,
+                    sign="both")
+
+
+def test_thesis_sign_is_a_setting_that_keys_reports():
+    from dataclasses import replace
+
+    assert HammerParams().thesis_sign == "text"  # today's behaviour stays the default
+    with pytest.raises(ValueError, match="thesis_sign"):
+        HammerParams(thesis_sign="signed")
+    text = RecognitionSettings()
+    printed = replace(text, hammer=HammerParams(thesis_sign="printed"))
+    assert text.fingerprint() != printed.fingerprint()
+    assert printed.fingerprint()["hammer"]["thesis_sign"] == "printed"
+
+
+def test_thesis_sign_flag_reaches_the_engine_settings():
+    from hammer_mv.cli import build_parser
+    from hammer_mv.cli.options import recognition_settings
+    from hammer_mv.cli.recognize import with_thesis_sign
+
+    for command in ("recognize", "batch"):
+        args = build_parser().parse_args([command, "x.mp4", "-o", "out",
+                                          "--thesis-sign", "printed"])
+        assert with_thesis_sign(recognition_settings(args), args).hammer.thesis_sign == "printed"
+        args = build_parser().parse_args([command, "x.mp4", "-o", "out"])
+        assert with_thesis_sign(recognition_settings(args), args).hammer.thesis_sign == "text"
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["recognize", "x.mp4", "-o", "out", "--thesis-sign", "x"])
+
+
+def test_printed_sign_changes_the_confidence_not_the_likelihood(rep):
+    tracks = demo_tracks("normal", 0)[0]
+    text = _score(tracks, rep)
+    printed = _score(tracks, rep, HammerParams(thesis_sign="printed"))
+    np.testing.assert_array_equal(text.log_likelihood, printed.log_likelihood)
+    assert not np.allclose(_conf(text), _conf(printed))
+    # printed: every observed closing lowers the grip term, so normal falls after its MGA
+    c = _conf(printed)
+    assert c.argmax() < len(c) - 1 and c[-1] < c.max()

@@ -12,7 +12,49 @@ TOOLS = Path(__file__).resolve().parents[1] / "tools"
 sys.path.insert(0, str(TOOLS))
 
 import reproduce_thesis  # noqa: E402
-from reproduce_common import claim, sensitivity  # noqa: E402
+from reproduce_common import (  # noqa: E402
+    CLAIM_KEYS,
+    claim,
+    quote_is_on_line,
+    sensitivity,
+    thesis_text,
+)
+
+
+def _row(cells) -> str:
+    return "| " + " | ".join(cells) + " |"
+
+
+#: The chapter modules whose citation tables are checked against the thesis text.
+CITING = ("reproduce_ch2", "reproduce_ch3", "reproduce_appendix_a", "reproduce_ch4",
+          "reproduce_ch5")
+
+
+def test_every_cited_line_holds_the_quoted_words():
+    # the tools find the thesis text as reproduce_common.thesis_text does: users may not
+    # have it, so the check is skipped, saying why
+    lines = thesis_text()
+    if lines is None:
+        pytest.skip("thesis text not found ($HAMMER_MV_THESIS or shared/seed/"
+                    "minimum-variance-thesis.txt in or beside the checkout)")
+    import importlib
+
+    checked = 0
+    for name in CITING:
+        for prefix, entry in importlib.import_module(name).CITES.items():
+            line, quote = entry[:2]
+            if line is None:  # our own check, not a thesis claim
+                continue
+            assert quote_is_on_line(lines, line, quote), (name, prefix, line, quote)
+            checked += 1
+    import reproduce_ch4
+
+    for c in reproduce_ch4._inconsistencies():
+        assert quote_is_on_line(lines, c["line"], c["quote"]), c["claim"]
+    assert checked >= 60
+    # and a wrong line is caught: the Fig. 4.8 claims are on 875/877, 880 is blank
+    assert not quote_is_on_line(lines, 880, "grip size increases and occurs *earlier*")
+    assert quote_is_on_line(lines, 877, "grip size increases and occurs *earlier*")
 
 FIGURES = [
     "fig2_5_minimum_jerk", "fig2_6_derivative_order", "fig2_7_angle_jerk_joints",
@@ -36,26 +78,30 @@ def test_quick_run_writes_every_figure_and_the_claims_table(tmp_path, capsys):
     assert len(sweep) == 8 and sweep["sd_total"].iloc[0] > sweep["sd_total"].iloc[-1]
 
     md = (tmp_path / "numbers.md").read_text()
-    header = "| claim | thesis location | measure | thesis value | ours | verdict | why |"
+    header = _row(reproduce_thesis.TABLE_HEADINGS)
     body, inside = [], False
-    for line in md.splitlines():  # the rows of each chapter's claims table
+    for line in md.splitlines():  # the rows of each chapter's thesis-claims table
         inside = line == header or (inside and line.startswith("|"))
         if inside and line != header and not line.startswith("|---"):
             body.append(line)
     assert len(body) >= 20
-    assert all(len(re.split(r"(?<!\\)\|", r)) == 9 for r in body)  # seven cells each
-    assert "## Chapter 3" in md and "## Appendix A" in md
+    assert all(len(re.split(r"(?<!\\)\|", r)) == 11 for r in body)  # nine cells each
+    assert "## Chapter 3" in md and "## Appendix A" in md and "## Settings" in md
     assert "#### Sensitivity: the length unit of eq. A.1" in md
     assert "skipped (--skip-ch4)" in md
+    assert "thesis claims:" in md and "checks of our own" in md
     claims = pd.read_csv(tmp_path / "numbers.csv", keep_default_na=False)
-    assert len(claims) == len(body)
-    assert list(claims.columns) == ["chapter", "section", "claim", "location", "measure",
-                                    "thesis", "ours", "verdict", "agrees", "why"]
-    # every row carries a thesis location and a measure
+    assert list(claims.columns) == ["chapter", *CLAIM_KEYS]
+    thesis = claims[claims["kind"] == "thesis"]
+    assert len(thesis) == len(body)
+    # every row carries a thesis location and a measure; every thesis claim its line,
+    # its words, and its verdict at the thesis's settings
     assert (claims["location"].str.len() > 0).all() and (claims["measure"].str.len() > 0).all()
+    assert (thesis["line"].astype(str).str.len() > 0).all()
+    assert (thesis["quote"].str.len() > 0).all() and (thesis["at_thesis"].str.len() > 0).all()
     assert set(claims["verdict"]) <= set(reproduce_thesis.VERDICTS)
     human = claims[claims["claim"].str.contains("closest to minimum jerk")].iloc[0]
-    assert "15/8" in human["ours"] and human["verdict"] == "agree"
+    assert "15/8" in human["ours"] and human["verdict"] == "by construction"  # closed form
     assert "human" in human["thesis"]  # 1.875 is the thesis's human value
     # the 'a' reverses at 70 % because we put its via-point there
     assert (claims[claims["claim"].str.contains("reversal comes")]["verdict"]
@@ -63,6 +109,13 @@ def test_quick_run_writes_every_figure_and_the_claims_table(tmp_path, capsys):
     for needle in ("Fig. 3.2(b)", "Fig. 3.5", "Fig. 3.7", "Fig. 3.6(a,c)", "Fig. 3.8(b)",
                    "Fig. A.1(b)", "Fig. A.2", "Fig. 3.4(c)", "Fig. 3.4(a)", "line 481"):
         assert claims["location"].str.contains(needle, regex=False).any(), needle
+    # the thesis's cost weights: the reach ends short of its goal (line 552)
+    goal = claims[claims["claim"].str.startswith("The cost weights give")].iloc[0]
+    assert goal["verdict"] == "agree" and goal["at_thesis"].startswith("differs")
+    lines = thesis_text()
+    if lines is not None:
+        for _, c in thesis.iterrows():
+            assert quote_is_on_line(lines, int(c["line"]), c["quote"]), (c["line"], c["quote"])
     assert "15 figures" in capsys.readouterr().out
 
 
@@ -120,7 +173,7 @@ def test_numbers_markdown_escapes_cells_and_checks_keys():
     # a record of the original six keys still renders, as a row of the new table
     row = dict(section="A.1", claim="a | b", thesis="1", ours="2", agrees=False, note="n")
     md = reproduce_thesis.numbers_markdown([row], ["note line"], ["header"])
-    assert "| a \\| b | A.1 | not stated | 1 | 2 | **differs** | n |" in md
+    assert "| a \\| b | A.1 |  | not stated | 1 | 2 | **differs** |  | n |" in md
     assert "- note line" in md and "1 claims: 0 agree, 1 differ" in md
     with pytest.raises(ValueError, match="lacks"):
         reproduce_thesis.numbers_markdown([{"section": "x"}], [], [])
@@ -137,10 +190,15 @@ def test_claims_and_tables_are_grouped_by_chapter():
     ]
     md = reproduce_thesis.numbers_markdown(rows, [], ["header"])
     assert md.index("## Chapter 2") < md.index("| c1 |") < md.index("## Chapter 4")
-    assert "| c1 | Fig. 2.6(c); line 276 | m1 | t | o | agree |  |" in md
-    assert "| **thesis inconsistent** | both |" in md
+    assert "| c1 | Fig. 2.6(c); line 276 |  | m1 | t | o | agree |  |  |" in md
+    assert "| **thesis inconsistent** |  | both |" in md
     assert "#### Sensitivity: tip_start" in md and "| 6 cm | **no** |" in md
-    assert "2 claims: 1 agree, 0 differ, 0 by construction, 1 thesis inconsistent." in md
+    assert "1 claims: 1 agree, 0 differ, 0 by construction, 0 thesis inconsistent" in md
+    # our own checks are counted apart from the thesis's claims
+    own = dict(claim("5.3", "o1", "—", "o", True, kind="own", measure="m"), chapter="Chapter 4")
+    md = reproduce_thesis.numbers_markdown([*rows, own], [], ["header"])
+    assert "- 2 thesis claims: 1 agree" in md and "- 1 checks of our own" in md
+    assert "### Our own checks (Chapter 4" in md and "| o1 | 5.3 | m | o | agree |  |" in md
 
 
 def test_claim_record():
@@ -156,6 +214,11 @@ def test_claim_record():
         claim("x", "c", "t", "o")
     with pytest.raises(ValueError, match="cells"):
         sensitivity("p", "l", "n", ["a", "b"], [["1"]])
+    with pytest.raises(ValueError, match="kind"):
+        claim("x", "c", "t", "o", True, kind="mine")
+    q = claim("x", "c", "t", "o", True, line=552, quote="r = 0.002", at_thesis="differs: x")
+    assert (q["kind"], q["line"], q["quote"], q["at_thesis"]) == ("thesis", 552, "r = 0.002",
+                                                                 "differs: x")
 
 
 def test_chapters_in_two_processes_give_the_same_records(tmp_path):

@@ -48,7 +48,9 @@ def test_digit_distance_is_lowest_with_the_viapoints_level():
 def test_mga_comes_at_60_to_80_percent_for_every_object_size():
     # thesis line 905, Fig. 4.10(b): sizes 0-8 cm
     times = [_mga_time(replace(GraspTask(), object_size=s)) for s in np.arange(9) * 0.01]
-    assert min(times) >= 0.60 - 1e-9 and max(times) <= 0.80
+    # holds only at its edge: the smallest object peaks at exactly 60 % (1 % steps), so
+    # any change that moves it earlier flips the verdict (numbers.md: conditional)
+    assert min(times) == pytest.approx(0.60, abs=1e-9) and max(times) <= 0.80
     assert np.all(np.diff(times) >= 0)  # and later for larger objects (line 903)
 
 
@@ -70,3 +72,23 @@ def test_with_the_tips_on_the_target_line_the_trends_fail():
     d = [_distance(replace(online, viapoint_height=h)) for h in (0.0, 0.005)]
     assert d[1] < d[0]  # lowest above level, not at it
     assert _mga_time(replace(online, object_size=0.0)) < 0.59
+
+
+def test_per_axis_sd_is_not_lowest_at_level():
+    # thesis line 790, Fig. 4.3(c,d) plots x and y apart: per axis ours is lowest off level
+    # (x at +0.5 cm, y at -0.5 cm); numbers.md's verdict 'differs' rests on this
+    heights = (-0.005, 0.0, 0.005)
+    cov = [_moments(replace(GraspTask(), viapoint_height=h)).finger_cov[-1] for h in heights]
+    sd_x, sd_y = (np.sqrt([c[i, i] for c in cov]) for i in (0, 1))
+    assert heights[int(np.argmin(sd_x))] == 0.005 and heights[int(np.argmin(sd_y))] == -0.005
+    total = np.sqrt(sd_x**2 + sd_y**2)
+    # the total is lowest at level, but by less than the 3.2 % standard error of an SD
+    # from the thesis's 500 repetitions
+    assert np.argmin(total) == 1 and total.max() / total.min() - 1 < 1 / np.sqrt(2 * 499)
+
+
+def test_sd_does_not_rise_below_70_percent():
+    # thesis line 834: "below approximately 70 % ... an increase"; ours falls from 70 to 60 %
+    sd = {f: np.sqrt(np.trace(_moments(replace(GraspTask(), viapoint_time=f)).finger_cov[-1]))
+          for f in (0.6, 0.7)}
+    assert sd[0.6] < sd[0.7]

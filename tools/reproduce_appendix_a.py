@@ -19,9 +19,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 from reproduce_common import (
+    THESIS_SETTINGS,
     Progress,
+    at_settings,
     borderline,
     ci95,
+    cite,
     claim,
     no_progress,
     rng_for,
@@ -208,16 +211,19 @@ def _fig_a2(out: Path, claims: list, trajs: list, comparison) -> None:
         "table gives the landmarks hit with eq. A.1 in cm and mm."))
 
 
-def _fig_a3(out: Path, claims: list, n: int, seed: int) -> None:
+def _fig_a3(out: Path | None, claims: list, n: int, seed: int, w: dict) -> None:
     rng = rng_for(seed, "figA_3")
     movement = letter_a(duration=A3_SLOW)
     faster = movement.retime(A3_FAST)
     smaller = movement.transform(scale=A3_SCALE)
-    results = [simulate_reach(m.to_task(), n, seed=rng) for m in (movement, faster, smaller)]
-    save(out, "figA_3_generalisation", generalisation_figure(*results))
-    _, p_slow = replay(movement)
-    _, p_fast = replay(faster)
-    _, p_small = replay(smaller)
+    results = [simulate_reach(m.to_task(**w), n, seed=rng) for m in (movement, faster, smaller)]
+    if out is not None:
+        save(out, "figA_3_generalisation", generalisation_figure(*results))
+    _, p_slow = replay(movement, **w)
+    _, p_fast = replay(faster, **w)
+    _, p_small = replay(smaller, **w)
+    scatter = float(np.median([path_distance(p, results[0].mean_position)
+                               for p in results[0].position]))
     s0 = np.asarray(movement.start)
     expected_small = A3_SCALE * (p_slow - s0) + s0
     shape = path_distance(p_slow, p_fast)
@@ -233,11 +239,14 @@ def _fig_a3(out: Path, claims: list, n: int, seed: int) -> None:
         claim("A.2", "Re-timed (eq. A.3) the 'a' keeps its basic shape",
               "shape retained, cruder when faster",
               f"{A3_SLOW * 1000:.0f} ms -> {A3_FAST * 1000:.0f} ms: expected paths at most "
-              f"{shape * 1000:.1f} mm apart (letter 10 cm high)", shape < 0.02,
+              f"{shape * 1000:.1f} mm apart (letter 10 cm high)", shape < 2 * scatter,
               location="Fig. A.3(a); lines 1358, 1364",
-              measure="Hausdorff distance between the expected paths; agree within 20 % of "
-              "the letter's height",
-              note="the faster movement cuts the bowl's corners." + borderline(shape, 0.02)),
+              measure="Hausdorff distance between the expected paths, against the repetition "
+              "noise: agree if below twice the median Hausdorff distance of a single "
+              f"repetition of the original from its mean path ({scatter * 1000:.1f} mm; the "
+              "thesis allows 'cruder', so twice what noise alone does)",
+              note="the faster movement cuts the bowl's corners. Our former 20 mm rule was "
+              "our own number." + borderline(shape, 2 * scatter)),
         claim("A.2",
               "Scaled by 1/2 (eqs. A.4-A.5) the 'a' is the same letter, half size",
               "same shape, half size",
@@ -282,5 +291,24 @@ def reproduce(
     progress("figA_2")
     _fig_a2(out, claims, trajs, comparison)
     progress("figA_3")
-    _fig_a3(out, claims, n, seed)
+    _fig_a3(out, claims, n, seed, {})
+    theirs: list[dict] = []
+    _fig_a3(None, theirs, n, seed, THESIS_SETTINGS)
+    at_settings(claims, theirs)
+    for c in claims:
+        c["at_thesis"] = c["at_thesis"] or "not computed (Figs. A.1-A.2 at our weights only)"
+    cite(claims, CITES)
     return claims + [_units_table(comparison, trajs, seed)]
+
+
+#: Claim prefix -> (thesis line, the thesis's words on it[, changes]).
+CITES = {
+    "Acceleration extrema capture": (1339, "maxima and minima of acceleration captures the "
+                                     "original trajectory well"),
+    "Curvature extrema give the best": (1339, "maxima and minima of curvature results in the "
+                                        "best replicated trajectory for the least number of "
+                                        "points"),
+    "Curvature via-points fall": (1351, "the start of the post-movement period"),
+    "Re-timed (eq. A.3)": (1364, "the basic same is retained"),
+    "Scaled by 1/2": (1364, "scaled by a factor of"),
+}

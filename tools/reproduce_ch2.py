@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from reproduce_common import Progress, claim, no_progress, rng_for, save
+from reproduce_common import Progress, cite, claim, no_progress, rng_for, save
 
 from minvar.analysis import count_speed_peaks, path_deviation, peak_to_mean_speed
 from minvar.baselines import (
@@ -189,4 +189,26 @@ def reproduce(
     arm = _fig2_7(out, claims, pairs)
     progress("fig2_8")
     _fig2_8(out, claims, pairs, arm)
+    cite(claims, CITES)
+    for c in claims:  # no cost weights enter chapter 2's models
+        c["at_thesis"] = f"{c['verdict']}: same (no cost weights in these models)"
     return claims
+
+
+_IDENTITY = {"verdict": "by construction", "why": "+By construction: a closed-form property of "
+             "the minimum-derivative model (nothing fitted), so it checks our implementation, "
+             "not a finding."}
+#: Claim prefix -> (thesis line, the thesis's words on it[, changes]).
+CITES = {
+    "Minimum jerk hand paths are straight": (
+        260, "fit the criterion for straight hand trajectories", _IDENTITY),
+    "Minimum jerk speed profiles": (260, "characteristic bell-shaped velocity profiles",
+                                    _IDENTITY),
+    "r, the peak/mean": (276, "the value of r increases with n", _IDENTITY),
+    "Humans (r": (276, "closest to minimum jerk trajectories", _IDENTITY),
+    "Minimum angle jerk: joint paths": (287, "leads to straight paths in joint space",
+                                        _IDENTITY),
+    "Minimum angle jerk: hand path": (294, "smooth and roughly straight, with a slight degree "
+                                      "of curvature"),
+    "Minimum angle jerk hand speed": (294, "the required bell-shape"),
+}

@@ -11,12 +11,21 @@ thesis leaves open that a verdict depends on, a table made by
 A claim is judged by the measure the thesis itself uses where it states one
 (or the one its figure shows), and the record says which: numbers.md prints
 the measure beside the verdict.
+
+Two kinds of row: ``thesis`` — a statement the thesis makes, with the line of
+``minimum-variance-thesis.txt`` it quotes and the quoted words (the tests check
+them against the text, found by :func:`thesis_text`), the verdict at our
+settings and ``at_thesis``, the verdict at the thesis's own (:data:`THESIS_SETTINGS`);
+``own`` — a check of the project's own (the verdict rule, the likelihood rule),
+counted apart.
 """
 
 from __future__ import annotations
 
+import os
+import re
 import zlib
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -30,14 +39,30 @@ from perception.io.atomic import save_figure, write_csv
 #: the thesis says two different things (both locations are cited).
 VERDICTS = ("agree", "differs", "by construction", "thesis inconsistent")
 
-#: Columns of numbers.md, in order (``why`` is a claim's ``note``).
-TABLE_KEYS = ("claim", "location", "measure", "thesis", "ours", "verdict", "why")
+#: Kinds of row: a statement of the thesis, or a check of the project's own.
+KINDS = ("thesis", "own")
+#: Columns of numbers.md's thesis-claim tables, in order (``why`` is a claim's ``note``).
+TABLE_KEYS = ("claim", "location", "quote", "measure", "thesis", "ours", "verdict",
+              "at_thesis", "why")
 #: Their headings in numbers.md.
-TABLE_HEADINGS = ("claim", "thesis location", "measure", "thesis value", "ours", "verdict",
-                  "why")
+TABLE_HEADINGS = ("claim", "thesis location (line)", "the thesis's words", "measure",
+                  "thesis value", "ours (our settings)", "verdict (our settings)",
+                  "at the thesis's settings", "why")
+#: Columns and headings of the tables of the project's own checks.
+OWN_KEYS = ("claim", "location", "measure", "ours", "verdict", "why")
+OWN_HEADINGS = ("check", "basis", "measure", "ours", "verdict", "why")
 #: Keys of a claim record (numbers.csv's columns, after ``chapter``).
-CLAIM_KEYS = ("section", "claim", "location", "measure", "thesis", "ours", "verdict",
-              "agrees", "why")
+CLAIM_KEYS = ("section", "kind", "claim", "line", "quote", "location", "measure", "thesis",
+              "ours", "verdict", "at_thesis", "agrees", "why")
+
+#: The thesis's cost weights (r: line 552; w_v, w_f: line 537). Ours are the
+#: defaults of :class:`minvar.task.ReachTask` and :class:`minvar.grasp.GraspTask`.
+THESIS_SETTINGS = {"r": 0.002, "w_v": 0.1, "w_f": 0.01}
+#: Where the thesis text is looked for, after ``$HAMMER_MV_THESIS``: a ``shared/seed``
+#: folder inside the checkout, then beside it.
+_ROOT = Path(__file__).resolve().parents[1]
+THESIS_CANDIDATES = tuple(base / "shared" / "seed" / "minimum-variance-thesis.txt"
+                          for base in (_ROOT, _ROOT.parent))
 
 Progress = Callable[[str], None]
 
@@ -53,6 +78,10 @@ def claim(
     location: str | None = None,
     measure: str = "",
     verdict: str | None = None,
+    kind: str = "thesis",
+    line: int | None = None,
+    quote: str = "",
+    at_thesis: str = "",
 ) -> dict:
     """One row of numbers.md: a statement of the thesis beside our value.
 
@@ -87,6 +116,15 @@ def claim(
         repetitions with a 95 % confidence interval, ...) and the rule.
     verdict : str, optional
         One of :data:`VERDICTS`; overrides ``agrees``.
+    kind : str
+        ``"thesis"`` (a statement of the thesis) or ``"own"`` (a check of ours).
+    line : int, optional
+        The line of the thesis text that ``quote`` is on.
+    quote : str
+        The thesis's words on ``line`` (checked by the tests).
+    at_thesis : str
+        The verdict, and our value, at the thesis's settings (:data:`THESIS_SETTINGS`,
+        or the other reading of eqs. 5.1/5.7 in chapter 5).
 
     Returns
     -------
@@ -105,9 +143,103 @@ def claim(
         verdict = "agree" if agrees else "differs"
     if verdict not in VERDICTS:
         raise ValueError(f"claim {claim!r}: verdict must be one of {VERDICTS}, got {verdict!r}")
-    values = (section, claim, location or section, measure, thesis, ours, verdict,
+    if kind not in KINDS:
+        raise ValueError(f"claim {claim!r}: kind must be one of {KINDS}, got {kind!r}")
+    values = (section, kind, claim, "" if line is None else int(line), quote,
+              location or section, measure, thesis, ours, verdict, at_thesis,
               verdict == "agree", note)
     return dict(zip(CLAIM_KEYS, values))
+
+
+def cite(claims: list[dict], table: Mapping[str, tuple]) -> list[dict]:
+    """Give each claim its thesis line and words from ``table``, by the claim's start.
+
+    Parameters
+    ----------
+    claims : list of dict
+        Claim records (changed in place and returned).
+    table : mapping
+        Claim text prefix -> ``(line, quote)`` or ``(line, quote, changes)``,
+        ``changes`` a dict of other keys to set (``verdict``, ``kind``, ``why``
+        appended with a leading ``+``). ``line`` None makes the row ``own``.
+
+    Returns
+    -------
+    list of dict
+    """
+    for c in claims:
+        for prefix, entry in table.items():
+            if not c["claim"].startswith(prefix):
+                continue
+            line, quote, changes = (*entry, {})[:3]
+            c["line"], c["quote"] = ("", "") if line is None else (int(line), quote)
+            if line is None:
+                c["kind"] = "own"
+            elif f"line {line}" not in c["location"] and f"{line}" not in c["location"]:
+                c["location"] = f"{c['location']}; line {line}"
+            for key, value in changes.items():
+                if key == "why" and value.startswith("+"):
+                    c["why"] = (c["why"] + " " + value[1:]).strip()
+                else:
+                    c[key] = value
+            c["agrees"] = c["verdict"] == "agree"
+            break
+    return claims
+
+
+def at_settings(ours: list[dict], theirs: list[dict], what: str = "") -> list[dict]:
+    """Fill each of ``ours``' ``at_thesis`` with the same claim's verdict and value in ``theirs``.
+
+    Parameters
+    ----------
+    ours : list of dict
+        Claims at our settings (changed in place and returned).
+    theirs : list of dict
+        The same claims computed at the thesis's settings (matched by ``claim``).
+    what : str
+        Prefix naming the settings (e.g. ``"r = 0.002, w_v = 0.1: "``).
+    """
+    by = {c["claim"]: c for c in theirs if not is_sensitivity(c)}
+    for c in ours:
+        if is_sensitivity(c) or c.get("at_thesis"):
+            continue
+        other = by.get(c["claim"])
+        if other is not None:
+            c["at_thesis"] = f"{what}{other['verdict']}: {other['ours']}"
+    return ours
+
+
+def thesis_text() -> list[str] | None:
+    """The thesis's lines (index 0 is line 1), or None where the text is not at hand.
+
+    Looked for at ``$HAMMER_MV_THESIS``, then :data:`THESIS_CANDIDATES`.
+    """
+    env = os.environ.get("HAMMER_MV_THESIS")
+    for path in ([Path(env)] if env else []) + list(THESIS_CANDIDATES):
+        if path.is_file():
+            return path.read_text(encoding="utf-8").splitlines()
+    return None
+
+
+def _plain(text: str) -> str:
+    return re.sub(r"\s+", " ", re.sub(r"[*_$]", "", text)).strip().lower()
+
+
+def quote_is_on_line(lines: list[str], line: int, quote: str) -> bool:
+    """Whether ``quote`` is on ``line`` (1-based) of the thesis ``lines``.
+
+    Case, runs of white space and markdown emphasis (``*``, ``_``, ``$``) are ignored.
+
+    Parameters
+    ----------
+    lines : list of str
+        From :func:`thesis_text`.
+    line : int
+        Line number, from 1.
+    quote : str
+        The words.
+    """
+    return 1 <= line <= len(lines) and bool(quote) and _plain(quote) in _plain(lines[line - 1])
 
 
 def as_claim(record: dict) -> dict:
@@ -126,10 +258,11 @@ def as_claim(record: dict) -> dict:
         If a required key is missing.
     """
     if "verdict" in record:
-        missing = [k for k in CLAIM_KEYS if k not in record]
+        defaults = {"kind": "thesis", "line": "", "quote": "", "at_thesis": ""}
+        missing = [k for k in CLAIM_KEYS if k not in record and k not in defaults]
         if missing:
             raise ValueError(f"claim {record!r} lacks {missing}")
-        return record
+        return {**defaults, **record}
     missing = [k for k in ("section", "claim", "thesis", "ours", "agrees") if k not in record]
     if missing:
         raise ValueError(f"claim {record!r} lacks {missing}")
@@ -226,13 +359,13 @@ def rng_for(seed: int, name: str) -> np.random.Generator:
     return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(key,)))
 
 
-def save(out: Path, name: str, fig=None, table=None) -> None:
+def save(out: Path | None, name: str, fig=None, table=None) -> None:
     """Write ``name``.png and/or ``name``.csv into ``out`` atomically.
 
     Parameters
     ----------
-    out : Path
-        Output folder.
+    out : Path or None
+        Output folder; None writes nothing (a run at other settings).
     name : str
         File stem, named after the thesis figure (``fig3_5_speed_accuracy``).
     fig : matplotlib.figure.Figure, optional
@@ -240,6 +373,8 @@ def save(out: Path, name: str, fig=None, table=None) -> None:
     table : pandas.DataFrame, optional
         Saved as CSV.
     """
+    if out is None:
+        return
     if fig is not None:
         save_figure(out / f"{name}.png", fig)
     if table is not None:
@@ -248,3 +383,42 @@ def save(out: Path, name: str, fig=None, table=None) -> None:
 
 def no_progress(_: str) -> None:
     """Progress callback that ignores the step name ``_``."""
+
+
+def settings_rows() -> list[list[str]]:
+    """numbers.md's settings table: each parameter, the thesis's value and line, ours.
+
+    Returns
+    -------
+    list of [parameter, thesis, ours, effect] rows (str).
+    """
+    from minvar.grasp import GraspTask
+    from minvar.task import ReachTask
+
+    reach, grasp = ReachTask((0.2, 0.2), (0.4, 0.5), 0.5), GraspTask()
+
+    def same(name):
+        return "same" if getattr(reach, name) == THESIS_SETTINGS[name] else "**differs**"
+
+    return [
+        ["r (effort weight)", "0.002 ('provided a good tradeoff between error and effort', "
+         "line 552)", f"{reach.r:g} ({same('r')})",
+         "chapters 3, 4 and A computed at both; chapter 5's models use ours"],
+        ["w_v (final velocity weight)", "0.1 (line 537)", f"{reach.w_v:g} ({same('w_v')})",
+         "as r"],
+        ["w_f (final force weight)", "0.01 (line 537)", f"{reach.w_f:g} ({same('w_f')})",
+         "as r"],
+        ["tip_start (closed digit tips ahead of the wrist)", "not given: 0 to 6 cm ('with "
+         "the digits touching', line 730; the targets 6 cm above the wrist target, line 724)",
+         f"{100 * grasp.tip_start:g} cm (chosen after the verdicts: not a thesis value)",
+         "rows that depend on it are reported as conditional, with the range over which "
+         "they hold (tip_start table)"],
+        ["wrist travel", "20 cm ('the distance to be moved', line 953)",
+         f"{100 * grasp.transport_distance:g} cm (same)", "transport distance table"],
+        ["w_r / w_g (thesis rule weights)", "1/2 (line 1125)", "1/2 (same)", ""],
+        ["sign of eqs. 5.1/5.7/5.8", "text: +1 if the changes agree, -1 if not (line 1070); "
+         "as printed: sgn(observed) x (predicted change)", "text (`--thesis-sign text`; "
+         "`printed` selectable)", "chapter 5 rows are scored under both readings"],
+        ["unstated geometry (Fig. 3.2 reach, the 'a' via-points and times, appendix A "
+         "trajectory)", "not given", "ours, stated in each row", "rows say so"],
+    ]

@@ -45,11 +45,14 @@ for _p in (ROOT, ROOT / "tools"):
 import pandas as pd  # noqa: E402
 from reproduce_common import (  # noqa: E402
     CLAIM_KEYS,
+    OWN_HEADINGS,
+    OWN_KEYS,
     TABLE_HEADINGS,
     TABLE_KEYS,
     VERDICTS,
     as_claim,
     is_sensitivity,
+    settings_rows,
 )
 from tqdm import tqdm  # noqa: E402
 
@@ -118,8 +121,48 @@ def _sensitivity_md(table: dict) -> list[str]:
     return lines + [""]
 
 
+def _table(rows: list[dict], keys, headings) -> list[str]:
+    lines = [_row(headings), "|" + "---|" * len(headings)]
+    for c in rows:
+        cells = [c[k] for k in keys]
+        cells[keys.index("measure")] = c["measure"] or "not stated"
+        if c["verdict"] != "agree":
+            cells[keys.index("verdict")] = f"**{c['verdict']}**"
+        lines.append(_row(cells))
+    return lines + [""]
+
+
+def at_thesis_verdict(text: str) -> str:
+    """The verdict word of an ``at_thesis`` cell (``conditional`` for tip_start-dependent rows).
+
+    Parameters
+    ----------
+    text : str
+        The cell, e.g. ``"printed: agree: ..."`` or ``"r = 0.002, w_v = 0.1: differs: ..."``.
+    """
+    text = str(text)
+    if text.startswith("conditional"):
+        return "conditional"
+    for prefix in ("printed: ", "r = 0.002, w_v = 0.1: "):
+        text = text[len(prefix):] if text.startswith(prefix) else text
+    return text.split(":")[0].strip() or "not computed"
+
+
+def at_thesis_counts(claims: list[dict]) -> str:
+    """``"20 agree, 9 differs, ..."``: the verdicts at the thesis's settings (first word).
+
+    Parameters
+    ----------
+    claims : list of dict
+        Thesis claims (current form).
+    """
+    words = [at_thesis_verdict(c.get("at_thesis", "")) for c in claims]
+    return ", ".join(f"{n} {w}" for w, n in pd.Series(words).value_counts().items())
+
+
 def numbers_markdown(records: list[dict], notes: list[str], header: list[str]) -> str:
-    """numbers.md: a header, run notes, and per chapter its claims and sensitivity tables.
+    """numbers.md: a header, the settings, and per chapter its thesis claims, our own
+    checks and sensitivity tables, then every verdict at both settings side by side.
 
     Parameters
     ----------
@@ -134,33 +177,60 @@ def numbers_markdown(records: list[dict], notes: list[str], header: list[str]) -
         Lines describing the run (options, timings).
     """
     claims = [as_claim(r) for r in records if not is_sensitivity(r)]
+    thesis = [c for c in claims if c["kind"] == "thesis"]
+    own = [c for c in claims if c["kind"] == "own"]
     lines = ["# Thesis claims beside ours", "", *header, ""]
     lines += [f"- {n}" for n in notes]
-    lines += [f"- {len(claims)} claims: {verdict_counts(claims)}.", ""]
+    lines += [f"- {len(thesis)} thesis claims: {verdict_counts(thesis)} (at our settings); "
+              f"at the thesis's settings: {at_thesis_counts(thesis)}.",
+              f"- {len(own)} checks of our own (not thesis claims): {verdict_counts(own)}.",
+              ""]
     lines += ["Verdicts: **agree** — ours supports the statement by the measure given; "
               "**differs** — it does not; **by construction** — it holds only because of "
               "how the model or the test was built; **thesis inconsistent** — the thesis "
-              "says two different things (both places are cited). Thesis locations give "
-              "the section, figure and line of the thesis text.", ""]
+              "says two different things (both places are cited). A thesis claim names the "
+              "line of the thesis text it quotes and the words; 'at the thesis's settings' "
+              "is the verdict (and our value) with the thesis's cost weights, or in chapter "
+              "5 under the other reading of eqs. 5.1/5.7; 'conditional' marks a verdict that "
+              "depends on geometry the thesis does not give, with the range where it holds.",
+              "", "## Settings: the thesis's and ours", ""]
+    lines += [_row(("parameter", "thesis", "ours", "effect on the rows")),
+              "|---|---|---|---|", *[_row(r) for r in settings_rows()], ""]
     chapters = list(dict.fromkeys(r.get("chapter", "Claims") for r in records))
     for chapter in chapters:
         mine = [r for r in records if r.get("chapter", "Claims") == chapter]
         rows = [as_claim(r) for r in mine if not is_sensitivity(r)]
         lines += [f"## {chapter}", ""]
-        if rows:
-            lines += [f"{len(rows)} claims: {verdict_counts(rows)}.", ""]
-            lines.append(_row(TABLE_HEADINGS))
-            lines.append("|" + "---|" * len(TABLE_HEADINGS))
-            for c in rows:
-                cells = [c[k] for k in TABLE_KEYS]
-                cells[TABLE_KEYS.index("measure")] = c["measure"] or "not stated"
-                if c["verdict"] != "agree":
-                    cells[TABLE_KEYS.index("verdict")] = f"**{c['verdict']}**"
-                lines.append(_row(cells))
-            lines.append("")
+        mine_thesis = [c for c in rows if c["kind"] == "thesis"]
+        mine_own = [c for c in rows if c["kind"] == "own"]
+        if mine_thesis:
+            lines += [f"### Thesis claims ({chapter})", "",
+                      f"{len(mine_thesis)} claims: {verdict_counts(mine_thesis)}; at the "
+                      f"thesis's settings: {at_thesis_counts(mine_thesis)}.", ""]
+            lines += _table(mine_thesis, TABLE_KEYS, TABLE_HEADINGS)
+        if mine_own:
+            lines += [f"### Our own checks ({chapter}; not thesis claims)", "",
+                      f"{len(mine_own)} checks: {verdict_counts(mine_own)}.", ""]
+            lines += _table(mine_own, OWN_KEYS, OWN_HEADINGS)
         for table in (r for r in mine if is_sensitivity(r)):
             lines += _sensitivity_md(table)
+    side = [(r.get("chapter", "Claims"), as_claim(r)) for r in records
+            if not is_sensitivity(r) and r.get("chapter") in SIDE_BY_SIDE]
+    side = [(ch, c) for ch, c in side if c["kind"] == "thesis"]
+    if side:
+        lines += ["## Verdicts at the thesis's settings and at ours (chapters 3-5)", "",
+                  "Chapters 3, 4 and A: the thesis's r = 0.002, w_v = 0.1, w_f = 0.01 against "
+                  "ours; chapter 5: eqs. 5.1/5.7 as printed against the text's reading (ours).",
+                  "", _row(("chapter", "claim", "line", "ours", "at the thesis's settings")),
+                  "|---|---|---|---|---|"]
+        lines += [_row((ch, c["claim"], c["line"], c["verdict"],
+                        at_thesis_verdict(c["at_thesis"]))) for ch, c in side]
+        lines.append("")
     return "\n".join(lines) + "\n"
+
+
+#: Chapters whose verdicts the side-by-side table lists.
+SIDE_BY_SIDE = ("Chapter 3", "Appendix A", "Chapter 4", "Chapter 5")
 
 
 def run_chapter(
@@ -354,7 +424,9 @@ def main(argv: list[str] | None = None) -> int:
         text += "\n" + result["markdown"]
     write_text(out / "numbers.md", text)
     figures = sorted(p.name for p in out.glob("fig*.png"))
-    print(f"{len(figures)} figures, {len(rows)} claims ({verdict_counts(rows)}) in {out} "
+    thesis = [r for r in rows if r["kind"] == "thesis"]
+    print(f"{len(figures)} figures, {len(thesis)} thesis claims ({verdict_counts(thesis)}), "
+          f"{len(rows) - len(thesis)} own checks in {out} "
           f"({total:.0f} s)")
     for n in notes:
         print(n)

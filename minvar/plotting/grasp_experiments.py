@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 from matplotlib.patches import Circle
 
 from ..grasp import plan_grasp
@@ -77,12 +78,16 @@ def _x(exp: GraspExperiment) -> np.ndarray:
 def _mean_paths(ax, exp: GraspExperiment, idx: list[int]) -> None:
     label, _, unit = _display(exp.shown)
     cols = _colours(len(idx))
+    handles = []
     for c, i in zip(cols, idx):
         cur = exp.curves[exp.curves.setting == i]
         v = _x(exp)[i]
         ax.plot(cur.finger_x * CM, cur.finger_y * CM, ":", color=c, lw=1.4)
-        ax.plot(cur.thumb_x * CM, cur.thumb_y * CM, "--", color=c, lw=1.4,
-                label=f"{v:g} {unit}")
+        ax.plot(cur.thumb_x * CM, cur.thumb_y * CM, "--", color=c, lw=1.4)
+        handles.append(Line2D([], [], color=c, lw=2, label=f"{v:g} {unit}"))
+    # the line styles as the title names them: finger dotted, thumb dashed
+    handles += [Line2D([], [], color="k", ls=":", lw=1.4, label="finger"),
+                Line2D([], [], color="k", ls="--", lw=1.4, label="thumb")]
     # the objects drawn: each one shown if size is swept, else the base object
     sizes = exp.values[idx] if exp.parameter == "object_size" else [exp.base.object_size]
     for s in sizes:
@@ -91,7 +96,7 @@ def _mean_paths(ax, exp: GraspExperiment, idx: list[int]) -> None:
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel("x (cm)")
     ax.set_ylabel("y (cm)")
-    ax.legend(fontsize=7, title=label, title_fontsize=7)
+    ax.legend(handles=handles, fontsize=7, title=label, title_fontsize=7)
 
 
 def paths_figure(exp: GraspExperiment) -> Figure:

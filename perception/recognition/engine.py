@@ -34,7 +34,7 @@ from perception.observation import Observation
 from perception.recognition.leaves import Leaves, forward_kinematics
 from perception.recognition.models import ChainModel, MotorModel
 from perception.recognition.result import Recognition
-from perception.recognition.scoring import RULES, likelihood_rule, thesis_rule
+from perception.recognition.scoring import RULES, THESIS_SIGNS, likelihood_rule, thesis_rule
 from perception.recognition.verdict import DEFAULT_THRESHOLD, UNFAMILIAR_THRESHOLD, misfit
 
 __all__ = ["HammerParams", "RULES", "recognize"]
@@ -72,6 +72,11 @@ class HammerParams:
         do not change with it, while delayed and open-close-open grasps earn
         less for motion the plan did not expect (final confidence 86 % and
         64 % of normal at 1, 63 % and 46 % at the default 0.3).
+    thesis_sign : str
+        Reading of the sign in the thesis rule (eqs. 5.1, 5.7, 5.8): ``text``
+        (default; +1 when the observed and predicted changes agree, -1 when
+        not, as the thesis's words say) or ``printed`` (the equations as
+        printed: the observed change's sign alone). See docs/recognition.md.
     """
 
     rule: str = "likelihood"
@@ -81,10 +86,14 @@ class HammerParams:
     filter_gain: float = 0.3
     familiarity_threshold: float = DEFAULT_THRESHOLD
     unfamiliar_threshold: float = UNFAMILIAR_THRESHOLD
+    thesis_sign: str = "text"
 
     def __post_init__(self):
         if self.rule not in RULES:
             raise ValueError(f"rule: expected one of {RULES}, got {self.rule!r}")
+        if self.thesis_sign not in THESIS_SIGNS:
+            raise ValueError(f"thesis_sign: expected one of {THESIS_SIGNS}, got "
+                             f"{self.thesis_sign!r}")
         if not (np.isfinite(self.w_r) and np.isfinite(self.w_g) and self.w_r >= 0
                 and self.w_g >= 0):
             raise ValueError(f"w_r, w_g: expected finite weights >= 0, got {self.w_r}, "
@@ -157,6 +166,35 @@ def _observed_angles(obs: Observation, chains: list[ChainModel]) -> np.ndarray:
     return q
 
 
+def _start(leaves: Leaves, steps: int) -> np.ndarray:
+    """Each model's estimate from its plan's start, run on its own for ``steps`` model steps."""
+    x = leaves.x0.copy()
+    for s in range(steps):
+        x = leaves.step(x, s)
+    return x
+
+
+def _advance(leaves: Leaves, x: np.ndarray, y: np.ndarray, s0: int, s1: int,
+             gain: float) -> tuple[np.ndarray, np.ndarray]:
+    """One frame on: the prediction (L, 2) of step ``s1`` from the angles ``y`` (L, 2) seen
+    at step ``s0``, and the filter's estimate (L, n) at ``s1``."""
+    ok = np.isfinite(y).all(axis=1)
+    y = np.where(ok[:, None], _unwrap_to(np.nan_to_num(y), x[:, :2]), x[:, :2])
+    # Two states per leaf step together: the prediction, which starts from
+    # the observed joint angles (the filter's estimate supplies only what
+    # is not observed: velocity, force), and the filter itself, which runs
+    # on; the frame's observation enters it at its first model step, the
+    # other steps are pure prediction.
+    innov = y - x[:, :2]
+    both = np.stack([x, x], axis=1)
+    both[:, 0, :2] = y
+    both = leaves.step(both, s0)
+    both[:, 1] += gain * np.einsum("lip,lp->li", leaves.Kp[s0], innov)
+    for s in range(s0 + 1, s1):
+        both = leaves.step(both, s)
+    return both[:, 0, :2], both[:, 1]
+
+
 def _predict(leaves: Leaves, q_obs: np.ndarray, s_of: np.ndarray,
              gain: float) -> tuple[np.ndarray, np.ndarray]:
     """One-step predictions of every leaf's joint angles and their covariance.
@@ -166,31 +204,12 @@ def _predict(leaves: Leaves, q_obs: np.ndarray, s_of: np.ndarray,
     N = len(s_of)
     # Each model's estimate starts from its plan's start, run on its own up to
     # the first frame's step (a fraction of a frame after the onset).
-    x = leaves.x0.copy()
-    for s in range(s_of[0]):
-        x = leaves.step(x, s)
+    x = _start(leaves, int(s_of[0]))
     q_pred = np.full((N, leaves.count, 2), np.nan)
     P_pred = np.zeros((N, leaves.count, 2, 2))
     for n in range(1, N):
-        s0, s1 = int(s_of[n - 1]), int(s_of[n])
-        y = q_obs[n - 1]
-        ok = np.isfinite(y).all(axis=1)
-        y = np.where(ok[:, None], _unwrap_to(np.nan_to_num(y), x[:, :2]), x[:, :2])
-        # Two states per leaf step together: the prediction, which starts from
-        # the observed joint angles (the filter's estimate supplies only what
-        # is not observed: velocity, force), and the filter itself, which runs
-        # on; the frame's observation enters it at its first model step, the
-        # other steps are pure prediction.
-        innov = y - x[:, :2]
-        both = np.stack([x, x], axis=1)
-        both[:, 0, :2] = y
-        both = leaves.step(both, s0)
-        both[:, 1] += gain * np.einsum("lip,lp->li", leaves.Kp[s0], innov)
-        for s in range(s0 + 1, s1):
-            both = leaves.step(both, s)
-        q_pred[n] = both[:, 0, :2]
-        P_pred[n] = leaves.P[s1]
-        x = both[:, 1]
+        q_pred[n], x = _advance(leaves, x, q_obs[n - 1], int(s_of[n - 1]), int(s_of[n]), gain)
+        P_pred[n] = leaves.P[int(s_of[n])]
     return q_pred, P_pred
 
 
@@ -292,7 +311,8 @@ def recognize(
     valid = (observed & prev_ok)[None] & np.isfinite(r_pred) & np.isfinite(g_pred)
     _refuse_broken_models(models, observed & prev_ok, valid)
     grasp = np.array([m.kind == "grasp" for m in models])
-    dC_r, dC_g = thesis_rule(r_obs, g_obs, r_pred, g_pred, grasp, valid, params.w_r, params.w_g)
+    dC_r, dC_g = thesis_rule(r_obs, g_obs, r_pred, g_pred, grasp, valid, params.w_r, params.w_g,
+                             params.thesis_sign)
     dll, maha = likelihood_rule(r_obs, g_obs, midpoint, opening, pred.cov, valid, params.obs_sd)
     _refuse_non_finite(models, {"confidence": dC_r + dC_g, "log-likelihood": dll})
     mis = misfit(maha, valid)

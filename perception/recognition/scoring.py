@@ -4,7 +4,12 @@
     ``dC_r = sgn(dr_obs) sgn(dr_pred) |dr_pred| w_r``, likewise ``dC_g`` with
     ``w_g``; ``sgn(0) = +1``; ``w_r / w_g = 1/2``. The thesis prints the last
     factor without the absolute value; its text (agreeing motion raises
-    confidence, faster agreement raises it faster) needs the magnitude.
+    confidence, faster agreement raises it faster) needs the magnitude. That
+    reading (``sign="text"``, the default) is ours; ``sign="printed"`` scores
+    the equations as printed, which reduce to ``sgn(dr_obs) |dr_pred| w_r``:
+    the observed direction alone decides the sign, with the change in distance
+    positive when the hand moves closer, as the thesis defines it (see
+    :data:`THESIS_SIGNS`).
     Reach-only models use ``dC_r`` alone. It rewards agreeing directions, so
     it yields the chapter 5 confidence profiles, but it cannot prefer a model
     that predicts no grip motion over one that does.
@@ -23,10 +28,17 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["RULES", "thesis_rule", "likelihood_rule"]
+__all__ = ["RULES", "THESIS_SIGNS", "thesis_rule", "likelihood_rule"]
 
 #: Rules that can pick the winner.
 RULES = ("likelihood", "thesis")
+#: Readings of the sign in the thesis rule (eqs. 5.1, 5.7, 5.8): ``text``, as the
+#: thesis's words say (+1 when observed and predicted changes agree, -1 when they
+#: differ, times the predicted change's magnitude); ``printed``, the equations as
+#: printed, ``sgn(observed) sgn(predicted) (predicted change)``, which is
+#: ``sgn(observed) |predicted change|`` (the change in distance positive when the
+#: hand moves closer, as the thesis defines it; the aperture's when it opens).
+THESIS_SIGNS = ("text", "printed")
 
 
 def _sgn(x: np.ndarray) -> np.ndarray:
@@ -35,7 +47,7 @@ def _sgn(x: np.ndarray) -> np.ndarray:
 
 def thesis_rule(r_obs: np.ndarray, g_obs: np.ndarray, r_pred: np.ndarray, g_pred: np.ndarray,
                 grasp: np.ndarray, valid: np.ndarray, w_r: float,
-                w_g: float) -> tuple[np.ndarray, np.ndarray]:
+                w_g: float, sign: str = "text") -> tuple[np.ndarray, np.ndarray]:
     """Per-step transport and grip terms of the thesis rule (eqs. 5.6-5.7).
 
     Parameters
@@ -50,6 +62,9 @@ def thesis_rule(r_obs: np.ndarray, g_obs: np.ndarray, r_pred: np.ndarray, g_pred
         Steps that count; others score 0.
     w_r, w_g : float
         Weights of the transport and grip terms.
+    sign : str
+        ``"text"`` (default) or ``"printed"``: the reading of eqs. 5.1/5.7/5.8
+        (:data:`THESIS_SIGNS`).
 
     Returns
     -------
@@ -60,8 +75,17 @@ def thesis_rule(r_obs: np.ndarray, g_obs: np.ndarray, r_pred: np.ndarray, g_pred
     dg_obs = np.diff(g_obs, prepend=np.nan)
     dr_pred = r_pred - np.concatenate([[np.nan], r_obs[:-1]])
     dg_pred = g_pred - np.concatenate([[np.nan], g_obs[:-1]])
-    dC_r = _sgn(dr_obs) * _sgn(dr_pred) * np.abs(dr_pred) * w_r
-    dC_g = _sgn(dg_obs) * _sgn(dg_pred) * np.abs(dg_pred) * w_g * grasp[:, None]
+    if sign not in THESIS_SIGNS:
+        raise ValueError(f"sign: expected one of {THESIS_SIGNS}, got {sign!r}")
+    if sign == "text":
+        dC_r = _sgn(dr_obs) * _sgn(dr_pred) * np.abs(dr_pred) * w_r
+        dC_g = _sgn(dg_obs) * _sgn(dg_pred) * np.abs(dg_pred) * w_g * grasp[:, None]
+    else:
+        # printed: sgn(obs) sgn(pred) pred = sgn(obs) |pred|, the prediction's direction
+        # drops out; the change in distance is signed as the thesis defines it, positive
+        # when the hand moves closer (line 1070), the aperture's positive when it opens
+        dC_r = _sgn(-dr_obs) * np.abs(dr_pred) * w_r
+        dC_g = _sgn(dg_obs) * np.abs(dg_pred) * w_g * grasp[:, None]
     # sgn(NaN) is +1, not NaN: what counts must come from the inputs.
     ok = valid & np.isfinite(dr_pred) & np.isfinite(dg_pred)
     return np.where(ok, dC_r, 0.0), np.where(ok, dC_g, 0.0)
