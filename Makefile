@@ -80,6 +80,7 @@ reproduce: $(STAMP)
 # video; `tools/evaluate_verdict.py --set dev` is the set to tune on.
 evaluate: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/python tools/evaluate_verdict.py --set heldout -o out/eval/heldout
+	$(BIN)/python tools/evaluate_online.py --set heldout -o out/eval-online/heldout
 
 clean:
 	rm -rf $(VENV) $(LATEST) .venv-lock out .pytest_cache

@@ -14,6 +14,7 @@ from .api import MotorModel as MotorModel
 from .api import MovementSpan as MovementSpan
 from .api import Observation as Observation
 from .api import ObserveParams as ObserveParams
+from .api import OnlineRecognizer as OnlineRecognizer
 from .api import PlanningError as PlanningError
 from .api import Recognition as Recognition
 from .api import RecognitionSettings as RecognitionSettings
@@ -21,6 +22,7 @@ from .api import RenderStyle as RenderStyle
 from .api import Repertoire as Repertoire
 from .api import Scene as Scene
 from .api import SceneSpec as SceneSpec
+from .api import SettleRule as SettleRule
 from .api import SimilarityTransform as SimilarityTransform
 from .api import Status as Status
 from .api import Tracker as Tracker

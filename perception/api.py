@@ -22,6 +22,7 @@ from perception.geometry import DEFAULT_OBJECT_DIAMETER, SimilarityTransform
 from perception.io.tracks import Status, Tracks, TracksWriter
 from perception.io.video import FrameSource, open_video, write_video
 from perception.observation import MovementSpan, Observation, ObserveParams, movement_span, observe
+from perception.online import OnlineRecognizer, SettleRule
 from perception.pipeline import RecognitionSettings, load_clip, recognize_clip
 from perception.recognition import (
     HammerParams,
@@ -57,11 +58,13 @@ __all__ = [
     "Observation",
     "ObserveParams",
     "Recognition",
+    "OnlineRecognizer",
     "RecognitionSettings",
     "RenderStyle",
     "Repertoire",
     "Scene",
     "SceneSpec",
+    "SettleRule",
     "SimilarityTransform",
     "Status",
     "Tracker",

@@ -29,6 +29,7 @@ from perception.errors import InputError
 from perception.geometry import DEFAULT_OBJECT_DIAMETER, SimilarityTransform
 
 __all__ = [
+    "AlphaBeta",
     "DIGIT_MARKERS",
     "MovementSpan",
     "ObserveParams",
@@ -213,30 +214,49 @@ def alpha_beta(z: np.ndarray, dt: np.ndarray | float, alpha: float, beta: float)
     z = np.asarray(z, dtype=float)
     dt = np.broadcast_to(np.asarray(dt, dtype=float), (z.shape[0],))
     out = np.full_like(z, np.nan)
-    x = np.full(z.shape[1:], np.nan)
-    v = np.zeros(z.shape[1:])
-    shape = z.shape[1:-1] + (1,)
-    missing_before = np.ones(shape, dtype=bool)
-    second = np.zeros(shape, dtype=bool)  # first measurement after a (re)start
+    step = AlphaBeta(z.shape[1:], alpha, beta)
     for i in range(z.shape[0]):
-        zi = z[i]
+        out[i] = step(z[i], dt[i])
+    return out
+
+
+class AlphaBeta:
+    """:func:`alpha_beta` one frame at a time (an online stream's filter).
+
+    Parameters
+    ----------
+    shape : tuple of int
+        Shape of one frame's positions, ``(..., 2)``.
+    alpha, beta : float
+        Position and velocity gains.
+    """
+
+    def __init__(self, shape: tuple[int, ...], alpha: float, beta: float):
+        self.alpha, self.beta = alpha, beta
+        self.x = np.full(shape, np.nan)
+        self.v = np.zeros(shape)
+        self.missing_before = np.ones(shape[:-1] + (1,), dtype=bool)
+        self.second = np.zeros(shape[:-1] + (1,), dtype=bool)  # first measurement after a (re)start
+
+    def __call__(self, zi: np.ndarray, dt: float) -> np.ndarray:
+        """The filtered positions of the next frame ``zi`` (NaN where missing), ``dt`` s later."""
+        x, v, alpha, beta = self.x, self.v, self.alpha, self.beta
         have = np.isfinite(zi).all(axis=-1, keepdims=True)
-        pred = x + v * dt[i]
+        pred = x + v * dt
         resid = zi - pred
         x_new = np.where(have, pred + alpha * resid, pred)
-        v_new = np.where(have, v + beta / max(dt[i], 1e-9) * resid, v)
+        v_new = np.where(have, v + beta / max(dt, 1e-9) * resid, v)
         # After a gap, start again from the measurement (coasting on an old
         # velocity lands far from the marker), and take the velocity from the
         # first two measurements back (two-point initiation).
-        fresh = have & missing_before
-        two = have & second & ~fresh
-        v_new = np.where(two, (zi - x) / max(dt[i], 1e-9), np.where(fresh, 0.0, v_new))
+        fresh = have & self.missing_before
+        two = have & self.second & ~fresh
+        v_new = np.where(two, (zi - x) / max(dt, 1e-9), np.where(fresh, 0.0, v_new))
         x_new = np.where(fresh | two, zi, x_new)
-        second = fresh | (second & ~have)
-        missing_before = ~have
-        x, v = x_new, v_new
-        out[i] = np.where(have, x, np.nan)
-    return out
+        self.second = fresh | (self.second & ~have)
+        self.missing_before = ~have
+        self.x, self.v = x_new, v_new
+        return np.where(have, x_new, np.nan)
 
 
 @dataclass(frozen=True)

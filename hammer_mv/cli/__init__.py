@@ -41,16 +41,19 @@ COMMANDS = {
     "repertoire": "build or inspect a model repertoire",
     "recognize": "recognise the grasp in one video or tracks file",
     "batch": "recognise a folder of clips (or a synth manifest)",
+    "watch": "recognise a movement while it is filmed (camera, file, stream)",
 }
 
 _EVERY = object()
 
-#: Thread-pool sizes of numpy's BLAS and OpenMP, read when they load.
-THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+#: Thread-pool sizes of numpy's BLAS and OpenMP, read when they load (here, and in
+#: the worker processes of ``--jobs``, which inherit this process's environment).
+THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
+                    "VECLIB_MAXIMUM_THREADS")
 
 #: The commands that track video: OpenCV's own thread pool is off while they
 #: run (:func:`serial_opencv`).
-TRACKING_COMMANDS = frozenset({"calibrate", "track", "recognize", "batch"})
+TRACKING_COMMANDS = frozenset({"calibrate", "track", "recognize", "batch", "watch"})
 
 
 def serial_opencv() -> None:

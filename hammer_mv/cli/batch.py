@@ -8,8 +8,8 @@ from pathlib import Path
 
 from hammer_mv.cli.checks import cap_jobs, output_folder
 from hammer_mv.cli.options import add_recognition_options, load_repertoire, recognition_settings
+from hammer_mv.cli.recognize import add_thesis_sign, with_thesis_sign
 from perception.batch import find_clips, run_batch
-from perception.workers import start_early
 
 
 def register(sub) -> None:
@@ -31,10 +31,12 @@ def register(sub) -> None:
     p.add_argument("-o", "--output", type=Path, required=True, metavar="REPORT_DIR",
                    help="report folder (report.html, summary.csv, per-clip reports)")
     p.add_argument("--jobs", type=int, default=1, metavar="N",
-                   help="local processes working on clips (this one and N-1 workers)")
+                   help="worker processes working on clips, one thread each (1: in this "
+                   "process)")
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="run on a dask.distributed scheduler, e.g. tcp://host:8786")
     add_recognition_options(p)
+    add_thesis_sign(p)
     p.set_defaults(func=run)
 
 
@@ -61,10 +63,9 @@ def run(args: argparse.Namespace) -> int:
               f"{names}{more}", file=sys.stderr)
     if not items:
         raise InputError("no clips found", args.input)
-    if jobs > 1 and len(items) > 1 and not args.scheduler:
-        start_early()  # the workers' fork server imports while the repertoire loads
     rep, rep_id = load_repertoire(args)
-    summary = run_batch(items, args.output, rep, recognition_settings(args), jobs=jobs,
+    summary = run_batch(items, args.output, rep,
+                        with_thesis_sign(recognition_settings(args), args), jobs=jobs,
                         scheduler=args.scheduler, repertoire_id=rep_id, quiet=args.quiet,
                         skipped=found.skipped)
     failed = int((summary["status"] != "ok").sum())

@@ -1,0 +1,103 @@
+"""The online recogniser: causal pieces equal the offline ones, and its end is `recognize`'s."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from _demos import default_repertoire
+
+from perception.errors import InputError
+from perception.observation import alpha_beta, movement_span
+from perception.online import OnlineRecognizer, SettleRule
+from perception.pipeline import recognize_tracks
+from perception.recognition.engine import HammerParams, recognize
+from perception.recognition.models import SceneSpec
+from perception.recognition.online import StepScorer
+from perception.synthetic.independent import draw_independent, independent_tracks
+
+
+@pytest.fixture(scope="module")
+def rep():
+    return default_repertoire()
+
+
+def _tracks(condition, seed=3, fps=30.0):
+    return independent_tracks(draw_independent(condition, np.random.default_rng(seed)), seed,
+                              fps=fps)[0]
+
+
+def _feed(rep, tracks, **kw):
+    rec = OnlineRecognizer(rep, markers=tracks.markers, tracker_attrs=dict(tracks.tracker), **kw)
+    states = [rec.update(tracks.position[i], tracks.time[i]) for i in range(tracks.n_frames)]
+    return rec, states
+
+
+def test_alpha_beta_one_frame_at_a_time_is_the_offline_filter():
+    from perception.observation import AlphaBeta
+
+    rng = np.random.default_rng(0)
+    z = rng.normal(size=(40, 3, 2))
+    z[5:8, 1] = np.nan  # a gap: the filter restarts after it
+    dt = rng.uniform(0.03, 0.04, 40)
+    f = AlphaBeta((3, 2), 0.5, 0.15)
+    online = np.stack([f(z[i], dt[i]) for i in range(40)])
+    np.testing.assert_array_equal(online, alpha_beta(z, dt, 0.5, 0.15))
+
+
+def test_step_scorer_gives_the_engine_columns_frame_by_frame(rep):
+    rec = recognize_tracks(_tracks("normal", fps=60.0), rep)
+    obs = rec.observation
+    models = rep.for_scene(SceneSpec.of(obs))
+    offline = recognize(obs, models)
+    scorer = StepScorer(models, HammerParams())
+    for n in range(obs.n_frames):
+        scorer.step(obs.time[n], obs.wrist[n], obs.finger[n], obs.thumb[n])
+        np.testing.assert_array_equal(scorer.log_likelihood, offline.log_likelihood[:, n])
+        np.testing.assert_array_equal(scorer.confidence, offline.confidence[:, n])
+    np.testing.assert_allclose(scorer.misfit, offline.misfit, rtol=1e-12)
+
+
+@pytest.mark.parametrize("condition", ["normal", "open-close-open", "reach"])
+def test_the_end_of_a_stream_is_recognize(rep, condition):
+    tracks = _tracks(condition)
+    rec, states = _feed(rep, tracks)
+    final = rec.finish()
+    offline = recognize_tracks(tracks, rep, clip="stream")
+    assert json.dumps(final.to_dict()) == json.dumps(offline.to_dict())
+    # the onset is found causally, at the offline onset, a few frames after it
+    span = movement_span(tracks)
+    moving = [s for s in states if s.phase == "moving"]
+    first = moving[0]
+    assert first.frame - span.onset_frame <= 8
+    assert first.since_onset == pytest.approx(tracks.time[first.frame] - span.onset_time)
+    assert [s.phase for s in states[:9]] == ["start"] * 9  # the scene needs 10 rest rows
+    assert np.all(np.diff([s.progress for s in moving]) >= 0)
+
+
+def test_a_second_opening_settles_abnormal_before_the_movement_ends(rep):
+    tracks = _tracks("open-close-open")
+    rec, states = _feed(rep, tracks)
+    d = rec.decision
+    assert d is not None and d.verdict == "abnormal" and d.detail == "re-opening"
+    end = movement_span(tracks).end_frame
+    assert d.frame < end
+    # once settled it stays: every later state carries the same decision
+    assert all(s.decision == d for s in states if s.frame >= d.frame)
+
+
+def test_a_settle_rule_that_cannot_be_met_leaves_the_verdict_to_the_end(rep):
+    rec, states = _feed(rep, _tracks("normal"), settle=SettleRule(margin=1e9))
+    assert rec.decision is None and not states[-1].settled
+    assert states[-1].verdict in ("normal", "abnormal")
+
+
+def test_bad_rows_and_rules_are_input_errors(rep):
+    rec = OnlineRecognizer(rep)
+    with pytest.raises(InputError, match="positions"):
+        rec.update(np.zeros((3, 2)), 0.0)
+    with pytest.raises(InputError, match="SettleRule"):
+        SettleRule(min_progress=2.0)
+    with pytest.raises(InputError, match="no frames"):
+        OnlineRecognizer(rep).finish()

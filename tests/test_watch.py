@@ -1,0 +1,99 @@
+"""`hammer-mv watch` on a video file and on a local UDP stream: recognize's outputs."""
+
+from __future__ import annotations
+
+import json
+import math
+import socket
+import subprocess
+import sys
+import time
+
+import pytest
+from _demos import default_repertoire
+
+from perception.synthetic.demos import render_demo_clip
+
+
+@pytest.fixture(scope="module")
+def clip(tmp_path_factory):
+    """A rendered 640 x 480 clip, its repertoire and `recognize`'s report of it."""
+    d = tmp_path_factory.mktemp("watch")
+    video = render_demo_clip(d, "clip.mp4", n=75)[0].video
+    rep = default_repertoire().save(d / "rep.h5")
+    proc = _hammer("recognize", video, "-o", d / "offline", "--no-figures", "--repertoire", rep)
+    assert proc.returncode == 0, proc.stderr
+    return video, rep, json.loads((d / "offline" / "clip.recognition.json").read_text()), d
+
+
+def _hammer(*args, **kw):
+    return subprocess.run([sys.executable, "-m", "hammer_mv", *map(str, args)],
+                          capture_output=True, text=True, **kw)
+
+
+def _close(a, b, path=""):
+    """Equal JSON values, floats to 1e-9 relative (a stream's time base rounds differently)."""
+    if isinstance(a, dict):
+        assert a.keys() == b.keys(), path
+        for k in a:
+            _close(a[k], b[k], f"{path}.{k}")
+    elif isinstance(a, list):
+        assert len(a) == len(b), path
+        for i, (x, y) in enumerate(zip(a, b)):
+            _close(x, y, f"{path}[{i}]")
+    elif isinstance(a, float) and isinstance(b, float):
+        assert math.isclose(a, b, rel_tol=1e-9, abs_tol=1e-12), (path, a, b)
+    else:
+        assert a == b, path
+
+
+def test_watch_a_file_writes_what_recognize_writes(clip, tmp_path):
+    video, rep, offline, d = clip
+    proc = _hammer("watch", video, "-o", tmp_path, "--no-figures", "--repertoire", rep,
+                   "--live", "--as-fast-as-possible")
+    assert proc.returncode == 0, proc.stderr
+    lines = proc.stdout.splitlines()
+    assert sum(" s  " in line for line in lines) == 75  # one per frame
+    online = json.loads((tmp_path / "clip.recognition.json").read_text())
+    info = online.pop("online")
+    assert online == offline  # identical, key for key, bit for bit
+    assert info["frames"] == 75 and info["dropped_frames"] == 0 and not info["interrupted"]
+    assert 0 < info["decision_fraction"] <= 1 and info["decision_time"] > 0
+    assert (tmp_path / "clip.confidence.csv").read_bytes() == \
+        (d / "offline" / "clip.confidence.csv").read_bytes()
+
+
+def _free_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_watch_a_udp_stream_fed_by_ffmpeg(clip, tmp_path):
+    imageio_ffmpeg = pytest.importorskip("imageio_ffmpeg")
+    video, rep, offline, _ = clip
+    port = _free_port()
+    watch = subprocess.Popen([sys.executable, "-m", "hammer_mv", "watch",
+                              f"udp://127.0.0.1:{port}", "-o", str(tmp_path), "--clip", "clip",
+                              "--no-figures", "--repertoire", str(rep), "--stall-timeout", "2"],
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(3)  # the receiver listens before the first packet is sent
+    # the file's own frames, re-muxed (not re-encoded); its decoder header with every keyframe
+    subprocess.run([imageio_ffmpeg.get_ffmpeg_exe(), "-loglevel", "error", "-re", "-i",
+                    str(video), "-c", "copy", "-bsf:v", "dump_extra", "-f", "mpegts",
+                    f"udp://127.0.0.1:{port}?pkt_size=1316"], check=True, timeout=60)
+    out, err = watch.communicate(timeout=60)
+    assert watch.returncode == 0, err
+    assert "settled" in out or "clip:" in out
+    online = json.loads((tmp_path / "clip.recognition.json").read_text())
+    info = online.pop("online")
+    assert info["source"] == "stream" and info["frames"] == 75 and info["dropped_frames"] == 0
+    assert online.pop("input") == f"udp://127.0.0.1:{port}"
+    expected = {k: v for k, v in offline.items() if k not in ("input", "fingerprint")}
+    _close(online, expected)
+
+
+def test_watch_refuses_a_missing_source_in_one_line(tmp_path):
+    proc = _hammer("watch", tmp_path / "nope.mp4", "-o", tmp_path / "out")
+    assert proc.returncode == 2
+    assert proc.stderr.count("\n") == 1 and "nope.mp4" in proc.stderr
