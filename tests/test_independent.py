@@ -1,6 +1,7 @@
 """The independent demonstration generator: literature kinematics, no minimum variance model."""
 
 import ast
+import dataclasses
 import subprocess
 import sys
 from pathlib import Path
@@ -126,3 +127,22 @@ def test_both_generators_name_the_same_conditions():
     from perception.synthetic import independent, stimuli
 
     assert independent.CONDITIONS == stimuli.CONDITIONS
+
+
+@pytest.mark.parametrize("condition", CONDITIONS)
+def test_the_digits_never_pass_through_the_object(condition):
+    """A late grip holds the hand back at the surface; a reach touches it, ending there."""
+    rng = np.random.default_rng(31)
+    for _ in range(15):
+        p = dataclasses.replace(draw_independent(condition, rng), wobble=0.0,
+                                marker_offset=0.0)
+        _, paths = independent_paths(p, 100.0)
+        radius = p.object_size / 2
+        depth = radius - min(np.linalg.norm(paths[d], axis=1).min() for d in ("finger", "thumb"))
+        assert depth < 0.5e-3, f"{condition}: a digit {depth * 1e3:.1f} mm inside the object"
+        if condition != "reach":  # a grasp still closes on the object (a grip axis turned
+            # far from the approach can be held back a few mm as it closes)
+            tips = (paths["finger"][-1] + paths["thumb"][-1]) / 2
+            assert np.linalg.norm(tips) < 6e-3
+        else:
+            assert abs(np.linalg.norm(paths["finger"][-1]) - radius) < 1e-3

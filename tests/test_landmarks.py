@@ -26,7 +26,7 @@ from perception.landmarks import (
     observed_landmarks,
     verdict_detail,
 )
-from perception.observation import observe
+from perception.observation import ObserveParams, observe
 from perception.pipeline import recognize_clip
 from perception.report import ClipSummary, write_clip_report
 from perception.synthetic.independent import IndependentParams, independent_tracks
@@ -68,8 +68,10 @@ def test_peaks_count_by_prominence_not_by_the_aperture_at_contact():
 @pytest.mark.parametrize("condition", ["normal", "delayed", "open-close-open"])
 @pytest.mark.parametrize("seed", [0, 2])
 def test_landmarks_recover_the_independent_generators_kinematics(condition, seed):
-    p = IndependentParams(condition=condition)
-    obs = observe(independent_tracks(p, seed)[0])
+    # a 3 cm object: the late grips open before the digits reach it, so the hand
+    # never waits and the generator's parameters are the movement's true kinematics
+    p = IndependentParams(condition=condition, object_size=0.03)
+    obs = observe(independent_tracks(p, seed)[0], ObserveParams(object_diameter=p.object_size))
     got = observed_landmarks(obs)
     T = got.movement_time
     # the movement span ends when no marker moves faster than the tracking noise allows
@@ -92,6 +94,15 @@ def test_landmarks_recover_the_independent_generators_kinematics(condition, seed
         assert got.opening_time > 0.45
     else:
         assert got.opening_time < 0.3
+
+
+def test_a_grip_opening_too_late_for_the_object_makes_the_hand_wait():
+    """A 10 cm ball: the delayed grip is still closed as the digits reach it, so the
+    hand holds back at its surface and the movement lasts longer than planned."""
+    p = IndependentParams(condition="delayed", object_size=0.1)
+    got = observed_landmarks(observe(independent_tracks(p, 0)[0]))
+    assert got.movement_time > p.duration + 0.2
+    assert got.mga == pytest.approx(p.mga, abs=0.004)
 
 
 def test_the_models_own_movement_matches_the_reference_models_own_landmarks():

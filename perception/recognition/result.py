@@ -25,6 +25,7 @@ from perception.recognition.verdict import (
 
 if TYPE_CHECKING:
     import pandas as pd
+    from matplotlib.figure import Figure
 
     from perception.observation import Observation
     from perception.recognition.models import MotorModel
@@ -139,18 +140,19 @@ class Recognition:
 
         With a :attr:`shape` pass, the verdict is that pass's: the movement's
         coordination judged at the repertoire's reference scale, not its speed,
-        size or camera; ``unfamiliar`` when even its transport is no human
-        reach; and a grasp the models find familiar is still ``abnormal`` if
-        its grip departs from the transport in the field's own measures
-        (:func:`perception.landmarks.grip_departs`: opening late, or
-        re-opening).
+        size or camera; a grasp whose grip departs from the transport in the
+        field's own measures (:func:`perception.landmarks.grip_departs`:
+        opening late, or re-opening) is ``abnormal`` even when the models find
+        it familiar, or find its transport like no reach of theirs (a hand
+        that waits at the object for a late grip); otherwise ``unfamiliar``
+        when even its transport is no human reach.
         """
         if self.shape is not None:
             d = self.shape.decision
+            if d.verdict in ("normal", "abnormal") and grip_departs(self.landmarks[0]):
+                return Verdict("abnormal", d.best, d.familiarity, d.margin)
             if d.verdict is not None and self.transport_familiarity < self.unfamiliar_threshold:
                 return Verdict("unfamiliar", d.best, d.familiarity, d.margin)
-            if d.verdict == "normal" and grip_departs(self.landmarks[0]):
-                return Verdict("abnormal", d.best, d.familiarity, d.margin)
             return d
         return decide(self.kinds, self.log_likelihood[:, -1], self.familiarity,
                       self.familiarity_threshold)
@@ -275,6 +277,26 @@ class Recognition:
         import pandas as pd
 
         return pd.DataFrame(self.columns())
+
+    def plot(self, kind: str = "confidence") -> Figure:
+        """The clip's figure as a matplotlib ``Figure`` (matplotlib is imported here).
+
+        Parameters
+        ----------
+        kind : str
+            ``confidence``: every model's confidence and log-likelihood
+            (:func:`~perception.report.figures.confidence_figure`, the
+            report's ``<clip>.confidence.png``); ``paths``: the demonstration
+            against the reference grasp model's own movement
+            (:func:`~perception.report.figures.paths_figure`, ``<clip>.paths.png``).
+        """
+        from perception.report.figures import confidence_figure, paths_figure
+
+        figures = {"confidence": confidence_figure, "paths": paths_figure}
+        if kind not in figures:
+            raise ValueError(f"Recognition.plot: kind must be one of {sorted(figures)}, "
+                             f"not {kind!r}")
+        return figures[kind](self)
 
     def to_dict(self) -> dict:
         """The recognition report (``<clip>.recognition.json``); NaN becomes None."""

@@ -56,6 +56,7 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+from scipy.ndimage import gaussian_filter1d, maximum_filter1d
 from scipy.special import betainc
 
 from perception.geometry import DEFAULT_OBJECT_DIAMETER
@@ -244,6 +245,25 @@ def _wobble(p: IndependentParams, t: np.ndarray, rng: np.random.Generator) -> np
     return p.wobble / 2.0 * window[:, None] * wave
 
 
+def _held_back(finger: np.ndarray, thumb: np.ndarray, radius: float, fps: float) -> np.ndarray:
+    """(F,) how far (m, along -y) the hand must stay back so no digit enters the object.
+
+    Real digits stop at the surface: a grip that opens late makes the hand wait
+    short of the object. The hold-back is smoothed over about 25 ms, widened
+    first so the smoothing never lets a digit in by more than a fraction of a mm,
+    and so ends within about 0.15 s of the grip opening wide enough.
+    """
+    need = np.zeros(len(finger))
+    for xy in (finger, thumb):
+        # a digit inside goes back out through the near surface, y = -sqrt(r^2 - x^2)
+        chord = np.sqrt(np.clip(radius**2 - xy[:, 0] ** 2, 0.0, None))
+        inside = np.hypot(xy[:, 0], xy[:, 1]) < radius
+        need = np.maximum(need, np.where(inside, xy[:, 1] + chord, 0.0))
+    sigma = 0.025 * fps
+    widened = maximum_filter1d(need, size=2 * math.ceil(3 * sigma) + 1, mode="nearest")
+    return gaussian_filter1d(widened, sigma, mode="nearest")
+
+
 def independent_paths(p: IndependentParams, fps: float, *,
                       seed: int | np.random.Generator = 0) -> tuple[np.ndarray, dict]:
     """World-frame marker paths of one demonstration, sampled at frame times.
@@ -274,7 +294,8 @@ def independent_paths(p: IndependentParams, fps: float, *,
     tau = np.clip((t - p.rest_before) / p.duration, 0.0, 1.0)
     # in the approach frame: +y toward the object, the object at the origin
     start = np.array([0.0, -p.distance])
-    goal = np.array([0.0, -p.hand_size])
+    # a grasp's digit tips close on the object's centre; a reach touches its near surface
+    goal = np.array([0.0, -p.hand_size - (p.object_size / 2 if p.condition == "reach" else 0.0)])
     s = _progress(p, tau)
     wrist = start + s[:, None] * (goal - start)
     wrist[:, 0] += p.curvature * np.sin(np.pi * s)
@@ -287,7 +308,9 @@ def independent_paths(p: IndependentParams, fps: float, *,
     # the wrist carries the grip midpoint to the object: shift it by the digits' asymmetry
     shift = ((0.5 - p.thumb_share) * g)[:, None] * across
     tips = {"wrist": wrist - shift, "finger": finger - shift, "thumb": thumb - shift}
-    tips = {name: xy + _wobble(p, t, rng) for name, xy in tips.items()}
+    back = _held_back(tips["finger"], tips["thumb"], p.object_size / 2, fps)
+    tips = {name: xy - back[:, None] * [0.0, 1.0] + _wobble(p, t, rng)
+            for name, xy in tips.items()}
     rot = math.radians(p.approach_angle_deg)
     R = np.array([[math.cos(rot), -math.sin(rot)], [math.sin(rot), math.cos(rot)]])
     marker = {"wrist": 0.0, "finger": p.marker_offset, "thumb": -p.marker_offset}
@@ -645,8 +668,8 @@ def render_population_set(out: str | os.PathLike, counts: dict[str, int], *, see
         How the clips look (default :data:`POPULATION_STYLE`; its frame rate is
         replaced by each clip's own).
     jobs : int
-        Processes rendering clips (this one and ``jobs - 1`` workers, as
-        ``hammer-mv synth --jobs``); the clips do not depend on it.
+        Worker processes rendering clips (as ``hammer-mv synth --jobs``; 1:
+        in this process); the clips do not depend on it.
     progress : bool
         Show a progress bar.
 
@@ -680,9 +703,9 @@ def render_population_set(out: str | os.PathLike, counts: dict[str, int], *, see
     with tqdm(total=len(work), desc="render population", unit="clip",
               disable=not progress) as bar:
         if jobs > 1 and len(work) > 1:
-            from perception.workers import run_shared  # worker processes only when asked
+            from perception.workers import run_pool  # worker processes only when asked
 
-            results = run_shared(list(enumerate(work)), _RenderPopulation(), int(jobs))
+            results = run_pool(enumerate(work), _RenderPopulation(), int(jobs))
         else:
             results = (_RenderPopulation().run(item, None) for item in enumerate(work))
         for i, row in results:
