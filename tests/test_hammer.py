@@ -244,14 +244,13 @@ def test_thesis_sign_is_a_setting_that_keys_reports():
 def test_thesis_sign_flag_reaches_the_engine_settings():
     from hammer_mv.cli import build_parser
     from hammer_mv.cli.options import recognition_settings
-    from hammer_mv.cli.recognize import with_thesis_sign
 
-    for command in ("recognize", "batch"):
+    for command in ("recognize", "batch", "watch"):
         args = build_parser().parse_args([command, "x.mp4", "-o", "out",
                                           "--thesis-sign", "printed"])
-        assert with_thesis_sign(recognition_settings(args), args).hammer.thesis_sign == "printed"
+        assert recognition_settings(args).hammer.thesis_sign == "printed"
         args = build_parser().parse_args([command, "x.mp4", "-o", "out"])
-        assert with_thesis_sign(recognition_settings(args), args).hammer.thesis_sign == "text"
+        assert recognition_settings(args).hammer.thesis_sign == "text"
     with pytest.raises(SystemExit):
         build_parser().parse_args(["recognize", "x.mp4", "-o", "out", "--thesis-sign", "x"])
 

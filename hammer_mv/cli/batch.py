@@ -8,7 +8,6 @@ from pathlib import Path
 
 from hammer_mv.cli.checks import cap_jobs, output_folder
 from hammer_mv.cli.options import add_recognition_options, load_repertoire, recognition_settings
-from hammer_mv.cli.recognize import add_thesis_sign, with_thesis_sign
 from perception.batch import find_clips, run_batch
 
 
@@ -36,7 +35,6 @@ def register(sub) -> None:
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="run on a dask.distributed scheduler, e.g. tcp://host:8786")
     add_recognition_options(p)
-    add_thesis_sign(p)
     p.set_defaults(func=run)
 
 
@@ -64,8 +62,7 @@ def run(args: argparse.Namespace) -> int:
     if not items:
         raise InputError("no clips found", args.input)
     rep, rep_id = load_repertoire(args)
-    summary = run_batch(items, args.output, rep,
-                        with_thesis_sign(recognition_settings(args), args), jobs=jobs,
+    summary = run_batch(items, args.output, rep, recognition_settings(args), jobs=jobs,
                         scheduler=args.scheduler, repertoire_id=rep_id, quiet=args.quiet,
                         skipped=found.skipped)
     failed = int((summary["status"] != "ok").sum())

@@ -19,6 +19,7 @@ from perception.observation import ObserveParams
 from perception.pipeline import RecognitionSettings
 from perception.recognition.engine import RULES, HammerParams
 from perception.recognition.repertoire import Repertoire
+from perception.recognition.scoring import THESIS_SIGNS
 
 _OBSERVE = ObserveParams()
 _HAMMER = HammerParams()
@@ -45,6 +46,11 @@ def add_recognition_options(p: argparse.ArgumentParser) -> None:
                    help=f"transport weight of the thesis rule (default: {_HAMMER.w_r:g})")
     g.add_argument("--w-g", type=float, default=_HAMMER.w_g,
                    help=f"grip weight of the thesis rule (default: {_HAMMER.w_g:g})")
+    g.add_argument("--thesis-sign", choices=THESIS_SIGNS, default=_HAMMER.thesis_sign,
+                   help="reading of the sign in the thesis rule, eqs. 5.1/5.7/5.8 (default: "
+                        f"{_HAMMER.thesis_sign}: +1 when observed and predicted changes agree; "
+                        "printed: the equations as printed, the observed change's sign "
+                        "alone); see docs/recognition.md")
     g.add_argument("--filter-gain", type=float, default=_HAMMER.filter_gain, metavar="G",
                    help="how strongly observed positions correct each model's estimate of "
                         "velocity and force (0: the plan alone; 1: the plan's Kalman gains; "
@@ -146,7 +152,7 @@ def recognition_settings(args: argparse.Namespace) -> RecognitionSettings:
             raise InputError(f"expected a finite weight >= 0, got {value}", field=flag)
     with options({"rule": "--rule", "filter_gain": "--filter-gain"}):
         hammer = HammerParams(rule=args.rule, w_r=args.w_r, w_g=args.w_g,
-                              filter_gain=args.filter_gain)
+                              filter_gain=args.filter_gain, thesis_sign=args.thesis_sign)
     tracking = None
     if getattr(args, "setup", None) is not None:
         from perception.tracking.setup import load_setup

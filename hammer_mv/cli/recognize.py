@@ -30,41 +30,7 @@ def register(sub) -> None:
     p.add_argument("--no-figures", action="store_true",
                    help="write the JSON and CSV only, not the figures (faster)")
     add_recognition_options(p)
-    add_thesis_sign(p)
     p.set_defaults(func=run)
-
-
-def add_thesis_sign(p: argparse.ArgumentParser) -> None:
-    """Add ``--thesis-sign`` (the reading of the thesis rule's sign) to parser ``p``.
-
-    Parameters
-    ----------
-    p : argparse.ArgumentParser
-        The ``recognize`` or ``batch`` parser.
-    """
-    from perception.recognition.scoring import THESIS_SIGNS
-
-    p.add_argument("--thesis-sign", choices=THESIS_SIGNS, default="text",
-                   help="reading of the sign in the thesis rule, eqs. 5.1/5.7/5.8 (default: "
-                        "text, +1 when observed and predicted changes agree; printed: the "
-                        "equations as printed, the observed change's sign alone); "
-                        "see docs/recognition.md")
-
-
-def with_thesis_sign(settings, args: argparse.Namespace):
-    """``settings`` (a RecognitionSettings) with ``args.thesis_sign`` in its engine parameters.
-
-    Parameters
-    ----------
-    settings : perception.pipeline.RecognitionSettings
-        From :func:`hammer_mv.cli.options.recognition_settings`.
-    args : argparse.Namespace
-        Parsed arguments with ``thesis_sign``.
-    """
-    import dataclasses
-
-    hammer = dataclasses.replace(settings.hammer, thesis_sign=args.thesis_sign)
-    return dataclasses.replace(settings, hammer=hammer)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -103,7 +69,7 @@ def run(args: argparse.Namespace) -> int:
     clip, kind = clip_name(path)
     if kind == "unknown":
         raise InputError("not a video, .tracks.h5 or pose file", path)
-    settings = with_thesis_sign(recognition_settings(args), args)
+    settings = recognition_settings(args)
     rep, rep_id = load_repertoire(args)
     # a few frames for the contact sheet, kept while tracking
     frames = None if args.no_figures else FrameSample()
