@@ -438,9 +438,9 @@ def _run_local(items: list[BatchItem], repertoire: Repertoire, job: _Job,
 
 
 def _prepare_report() -> None:
-    """Import what the batch report needs (pandas, scipy.special: 0.5 s) on the core
-    a worker has left while the others finish the last clips: this process would
-    otherwise wait idle, then import them. Workers never import them."""
+    """Import what the batch report needs (pandas, scipy.special, matplotlib: about
+    1 s) on the core a worker has left while the others finish the last clips:
+    this process would otherwise wait idle, then import them."""
     import matplotlib.figure  # noqa: F401 - the chapter 5 figures' (0.4 s)
     import scipy.special  # noqa: F401
 
