@@ -7,8 +7,8 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-stamp
 JOBS ?= 2
 CONSTRAINTS := constraints.txt
-# PIP_CONSTRAINT, not -c: pip applies it to the isolated build environment
-# too, so setuptools (the build backend) is pinned as well
+# -c pins what is installed; PIP_CONSTRAINT as well, because pip applies it to
+# the isolated build environment too, so setuptools (the build backend) is pinned
 PIN := PIP_CONSTRAINT=$(CURDIR)/$(CONSTRAINTS)
 LATEST := .venv-latest
 
@@ -17,8 +17,8 @@ LATEST := .venv-latest
 $(STAMP): pyproject.toml setup.py minvar/_lqg_kernel.c $(CONSTRAINTS)
 	$(PYTHON) -c 'import sys; assert sys.version_info >= (3, 11), "hammer-mv needs Python >= 3.11"'
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
-	$(PIN) $(BIN)/python -m pip install --quiet --upgrade pip setuptools wheel
-	$(PIN) $(BIN)/python -m pip install --quiet -e '.[dev,pose]'
+	$(PIN) $(BIN)/python -m pip install --quiet -c $(CONSTRAINTS) --upgrade pip setuptools wheel
+	$(PIN) $(BIN)/python -m pip install --quiet -c $(CONSTRAINTS) -e '.[dev,pose]'
 	$(MAKE) --no-print-directory bytecode
 	touch $(STAMP)
 

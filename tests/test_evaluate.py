@@ -14,14 +14,12 @@ import pandas as pd
 import pytest
 
 from perception.io.tracks import Tracks
-from perception.synthetic.independent import (
-    CONDITIONS,
+from perception.synthetic.independent import CONDITIONS, RANGES, independent_paths
+from perception.synthetic.population import (
     POPULATION_FPS,
     POPULATION_RANGES,
     POPULATION_STYLE,
-    RANGES,
     draw_population,
-    independent_paths,
     population_camera,
     render_population_set,
 )
@@ -201,7 +199,7 @@ def test_clips_at_the_extremes_stay_in_the_frame(tmp_path, extreme):
 
 
 def test_every_drawn_population_clip_fits_its_frame():
-    from perception.synthetic.independent import _check_in_frame
+    from perception.synthetic.population import _check_in_frame
 
     for seed in range(300):
         for cond in CONDITIONS:

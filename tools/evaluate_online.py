@@ -103,7 +103,7 @@ def run(set_name: str, out: Path, counts: dict[str, int], jobs: int = 2) -> str:
     """Render, track, recognise online; write and return the markdown."""
     from perception.io.tracks import Tracks
     from perception.recognition.repertoire import Repertoire
-    from perception.synthetic.independent import render_population_set
+    from perception.synthetic.population import render_population_set
     from perception.tracking.tracker import track_video
 
     seeds = set_seeds(set_name, sum(counts.values()))

@@ -2,8 +2,8 @@
 
 Renders a population of the independent generator (movements built from
 published human kinematics, not by the minimum variance model;
-:func:`perception.synthetic.independent.render_population_set`, ranges in
-:data:`~perception.synthetic.independent.POPULATION_RANGES`), tracks and
+:func:`perception.synthetic.population.render_population_set`, ranges in
+:data:`~perception.synthetic.population.POPULATION_RANGES`), tracks and
 recognises it from video with ``hammer-mv batch`` (the default repertoire),
 and reports how often the verdict is right::
 
@@ -280,7 +280,7 @@ def hammer_mv() -> list[str]:
 def run(set_name: str, out: str | os.PathLike, counts: dict[str, int], *, jobs: int = 2,
         quiet: bool = False) -> tuple[pd.DataFrame, dict]:
     """Render the set, run ``hammer-mv batch`` on it, evaluate, write the tables."""
-    from perception.synthetic.independent import render_population_set
+    from perception.synthetic.population import render_population_set
 
     out = Path(out)
     n = sum(counts.values())

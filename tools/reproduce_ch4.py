@@ -37,31 +37,30 @@ for _p in (ROOT, ROOT / "tools"):
     if str(_p) not in sys.path:
         sys.path.insert(0, str(_p))
 
-from reproduce_common import THESIS_SETTINGS, at_settings, cite, claim, sensitivity  # noqa: E402
+from reproduce_ch4_sensitivity import (  # noqa: E402
+    UM,
+    cm,
+    level_is_best,
+    pct,
+    tip_start_table,
+    travel_table,
+    u_minimum,
+)
+from reproduce_common import THESIS_SETTINGS, at_settings, cite, claim  # noqa: E402
 
 from hammer_mv.cli.grasp import write_experiment  # noqa: E402
 from minvar.analysis import path_deviation  # noqa: E402
 from minvar.grasp import GraspTask, plan_grasp, simulate_grasp  # noqa: E402
 from minvar.grasp_experiments import EXPERIMENTS, GraspExperiment  # noqa: E402
-from minvar.grasp_stats import end_distance, grasp_moments  # noqa: E402
 from minvar.plotting.grasp import grasp_figure, setup_figure  # noqa: E402
 from perception.io.atomic import save_figure, write_csv  # noqa: E402
 
 log = logging.getLogger("reproduce_ch4")
 
-UM = 1e6
 #: Sampling error of an SD from the thesis's 500 repetitions, 1/sqrt(2 (n - 1)).
 SD_ERROR_500 = 1 / np.sqrt(2 * 499)
 #: The thesis's MGA slope (line 903) and the human one (lines 696, 742).
 SLOPE_THESIS, SLOPE_HUMAN = 0.92, 0.8
-
-
-def _pct(x: float) -> str:
-    return f"{100 * x:.0f} %"
-
-
-def _cm(x: float) -> str:
-    return f"{100 * x:g} cm"
 
 
 def _ci(pair, scale: float, fmt: str = ".1f") -> str:
@@ -82,24 +81,6 @@ def _total_sd(s: pd.DataFrame, digit: str = "finger") -> np.ndarray:
     return np.hypot(s[f"{digit}_sd_x_exact"], s[f"{digit}_sd_y_exact"]).to_numpy()
 
 
-# --- verdict rules shared by the claims and the sensitivity tables ----------------
-def level_is_best(heights, values) -> bool:
-    """Lowest at the level setting, falling toward it from below and rising above."""
-    h, v = np.asarray(heights), np.asarray(values)
-    i = int(np.argmin(v))
-    return bool(abs(h[i]) < 1e-9 and np.all(np.diff(v[: i + 1]) < 0)
-                and np.all(np.diff(v[i:]) > 0))
-
-
-def u_minimum(times, sd, upto: float = 0.85) -> tuple[float, bool]:
-    """Where the SD is lowest among via-point times <= ``upto``, and whether that is
-    an interior minimum (the SD rises on both sides: the thesis's U shape)."""
-    t, y = np.asarray(times), np.asarray(sd)
-    keep = t <= upto + 1e-9
-    i = int(np.argmin(np.where(keep, y, np.inf)))
-    return float(t[i]), bool(0 < i < int(keep.sum()) - 1)
-
-
 # --- 4.2.1: via-point position ------------------------------------------------------
 def _viapoint_height(e: GraspExperiment) -> list[dict]:
     s = e.summary
@@ -112,7 +93,7 @@ def _viapoint_height(e: GraspExperiment) -> list[dict]:
         "4.2.1.1", "Digit end-point distance from the target falls as the via-points come "
         "level with the targets and rises again above them",
         "decreases toward level, increases above", ", ".join(
-            f"{_cm(x)}: {y * UM:.0f}" for x, y in zip(h, d)) + f" µm (finger; level, "
+            f"{cm(x)}: {y * UM:.0f}" for x, y in zip(h, d)) + f" µm (finger; level, "
         f"{s.trials.iloc[lvl]} repetitions: {mc * UM:.0f} ± {half * UM:.0f} µm)",
         level_is_best(h, d), location="Fig. 4.3(a,b); line 788",
         measure="exact mean end-point distance (expected distance of the exact end-point "
@@ -128,8 +109,8 @@ def _viapoint_height(e: GraspExperiment) -> list[dict]:
     out.append(claim(
         "4.2.1.1", "Digit end-point SD is lowest with the via-points level with the targets",
         "lowest at 0 cm (level), per digit and axis as Fig. 4.3(c,d) plots it",
-        "lowest x SD at " + _cm(lowest["x"]) + ", lowest y SD at " + _cm(lowest["y"])
-        + f"; total SD lowest at {_cm(h[int(np.argmin(sd))])} ({sd[lvl] * UM:.2f} µm level, "
+        "lowest x SD at " + cm(lowest["x"]) + ", lowest y SD at " + cm(lowest["y"])
+        + f"; total SD lowest at {cm(h[int(np.argmin(sd))])} ({sd[lvl] * UM:.2f} µm level, "
         f"neighbours {100 * near.min():.1f}-{100 * near.max():.1f} % higher)",
         all(level_is_best(h, v) for v in axes.values()), location="Fig. 4.3(c,d); line 790",
         measure="exact finger end-point SD per axis (x, y; the figure's panels) per height; "
@@ -149,8 +130,8 @@ def _viapoint_time(e: GraspExperiment) -> list[dict]:
     out = [claim(
         "4.2.1.2", "End-point SD peaks for a via-point late in the movement, falling after",
         "peak at about 87 %",
-        f"peak at {_pct(f[i_max])} ({sd[i_max] * UM:.1f} µm), {sd[-1] * UM:.1f} µm at "
-        f"{_pct(f[-1])}", abs(f[i_max] - 0.87) <= 0.05 and sd[-1] < sd[i_max],
+        f"peak at {pct(f[i_max])} ({sd[i_max] * UM:.1f} µm), {sd[-1] * UM:.1f} µm at "
+        f"{pct(f[-1])}", abs(f[i_max] - 0.87) <= 0.05 and sd[-1] < sd[i_max],
         location="Fig. 4.5(c,d); line 818",
         measure="exact total finger end-point SD over via-point times 50-95 % (2.5 % "
         "steps); agree if the peak is within 5 % of the movement of 87 % and the SD falls "
@@ -167,14 +148,14 @@ def _viapoint_time(e: GraspExperiment) -> list[dict]:
         "4.2.1.2", "End-point SD is lowest for a via-point near 70 % and rises below it",
         "below approximately 70 %: an increase in SD",
         f"SD at 50-67.5 % is {100 * rise.min():+.1f} to {100 * rise.max():+.1f} % of the SD at "
-        f"70 % ({sd[i70] * UM:.2f} µm); lowest at {_pct(t_min)} "
+        f"70 % ({sd[i70] * UM:.2f} µm); lowest at {pct(t_min)} "
         f"({'interior' if interior else 'at the edge'})",
         agrees, location="Fig. 4.5(c,d); lines 834, 838",
         measure="exact total finger end-point SD for via-point times 50-67.5 % against 70 %; "
         "an increase counts only beyond 2 standard errors of an SD from the thesis's 500 "
         f"repetitions ({100 * resolved:.1f} %); agree if the SD is higher at every earlier time "
         "and resolvably so somewhere",
-        note=f"ours falls below 70 % (flat bottom {_pct(flat.min())}-{_pct(flat.max())}); "
+        note=f"ours falls below 70 % (flat bottom {pct(flat.min())}-{pct(flat.max())}); "
         f"the wrist, which the via-point does not move, supplies {wrist * UM:.1f} of the "
         f"{sd[i70] * UM:.1f} µm. Our former rule (an interior minimum within 50-80 %) was "
         "our own and passed any flat curve."))
@@ -232,7 +213,7 @@ def _curvature_claim(e: GraspExperiment) -> dict:
         "the via-point time, and their peak curvature in the hand frame (the turn onto the "
         "target line) must fall",
         note="" if top >= e.values.max() - 1e-9 else
-        f"over the whole sweep the chord distance peaks at {_pct(top)} and falls again for "
+        f"over the whole sweep the chord distance peaks at {pct(top)} and falls again for "
         "later via-points, beyond the figure's range (a via-point that close to the end "
         "pulls the path out for less time)")
 
@@ -246,7 +227,7 @@ def _viapoint_distance(e: GraspExperiment) -> list[dict]:
     return [
         claim("4.2.2.1", "A via-point further from the object gives a larger MGA",
               "MGA increases with via-point distance",
-              f"MGA {m[0] * 100:.2f} -> {m[-1] * 100:.2f} cm for {_cm(o[0])} -> {_cm(o[-1])}; "
+              f"MGA {m[0] * 100:.2f} -> {m[-1] * 100:.2f} cm for {cm(o[0])} -> {cm(o[-1])}; "
               f"slope {e.stats['mga_slope']:.2f} (95 % CI {lo:.2f} to {hi:.2f})",
               _monotonic(m, True) and lo > 0, location="Fig. 4.8(a); lines 875, 877",
               measure="mean MGA of 500 repetitions per distance; agree if it rises at every "
@@ -254,7 +235,7 @@ def _viapoint_distance(e: GraspExperiment) -> list[dict]:
               note="slope about 2: both digits move out by the offset"),
         claim("4.2.2.1", "A via-point further from the object gives an earlier MGA",
               "MGA occurs earlier with via-point distance",
-              f"MGA at {_pct(t[0])} -> {_pct(t[-1])} for {_cm(o[0])} -> {_cm(o[-1])}",
+              f"MGA at {pct(t[0])} -> {pct(t[-1])} for {cm(o[0])} -> {cm(o[-1])}",
               bool(np.all(np.diff(t) <= 0) and t[-1] < t[0]),
               location="Fig. 4.8(b); lines 875, 877",
               measure="mean relative time of the MGA (1 % steps); agree if never later and "
@@ -290,7 +271,7 @@ def _object_size(e: GraspExperiment) -> list[dict]:
               f"{abs(slope - SLOPE_HUMAN):.2f} from 0.8"),
         claim("4.2.2.2", "MGA occurs at 60-80 % of the movement for every object size",
               "60-80 % for sizes 0-8 cm",
-              f"{_pct(t.min())}-{_pct(t.max())} (" + ", ".join(_pct(x) for x in t)
+              f"{pct(t.min())}-{pct(t.max())} (" + ", ".join(pct(x) for x in t)
               + " for " + ", ".join(f"{100 * x:g}" for x in sz) + " cm)", inside,
               location="Fig. 4.10(b); line 905 (also 973)",
               measure="time of the exact mean aperture's maximum (1 % steps; the "
@@ -298,7 +279,7 @@ def _object_size(e: GraspExperiment) -> list[dict]:
               "60-80 %", note="depends on where the closed tips start: 56-59 % at 0-1 cm "
               "with them on the target line (tip_start table)." + edge),
         claim("4.2.2.2", "MGA occurs later for larger objects", "later for larger objects",
-              f"{_pct(t[0])} at {_cm(sz[0])} -> {_pct(t[-1])} at {_cm(sz[-1])}",
+              f"{pct(t[0])} at {cm(sz[0])} -> {pct(t[-1])} at {cm(sz[-1])}",
               bool(np.all(np.diff(t) >= 0) and t[-1] > t[0]),
               location="Fig. 4.10(b); line 903",
               measure="time of the exact mean aperture's maximum; agree if never earlier and "
@@ -405,7 +386,7 @@ def _variability_size(e: GraspExperiment) -> list[dict]:
               note=construction + " single out size 0; the thesis's result may come from "
               "its implementation (e.g. a degenerate grip target at zero size)"),
         claim("4.2.3.2", "Wrist peak SD occurs slightly later for larger objects",
-              "slightly later", f"{_pct(tw[0])} at every size", tw[-1] > tw[0],
+              "slightly later", f"{pct(tw[0])} at every size", tw[-1] > tw[0],
               location="Fig. 4.14(b); line 943", measure="exact time of the wrist peak SD",
               note=construction + " move in time either"),
         claim("4.2.3.2", "Aperture peak SD grows (linearly) with object size",
@@ -419,7 +400,7 @@ def _variability_size(e: GraspExperiment) -> list[dict]:
               note="wider grips need larger digit commands, hence more signal-dependent noise"),
         claim("4.2.3.2", "Timing of the aperture peak SD does not vary significantly with "
               "object size", "no significant change",
-              f"{_pct(ta.min())}-{_pct(ta.max())}; largest difference "
+              f"{pct(ta.min())}-{pct(ta.max())}; largest difference "
               f"{st['aperture_sd_peak_time_max_diff'] * 100:+.0f} % ({_ci(ci_t, 100, '+.0f')} %)",
               not _excludes_zero(ci_t), location="Fig. 4.14(d); line 947",
               measure="exact time of the aperture peak SD; 95 % bootstrap CI of the largest "
@@ -449,8 +430,8 @@ def _variability_distance(e: GraspExperiment) -> list[dict]:
               "effect in people, which the thesis also does not reproduce (line 965)"),
         claim("4.2.3.3", "Wrist SD changes with transport distance",
               "decreases (line 963); increases (lines 1207, 1209)",
-              f"{_trend(e, 'wrist_sd_peak', UM, 'µm')} for wrist travel {_cm(travel[0])} -> "
-              f"{_cm(travel[-1])}", False, verdict="thesis inconsistent",
+              f"{_trend(e, 'wrist_sd_peak', UM, 'µm')} for wrist travel {cm(travel[0])} -> "
+              f"{cm(travel[-1])}", False, verdict="thesis inconsistent",
               location="Figs. 4.15(a), 4.16(a); line 963 vs lines 1207-1209 (965 cites "
               "Kudoh et al.'s significant effect)",
               measure=_EFFECT + "; distance = how far the wrist moves (line 953)",
@@ -468,7 +449,7 @@ def _variability_distance(e: GraspExperiment) -> list[dict]:
               "faster (shorter) movements peak later"),
         claim("4.2.3.3", "Time of the aperture peak SD against transport distance",
               "not stated (Fig. 4.16(d))",
-              f"{_pct(s.aperture_sd_peak_time_exact.iloc[0])} at every distance", False,
+              f"{pct(s.aperture_sd_peak_time_exact.iloc[0])} at every distance", False,
               verdict="by construction", location="Fig. 4.16(d); lines 961-965",
               measure="exact time of the aperture peak SD",
               note="the grip's plan does not depend on distance"),
@@ -484,119 +465,6 @@ _CLAIMS = {
     "variability-size": _variability_size,
     "variability-distance": _variability_distance,
 }
-
-
-# --- sensitivity to what the thesis leaves open -----------------------------------------
-#: tip_start values tabulated: from just ahead of the wrist to on the target line.
-TIP_STARTS = (0.01, 0.02, 0.03, 0.04, 0.06)
-#: Settings each tip_start is checked on (a coarser grid than the sweeps').
-SENS_HEIGHTS = (-0.005, 0.0, 0.005)
-SENS_TIMES = (0.5, 0.55, 0.6, 0.65, 0.7, 0.75, 0.8)
-SENS_SIZES = (0.0, 0.08)
-
-
-def _geometry_moments(base: GraspTask) -> dict:
-    """Exact moments of the sensitivity settings of one geometry, by (parameter, value)."""
-    tasks = {("viapoint_height", h): replace(base, viapoint_height=h) for h in SENS_HEIGHTS}
-    tasks.update({("viapoint_time", f): replace(base, viapoint_time=f) for f in SENS_TIMES})
-    tasks.update({("object_size", x): replace(base, object_size=x) for x in SENS_SIZES})
-    exact = {}
-    for task in tasks.values():
-        if task not in exact:  # the base recurs: plan it once
-            exact[task] = grasp_moments(plan_grasp(task))
-    return {key: (task, exact[task]) for key, task in tasks.items()}
-
-
-def _verdict_cells(moments: dict) -> list[str]:
-    """Height verdict, via-time minimum, MGA-time range and slope for one geometry."""
-    def dist(key):
-        task, m = moments[key]
-        return end_distance(m, "finger", task.finger_target)
-
-    def sd(key):
-        return float(np.sqrt(np.trace(moments[key][1].finger_cov[-1])))
-
-    d = [dist(("viapoint_height", h)) for h in SENS_HEIGHTS]
-    t_min, interior = u_minimum(SENS_TIMES, [sd(("viapoint_time", f)) for f in SENS_TIMES])
-    mga = {x: moments[("object_size", x)][1] for x in SENS_SIZES}
-    times = [m.relative_time[np.argmax(m.aperture_mean)] for m in mga.values()]
-    slope = (mga[0.08].aperture_mean.max() - mga[0.0].aperture_mean.max()) / 0.08
-    best = SENS_HEIGHTS[int(np.argmin(d))]
-    return [
-        f"{'yes' if level_is_best(SENS_HEIGHTS, d) else '**no**'} (lowest at {_cm(best)})",
-        f"{_pct(t_min)} ({'U-shaped' if interior else '**no interior minimum**'})",
-        f"{_pct(min(times))}-{_pct(max(times))}"
-        + ("" if min(times) >= 0.6 - 1e-9 and max(times) <= 0.8 + 1e-9 else " (**outside**)"),
-        f"{slope:.3f}",
-    ]
-
-
-def _from_experiments(done: dict[str, GraspExperiment]) -> dict:
-    """The sensitivity settings of the default geometry, from the sweeps' own moments."""
-    sweeps = {"viapoint_height": ("viapoint-height", SENS_HEIGHTS),
-              "viapoint_time": ("viapoint-time", SENS_TIMES),
-              "object_size": ("object-size", SENS_SIZES)}
-    out = {}
-    for parameter, (name, values) in sweeps.items():
-        e = done[name]
-        for v in values:
-            i = int(np.argmin(np.abs(e.values - v)))
-            if abs(e.values[i] - v) > 1e-9:
-                raise ValueError(f"{name} has no setting {v}")
-            out[(parameter, v)] = (replace(e.base, **{parameter: v}), e.moments[i])
-    return out
-
-
-def _tip_start_table(base: GraspTask, done: dict[str, GraspExperiment]) -> tuple[dict, dict]:
-    """The tip_start table, and the default geometry's moments (reused for travel)."""
-    rows, used = [], _from_experiments(done)
-    for ts in TIP_STARTS:
-        mine = abs(ts - base.tip_start) < 1e-12
-        moments = used if mine else _geometry_moments(replace(base, tip_start=ts))
-        mark = " (used)" if mine else (
-            " (on the target line)" if abs(ts - base.wrist_offset) < 1e-12 else "")
-        rows.append([f"{_cm(ts)}{mark}", *_verdict_cells(moments)])
-    table = sensitivity(
-        "tip_start, where the closed digit tips start ahead of the wrist",
-        "not given; Fig. 4.4(a) (line 814) has the digits reach the level of the targets "
-        "during the movement, so they start below it (0 < tip_start < wrist_offset = 6 cm)",
-        f"We use {_cm(base.tip_start)}. Exact moments; via-point heights "
-        f"{', '.join(_cm(h) for h in SENS_HEIGHTS)}, times {_pct(SENS_TIMES[0])}-"
-        f"{_pct(SENS_TIMES[-1])} in 5 % steps, sizes 0 and 8 cm (the MGA time rises with size, "
-        "so these bound it; the slope is theirs). The wrist travels "
-        f"{_cm(base.transport_distance)}.",
-        ["tip_start", "digit distance lowest at level (Fig. 4.3a,b)",
-         "via-point time of lowest SD (Fig. 4.5c,d)", "MGA time, sizes 0-8 cm (Fig. 4.10b)",
-         "MGA slope (Fig. 4.10a)"], rows)
-    return table, used
-
-
-def _travel_table(base: GraspTask, used: dict) -> dict:
-    """The digit end-point verdicts for the three readings of the thesis's "20 cm"."""
-    readings = (
-        (0.20, "object centre 20 cm from the wrist's start (lines 770, 915, read literally)"),
-        (0.20 + base.tip_start, "object centre 20 cm from the closed tips"),
-        (0.20 + base.wrist_offset, "the wrist moves 20 cm (line 953, 'distance to be moved'; "
-         "used)"),
-    )
-    rows = []
-    for distance, what in readings:
-        wrist = grasp_moments(plan_grasp(replace(base, distance=distance)))
-        moved = {k: (replace(t, distance=distance), m.with_transport(wrist))
-                 for k, (t, m) in used.items()}
-        cells = _verdict_cells(moved)
-        rows.append([f"{_cm(distance - base.wrist_offset)}: {what}", cells[0], cells[1],
-                     f"{float(np.sqrt(np.trace(wrist.wrist_cov[-1]))) * UM:.1f} µm"])
-    return sensitivity(
-        "transport distance, how far the wrist travels in the standard grasp",
-        "'a disk located 20cm directly in front of the starting position of the arm and "
-        "hand' (line 770; 'in front of the hand', line 915) and 'the distance to be moved' "
-        "(line 953)",
-        "Only the wrist's moments change (the grip is planned in the hand frame), so the "
-        "digit end-point verdicts are recomputed exactly from the grip's moments and each "
-        "transport's; the MGA does not depend on it.",
-        ["wrist travel", "digit distance lowest at level", "via-point time of lowest SD",
-         "wrist end-point SD"], rows)
 
 
 def _claims(base: GraspTask, trials: int, seed: int, out: Path | None):
@@ -750,8 +618,8 @@ def reproduce(out: Path, *, trials: int = 500, seed: int = 0) -> list[dict]:
     theirs, _, _ = _claims(replace(base, **THESIS_SETTINGS), trials, seed, None)
     at_settings(claims, theirs, "r = 0.002, w_v = 0.1: ")
     t0 = time.perf_counter()
-    tip, used = _tip_start_table(base, done)
-    tables = [tip, _travel_table(base, used)]
+    tip, used = tip_start_table(base, done)
+    tables = [tip, travel_table(base, used)]
     log.info("sensitivity: %.1f s", time.perf_counter() - t0)
     _conditional(claims, tip)
     cite(claims, CITES)

@@ -43,6 +43,7 @@ for _p in (ROOT, ROOT / "tools"):
     if str(_p) not in sys.path:
         sys.path.insert(0, str(_p))
 
+from reproduce_ch5_cites import CITES, READING, where  # noqa: E402
 from reproduce_common import at_settings, claim, no_progress, save  # noqa: E402
 
 from perception.batch import discover, run_batch  # noqa: E402
@@ -136,7 +137,7 @@ def verdict_claims(b: Batch, out: Path) -> list[dict]:
             f"{100 * right:.0f} % of {len(group)}", right >= 0.95,
             "confusion table (rows: condition, columns: verdict): "
             + "; ".join(f"{c}: " + ", ".join(f"{v} {n}" for v, n in table.loc[c].items() if n)
-                        for c in table.index) + ".", kind="own", **_at("verdict")))
+                        for c in table.index) + ".", kind="own", **where("verdict")))
     grasp = s[s["condition"].isin(["normal", *ABNORMAL])]
     fam = grasp["familiarity"].to_numpy(float)
     auc = _auc(fam[grasp["condition"].to_numpy() == "normal"],
@@ -144,7 +145,7 @@ def verdict_claims(b: Batch, out: Path) -> list[dict]:
     rows.append(claim("5.3 (verdict; issue 10)", f"{b.name}: familiarity tells normal from "
                       "abnormal grasps (ROC AUC)", "—", f"AUC {auc:.3f}", auc >= 0.95,
                       "familiarity of the best model, normal clips against delayed and "
-                      "open-close-open ones; agreement: AUC >= 0.95.", kind="own", **_at("auc")))
+                      "open-close-open ones; agreement: AUC >= 0.95.", kind="own", **where("auc")))
     return rows
 
 
@@ -160,7 +161,7 @@ def likelihood_claim(b: Batch) -> dict:
                  "is higher for every normal clip than for every abnormal one", "—",
                  f"lowest normal minus highest abnormal: {gap:.0f}", gap > 0,
                  f"medians: normal {np.median(normal):.0f}, abnormal {np.median(other):.0f}.",
-                 kind="own", **_at("likelihood"))
+                 kind="own", **where("likelihood"))
 
 
 # -- the thesis rule, read on the reference grasp model (Fig. 5.8) -------------------
@@ -192,7 +193,7 @@ def final_claims(b: Batch) -> list[dict]:
             f"{t.statistic:.1f}, p = {t.pvalue:.2g}; Hedges' g = {g:.1f}",
             pairs >= 0.95 and margin >= 0.10 and t.pvalue < 0.01,
             "agreement (issue 10): >= 95 % of pairs, median margin >= 10 % of normal's, "
-            "p < 0.01.", **_at("final")))
+            "p < 0.01.", **where("final")))
     return rows
 
 
@@ -222,7 +223,7 @@ def first_half_claim(b: Batch) -> dict:
         "Fig. 5.8 plots the whole confidence C, so C is judged: 'significant' is beyond 2 "
         "standard errors across clips. The grip term alone hardly rises; the transport "
         "term, the same movement in both stimuli, rises as for a normal grasp.",
-        **_at("first half"))
+        **where("first half"))
 
 
 def later_claims(b: Batch) -> list[dict]:
@@ -246,7 +247,7 @@ def later_claims(b: Batch) -> list[dict]:
               f"{100 * se_d:.2f} cm; final C {100 * fin['delayed'].mean():.1f} vs normal's "
               f"{100 * fin['normal'].mean():.1f} cm", m_d > 2 * se_d and low[0] > 2 * low[1],
               "agree if the second half's rise and normal's lead at the end both exceed 2 "
-              "standard errors across clips.", **_at("gradual")),
+              "standard errors across clips.", **where("gradual")),
         claim("5.4.3, Fig. 5.8(a,c)", f"{b.name}: the rate of increase over the second half is "
               "greatest for normal", "still greater for the prediction against the observed "
               "normal grasp than for either of the other two", "normal's second-half rise "
@@ -254,7 +255,7 @@ def later_claims(b: Batch) -> list[dict]:
                                    for c, (g, e) in faster.items()),
               all(g > 2 * e for g, e in faster.values()),
               "agree if normal's rise over 50-100 % exceeds each other stimulus's by more than "
-              "2 standard errors of the difference.", **_at("rate")),
+              "2 standard errors of the difference.", **where("rate")),
         claim("5.4.3, Fig. 5.8(a)", f"{b.name}: open-close-open follows normal until the "
               "unexpected closing", "closely follows the trend of the normal movement until "
               "the point of the sudden digit closure", f"C at 40 %: normal minus "
@@ -262,7 +263,7 @@ def later_claims(b: Batch) -> list[dict]:
               abs(before[0]) < 2 * before[1],
               "agree if the two mean profiles at 40 % of the movement (before any closing) do "
               "not differ by more than 2 standard errors of the difference.",
-              **_at("follows")),
+              **where("follows")),
     ]
 
 
@@ -281,7 +282,7 @@ def weights_claim(b: Batch) -> dict:
         f"transport's share of sum |dC| on normal clips {100 * mean:.0f} ± {100 * se:.0f} % "
         f"(range {100 * min(shares):.0f}-{100 * max(shares):.0f} %)",
         abs(mean - 0.5) < 2 * se, "agree if the share is 50 % within 2 standard errors "
-        "across clips.", **_at("weights"))
+        "across clips.", **where("weights"))
 
 
 def selection_claim(b: Batch) -> dict:
@@ -303,7 +304,7 @@ def selection_claim(b: Batch) -> dict:
         all(k > n / 2 for k, n in right.values()),
         "the thesis rule's final confidence over the whole repertoire (grasp and reach "
         "models); agree if most clips of each kind pick a model of their kind.",
-        **_at("selection"))
+        **where("selection"))
 
 
 def _closing(s: dict) -> tuple[int, int] | None:
@@ -351,7 +352,7 @@ def oco_claims(b: Batch) -> list[dict]:
         claim("5.4.3, Fig. 5.8(c)", f"{b.name}: the mean open-close-open profile falls after "
               "the unexpected closing (by >= 3 % of its value), then recovers", what,
               f"falls {100 * mean_fall:.1f} %; recovers: {'yes' if mean_up else 'no'}",
-              mean_fall >= 0.03 and mean_up, how, **_at("oco")),
+              mean_fall >= 0.03 and mean_up, how, **where("oco")),
         claim("5.4.3, Fig. 5.8(b)", f"{b.name}: each open-close-open clip's profile falls "
               "(by >= 3 %) and recovers", what,
               f"falls >= 3 % in {100 * share:.0f} % of {len(falls)} clips (median "
@@ -360,7 +361,7 @@ def oco_claims(b: Batch) -> list[dict]:
               how + " Agreement: >= 95 % of clips. A clip whose closing coincides with the "
               "reference model's own closing (a slow demonstration read on a faster model) "
               "earns confidence for it instead: the model predicts that closing too.",
-              **_at("oco")),
+              **where("oco")),
     ]
 
 
@@ -395,7 +396,7 @@ def normal_peak_claim(b: Batch) -> dict:
         f"{100 * np.median(printed[:, 0]):.0f} % and falls "
         f"{100 * np.median(printed[:, 1]):.1f} % after it: the thesis's shape comes from "
         "its printed sign, which ignores the predicted direction, so it is not our rule.",
-        **_at("peak"))
+        **where("peak"))
 
 
 def _rise_sd(b: Batch, cond: str, lo: float, hi: float) -> float:
@@ -434,7 +435,7 @@ def sd_claim(b: Batch) -> dict:
         "opposing steps cancel), so it varies little there; it varies once each clip's late "
         "opening begins, at a different time in each. An open-close-open clip varies most "
         "before its closing, in what its first opening earns; the fall itself is alike.",
-        **_at("sd"))
+        **where("sd"))
 
 
 def aperture_claims(b: Batch) -> list[dict]:
@@ -454,7 +455,7 @@ def aperture_claims(b: Batch) -> list[dict]:
               f"(model {b.reference}: {100 * mga_model:.1f} cm at {100 * t_model:.0f} %)",
               abs(mga_obs - mga_model) <= 0.02 and abs(t_obs - t_model) <= 0.1,
               "agreement: maximum aperture within 2 cm and 10 % of the movement.",
-              **_at("aperture")),
+              **where("aperture")),
         claim("5.4.1, Fig. 5.4(d)", f"{b.name}: aperture varies more for the abnormal grasps",
               "variances greater for the non-natural grips",
               "largest SD " + ", ".join(f"{c} {100 * v[1]:.2f} cm" for c, v in sd.items())
@@ -462,7 +463,7 @@ def aperture_claims(b: Batch) -> list[dict]:
               all(sd[c][1] > sd["normal"][1] for c in ABNORMAL if c in sd),
               "SD across clips over normalised movement time; agreement judged on the largest "
               "(the widest band of the figure). A delayed grasp's closed digits vary little for "
-              "half the movement, so its mean SD can be below normal's.", **_at("aperture sd")),
+              "half the movement, so its mean SD can be below normal's.", **where("aperture sd")),
     ]
 
 
@@ -488,91 +489,7 @@ def prediction_claim(b: Batch, recs: dict, inside: str) -> dict:
         f"fig5_5-5_7_*_{b.name}.png): its noise-free movement from the clip's onset; "
         "agreement: abnormal > 1.5 x normal. Clips whose observed digit paths enter the "
         f"object by more than 1 cm: {inside} (the stimulus generator's, not the figure's).",
-        **_at("prediction"))
-
-
-#: Per kind of claim: where the thesis says it, and the measure it is judged by.
-_WHERE = {
-    "verdict": ("issue 10 (not in the thesis; 5.3 picks the most confident model, line 1061)",
-                "share of the condition's clips, rendered and tracked, whose verdict is the "
-                "condition's"),
-    "auc": ("issue 10 (not in the thesis; 5.3, line 1061)",
-            "ROC AUC of the best model's familiarity, normal clips against delayed and "
-            "open-close-open ones"),
-    "likelihood": ("5.3, line 1061",
-                   "the best grasp model's final log-likelihood: lowest normal minus highest "
-                   "abnormal"),
-    "final": ("5.4.3, Fig. 5.8; lines 995, 1156",
-              "the reference model's final C: share of pairs, median margin, Welch t, "
-              "Hedges' g"),
-    "first half": ("5.4.3, Fig. 5.8(a); line 1139",
-                   "rise of C and of its grip and transport terms up to 50 % of the movement, "
-                   "as shares of normal's"),
-    "oco": ("5.4.3, Fig. 5.8; line 1154",
-            "fall of C from its peak before the closing's deepest point, as a share of the peak"),
-    "peak": ("5.4.3, Fig. 5.8(a); line 1137",
-             "phase of C's maximum against the maximum aperture's; fall after it"),
-    "sd": ("5.4.3, Fig. 5.8(c); line 1156",
-           "SD across clips of C's rise within windows of normalised movement time"),
-    "aperture": ("5.4.1, Fig. 5.4(d); line 1093",
-                 "maximum aperture and its time against the reference model's own"),
-    "aperture sd": ("5.4.1, Fig. 5.4(d); line 1109",
-                    "largest SD across clips of the aperture over normalised movement time"),
-    "prediction": ("5.4.3, Figs. 5.5-5.7; line 1133",
-                   "median |observed - model's own| aperture over the movement"),
-    "gradual": ("5.4.3, Fig. 5.8(a); line 1152",
-                "rise of C over 50-100 % of the movement, and the final C against normal's"),
-    "rate": ("5.4.3, Figs. 5.8(a,c); line 1154", "rise of C over 50-100 %, normal against "
-             "each other stimulus"),
-    "follows": ("5.4.3, Fig. 5.8(a); line 1154", "mean C at 40 % of the movement, normal "
-                "against open-close-open"),
-    "weights": ("5.4.2; line 1125", "transport term's share of the summed |dC| on normal "
-                "clips"),
-    "selection": ("5.3; lines 1033, 1061", "kind of the model with the highest final thesis-"
-                  "rule confidence, normal and reach clips"),
-}
-
-#: Claim text after the generator's name -> (thesis line, the words, what supports a reading).
-CITES = {
-    "final confidence of": (995, "significantly higher confidences when presented with normal "
-                            "grasps"),
-    "delayed opening rises little": (1139, "does not show any significant increase in value "
-                                     "during the first half"),
-    "the mean open-close-open profile falls": (1154, "a notable descending trend followed by a "
-                                               "gradual increase"),
-    "each open-close-open clip's profile falls": (1156, "This pattern is reproduced amongst all "
-                                                  "captured trajectories"),
-    "normal's confidence peaks": (1137, "reaching its maximum at the point of maximum "
-                                  "aperture and subsequently reducing slightly"),
-    "the confidence varies little": (1156, "These bars are small for the prediction against "
-                                     "the normal grasp"),
-    "the normal grasp's aperture is like": (1093, "the similarity between the grip aperture "
-                                            "profile"),
-    "aperture varies more": (1109, "understandably greater for the non-natural grips"),
-    "the normal grasp model's own movement": (1133, "how similar the predicted movement is to "
-                                              "the observed movement"),
-    "delayed rises gradually": (1152, "causing a gradual increase in the confidence level"),
-    "the rate of increase over the second half": (1154, "the rate of confidence increase during "
-                                                  "the second half of the movement is still "
-                                                  "greater"),
-    "open-close-open follows normal": (1154, "closely follows the trend of the normal "
-                                       "movement until the point of the sudden digit closure"),
-    "with w_r / w_g = 1/2": (1125, "the relative contribution of each component of the "
-                             "movement to the overall confidence is the same"),
-    "the model with the highest confidence": (1061, "the model with the highest confidence "
-                                              "can be selected"),
-}
-#: Which reading of eqs. 5.1/5.7 the thesis's own words and figure support, per row.
-READING = {
-    "normal's confidence peaks": "the figure's shape (a peak at maximum aperture, a fall "
-    "after it) matches the printed reading; the text (line 1070) is ours",
-}
-
-
-def _at(kind: str) -> dict:
-    """``location`` and ``measure`` of a kind of claim (keys of :data:`_WHERE`)."""
-    location, measure = _WHERE[kind]
-    return {"location": location, "measure": measure}
+        **where("prediction"))
 
 
 def _dress(c: dict, generator: str) -> dict:
