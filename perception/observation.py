@@ -34,9 +34,13 @@ __all__ = [
     "MovementSpan",
     "ObserveParams",
     "Observation",
+    "RestScene",
     "alpha_beta",
+    "check_hand",
     "movement_span",
     "observe",
+    "onset_time",
+    "rest_scene",
 ]
 
 log = logging.getLogger(__name__)
@@ -367,18 +371,50 @@ class Observation:
         return np.linalg.norm(self.finger - self.thumb, axis=-1)
 
 
+class RestScene(NamedTuple):
+    """What the first frames of a clip fix (:func:`rest_scene`).
+
+    The offline observation and the online recogniser
+    (:class:`perception.online.OnlineRecognizer`) both start from it.
+
+    Attributes
+    ----------
+    source : str
+        What errors name: the tracks file, else the clip.
+    time : (T,) float
+        Time stamps, s (finite, increasing).
+    dts : (T-1,) float
+        Frame periods, s.
+    dt : float
+        The median frame period, s.
+    transform : SimilarityTransform
+        Pixels -> model frame: the object at the origin, the wrist's rest
+        position on the -y axis, metres.
+    raw : (T, 3, 2) float
+        Wrist, finger and thumb markers in the model frame, m, unfiltered.
+    rest : (3, 2) float
+        The mean rest posture, m, in that order.
+    noise : float
+        Tracking noise at rest (robust SD), m.
+    """
+
+    source: str
+    time: np.ndarray
+    dts: np.ndarray
+    dt: float
+    transform: SimilarityTransform
+    raw: np.ndarray
+    rest: np.ndarray
+    noise: float
+
+
 class _Prepared(NamedTuple):
-    """Everything known about a clip once its movement is found."""
+    """A clip's scene, its smoothed positions (T, 3, 2) m and its movement."""
 
     name: str
     frames: np.ndarray
-    time: np.ndarray
-    dt: float
-    transform: SimilarityTransform
-    raw: np.ndarray      # (T, 3, 2) m, DIGIT_MARKERS order
-    filtered: np.ndarray  # (T, 3, 2) m
-    rest_mean: np.ndarray  # (3, 2) m
-    noise: float
+    scene: RestScene
+    filtered: np.ndarray
     span: MovementSpan
 
 
@@ -482,12 +518,32 @@ def _rest_noise(raw: np.ndarray, params: ObserveParams, name: str) -> tuple[floa
     return float(noise), mean
 
 
-def _onset_time(filtered: np.ndarray, time: np.ndarray, noise: float, params: ObserveParams,
-                name: str) -> float:
+def onset_time(filtered: np.ndarray, time: np.ndarray, noise: float, params: ObserveParams,
+               name: str) -> float:
     """When the movement's command began, s: the wrist's crossing less the model's latency.
 
     The crossing is where the wrist's displacement from rest first exceeds
-    the threshold for ``onset_hold_frames`` frames, interpolated between frames.
+    the threshold for ``onset_hold_frames`` frames, interpolated between
+    frames. It looks at no frame past those ``onset_hold_frames``, so the
+    online recogniser applies it to the rows seen so far.
+
+    Parameters
+    ----------
+    filtered : (T, 3, 2) array
+        Smoothed wrist, finger and thumb positions in the model frame, m.
+    time : (T,) array
+        Their times, s.
+    noise : float
+        Tracking noise at rest, m (:attr:`RestScene.noise`).
+    params : ObserveParams
+        The onset rule's settings.
+    name : str
+        What an error names.
+
+    Raises
+    ------
+    InputError
+        The wrist never leaves its rest position.
     """
     w = filtered[:, 0]
     disp = np.linalg.norm(w - np.median(w[: params.rest_frames], axis=0), axis=1)
@@ -534,25 +590,50 @@ def _end_row(filtered: np.ndarray, time: np.ndarray, noise: float, dt: float,
     return int(min(last, active[-1] + k * params.end_pad_frames)) if len(active) else last
 
 
-def _prepare(tracks, params: ObserveParams, name: str) -> _Prepared:
-    """Scene, smoothed model-frame positions and the movement span of some tracks."""
-    where = _source(tracks, name)  # errors name the tracks file where there is one
+def rest_scene(tracks, params: ObserveParams | None = None, *,
+               clip: str | None = None) -> RestScene:
+    """The scene a clip's first frames fix: transform, rest posture and noise.
+
+    Parameters
+    ----------
+    tracks : Tracks
+        See :func:`observe`; only the first ``2 x params.rest_frames`` rows
+        are needed (the online recogniser passes no more).
+    params : ObserveParams, optional
+        Scale and rest settings.
+    clip : str, optional
+        Clip name for messages.
+
+    Raises
+    ------
+    InputError
+        A needed marker is missing or never seen, the time stamps are not
+        finite, increasing seconds, the scale is unknown, or the clip does
+        not start with the hand still and visible.
+    """
+    params = ObserveParams() if params is None else params
+    where = _source(tracks, _clip_name(tracks, clip))  # the tracks file where there is one
     px = _marker_pixels(tracks, params, where)
     time, dts = _frame_times(tracks, params, where)
-    dt = float(np.median(dts))
     transform = _scene_transform(px, tracks, params, where)
     raw = np.stack([transform.to_model(px[m]) for m in DIGIT_MARKERS], axis=1)
-    noise, rest_mean = _rest_noise(raw, params, where)
-    filtered = alpha_beta(raw, np.concatenate([[dt], dts]), params.alpha, params.beta)
-    onset_time = _onset_time(filtered, time, noise, params, where)
-    start = int(np.searchsorted(time, onset_time))
-    end = _end_row(filtered, time, noise, dt, params)
+    noise, rest = _rest_noise(raw, params, where)
+    return RestScene(where, time, dts, float(np.median(dts)), transform, raw, rest, noise)
+
+
+def _prepare(tracks, params: ObserveParams, name: str) -> _Prepared:
+    """Scene, smoothed model-frame positions and the movement span of some tracks."""
+    sc = rest_scene(tracks, params, clip=name)
+    filtered = alpha_beta(sc.raw, np.concatenate([[sc.dt], sc.dts]), params.alpha, params.beta)
+    onset = onset_time(filtered, sc.time, sc.noise, params, sc.source)
+    start = int(np.searchsorted(sc.time, onset))
+    end = _end_row(filtered, sc.time, sc.noise, sc.dt, params)
     if end - start + 1 < params.min_frames:
         raise InputError(f"movement too short to score: {end - start + 1} frames "
-                         f"(need at least {params.min_frames})", where)
-    frames = np.asarray(getattr(tracks, "frame", np.arange(len(time))))
-    span = MovementSpan(start, end + 1, int(frames[start]), int(frames[end]), onset_time)
-    return _Prepared(name, frames, time, dt, transform, raw, filtered, rest_mean, noise, span)
+                         f"(need at least {params.min_frames})", sc.source)
+    frames = np.asarray(getattr(tracks, "frame", np.arange(len(sc.time))))
+    span = MovementSpan(start, end + 1, int(frames[start]), int(frames[end]), onset)
+    return _Prepared(name, frames, sc, filtered, span)
 
 
 def movement_span(tracks, params: ObserveParams | None = None, *,
@@ -577,9 +658,19 @@ def movement_span(tracks, params: ObserveParams | None = None, *,
     return _prepare(tracks, params, _clip_name(tracks, clip)).span
 
 
-def _check_hand(rest_mean: np.ndarray, params: ObserveParams, name: str) -> None:
-    """The rest posture must look like a hand: digits touching, in front of the wrist."""
-    wrist, finger, thumb = rest_mean
+def check_hand(scene: RestScene, params: ObserveParams | None = None) -> None:
+    """Refuse a rest posture that does not look like a hand.
+
+    The digits must touch, and sit in front of the wrist at a hand's
+    distance (``params.max_rest_aperture``, ``params.hand_size_range``).
+
+    Raises
+    ------
+    InputError
+        Naming ``scene.source``.
+    """
+    params = ObserveParams() if params is None else params
+    wrist, finger, thumb = scene.rest
     apart = float(np.linalg.norm(finger - thumb))
     size = float(np.linalg.norm(0.5 * (finger + thumb) - wrist))
     lo, hi = params.hand_size_range
@@ -587,7 +678,7 @@ def _check_hand(rest_mean: np.ndarray, params: ObserveParams, name: str) -> None
         raise InputError(f"the hand at rest does not look like a hand: finger and thumb "
                          f"markers {apart * 100:.1f} cm apart, {size * 100:.1f} cm from the "
                          "wrist (a same-coloured object taken for a marker? give --roi when "
-                         "tracking, or check --px-per-m)", name)
+                         "tracking, or check --px-per-m)", scene.source)
 
 
 def observe(tracks, params: ObserveParams | None = None, *, clip: str | None = None) -> Observation:
@@ -619,8 +710,9 @@ def observe(tracks, params: ObserveParams | None = None, *, clip: str | None = N
     """
     params = ObserveParams() if params is None else params
     p = _prepare(tracks, params, _clip_name(tracks, clip))
-    _check_hand(p.rest_mean, params, _source(tracks, p.name))
-    start, finger0, thumb0 = p.rest_mean
+    sc = p.scene
+    check_hand(sc, params)
+    start, finger0, thumb0 = sc.rest
     # The digits touch at rest (as in the model), so the markers' separation
     # then is where they sit on the digits, outside the tips: take it off.
     half = 0.5 * (finger0 - thumb0)
@@ -631,21 +723,21 @@ def observe(tracks, params: ObserveParams | None = None, *, clip: str | None = N
     moved = float(np.nanmax(np.linalg.norm(filt[sl, 0] - start, axis=-1), initial=0.0))
     if moved < params.min_movement:
         raise InputError(f"no movement: the wrist moves {moved * 1000:.0f} mm (a reach moves at "
-                         f"least {params.min_movement * 1000:.0f} mm)", _source(tracks, p.name),
+                         f"least {params.min_movement * 1000:.0f} mm)", sc.source,
                          field="wrist")
     log.info("%s: onset at frame %d, %d frames scored, start distance %.3f m",
              p.name, p.span.onset_frame, p.span.n_frames, np.linalg.norm(start))
     return Observation(
         clip=p.name,
         frame=p.frames[sl],
-        time=p.time[sl] - p.span.onset_time,
+        time=sc.time[sl] - p.span.onset_time,
         wrist=filt[sl, 0],
         finger=filt[sl, 1],
         thumb=filt[sl, 2],
-        raw={m: p.raw[sl, i] for i, m in enumerate(DIGIT_MARKERS)},
-        noise=p.noise,
-        scene=p.transform,
-        dt=p.dt,
+        raw={m: sc.raw[sl, i] for i, m in enumerate(DIGIT_MARKERS)},
+        noise=sc.noise,
+        scene=sc.transform,
+        dt=sc.dt,
         onset_frame=p.span.onset_frame,
         end_frame=p.span.end_frame,
         start_distance=float(np.linalg.norm(start)),

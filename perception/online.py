@@ -36,16 +36,7 @@ import numpy as np
 
 from perception.errors import InputError
 from perception.io.tracks import Status, Tracks
-from perception.observation import (
-    DIGIT_MARKERS,
-    AlphaBeta,
-    _check_hand,
-    _frame_times,
-    _marker_pixels,
-    _onset_time,
-    _rest_noise,
-    _scene_transform,
-)
+from perception.observation import DIGIT_MARKERS, AlphaBeta, check_hand, onset_time, rest_scene
 from perception.pipeline import RecognitionSettings, recognize_tracks
 from perception.recognition.models import SceneSpec
 from perception.recognition.online import StepScorer
@@ -204,16 +195,11 @@ class OnlineRecognizer:
 
     def _fix_scene(self) -> None:
         """Scene, rest posture, noise and models from the rest frames, as offline; plan once."""
-        params, name = self.settings.observe, self.clip
-        tracks = self.tracks()
-        px = _marker_pixels(tracks, params, name)
-        time, dts = _frame_times(tracks, params, name)
-        transform = _scene_transform(px, tracks, params, name)
-        raw = np.stack([transform.to_model(px[m]) for m in DIGIT_MARKERS], axis=1)
-        noise, rest = _rest_noise(raw, params, name)
-        _check_hand(rest, params, name)
+        params = self.settings.observe
+        first = rest_scene(self.tracks(), params, clip=self.clip)
+        check_hand(first, params)
+        transform, rest, noise, dt = first.transform, first.rest, first.noise, first.dt
         half = 0.5 * (rest[1] - rest[2])
-        dt = float(np.median(dts))
         scene = SceneSpec(distance=float(np.linalg.norm(rest[0])),
                           object_size=params.object_diameter, frame_period=dt,
                           tip_start=float((0.5 * (rest[1] + rest[2]) - rest[0])[1]))
@@ -254,7 +240,7 @@ class OnlineRecognizer:
         sc, params = self._scene, self.settings.observe
         time = np.asarray(self._rows["time"], dtype=float)
         try:
-            onset = _onset_time(np.asarray(sc.filtered), time, sc.noise, params, self.clip)
+            onset = onset_time(np.asarray(sc.filtered), time, sc.noise, params, self.clip)
         except InputError:  # no movement yet
             return
         self._onset = onset

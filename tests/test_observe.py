@@ -6,7 +6,14 @@ from _demos import demo_tracks
 
 from perception.errors import InputError
 from perception.geometry import SimilarityTransform
-from perception.observation import ObserveParams, alpha_beta, movement_span, observe
+from perception.observation import (
+    ObserveParams,
+    alpha_beta,
+    check_hand,
+    movement_span,
+    observe,
+    rest_scene,
+)
 
 
 def test_pixel_transform_round_trip():
@@ -156,3 +163,24 @@ def test_movement_span_is_what_observe_scores():
         np.testing.assert_array_equal(tracks.frame[span.rows], obs.frame)
         assert span.n_frames == obs.n_frames
         assert abs(span.onset_frame - truth["onset_frame"]) <= 1
+
+
+@pytest.mark.parametrize("angle", [0.0, 35.0])
+def test_rest_scene_from_the_first_rows_is_the_whole_clips(angle):
+    # the online recogniser fixes the scene from 2 x rest_frames rows: it
+    # must be the scene the offline observation fixes from the whole clip
+    tracks, truth = demo_tracks("normal", 1, angle_deg=angle, noise_px=0.3)
+    params = ObserveParams()
+    whole = rest_scene(tracks, params)
+    first = rest_scene(tracks.rows(0, 2 * params.rest_frames), params)
+    np.testing.assert_array_equal(first.transform.matrix, whole.transform.matrix)
+    np.testing.assert_array_equal(first.rest, whole.rest)
+    assert first.noise == whole.noise
+    obs = observe(tracks, params)
+    np.testing.assert_array_equal(whole.transform.matrix, obs.scene.matrix)
+    assert whole.noise == obs.noise
+    # the rest posture is the true one, in metres
+    np.testing.assert_allclose(whole.rest[0], truth["world"]["wrist"][0], atol=2e-3)
+    check_hand(whole, params)  # a hand: no error
+    with pytest.raises(InputError, match="does not look like a hand"):
+        check_hand(whole._replace(rest=whole.rest * 10), params)

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import math
 import socket
 import subprocess
 import sys
@@ -11,6 +10,7 @@ import time
 
 import pytest
 from _demos import default_repertoire
+from _reports import assert_json_close
 
 from perception.synthetic.demos import render_demo_clip
 
@@ -31,20 +31,9 @@ def _hammer(*args, **kw):
                           capture_output=True, text=True, **kw)
 
 
-def _close(a, b, path=""):
-    """Equal JSON values, floats to 1e-9 relative (a stream's time base rounds differently)."""
-    if isinstance(a, dict):
-        assert a.keys() == b.keys(), path
-        for k in a:
-            _close(a[k], b[k], f"{path}.{k}")
-    elif isinstance(a, list):
-        assert len(a) == len(b), path
-        for i, (x, y) in enumerate(zip(a, b)):
-            _close(x, y, f"{path}[{i}]")
-    elif isinstance(a, float) and isinstance(b, float):
-        assert math.isclose(a, b, rel_tol=1e-9, abs_tol=1e-12), (path, a, b)
-    else:
-        assert a == b, path
+# floats to 1e-9 relative: a stream's time base rounds differently
+def _close(a, b):
+    return assert_json_close(a, b, rel=1e-9, abs_=1e-12)
 
 
 def test_watch_a_file_writes_what_recognize_writes(clip, tmp_path):

@@ -112,23 +112,20 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message}\n")
 
 
-def _common_flags(parser: argparse.ArgumentParser) -> None:
-    """Give ``parser`` and every parser below it ``-v/--verbose`` and ``--quiet``.
+def _common_flags(parser: argparse.ArgumentParser, top: bool = True) -> None:
+    """Give ``parser`` and every command parser below it ``-v/--verbose`` and ``--quiet``.
 
     Below the top level they default to SUPPRESS, so ``hammer-mv -v track``
     and ``hammer-mv track -v`` mean the same.
     """
     subs = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
     for child in {id(c): c for a in subs for c in a.choices.values()}.values():
-        _common_flags(child)
-    if parser.prog == "hammer-mv" or subs:
-        return
-    flags = {s for a in parser._actions for s in a.option_strings}
-    if "--verbose" not in flags:
-        parser.add_argument("-v", "--verbose", action="store_true", default=argparse.SUPPRESS,
+        _common_flags(child, top=False)
+    if top or not subs:
+        default = False if top else argparse.SUPPRESS
+        parser.add_argument("-v", "--verbose", action="store_true", default=default,
                             help="log progress details and show library warnings")
-    if "--quiet" not in flags:
-        parser.add_argument("--quiet", action="store_true", default=argparse.SUPPRESS,
+        parser.add_argument("--quiet", action="store_true", default=default,
                             help="no progress bars or summaries")
 
 
@@ -143,9 +140,6 @@ def build_parser(command: str | None | object = _EVERY) -> argparse.ArgumentPars
     """
     parser = _Parser(prog="hammer-mv", description=DESCRIPTION)
     parser.add_argument("--version", action="version", version=f"hammer-mv {__version__}")
-    parser.add_argument("-v", "--verbose", action="store_true",
-                        help="log progress details and show library warnings")
-    parser.add_argument("--quiet", action="store_true", help="no progress bars or summaries")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     for name, summary in COMMANDS.items():
         if command is _EVERY or command == name:
@@ -157,7 +151,6 @@ def build_parser(command: str | None | object = _EVERY) -> argparse.ArgumentPars
 
 
 def _command(argv: list[str]) -> str | None:
-    """The subcommand named in ``argv`` (its first word that is not an option)."""
     for arg in argv:
         if arg == "--":
             return None
@@ -181,7 +174,6 @@ def _user_error(exc: BaseException) -> str:
 
 
 def _warnings_line(command: str, caught: list[warnings.WarningMessage]) -> str:
-    """One line that counts the library warnings a command raised, naming the first."""
     first = caught[0]
     return (f"hammer-mv {command}: {len(caught)} library warning(s) hidden (first: "
             f"{first.category.__name__}: {_first_line(str(first.message))}); -v shows them")
@@ -227,10 +219,8 @@ def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     parser = build_parser(_command(argv))
     args = parser.parse_args(argv)
-    logging.basicConfig(
-        level=logging.INFO if args.verbose else logging.WARNING,
-        format="%(levelname)s %(name)s: %(message)s",
-    )
+    logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
+                        format="%(levelname)s %(name)s: %(message)s")
     if not getattr(args, "func", None):
         parser.print_help(sys.stderr)
         return 2

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections import Counter
 from pathlib import Path
 
 from hammer_mv.cli.checks import cap_jobs, output_folder
@@ -91,17 +92,14 @@ def failure_reasons(summary, items) -> str:
     items : list of BatchItem
         The clips (their paths).
     """
-    from collections import Counter
-
     paths = {item.clip: str(item.path) for item in items}
     reasons = Counter()
     for clip, status, error in zip(summary["clip"], summary["status"], summary["error"]):
         if status == "ok":
             continue
         reason = str(error or "").strip() or "unknown error"
-        prefix = f"{paths.get(clip, '')}: "
-        if prefix != ": " and reason.startswith(prefix):
-            reason = reason[len(prefix):]
+        if clip in paths:
+            reason = reason.removeprefix(f"{paths[clip]}: ")
         reasons[reason.splitlines()[0]] += 1
     reason, count = reasons.most_common(1)[0]
     others = sum(reasons.values()) - count

@@ -12,15 +12,11 @@ from hammer_mv.cli.track import parse_rois
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``calibrate`` subcommand to ``subparsers`` (an argparse subparsers action)."""
     p = subparsers.add_parser(
-        "calibrate",
-        help="learn the colour models and marker sizes of a setup from one clip",
-        description=(
-            "Learn each marker's colour (hue, saturation and value ranges of its own pixels) "
-            "and the markers' sizes from the first frames of VIDEO (the hand at rest, every "
-            "marker in view), and write a setup file that track, recognize and batch take "
-            "with --setup. Markers are found automatically; give --roi where that fails."
-        ),
-    )
+        "calibrate", help="learn the colour models and marker sizes of a setup from one clip",
+        description="Learn each marker's colour (hue, saturation and value ranges of its own "
+        "pixels) and the markers' sizes from the first frames of VIDEO (the hand at rest, every "
+        "marker in view), and write a setup file that track, recognize and batch take with "
+        "--setup. Markers are found automatically; give --roi where that fails.")
     p.add_argument("video", type=Path, metavar="VIDEO", help="one clip of the session")
     p.add_argument("-o", "--output", type=Path, required=True, metavar="SETUP.toml",
                    help="setup file to write")

@@ -13,7 +13,7 @@ import os
 import re
 import sys
 from collections.abc import Iterator, Mapping
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from pathlib import Path
 
 from perception.errors import HammerMVError, InputError
@@ -23,12 +23,6 @@ __all__ = ["WORKER_BYTES", "cap_jobs", "check_seed", "free_memory", "option", "o
 
 #: Memory one worker process may need (a clip's frames, tracks and models), bytes.
 WORKER_BYTES = 600 * 2**20
-
-
-def _problem(message: str, field: str) -> str:
-    """``message`` without a leading ``"<field>: "`` (the field is named once)."""
-    prefix = f"{field}: "
-    return message[len(prefix):] if message.startswith(prefix) else message
 
 
 @contextmanager
@@ -50,11 +44,10 @@ def option(field: str) -> Iterator[None]:
         if exc.path is not None or exc.field == field:
             raise
         # a library's own name for the value ("ViaPoint.position") after the option's
-        problem = _problem(exc.problem if exc.field is None else f"{exc.field}: {exc.problem}",
-                           field)
-        raise type(exc)(problem, field=field) from None
+        problem = exc.problem if exc.field is None else f"{exc.field}: {exc.problem}"
+        raise type(exc)(problem.removeprefix(f"{field}: "), field=field) from None
     except ValueError as exc:
-        raise InputError(_problem(str(exc), field), field=field) from None
+        raise InputError(str(exc).removeprefix(f"{field}: "), field=field) from None
 
 
 #: ``Owner.attribute[i]: message`` of the minvar and perception validators.
@@ -97,17 +90,16 @@ def options(fields: Mapping[str, str]) -> Iterator[None]:
 
 def _renamed(message: str, fields: Mapping[str, str]) -> tuple[str, str | None] | None:
     """(problem, option) for :func:`options`, or None if the message names no option."""
-    flag = next((f for f in fields.values() if message.startswith(f"{f}: ")
-                 or message.startswith(f"{f} ")), None)
+    flag = next((f for f in fields.values() if message.startswith((f"{f}: ", f"{f} "))), None)
     if flag is not None:  # the message names the flag itself
         if message.startswith(f"{flag}: "):
-            return _problem(message, flag), flag
+            return message.removeprefix(f"{flag}: "), flag
         return message, None  # "--flag VALUE: ..."
     match = _ATTRIBUTE.match(message)
     if match is None or match.group(1) not in fields:
         return None
     field = fields[match.group(1)]
-    return _problem(match.group(2), field), field
+    return match.group(2).removeprefix(f"{field}: "), field
 
 
 def check_seed(seed: int, field: str = "--seed") -> int:
@@ -143,13 +135,10 @@ def usable_cores() -> int:
 
 def free_memory() -> int | None:
     """Memory available to new processes, bytes (``MemAvailable``), or None if unknown."""
-    try:
-        with open("/proc/meminfo") as fh:
-            for line in fh:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024  # kB
-    except (OSError, ValueError, IndexError):
-        pass
+    with suppress(OSError, ValueError, IndexError), open("/proc/meminfo") as fh:
+        for line in fh:
+            if line.startswith("MemAvailable:"):
+                return int(line.split()[1]) * 1024  # kB
     return None
 
 

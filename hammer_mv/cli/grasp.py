@@ -9,7 +9,6 @@ thesis's figures).
 from __future__ import annotations
 
 import argparse
-import logging
 import time
 from pathlib import Path
 
@@ -19,8 +18,6 @@ from minvar.grasp_experiments import EXPERIMENTS, THESIS_TRIALS, check_trials
 from minvar.limits import MAX_TRIALS, check_position, check_steps
 from minvar.plant import PointMassPlant
 from perception.io.atomic import save_figure, write_csv, write_json
-
-log = logging.getLogger(__name__)
 
 #: Columns of trajectories.csv (:meth:`minvar.grasp.GraspResult.to_pandas`).
 TABLE_COLUMNS = 17
@@ -139,7 +136,7 @@ def run_simulate(args: argparse.Namespace) -> int:
         plant = PointMassPlant(dt=args.dt)
     with option("--duration"):
         check_steps(args.duration, args.dt, "--duration")
-    output_folder(args.output)
+    out = output_folder(args.output)
     with options(TASK_FIELDS):
         task = GraspTask(
             object_size=args.object_size, distance=args.distance, duration=args.duration,
@@ -154,12 +151,10 @@ def run_simulate(args: argparse.Namespace) -> int:
     plan = plan_grasp(task)
     result = simulate_grasp(task, args.trials, seed=args.seed, plan=plan)
     summary = summarize_grasp(result, grasp_moments(plan))
-    out: Path = args.output
     info = {
         "task": {k: getattr(task, k) for k in (
             "object_size", "distance", "transport_distance", "duration", "viapoint_offset",
-            "viapoint_height",
-            "viapoint_time", "reach_only", "execution_cv", "execution_sigma_s",
+            "viapoint_height", "viapoint_time", "reach_only", "execution_cv", "execution_sigma_s",
             "wrist_offset", "tip_start", "shoulder_offset", "arm_links", "digit_links")},
         "dt_s": task.plant.dt,
         "trials": args.trials,
@@ -190,9 +185,8 @@ def run_experiment(args: argparse.Namespace) -> int:
     with option("--trials"):
         check_trials(args.trials, name="--trials")
     check_seed(args.seed)
-    output_folder(args.output)
+    out = output_folder(args.output)
     names = list(EXPERIMENTS) if args.name == "all" else [args.name]
-    out: Path = args.output
     for name in names:
         t0 = time.perf_counter()
         exp = EXPERIMENTS[name](trials=args.trials, seed=args.seed)

@@ -7,6 +7,7 @@ library agree by construction.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import hashlib
 import json
 import math
@@ -125,8 +126,6 @@ def pose_import(args: argparse.Namespace):
     config = getattr(args, "pose_config", None)
     if config is None and not given:
         return None
-    import dataclasses
-
     from perception.io.pose import PoseImport, load_pose_config
 
     base = load_pose_config(config) if config is not None else PoseImport()

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import logging
 from pathlib import Path
 
 import numpy as np
@@ -31,8 +30,6 @@ from minvar.reach import simulate_reach
 from minvar.task import ReachTask, ViaPoint
 from perception.errors import InputError
 from perception.io.atomic import save_figure, write_csv, write_json
-
-log = logging.getLogger(__name__)
 
 #: Columns of trajectories.csv (:meth:`minvar.reach.ReachResult.to_pandas`).
 TABLE_COLUMNS = 10

@@ -74,10 +74,8 @@ def run(args: argparse.Namespace) -> int:
     # a few frames for the contact sheet, kept while tracking
     frames = None if args.no_figures else FrameSample()
     tracks_out = subfolder(args.output, "tracks") / f"{output_stem(clip)}{TRACKS_SUFFIX}"
-    tracks = load_clip(path, tracks_out=tracks_out,
-                       progress=not args.quiet and sys.stderr.isatty(),
-                       setup=settings.tracking, pose=settings.pose,
-                       frames=frames,
+    tracks = load_clip(path, tracks_out=tracks_out, progress=not args.quiet and sys.stderr.isatty(),
+                       setup=settings.tracking, pose=settings.pose, frames=frames,
                        **settings.video_options())
     rec = recognize_tracks(tracks, rep, settings, clip=clip, source=path)
     extra = {"fingerprint": clip_fingerprint(path, settings, rep_id), "condition": None,

@@ -10,7 +10,7 @@ from hammer_mv.cli.checks import option
 from minvar.limits import check_position, check_steps
 from perception.errors import InputError, PlanningError
 from perception.limits import MAX_FPS
-from perception.recognition.models import SceneSpec
+from perception.recognition.models import SceneSpec, model_substeps
 from perception.recognition.planning import DEFAULT_DURATIONS, default_specs
 from perception.recognition.repertoire import Repertoire
 
@@ -60,8 +60,6 @@ def run_build(args: argparse.Namespace) -> int:
                 check_position(value, flag)
         scene = SceneSpec(distance=args.distance, object_size=args.object_size,
                           frame_period=1.0 / args.fps)
-        from perception.recognition.models import model_substeps
-
         dt = scene.frame_period / model_substeps(scene.frame_period)
         for duration in args.durations:  # named by the flag, before any planning
             with option("--durations"):

@@ -12,48 +12,22 @@ from hammer_mv.cli.flags import add_video_options
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``track`` subcommand to ``subparsers`` (an argparse subparsers action)."""
     p = subparsers.add_parser(
-        "track",
-        help="track the thumb, finger, wrist and object markers of a video",
-        description=(
-            "Track the colour markers of VIDEO with CamShift and write their pixel "
-            "positions, likelihoods and status per frame to an HDF5 tracks file."
-        ),
-    )
+        "track", help="track the thumb, finger, wrist and object markers of a video",
+        description="Track the colour markers of VIDEO with CamShift and write their pixel "
+        "positions, likelihoods and status per frame to an HDF5 tracks file.")
     p.add_argument("video", type=Path, metavar="VIDEO", help="video file (mp4, avi, mkv, ...)")
-    p.add_argument(
-        "-o",
-        "--output",
-        type=Path,
-        metavar="OUT.h5",
-        help="tracks file (default: <video stem>.tracks.h5 beside the video)",
-    )
-    p.add_argument(
-        "--colours",
-        type=Path,
-        metavar="FILE",
-        help="JSON or TOML file overriding marker colour models",
-    )
-    p.add_argument(
-        "--roi",
-        nargs=5,
-        action="append",
-        default=[],
-        metavar=("MARKER", "X", "Y", "W", "H"),
-        help="look for MARKER only inside this first-frame rectangle (px); repeatable",
-    )
-    p.add_argument(
-        "--setup",
-        type=Path,
-        metavar="SETUP.toml",
-        help="colour models and marker sizes of the session (hammer-mv calibrate); "
-        "--colours overrides its colours",
-    )
-    p.add_argument(
-        "--labelled-video",
-        type=Path,
-        metavar="OUT.mp4",
-        help="also write the video with every marker drawn (name, likelihood, trail)",
-    )
+    p.add_argument("-o", "--output", type=Path, metavar="OUT.h5",
+                   help="tracks file (default: <video stem>.tracks.h5 beside the video)")
+    p.add_argument("--colours", type=Path, metavar="FILE",
+                   help="JSON or TOML file overriding marker colour models")
+    p.add_argument("--roi", nargs=5, action="append", default=[],
+                   metavar=("MARKER", "X", "Y", "W", "H"),
+                   help="look for MARKER only inside this first-frame rectangle (px); repeatable")
+    p.add_argument("--setup", type=Path, metavar="SETUP.toml",
+                   help="colour models and marker sizes of the session (hammer-mv calibrate); "
+                        "--colours overrides its colours")
+    p.add_argument("--labelled-video", type=Path, metavar="OUT.mp4",
+                   help="also write the video with every marker drawn (name, likelihood, trail)")
     add_video_options(p)
     p.set_defaults(func=run)
 
@@ -80,9 +54,8 @@ def parse_rois(specs: list[list[str]], names: tuple[str, ...]) -> dict[str, tupl
         name, *numbers = spec
         shown = " ".join(spec)
         if name not in names:
-            raise InputError(
-                f"--roi {shown}: unknown marker {name!r} (expected {', '.join(names)})"
-            )
+            raise InputError(f"--roi {shown}: unknown marker {name!r} "
+                             f"(expected {', '.join(names)})")
         if name in rois:
             raise InputError(f"--roi {shown}: a second ROI for {name}")
         try:

@@ -9,8 +9,7 @@ from pathlib import Path
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``tracks`` subcommand and its actions to ``subparsers``."""
     p = subparsers.add_parser("tracks", help="inspect or export a tracks file")
-    actions = p.add_subparsers(dest="tracks_action", metavar="ACTION")
-    actions.required = True
+    actions = p.add_subparsers(dest="tracks_action", metavar="ACTION", required=True)
 
     info = actions.add_parser("info", help="summarise a tracks file")
     info.add_argument("file", type=Path, metavar="FILE", help="tracks file (.tracks.h5)")
@@ -22,28 +21,18 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "(docs/pose-files.md describes every column).")
     export.add_argument("file", type=Path, metavar="FILE", help="tracks file (.tracks.h5)")
     export.add_argument(
-        "--format",
-        required=True,
-        choices=("dlc", "movement", "trackpy", "csv"),
+        "--format", required=True, choices=("dlc", "movement", "trackpy", "csv"),
         help="dlc: DeepLabCut table, a real .h5 (pandas HDF, key df_with_missing) or a .csv "
         "by OUT's ending, plus OUT's stem .status.csv; movement: a movement poses dataset "
-        "(.nc); trackpy: long table, one row per frame and seen marker; csv: plain wide table",
-    )
+        "(.nc); trackpy: long table, one row per frame and seen marker; csv: plain wide table")
     export.add_argument("-o", "--output", type=Path, required=True, metavar="OUT",
                         help="output file")
-    export.add_argument(
-        "--max-gap",
-        type=int,
-        default=0,
-        metavar="N",
-        help="first fill gaps of up to N lost frames by linear interpolation (status 3)",
-    )
-    export.add_argument(
-        "--trim",
-        action="store_true",
-        help="export only the movement recognition scores (onset to end of activity; "
-        "needs the object and a hand at rest in the first frames)",
-    )
+    export.add_argument("--max-gap", type=int, default=0, metavar="N",
+                        help="first fill gaps of up to N lost frames by linear interpolation "
+                             "(status 3)")
+    export.add_argument("--trim", action="store_true",
+                        help="export only the movement recognition scores (onset to end of "
+                             "activity; needs the object and a hand at rest in the first frames)")
     export.set_defaults(func=run_export)
 
     render = actions.add_parser(
@@ -76,21 +65,15 @@ def run_info(args: argparse.Namespace) -> int:
     v = t.video
     print(f"{args.file}: hammer-mv tracks, {t.n_frames} frames, markers {', '.join(t.markers)}")
     if v:
-        print(
-            f"video: {v.get('path', '?')} {v.get('width', '?')}x{v.get('height', '?')} "
-            f"{v.get('fourcc', '?')} {v.get('fps_nominal', 0):g} fps, "
-            f"{v.get('n_frames', '?')} frames (header {v.get('n_frames_header', '?')}), "
-            f"times from {v.get('time_source', '?')}, "
-            f"sha256 {str(v.get('sha256', ''))[:12]}"
-        )
+        print(f"video: {v.get('path', '?')} {v.get('width', '?')}x{v.get('height', '?')} "
+              f"{v.get('fourcc', '?')} {v.get('fps_nominal', 0):g} fps, "
+              f"{v.get('n_frames', '?')} frames (header {v.get('n_frames_header', '?')}), "
+              f"times from {v.get('time_source', '?')}, sha256 {str(v.get('sha256', ''))[:12]}")
     if t.n_frames:
         print(f"time: {t.time[0]:.3f} .. {t.time[-1]:.3f} s")
         print(_movement_line(t))
-    header = (
-        f"{'marker':<8} {'tracked':>8} {'reacq.':>7} {'lost':>7} {'interp.':>8} {'ambig.':>7} "
-        f"{'mean lik.':>9}"
-    )
-    print(header)
+    print(f"{'marker':<8} {'tracked':>8} {'reacq.':>7} {'lost':>7} {'interp.':>8} {'ambig.':>7} "
+          f"{'mean lik.':>9}")
     for j, name in enumerate(t.markers):
         counts = [int((t.status[:, j] == s).sum()) for s in Status]
         valid = t.valid[:, j]
@@ -128,10 +111,9 @@ def _movement_line(t) -> str:
         span = movement_span(t)
     except InputError as exc:
         return f"active: none ({exc.problem})"
-    last = span.stop - 1
     return (f"active: frames {span.onset_frame} .. {span.end_frame} "
-            f"({t.time[span.start]:.3f} .. {t.time[last]:.3f} s, the movement recognition "
-            "scores)")
+            f"({t.time[span.start]:.3f} .. {t.time[span.stop - 1]:.3f} s, the movement "
+            "recognition scores)")
 
 
 def run_export(args: argparse.Namespace) -> int:

@@ -6,6 +6,7 @@ import argparse
 import math
 import queue
 import re
+import sys
 import threading
 import time
 from pathlib import Path
@@ -55,9 +56,9 @@ def _frames(source: str, settings, args):
     """``(kind, header fps, iterator of (index, time s, frame), info)`` of ``source``."""
     from perception.errors import InputError
 
-    if re.fullmatch(r"\d+", source):
+    if _device(source) == "camera":
         return "camera", *_capture(int(source), args, clock=True)
-    if "://" in source:
+    if _device(source) == "stream":
         return "stream", *_capture(source, args, clock=False)
     path = Path(source)
     if not path.exists():
@@ -66,6 +67,13 @@ def _frames(source: str, settings, args):
 
     src = FrameSource(path, keep_truncated=settings.keep_truncated, fps=settings.fps)
     return "file", src.header.fps_nominal, iter(src), src
+
+
+def _device(source: str) -> str | None:
+    """``"camera"`` or ``"stream"`` for a camera index or a URL; None for a file."""
+    if re.fullmatch(r"\d+", source):
+        return "camera"
+    return "stream" if "://" in source else None
 
 
 def _capture(target, args, *, clock: bool):
@@ -79,7 +87,11 @@ def _capture(target, args, *, clock: bool):
     from perception.errors import InputError
     from perception.io.video import TimeResolver
 
-    ms = int(args.stall_timeout * 1000)
+    stall = args.stall_timeout
+    if not (math.isfinite(stall) and stall > 0):
+        raise InputError(f"expected a positive number of seconds, got {stall}",
+                         field="--stall-timeout")
+    ms = int(stall * 1000)
     cap = cv2.VideoCapture(target, cv2.CAP_ANY if clock else cv2.CAP_FFMPEG,
                            [cv2.CAP_PROP_OPEN_TIMEOUT_MSEC, max(ms, 10000),
                             cv2.CAP_PROP_READ_TIMEOUT_MSEC, ms])
@@ -89,21 +101,50 @@ def _capture(target, args, *, clock: bool):
     fps = float(fps) if math.isfinite(fps) and 0 < fps < 1000 else 0.0
     times = TimeResolver(fps or 30.0)
     out: queue.SimpleQueue = queue.SimpleQueue()
+    stop = threading.Event()  # set when the frames are no longer wanted
 
     def read() -> None:
         t0, n = time.monotonic(), 0
-        while True:
-            ok, frame = cap.read()
-            if not ok or frame is None:
-                break
-            t = time.monotonic() - t0 if clock else times(cap.get(cv2.CAP_PROP_POS_MSEC))
-            out.put((n, t, frame))
-            n += 1
-        out.put(None)
-        cap.release()
+        try:
+            while not stop.is_set():
+                ok, frame = cap.read()
+                if not ok or frame is None:
+                    break
+                t = time.monotonic() - t0 if clock else times(cap.get(cv2.CAP_PROP_POS_MSEC))
+                out.put((n, t, frame))
+                n += 1
+        finally:  # a read that raised ends the stream too, not the wait for it
+            out.put(None)
+            cap.release()
 
     threading.Thread(target=read, name="watch-reader", daemon=True).start()
-    return fps, iter(out.get, None), None
+    return fps, _received(out, stall, stop), None
+
+
+#: Seconds past ``--stall-timeout`` before the wait for a stuck reader ends.
+STALL_GRACE = 1.0
+
+
+def _received(out: queue.SimpleQueue, stall: float, stop: threading.Event):
+    """The reader's frames until it ends or sends none for ``stall`` s.
+
+    The backend's read timeout does not hold everywhere (a camera's driver
+    may block in ``read`` for good): the wait ends here too, whatever the
+    reader is stuck in, :data:`STALL_GRACE` s later, once FFmpeg, where its
+    timeout holds, has ended the stream and handed over the frames its
+    decoder still held.
+    """
+    try:
+        while True:
+            try:
+                item = out.get(timeout=stall + STALL_GRACE)
+            except queue.Empty:
+                return
+            if item is None:
+                return
+            yield item
+    finally:
+        stop.set()
 
 
 def _clip(source: str, kind: str, name: str | None) -> str:
@@ -124,12 +165,16 @@ def run(args: argparse.Namespace) -> int:
 
     from hammer_mv.cli.checks import output_folder
     from hammer_mv.cli.options import load_repertoire, recognition_settings
+    from perception.io.atomic import check_output
     from perception.online import OnlineRecognizer, decision_summary
     from perception.pipeline import clip_fingerprint
     from perception.report.clip import write_clip_report
     from perception.report.tracking import write_tracking_report
 
     output_folder(args.output)
+    if args.labelled_video is not None:  # refused before the first frame, not after
+        files = [args.repertoire, None if _device(args.source) else args.source]
+        check_output(args.labelled_video, [f for f in files if f is not None])
     settings = recognition_settings(args)
     rep, rep_id = load_repertoire(args)
     kind, fps, frames, src = _frames(args.source, settings, args)
@@ -162,9 +207,12 @@ def run(args: argparse.Namespace) -> int:
                     f"({decided.since_onset:.3f} s after the onset)")
     except KeyboardInterrupt:  # the outputs of what was seen
         interrupted = True
-    finally:
+    except BaseException:  # a failed run leaves no labelled video behind
         if draw is not None:
-            draw.close()
+            draw.close(*sys.exc_info())
+        raise
+    if draw is not None:
+        draw.close()
     video = src.attrs() if src is not None else {"source": args.source, "fps": fps}
     result = rec.finish(video, source=args.source)
     online = {**decision_summary(result, rec.decision), "source": kind,
@@ -198,16 +246,19 @@ class _Drawer:
         from perception.tracking.overlay import Labeller
 
         if self.writer is None:
-            self.writer = VideoWriter(self.path, self.fps, (frame.shape[1], frame.shape[0]))
-            self.writer.__enter__()
+            # kept only once entered: close() must not finish a writer that never opened
+            self.writer = VideoWriter(self.path, self.fps,
+                                      (frame.shape[1], frame.shape[0])).__enter__()
             self.labeller = Labeller(rec.markers, [(0, 255, 255)] * len(rec.markers))
         rows = rec._rows
         img = frame.copy() if not rows["position"] else self.labeller.draw(
             frame, rows["position"][-1], rows["likelihood"][-1], rows["status"][-1])
         ll = np.asarray(state.log_likelihood, dtype=float)
         share = np.exp(ll - ll.max()) / np.exp(ll - ll.max()).sum() if ll.size else ll
+        # stacked above the verdict line: the top left holds the markers' legend
+        bottom = img.shape[0] - 30 - 14 * (len(state.names) - 1)
         for i, (name, p) in enumerate(zip(state.names, share)):
-            y = 14 + 14 * i
+            y = bottom + 14 * i
             cv2.rectangle(img, (8, y - 9), (8 + int(120 * p), y + 1), (80, 200, 80), -1)
             cv2.putText(img, name, (132, y), cv2.FONT_HERSHEY_PLAIN, 0.9, (255, 255, 255))
         text = f"{state.verdict or '-'}{' (settled)' if state.settled else ''}"
@@ -215,6 +266,8 @@ class _Drawer:
                     (255, 255, 255), 1)
         self.writer.write(img)
 
-    def close(self) -> None:
-        if self.writer is not None:
-            self.writer.__exit__(None, None, None)
+    def close(self, *exc_info) -> None:
+        """Finish the video; given an exception's ``sys.exc_info()``, discard it instead."""
+        writer, self.writer = self.writer, None
+        if writer is not None:
+            writer.__exit__(*(exc_info or (None, None, None)))

@@ -86,16 +86,15 @@ def owner_tag() -> str:
 
 def owner_gone(name: str) -> bool:
     """Whether the writer tagged in ``name`` is a process of this host that has ended."""
-    tags = list(_TAG.finditer(name))  # the last: a clip's own name may look like one
-    m = tags[-1] if tags else None
-    if m is None or m.group(1) != _HOST:
+    tags = _TAG.findall(name)  # the last: a clip's own name may look like one
+    if not tags or tags[-1][0] != _HOST:
         return False
     try:
-        os.kill(int(m.group(2)), 0)
+        os.kill(int(tags[-1][1]), 0)
     except ProcessLookupError:
         return True
     except (PermissionError, OverflowError):
-        return False  # alive, someone else's
+        pass  # alive, someone else's
     return False
 
 
@@ -224,14 +223,12 @@ def atomic_path(path: str | os.PathLike, *, suffix: str | None = None) -> Iterat
         yield tmp_path
         os.replace(tmp_path, final)
     except OSError as exc:
-        with contextlib.suppress(FileNotFoundError):
-            tmp_path.unlink()
+        tmp_path.unlink(missing_ok=True)
         if isinstance(exc, InputError | FileNotFoundError) or exc.errno is None:
             raise
         raise OSError(exc.errno, f"cannot write {final}: {exc.strerror or exc}") from None
     except BaseException:
-        with contextlib.suppress(FileNotFoundError):
-            tmp_path.unlink()
+        tmp_path.unlink(missing_ok=True)
         raise
 
 
@@ -297,8 +294,6 @@ def jsonable(value):
     value : object
         Something :mod:`json` cannot encode by itself.
     """
-    import numpy as np
-
     if isinstance(value, np.ndarray):
         return value.tolist()
     if isinstance(value, np.generic):

@@ -12,6 +12,7 @@ OpenCV takes, a table is a table. Every problem is an
 
 from __future__ import annotations
 
+import contextlib
 import difflib
 import math
 import numbers
@@ -179,10 +180,8 @@ def check_fields(obj: Any, specs: Mapping[str, Spec], where: str) -> None:
         if value is None and defaults.get(name) is None:
             continue
         if spec.size is not None and not isinstance(value, str | Mapping):
-            try:
+            with contextlib.suppress(TypeError):  # not a sequence: check_value says so
                 value = tuple(value)
-            except TypeError:
-                pass
         problem = check_value(value, spec)
         if problem:
             raise InputError(problem, field=f"{where}.{name}")
@@ -247,7 +246,7 @@ def check_keys(table: Mapping[str, Any], valid: Iterable[str], where: str,
 
 
 def sub_table(data: Mapping[str, Any], name: str, where: str,
-          path: str | os.PathLike | None = None) -> Mapping[str, Any]:
+              path: str | os.PathLike | None = None) -> Mapping[str, Any]:
     """``data[name]`` if it is a table (``{}`` when absent).
 
     Parameters

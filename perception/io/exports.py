@@ -25,9 +25,8 @@ from pathlib import Path
 
 from perception.errors import InputError
 from perception.io.atomic import write_text
-from perception.io.pose import write_dlc, write_movement
+from perception.io.pose import _check_markers, write_dlc, write_movement
 from perception.io.tracks import Tracks
-from perception.limits import MAX_MARKERS
 
 __all__ = ["EXPORT_FORMATS", "export_tracks", "status_path_for"]
 
@@ -47,10 +46,10 @@ def status_path_for(path: str | os.PathLike) -> Path:
     return p.with_name(f"{p.stem}.status.csv")
 
 
-def _write_csv(table, path: Path, *, index: bool = False) -> None:
+def _write_csv(table, path: Path) -> None:
     # the whole text in memory, written and synced under a temporary name and
     # renamed: a full disk is an OSError and leaves nothing behind
-    write_text(path, table.to_csv(index=index, na_rep="NaN"))
+    write_text(path, table.to_csv(index=False, na_rep="NaN"))
 
 
 def export_tracks(tracks: Tracks, path: str | os.PathLike, format: str) -> list[Path]:
@@ -75,9 +74,7 @@ def export_tracks(tracks: Tracks, path: str | os.PathLike, format: str) -> list[
     if format not in EXPORT_FORMATS:
         raise InputError(f"expected one of {', '.join(EXPORT_FORMATS)}, got {format!r}",
                          field="--format")
-    if len(tracks.markers) > MAX_MARKERS:
-        raise InputError(f"the tracks hold {len(tracks.markers)} markers, more than the "
-                         f"{MAX_MARKERS} an export may hold", tracks.path, field="markers")
+    _check_markers(tracks, tracks.path)
     if format == "dlc":
         write_dlc(tracks, path)
         status = status_path_for(path)
@@ -94,10 +91,5 @@ def export_tracks(tracks: Tracks, path: str | os.PathLike, format: str) -> list[
             raise InputError("a movement dataset is written as netCDF: end the name in .nc",
                              path)
         return [write_movement(tracks, path)]
-    if format == "trackpy":
-        _write_csv(tracks.to_trackpy(), path)
-    elif format == "csv":
-        _write_csv(tracks.to_pandas(), path)
-    else:
-        raise InputError(f"format: expected one of {', '.join(EXPORT_FORMATS)}, got {format!r}")
+    _write_csv(tracks.to_trackpy() if format == "trackpy" else tracks.to_pandas(), path)
     return [path]

@@ -66,8 +66,6 @@ class _QuietMovementLogging(importlib.abc.MetaPathFinder):
 
 
 class _ExecWrapper(importlib.abc.Loader):
-    """A loader like ``loader`` whose ``exec_module`` is ``exec_module``."""
-
     def __init__(self, loader, exec_module):
         self._loader, self._exec = loader, exec_module
 

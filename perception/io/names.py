@@ -50,10 +50,7 @@ def _only_escapes(name: str) -> bool:
 
 def _cut(text: str, limit: int) -> str:
     """The longest start of ``text`` whose UTF-8 form has at most ``limit`` bytes."""
-    data = text.encode("utf-8")
-    if len(data) <= limit:
-        return text
-    return data[:limit].decode("utf-8", "ignore")
+    return text.encode("utf-8")[:limit].decode("utf-8", "ignore")
 
 
 def output_stem(clip: str, limit: int = STEM_MAX) -> str:

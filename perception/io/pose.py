@@ -209,12 +209,9 @@ def is_pose_file(path: str | os.PathLike) -> bool:
 def _source(path: Path) -> str:
     """Which tool wrote a pose file: ``dlc``, ``sleap``, ``lp``, ``nwb`` or ``movement``."""
     suffix = path.suffix.lower()
-    if suffix == ".nc":
-        return "movement"
-    if suffix == ".slp":
-        return "sleap"
-    if suffix == ".nwb":
-        return "nwb"
+    by_suffix = {".nc": "movement", ".slp": "sleap", ".nwb": "nwb"}
+    if suffix in by_suffix:
+        return by_suffix[suffix]
     if suffix == ".csv":
         with open(path, encoding="utf-8", errors="replace") as fh:
             first = fh.readline().strip().lower()
@@ -245,9 +242,9 @@ def _check_hdf5_sizes(path: Path, source: str) -> None:
 
     def visit(name, obj):
         if isinstance(obj, h5py.Dataset):
-            fields = len(obj.dtype.fields) if obj.dtype.fields else 1
-            sub = max(1, obj.dtype.itemsize // 8) if obj.dtype.fields else 1
-            found.append((f"/{name}", tuple(int(n) for n in obj.shape or ()), max(fields, sub)))
+            dtype = obj.dtype
+            width = max(len(dtype.fields), dtype.itemsize // 8, 1) if dtype.fields else 1
+            found.append((f"/{name}", tuple(int(n) for n in obj.shape or ()), width))
 
     try:
         with h5py.File(path, "r") as fh:
@@ -317,9 +314,7 @@ def _load_dataset(path: Path, source: str, fps: float | None):
         try:
             _check_hdf5_sizes(path, source)
         except InputError:
-            if suffix == ".nc":  # a netCDF3 file is not HDF5: xarray checks it lazily below
-                pass
-            else:
+            if suffix != ".nc":  # a netCDF3 file is not HDF5: xarray checks it lazily below
                 raise
     elif path.stat().st_size > _MAX_TABLE_BYTES:
         raise InputError(f"a table of {path.stat().st_size / 1e9:.3g} GB holds more than the "
@@ -354,7 +349,6 @@ def _load_dataset(path: Path, source: str, fps: float | None):
 
 
 def _check_sizes(ds, path: Path) -> None:
-    """A dataset's frames, keypoints and points, within the limits."""
     sizes = dict(ds.sizes)
     frames, keypoints = sizes.get("time", 0), sizes.get("keypoints", 0)
     points = frames * keypoints * sizes.get("individuals", 1)
@@ -428,12 +422,11 @@ def _frame_times(ds, options: PoseImport, path: Path,
 def _marker_arrays(ds, options: PoseImport, path: Path) -> tuple[np.ndarray, np.ndarray]:
     """(T, 4, 2) px positions and (T, 4) likelihoods of the mapped keypoints."""
     names = [str(k) for k in ds["keypoints"].values]
-    missing = [f"{m}={options.keypoint(m)}" for m in MARKERS if options.keypoint(m) not in names]
+    missing = [m for m in MARKERS if options.keypoint(m) not in names]
     if missing:
-        raise InputError(f"keypoint {missing[0].split('=')[1]!r} (for "
-                         f"{missing[0].split('=')[0]}) is not in the file (keypoints: "
-                         f"{', '.join(names)}); map the markers with --keypoints "
-                         "thumb=NAME finger=NAME wrist=NAME object=NAME", path)
+        raise InputError(f"keypoint {options.keypoint(missing[0])!r} (for {missing[0]}) is not "
+                         f"in the file (keypoints: {', '.join(names)}); map the markers with "
+                         "--keypoints thumb=NAME finger=NAME wrist=NAME object=NAME", path)
     pos = ds["position"].transpose("time", "keypoints", "space")
     if pos.sizes["space"] != 2:
         raise InputError(f"expected 2-D poses (x, y), got {pos.sizes['space']} coordinates",
@@ -603,7 +596,6 @@ def write_movement(tracks: Tracks, path: str | os.PathLike) -> Path:
 
 
 def _fps(tracks: Tracks) -> float:
-    """The tracks' frame rate: from the video header, else from the time stamps."""
     nominal = float(tracks.video.get("fps_nominal", 0) or 0)
     if nominal > 0:
         return nominal

@@ -127,13 +127,10 @@ def write_repertoire(path: str | os.PathLike, config: Mapping[str, Any],
     models : sequence of StoredModel
         The models, in order.
     """
-
     path = Path(path)
     with atomic_hdf5(path) as f:
-        f.attrs["schema"] = SCHEMA
-        f.attrs["schema_version"] = SCHEMA_VERSION
-        f.attrs["software_version"] = __version__
-        f.attrs["config"] = json.dumps(config)
+        f.attrs.update(schema=SCHEMA, schema_version=SCHEMA_VERSION,
+                       software_version=__version__, config=json.dumps(config))
         g = f.create_group("models")
         for i, m in enumerate(models):
             mg = g.create_group(m.name)
@@ -186,8 +183,7 @@ def _read_chain(cg, path: Path) -> StoredChain:
     elbow = scalar_attr(attrs, "elbow", "integer", cg.name, path)
     if elbow not in (1, -1):
         raise InputError(f"must be +1 or -1, got {elbow!r}", path, field=f"{cg.name}.elbow")
-    return StoredChain(arrays=arrays, l1=lengths["l1"], l2=lengths["l2"], base=base,
-                       elbow=elbow)
+    return StoredChain(arrays=arrays, base=base, elbow=elbow, **lengths)
 
 
 def _check_covariance(P: np.ndarray, where: str, path: Path) -> None:
@@ -307,7 +303,6 @@ def read_repertoire(path: str | os.PathLike) -> tuple[dict, list[StoredModel]]:
     InputError
         If the file is missing, not HDF5, of another schema or version, or corrupt.
     """
-
     path = Path(path)
     try:
         with open_hdf5(path, "repertoire") as f:

@@ -22,10 +22,10 @@ ignored by :meth:`Tracks.load`.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import enum
 import json
 import os
-import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -50,6 +50,7 @@ from perception.io.tracks_checks import (
     _check_values,
     _check_video,
     _group_attrs,
+    _row_shapes,
 )
 from perception.io.tracks_checks import position_bounds as position_bounds  # re-exported
 from perception.provenance import code_digest
@@ -61,6 +62,10 @@ SCHEMA_VERSION = 1
 #: two detections it bridges: below DeepLabCut's default cutoff (0.6), so
 #: tools that filter by likelihood never take a bridge for a detection.
 INTERPOLATED_LIKELIHOOD = 0.5
+
+#: The per-frame datasets of ``/tracks`` and their dtypes, in the order they are written.
+_DTYPES = {"frame": np.int64, "time": np.float64, "position": np.float64,
+           "likelihood": np.float32, "status": np.int8}
 
 
 class Status(enum.IntEnum):
@@ -87,11 +92,8 @@ def _attr_value(value: Any) -> Any:
         return value
     if isinstance(value, np.ndarray) and value.dtype.kind in "biuf":
         return value  # numeric arrays as read back from a file: store them as they are
-    if (
-        isinstance(value, (list, tuple))
-        and value
-        and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
-    ):
+    if isinstance(value, (list, tuple)) and value and all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
         return np.asarray(value)
     return json.dumps(value)
 
@@ -142,39 +144,24 @@ class Tracks:
 
     def __post_init__(self) -> None:
         markers = tuple(str(m) for m in self.markers)
-        frame = np.asarray(self.frame, dtype=np.int64)
-        time = np.asarray(self.time, dtype=np.float64)
-        position = np.asarray(self.position, dtype=np.float64)
-        likelihood = np.asarray(self.likelihood, dtype=np.float32)
-        status = np.asarray(self.status, dtype=np.int8)
+        arrays = {name: np.asarray(getattr(self, name), dtype=dtype)
+                  for name, dtype in _DTYPES.items()}
+        frame = arrays["frame"]
         t, m = frame.shape[0] if frame.ndim == 1 else -1, len(markers)
-        checks = [
-            ("frame", frame, (t,)),
-            ("time", time, (t,)),
-            ("position", position, (t, m, 2)),
-            ("likelihood", likelihood, (t, m)),
-            ("status", status, (t, m)),
-        ]
-        for name, arr, shape in checks:
-            if arr.shape != shape:
-                raise ValueError(
-                    f"Tracks.{name}: expected shape {shape} (T, M={m}), got {arr.shape}"
-                )
-        object.__setattr__(self, "markers", markers)
-        object.__setattr__(self, "frame", frame)
-        object.__setattr__(self, "time", time)
-        object.__setattr__(self, "position", position)
-        object.__setattr__(self, "likelihood", likelihood)
-        object.__setattr__(self, "status", status)
+        for name, shape in _row_shapes(t, m).items():
+            if arrays[name].shape != shape:
+                raise ValueError(f"Tracks.{name}: expected shape {shape} (T, M={m}), "
+                                 f"got {arrays[name].shape}")
+        for name, value in {"markers": markers, **arrays}.items():
+            object.__setattr__(self, name, value)
         for name in ("video", "tracker", "attrs"):
             object.__setattr__(self, name, MappingProxyType(dict(getattr(self, name))))
 
     def __reduce__(self):
         # MappingProxyType does not pickle: batch workers send tracks between processes
-        fields = {name: getattr(self, name) for name in _FIELDS}
-        for name in ("video", "tracker", "attrs"):
-            fields[name] = dict(fields[name])
-        return _rebuild_tracks, (fields,)
+        return Tracks, (self.frame, self.time, self.markers, self.position, self.likelihood,
+                        self.status, dict(self.video), dict(self.tracker), dict(self.attrs),
+                        self.path)
 
     # -- basic views --------------------------------------------------------
     @property
@@ -237,9 +224,7 @@ class Tracks:
 
     def replace(self, **changes: Any) -> Tracks:
         """Copy with some attributes replaced."""
-        kwargs = {name: getattr(self, name) for name in _FIELDS}
-        kwargs.update(changes)
-        return Tracks(**kwargs)
+        return dataclasses.replace(self, **changes)
 
     # -- processing ---------------------------------------------------------
     def interpolate(self, max_gap: int = 5) -> Tracks:
@@ -271,8 +256,7 @@ class Tracks:
             ok = np.flatnonzero(valid[:, j])
             if ok.size < 2:
                 continue
-            gaps = np.flatnonzero(np.diff(ok) > 1)
-            for g in gaps:
+            for g in np.flatnonzero(np.diff(ok) > 1):
                 a, b = ok[g], ok[g + 1]
                 if b - a - 1 > max_gap:
                     continue
@@ -296,14 +280,9 @@ class Tracks:
             Row range, as in a slice.
         """
         s = slice(start, stop)
-        return self.replace(
-            frame=self.frame[s],
-            time=self.time[s],
-            position=self.position[s],
-            likelihood=self.likelihood[s],
-            status=self.status[s],
-            attrs={**self.attrs, "trimmed_rows": (start, stop)},
-        )
+        return self.replace(frame=self.frame[s], time=self.time[s], position=self.position[s],
+                            likelihood=self.likelihood[s], status=self.status[s],
+                            attrs={**self.attrs, "trimmed_rows": (start, stop)})
 
     # -- tables -----------------------------------------------------------
     def to_dlc(self, scorer: str = "hammer-mv") -> pd.DataFrame:
@@ -314,13 +293,10 @@ class Tracks:
         """
         import pandas as pd
 
-        cols = pd.MultiIndex.from_product(
-            [[scorer], list(self.markers), ["x", "y", "likelihood"]],
-            names=["scorer", "bodyparts", "coords"],
-        )
-        data = np.concatenate(
-            [self.position, self.likelihood[..., None].astype(np.float64)], axis=-1
-        ).reshape(self.n_frames, -1)
+        cols = pd.MultiIndex.from_product([[scorer], list(self.markers), ["x", "y", "likelihood"]],
+                                          names=["scorer", "bodyparts", "coords"])
+        data = np.concatenate([self.position, self.likelihood[..., None].astype(np.float64)],
+                              axis=-1).reshape(self.n_frames, -1)
         return pd.DataFrame(data, index=pd.Index(self.frame, name="frame"), columns=cols)
 
     def to_trackpy(self) -> pd.DataFrame:
@@ -333,20 +309,17 @@ class Tracks:
         import pandas as pd
 
         t, m = self.n_frames, len(self.markers)
-        table = pd.DataFrame(
-            {
-                "frame": np.repeat(self.frame, m),
-                "time": np.repeat(self.time, m),
-                "particle": np.tile(np.arange(m), t),
-                "marker": pd.Categorical(
-                    np.tile(np.array(self.markers, dtype=object), t), categories=list(self.markers)
-                ),
-                "x": self.position[..., 0].ravel(),
-                "y": self.position[..., 1].ravel(),
-                "likelihood": self.likelihood.ravel(),
-                "status": self.status.ravel(),
-            }
-        )
+        markers = np.tile(np.array(self.markers, dtype=object), t)
+        table = pd.DataFrame({
+            "frame": np.repeat(self.frame, m),
+            "time": np.repeat(self.time, m),
+            "particle": np.tile(np.arange(m), t),
+            "marker": pd.Categorical(markers, categories=list(self.markers)),
+            "x": self.position[..., 0].ravel(),
+            "y": self.position[..., 1].ravel(),
+            "likelihood": self.likelihood.ravel(),
+            "status": self.status.ravel(),
+        })
         return table[self.valid.ravel()].reset_index(drop=True)
 
     def to_status(self) -> pd.DataFrame:
@@ -372,9 +345,8 @@ class Tracks:
     # -- files ----------------------------------------------------------------
     def save(self, path: str | os.PathLike) -> Path:
         """Write this object as a tracks file (atomically); return the path."""
-        with TracksWriter(
-            path, self.markers, video=self.video, tracker=self.tracker, attrs=self.attrs
-        ) as w:
+        with TracksWriter(path, self.markers, video=self.video, tracker=self.tracker,
+                          attrs=self.attrs) as w:
             w.extend(self.frame, self.time, self.position, self.likelihood, self.status)
         return Path(path)
 
@@ -399,24 +371,19 @@ class Tracks:
             root = decode_attrs(fh.attrs, "/", p)
             schema = scalar_attr(root, "schema", "string", "/", p)
             if schema != SCHEMA:
-                raise InputError(
-                    f"not a hammer-mv tracks file (schema {schema!r}, expected {SCHEMA!r})", p
-                )
+                raise InputError(f"not a hammer-mv tracks file (schema {schema!r}, expected "
+                                 f"{SCHEMA!r})", p)
             version = scalar_attr(root, "schema_version", "integer", "/", p)
             if version != SCHEMA_VERSION:
-                raise InputError(
-                    f"tracks schema_version {version!r} is not supported "
-                    f"(this hammer-mv reads version {SCHEMA_VERSION})",
-                    p,
-                )
+                raise InputError(f"tracks schema_version {version!r} is not supported "
+                                 f"(this hammer-mv reads version {SCHEMA_VERSION})", p)
             for key in ("schema", "schema_version", "software_version"):
                 root.pop(key, None)
             _check_shapes(fh, p)
             data = {name: read_dataset(fh, f"tracks/{name}", kind, ndim, p)
                     for name, (kind, ndim) in _DATASETS.items()}
-            markers = tuple(
-                m.decode("utf-8") if isinstance(m, bytes) else str(m) for m in data.pop("markers")
-            )
+            markers = tuple(m.decode("utf-8") if isinstance(m, bytes) else str(m)
+                            for m in data.pop("markers"))
             video = _group_attrs(fh, "video", p)
             for key, kind in _VIDEO_ATTRS.items():
                 scalar_attr(video, key, kind, "/video", p)
@@ -428,15 +395,6 @@ class Tracks:
             return cls(markers=markers, video=video, tracker=tracker, attrs=root, path=p, **data)
         except ValueError as exc:
             raise InputError(f"inconsistent datasets: {exc}", p, field="/tracks") from None
-
-
-#: The fields of :class:`Tracks`, in order.
-_FIELDS = ("frame", "time", "markers", "position", "likelihood", "status", "video", "tracker",
-           "attrs", "path")
-
-
-def _rebuild_tracks(fields: dict) -> Tracks:
-    return Tracks(**fields)
 
 
 class TracksWriter:
@@ -466,36 +424,20 @@ class TracksWriter:
     ...     w.append(0, 0.0, [[10.0, 20.0]], [1.0], [0])
     """
 
-    def __init__(
-        self,
-        path: str | os.PathLike,
-        markers: Sequence[str],
-        *,
-        video: Mapping[str, Any] | None = None,
-        tracker: Mapping[str, Any] | None = None,
-        attrs: Mapping[str, Any] | None = None,
-        chunk_frames: int = 512,
-    ):
+    def __init__(self, path: str | os.PathLike, markers: Sequence[str], *,
+                 video: Mapping[str, Any] | None = None, tracker: Mapping[str, Any] | None = None,
+                 attrs: Mapping[str, Any] | None = None, chunk_frames: int = 512):
         self.path = Path(path)
         self.markers = tuple(markers)
         if not self.markers:
             raise ValueError("TracksWriter.markers: expected at least one marker")
         if chunk_frames < 1:
             raise ValueError(f"TracksWriter.chunk_frames: expected >= 1, got {chunk_frames}")
-        self.meta = {
-            "video": dict(video or {}),
-            "tracker": dict(tracker or {}),
-            "attrs": dict(attrs or {}),
-        }
+        self.meta = {"video": dict(video or {}), "tracker": dict(tracker or {}),
+                     "attrs": dict(attrs or {})}
         self.chunk = int(chunk_frames)
-        m = len(self.markers)
-        self._buf = {
-            "frame": np.empty(self.chunk, np.int64),
-            "time": np.empty(self.chunk, np.float64),
-            "position": np.empty((self.chunk, m, 2), np.float64),
-            "likelihood": np.empty((self.chunk, m), np.float32),
-            "status": np.empty((self.chunk, m), np.int8),
-        }
+        self._buf = {name: np.empty(shape, _DTYPES[name])
+                     for name, shape in _row_shapes(self.chunk, len(self.markers)).items()}
         self._n_buf = 0
         self.n_written = 0
         self._stack: contextlib.ExitStack | None = None
@@ -508,29 +450,18 @@ class TracksWriter:
                 self.meta[key].update(values)
 
     def __enter__(self) -> TracksWriter:
-        stack = contextlib.ExitStack()
-        try:
+        # An error here exits the atomic output with it (its temporary file is removed);
+        # pop_all keeps the file open past the block otherwise.
+        with contextlib.ExitStack() as stack:
             fh = stack.enter_context(atomic_hdf5(self.path))
             g = fh.create_group("tracks")
-            c = self.chunk
-            g.create_dataset(
-                "markers", data=np.array(self.markers, dtype=object), dtype=h5py.string_dtype()
-            )
+            g.create_dataset("markers", data=np.array(self.markers, dtype=object),
+                             dtype=h5py.string_dtype())
             for name, buf in self._buf.items():
-                g.create_dataset(
-                    name,
-                    shape=(0, *buf.shape[1:]),
-                    maxshape=(None, *buf.shape[1:]),
-                    chunks=(c, *buf.shape[1:]),
-                    dtype=buf.dtype,
-                    fillvalue=np.nan if name == "position" else 0,
-                )
-        except BaseException:
-            # Exit the stack *with* the error: a plain close() would let the
-            # atomic output rename its empty temporary file into place.
-            if not stack.__exit__(*sys.exc_info()):
-                raise
-        self._stack, self._fh = stack, fh
+                row = buf.shape[1:]
+                g.create_dataset(name, shape=(0, *row), maxshape=(None, *row), chunks=buf.shape,
+                                 dtype=buf.dtype, fillvalue=np.nan if name == "position" else 0)
+            self._stack, self._fh = stack.pop_all(), fh
         return self
 
     def append(self, frame: int, time: float, position, likelihood, status) -> None:
@@ -549,41 +480,22 @@ class TracksWriter:
         status : (M,) array_like of int
             :class:`Status` codes.
         """
-        i = self._n_buf
-        b = self._buf
-        b["frame"][i] = frame
-        b["time"][i] = time
-        b["position"][i] = position
-        b["likelihood"][i] = likelihood
-        b["status"][i] = status
-        self._n_buf = i + 1
+        for buf, value in zip(self._buf.values(), (frame, time, position, likelihood, status)):
+            buf[self._n_buf] = value
+        self._n_buf += 1
         if self._n_buf == self.chunk:
             self.flush()
 
     def extend(self, frame, time, position, likelihood, status) -> None:
         """Append many rows at once (arrays with a leading T axis)."""
         self.flush()
-        m = len(self.markers)
-        arrays = {
-            "frame": np.asarray(frame, np.int64),
-            "time": np.asarray(time, np.float64),
-            "position": np.asarray(position, np.float64),
-            "likelihood": np.asarray(likelihood, np.float32),
-            "status": np.asarray(status, np.int8),
-        }
+        values = (frame, time, position, likelihood, status)
+        arrays = {name: np.asarray(v, dtype) for (name, dtype), v in zip(_DTYPES.items(), values)}
         t = arrays["frame"].shape[0]
-        expected = {
-            "frame": (t,),
-            "time": (t,),
-            "position": (t, m, 2),
-            "likelihood": (t, m),
-            "status": (t, m),
-        }
-        for name, arr in arrays.items():
-            if arr.shape != expected[name]:
-                raise ValueError(
-                    f"TracksWriter.extend: {name}: expected shape {expected[name]}, got {arr.shape}"
-                )
+        for name, shape in _row_shapes(t, len(self.markers)).items():
+            if arrays[name].shape != shape:
+                raise ValueError(f"TracksWriter.extend: {name}: expected shape {shape}, "
+                                 f"got {arrays[name].shape}")
         self._write(arrays, t)
 
     def flush(self) -> None:
@@ -606,22 +518,18 @@ class TracksWriter:
 
     def __exit__(self, exc_type, exc, tb) -> bool:
         assert self._stack is not None and self._fh is not None
-        if exc_type is None:
-            try:
-                self.flush()
-                fh = self._fh
-                fh.attrs["schema"] = SCHEMA
-                fh.attrs["schema_version"] = SCHEMA_VERSION
-                fh.attrs["software_version"] = __version__
-                # what tracks reuse is keyed on (perception.pipeline.current_tracks)
-                fh.attrs["software_digest"] = code_digest()
-                _write_attrs(fh.attrs, self.meta["attrs"])
-                _write_attrs(fh.require_group("video").attrs, self.meta["video"])
-                _write_attrs(fh.require_group("tracker").attrs, self.meta["tracker"])
-            except BaseException:
-                self._stack.__exit__(*sys.exc_info())
-                raise
-        return bool(self._stack.__exit__(exc_type, exc, tb))
+        if exc_type is not None:
+            return bool(self._stack.__exit__(exc_type, exc, tb))
+        with self._stack:  # an error while finishing removes the temporary file too
+            self.flush()
+            fh = self._fh
+            # software_digest: what tracks reuse is keyed on (perception.pipeline.current_tracks)
+            fh.attrs.update(schema=SCHEMA, schema_version=SCHEMA_VERSION,
+                            software_version=__version__, software_digest=code_digest())
+            _write_attrs(fh.attrs, self.meta["attrs"])
+            _write_attrs(fh.require_group("video").attrs, self.meta["video"])
+            _write_attrs(fh.require_group("tracker").attrs, self.meta["tracker"])
+        return False
 
     @property
     def file(self) -> h5py.File:

@@ -18,6 +18,7 @@ checks accept are passed in.
 
 from __future__ import annotations
 
+import contextlib
 import json
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -47,15 +48,18 @@ def _check_shapes(fh, path: Path) -> None:
     if not 1 <= m <= MAX_MARKERS:
         raise InputError(f"claims {m} markers, expected 1 to {MAX_MARKERS}", path,
                          field="/tracks/markers")
-    want = {"time": (t,), "position": (t, m, 2), "likelihood": (t, m), "status": (t, m)}
-    for name, shape in want.items():
+    for name, shape in _row_shapes(t, m).items():
         if tuple(shapes[name]) != shape:
             raise InputError(f"has shape {tuple(shapes[name])}, expected {shape} "
                              f"({t} frames, {m} markers)", path, field=f"/tracks/{name}")
 
 
+def _row_shapes(t: int, m: int) -> dict[str, tuple[int, ...]]:
+    return {"frame": (t,), "time": (t,), "position": (t, m, 2), "likelihood": (t, m),
+            "status": (t, m)}
+
+
 def _check_video(video: Mapping[str, Any], path: Path) -> None:
-    """The ``/video`` attributes readers use, within range."""
     for key in ("width", "height"):
         v = video.get(key)
         if v is not None and not 1 <= v <= MAX_VIDEO_SIDE:
@@ -152,23 +156,21 @@ def _check_tracker(tracker: Mapping[str, Any], markers: tuple[str, ...], path: P
         value = tracker["colour_models"]
         models = None
         if isinstance(value, str):
-            try:
+            with contextlib.suppress(ValueError):
                 models = json.loads(value)
-            except ValueError:
-                models = None
         if not isinstance(models, dict):
             raise InputError("expected a JSON object of marker colour models", path,
                              field="/tracker.colour_models")
         for name, model in models.items():
-            bgr = model.get("bgr") if isinstance(model, dict) else None
+            if not isinstance(model, dict):
+                raise InputError(f"marker {name!r}: expected an object", path,
+                                 field="/tracker.colour_models")
+            bgr = model.get("bgr")
             if bgr is not None and not (
                     isinstance(bgr, list) and len(bgr) == 3
                     and all(isinstance(c, int) and not isinstance(c, bool) and 0 <= c <= 255
                             for c in bgr)):
                 raise InputError(f"marker {name!r}: bgr must be 3 integers 0..255", path,
-                                 field="/tracker.colour_models")
-            if not isinstance(model, dict):
-                raise InputError(f"marker {name!r}: expected an object", path,
                                  field="/tracker.colour_models")
 
 
@@ -182,7 +184,6 @@ _VIDEO_ATTRS = {"path": "string", "sha256": "string", "fps_nominal": "number",
 
 
 def _group_attrs(fh, name: str, path: Path) -> dict[str, Any]:
-    """The attributes of group ``/name`` (empty if there is none)."""
     import h5py
 
     if name not in fh:

@@ -24,9 +24,9 @@ import logging
 import math
 import os
 import queue
-import sys
 import threading
 from collections.abc import Iterable, Iterator, Mapping
+from concurrent.futures import Future
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from types import MappingProxyType
@@ -74,33 +74,22 @@ def sha256_file(path: str | os.PathLike, chunk: int = 1 << 20) -> str:
     return h.hexdigest()
 
 
-class _Sha256Thread(threading.Thread):
-    """:func:`sha256_file` of a file in a background thread.
+def _sha256_in_background(path: Path) -> Future:
+    """:func:`sha256_file` of a file in a background thread; ``result()`` waits for it.
 
     Reading and hashing release the GIL, so the digest costs a clip's
-    tracking no time where a core is free; :meth:`result` waits for it.
+    tracking no time where a core is free.
     """
+    digest: Future = Future()
 
-    def __init__(self, path: Path):
-        super().__init__(name=f"sha256:{path.name}", daemon=True)
-        self.path = path
-        self._digest: str | None = None
-        self._error: BaseException | None = None
-        self.start()
-
-    def run(self) -> None:
+    def run() -> None:
         try:
-            self._digest = sha256_file(self.path)
+            digest.set_result(sha256_file(path))
         except BaseException as exc:  # raised again by result(), in the caller's thread
-            self._error = exc
+            digest.set_exception(exc)
 
-    def result(self) -> str:
-        """The hex digest (re-raises what reading the file raised)."""
-        self.join()
-        if self._error is not None:
-            raise self._error
-        assert self._digest is not None
-        return self._digest
+    threading.Thread(target=run, name=f"sha256:{path.name}", daemon=True).start()
+    return digest
 
 
 @dataclass(frozen=True)
@@ -265,7 +254,7 @@ class FrameSource:
         height, width = first.shape[:2]
         n_header = cap.get(cv2.CAP_PROP_FRAME_COUNT)
         fps = cap.get(cv2.CAP_PROP_FPS)
-        self._sha256 = _Sha256Thread(self.path) if hash else None
+        self._sha256 = _sha256_in_background(self.path) if hash else None
         self._info = VideoInfo(
             path=os.fspath(path),
             sha256="",
@@ -392,12 +381,8 @@ class FrameSource:
             logger.warning("%s: decoded %d of the %d frames the header claims; keeping them "
                            "(--keep-truncated)", self.path, self.n_decoded, claimed)
         if self._times.n_fallback and self.fps_override is None:
-            logger.warning(
-                "%s: %d of %d frames had no usable container timestamp; used previous + 1/fps",
-                self.path,
-                self._times.n_fallback,
-                self.n_decoded,
-            )
+            logger.warning("%s: %d of %d frames had no usable container timestamp; used "
+                           "previous + 1/fps", self.path, self._times.n_fallback, self.n_decoded)
 
     @property
     def header(self) -> VideoInfo:
@@ -477,9 +462,8 @@ def codec_for(path: str | os.PathLike, codec: str | None = None) -> str:
     if codec is None:
         ext = Path(path).suffix.lower()
         if ext not in CODECS:
-            raise InputError(
-                f"unknown video extension {ext!r} (expected one of {', '.join(CODECS)})", path
-            )
+            raise InputError(f"unknown video extension {ext!r} (expected one of "
+                             f"{', '.join(CODECS)})", path)
         return CODECS[ext]
     if len(codec) != 4:
         raise InputError(f"codec: expected a 4-character FourCC, got {codec!r}", path)
@@ -504,13 +488,8 @@ class VideoWriter:
         FourCC overriding the extension's default.
     """
 
-    def __init__(
-        self,
-        path: str | os.PathLike,
-        fps: float,
-        size: tuple[int, int],
-        codec: str | None = None,
-    ):
+    def __init__(self, path: str | os.PathLike, fps: float, size: tuple[int, int],
+                 codec: str | None = None):
         self.path = Path(path)
         self.codec = codec_for(self.path, codec)
         if not (math.isfinite(fps) and fps > 0):
@@ -526,54 +505,44 @@ class VideoWriter:
         self.tmp_path: Path | None = None
 
     def __enter__(self) -> VideoWriter:
-        stack = contextlib.ExitStack()
-        try:
+        # An error here exits the atomic output with it (its temporary file is removed);
+        # pop_all keeps the output open past the block otherwise.
+        with contextlib.ExitStack() as stack:
             self.tmp_path = stack.enter_context(atomic_path(self.path))
             if not utf8_name(self.tmp_path):
                 raise InputError("OpenCV cannot write a video whose name is not valid UTF-8; "
                                  "choose another name", self.path)
             with quiet_native_stderr():
-                vw = cv2.VideoWriter(
-                    os.fspath(self.tmp_path), cv2.VideoWriter_fourcc(*self.codec), self.fps,
-                    self.size
-                )
+                vw = cv2.VideoWriter(os.fspath(self.tmp_path),
+                                     cv2.VideoWriter_fourcc(*self.codec), self.fps, self.size)
             if not vw.isOpened():
                 raise OSError(f"{self.path}: OpenCV cannot write {self.codec!r} video here")
-        except BaseException:
-            # Exit the stack *with* the error: a plain close() would let the
-            # atomic output rename its empty temporary file into place.
-            if not stack.__exit__(*sys.exc_info()):
-                raise
-        self._stack, self._vw = stack, vw
+            self._stack, self._vw = stack.pop_all(), vw
         return self
 
     def write(self, frame: np.ndarray) -> None:
         """Append one frame: ``(height, width, 3)`` uint8, BGR."""
         w, h = self.size
         if frame.shape != (h, w, 3) or frame.dtype != np.uint8:
-            raise ValueError(
-                f"VideoWriter.write: expected a ({h}, {w}, 3) uint8 frame, "
-                f"got {frame.shape} {frame.dtype}"
-            )
+            raise ValueError(f"VideoWriter.write: expected a ({h}, {w}, 3) uint8 frame, "
+                             f"got {frame.shape} {frame.dtype}")
         self._vw.write(frame)
         self.n_written += 1
 
     def __exit__(self, exc_type, exc, tb) -> bool:
         assert self._stack is not None and self._vw is not None
         self._vw.release()
-        if exc_type is None:
-            err = None
+        if exc_type is not None:
+            return bool(self._stack.__exit__(exc_type, exc, tb))
+        with self._stack:  # an error here removes the temporary file
             if self.n_written == 0:
-                err = ValueError(f"{self.path}: no frames written")
-            elif not _readable(self.tmp_path, self.n_written):
+                raise ValueError(f"{self.path}: no frames written")
+            if not _readable(self.tmp_path, self.n_written):
                 # OpenCV reports no write errors: a full disk shows as a file
                 # FFmpeg cannot open, or one with fewer frames than written.
-                err = OSError(f"cannot write {self.path}: the video came out incomplete "
+                raise OSError(f"cannot write {self.path}: the video came out incomplete "
                               "(is the disk full?)")
-            if err is not None:
-                self._stack.__exit__(type(err), err, None)  # removes the temporary file
-                raise err
-        return bool(self._stack.__exit__(exc_type, exc, tb))
+        return False
 
 
 def _readable(path: Path, n_frames: int) -> bool:
@@ -596,12 +565,8 @@ def _readable(path: Path, n_frames: int) -> bool:
         cap.release()
 
 
-def write_video(
-    frames: Iterable[np.ndarray],
-    path: str | os.PathLike,
-    fps: float,
-    codec: str | None = None,
-) -> int:
+def write_video(frames: Iterable[np.ndarray], path: str | os.PathLike, fps: float,
+                codec: str | None = None) -> int:
     """Write an iterable of BGR frames to ``path`` atomically; return the frame count.
 
     Parameters

@@ -13,7 +13,6 @@ Two kinds, both with their ground truth:
 
 from __future__ import annotations
 
-import math
 import os
 from pathlib import Path
 from typing import Any
@@ -21,11 +20,11 @@ from typing import Any
 import numpy as np
 
 from perception.geometry import DEFAULT_OBJECT_DIAMETER
-from perception.io.tracks import Status, Tracks
+from perception.io.tracks import Tracks
+from perception.synthetic.independent import tracked_paths
 from perception.synthetic.render import RenderResult, render_clip
 from perception.synthetic.scene import Camera, RenderStyle, Scene
 from perception.synthetic.stimuli import StimulusParams, stimulus_paths
-from perception.tracking.markers import MARKER_NAMES
 
 __all__ = ["DEMO_CAMERA", "HARD", "demo_tracks", "render_demo_clip"]
 
@@ -71,20 +70,8 @@ def demo_tracks(condition: str, seed: int = 0, *, fps: float = 30.0, angle_deg: 
     t, paths = stimulus_paths(p, fps, seed=seed)
     cam = Camera(DEMO_CAMERA.px_per_m, DEMO_CAMERA.origin_px, angle_deg)
     world = {**paths, "object": np.zeros_like(paths["wrist"])}
-    rng = np.random.default_rng(seed + 1000)
-    pos = np.stack([cam.world_to_pixel(world[m]) for m in MARKER_NAMES], axis=1)
-    pos = pos + noise_px * rng.standard_normal(pos.shape)
-    for marker, frames in (lost or {}).items():
-        pos[frames, MARKER_NAMES.index(marker)] = np.nan
-    ok = np.isfinite(pos).all(axis=-1)
-    diameter = [p.object_size * cam.px_per_m if m == "object" else math.nan
-                for m in MARKER_NAMES]
-    tracks = Tracks(
-        frame=np.arange(len(t)), time=t, markers=MARKER_NAMES, position=pos,
-        likelihood=ok.astype(np.float32),
-        status=np.where(ok, Status.TRACKED, Status.LOST).astype(np.int8),
-        tracker={"method": "demo", "diameter_px": diameter},
-    )
+    tracks = tracked_paths(t, world, cam, p.object_size, "demo", seed=seed, noise_px=noise_px,
+                      lost=lost)
     truth = {"world": world, "onset_frame": int(round(p.rest_before * fps)), "params": p}
     return tracks, truth
 

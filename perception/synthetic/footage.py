@@ -37,17 +37,8 @@ import numpy as np
 from perception.errors import InputError
 from perception.io.atomic import atomic_path
 
-__all__ = [
-    "BACKGROUND_KINDS",
-    "H264_CODECS",
-    "H264Writer",
-    "check_background",
-    "flicker_gain",
-    "load_background",
-    "photo_names",
-    "shaded_band",
-    "shaded_disc",
-]
+__all__ = ["BACKGROUND_KINDS", "H264_CODECS", "H264Writer", "check_background", "flicker_gain",
+           "load_background", "photo_names", "shaded_band", "shaded_disc"]
 
 #: Prefixes of ``RenderStyle.background``.
 BACKGROUND_KINDS = ("photo", "video")
@@ -195,8 +186,7 @@ def _lit(light: np.ndarray, bgr, shading: float, spec: np.ndarray) -> np.ndarray
     base = np.asarray(bgr, np.float32)
     diffuse = (1.0 - shading) + shading * light
     col = diffuse[..., None] * base
-    col = col + (255.0 - col) * (0.75 * shading * spec)[..., None]
-    return col
+    return col + (255.0 - col) * (0.75 * shading * spec)[..., None]
 
 
 def _composite(img: np.ndarray, x0: int, y0: int, cover: np.ndarray, col: np.ndarray) -> None:
@@ -215,7 +205,7 @@ def _patch(img: np.ndarray, centre, half: float):
     if x1 <= x0 or y1 <= y0:
         return None
     yy, xx = np.mgrid[y0:y1, x0:x1].astype(np.float32)
-    return x0, y0, xx - np.float32(centre[0]), yy - np.float32(centre[1])
+    return x0, y0, xx - np.float32(cx), yy - np.float32(cy)
 
 
 def shaded_disc(img: np.ndarray, centre, radius: float, bgr, shading: float) -> None:

@@ -59,7 +59,7 @@ from scipy.special import betainc
 from perception.geometry import DEFAULT_OBJECT_DIAMETER
 from perception.io.atomic import write_csv
 from perception.io.tracks import Status, Tracks
-from perception.synthetic.scene import Camera, RenderStyle, Scene
+from perception.synthetic.scene import Camera, RenderStyle, Scene, min_jerk
 from perception.tracking.markers import MARKER_NAMES
 
 __all__ = ["CONDITIONS", "RANGES", "IndependentParams", "draw_independent",
@@ -180,11 +180,6 @@ class IndependentParams:
         return self.object_size + self.mga_excess
 
 
-def _min_jerk(tau: np.ndarray) -> np.ndarray:
-    tau = np.clip(tau, 0.0, 1.0)
-    return tau**3 * (10 - 15 * tau + 6 * tau**2)
-
-
 def _keyframes(p: IndependentParams) -> list[tuple[float, float]]:
     """(time fraction, aperture m) key points of the grip, joined by minimum-jerk segments."""
     closed, final = 0.0, p.object_size
@@ -215,8 +210,7 @@ def independent_aperture(p: IndependentParams, tau: np.ndarray) -> np.ndarray:
     g = np.full(tau.shape, keys[0][1])
     for (t0, g0), (t1, g1) in zip(keys, keys[1:]):
         if t1 > t0:
-            inside = tau >= t0
-            g = np.where(inside, g0 + (g1 - g0) * _min_jerk((tau - t0) / (t1 - t0)), g)
+            g = np.where(tau >= t0, g0 + (g1 - g0) * min_jerk((tau - t0) / (t1 - t0)), g)
     return g
 
 
@@ -237,7 +231,7 @@ def _wobble(p: IndependentParams, t: np.ndarray, rng: np.random.Generator) -> np
     wave = (amp * np.sin(2 * np.pi * freqs * tm[:, None, None] + phase)
             - amp * np.sin(phase)).sum(axis=1)  # starts at 0
     # grows in as the hand gets going and dies out as it closes on the object
-    window = _min_jerk(tm / (0.3 * p.duration)) * (1 - _min_jerk((tm / p.duration - 0.7) / 0.3))
+    window = min_jerk(tm / (0.3 * p.duration)) * (1 - min_jerk((tm / p.duration - 0.7) / 0.3))
     return p.wobble / 2.0 * window[:, None] * wave
 
 
@@ -353,6 +347,24 @@ def draw_independent(condition: str, rng: np.random.Generator, **fixed: Any) -> 
     return IndependentParams(condition=condition, **{**drawn, **fixed})
 
 
+def tracked_paths(t: np.ndarray, world: dict, camera: Camera, object_size: float, method: str,
+                  *, seed: int, noise_px: float, lost: dict[str, slice] | None = None) -> Tracks:
+    """``world`` (marker -> (F, 2) m) as a tracker would report it: pixel noise drawn from
+    ``seed + 1000``; ``lost`` frames NaN, likelihood 0, status lost."""
+    rng = np.random.default_rng(seed + 1000)
+    pos = np.stack([camera.world_to_pixel(world[m]) for m in MARKER_NAMES], axis=1)
+    pos = pos + noise_px * rng.standard_normal(pos.shape)
+    for marker, frames in (lost or {}).items():
+        pos[frames, MARKER_NAMES.index(marker)] = np.nan
+    ok = np.isfinite(pos).all(axis=-1)
+    diameter = [object_size * camera.px_per_m if m == "object" else math.nan
+                for m in MARKER_NAMES]
+    return Tracks(frame=np.arange(len(t)), time=t, markers=MARKER_NAMES, position=pos,
+                  likelihood=ok.astype(np.float32),
+                  status=np.where(ok, Status.TRACKED, Status.LOST).astype(np.int8),
+                  tracker={"method": method, "diameter_px": diameter})
+
+
 def independent_tracks(p: IndependentParams, seed: int = 0, *, fps: float = 30.0,
                        camera: Camera | None = None,
                        noise_px: float = 0.4) -> tuple[Tracks, dict[str, Any]]:
@@ -378,19 +390,11 @@ def independent_tracks(p: IndependentParams, seed: int = 0, *, fps: float = 30.0
     truth : dict
         ``world`` (marker -> (F, 2) m), ``aperture`` (F,) m, ``onset_frame``, ``params``.
     """
-    cam = Camera() if camera is None else camera
     t, paths = independent_paths(p, fps, seed=seed)
     world = {m: paths[m] for m in ("wrist", "finger", "thumb")}
     world["object"] = np.zeros_like(paths["wrist"])
-    rng = np.random.default_rng(seed + 1000)
-    pos = np.stack([cam.world_to_pixel(world[m]) for m in MARKER_NAMES], axis=1)
-    pos = pos + noise_px * rng.standard_normal(pos.shape)
-    diameter = [p.object_size * cam.px_per_m if m == "object" else math.nan
-                for m in MARKER_NAMES]
-    tracks = Tracks(frame=np.arange(len(t)), time=t, markers=MARKER_NAMES, position=pos,
-                    likelihood=np.ones(pos.shape[:2], np.float32),
-                    status=np.full(pos.shape[:2], Status.TRACKED, np.int8),
-                    tracker={"method": "independent", "diameter_px": diameter})
+    tracks = tracked_paths(t, world, Camera() if camera is None else camera, p.object_size,
+                      "independent", seed=seed, noise_px=noise_px)
     truth = {"world": world, "aperture": paths["aperture"],
              "onset_frame": int(round(p.rest_before * fps)), "params": p}
     return tracks, truth

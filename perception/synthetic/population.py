@@ -176,13 +176,14 @@ def population_camera(draw: PopulationDraw, style: RenderStyle = POPULATION_STYL
 def _check_in_frame(paths: dict, camera: Camera, style: RenderStyle, clip: str) -> None:
     """Every marker, with its extent (the wrist band's half-width), inside the frame."""
     k = camera.px_per_m
-    margin = {"wrist": 0.5 * max(style.band_size) * k, "finger": 0.5 * style.marker_diameter * k,
-              "thumb": 0.5 * style.marker_diameter * k}
-    objects = {"object": (np.zeros((1, 2)), 0.5 * DEFAULT_OBJECT_DIAMETER * k)}
-    for name, (xy, m) in {**{n: (paths[n], margin[n]) for n in margin}, **objects}.items():
+    digit = 0.5 * style.marker_diameter * k
+    parts = {"wrist": (paths["wrist"], 0.5 * max(style.band_size) * k),
+             "finger": (paths["finger"], digit), "thumb": (paths["thumb"], digit),
+             "object": (np.zeros((1, 2)), 0.5 * DEFAULT_OBJECT_DIAMETER * k)}
+    size = (style.width, style.height)
+    for name, (xy, m) in parts.items():
         px = camera.world_to_pixel(xy)
-        if (px.min(axis=0) - m < 0).any() or (px[:, 0].max() + m > style.width
-                                              or px[:, 1].max() + m > style.height):
+        if (px.min(axis=0) - m < 0).any() or (px.max(axis=0) + m > size).any():
             raise ValueError(f"{clip}: the {name} marker leaves the {style.width} x "
                              f"{style.height} frame at {camera.px_per_m:.0f} px/m")
 
@@ -209,13 +210,6 @@ def _render_population_one(work: tuple) -> dict:
                          label=cond, params=meta)
     return {"clip": clip, "condition": cond, "seed": int(clip_seed), "video": result.video.name,
             "truth": result.truth.name, **draw.row(), "parameters": json.dumps(meta)}
-
-
-class _RenderPopulation:
-    """:func:`_render_population_one` of item ``(index, work)``: a :mod:`perception.workers` job."""
-
-    def run(self, item: tuple[int, tuple], shared: None) -> tuple[int, dict]:
-        return item[0], _render_population_one(item[1])
 
 
 def render_population_set(out: str | os.PathLike, counts: dict[str, int], *, seed: int = 0,
@@ -269,26 +263,17 @@ def render_population_set(out: str | os.PathLike, counts: dict[str, int], *, see
     """
     from tqdm import tqdm
 
+    from perception.synthetic.render import render_rows  # OpenCV only when rendering
+
     style = POPULATION_STYLE if style is None else style
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    work, k = [], 0
-    for cond in CONDITIONS:
-        for i in range(counts.get(cond, 0)):
-            work.append((out, f"{cond}-{i + 1:02d}", cond, seed + k, ranges, fps_choices, style))
-            k += 1
-    rows: list[dict | None] = [None] * len(work)
+    clips = [(cond, i) for cond in CONDITIONS for i in range(counts.get(cond, 0))]
+    work = [(out, f"{cond}-{i + 1:02d}", cond, seed + k, ranges, fps_choices, style)
+            for k, (cond, i) in enumerate(clips)]
     with tqdm(total=len(work), desc="render population", unit="clip",
               disable=not progress) as bar:
-        if jobs > 1 and len(work) > 1:
-            from perception.workers import run_pool  # worker processes only when asked
-
-            results = run_pool(enumerate(work), _RenderPopulation(), int(jobs))
-        else:
-            results = (_RenderPopulation().run(item, None) for item in enumerate(work))
-        for i, row in results:
-            rows[i] = row
-            bar.update()
+        rows = render_rows(_render_population_one, work, int(jobs), bar)
     manifest = pd.DataFrame(rows)
     write_csv(out / "manifest.csv", manifest)
     return manifest

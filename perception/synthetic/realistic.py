@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -172,7 +172,7 @@ def render_realistic_set(out: str | os.PathLike, *, width: int = 640, height: in
         render_seed = int(rng.integers(2**31))
         real = render_clip(scene, camera, look, out / f"{name}.mp4", seed=render_seed,
                            label=cond, params={"background": bg, "sleeve": has_sleeve})
-        twin = render_clip(scene, camera, replace(clean), out / f"{name}.clean.mp4",
+        twin = render_clip(scene, camera, clean, out / f"{name}.clean.mp4",
                            seed=render_seed, label=cond, params={"background": None})
         clips.append(RealisticClip(name, bg, cond, real, twin, has_sleeve))
     return clips

@@ -27,7 +27,7 @@ from perception.io.config import Spec, check_keys, check_table, read_toml, sub_t
 from perception.io.video import CODECS
 from perception.limits import MAX_CLIPS
 from perception.synthetic.footage import load_background
-from perception.synthetic.render import render_clip
+from perception.synthetic.render import render_clip, render_rows
 from perception.synthetic.scene import (
     DISTRACTOR_LIMITS,
     OCCLUSION_LIMITS,
@@ -286,7 +286,7 @@ def synthesize(recipe: Recipe, out: str | os.PathLike, *, seed: int = 0,
     work = [(recipe, out, plan) for plan in plans]
     bar = tqdm(total=len(plans), desc=f"synth {recipe.name}", unit="clip", disable=not progress)
     with bar:
-        rows = _render_all(work, int(jobs), bar)
+        rows = render_rows(_render_one, work, int(jobs), bar)
     manifest = pd.DataFrame(rows)
     write_csv(out / "manifest.csv", manifest)
     return manifest
@@ -308,25 +308,6 @@ def _render_one(work: tuple) -> dict:
     return {"clip": clip, "condition": cond, "seed": clip_seed,
             "video": result.video.name, "truth": result.truth.name,
             "parameters": json.dumps(meta)}
-
-
-class _Render:
-    """:func:`_render_one` of item ``(index, work)`` as a :mod:`perception.workers` job."""
-
-    def run(self, item: tuple[int, tuple], shared: None) -> tuple[int, dict]:
-        return item[0], _render_one(item[1])
-
-
-def _render_all(work: list, jobs: int, bar) -> list[dict]:
-    """:func:`_render_one` of every item, here (``jobs`` 1) or in ``jobs`` worker
-    processes (one OpenCV thread each)."""
-    from perception.workers import run_pool
-
-    rows: list[dict | None] = [None] * len(work)
-    for i, row in run_pool(enumerate(work), _Render(), jobs):
-        rows[i] = row
-        bar.update()
-    return rows
 
 
 def _suffix(style: RenderStyle) -> str:

@@ -21,7 +21,7 @@ from __future__ import annotations
 import json
 import math
 import os
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, NamedTuple
@@ -53,7 +53,6 @@ TABLE_BGR = (140, 160, 178)
 _SHIFT = 4  # fractional bits of OpenCV drawing coordinates (1/16 px)
 _ONE = 1 << _SHIFT
 _AA_CIRCLE_EXCESS_PX = 0.6
-
 
 
 class RenderedFrame(NamedTuple):
@@ -97,7 +96,6 @@ def truth_path_for(video: str | os.PathLike) -> Path:
 
 # -- drawing ------------------------------------------------------------------
 def _fixed(px: np.ndarray) -> np.ndarray:
-    """Pixels -> OpenCV fixed-point int32 coordinates (1/16 px)."""
     return np.round(np.asarray(px) * _ONE).astype(np.int32)
 
 
@@ -116,7 +114,6 @@ def _poly(img: np.ndarray, pts_px: np.ndarray, bgr) -> None:
 
 
 def _rect(centre: np.ndarray, half: tuple[float, float]) -> np.ndarray:
-    """Corners (4, 2) of an axis-aligned world rectangle."""
     hx, hy = half
     return centre + np.array([[-hx, -hy], [hx, -hy], [hx, hy], [-hx, hy]])
 
@@ -139,15 +136,8 @@ def _draw_hand(img, camera: Camera, wrist, finger, thumb) -> None:
     width = max(1, int(round(0.016 * k)))
     for base, tip in ((wrist + (0.022, 0.04), finger), (wrist + (-0.03, 0.015), thumb)):
         b, t = _fixed(to_px(base)), _fixed(to_px(tip))
-        cv2.line(
-            img,
-            (int(b[0]), int(b[1])),
-            (int(t[0]), int(t[1])),
-            SKIN_BGR,
-            width,
-            cv2.LINE_AA,
-            _SHIFT,
-        )
+        cv2.line(img, (int(b[0]), int(b[1])), (int(t[0]), int(t[1])), SKIN_BGR, width,
+                 cv2.LINE_AA, _SHIFT)
 
 
 def _background(style: RenderStyle, rng: np.random.Generator) -> np.ndarray:
@@ -190,12 +180,8 @@ class _NoiseBank:
     def __init__(self, style: RenderStyle, rng: np.random.Generator, n: int = 4, pad: int = 16):
         h, w = style.height, style.width
         self.rng, self.pad, self.h, self.w = rng, pad, h, w
-        self.bank = [
-            np.round(
-                rng.standard_normal((h + pad, w + pad, 3), dtype=np.float32) * style.noise_sd
-            ).astype(np.int16)
-            for _ in range(n)
-        ]
+        self.bank = [np.round(rng.standard_normal((h + pad, w + pad, 3), dtype=np.float32)
+                              * style.noise_sd).astype(np.int16) for _ in range(n)]
 
     def next(self) -> np.ndarray:
         k, dy, dx = self.rng.integers(len(self.bank)), *self.rng.integers(self.pad, size=2)
@@ -259,7 +245,7 @@ def _draw_moving(img, camera: Camera, style: RenderStyle, scene: Scene, t: float
         if name == "object" or not visible[j]:
             continue
         if name == "wrist":
-            corners = camera.world_to_pixel(_rect(wrist, (half[0], half[1])))
+            corners = camera.world_to_pixel(_rect(wrist, half))
             if style.shading > 0:
                 shaded_band(img, corners, colours[name], style.shading)
             else:
@@ -273,14 +259,8 @@ def _draw_moving(img, camera: Camera, style: RenderStyle, scene: Scene, t: float
                 _disc(img, centre, style.marker_diameter / 2 * k, colours[name])
 
 
-def render_frames(
-    scene: Scene,
-    camera: Camera,
-    style: RenderStyle | None = None,
-    *,
-    seed: int = 0,
-    markers: MarkerSet | None = None,
-) -> Iterator[RenderedFrame]:
+def render_frames(scene: Scene, camera: Camera, style: RenderStyle | None = None, *,
+                  seed: int = 0, markers: MarkerSet | None = None) -> Iterator[RenderedFrame]:
     """Generate the clip's frames one at a time (streaming; nothing is kept).
 
     Parameters
@@ -362,9 +342,8 @@ def _check_scene(scene: Scene, style: RenderStyle, markers: MarkerSet) -> None:
     names = markers.names
     missing = [n for n in ("thumb", "finger", "wrist", "object") if n not in names]
     if missing:
-        raise ValueError(
-            f"render: markers: expected thumb, finger, wrist, object; missing {missing}"
-        )
+        raise ValueError(f"render: markers: expected thumb, finger, wrist, object; "
+                         f"missing {missing}")
     for occ in style.occlusions:
         if occ.marker not in names:
             raise ValueError(f"RenderStyle.occlusions: unknown marker {occ.marker!r}")
@@ -373,17 +352,10 @@ def _check_scene(scene: Scene, style: RenderStyle, markers: MarkerSet) -> None:
             raise ValueError(f"RenderStyle.distractors: unknown marker colour {d.colour!r}")
 
 
-def render_clip(
-    scene: Scene,
-    camera: Camera,
-    style: RenderStyle | None,
-    out_path: str | os.PathLike,
-    *,
-    seed: int = 0,
-    label: str | None = None,
-    params: Mapping[str, Any] | None = None,
-    markers: MarkerSet | None = None,
-) -> RenderResult:
+def render_clip(scene: Scene, camera: Camera, style: RenderStyle | None,
+                out_path: str | os.PathLike, *, seed: int = 0, label: str | None = None,
+                params: Mapping[str, Any] | None = None,
+                markers: MarkerSet | None = None) -> RenderResult:
     """Render a clip to ``out_path`` and its ground truth to ``<stem>.truth.h5``.
 
     Frames are generated and written one at a time. Both files are written
@@ -423,9 +395,8 @@ def render_clip(
     diameter = [scene.object_diameter * camera.px_per_m if n == "object" else math.nan
                 for n in markers.names]
     tracker = {"method": "render", "colour_models": markers.to_json(), "diameter_px": diameter}
-    n_markers = len(markers)
-    ones = np.ones(n_markers, np.float32)
-    zeros = np.zeros(n_markers, np.int8)
+    ones = np.ones(len(markers), np.float32)
+    zeros = np.zeros(len(markers), np.int8)
     video_done = False
     try:
         with TracksWriter(truth_path, markers.names, tracker=tracker, attrs=root) as tw:
@@ -437,20 +408,11 @@ def render_clip(
                     vw.write(fr.image)
                     tw.append(fr.index, fr.time, fr.truth, ones, zeros)
             video_done = True
-            tw.update(
-                video={
-                    "path": os.fspath(out),
-                    "sha256": sha256_file(out),
-                    "fps_nominal": float(style.fps),
-                    "n_frames": scene.n_frames,
-                    "width": style.width,
-                    "height": style.height,
-                    "fourcc": codec,
-                }
-            )
-            tw.file.create_dataset(
-                "truth/visible", data=visibility(style, markers.names, scene.n_frames)
-            )
+            tw.update(video={"path": os.fspath(out), "sha256": sha256_file(out),
+                             "fps_nominal": float(style.fps), "n_frames": scene.n_frames,
+                             "width": style.width, "height": style.height, "fourcc": codec})
+            tw.file.create_dataset("truth/visible",
+                                   data=visibility(style, markers.names, scene.n_frames))
     except BaseException:
         if video_done:  # the truth failed after the video appeared: take it back
             out.unlink(missing_ok=True)
@@ -458,12 +420,39 @@ def render_clip(
     return RenderResult(out, truth_path, scene.n_frames)
 
 
-__all__ = [
-    "SKIN_BGR",
-    "TABLE_BGR",
-    "RenderResult",
-    "RenderedFrame",
-    "render_clip",
-    "render_frames",
-    "truth_path_for",
-]
+class _Indexed:
+    """``render(work)`` of item ``(index, work)``: a :mod:`perception.workers` job."""
+
+    def __init__(self, render: Callable[[Any], dict]):
+        self.render = render
+
+    def run(self, item: tuple[int, Any], shared: None) -> tuple[int, dict]:
+        return item[0], self.render(item[1])
+
+
+def render_rows(render: Callable[[Any], dict], work: list, jobs: int, bar) -> list[dict]:
+    """``render(item)`` of every item of ``work``, in its order: a set's manifest rows.
+
+    Parameters
+    ----------
+    render : callable
+        One item -> its clip's manifest row (a module-level function: it is
+        sent to the worker processes).
+    work : list
+        The items.
+    jobs : int
+        Worker processes (1: here, one OpenCV thread each otherwise).
+    bar : tqdm
+        Advanced by one per clip done.
+    """
+    from perception.workers import run_pool
+
+    rows: list[dict | None] = [None] * len(work)
+    for i, row in run_pool(enumerate(work), _Indexed(render), jobs):
+        rows[i] = row
+        bar.update()
+    return rows
+
+
+__all__ = ["SKIN_BGR", "TABLE_BGR", "RenderResult", "RenderedFrame", "render_clip",
+           "render_frames", "truth_path_for"]

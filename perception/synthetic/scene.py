@@ -106,22 +106,14 @@ class Camera:
     angle_deg: float = 0.0
 
     def __post_init__(self) -> None:
-        origin = tuple(float(v) for v in self.origin_px)
-        object.__setattr__(self, "origin_px", origin)
+        object.__setattr__(self, "origin_px", tuple(float(v) for v in self.origin_px))
         object.__setattr__(self, "px_per_m", float(self.px_per_m))
         object.__setattr__(self, "angle_deg", float(self.angle_deg))
         self.transform  # noqa: B018 - validates scale, origin and angle
 
     @classmethod
-    def for_frame(
-        cls,
-        width: int,
-        height: int,
-        *,
-        px_per_m: float | None = None,
-        angle_deg: float = 0.0,
-        origin: tuple[float, float] = (0.5, 0.3),
-    ) -> Camera:
+    def for_frame(cls, width: int, height: int, *, px_per_m: float | None = None,
+                  angle_deg: float = 0.0, origin: tuple[float, float] = (0.5, 0.3)) -> Camera:
         """A camera whose frame height spans 0.6 m of table, object 30 % from the top.
 
         Parameters
@@ -307,13 +299,11 @@ class RenderStyle:
                              f"got {self.exposure!r}", field="RenderStyle.exposure")
         for name, kind in (("distractors", Distractor), ("occlusions", Occlusion)):
             items = getattr(self, name)
-            if not isinstance(items, list | tuple) or not all(isinstance(i, kind)
-                                                              for i in items):
+            if not (isinstance(items, list | tuple) and all(isinstance(i, kind) for i in items)):
                 raise InputError(f"expected {kind.__name__}s, got {items!r}"[:120],
                                  field=f"RenderStyle.{name}")
+            object.__setattr__(self, name, tuple(items))
         check_background(self.background)
-        object.__setattr__(self, "distractors", tuple(self.distractors))
-        object.__setattr__(self, "occlusions", tuple(self.occlusions))
 
     def to_dict(self) -> dict[str, Any]:
         """Plain-data form (JSON-ready)."""
@@ -347,9 +337,8 @@ class Scene:
             if arr.ndim != 2 or arr.shape[1] != 2 or arr.shape[0] < 1:
                 raise ValueError(f"Scene.{name}: expected shape (T, 2) in m, got {arr.shape}")
             if n is not None and arr.shape[0] != n:
-                raise ValueError(
-                    f"Scene.{name}: expected T = {n} rows like wrist, got {arr.shape[0]}"
-                )
+                raise ValueError(f"Scene.{name}: expected T = {n} rows like wrist, "
+                                 f"got {arr.shape[0]}")
             if not np.all(np.isfinite(arr)):
                 raise ValueError(f"Scene.{name}: expected finite positions, found NaN or inf")
             n = arr.shape[0]
@@ -371,19 +360,11 @@ class Scene:
         return out
 
     @classmethod
-    def reach_to_grasp(
-        cls,
-        n_frames: int,
-        fps: float,
-        *,
-        start: tuple[float, float] = (0.0, -0.40),
-        onset: float = 0.3,
-        duration: float = 1.0,
-        aperture: tuple[float, float] = (0.035, 0.14),
-        peak_at: float = 0.7,
-        object_diameter: float = DEFAULT_OBJECT_DIAMETER,
-        wrist_offset: float = 0.06,
-    ) -> Scene:
+    def reach_to_grasp(cls, n_frames: int, fps: float, *,
+                       start: tuple[float, float] = (0.0, -0.40), onset: float = 0.3,
+                       duration: float = 1.0, aperture: tuple[float, float] = (0.035, 0.14),
+                       peak_at: float = 0.7, object_diameter: float = DEFAULT_OBJECT_DIAMETER,
+                       wrist_offset: float = 0.06) -> Scene:
         """Analytic reach-to-grasp: minimum-jerk transport, aperture up then down.
 
         A stand-in for grasp-model stimuli in tests and benchmarks. The wrist
@@ -414,13 +395,13 @@ class Scene:
         """
         t = np.arange(n_frames) / fps
         tau = np.clip((t - onset) / duration, 0.0, 1.0)
-        s = _min_jerk(tau)
+        s = min_jerk(tau)
         start_arr = np.asarray(start, dtype=np.float64)
         goal = np.array([0.0, -wrist_offset])
         wrist = start_arr + s[:, None] * (goal - start_arr)
         a0, amax = aperture
-        opening = _min_jerk(np.clip(tau / peak_at, 0, 1))
-        closing = _min_jerk(np.clip((tau - peak_at) / (1 - peak_at), 0, 1))
+        opening = min_jerk(tau / peak_at)
+        closing = min_jerk((tau - peak_at) / (1 - peak_at))
         ap = a0 + (amax - a0) * opening + (object_diameter - amax) * closing
         ahead = wrist + np.array([0.0, wrist_offset])
         lateral = np.stack([ap / 2, np.zeros_like(ap)], axis=1)
@@ -432,7 +413,9 @@ document_ranges(Occlusion, OCCLUSION_LIMITS)
 document_ranges(RenderStyle, RENDER_LIMITS)
 
 
-def _min_jerk(tau: np.ndarray) -> np.ndarray:
+def min_jerk(tau: np.ndarray) -> np.ndarray:
+    """The minimum-jerk profile 10τ³ − 15τ⁴ + 6τ⁵ at ``tau`` clipped to [0, 1]."""
+    tau = np.clip(tau, 0.0, 1.0)
     return tau**3 * (10 - 15 * tau + 6 * tau**2)
 
 

@@ -143,8 +143,7 @@ def stimulus_paths(p: StimulusParams, fps: float, *, seed) -> tuple[np.ndarray, 
     paths = {}
     for name in ("wrist", "finger", "thumb"):
         xy = getattr(res, name)[0]
-        paths[name] = np.stack([np.interp(tm, t_model, xy[:, 0]),
-                                np.interp(tm, t_model, xy[:, 1])], axis=1)
+        paths[name] = np.stack([np.interp(tm, t_model, v) for v in xy.T], axis=1)
     # the hand frame is not rotated: across the grip is the world x axis
     paths["finger"][:, 0] += p.marker_offset
     paths["thumb"][:, 0] -= p.marker_offset

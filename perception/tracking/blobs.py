@@ -98,13 +98,34 @@ def find_blobs(
     if scale is not None:
         fx, fy = scale
         areas = areas * (fx * fy)
-        centres = np.column_stack(
-            ((centres[:, 0] + 0.5) * fx - 0.5, (centres[:, 1] + 0.5) * fy - 0.5)
-        )
+        centres = (centres + 0.5) * (fx, fy) - 0.5
         boxes = np.rint(boxes * np.array([fx, fy, fx, fy])).astype(np.int64)
     keep = np.flatnonzero((areas >= min_area) & (areas <= max_area))
     centres, areas, boxes = centres[keep].tolist(), areas[keep].tolist(), boxes[keep].tolist()
     return [Blob((c[0], c[1]), float(a), tuple(b)) for c, a, b in zip(centres, areas, boxes)]
+
+
+def blob_at(mask: np.ndarray, point: tuple[int, int]) -> np.ndarray | None:
+    """The blob of ``mask`` at ``point`` (x, y) px, as a bool mask; None on background.
+
+    A point outside the mask is moved onto its nearest pixel.
+    """
+    _, labels = cv2.connectedComponents(mask, ltype=label_type(mask.shape))
+    h, w = mask.shape
+    lab = labels[min(max(point[1], 0), h - 1), min(max(point[0], 0), w - 1)]
+    return labels == lab if lab else None
+
+
+def principal_axes(mask: np.ndarray) -> tuple[float, float, float]:
+    """Variances (px^2) of a binary mask along its major and minor axes; the major's angle, rad.
+
+    The minor variance of a line may be a rounding error below 0.
+    """
+    mo = cv2.moments(mask, True)
+    m = max(mo["m00"], 1.0)
+    a, b, c = mo["mu20"] / m, mo["mu11"] / m, mo["mu02"] / m
+    root = math.sqrt(max((a - c) ** 2 / 4 + b * b, 0.0))
+    return (a + c) / 2 + root, (a + c) / 2 - root, 0.5 * math.atan2(2 * b, a - c)
 
 
 def by_distance(blobs: Sequence[Blob], point: Sequence[float]) -> list[Blob]:

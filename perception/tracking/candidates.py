@@ -33,7 +33,7 @@ from dataclasses import dataclass, replace
 import cv2
 import numpy as np
 
-from perception.tracking.blobs import Blob, find_blobs, label_type, nearest_blob
+from perception.tracking.blobs import Blob, find_blobs, label_type, nearest_blob, principal_axes
 from perception.tracking.markers import MarkerColour
 from perception.tracking.params import TrackerParams
 
@@ -85,18 +85,6 @@ class Candidate:
         return self.blob.area
 
 
-def _shape(mask: np.ndarray) -> tuple[float, tuple[float, float]]:
-    """Roundness and major-axis direction of a binary mask."""
-    mo = cv2.moments(mask, True)
-    m = max(mo["m00"], 1.0)
-    a, b, c = mo["mu20"] / m, mo["mu11"] / m, mo["mu02"] / m
-    root = math.sqrt(max((a - c) ** 2 / 4 + b * b, 0.0))
-    major, minor = (a + c) / 2 + root, (a + c) / 2 - root
-    angle = 0.5 * math.atan2(2 * b, a - c)
-    return math.sqrt(max(minor, 0.0) / major) if major > 0 else 1.0, (math.cos(angle),
-                                                                       math.sin(angle))
-
-
 def _moved(later: np.ndarray, colour: MarkerColour, blob: Blob, size_change: float) -> float:
     """How far a blob moved in a later HSV frame, px (inf: gone or changed size).
 
@@ -112,7 +100,7 @@ def _moved(later: np.ndarray, colour: MarkerColour, blob: Blob, size_change: flo
                          (blob.centre[0] - x0, blob.centre[1] - y0))
     if found is None or not blob.area / size_change <= found.area <= size_change * blob.area:
         return math.inf
-    return math.hypot(found.centre[0] + x0 - blob.centre[0], found.centre[1] + y0 - blob.centre[1])
+    return math.dist(found.moved(x0, y0).centre, blob.centre)
 
 
 def strict(colour: MarkerColour, params: TrackerParams) -> MarkerColour:
@@ -178,7 +166,9 @@ def describe(hsv: np.ndarray, colour: MarkerColour, min_area: float,
         x, y, w, h, area = (int(v) for v in stats[k])
         sub = labels[y:y + h, x:x + w] == k
         pix = region[y:y + h, x:x + w][sub]
-        roundness, axis = _shape(sub.astype(np.uint8))
+        major, minor, angle = principal_axes(sub.astype(np.uint8))
+        roundness = math.sqrt(max(minor, 0.0) / major) if major > 0 else 1.0
+        axis = math.cos(angle), math.sin(angle)
         blob = Blob((float(cents[k][0]) + x0, float(cents[k][1]) + y0), float(area),
                     (x + x0, y + y0, w, h))
         moved = _moved(later, colour, blob, size_change) if later is not None else math.nan

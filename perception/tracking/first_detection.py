@@ -29,7 +29,7 @@ import numpy as np
 
 from perception.errors import InputError
 from perception.io.tracks import Status
-from perception.tracking.blobs import Blob, find_blobs, label_type
+from perception.tracking.blobs import Blob, blob_at
 from perception.tracking.candidates import (
     Candidate,
     describe,
@@ -43,6 +43,7 @@ from perception.tracking.marker_track import Located, MarkerTrack
 from perception.tracking.markers import MarkerColour
 from perception.tracking.measurement import clamp_window, measure, soft_diameter
 from perception.tracking.params import TrackerParams
+from perception.tracking.reacquisition import ROI
 
 __all__ = ["FirstDetection"]
 
@@ -108,9 +109,8 @@ class FirstDetection:
         if self._height is None:
             self._height = frame.shape[0]
         tracks = self.tracks
-        found: dict[int, Located | None] = {}
-        for j in [j for j in todo if tracks[j].still]:
-            found[j] = self._find_still(tracks[j], frame)
+        found: dict[int, Located | None] = {
+            j: self._find_still(tracks[j], frame) for j in todo if tracks[j].still}
         hand = [j for j in todo if not tracks[j].still]
         if hand:
             found.update(self._find_hand(frame, hand))
@@ -131,17 +131,19 @@ class FirstDetection:
 
     def _scale_or_guess(self) -> float:
         """px/m: from the object, or a frame height spanning ``table_height_m`` of table."""
-        if self.scale is not None:
-            return self.scale
-        return self._height / self.params.table_height_m
+        return self._height / self.params.table_height_m if self.scale is None else self.scale
+
+    def _describe(self, frame: np.ndarray, colour: MarkerColour, roi: ROI | None,
+                  later: bool) -> list[Candidate]:
+        p = self.params
+        return describe(self._full_hsv(frame), colour, p.min_area_px, roi,
+                        self._later if later else None, p.max_blobs, p.rest_area_ratio)
 
     def _candidates(self, tr: MarkerTrack, frame: np.ndarray, later: bool) -> list[Candidate]:
         # A ROI says where the marker is on the first frame only.
         if tr.roi is not None and self._index > 0:
             return []
-        p = self.params
-        cands = describe(self._full_hsv(frame), tr.colour, p.min_area_px, tr.roi,
-                         self._later if later else None, p.max_blobs, p.rest_area_ratio)
+        cands = self._describe(frame, tr.colour, tr.roi, later)
         if tr.roi is not None and not cands:
             raise InputError(f"{tr.name}: nothing of its colour in the ROI {list(tr.roi)} "
                              "on the first frame")
@@ -168,8 +170,7 @@ class FirstDetection:
         if keep or not too_big or tr.roi is not None:
             return keep
         narrow = strict(tr.colour, p)
-        pure = describe(self._full_hsv(frame), narrow, p.min_area_px, None,
-                        self._later if later else None, p.max_blobs, p.rest_area_ratio)
+        pure = self._describe(frame, narrow, None, later)
         keep = [c for c in pure if reject_reason(c, tr.name, narrow, expected, p) is None]
         if keep:
             tr.colour = narrow
@@ -179,15 +180,10 @@ class FirstDetection:
         """The track's gate narrowed to its marker's own pixels (see :func:`own_gate`)."""
         x, y, w, h = blob.box
         hsv = self._full_hsv(frame)[y:y + h, x:x + w]
-        found = find_blobs(tr.colour.backproject(hsv))
-        mask = tr.colour.backproject(hsv) > 0
-        if found:  # only the component of the blob, not neighbours in its box
-            n, labels = cv2.connectedComponents(mask.astype(np.uint8), ltype=label_type(mask.shape))
-            cx, cy = int(blob.centre[0]) - x, int(blob.centre[1]) - y
-            lab = labels[min(max(cy, 0), h - 1), min(max(cx, 0), w - 1)]
-            if lab:
-                mask = labels == lab
-        return own_gate(tr.colour, hsv, mask, self.params)
+        bp = tr.colour.backproject(hsv)
+        # only the component of the blob, not neighbours in its box
+        mask = blob_at(bp, (int(blob.centre[0]) - x, int(blob.centre[1]) - y))
+        return own_gate(tr.colour, hsv, bp > 0 if mask is None else mask, self.params)
 
     def _find_still(self, tr: MarkerTrack, frame: np.ndarray) -> Located | None:
         """The object: the largest round, pure, still blob of its colour; it sets the scale."""
@@ -221,11 +217,11 @@ class FirstDetection:
         survivors = {}
         for j in todo:
             tr = tracks[j]
-            keep = self._survivors(tr, cands[j], expected_area(tr.name, scale, p), frame,
-                                   at_rest)
+            expected = expected_area(tr.name, scale, p)
+            keep = self._survivors(tr, cands[j], expected, frame, at_rest)
             if tr.roi is not None and not keep and cands[j]:
                 keep = cands[j][:1]  # the user pointed at it
-            target = expected_area(tr.name, scale, p) or 1.0
+            target = expected or 1.0
             keep.sort(key=lambda c: abs(math.log(c.area / target)))
             survivors[j] = keep[: p.init_candidates]
         if self._later is not None and any(
@@ -240,7 +236,7 @@ class FirstDetection:
             if tracks[j].roi is not None and survivors[j]:
                 anchors[tracks[j].name] = survivors[j][0].centre
         choice = choose_hand(free, anchors, scale, p, at_rest=at_rest)
-        out: dict[int, Located | None] = {}
+        out: dict[int, Located | None] = dict.fromkeys(todo)
         for j in todo:
             tr = tracks[j]
             if tr.roi is not None:
@@ -248,9 +244,7 @@ class FirstDetection:
             elif tr.name in choice.chosen:
                 out[j] = self._start(tr, frame, choice.chosen[tr.name].blob)
             elif tr.name in choice.ambiguous:
-                out[j] = self._ambiguous(tr, choice.ambiguous[tr.name])
-            else:
-                out[j] = None
+                self._ambiguous(tr, choice.ambiguous[tr.name])
         return out
 
     def _hand_at_rest(self) -> bool:
@@ -262,8 +256,7 @@ class FirstDetection:
             return False
         near = 2 * self.params.rest_motion_px
         return all(t.name in self._rest and not t.lost
-                   and math.hypot(t.x[0] - self._rest[t.name][0],
-                                  t.x[1] - self._rest[t.name][1]) <= near for t in tracked)
+                   and math.dist(t.x, self._rest[t.name]) <= near for t in tracked)
 
     def _not_rivals(self, tr: MarkerTrack, cands: list[Candidate]) -> list[Candidate]:
         """Candidates of an ambiguous marker that have left every rival blob's place.
@@ -275,8 +268,7 @@ class FirstDetection:
         if not tr.rivals:
             return cands
         near = self.params.rest_motion_px
-        return [c for c in cands
-                if all(math.hypot(c.centre[0] - x, c.centre[1] - y) > near for x, y in tr.rivals)]
+        return [c for c in cands if all(math.dist(c.centre, r) > near for r in tr.rivals)]
 
     def _ambiguous(self, tr: MarkerTrack, rivals: list[Candidate]) -> None:
         """Say once that a marker has rivals; it is reported ambiguous until resolved."""
@@ -286,7 +278,6 @@ class FirstDetection:
             logger.warning("%s: %s; reported ambiguous (status %d) until it can be told "
                            "from them; give --roi %s X Y W H or a setup file (--setup)",
                            tr.name, tr.why_not_found(), Status.AMBIGUOUS, tr.name)
-        return None
 
     def _start(self, tr: MarkerTrack, frame: np.ndarray, blob: Blob) -> Located | None:
         """Begin a track on a blob found by first detection."""
@@ -309,12 +300,7 @@ class FirstDetection:
         if tr.still and not np.isfinite(tr.diameter):
             tr.diameter = soft_diameter(frame, tr.colour, meas.centre, meas.window, p)
         tr.observe(meas, p)
-        logger.info(
-            "%s found at (%.1f, %.1f) px on frame %d, %d px of its colour",
-            tr.name,
-            *meas.centre,
-            self._index,
-            meas.mass,
-        )
+        logger.info("%s found at (%.1f, %.1f) px on frame %d, %d px of its colour",
+                    tr.name, *meas.centre, self._index, meas.mass)
         status = Status.TRACKED if self._index == 0 else Status.REACQUIRED
         return meas.centre, tr.likelihood(meas, p), status

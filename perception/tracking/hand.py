@@ -55,10 +55,6 @@ class HandChoice:
         return len(self.chosen) + len(self.ambiguous)
 
 
-def _dist(p: Sequence[float], q: Sequence[float]) -> float:
-    return math.hypot(p[0] - q[0], p[1] - q[1])
-
-
 def hand_cost(points: Mapping[str, Sequence[float]], band_axis: Sequence[float] | None,
               px_per_m: float, params: TrackerParams, *, at_rest: bool) -> float | None:
     """Cost of one placement of the hand markers; None when it is not a hand.
@@ -86,7 +82,7 @@ def hand_cost(points: Mapping[str, Sequence[float]], band_axis: Sequence[float] 
     cost = 0.0
     digits = [points[n] for n in ("thumb", "finger") if n in points]
     if len(digits) == 2:
-        gap = _dist(*digits) / px_per_m
+        gap = math.dist(*digits) / px_per_m
         limit = params.digit_gap if at_rest else params.hand_span
         if gap > limit:
             return None
@@ -95,7 +91,7 @@ def hand_cost(points: Mapping[str, Sequence[float]], band_axis: Sequence[float] 
     if wrist is None or not digits:
         return cost
     for d in digits:
-        reach = _dist(d, wrist) / px_per_m
+        reach = math.dist(d, wrist) / px_per_m
         if not params.min_band_distance <= reach <= params.hand_span:
             return None
         cost += abs(reach - params.typical_reach) / params.typical_reach / len(digits)
@@ -167,7 +163,7 @@ def choose_hand(candidates: Mapping[str, Sequence[Candidate]],
     for n in names:
         rivals = [best[n]]
         for picked in close[1:]:
-            if all(_dist(picked[n].centre, r.centre) > separation_px for r in rivals):
+            if all(math.dist(picked[n].centre, r.centre) > separation_px for r in rivals):
                 rivals.append(picked[n])
         if len(rivals) == 1:
             chosen[n] = best[n]

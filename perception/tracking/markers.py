@@ -30,7 +30,7 @@ import cv2
 import numpy as np
 
 from perception.errors import InputError
-from perception.io.config import Spec, check_keys, check_value, read_toml, suggest
+from perception.io.config import Spec, check_fields, check_keys, check_value, read_toml, suggest
 from perception.io.files import input_file
 
 #: Marker names in file order (``/tracks/markers``).
@@ -71,14 +71,8 @@ class MarkerColour:
             raise InputError(f"expected 3 integers 0..255, got {self.bgr!r}",
                              field=f"{self.name}.bgr")
         object.__setattr__(self, "bgr", tuple(int(c) for c in bgr))
-        hue = _normalise_hue(self.hue, f"{self.name}.hue")
-        object.__setattr__(self, "hue", hue)
-        for name in ("sat_min", "val_min"):
-            value = getattr(self, name)
-            problem = check_value(value, Spec(int, 0, 255))
-            if problem:
-                raise InputError(problem, field=f"{self.name}.{name}")
-            object.__setattr__(self, name, int(value))
+        object.__setattr__(self, "hue", _normalise_hue(self.hue, f"{self.name}.hue"))
+        check_fields(self, {"sat_min": Spec(int, 0, 255), "val_min": Spec(int, 0, 255)}, self.name)
 
     @cached_property
     def hsv(self) -> tuple[int, int, int]:
@@ -91,14 +85,9 @@ class MarkerColour:
         # cv2.inRange takes one box per call: split wrapping ranges in two.
         boxes = []
         for lo, hi in self.hue:
-            spans = [(lo, hi)] if lo <= hi else [(lo, 179), (0, hi)]
-            for a, b in spans:
-                boxes.append(
-                    (
-                        np.array([a, self.sat_min, self.val_min], dtype=np.uint8),
-                        np.array([b, 255, 255], dtype=np.uint8),
-                    )
-                )
+            for a, b in [(lo, hi)] if lo <= hi else [(lo, 179), (0, hi)]:
+                boxes.append((np.array([a, self.sat_min, self.val_min], dtype=np.uint8),
+                              np.array([b, 255, 255], dtype=np.uint8)))
         return tuple(boxes)
 
     def backproject(self, hsv: np.ndarray) -> np.ndarray:
@@ -148,8 +137,7 @@ def _normalise_hue(hue: Any, field: str) -> tuple[tuple[int, int], ...]:
         raise bad from None
     if arr.dtype == object or arr.size > 2 * 180:
         raise bad
-    if arr.ndim == 1:
-        arr = arr[None, :]
+    arr = np.atleast_2d(arr)
     if arr.ndim != 2 or arr.shape[1] != 2 or arr.shape[0] == 0:
         raise bad
     if arr.dtype.kind not in "iu" and not (
@@ -261,10 +249,9 @@ class MarkerSet:
     def from_dict(cls, data: Mapping[str, Any], source: str = "colours") -> MarkerSet:
         """Build from a full ``{name: fields}`` mapping (as :meth:`to_dict` writes)."""
         markers = []
+        known = {f.name for f in fields(MarkerColour)}
         for name, table in data.items():
-            kwargs = {
-                k: v for k, v in dict(table).items() if k in {f.name for f in fields(MarkerColour)}
-            }
+            kwargs = {k: v for k, v in dict(table).items() if k in known}
             try:
                 markers.append(MarkerColour(name=name, **kwargs))
             except (ValueError, TypeError) as exc:

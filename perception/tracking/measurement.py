@@ -34,7 +34,7 @@ from typing import NamedTuple
 import cv2
 import numpy as np
 
-from perception.tracking.blobs import find_blobs, label_type, nearest_blob
+from perception.tracking.blobs import blob_at, find_blobs, nearest_blob
 from perception.tracking.markers import MarkerColour
 from perception.tracking.params import TrackerParams
 
@@ -95,19 +95,14 @@ def clamp_window(win: tuple[int, int], ref: float, params: TrackerParams) -> tup
         ``min_window_px`` and ``max_window_ratio``.
     """
     min_side = params.min_window_px
-    if ref > 0:
-        cap = max(int(params.max_window_ratio * ref_side(ref, params)), min_side)
-    else:
-        cap = 10**6
+    cap = max(int(params.max_window_ratio * ref_side(ref, params)), min_side) if ref > 0 else 10**6
     return (min(max(int(win[0]), min_side), cap), min(max(int(win[1]), min_side), cap))
 
 
 def _extent(mo: dict[str, float], mass: float, rim_px: int) -> tuple[int, int]:
     """A blob's window from its central moments: 2r for a disc, plus ``rim_px`` for the rim."""
-    return (
-        int(4 * math.sqrt(mo["mu20"] / mass)) + rim_px,
-        int(4 * math.sqrt(mo["mu02"] / mass)) + rim_px,
-    )
+    return (int(4 * math.sqrt(mo["mu20"] / mass)) + rim_px,
+            int(4 * math.sqrt(mo["mu02"] / mass)) + rim_px)
 
 
 def measure(
@@ -177,7 +172,6 @@ def _measure_region(
     cx, cy = float(centre[0]), float(centre[1])
     if not (math.isfinite(cx) and math.isfinite(cy)):
         return None
-    # The region: the window at the centre plus the margin, within the frame.
     h, w = frame.shape[:2]
     ww, wh = window
     x0, y0 = int(cx - ww / 2 - margin), int(cy - wh / 2 - margin)
@@ -292,21 +286,12 @@ def _cut_off(
     bp: np.ndarray, meas: Measurement, region: tuple[int, int, int, int], shape: tuple[int, ...]
 ) -> bool:
     """Whether the measured blob reaches an edge of its region that is not the frame's."""
-    x0, y0, x1, y1 = region
-    h, w = shape[:2]
     rh, rw = bp.shape
-    cx, cy = meas.centre[0] - x0, meas.centre[1] - y0
+    cx, cy = meas.centre[0] - region[0], meas.centre[1] - region[1]
     hx, hy = meas.window[0] / 2 + 1, meas.window[1] / 2 + 1
     lx, hx_ = max(int(cx - hx), 0), min(int(cx + hx) + 1, rw)
     ly, hy_ = max(int(cy - hy), 0), min(int(cy + hy) + 1, rh)
-    if lx >= hx_ or ly >= hy_:
-        return False
-    return bool(
-        (lx == 0 < x0 and cv2.countNonZero(bp[ly:hy_, 0]))
-        or (ly == 0 < y0 and cv2.countNonZero(bp[0, lx:hx_]))
-        or (hx_ == rw and x1 < w and cv2.countNonZero(bp[ly:hy_, rw - 1]))
-        or (hy_ == rh and y1 < h and cv2.countNonZero(bp[rh - 1, lx:hx_]))
-    )
+    return lx < hx_ and ly < hy_ and _touches_edge(bp, region, shape, (lx, ly, hx_, hy_))
 
 
 def measure_still(
@@ -355,7 +340,7 @@ def measure_still(
     found = (mo["m10"] / mass + x0, mo["m01"] / mass + y0)
     if (
         mass >= params.hold_ratio * ref
-        and math.hypot(found[0] - cx, found[1] - cy) > params.still_shift_px
+        and math.dist(found, (cx, cy)) > params.still_shift_px
     ):
         return None  # whole but off-centre: it is moving
     if _touches_edge(bp, (x0, y0, x1, y1), (h, w)):
@@ -364,17 +349,22 @@ def measure_still(
 
 
 def _touches_edge(
-    bp: np.ndarray, region: tuple[int, int, int, int], shape: tuple[int, ...]
+    bp: np.ndarray, region: tuple[int, int, int, int], shape: tuple[int, ...],
+    span: tuple[int, int, int, int] | None = None,
 ) -> bool:
-    """Whether any pixel of the colour lies on an edge of the region that is not the frame's."""
+    """Whether any pixel of the colour lies on an edge of the region that is not the frame's.
+
+    ``span`` (x0, y0, x1, y1), in the region, limits the search to the edges it reaches.
+    """
     x0, y0, x1, y1 = region
     h, w = shape[:2]
     rh, rw = bp.shape
+    lx, ly, hx, hy = (0, 0, rw, rh) if span is None else span
     return bool(
-        (x0 > 0 and cv2.countNonZero(bp[:, 0]))
-        or (y0 > 0 and cv2.countNonZero(bp[0, :]))
-        or (x1 < w and cv2.countNonZero(bp[:, rw - 1]))
-        or (y1 < h and cv2.countNonZero(bp[rh - 1, :]))
+        (lx == 0 < x0 and cv2.countNonZero(bp[ly:hy, 0]))
+        or (ly == 0 < y0 and cv2.countNonZero(bp[0, lx:hx]))
+        or (hx == rw and x1 < w and cv2.countNonZero(bp[ly:hy, rw - 1]))
+        or (hy == rh and y1 < h and cv2.countNonZero(bp[rh - 1, lx:hx]))
     )
 
 
@@ -419,11 +409,8 @@ def soft_diameter(
     x1, y1 = min(cx + half + 1, w), min(cy + half + 1, h)
     region = frame[y0:y1, x0:x1]
     gate = colour.backproject(cv2.cvtColor(region, cv2.COLOR_BGR2HSV))
-    n, labels = cv2.connectedComponents((gate > 0).astype(np.uint8), ltype=label_type(gate.shape))
-    lab = labels[min(cy - y0, labels.shape[0] - 1), min(cx - x0, labels.shape[1] - 1)]
-    if n < 2 or lab == 0:
-        return float("nan")
-    zones = _rim_zones((labels == lab).astype(np.uint8))
+    blob = blob_at(gate, (cx - x0, cy - y0))
+    zones = None if blob is None else _rim_zones(blob.astype(np.uint8))
     if zones is None:
         return float("nan")
     inner, near, ring = zones

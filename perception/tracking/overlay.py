@@ -9,6 +9,7 @@ what the tracker saw (the counterpart of DeepLabCut's labelled videos).
 
 from __future__ import annotations
 
+import json
 import os
 from collections import deque
 from pathlib import Path
@@ -17,8 +18,9 @@ import cv2
 import numpy as np
 
 from perception.errors import InputError
+from perception.io.files import input_file
 from perception.io.tracks import Status, Tracks
-from perception.io.video import FrameSource, VideoWriter
+from perception.io.video import FrameSource, VideoWriter, sha256_file
 
 __all__ = ["Labeller", "render_labelled", "tracked_video"]
 
@@ -102,13 +104,10 @@ class Labeller:
 
 def _colours(tracks: Tracks) -> list[tuple[int, int, int]]:
     """Each marker's drawing colour: its colour model's ``bgr``, else a default palette."""
-    import json
-
-    models = {}
     try:
         models = json.loads(tracks.tracker.get("colour_models", "{}"))
     except (TypeError, ValueError):
-        pass
+        models = {}
     if not isinstance(models, dict):
         models = {}
     palette = [(60, 60, 230), (60, 200, 60), (230, 120, 40), (40, 210, 230), (200, 60, 200)]
@@ -140,9 +139,6 @@ def tracked_video(tracks: Tracks, video: str | os.PathLike | None = None) -> Pat
         No video given or recorded, not a regular file, or a file whose
         SHA-256 differs from the one the tracks record.
     """
-    from perception.io.files import input_file
-    from perception.io.video import sha256_file
-
     field = "VIDEO" if video is not None else "/video.path"
     if video is None:
         stored = tracks.video.get("path")

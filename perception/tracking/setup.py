@@ -45,6 +45,7 @@ from perception.errors import InputError
 from perception.io.atomic import write_text
 from perception.io.config import Spec, check_keys, check_table, read_toml, sub_table
 from perception.io.files import input_file
+from perception.tracking.blobs import blob_at, principal_axes
 from perception.tracking.markers import MarkerColour, MarkerSet, default_markers
 from perception.tracking.measurement import soft_diameter
 from perception.tracking.params import LIMITS, TrackerParams
@@ -125,19 +126,13 @@ def write_setup(path: str | os.PathLike, setup: TrackingSetup) -> Path:
         What to write.
     """
     d = setup.to_dict()
-    lines = ["# hammer-mv tracking setup (hammer-mv calibrate); docs/markers.md", ""]
-    for table in ("setup", "sizes"):
-        lines.append(f"[{table}]")
-        lines += [f"{k} = {_toml(v)}" for k, v in d[table].items()]
-        lines.append("")
-    for name, fields in d["markers"].items():
-        lines.append(f"[markers.{name}]")
-        lines += [f"{k} = {_toml(v)}" for k, v in fields.items()]
-        lines.append("")
+    tables = {"setup": d["setup"], "sizes": d["sizes"],
+              **{f"markers.{name}": fields for name, fields in d["markers"].items()}}
     if "tracker" in d:
-        lines.append("[tracker]")
-        lines += [f"{k} = {_toml(v)}" for k, v in d["tracker"].items()]
-        lines.append("")
+        tables["tracker"] = d["tracker"]
+    lines = ["# hammer-mv tracking setup (hammer-mv calibrate); docs/markers.md", ""]
+    for title, values in tables.items():
+        lines += [f"[{title}]", *(f"{k} = {_toml(v)}" for k, v in values.items()), ""]
     return write_text(path, "\n".join(lines))
 
 
@@ -222,11 +217,9 @@ def _learn_colour(colour: MarkerColour, frame: np.ndarray, hsv: np.ndarray,
     x0, y0 = max(cx - half, 0), max(cy - half, 0)
     x1, y1 = min(cx + half + 1, w), min(cy + half + 1, h)
     region = hsv[y0:y1, x0:x1]
-    n, labels = cv2.connectedComponents(colour.backproject(region))
-    lab = labels[min(cy - y0, labels.shape[0] - 1), min(cx - x0, labels.shape[1] - 1)]
-    if n < 2 or lab == 0:
+    mask = blob_at(colour.backproject(region), (cx - x0, cy - y0))
+    if mask is None:
         raise ValueError(f"{colour.name}: no pixels of its colour at ({cx}, {cy}) px")
-    mask = labels == lab
     pix = region[mask]
     lo, hi = _hue_range(pix[:, 0])
     learned = dataclasses.replace(
@@ -239,15 +232,6 @@ def _learn_colour(colour: MarkerColour, frame: np.ndarray, hsv: np.ndarray,
     full = np.zeros((h, w), bool)
     full[y0:y1, x0:x1] = mask
     return learned, full
-
-
-def _axes(mask: np.ndarray) -> tuple[float, float]:
-    """Major and minor standard deviations (px) of a blob."""
-    mo = cv2.moments(mask.astype(np.uint8), True)
-    m = max(mo["m00"], 1.0)
-    a, b, c = mo["mu20"] / m, mo["mu11"] / m, mo["mu02"] / m
-    root = math.sqrt(max((a - c) ** 2 / 4 + b * b, 0.0))
-    return math.sqrt((a + c) / 2 + root), math.sqrt(max((a + c) / 2 - root, 0.0))
 
 
 def calibrate(frames: Sequence[np.ndarray], *, rois: Mapping[str, tuple[int, int, int, int]]
@@ -321,7 +305,9 @@ def calibrate(frames: Sequence[np.ndarray], *, rois: Mapping[str, tuple[int, int
     if digits:
         sizes["marker_diameter"] = float(np.mean(digits))
     if "wrist" in masks:
-        major, minor = _axes(masks["wrist"])
-        sizes["band_size"] = (math.sqrt(12) * major / scale, math.sqrt(12) * minor / scale)
+        # a uniform band of length L has variance L^2 / 12 along it
+        major, minor, _ = principal_axes(masks["wrist"].astype(np.uint8))
+        sizes["band_size"] = tuple(math.sqrt(12) * math.sqrt(max(v, 0.0)) / scale
+                                   for v in (major, minor))
     return TrackingSetup(MarkerSet(tuple(learned)), dataclasses.replace(params, **sizes),
                          source, len(frames))

@@ -68,12 +68,13 @@ import numpy as np
 
 from perception.errors import InputError
 from perception.io.tracks import Status, TracksWriter, tracks_path_for
-from perception.io.video import FrameSource
+from perception.io.video import FrameSource, VideoWriter
 from perception.tracking.candidates import describe, reject_reason
 from perception.tracking.first_detection import FirstDetection
 from perception.tracking.marker_track import Located, MarkerTrack
 from perception.tracking.markers import MarkerSet, default_markers
 from perception.tracking.measurement import Measurement, likelihood, measure, measure_still
+from perception.tracking.overlay import Labeller
 from perception.tracking.params import TrackerParams
 from perception.tracking.reacquisition import ROI, downscaled_hsv, reacquire, search_scale
 
@@ -234,8 +235,7 @@ class Tracker:
             :class:`~perception.io.tracks.Status` codes.
         """
         self._check_frame(frame)
-        self._time = (self.n_frames / self.params.default_fps if time_s is None
-                      else float(time_s))
+        self._time = self.n_frames / self.params.default_fps if time_s is None else float(time_s)
         tracks = self._tracks
         position, lik, status = (a.copy() for a in self._lost_row)
         self._small = None
@@ -268,9 +268,8 @@ class Tracker:
                 tr.n_lost = 0
             centre, lik[j], status[j] = result
             position[j] = centre
-            x, y = centre
-            if math.isfinite(x) and math.isfinite(y):
-                centres[j] = (x, y)
+            if math.isfinite(centre[0]) and math.isfinite(centre[1]):
+                centres[j] = centre
         self._record_offsets(centres)
         self._first.frame_done(self.n_frames)
         self.n_frames += 1
@@ -299,8 +298,7 @@ class Tracker:
         cands = describe(hsv, tr.colour, self.params.min_area_px)
         if not cands:
             return False
-        c = min(cands, key=lambda c: math.hypot(c.centre[0] + x0 - centre[0],
-                                                c.centre[1] + y0 - centre[1]))
+        c = min(cands, key=lambda c: math.dist(c.blob.moved(x0, y0).centre, centre))
         return reject_reason(c, tr.name, tr.colour, None, self.params) is None
 
     def _anchor(self, tr: MarkerTrack,
@@ -381,8 +379,7 @@ class Tracker:
         cx, cy = meas.centre
         scale = self._first.scale
         if scale is not None:
-            reach = p.max_speed * max(self._time - tr.seen_at, 1 / 60) * scale + max(tr.win)
-            if math.hypot(cx - tr.x[0], cy - tr.x[1]) > reach:
+            if math.dist(meas.centre, tr.x) > self._reach_px(tr):
                 return None  # faster than a hand: something else
             offset = tr.offset
             if offset is not None and not tr.still and tr.name != "wrist":
@@ -413,7 +410,7 @@ class Tracker:
         span = self.params.hand_span * self.px_per_m
         others = [t.x for t in self._tracks
                   if t is not tr and t.found and not t.lost and not t.still]
-        return all(math.hypot(centre[0] - x, centre[1] - y) <= span for x, y in others)
+        return all(math.dist(centre, other) <= span for other in others)
 
     def _reacquire(self, tr: MarkerTrack, frame: np.ndarray) -> Located | None:
         """Global search while lost (see :func:`perception.tracking.reacquisition.reacquire`)."""
@@ -421,8 +418,7 @@ class Tracker:
         where, reach = self._expected_here(tr)
 
         def accept(meas: Measurement) -> bool:
-            jump = math.hypot(meas.centre[0] - where[0], meas.centre[1] - where[1])
-            return (jump <= reach and self._plausible_here(tr, meas.centre)
+            return (math.dist(meas.centre, where) <= reach and self._plausible_here(tr, meas.centre)
                     and self._looks_right(tr, frame, meas.centre))
 
         meas = reacquire(frame, self._small_hsv(frame), tr.colour, tr.ref, where, tr.win, p,
@@ -579,9 +575,6 @@ def track_video(
         w = stack.enter_context(TracksWriter(out_path, markers.names))
         each = None
         if labelled_video is not None:
-            from perception.io.video import VideoWriter
-            from perception.tracking.overlay import Labeller
-
             rate = fps or src.header.fps_nominal or 30.0
             vw = stack.enter_context(VideoWriter(labelled_video, rate,
                                                  (src.header.width, src.header.height)))
