@@ -27,8 +27,8 @@ if TYPE_CHECKING:
     from perception.observation import Observation
 
 __all__ = ["DETAILS", "MODEL_SPAN_FRACTION", "Landmarks", "count_peaks", "grip_departs",
-           "movement_landmarks", "movement_time", "observed_landmarks", "verdict_detail",
-           "wrist_movement_time"]
+           "longest_gap", "movement_landmarks", "movement_time", "observed_landmarks",
+           "verdict_detail", "wrist_movement_time"]
 
 
 #: The wrist covers the middle 80 % of its path (10 % to 90 %) in this
@@ -280,6 +280,23 @@ def wrist_movement_time(time: np.ndarray, wrist: np.ndarray) -> float:
     time, wrist = np.asarray(time, dtype=float), np.asarray(wrist, dtype=float)
     return ((_progress_time(time, wrist, 0.9) - _progress_time(time, wrist, 0.1))
             / MODEL_SPAN_FRACTION)
+
+
+def longest_gap(time: np.ndarray, values: np.ndarray) -> float:
+    """The longest time between two consecutive seen samples of ``values``, s.
+
+    Parameters
+    ----------
+    time : (N,) array
+        Time stamps, s.
+    values : (N,) array
+        Values, NaN where lost (none seen: the whole span).
+    """
+    time = np.asarray(time, dtype=float)
+    ts = time[np.isfinite(np.asarray(values, dtype=float))]
+    if len(ts) < 2:
+        return float(time[-1] - time[0]) if len(time) else 0.0
+    return float(np.diff(ts).max())
 
 
 def movement_landmarks(time: np.ndarray, wrist: np.ndarray, aperture: np.ndarray,

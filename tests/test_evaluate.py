@@ -77,9 +77,10 @@ def test_population_clips_start_and_end_at_rest():
 
 
 def test_dev_and_heldout_seeds_never_overlap():
-    dev = set(ev.set_seeds("dev", ev.MAX_CLIPS))
-    held = set(ev.set_seeds("heldout", ev.MAX_CLIPS))
-    assert not dev & held
+    seeds = {name: set(ev.set_seeds(name, ev.MAX_CLIPS)) for name in ev.SETS}
+    for a in seeds:
+        for b in seeds:
+            assert a == b or not seeds[a] & seeds[b], (a, b)
     with pytest.raises(ValueError):
         ev.set_seeds("dev", ev.MAX_CLIPS + 1)
     assert ev.parse_counts("normal=30,delayed=10,open-close-open=10,reach=10") == \

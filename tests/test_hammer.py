@@ -153,9 +153,10 @@ def test_a_gap_in_any_marker_is_not_scored_and_leaves_no_outliers(rep, marker):
         assert np.all(rec.dC_r[:, gap] == 0) and np.all(rec.dC_g[:, gap] == 0)
         step_ll = np.diff(rec.log_likelihood, axis=1, prepend=0)
         assert np.all(step_ll[:, gap] == 0)
-        # no frame after the gap scores wildly off the clip's usual steps
-        typical = np.median(np.abs(step_ll[:, ~gap]))
-        assert np.abs(step_ll).max() < 20 * typical + 50
+        # no frame after the gap scores wildly off each model's usual steps on the
+        # clip (a 0.5 s model scores a 1 s movement's steps coarsely, gap or not)
+        typical = np.median(np.abs(step_ll[:, ~gap]), axis=1)
+        assert np.all(np.abs(step_ll).max(axis=1) < 20 * typical + 50)
         assert rec.kinds[rec.names.index(rec.winner)] == full.kinds[full.names.index(full.winner)]
 
 

@@ -17,6 +17,10 @@ Two populations, disjoint by seed (clip *k* of a set draws everything from
 * ``heldout`` — seeds 9000, 9001, …: never used to choose a parameter; its
   report gives aggregates only (no list of the clips it got wrong).
 
+and two of fast grasps, beyond the population's 0.65 s (movement times of
+0.45-0.65 s, :data:`FAST_DURATION`; everything else as the population):
+``fast-dev`` (seeds 20000, …) and ``fast-heldout`` (seeds 29000, …).
+
 Writes ``OUT/clips/`` (clips, ground truth, ``manifest.csv`` with the drawn
 parameters), ``OUT/report/`` (the batch report), ``OUT/evaluation.md``
 (markdown tables) and ``OUT/evaluation.json``, and prints the tables:
@@ -52,9 +56,14 @@ import numpy as np
 import pandas as pd
 
 #: The first seed of each population; clip k of a set uses ``first_seed + k``.
-SETS: dict[str, int] = {"dev": 1000, "heldout": 9000}
-#: Most clips in one set: the dev seeds (1000 + k) never reach the held-out ones.
+SETS: dict[str, int] = {"dev": 1000, "heldout": 9000, "fast-dev": 20000, "fast-heldout": 29000}
+#: Most clips in one set: no set's seeds reach the next one's.
 MAX_CLIPS = SETS["heldout"] - SETS["dev"]
+#: Movement times of the fast sets, s: people asked to be quick (the population's
+#: shortest is 0.65 s).
+FAST_DURATION = (0.45, 0.65)
+#: The sets held out: their reports list no clips.
+HELD_OUT = ("heldout", "fast-heldout")
 #: Clips per condition by default (at least 60 in all).
 DEFAULT_COUNTS: dict[str, int] = {"normal": 30, "delayed": 10, "open-close-open": 10, "reach": 10}
 QUICK_COUNTS: dict[str, int] = {"normal": 1, "delayed": 1, "open-close-open": 1, "reach": 1}
@@ -280,15 +289,17 @@ def hammer_mv() -> list[str]:
 def run(set_name: str, out: str | os.PathLike, counts: dict[str, int], *, jobs: int = 2,
         quiet: bool = False) -> tuple[pd.DataFrame, dict]:
     """Render the set, run ``hammer-mv batch`` on it, evaluate, write the tables."""
-    from perception.synthetic.population import render_population_set
+    from perception.synthetic.population import POPULATION_RANGES, render_population_set
 
+    ranges = ({**POPULATION_RANGES, "duration": FAST_DURATION} if set_name.startswith("fast")
+              else None)
     out = Path(out)
     n = sum(counts.values())
     seeds = set_seeds(set_name, n)
     tty = sys.stderr.isatty() and not quiet
     t0 = time.perf_counter()
-    manifest = render_population_set(out / "clips", counts, seed=seeds.start, jobs=jobs,
-                                     progress=tty)
+    manifest = render_population_set(out / "clips", counts, seed=seeds.start, ranges=ranges,
+                                     jobs=jobs, progress=tty)
     t1 = time.perf_counter()
     if tty:
         print(f"tracking and recognising {n} clips from video (hammer-mv batch --jobs {jobs}) …",
@@ -307,7 +318,7 @@ def run(set_name: str, out: str | os.PathLike, counts: dict[str, int], *, jobs: 
               "counts": counts, "jobs": jobs, "batch_exit": proc.returncode,
               "timing": {"render_s": t1 - t0, "batch_s": t2 - t1},
               "groups": by_group}
-    text = markdown(result, table, list_clips=set_name != "heldout")
+    text = markdown(result, table, list_clips=set_name not in HELD_OUT)
     (out / "evaluation.md").write_text(text, encoding="utf-8")
     clips = table[[c for c in table.columns if c != "error"]].to_dict(orient="records")
     (out / "evaluation.json").write_text(
@@ -324,7 +335,8 @@ def build_parser() -> argparse.ArgumentParser:
         formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     p.add_argument("--set", choices=tuple(SETS), default="dev",
                    help="population: dev (seeds 1000 + k, for tuning) or heldout (seeds "
-                        "9000 + k, never for choosing a parameter)")
+                        "9000 + k, never for choosing a parameter); fast-dev / fast-heldout: "
+                        "the same with movement times of 0.45-0.65 s")
     p.add_argument("-o", "--output", required=True, metavar="OUT",
                    help="folder for clips/, report/, evaluation.md and evaluation.json")
     p.add_argument("--per-condition", type=parse_counts, default=None, metavar="COUNTS",

@@ -24,7 +24,7 @@ __all__ = ["DEFAULT_DURATIONS", "build_model", "build_models", "default_specs",
            "planning_threads"]
 
 #: Movement-time variants of the default repertoire, s.
-DEFAULT_DURATIONS = (0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2)
+DEFAULT_DURATIONS = (0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2)
 
 
 #: The joint-angle error covariance of each solution still in use (identical

@@ -9,8 +9,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from perception.landmarks import (
+    MAX_GAP,
     Landmarks,
     grip_departs,
+    longest_gap,
     model_landmarks,
     observed_landmarks,
     verdict_detail,
@@ -145,13 +147,21 @@ class Recognition:
         opening late, or re-opening) is ``abnormal`` even when the models find
         it familiar, or find its transport like no reach of theirs (a hand
         that waits at the object for a late grip); otherwise ``unfamiliar``
-        when even its transport is no human reach.
+        when even its transport is no human reach, or when it would be
+        ``normal`` but a digit was lost for longer than
+        :data:`~perception.landmarks.MAX_GAP` during the movement (the gap
+        may hide a second opening, and the models' filters coast over it as
+        if the grip had stayed open).
         """
         if self.shape is not None:
             d = self.shape.decision
-            if d.verdict in ("normal", "abnormal") and grip_departs(self.landmarks[0]):
+            seen = self.landmarks[0]
+            if d.verdict in ("normal", "abnormal") and grip_departs(seen):
                 return Verdict("abnormal", d.best, d.familiarity, d.margin)
             if d.verdict is not None and self.transport_familiarity < self.unfamiliar_threshold:
+                return Verdict("unfamiliar", d.best, d.familiarity, d.margin)
+            obs = self.observation
+            if d.verdict == "normal" and longest_gap(obs.time, obs.g) > MAX_GAP + 1e-9:
                 return Verdict("unfamiliar", d.best, d.familiarity, d.margin)
             return d
         return decide(self.kinds, self.log_likelihood[:, -1], self.familiarity,
