@@ -155,8 +155,7 @@ class Recognition:
         """
         if self.shape is not None:
             d = self.shape.decision
-            seen = self.landmarks[0]
-            if d.verdict in ("normal", "abnormal") and grip_departs(seen):
+            if d.verdict in ("normal", "abnormal") and grip_departs(self.landmarks[0]):
                 return Verdict("abnormal", d.best, d.familiarity, d.margin)
             if d.verdict is not None and self.transport_familiarity < self.unfamiliar_threshold:
                 return Verdict("unfamiliar", d.best, d.familiarity, d.margin)
