@@ -1,12 +1,12 @@
 # `make demo` and `make test` each build .venv from this project's own files,
-# with the versions pinned in constraints.txt (`make lock` renews
+# with the versions pinned in requirements-lock.txt (`make lock` renews
 # them; `make test-latest` tries the newest versions the registry serves).
 PYTHON ?= $(shell command -v python3.11 2>/dev/null || command -v python3)
 VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-stamp
 JOBS ?= 2
-CONSTRAINTS := constraints.txt
+CONSTRAINTS := requirements-lock.txt
 # -c pins what is installed; PIP_CONSTRAINT as well, because pip applies it to
 # the isolated build environment too, so setuptools (the build backend) is pinned
 PIN := PIP_CONSTRAINT=$(CURDIR)/$(CONSTRAINTS)

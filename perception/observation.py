@@ -12,9 +12,10 @@ from the wrist's displacement from rest, less the model's own latency) to
 the end of activity. :func:`movement_span` is the one detector of it: the
 recognition and ``hammer-mv tracks export --trim`` both use it. The trimmed
 frames stay in the tracks file. Marker positions are smoothed by a causal
-alpha-beta filter before their changes are compared with predictions: with
-raw tracks half a pixel of noise randomises the sign of the small per-frame
-changes the thesis's confidence rule counts (docs/recognition.md).
+alpha-beta filter (:mod:`perception.filtering`) before their changes are
+compared with predictions: with raw tracks half a pixel of noise randomises
+the sign of the small per-frame changes the thesis's confidence rule counts
+(docs/recognition.md).
 """
 
 from __future__ import annotations
@@ -26,16 +27,15 @@ from typing import NamedTuple
 import numpy as np
 
 from perception.errors import InputError
+from perception.filtering import alpha_beta
 from perception.geometry import DEFAULT_OBJECT_DIAMETER, SimilarityTransform
 
 __all__ = [
-    "AlphaBeta",
     "DIGIT_MARKERS",
     "MovementSpan",
     "ObserveParams",
     "Observation",
     "RestScene",
-    "alpha_beta",
     "check_hand",
     "movement_span",
     "observe",
@@ -195,72 +195,6 @@ class ObserveParams:
         """
         d, t = np.asarray(self.onset_profile, dtype=float).T
         return float(np.interp(displacement, d, t))
-
-
-def alpha_beta(z: np.ndarray, dt: np.ndarray | float, alpha: float, beta: float) -> np.ndarray:
-    """Causal alpha-beta filter of positions, coasting through gaps.
-
-    Parameters
-    ----------
-    z : (N, ..., 2) array
-        Positions; NaN where missing.
-    dt : float or (N,) array
-        Frame period(s), s (``dt[i]`` is the time from frame i-1 to i).
-    alpha, beta : float
-        Position and velocity gains.
-
-    Returns
-    -------
-    (N, ..., 2) array
-        Filtered positions; NaN where the input is missing (a gap is not filled;
-        the filter restarts from the first measurement after it).
-    """
-    z = np.asarray(z, dtype=float)
-    dt = np.broadcast_to(np.asarray(dt, dtype=float), (z.shape[0],))
-    out = np.full_like(z, np.nan)
-    step = AlphaBeta(z.shape[1:], alpha, beta)
-    for i in range(z.shape[0]):
-        out[i] = step(z[i], dt[i])
-    return out
-
-
-class AlphaBeta:
-    """:func:`alpha_beta` one frame at a time (an online stream's filter).
-
-    Parameters
-    ----------
-    shape : tuple of int
-        Shape of one frame's positions, ``(..., 2)``.
-    alpha, beta : float
-        Position and velocity gains.
-    """
-
-    def __init__(self, shape: tuple[int, ...], alpha: float, beta: float):
-        self.alpha, self.beta = alpha, beta
-        self.x = np.full(shape, np.nan)
-        self.v = np.zeros(shape)
-        self.missing_before = np.ones(shape[:-1] + (1,), dtype=bool)
-        self.second = np.zeros(shape[:-1] + (1,), dtype=bool)  # first measurement after a (re)start
-
-    def __call__(self, zi: np.ndarray, dt: float) -> np.ndarray:
-        """The filtered positions of the next frame ``zi`` (NaN where missing), ``dt`` s later."""
-        x, v, alpha, beta = self.x, self.v, self.alpha, self.beta
-        have = np.isfinite(zi).all(axis=-1, keepdims=True)
-        pred = x + v * dt
-        resid = zi - pred
-        x_new = np.where(have, pred + alpha * resid, pred)
-        v_new = np.where(have, v + beta / max(dt, 1e-9) * resid, v)
-        # After a gap, start again from the measurement (coasting on an old
-        # velocity lands far from the marker), and take the velocity from the
-        # first two measurements back (two-point initiation).
-        fresh = have & self.missing_before
-        two = have & self.second & ~fresh
-        v_new = np.where(two, (zi - x) / max(dt, 1e-9), np.where(fresh, 0.0, v_new))
-        x_new = np.where(fresh | two, zi, x_new)
-        self.second = fresh | (self.second & ~have)
-        self.missing_before = ~have
-        self.x, self.v = x_new, v_new
-        return np.where(have, x_new, np.nan)
 
 
 @dataclass(frozen=True)

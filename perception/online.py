@@ -35,8 +35,9 @@ from types import SimpleNamespace
 import numpy as np
 
 from perception.errors import InputError
+from perception.filtering import AlphaBeta
 from perception.io.tracks import Status, Tracks
-from perception.observation import DIGIT_MARKERS, AlphaBeta, check_hand, onset_time, rest_scene
+from perception.observation import DIGIT_MARKERS, check_hand, onset_time, rest_scene
 from perception.pipeline import RecognitionSettings, recognize_tracks
 from perception.recognition.models import SceneSpec
 from perception.recognition.online import StepScorer

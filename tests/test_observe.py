@@ -5,10 +5,10 @@ import pytest
 from _demos import demo_tracks
 
 from perception.errors import InputError
+from perception.filtering import alpha_beta
 from perception.geometry import SimilarityTransform
 from perception.observation import (
     ObserveParams,
-    alpha_beta,
     check_hand,
     movement_span,
     observe,

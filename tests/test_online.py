@@ -9,7 +9,8 @@ import pytest
 from _demos import default_repertoire
 
 from perception.errors import InputError
-from perception.observation import alpha_beta, movement_span
+from perception.filtering import AlphaBeta, alpha_beta
+from perception.observation import movement_span
 from perception.online import OnlineRecognizer, SettleRule
 from perception.pipeline import recognize_tracks
 from perception.recognition.engine import HammerParams, recognize
@@ -35,7 +36,6 @@ def _feed(rep, tracks, **kw):
 
 
 def test_alpha_beta_one_frame_at_a_time_is_the_offline_filter():
-    from perception.observation import AlphaBeta
 
     rng = np.random.default_rng(0)
     z = rng.normal(size=(40, 3, 2))

@@ -2,10 +2,10 @@
 
 Used by ``make test-latest``: run with the interpreter of an unpinned
 environment, it lists each package whose installed version is not the one
-``constraints.txt`` pins (and packages that only one side has).
+``requirements-lock.txt`` pins (and packages that only one side has).
 Exits 0 whatever it finds: it reports, the test run decides nothing here.
 
-    python tools/compare_lock.py constraints.txt
+    python tools/compare_lock.py requirements-lock.txt
 """
 
 from __future__ import annotations
@@ -43,7 +43,7 @@ def installed() -> dict[str, str]:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("constraints", help="the lock (constraints.txt)")
+    parser.add_argument("constraints", help="the lock (requirements-lock.txt)")
     args = parser.parse_args(argv)
     lock, now = pinned(args.constraints), installed()
     rows = [(name, lock.get(name, "-"), now.get(name, "-")) for name in sorted(lock | now)

@@ -56,10 +56,10 @@ def _frames(source: str, settings, args):
     """``(kind, header fps, iterator of (index, time s, frame), info)`` of ``source``."""
     from perception.errors import InputError
 
-    if _device(source) == "camera":
-        return "camera", *_capture(int(source), args, clock=True)
-    if _device(source) == "stream":
-        return "stream", *_capture(source, args, clock=False)
+    kind = _device(source)
+    if kind is not None:  # a camera's frames are timed by this clock, a stream's by its own
+        camera = kind == "camera"
+        return kind, *_capture(int(source) if camera else source, args, clock=camera)
     path = Path(source)
     if not path.exists():
         raise InputError("no such file (nor a camera index or stream URL)", path)
