@@ -18,7 +18,7 @@ $(STAMP): pyproject.toml setup.py minvar/_lqg_kernel.c $(CONSTRAINTS)
 	$(PYTHON) -c 'import sys; assert sys.version_info >= (3, 11), "hammer-mv needs Python >= 3.11"'
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(PIN) $(BIN)/python -m pip install --quiet -c $(CONSTRAINTS) --upgrade pip setuptools wheel
-	$(PIN) $(BIN)/python -m pip install --quiet -c $(CONSTRAINTS) -e '.[dev,pose]'
+	$(PIN) $(BIN)/python -m pip install --quiet -c $(CONSTRAINTS) -e '.[dev,pose,mocap]'
 	$(MAKE) --no-print-directory bytecode
 	touch $(STAMP)
 
@@ -28,7 +28,7 @@ lock:
 	rm -rf .venv-lock
 	$(PYTHON) -m venv .venv-lock
 	.venv-lock/bin/python -m pip install --quiet --upgrade pip setuptools wheel
-	.venv-lock/bin/python -m pip install --quiet '.[dev,pose]'
+	.venv-lock/bin/python -m pip install --quiet '.[dev,pose,mocap]'
 	{ echo "# Versions make demo, make test and CI install (make lock renews them)."; \
 	  echo "# Resolved $$(date -u +%Y-%m-%d) for Python $$(.venv-lock/bin/python -c 'import platform; print(platform.python_version())')."; \
 	  .venv-lock/bin/python -m pip freeze --all --exclude hammer-mv; } > $(CONSTRAINTS).part
@@ -42,7 +42,7 @@ test-latest:
 	rm -rf $(LATEST)
 	$(PYTHON) -m venv $(LATEST)
 	$(LATEST)/bin/python -m pip install --quiet --upgrade pip setuptools wheel
-	$(LATEST)/bin/python -m pip install --quiet -e '.[dev,pose]'
+	$(LATEST)/bin/python -m pip install --quiet -e '.[dev,pose,mocap]'
 	-$(LATEST)/bin/python tools/compare_lock.py $(CONSTRAINTS)
 	-MPLBACKEND=Agg $(LATEST)/bin/python -m pytest -n $(JOBS) -q -p no:cacheprovider \
 	    > $(LATEST)/pytest.log 2>&1; \

@@ -52,7 +52,7 @@ PEAK_MIN_PROMINENCE = 0.005
 #: The aperture has started to open when it first exceeds rest + this share of the opening.
 OPENING_LEVEL = 0.10
 #: A gap in the aperture longer than this, s, may hide a dip: no peak count.
-MAX_GAP = 0.1
+MAX_GAP = 0.25
 #: The reference model's movement ends when no hand point moves faster than
 #: this, m/s (``ObserveParams.end_speed``: the observation's end rule without
 #: tracking noise).
@@ -65,29 +65,162 @@ NO_OPENING = 0.30
 #: opening) later than this share of the movement: a normal hand starts to open within
 #: the first ~20 % and a smooth opening that peaks by 80 % gets a tenth of the way up a
 #: quarter of the way along, 0.2 + 0.26 x 0.6 = 0.36 at the latest...
-LATE_OPENING = 0.40
+LATE_OPENING = 0.66
 #: ... or its maximum comes later than this share (while the reference's comes earlier).
-LATE_MGA = 0.85
+LATE_MGA = 0.95
+
+
+@dataclass(frozen=True)
+class LandmarkParams:
+    """The field's definitions of a movement's bounds, and the filter before them.
+
+    A movement begins where the transport speed rises above a threshold and
+    ends where it falls below it again: by default 5 % of the movement's
+    peak speed (``threshold``), or an absolute speed (``speed``) held for
+    ``hold`` seconds, as labs variously define it. Positions are low-pass
+    filtered first, without lag (a Butterworth filter run forwards and
+    backwards, :func:`scipy.signal.filtfilt`), at ``cutoff`` Hz, as the
+    field filters motion capture (6-10 Hz); ``cutoff=None`` measures the
+    samples as they are.
+
+    Parameters
+    ----------
+    threshold : float
+        Share of the peak speed that bounds the movement (0-1).
+    speed : float, optional
+        An absolute speed, m/s, instead of the share.
+    hold : float
+        The speed must stay beyond the bound this long for a crossing to count, s.
+    cutoff : float, optional
+        Low-pass cutoff, Hz (capped below the Nyquist frequency); None: no filter.
+    order : int
+        The Butterworth filter's order (run twice: zero lag, twice the roll-off).
+    """
+
+    threshold: float = 0.05
+    speed: float | None = None
+    hold: float = 0.0
+    cutoff: float | None = 10.0
+    order: int = 2
+
+    def __post_init__(self):
+        if not (0 < self.threshold < 1):
+            raise ValueError(f"LandmarkParams.threshold: expected 0 < share < 1, got "
+                             f"{self.threshold!r}")
+        for name in ("speed", "cutoff"):
+            v = getattr(self, name)
+            if v is not None and not (math.isfinite(v) and v > 0):
+                raise ValueError(f"LandmarkParams.{name}: expected a positive number, got {v!r}")
+        if not (math.isfinite(self.hold) and self.hold >= 0):
+            raise ValueError(f"LandmarkParams.hold: expected a time >= 0, got {self.hold!r}")
+        if not (isinstance(self.order, int) and 1 <= self.order <= 8):
+            raise ValueError(f"LandmarkParams.order: expected 1-8, got {self.order!r}")
+
+    def lowpass(self, time: np.ndarray, values: np.ndarray) -> np.ndarray:
+        """``values`` (N, ...) low-passed without lag; NaN stays NaN.
+
+        Each run of seen samples is filtered on its own (a filter never
+        reaches across a gap); runs too short for the filter are kept as they
+        are.
+
+        Parameters
+        ----------
+        time : (N,) array
+            Sample times, s (their median step sets the sampling rate).
+        values : (N, ...) array
+            Values, NaN where missing.
+        """
+        x = np.array(values, dtype=float)
+        if self.cutoff is None or len(time) < 2:
+            return x
+        from scipy.signal import butter, filtfilt  # noqa: PLC0415 (only when filtering)
+
+        rate = 1.0 / float(np.median(np.diff(time)))
+        wn = min(self.cutoff / (0.5 * rate), 0.95)
+        b, a = butter(self.order, wn)
+        flat = x.reshape(len(x), -1)
+        ok = np.isfinite(flat).all(axis=1)
+        edges = np.diff(np.r_[0, ok.astype(np.int8), 0])
+        for lo, hi in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)):
+            if hi - lo > 3 * max(len(a), len(b)):
+                flat[lo:hi] = filtfilt(b, a, flat[lo:hi], axis=0)
+        return flat.reshape(x.shape)
+
+    def speed_of(self, time: np.ndarray, path: np.ndarray) -> np.ndarray:
+        """(N,) speed of a path (N, D) after :meth:`lowpass`, m/s (NaN where lost)."""
+        p = self.lowpass(time, path)
+        if len(time) < 3:
+            return np.full(len(time), np.nan)
+        return np.linalg.norm(np.gradient(p, np.asarray(time, dtype=float), axis=0), axis=1)
+
+
+def movement_bounds(time: np.ndarray, speed: np.ndarray, peak: int,
+                    params: LandmarkParams | None = None) -> tuple[int | None, int | None]:
+    """Rows of a movement's onset and end around its speed peak.
+
+    The onset is the first row above the bound after the last stretch below
+    it (at least ``params.hold`` long) before ``peak``; the end the last row
+    before the first such stretch after it. None where the recording starts
+    or ends in the movement (the speed never falls below the bound there).
+
+    Parameters
+    ----------
+    time : (N,) array
+        Sample times, s.
+    speed : (N,) array
+        Transport speed, m/s (NaN where lost: neither above nor below).
+    peak : int
+        Row of the movement's peak speed.
+    params : LandmarkParams, optional
+    """
+    params = LandmarkParams() if params is None else params
+    bound = params.speed if params.speed is not None else params.threshold * speed[peak]
+    below = np.isfinite(speed) & (speed < bound)
+    edges = np.diff(np.r_[0, below.astype(np.int8), 0])
+    runs = [(a, b) for a, b in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1))
+            if time[b - 1] - time[a] >= params.hold - 1e-9]
+    before = [b for a, b in runs if b <= peak]
+    after = [a for a, b in runs if a > peak]
+    return (int(before[-1]) if before else None, int(after[0]) - 1 if after else None)
+
+
+def _cross_time(time, speed, row, bound, rising) -> float:
+    """The bound's crossing between ``row`` and its neighbour outside the movement, s."""
+    other = row - 1 if rising else row + 1
+    if not 0 <= other < len(time) or not np.isfinite(speed[[row, other]]).all():
+        return float(time[row])
+    s0, s1 = speed[other], speed[row]
+    f = 0.0 if s1 == s0 else float(np.clip((bound - s0) / (s1 - s0), 0, 1))
+    return float(time[other] + f * (time[row] - time[other]))
 
 
 @dataclass(frozen=True)
 class Landmarks:
     """The standard landmarks of one reach-to-grasp movement (NaN where not computable).
 
+    Times called shares are fractions of the movement time from its onset
+    (0-1); the movement runs from onset to end by :class:`LandmarkParams`.
+
     Attributes
     ----------
+    onset_time, end_time : float
+        The movement's onset and end on the recording's clock, s (NaN where
+        the recording starts or ends in the movement).
     movement_time : float
-        From the movement's onset to its end, s.
+        End minus onset, s.
     peak_speed : float
-        Peak speed of the wrist, m/s.
+        Peak transport speed, m/s.
     peak_speed_time : float
-        When it comes, fraction of the movement time.
+        When it comes, share.
+    deceleration_time : float
+        From the peak speed to the end, s.
     mga : float
-        Maximum grip aperture, m.
+        Maximum grip aperture, m: the largest tip-to-tip (marker-to-marker)
+        distance between onset and end.
     mga_time : float
-        When it comes, fraction of the movement time.
+        When it comes, share.
     contact_aperture : float
-        Grip aperture at the end of the movement, m.
+        Grip aperture at the movement's end, m.
     aperture_peaks : int or None
         Maxima of the aperture with a prominence of at least
         :data:`PEAK_PROMINENCE` of the opening and :data:`PEAK_MIN_PROMINENCE`
@@ -97,7 +230,11 @@ class Landmarks:
         Grip aperture at the movement's onset, m.
     opening_time : float
         When the aperture first exceeds ``rest_aperture`` + :data:`OPENING_LEVEL`
-        of the opening, fraction of the movement time.
+        of the opening: the grip starts to open, share.
+    peak_opening_speed : float
+        The aperture's fastest widening before the MGA, m/s.
+    closing_time : float
+        From the MGA to the movement's end, s.
     """
 
     movement_time: float = math.nan
@@ -109,19 +246,36 @@ class Landmarks:
     aperture_peaks: int | None = None
     rest_aperture: float = math.nan
     opening_time: float = math.nan
+    onset_time: float = math.nan
+    end_time: float = math.nan
+    deceleration_time: float = math.nan
+    peak_opening_speed: float = math.nan
+    closing_time: float = math.nan
 
     @property
     def opening(self) -> float:
         """How far the hand opened: ``mga - rest_aperture``, m."""
         return self.mga - self.rest_aperture
 
+    @property
+    def peak_speed_seconds(self) -> float:
+        """When the peak speed comes, s from the onset."""
+        return self.peak_speed_time * self.movement_time
+
+    @property
+    def mga_seconds(self) -> float:
+        """When the MGA comes, s from the onset."""
+        return self.mga_time * self.movement_time
+
     def to_dict(self) -> dict:
-        """The landmarks and ``opening`` as JSON values (NaN becomes None)."""
+        """The landmarks, ``opening``, ``peak_speed_seconds`` and ``mga_seconds`` as JSON
+        values (NaN becomes None)."""
         out = {}
         for f in fields(self):
             v = getattr(self, f.name)
             out[f.name] = v if v is None or isinstance(v, int) else _num(v)
-        out["opening"] = _num(self.opening)
+        for name in ("opening", "peak_speed_seconds", "mga_seconds"):
+            out[name] = _num(getattr(self, name))
         return out
 
     @classmethod
@@ -299,112 +453,121 @@ def longest_gap(time: np.ndarray, values: np.ndarray) -> float:
     return float(np.diff(ts).max())
 
 
-def movement_landmarks(time: np.ndarray, wrist: np.ndarray, aperture: np.ndarray,
-                       duration: float | None = None) -> Landmarks:
-    """The landmarks of a movement sampled from its onset (``time`` 0) to its end.
+def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.ndarray,
+                       params: LandmarkParams | None = None) -> Landmarks:
+    """The landmarks of a sampled movement, by the field's definitions (:class:`LandmarkParams`).
+
+    The movement is the one around the transport's peak speed, from the
+    onset to the end where the (low-passed) speed crosses the bound; every
+    other landmark is looked for between the two, so shares never exceed 1.
+    Where the samples start or end inside the movement, its onset or end is
+    missing (NaN) and so is everything measured against it; the peak speed
+    and the MGA seen are still given.
 
     Parameters
     ----------
     time : (N,) array
-        Time since the movement's onset, s, increasing; the movement time
-        is the last one unless ``duration`` is given.
-    wrist : (N, 2) array
-        Wrist positions, m (NaN where lost). Its speed is the distance
-        between consecutive positions over their time interval, at the
-        interval's middle.
+        Sample times, s, increasing.
+    transport : (N, D) array
+        The point that carries the transport (the wrist, or the grip
+        midpoint), m; NaN where lost.
     aperture : (N,) array
-        Grip aperture, m (NaN where lost).
-    duration : float, optional
-        The movement time, s, if known better than from the last sample.
+        Grip aperture (tip to tip), m; NaN where lost.
+    params : LandmarkParams, optional
     """
+    params = LandmarkParams() if params is None else params
     time = np.asarray(time, dtype=float)
-    wrist = np.asarray(wrist, dtype=float)
-    g = np.asarray(aperture, dtype=float)
-    if len(time) < 2 or not np.isfinite(time[-1]) or time[-1] <= 0:
+    g_raw = np.asarray(aperture, dtype=float)
+    if len(time) < 3:
         return Landmarks()
-    T = float(duration) if duration is not None and math.isfinite(duration) and duration > 0 \
-        else float(time[-1])
-    speed = np.linalg.norm(np.diff(wrist, axis=0), axis=1) / np.diff(time)
-    peak_speed = peak_speed_time = math.nan
-    if np.isfinite(speed).any():
-        i = int(np.nanargmax(speed))
-        peak_speed = float(speed[i])
-        peak_speed_time = float(0.5 * (time[i] + time[i + 1]) / T)
-    seen = np.flatnonzero(np.isfinite(g))
+    speed = params.speed_of(time, np.asarray(transport, dtype=float))
+    if not np.isfinite(speed).any():
+        return Landmarks()
+    peak = int(np.nanargmax(speed))
+    onset, end = movement_bounds(time, speed, peak, params)
+    bound = params.speed if params.speed is not None else params.threshold * speed[peak]
+    t_on = _cross_time(time, speed, onset, bound, True) if onset is not None else math.nan
+    t_end = _cross_time(time, speed, end, bound, False) if end is not None else math.nan
+    T = t_end - t_on
+    lo = onset if onset is not None else 0
+    hi = end if end is not None else len(time) - 1
+    share = (lambda t: float(np.clip((t - t_on) / T, 0, 1))) if T > 0 else (lambda t: math.nan)
+    base = {"onset_time": t_on, "end_time": t_end, "movement_time": T,
+            "peak_speed": float(speed[peak]), "peak_speed_time": share(time[peak]),
+            "deceleration_time": t_end - float(time[peak])}
+    g = params.lowpass(time, g_raw)
+    rows = np.arange(lo, hi + 1)
+    seen = rows[np.isfinite(g[rows])]
     if len(seen) < 3:
-        return Landmarks(T, peak_speed, peak_speed_time)
+        return Landmarks(**base)
     j = int(seen[np.argmax(g[seen])])
     mga, rest = float(g[j]), float(g[seen[0]])
     opening = mga - rest
     ts = time[seen]
-    gaps = np.r_[ts[0], np.diff(ts), T - ts[-1]]
+    gaps = np.r_[ts[0] - time[lo], np.diff(ts), time[hi] - ts[-1]]
     peaks = None
-    if gaps.max() <= MAX_GAP + 1e-9 or len(seen) == len(g):
+    if gaps.max() <= MAX_GAP + 1e-9:
         peaks = count_peaks(g[seen], max(PEAK_PROMINENCE * opening, PEAK_MIN_PROMINENCE))
+    rate = np.gradient(g, time)
+    widening = rate[lo:j + 1][np.isfinite(rate[lo:j + 1])]
     return Landmarks(
-        movement_time=T, peak_speed=peak_speed, peak_speed_time=peak_speed_time,
-        mga=mga, mga_time=float(time[j] / T), contact_aperture=float(g[seen[-1]]),
+        **base, mga=mga, mga_time=share(time[j]), contact_aperture=float(g[seen[-1]]),
         aperture_peaks=peaks, rest_aperture=rest,
-        opening_time=_crossing(time, g, rest + OPENING_LEVEL * opening) / T)
+        opening_time=share(_crossing(time[lo:hi + 1], g[lo:hi + 1], rest + OPENING_LEVEL * opening)),
+        peak_opening_speed=float(widening.max()) if len(widening) else math.nan,
+        closing_time=t_end - float(time[j]))
 
 
-def observed_landmarks(obs: Observation) -> Landmarks:
-    """The landmarks of a demonstration, from its onset, over :func:`movement_time`.
+def observed_landmarks(obs: Observation, params: LandmarkParams | None = None) -> Landmarks:
+    """The landmarks of a demonstration, by the field's definitions (:func:`movement_landmarks`).
 
-    Measured on the unfiltered positions (``obs.raw``) smoothed without lag
-    (:func:`smooth`); the grip aperture is the digit markers' distance less
-    their separation at rest (``obs.marker_separation``: the markers sit
-    outside the tips, across the grip). An observation without unfiltered
-    positions is measured on its filtered ones.
+    Measured on the whole clip's unfiltered positions (``obs.clip_raw``),
+    not only the span the models score: the field's end of a slow approach
+    may come after it. The transport is the wrist's; the aperture is the
+    tip-to-tip distance of the digit markers, as a lab reports it (the
+    rest-subtracted opening is :attr:`Landmarks.opening`). Times are on
+    the observation's clock (0 at the scored span's onset).
 
     Parameters
     ----------
     obs : Observation
         The demonstration.
+    params : LandmarkParams, optional
     """
-    raw = getattr(obs, "raw", None) or {}
-    if all(k in raw for k in ("wrist", "finger", "thumb")):
-        wrist, finger, thumb = (smooth(obs.time, raw[k]) for k in ("wrist", "finger", "thumb"))
-        aperture = np.linalg.norm(finger - thumb, axis=1) - obs.marker_separation
-    else:
-        wrist, aperture = obs.wrist, obs.g
-    # the span's end is where no marker moves faster than the noise floor,
-    # which cuts a normal grasp's slow approach short (by 0.09 s on average):
-    # the movement time comes from the wrist's path instead (movement_time)
-    return movement_landmarks(obs.time, wrist, aperture, movement_time(obs))
+    time = getattr(obs, "clip_time", None)
+    raw = getattr(obs, "clip_raw", None)
+    if time is None or raw is None:
+        r = getattr(obs, "raw", None) or {}
+        if not all(k in r for k in ("wrist", "finger", "thumb")):
+            return movement_landmarks(obs.time, obs.wrist,
+                                      obs.g + obs.marker_separation, params)
+        time = obs.time
+        raw = np.stack([r[k] for k in ("wrist", "finger", "thumb")], axis=1)
+    return movement_landmarks(time, raw[:, 0], np.linalg.norm(raw[:, 1] - raw[:, 2], axis=1),
+                              params)
 
 
 def model_landmarks(time: np.ndarray, wrist: np.ndarray, finger: np.ndarray,
-                    thumb: np.ndarray, end_speed: float = MODEL_END_SPEED,
-                    duration: float | None = None) -> Landmarks:
-    """The landmarks of a model's own (noise-free) movement, sampled past its end.
-
-    The movement ends when no hand point moves faster than ``end_speed``
-    any more; its movement time is ``duration`` (the planned one) or else
-    measured as an observation's (:func:`wrist_movement_time`).
+                    thumb: np.ndarray, params: LandmarkParams | None = None) -> Landmarks:
+    """The landmarks of a model's own (noise-free) movement, by the same definitions.
 
     Parameters
     ----------
     time : (N,) array
-        Time since the movement's (command) onset, s.
+        Time since the movement's (command) onset, s, from rest to past its end.
     wrist, finger, thumb : (N, 2) arrays
         Positions, m.
-    end_speed : float
-        Speed below which the hand has stopped, m/s.
-    duration : float, optional
-        The planned movement time, s.
+    params : LandmarkParams, optional
     """
-    time = np.asarray(time, dtype=float)
-    pts = np.stack([wrist, finger, thumb], axis=1)
-    speed = np.linalg.norm(np.diff(pts, axis=0), axis=-1).max(axis=1) / np.diff(time)
-    moving = np.flatnonzero(speed > end_speed)
-    stop = int(moving[-1]) + 2 if len(moving) else len(time)
-    sl = slice(0, max(stop, 2))
-    return movement_landmarks(time[sl], np.asarray(wrist)[sl],
-                              np.linalg.norm(np.asarray(finger) - np.asarray(thumb),
-                                             axis=1)[sl],
-                              duration if duration is not None
-                              else wrist_movement_time(time[sl], np.asarray(wrist)[sl]))
+    wrist = np.asarray(wrist, dtype=float)
+    # a noise-free movement starts from exact rest: prepend it so the onset is seen
+    dt = float(time[1] - time[0])
+    pad = 10
+    t = np.r_[time[0] - dt * np.arange(pad, 0, -1), time]
+    rest = lambda a: np.concatenate([np.repeat(np.asarray(a, dtype=float)[:1], pad, 0),  # noqa: E731
+                                     np.asarray(a, dtype=float)])
+    return movement_landmarks(t, rest(wrist),
+                              np.linalg.norm(rest(finger) - rest(thumb), axis=1), params)
 
 
 def verdict_detail(observed: Landmarks, reference: Landmarks | None) -> str:

@@ -265,6 +265,11 @@ class Observation:
         Tracking noise of the positions at rest (robust SD), m.
     object_diameter : float
         Object diameter, m.
+    clip_time : (T,) array, optional
+        Every sample of the clip, s on the same clock as ``time``.
+    clip_raw : (T, 3, 2) array, optional
+        Unfiltered wrist, finger and thumb positions over the whole clip, m
+        (the landmarks' movement may end after the scored span).
     """
 
     clip: str
@@ -283,6 +288,8 @@ class Observation:
     object_diameter: float = DEFAULT_OBJECT_DIAMETER
     marker_separation: float = 0.0
     noise: float = 0.0
+    clip_time: np.ndarray | None = field(default=None, repr=False)
+    clip_raw: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def n_frames(self) -> int:
@@ -678,4 +685,6 @@ def observe(tracks, params: ObserveParams | None = None, *, clip: str | None = N
         hand_offset=0.5 * (finger0 + thumb0) - start,
         object_diameter=params.object_diameter,
         marker_separation=float(np.linalg.norm(2 * half)),
+        clip_time=sc.time - p.span.onset_time,
+        clip_raw=sc.raw,
     )

@@ -64,6 +64,7 @@ def add_recognition_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--mirror", action="store_true",
                    help="mirror the image so the finger lies on the model's +x side")
     add_pose_options(p)
+    add_mocap_options(p)
     add_video_options(p, fps=False)
     g.add_argument("--setup", type=Path, metavar="SETUP.toml",
                    help="colour models and marker sizes for tracking videos "
@@ -97,6 +98,67 @@ def add_pose_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--object-diameter-px", type=float, default=None, metavar="D",
                    help="the object's apparent diameter in pixels: sets the metric scale of "
                         "a pose file (or give --px-per-m)")
+
+
+def add_mocap_options(p: argparse.ArgumentParser) -> None:
+    """Add the options that turn motion-capture files (C3D, Qualisys TSV, tables) into reaches.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser.
+    """
+    g = p.add_argument_group("motion capture (C3D, Qualisys TSV, X/Y/Z tables; docs/mocap.md)")
+    g.add_argument("--markers", nargs="+", metavar="ROLE=NAME", default=None,
+                   help="which markers are which: thumb=NAME finger=NAME, and optionally "
+                        "wrist=NAME[+NAME...] object=NAME[+NAME...] (default: guessed from "
+                        "the names: thumb*, index*, hand*/wrist*, object/pillow/target*)")
+    g.add_argument("--rate", type=float, default=None, metavar="HZ",
+                   help="samples per second of a table without a time column")
+    g.add_argument("--units", choices=("mm", "cm", "m"), default=None,
+                   help="the file's length unit, if it does not say (default: inferred)")
+    g.add_argument("--trial-column", metavar="NAME", default=None,
+                   help="the column that numbers a long table's trials (default: trial, "
+                        "trialN, ...)")
+    g.add_argument("--object-size", type=float, default=None, metavar="M",
+                   help="the object's size across the grip, m (default: the grip's opening "
+                        "at the reach's end)")
+
+
+def mocap_import(args: argparse.Namespace):
+    """The :class:`~perception.recordings.MocapImport` the motion-capture options ask for.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments of :func:`add_mocap_options`.
+    """
+    from perception.reaches import MarkerMap, ReachParams
+    from perception.recordings import MocapImport
+
+    markers = None
+    if getattr(args, "markers", None):
+        roles = {}
+        for pair in args.markers:
+            role, sep, name = pair.partition("=")
+            if not sep or role not in ("thumb", "finger", "wrist", "object") or not name:
+                raise InputError(f"{pair}: expected ROLE=NAME with ROLE thumb, finger, wrist "
+                                 "or object", field="--markers")
+            roles[role] = name
+        if "thumb" not in roles or "finger" not in roles:
+            raise InputError("give both thumb=NAME and finger=NAME", field="--markers")
+        markers = MarkerMap(roles["thumb"], roles["finger"],
+                            tuple(roles.get("wrist", "").split("+")) if "wrist" in roles else (),
+                            tuple(roles.get("object", "").split("+")) if "object" in roles
+                            else ())
+    size = getattr(args, "object_size", None)
+    if size is not None and not (math.isfinite(size) and 0 < size < 1):
+        raise InputError(f"expected a size in metres between 0 and 1, got {size}",
+                         field="--object-size")
+    return MocapImport(markers=markers, rate=getattr(args, "rate", None),
+                       units=getattr(args, "units", None),
+                       trial_column=getattr(args, "trial_column", None),
+                       reaches=ReachParams(object_size=size))
 
 
 def _mapping(pairs: list[str]) -> dict[str, str]:

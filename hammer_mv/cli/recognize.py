@@ -19,12 +19,14 @@ def register(sub) -> None:
     """
     p = sub.add_parser("recognize", help="recognise the grasp in one video or tracks file",
                        description="Track INPUT (a video), load it (a .tracks.h5) or read it "
-                       "(a DeepLabCut, SLEAP, Lightning Pose or movement pose file), score it "
+                       "(a DeepLabCut, SLEAP, Lightning Pose or movement pose file, or a motion-capture "
+                       "recording: every reach in it), score it "
                        "against every model with HAMMER-MV and write DIR/<clip>.recognition.json, "
                        "a per-step CSV and figures. A current tracks file of the video (in "
                        "DIR/tracks/ or beside the video) is reused instead of tracking again.")
     p.add_argument("input", type=Path, metavar="INPUT",
-                   help="video, .tracks.h5 or pose file (.h5, .csv, .slp, .nc, .nwb)")
+                   help="video, .tracks.h5, pose file (.h5, .csv, .slp, .nc, .nwb) or "
+                        "motion-capture file (.c3d, Qualisys .tsv, X/Y/Z table)")
     p.add_argument("-o", "--output", type=Path, required=True, metavar="DIR",
                    help="folder for the clip's report")
     p.add_argument("--no-figures", action="store_true",
@@ -66,6 +68,10 @@ def run(args: argparse.Namespace) -> int:
     if path.is_dir():
         raise InputError("expected a video, tracks or pose file, got a folder "
                          "(use hammer-mv batch)", path)
+    from perception.io.mocap import is_mocap_file
+
+    if is_mocap_file(path):
+        return _run_mocap(args, path)
     clip, kind = clip_name(path)
     if kind == "unknown":
         raise InputError("not a video, .tracks.h5 or pose file", path)
@@ -91,4 +97,30 @@ def run(args: argparse.Namespace) -> int:
                       else "; the scene is mirrored: scored as with --mirror")
         print(f"{clip}: {rec.verdict or 'no verdict'}{detail}, winner {rec.winner} "
               f"({rec.rule} rule){mirror} -> {paths['json']}")
+    return 0
+
+
+def _run_mocap(args: argparse.Namespace, path: Path) -> int:
+    """``recognize`` of a motion-capture file: every reach in it, one report each."""
+    from hammer_mv.cli.options import load_repertoire, mocap_import, recognition_settings
+    from perception.pipeline import clip_fingerprint
+    from perception.recordings import read_reaches, recognize_reach
+    from perception.report.clip import write_clip_report
+
+    settings = recognition_settings(args)
+    options = mocap_import(args)
+    reaches = read_reaches(path, options)
+    rep, rep_id = load_repertoire(args)
+    fingerprint = clip_fingerprint(path, settings, rep_id + repr(options.to_dict()))
+    for reach in reaches:
+        rec, info = recognize_reach(reach, rep, settings, options)
+        extra = {"fingerprint": fingerprint, "condition": None, "input": str(path),
+                 "mocap": info}
+        paths = write_clip_report(rec, args.output, extra=extra, figures=not args.no_figures)
+        for warning in rec.warnings:
+            print(f"{reach.name}: warning: {warning}", file=sys.stderr)
+        if not args.quiet:
+            detail = f" ({rec.verdict_detail})" if rec.verdict_detail else ""
+            print(f"{reach.name}: {rec.verdict or 'no verdict'}{detail}, winner {rec.winner} "
+                  f"-> {paths['json']}")
     return 0

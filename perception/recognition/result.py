@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING
@@ -35,6 +36,13 @@ if TYPE_CHECKING:
 
 __all__ = ["Recognition"]
 
+
+#: The movement times (onset to end by the field's rule, s) the verdict was
+#: validated on: the synthetic populations' 0.45-1.2 s grasps and a lab's real
+#: Optotrak grasps (1.05-2.06 s).
+VALIDATED_MOVEMENT_TIME = (0.4, 2.1)
+#: The reach distances (wrist at rest to the object's centre, m) it was validated on.
+VALIDATED_DISTANCE = (0.1, 0.7)
 
 @dataclass(frozen=True, eq=False)
 class Recognition:
@@ -172,6 +180,73 @@ class Recognition:
         return self.decision.verdict
 
     @property
+    def verdict_reason(self) -> str | None:
+        """Why an ``unfamiliar`` or ``abnormal`` verdict was given, in words (None otherwise).
+
+        ``unfamiliar`` is either "not a human reach" (even the transport is
+        like none of the reach models' own) or "insufficient data" naming
+        the digit lost longest and where; ``abnormal`` names the rule.
+        """
+        v = self.verdict
+        if v == "unfamiliar":
+            if self.transport_familiarity < self.unfamiliar_threshold:
+                return (f"not a human reach: its transport fits the reach models worse than "
+                        f"{1 - self.unfamiliar_threshold:.0%} of their own reaches")
+            return "insufficient data: " + self._longest_loss()
+        if v == "abnormal":
+            if self.shape is not None and grip_departs(self.landmarks[0]):
+                return "the grip opens late or twice (the field's landmarks)"
+            return "no model explains the movement as well as 95 % of its own movements"
+        return None
+
+    def _longest_loss(self) -> str:
+        """The digit lost longest during the movement, for how long and where."""
+        obs, lm = self.observation, self.landmarks[0]
+        worst = (0.0, "", math.nan)
+        for name in ("finger", "thumb"):
+            values = obs.raw.get(name) if obs.raw else None
+            if values is None:
+                continue
+            gap = longest_gap(obs.time, values[:, 0])
+            seen = obs.time[np.isfinite(values[:, 0])]
+            if gap > worst[0] and len(seen):
+                steps = np.diff(np.r_[obs.time[0], seen, obs.time[-1]])
+                k = int(np.argmax(steps))
+                start = float(np.r_[obs.time[0], seen][k])
+                worst = (gap, name, start)
+        gap, name, start = worst
+        if not name:
+            return "the digits are seen too little to score"
+        where = ""
+        if math.isfinite(lm.onset_time) and lm.movement_time > 0:
+            a = (start - lm.onset_time) / lm.movement_time
+            b = (start + gap - lm.onset_time) / lm.movement_time
+            where = f" at {max(a, 0):.0%}-{min(b, 1):.0%} of the movement"
+        return f"the {name} lost {gap:.2f} s{where} (a gap over {MAX_GAP:.2f} s may hide a " \
+               "second opening)"
+
+    @property
+    def warnings(self) -> list[str]:
+        """Where the movement lies outside what the verdict was validated on (docs/mocap.md)."""
+        out = []
+        lm = self.landmarks[0]
+        lo, hi = VALIDATED_MOVEMENT_TIME
+        if math.isfinite(lm.movement_time) and not lo <= lm.movement_time <= hi:
+            out.append(f"movement time {lm.movement_time:.2f} s is outside the "
+                       f"{lo}-{hi} s the verdict was validated on")
+        lo, hi = VALIDATED_DISTANCE
+        d = self.observation.start_distance
+        if not lo <= d <= hi:
+            out.append(f"reach distance {d:.2f} m is outside the {lo}-{hi} m the verdict "
+                       "was validated on")
+        if math.isfinite(lm.movement_time) and lm.movement_time > 0 and self.shape is not None:
+            n = self.normalisation
+            if n is not None and abs(n.time_scale - 1) > 1e-9:
+                out.append(f"judged at the repertoire's speed: times scaled by "
+                           f"{n.time_scale:.2f}")
+        return out
+
+    @property
     def reference_model(self) -> str | None:
         """The grasp model with the highest log-likelihood (None if there is none)."""
         grasp = [i for i, k in enumerate(self.kinds) if k == "grasp"]
@@ -223,8 +298,7 @@ class Recognition:
 
         m = self.models[self.names.index(model)]
         run = rollout([m], int(np.ceil(1.5 * m.duration / m.dt)) + 1)
-        return model_landmarks(run.time, run.wrist[0, 0], run.finger[0, 0], run.thumb[0, 0],
-                               duration=m.duration)
+        return model_landmarks(run.time, run.wrist[0, 0], run.finger[0, 0], run.thumb[0, 0])
 
     @cached_property
     def landmarks(self) -> tuple[Landmarks, Landmarks | None]:
@@ -325,6 +399,8 @@ class Recognition:
             "rule": self.rule,
             "verdict": d.verdict,
             "verdict_detail": self.verdict_detail,
+            "verdict_reason": self.verdict_reason,
+            "warnings": self.warnings,
             "familiarity": _num(d.familiarity),
             "margin": _num(d.margin),
             "familiarity_threshold": float(self.familiarity_threshold),

@@ -104,7 +104,7 @@ class CalibrationParams:
     grip_shift: float = 0.08
     aperture_scale: float = 0.10
     path_bow: float = 0.03
-    transport_skew: float = 0.5
+    transport_skew: float = 0.8
     noise_px: float = 0.4
     noise_spread: float = 0.5
     px_per_m: float = 800.0

@@ -1,0 +1,184 @@
+"""Real motion-capture recordings: lost samples, reaches, the field's landmarks, the verdict.
+
+The recordings are trimmed copies of real ones (tests/data/mocap/, licences
+beside them): four Optotrak grasps of a healthy adult at 85 Hz, and a
+Qualisys session of reaching to a cushion at 100 Hz.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from _demos import default_repertoire
+from scipy.signal import butter, filtfilt
+
+from perception.cleaning import CleaningParams, clean_path
+from perception.io.mocap import read_mocap
+from perception.landmarks import LandmarkParams, movement_landmarks
+from perception.reaches import MarkerMap, fit_plane, reach_tracks, recording_reaches
+from perception.recordings import MocapImport, read_reaches, recognize_reach
+from perception.synthetic.variants import late_opening, reopening
+
+DATA = Path(__file__).parent / "data" / "mocap"
+OPTOTRAK = DATA / "optotrak-trials.tsv"
+QUALISYS = DATA / "qualisys-recording.tsv"
+RATE = 1 / 0.01176471
+
+
+@pytest.fixture(scope="module")
+def optotrak_reaches():
+    return read_reaches(OPTOTRAK, MocapImport(rate=RATE))
+
+
+def test_a_spike_and_a_held_marker_are_lost_a_short_gap_bridged():
+    t = np.arange(200) / 100.0
+    path = np.stack([0.3 * t, 0.1 * np.sin(t), np.zeros_like(t)], axis=1)
+    path += 1e-5 * np.random.default_rng(0).standard_normal(path.shape)
+    raw = path.copy()
+    raw[0] += [0.05, 0, 0]                  # a glitched first sample, 50 mm off
+    raw[100:112] = raw[99]                  # held for 12 samples while occluded
+    raw[150:152] = np.nan                   # a two-sample dropout
+    clean, rep = clean_path(t, raw, CleaningParams())
+    assert rep.spikes == 1 and rep.held == 12 and rep.missing == 2
+    assert np.isnan(clean[0]).all() and np.isnan(clean[100:112]).all()
+    assert np.allclose(clean[150:152], path[150:152], atol=2e-4)   # bridged: 30 ms
+    assert rep.longest_gap == pytest.approx(0.13, abs=1e-9)        # the held run stays lost
+    assert "held" in rep.describe("thumb")
+
+
+def _independent_landmarks(time, index, thumb):
+    """The field's definitions written out plainly: 10 Hz Butterworth, 5 % of peak speed."""
+    b, a = butter(2, 10 / (0.5 * RATE))
+    mid = filtfilt(b, a, 0.5 * (index + thumb), axis=0)
+    g = filtfilt(b, a, np.linalg.norm(index - thumb, axis=1))
+    v = np.linalg.norm(np.gradient(mid, time, axis=0), axis=1)
+    p = int(np.argmax(v))
+    on = p - int(np.argmax(v[p::-1] < 0.05 * v[p])) + 1
+    end = p + int(np.argmax(v[p:] < 0.05 * v[p])) - 1
+    j = on + int(np.argmax(g[on:end + 1]))
+    return time[end] - time[on], (time[j] - time[on]) / (time[end] - time[on]), g[j]
+
+
+def _window(trial):
+    """The samples from the first clean one to just before the return starts."""
+    reach = recording_reaches(trial, MarkerMap("thumb", "index"))[0]
+    rows = (trial.time > trial.time[0]) & (trial.time <= reach.time[-1])
+    return trial.time[rows], trial.markers["index"][rows], trial.markers["thumb"][rows]
+
+
+def test_landmarks_agree_with_the_fields_definitions_computed_by_hand():
+    trials = read_mocap(OPTOTRAK, rate=RATE)
+    assert len(trials) == 4
+    for trial in trials:
+        t, index, thumb = _window(trial)
+        mt, mga_share, mga = _independent_landmarks(t, index, thumb)
+        lm = movement_landmarks(t, 0.5 * (index + thumb), np.linalg.norm(index - thumb, axis=1))
+        # the crossings are interpolated between samples: within a sample of the hand's
+        assert abs(lm.movement_time - mt) < 2 / RATE
+        assert abs(lm.mga_time - mga_share) < 0.05
+        assert lm.mga == pytest.approx(mga, abs=1e-4)
+        assert 0 <= lm.peak_speed_time <= 1 and 0 <= lm.opening_time <= 1
+
+
+def test_a_recording_that_starts_in_motion_gives_the_landmarks_it_can():
+    t, index, thumb = _window(read_mocap(OPTOTRAK, rate=RATE)[0])
+    mid, g = 0.5 * (index + thumb), np.linalg.norm(index - thumb, axis=1)
+    full = movement_landmarks(t, mid, g)
+    k = int(np.searchsorted(t, full.onset_time + 0.3))
+    cut = movement_landmarks(t[k:], mid[k:], g[k:])
+    assert math.isnan(cut.onset_time) and math.isnan(cut.movement_time)
+    assert cut.end_time == pytest.approx(full.end_time, abs=2 / RATE)
+    assert cut.peak_speed > 0
+
+
+def test_each_trial_holds_one_reach_not_its_return(optotrak_reaches):
+    assert [r.name for r in optotrak_reaches] == [f"optotrak-trials-trial{k}" for k in range(4)]
+    for r in optotrak_reaches:
+        g = r.aperture
+        assert np.nanmax(g[r.onset:r.end + 1]) - g[r.onset] > 0.05   # the grip opens
+        plane = fit_plane(r, r.transport[r.end])
+        assert plane.rms < 0.02                                    # a nearly planar reach
+
+
+def test_a_long_session_is_split_into_its_reaches():
+    trial = read_mocap(QUALISYS)[0]
+    assert trial.rate == 100
+    reaches = recording_reaches(trial)
+    assert len(reaches) >= 1
+    r = reaches[0]
+    # the object's markers mark where the hand goes: it ends near the cushion
+    assert np.linalg.norm(r.transport[r.end] - r.object) < 0.15
+    assert np.linalg.norm(r.transport[r.onset] - r.object) > 0.2
+
+
+def test_tracks_of_a_reach_hold_its_3d_aperture(optotrak_reaches):
+    r = optotrak_reaches[0]
+    tracks, info = reach_tracks(r)
+    finger, thumb = tracks.marker("finger"), tracks.marker("thumb")
+    g2d = np.linalg.norm(finger - thumb, axis=1) / 1000
+    # the 2D digits stand at the 3D distance, sample for sample (rest held at the start)
+    g3d = r.aperture[np.isfinite(r.aperture)]
+    assert np.nanmax(g2d) == pytest.approx(np.nanmax(g3d), abs=1e-9)
+    assert info["plane"]["rms_out_of_plane"] < 0.02
+    assert any("where the grip closes" in n for n in info["notes"])
+
+
+@pytest.mark.slow
+def test_real_grasps_are_normal_and_their_variants_abnormal(optotrak_reaches):
+    rep = default_repertoire()
+    for r in optotrak_reaches:
+        rec, _ = recognize_reach(r, rep)
+        assert rec.verdict == "normal", (r.name, rec.verdict, rec.verdict_reason)
+        late, _ = recognize_reach(late_opening(r), rep)
+        assert (late.verdict, late.verdict_detail) == ("abnormal", "delayed-opening"), r.name
+        twice, _ = recognize_reach(reopening(r), rep)
+        assert (twice.verdict, twice.verdict_detail) == ("abnormal", "re-opening"), r.name
+        assert late.verdict_reason and twice.verdict_reason
+
+
+def test_recognize_reads_a_lab_table_and_reports_every_trial(tmp_path):
+    out = tmp_path / "out"
+    res = subprocess.run([sys.executable, "-m", "hammer_mv", "recognize", str(OPTOTRAK),
+                          "--rate", str(RATE), "-o", str(out), "--no-figures"],
+                         capture_output=True, text=True, timeout=300)
+    assert res.returncode == 0, res.stderr
+    reports = sorted(out.glob("*.recognition.json"))
+    assert len(reports) == 4
+    d = json.loads(reports[0].read_text())
+    assert d["verdict"] in ("normal", "abnormal", "reach", "unfamiliar")
+    assert "verdict_reason" in d and isinstance(d["warnings"], list)
+    assert d["mocap"]["rate"] == pytest.approx(RATE, rel=1e-3)
+    assert 1.0 < d["kinematics"]["observed"]["movement_time"] < 2.5
+
+
+def test_a_table_without_its_rate_is_one_line_naming_the_flag(tmp_path):
+    res = subprocess.run([sys.executable, "-m", "hammer_mv", "recognize", str(OPTOTRAK),
+                          "-o", str(tmp_path / "out")], capture_output=True, text=True,
+                         timeout=120)
+    assert res.returncode == 2
+    assert "--rate" in res.stderr and "Traceback" not in res.stderr
+    assert len(res.stderr.strip().splitlines()) == 1
+
+
+def test_a_wrong_marker_name_is_refused(tmp_path):
+    res = subprocess.run([sys.executable, "-m", "hammer_mv", "recognize", str(OPTOTRAK),
+                          "--rate", "85", "--markers", "thumb=thumb", "finger=pinky",
+                          "-o", str(tmp_path / "out")], capture_output=True, text=True,
+                         timeout=120)
+    assert res.returncode == 2 and "pinky" in res.stderr and "Traceback" not in res.stderr
+
+
+def test_the_landmark_definitions_are_settable():
+    t, index, thumb = _window(read_mocap(OPTOTRAK, rate=RATE)[1])
+    mid, g = 0.5 * (index + thumb), np.linalg.norm(index - thumb, axis=1)
+    five = movement_landmarks(t, mid, g)
+    ten = movement_landmarks(t, mid, g, LandmarkParams(threshold=0.10))
+    absolute = movement_landmarks(t, mid, g, LandmarkParams(speed=0.05, hold=0.05))
+    assert ten.movement_time < five.movement_time       # a higher bound, a shorter movement
+    assert absolute.movement_time > 0 and math.isfinite(absolute.onset_time)
