@@ -21,9 +21,12 @@ from perception.errors import HammerMVError, InputError, PlanningError, Tracking
 from perception.geometry import DEFAULT_OBJECT_DIAMETER, SimilarityTransform
 from perception.io.tracks import Status, Tracks, TracksWriter
 from perception.io.video import FrameSource, open_video, write_video
+from perception.landmarks import LandmarkParams, Landmarks
+from perception.measure import landmarks
 from perception.observation import MovementSpan, Observation, ObserveParams, movement_span, observe
 from perception.online import OnlineRecognizer, SettleRule
 from perception.pipeline import RecognitionSettings, load_clip, recognize_clip
+from perception.reaches import MarkerMap
 from perception.recognition import (
     HammerParams,
     ModelSpec,
@@ -33,6 +36,7 @@ from perception.recognition import (
     SceneSpec,
     recognize,
 )
+from perception.recordings import MocapImport, read_reaches, recognize_reach
 from perception.report import write_batch_report, write_clip_report
 from perception.synthetic.demos import demo_tracks
 from perception.synthetic.recipes import load_recipe, synthesize
@@ -42,6 +46,10 @@ from perception.tracking.markers import MarkerSet, default_markers
 from perception.tracking.tracker import Tracker, TrackerParams, track_video
 
 __all__ = [
+    "MocapImport",
+    "MarkerMap",
+    "Landmarks",
+    "LandmarkParams",
     "BatchItem",
     "Camera",
     "DEFAULT_OBJECT_DIAMETER",
@@ -75,6 +83,9 @@ __all__ = [
     "demo_tracks",
     "discover",
     "load_clip",
+    "recognize_reach",
+    "read_reaches",
+    "landmarks",
     "load_recipe",
     "movement_span",
     "observe",

@@ -61,7 +61,7 @@ COMPANION_SUFFIXES = (".truth.h5", ".recognition.json", ".confidence.csv", ".con
 #: video is what the lab tracked it with; a tracks file beside a video stands
 #: for it only when it is current (checked when the video is loaded), so the
 #: video is the clip.
-_PREFERENCE = {"pose": 3, "video": 2, "tracks": 1, "unknown": 0}
+_PREFERENCE = {"mocap": 4, "pose": 3, "video": 2, "tracks": 1, "unknown": 0}
 COMPANION_NAMES = ("manifest.csv", "README.md", "recipe.toml", "summary.csv", "statistics.csv",
                    "condition_profiles.csv", "condition_profiles.png", "report.html",
                    "batch.json", "repertoire.h5", "aperture_profiles.csv",
@@ -85,16 +85,19 @@ class BatchItem:
     path : Path
         Video, tracks or pose file.
     kind : str
-        ``video``, ``tracks`` or ``pose`` (a manifest row may name a file of
-        another kind: ``unknown``, recorded as a failure).
+        ``video``, ``tracks``, ``pose`` or ``mocap`` (a manifest row may name
+        a file of another kind: ``unknown``, recorded as a failure).
     condition : str or None
         Stimulus condition, when a manifest gives it.
+    reach : int or None
+        Which reach of a motion-capture recording (:func:`expand_recordings`).
     """
 
     clip: str
     path: Path
     kind: str
     condition: str | None = None
+    reach: int | None = None
 
 
 def check_clip_name(name: str, where: str) -> str:
@@ -236,6 +239,61 @@ def find_clips(source: str | os.PathLike) -> Discovery:
     return Discovery(sorted(items, key=lambda i: i.clip), skipped)
 
 
+def expand_recordings(items: Iterable[BatchItem], settings: RecognitionSettings
+                      ) -> list[BatchItem]:
+    """Each motion-capture recording as one item per reach in it (other items as they are).
+
+    A recording that cannot be read stays one item, which fails with its
+    error when processed.
+
+    Parameters
+    ----------
+    items : iterable of BatchItem
+        Clips (see :func:`discover`).
+    settings : RecognitionSettings
+        Their ``mocap`` settings say how recordings are read.
+    """
+    from perception.recordings import cached_reaches
+
+    out = []
+    for item in items:
+        if item.kind != "mocap" or item.reach is not None:
+            out.append(item)
+            continue
+        try:
+            reaches = cached_reaches(item.path, settings.mocap)
+        except (HammerMVError, OSError):
+            out.append(item)
+            continue
+        out += [BatchItem(check_clip_name(r.name, str(item.path)), item.path, "mocap",
+                          item.condition, k) for k, r in enumerate(reaches)]
+    return out
+
+
+def _recognized(item: BatchItem, out: Path, repertoire: Repertoire,
+                settings: RecognitionSettings, fp: str, progress: bool,
+                plan_cache: PlanCache | None):
+    """The recognition of one item and its report's extra entries."""
+    if item.kind == "mocap":
+        from perception.recordings import cached_reaches, recognize_reach
+
+        reach = cached_reaches(item.path, settings.mocap)[item.reach or 0]
+        rec, info = recognize_reach(reach, repertoire, settings, settings.mocap,
+                                    plan_cache=plan_cache)
+        return rec, {"fingerprint": fp, "condition": item.condition, "input": str(item.path),
+                     "mocap": info}
+    frames = FrameSample()
+    tracks_out = output_folder(out, "tracks") / f"{output_stem(item.clip)}{TRACKS_SUFFIX}"
+    tracks = load_clip(item.path, tracks_out=tracks_out,
+                       progress=progress, setup=settings.tracking, pose=settings.pose,
+                       frames=frames, **settings.video_options())
+    rec = recognize_tracks(tracks, repertoire, settings, clip=item.clip, source=item.path,
+                           plan_cache=plan_cache)
+    tracking = write_tracking_report(tracks, out, item.clip, frames=frames)
+    return rec, {"fingerprint": fp, "condition": item.condition, "input": str(item.path),
+                 "tracking": tracking}
+
+
 def _current_report(item: BatchItem, out: Path, fingerprint: str) -> dict | None:
     """The clip's finished report if it was made from this input and these settings."""
     p = clip_outputs(out, item.clip)
@@ -316,20 +374,12 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
     base = dict(clip=item.clip, condition=item.condition, rule=settings.hammer.rule)
     try:
         input_file(item.path, "clip")  # before hashing: a FIFO or device would never end
-        fp = clip_fingerprint(item.path, settings, repertoire_id)
+        fp = clip_fingerprint(item.path, settings, repertoire_id + (
+            f"#reach{item.reach}" if item.reach is not None else ""))
         done = _current_report(item, out, fp)
         if done is not None:
             return ClipResult(**base, status="reused", summary=ClipSummary.from_dict(done))
-        frames = FrameSample()
-        tracks_out = output_folder(out, "tracks") / f"{output_stem(item.clip)}{TRACKS_SUFFIX}"
-        tracks = load_clip(item.path, tracks_out=tracks_out,
-                           progress=progress, setup=settings.tracking, pose=settings.pose,
-                           frames=frames, **settings.video_options())
-        rec = recognize_tracks(tracks, repertoire, settings, clip=item.clip, source=item.path,
-                               plan_cache=plan_cache)
-        tracking = write_tracking_report(tracks, out, item.clip, frames=frames)
-        extra = {"fingerprint": fp, "condition": item.condition, "input": str(item.path),
-                 "tracking": tracking}
+        rec, extra = _recognized(item, out, repertoire, settings, fp, progress, plan_cache)
         write_clip_report(rec, out, extra=extra)
         return ClipResult(**base, status="ok", summary=ClipSummary.from_recognition(rec, extra))
     except (HammerMVError, OSError) as exc:  # the clip's fault; anything else is a bug
@@ -588,7 +638,7 @@ def run_batch(
     settings = RecognitionSettings() if settings is None else settings
     if jobs < 1:
         raise InputError(f"expected at least 1, got {jobs}", field="--jobs")
-    items = list(items)
+    items = expand_recordings(items, settings)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     for sub in ("tracks", PLANS_FOLDER):  # a link leading out of the report: refused now

@@ -65,7 +65,7 @@ NO_OPENING = 0.30
 #: opening) later than this share of the movement: a normal hand starts to open within
 #: the first ~20 % and a smooth opening that peaks by 80 % gets a tenth of the way up a
 #: quarter of the way along, 0.2 + 0.26 x 0.6 = 0.36 at the latest...
-LATE_OPENING = 0.66
+LATE_OPENING = 0.55
 #: ... or its maximum comes later than this share (while the reference's comes earlier).
 LATE_MGA = 0.95
 
@@ -513,7 +513,8 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
     return Landmarks(
         **base, mga=mga, mga_time=share(time[j]), contact_aperture=float(g[seen[-1]]),
         aperture_peaks=peaks, rest_aperture=rest,
-        opening_time=share(_crossing(time[lo:hi + 1], g[lo:hi + 1], rest + OPENING_LEVEL * opening)),
+        opening_time=share(_crossing(time[lo:hi + 1], g[lo:hi + 1],
+                                     rest + OPENING_LEVEL * opening)),
         peak_opening_speed=float(widening.max()) if len(widening) else math.nan,
         closing_time=t_end - float(time[j]))
 

@@ -30,6 +30,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from perception.errors import InputError, PlanningError
+from perception.io.mocap import is_mocap_file
 from perception.io.tracks import Tracks, tracks_path_for
 from perception.observation import ObserveParams, observe
 from perception.provenance import code_digest
@@ -41,6 +42,7 @@ from perception.recognition.result import Recognition
 if TYPE_CHECKING:  # the tracker (OpenCV) and movement are imported only when needed
     from perception.io.frame_sample import FrameSample
     from perception.io.pose import PoseImport
+    from perception.recordings import MocapImport
     from perception.tracking.setup import TrackingSetup
 
 __all__ = [
@@ -84,6 +86,9 @@ class RecognitionSettings:
         (``--keep-truncated``).
     fps : float, optional
         The true frame rate of videos whose header is wrong, frames/s (``--fps``).
+    mocap : MocapImport, optional
+        How motion-capture recordings become reaches (markers, rate, units,
+        object size); default: :class:`~perception.recordings.MocapImport`.
     """
 
     observe: ObserveParams = field(default_factory=ObserveParams)
@@ -92,6 +97,7 @@ class RecognitionSettings:
     pose: PoseImport | None = None
     keep_truncated: bool = False
     fps: float | None = None
+    mocap: MocapImport | None = None
 
     def video_options(self) -> dict:
         """How to read videos, as keyword arguments of :func:`load_clip`."""
@@ -106,13 +112,16 @@ class RecognitionSettings:
             out["tracking"] = self.tracking.to_dict()
         if self.pose is not None:
             out["pose"] = self.pose.to_dict()
+        if self.mocap is not None:
+            out["mocap"] = self.mocap.to_dict()
         if self.keep_truncated or self.fps is not None:
             out["video"] = self.video_options()
         return out
 
 
 def clip_name(path: str | os.PathLike) -> tuple[str, str]:
-    """Clip name and input kind (``video``, ``tracks``, ``pose`` or ``unknown``) of a file.
+    """Clip name and input kind (``video``, ``tracks``, ``pose``, ``mocap`` or ``unknown``) of a
+    file.
 
     Parameters
     ----------
@@ -125,6 +134,8 @@ def clip_name(path: str | os.PathLike) -> tuple[str, str]:
         return name[: -len(TRACKS_SUFFIX)], "tracks"
     if path.suffix.lower() in VIDEO_SUFFIXES:
         return path.stem, "video"
+    if is_mocap_file(path):
+        return path.stem, "mocap"
     if path.suffix.lower() in POSE_SUFFIXES:
         return path.stem, "pose"
     return path.stem, "unknown"
@@ -225,6 +236,10 @@ def load_clip(source: str | os.PathLike | Tracks, *, tracks_out: str | os.PathLi
         raise InputError("not a video, tracks or pose file", path)
     if kind == "tracks":
         return Tracks.load(path)
+    if kind == "mocap":
+        raise InputError("a motion-capture recording holds reaches, not one clip's tracks: "
+                         "read them with read_reaches and score each with recognize_reach",
+                         path)
     if kind == "pose":
         from perception.io.pose import read_pose  # movement only for pose files
 

@@ -3,11 +3,12 @@
 A motion-capture trial holds more than the reach: rest, the reach to the
 object, the grasp, often the return, and in a long session many of each.
 :func:`find_reaches` finds every reach-to-grasp in one: movements of the
-transport point (the grip midpoint; the wrist where the digits are not
-seen) from onset to end by the field's threshold rule
+transport point (the wrist markers' mean where a wrist is mapped, else the
+grip midpoint) from onset to end by the field's threshold rule
 (:func:`perception.landmarks.movement_bounds`), kept when the grip opens
 during the movement (a return carries a closed or closing hand) or, with
-object markers, when the hand ends nearer the object than it started.
+object markers, when the hand ends :data:`APPROACH` of its distance nearer
+the object than it started.
 
 :func:`reach_tracks` turns one reach into the tracks the recognition reads:
 
@@ -19,9 +20,9 @@ object markers, when the hand ends nearer the object than it started.
   placed across the approach at that aperture, the finger on the model's +x
   side (a projection would hide a grip that lies out of the plane, as it
   does when a lab's participants grasp along the line of sight).
-* **the wrist**: a wrist marker, projected, if one is mapped; otherwise a
-  point :data:`WRIST_BEHIND` behind the grip midpoint along the approach,
-  so that the transport is carried by the grip midpoint.
+* **the wrist**: a point :data:`WRIST_BEHIND` behind the grip midpoint
+  along the approach, the models' own hand (a lab's wrist or hand markers
+  carry the transport landmarks, in 3D, not the models' tracks).
 * **the object**: the mean of its markers, a given position, or else where
   the grip midpoint comes to rest at the reach's end (where the hand closes
   on it); its size as given, or else the aperture there less the aperture
@@ -38,6 +39,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 
@@ -55,6 +57,10 @@ PX_PER_M = 1000.0
 WRIST_BEHIND = 0.06
 #: Least stillness before a reach's onset the recognition needs, s.
 MIN_REST = 0.3
+#: With object markers, a movement is a reach when the hand ends at least this share
+#: of its starting distance nearer the object (a marker set on the back of the hand
+#: stops well short of the object's centre).
+APPROACH = 0.4
 _ORIGIN_PX = np.array([2000.0, 2000.0])
 
 
@@ -200,7 +206,13 @@ def _mean_marker(markers, names, time, params, notes) -> np.ndarray | None:
         if (line := rep.describe(m)) is not None:
             notes.append(line)
         paths.append(p)
-    return np.nanmean(np.stack(paths), axis=0) if len(paths) > 1 else paths[0]
+    if len(paths) == 1:
+        return paths[0]
+    stack = np.stack(paths)
+    seen = np.isfinite(stack)
+    n = seen.sum(axis=0)
+    # the mean of the markers seen; NaN where none is (without numpy's empty-slice warning)
+    return np.where(n > 0, np.where(seen, stack, 0.0).sum(axis=0) / np.maximum(n, 1), np.nan)
 
 
 def find_reaches(time: np.ndarray, transport: np.ndarray, aperture: np.ndarray,
@@ -248,9 +260,9 @@ def find_reaches(time: np.ndarray, transport: np.ndarray, aperture: np.ndarray,
             continue
         g = aperture[onset:end + 1]
         if object_path is not None and np.isfinite(object_path[[onset, end]]).all():
-            near = (np.linalg.norm(transport[end] - object_path[end])
-                    < 0.5 * np.linalg.norm(transport[onset] - object_path[onset]))
-            if not near:
+            d0 = np.linalg.norm(transport[onset] - object_path[onset])
+            d1 = np.linalg.norm(transport[end] - object_path[end])
+            if not d0 - d1 >= APPROACH * d0:
                 continue
         elif not (np.isfinite(g).any() and np.isfinite(g[0])
                   and np.nanmax(g) - g[0] >= params.min_opening):
@@ -286,7 +298,7 @@ def recording_reaches(trial, markers: MarkerMap | None = None,
     wrist = _mean_marker(trial.markers, markers.wrist, time, params, notes)
     obj = _mean_marker(trial.markers, markers.object, time, params, notes)
     mid = 0.5 * (finger + thumb)
-    transport = mid if wrist is None else np.where(np.isfinite(mid), mid, wrist)
+    transport = mid if wrist is None else wrist  # the field's transport marker
     aperture = np.linalg.norm(finger - thumb, axis=1)
     spans = find_reaches(time, transport, aperture, params, obj)
     if not spans:
@@ -368,15 +380,37 @@ def fit_plane(reach: Reach, origin: np.ndarray) -> PlaneFit:
                     float(np.abs(off).max()))
 
 
-def reach_tracks(reach: Reach, params: ReachParams | None = None) -> tuple[Tracks, dict]:
+class ReachTracks(NamedTuple):
+    """A reach as the recognition reads it (:func:`reach_tracks`).
+
+    Attributes
+    ----------
+    tracks : Tracks
+        Markers thumb, finger, wrist and object in the movement's plane, 1 px
+        = 1 mm, y down; the object's apparent diameter in the tracker attributes.
+    info : dict
+        What the report says of it: ``plane`` (normal, out-of-plane RMS and
+        largest, m), ``object_size`` (m), ``rest_aperture`` (m), ``notes``.
+    transport, aperture : (T, 3) and (T,) arrays
+        The 3D transport point and aperture, m, row for row with ``tracks``:
+        the landmarks are measured on these, not on their projection.
+    """
+
+    tracks: Tracks
+    info: dict
+    transport: np.ndarray
+    aperture: np.ndarray
+
+
+def reach_tracks(reach: Reach, params: ReachParams | None = None) -> ReachTracks:
     """A reach as tracks in its plane (1 px = 1 mm), and what the report says of it.
 
-    Returns
-    -------
-    Tracks, dict
-        The tracks (markers thumb, finger, wrist, object; the object's
-        apparent diameter in the tracker attributes) and ``plane`` (normal,
-        out-of-plane RMS and largest, m), ``object_size`` (m), ``notes``.
+    Parameters
+    ----------
+    reach : Reach
+        From :func:`recording_reaches`.
+    params : ReachParams, optional
+        Its ``object_size``, if given, is the object's.
     """
     params = ReachParams() if params is None else params
     notes = list(reach.notes)
@@ -388,26 +422,30 @@ def reach_tracks(reach: Reach, params: ReachParams | None = None) -> tuple[Track
         origin = reach.transport[seen_end[-1]]
         notes.append("object: where the grip closes (the reach's end)")
     plane = fit_plane(reach, origin)
-    mid = plane.project(reach.transport)
-    rest_g = float(np.nanmedian(g[max(0, reach.onset - 5):reach.onset + 1]))
+    mid = plane.project(0.5 * (reach.finger + reach.thumb))
+    near_onset = g[max(0, reach.onset - 5):reach.onset + 1]
+    near_onset = near_onset[np.isfinite(near_onset)]
+    rest_g = float(np.median(near_onset)) if len(near_onset) else 0.0
     if params.object_size is not None:
         size = float(params.object_size)
     else:
-        size = float(np.nanmedian(g[max(0, reach.end - 2):reach.end + 1])) - rest_g
+        at_end = g[max(0, reach.end - 2):reach.end + 1]
+        at_end = at_end[np.isfinite(at_end)]
+        size = (float(np.median(at_end)) if len(at_end) else math.nan) - rest_g
         notes.append(f"object size: the grip's opening at the reach's end, "
                      f"{size * 1000:.0f} mm")
     if not size > 0.005:
         size = 0.005
-    if reach.wrist is not None:
-        wrist = plane.project(reach.wrist)
-    else:
-        wrist = mid - np.array([0.0, WRIST_BEHIND])
+    # the models' hand: a wrist behind the grip, whatever markers the lab put on it
+    # (a marker on the back of the hand projects anywhere near the grip)
+    wrist = mid - np.array([0.0, WRIST_BEHIND])
     across = np.array([1.0, 0.0])
     finger = mid + 0.5 * g[:, None] * across
     thumb = mid - 0.5 * g[:, None] * across
     obj = np.zeros_like(mid)
     time = reach.time.copy()
     pos = np.stack([thumb, finger, wrist, obj], axis=1)
+    solid = np.concatenate([reach.transport, g[:, None]], axis=1)
     dt = float(np.median(np.diff(time)))
     # rest the recognition can read: stillness before the onset, first clean sample held
     first = int(np.argmax(np.isfinite(pos[:, :3]).all(axis=(1, 2))))
@@ -418,8 +456,9 @@ def reach_tracks(reach: Reach, params: ReachParams | None = None) -> tuple[Track
                      f"{n * dt * 1000:.0f} ms of its first clean sample added")
         time = np.r_[time[first] - dt * np.arange(n, 0, -1), time[first:]]
         pos = np.concatenate([np.repeat(pos[first:first + 1], n, axis=0), pos[first:]])
+        solid = np.concatenate([np.repeat(solid[first:first + 1], n, axis=0), solid[first:]])
     elif first:
-        time, pos = time[first:], pos[first:]
+        time, pos, solid = time[first:], pos[first:], solid[first:]
     px = _ORIGIN_PX + PX_PER_M * pos * np.array([1.0, -1.0])
     lost = ~np.isfinite(px).all(axis=-1)
     status = np.where(lost, Status.LOST, Status.TRACKED).astype(np.int8)
@@ -430,8 +469,9 @@ def reach_tracks(reach: Reach, params: ReachParams | None = None) -> tuple[Track
                     video={"path": reach.source, "fps_nominal": 1 / dt},
                     tracker={"diameter_px": diameter, "source": "mocap"},
                     attrs={"clip": reach.name})
-    return tracks, {"plane": plane.to_dict(), "object_size": size, "notes": notes,
-                    "rest_aperture": rest_g}
+    info = {"plane": plane.to_dict(), "object_size": size, "notes": notes,
+            "rest_aperture": rest_g}
+    return ReachTracks(tracks, info, solid[:, :3], solid[:, 3])
 
 
-__all__ += ["PlaneFit", "Repairs", "fit_plane"]
+__all__ += ["PlaneFit", "ReachTracks", "Repairs", "fit_plane"]

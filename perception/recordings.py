@@ -14,13 +14,17 @@ docs/mocap.md describes the formats, the mapping and what is reported.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from perception.errors import InputError
+from perception.landmarks import movement_landmarks
 from perception.reaches import PX_PER_M, MarkerMap, Reach, ReachParams, reach_tracks
 
-__all__ = ["MocapImport", "read_reaches", "recognize_reach"]
+__all__ = ["MocapImport", "cached_reaches", "read_reaches", "recognize_reach"]
 
 
 @dataclass(frozen=True)
@@ -88,6 +92,31 @@ def read_reaches(path, options: MocapImport | None = None) -> list[Reach]:
     return out
 
 
+@functools.lru_cache(maxsize=4)
+def _cached(key: tuple, options: MocapImport) -> tuple[Reach, ...]:
+    """The reaches of ``key[0]``; its size and time of change, the rest of ``key``, keep a
+    changed file from being answered from the cache."""
+    return tuple(read_reaches(key[0], options))
+
+
+def cached_reaches(path, options: MocapImport | None = None) -> tuple[Reach, ...]:
+    """:func:`read_reaches`, read once per process while the file is unchanged.
+
+    A batch scores a recording's reaches one by one, perhaps in several
+    processes: each reads the file once, not once per reach.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The recording.
+    options : MocapImport, optional
+    """
+    import os
+
+    st = os.stat(path)
+    return _cached((str(path), st.st_size, st.st_mtime_ns), options or MocapImport())
+
+
 def recognize_reach(reach: Reach, repertoire, settings=None,
                     options: MocapImport | None = None, plan_cache=None):
     """Score one reach: its tracks in the movement's plane, recognised as a clip's.
@@ -112,22 +141,27 @@ def recognize_reach(reach: Reach, repertoire, settings=None,
 
     options = MocapImport() if options is None else options
     settings = RecognitionSettings() if settings is None else settings
-    tracks, info = reach_tracks(reach, options.reaches)
+    tracks, info, transport, aperture = reach_tracks(reach, options.reaches)
     observe = dataclasses.replace(
         settings.observe, px_per_m=PX_PER_M, object_diameter=info["object_size"],
         # a whole-hand grasp may rest with the digits apart: the rest
         # aperture is taken off like the markers' separation at rest
         max_rest_aperture=max(settings.observe.max_rest_aperture,
-                              info["rest_aperture"] + 0.01))
+                              float(np.max(aperture[:2 * settings.observe.rest_frames],
+                                           initial=0.0, where=np.isfinite(
+                                               aperture[:2 * settings.observe.rest_frames])))
+                              + 0.01))
     rec = recognize_tracks(tracks, repertoire, dataclasses.replace(settings, observe=observe),
                            clip=reach.name, source=reach.source, plan_cache=plan_cache)
+    # the landmarks from the 3D speed and aperture, on the observation's clock
+    clock = rec.observation.clip_time
+    rec = dataclasses.replace(rec, measured=movement_landmarks(clock, transport, aperture,
+                                                               options.reaches.landmarks))
     info = {**info, "trial": reach.name, "source": reach.source,
             "rate": round(1 / float(_median_step(reach.time)), 3)}
     return rec, info
 
 
 def _median_step(time) -> float:
-    import numpy as np
-
     step = float(np.median(np.diff(time)))
     return step if math.isfinite(step) and step > 0 else 1.0

@@ -104,7 +104,7 @@ def test_long_clip_names_fit_every_output_and_temporary_name(tracks, rep, tmp_pa
     paths = _report(rec, tmp_path, tracks)
     for path in paths.values():
         assert path.is_file() and len(os.fsencode(path.name)) <= NAME_MAX
-    assert len(renames) == 4
+    assert len(renames) == 5  # JSON, CSV and three figures
     for tmp, final in renames:
         assert len(os.fsencode(final)) <= NAME_MAX
         assert len(os.fsencode(tmp)) <= len(os.fsencode(final)), (tmp, final)

@@ -20,6 +20,7 @@ from scipy.special import beta as beta_fn
 from perception.batch import ClipResult, summary_table
 from perception.landmarks import (
     DETAILS,
+    LATE_OPENING,
     Landmarks,
     count_peaks,
     movement_landmarks,
@@ -68,41 +69,43 @@ def test_peaks_count_by_prominence_not_by_the_aperture_at_contact():
 @pytest.mark.parametrize("condition", ["normal", "delayed", "open-close-open"])
 @pytest.mark.parametrize("seed", [0, 2])
 def test_landmarks_recover_the_independent_generators_kinematics(condition, seed):
-    # a 3 cm object: the late grips open before the digits reach it, so the hand
-    # never waits and the generator's parameters are the movement's true kinematics
+    # the truth: the field's definitions applied to the generator's own noise-free
+    # marker paths; the tracked clip (0.4 px of noise at 30 frames/s) must agree
     p = IndependentParams(condition=condition, object_size=0.03)
-    obs = observe(independent_tracks(p, seed)[0], ObserveParams(object_diameter=p.object_size))
-    got = observed_landmarks(obs)
-    T = got.movement_time
-    # the movement span ends when no marker moves faster than the tracking noise allows
-    # (about 0.09 m/s here): a slow final approach is cut short, a late closing is not
-    assert -0.25 < T - p.duration < 0.1
-    if condition != "normal":
-        assert abs(T - p.duration) < 0.1
-    # the landmarks' times, s since onset, within 0.05 / 0.06 of the 1 s movement
-    assert got.mga_time * T == pytest.approx(_mga_time(p) * p.duration, abs=0.05)
-    assert got.peak_speed_time * T == pytest.approx(p.peak_velocity_time * p.duration,
-                                                    abs=0.06)
-    # as fractions of the measured movement time: off by as much as its end
-    assert got.mga_time == pytest.approx(_mga_time(p), abs=0.1)
-    assert got.mga == pytest.approx(p.mga, abs=0.004)
+    tracks, truth = independent_tracks(p, seed)
+    got = observed_landmarks(observe(tracks, ObserveParams(object_diameter=p.object_size)))
+    w = truth["world"]
+    want = movement_landmarks(tracks.time, w["wrist"],
+                              np.linalg.norm(w["finger"] - w["thumb"], axis=1))
+    assert got.movement_time == pytest.approx(want.movement_time, abs=0.05)
+    # the 5 % bounds cut the bell profile's tails: shorter than the generator's duration
+    assert 0.75 * p.duration < got.movement_time < p.duration
+    for share in ("mga_time", "peak_speed_time", "opening_time"):
+        assert getattr(got, share) == pytest.approx(getattr(want, share), abs=0.06), share
+    assert got.mga == pytest.approx(want.mga, abs=0.002)
+    assert got.peak_speed == pytest.approx(want.peak_speed, rel=0.05)
     assert got.peak_speed == pytest.approx(_peak_speed(p), rel=0.12)
-    assert got.rest_aperture == pytest.approx(0.0, abs=0.003)
-    assert got.contact_aperture == pytest.approx(p.object_size, abs=0.012)
+    # the generator's MGA, s after its own onset, where the landmarks put it
+    assert want.onset_time + want.mga_seconds == pytest.approx(
+        p.rest_before + _mga_time(p) * p.duration, abs=0.06)
     assert got.aperture_peaks == (2 if condition == "open-close-open" else 1)
+    assert 0 <= got.opening_time <= 1 and 0 <= got.mga_time <= 1
     if condition == "delayed":
-        assert got.opening_time > 0.45
+        assert got.opening_time > LATE_OPENING
     else:
         assert got.opening_time < 0.3
 
 
 def test_a_grip_opening_too_late_for_the_object_makes_the_hand_wait():
     """A 10 cm ball: the delayed grip is still closed as the digits reach it, so the
-    hand holds back at its surface and the movement lasts longer than planned."""
+    hand holds back at its surface and the movement lasts longer than a normal one."""
     p = IndependentParams(condition="delayed", object_size=0.1)
     got = observed_landmarks(observe(independent_tracks(p, 0)[0]))
-    assert got.movement_time > p.duration + 0.2
-    assert got.mga == pytest.approx(p.mga, abs=0.004)
+    normal = observed_landmarks(observe(independent_tracks(
+        IndependentParams(condition="normal", object_size=0.1), 0)[0]))
+    assert got.movement_time > normal.movement_time + 0.05
+    # the raw tip-to-tip maximum: the markers sit 6.5 mm outside each tip
+    assert got.mga == pytest.approx(p.mga + 2 * p.marker_offset, abs=0.004)
 
 
 def test_the_models_own_movement_matches_the_reference_models_own_landmarks():
@@ -110,12 +113,16 @@ def test_the_models_own_movement_matches_the_reference_models_own_landmarks():
     rec = recognize_clip(demo_tracks("normal", 0)[0], rep, clip="n")
     assert rec.reference_model == "grasp-1.0s"
     observed, reference = rec.landmarks
-    assert reference.movement_time == 1.0  # the planned movement time
+    # the 5 % bounds leave out the planned movement's slowest start and end
+    assert 0.8 < reference.movement_time < 1.0
     assert observed.movement_time == pytest.approx(reference.movement_time, abs=0.1)
-    assert observed.mga == pytest.approx(reference.mga, abs=0.004)
+    # the raw MGA holds the markers' separation at rest; the opening does not
+    assert observed.opening == pytest.approx(reference.opening, abs=0.004)
     assert observed.mga_time == pytest.approx(reference.mga_time, abs=0.06)
     assert observed.peak_speed == pytest.approx(reference.peak_speed, rel=0.1)
-    assert observed.peak_speed_time == pytest.approx(reference.peak_speed_time, abs=0.08)
+    # the model's speed is flat within 3 % of its peak for 0.1 s (3 frames at 30 frames/s):
+    # the tracked clip's maximum may fall anywhere on that top
+    assert observed.peak_speed_time == pytest.approx(reference.peak_speed_time, abs=0.1)
     assert observed.aperture_peaks == reference.aperture_peaks == 1
     assert rec.verdict == "normal" and rec.verdict_detail is None
 
@@ -134,10 +141,11 @@ def test_the_detail_rule_in_the_fields_terms():
     assert verdict_detail(_lm(mga=0.03), ref) == "no-opening"  # 25 % of the reference's
     assert verdict_detail(_lm(mga=0.03, aperture_peaks=2), ref) == "no-opening"
     assert verdict_detail(_lm(aperture_peaks=2), ref) == "re-opening"
-    assert verdict_detail(_lm(opening_time=0.5), ref) == "delayed-opening"
-    assert verdict_detail(_lm(mga_time=0.9), ref) == "delayed-opening"
+    assert verdict_detail(_lm(opening_time=0.6), ref) == "delayed-opening"
+    assert verdict_detail(_lm(opening_time=0.5), ref) == "other"   # real grips open so late
+    assert verdict_detail(_lm(mga_time=0.97), ref) == "delayed-opening"
     # a late MGA is no delay when the reference's own is as late
-    assert verdict_detail(_lm(mga_time=0.9), _lm(mga_time=0.9)) == "other"
+    assert verdict_detail(_lm(mga_time=0.97), _lm(mga_time=0.97)) == "other"
     # scale-free: the same grasp at twice the size
     big = _lm(mga=0.06, rest_aperture=0.0)
     assert verdict_detail(big, _lm(mga=0.24)) == "no-opening"
@@ -170,14 +178,14 @@ def test_landmarks_survive_missing_markers():
     wrist = np.c_[np.zeros(31), np.linspace(-0.2, 0, 31)]
     empty = movement_landmarks(t, wrist, np.full(31, np.nan))
     assert math.isnan(empty.mga) and empty.aperture_peaks is None
-    assert empty.peak_speed == pytest.approx(0.2)
+    assert empty.peak_speed == pytest.approx(0.2, rel=1e-3)
     lost = movement_landmarks(t, np.full((31, 2), np.nan), np.full(31, np.nan))
-    assert math.isnan(lost.peak_speed) and lost.movement_time == 1.0
-    # the finger lost for 0.2 s in mid-movement: a dip could hide there, so no peak count
-    tracks, _ = demo_tracks("normal", 0, lost={"finger": slice(20, 26)})
+    assert math.isnan(lost.peak_speed) and math.isnan(lost.movement_time)
+    # the finger lost for 0.3 s in mid-movement: a dip could hide there, so no peak count
+    tracks, _ = demo_tracks("normal", 0, lost={"finger": slice(20, 29)})
     got = observed_landmarks(observe(tracks))
     assert got.aperture_peaks is None
-    assert got.mga == pytest.approx(0.119, abs=0.01) and math.isfinite(got.peak_speed)
+    assert got.opening == pytest.approx(0.119, abs=0.01) and math.isfinite(got.peak_speed)
     d = json.loads(json.dumps(got.to_dict()))
     assert d["aperture_peaks"] is None and Landmarks.from_dict(d).mga == pytest.approx(got.mga)
 

@@ -3,8 +3,9 @@
 Each ```sh block of README.md (but the first: ``make demo`` and ``make
 test`` build this very environment) runs under ``bash -e`` with
 ``hammer-mv`` on PATH, in one scratch folder that holds the shipped
-``datasets/``: the pipeline block renders the clips the later blocks track,
-export and score, so a renamed flag or a changed output name fails here.
+``datasets/`` and ``tests/`` (its real recordings): the pipeline block
+renders the clips the later blocks track, export and score, so a renamed
+flag or a changed output name fails here.
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ def _blocks() -> list[tuple[int, str]]:
 def workdir(tmp_path_factory):
     d = tmp_path_factory.mktemp("readme")
     (d / "datasets").symlink_to(ROOT / "datasets")
+    (d / "tests").symlink_to(ROOT / "tests")  # the trimmed real recordings of tests/data
     bin_dir = d / "bin"
     bin_dir.mkdir()
     shim = bin_dir / "hammer-mv"

@@ -31,14 +31,16 @@ def test_start_up_imports_nothing_heavy(args):
     assert not _imported(*args) & heavy
 
 
-def test_recognize_imports_no_pandas_scipy_or_dask(tmp_path):
+def test_recognize_imports_no_pandas_matplotlib_or_dask(tmp_path):
     from perception.synthetic.demos import demo_tracks
 
     tracks = demo_tracks("normal", 0)[0].save(tmp_path / "c.tracks.h5")
     loaded = _imported("recognize", str(tracks), "-o", str(tmp_path / "out"), "--quiet",
                        "--no-figures")
     assert (tmp_path / "out" / "c.confidence.csv").exists()  # the command did run
-    assert not loaded & {"pandas", "scipy", "matplotlib", "dask"}
+    # scipy.signal filters the landmarks as the field does (a zero-lag Butterworth);
+    # pandas, matplotlib and dask stay out of a recognition without figures
+    assert not loaded & {"pandas", "matplotlib", "dask"}
 
 
 def test_command_list_matches_the_command_modules():

@@ -171,7 +171,10 @@ def test_abnormal_grasps_are_abnormal_even_when_a_reach_model_wins():
         rec = recognize_clip(_tracks("independent", "open-close-open", i), rep)
         if rec.kinds[rec.names.index(rec.winner)] == "reach":
             seen += 1
-            assert rec.verdict == "abnormal" and rec.decision.familiarity < DEFAULT_THRESHOLD
+            # abnormal for its second opening whatever the familiarity: the calibration
+            # now covers real grasps' early speed peaks, so the fit alone is less sure
+            assert rec.verdict == "abnormal" and rec.verdict_detail == "re-opening"
+            assert rec.decision.familiarity < 0.5
     assert seen >= 2  # the case arises
 
 

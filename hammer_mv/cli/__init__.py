@@ -40,6 +40,7 @@ COMMANDS = {
     "tracks": "inspect or export a tracks file",
     "repertoire": "build or inspect a model repertoire",
     "recognize": "recognise the grasp in one video or tracks file",
+    "landmarks": "measure reach-to-grasp landmarks, no models (CSV)",
     "batch": "recognise a folder of clips (or a synth manifest)",
     "watch": "recognise a movement while it is filmed (camera, file, stream)",
 }

@@ -219,9 +219,13 @@ def recognition_settings(args: argparse.Namespace) -> RecognitionSettings:
         from perception.tracking.setup import load_setup
 
         tracking = load_setup(args.setup)
+    mocap = None
+    if any(getattr(args, k, None) is not None for k in ("markers", "rate", "units",
+                                                        "trial_column", "object_size")):
+        mocap = mocap_import(args)
     return RecognitionSettings(observe=observe, hammer=hammer, tracking=tracking,
                                pose=pose_import(args), keep_truncated=args.keep_truncated,
-                               fps=args.fps)
+                               fps=args.fps, mocap=mocap)
 
 
 def load_repertoire(args: argparse.Namespace) -> tuple[Repertoire, str]:

@@ -19,8 +19,8 @@ def register(sub) -> None:
     """
     p = sub.add_parser("recognize", help="recognise the grasp in one video or tracks file",
                        description="Track INPUT (a video), load it (a .tracks.h5) or read it "
-                       "(a DeepLabCut, SLEAP, Lightning Pose or movement pose file, or a motion-capture "
-                       "recording: every reach in it), score it "
+                       "(a DeepLabCut, SLEAP, Lightning Pose or movement pose file, or a "
+                       "motion-capture recording: every reach in it), score it "
                        "against every model with HAMMER-MV and write DIR/<clip>.recognition.json, "
                        "a per-step CSV and figures. A current tracks file of the video (in "
                        "DIR/tracks/ or beside the video) is reused instead of tracking again.")
@@ -108,11 +108,11 @@ def _run_mocap(args: argparse.Namespace, path: Path) -> int:
     from perception.report.clip import write_clip_report
 
     settings = recognition_settings(args)
-    options = mocap_import(args)
+    options = settings.mocap or mocap_import(args)
     reaches = read_reaches(path, options)
     rep, rep_id = load_repertoire(args)
-    fingerprint = clip_fingerprint(path, settings, rep_id + repr(options.to_dict()))
-    for reach in reaches:
+    for k, reach in enumerate(reaches):
+        fingerprint = clip_fingerprint(path, settings, f"{rep_id}#reach{k}")
         rec, info = recognize_reach(reach, rep, settings, options)
         extra = {"fingerprint": fingerprint, "condition": None, "input": str(path),
                  "mocap": info}
@@ -120,7 +120,9 @@ def _run_mocap(args: argparse.Namespace, path: Path) -> int:
         for warning in rec.warnings:
             print(f"{reach.name}: warning: {warning}", file=sys.stderr)
         if not args.quiet:
-            detail = f" ({rec.verdict_detail})" if rec.verdict_detail else ""
+            why = rec.verdict_detail or (rec.verdict_reason if rec.verdict == "unfamiliar"
+                                         else None)
+            detail = f" ({why})" if why else ""
             print(f"{reach.name}: {rec.verdict or 'no verdict'}{detail}, winner {rec.winner} "
                   f"-> {paths['json']}")
     return 0

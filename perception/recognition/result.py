@@ -41,6 +41,8 @@ __all__ = ["Recognition"]
 #: validated on: the synthetic populations' 0.45-1.2 s grasps and a lab's real
 #: Optotrak grasps (1.05-2.06 s).
 VALIDATED_MOVEMENT_TIME = (0.4, 2.1)
+#: The widest digit separation at rest, m, of the grasps it was validated on.
+VALIDATED_REST_APERTURE = 0.04
 #: The reach distances (wrist at rest to the object's centre, m) it was validated on.
 VALIDATED_DISTANCE = (0.1, 0.7)
 
@@ -95,6 +97,10 @@ class Recognition:
     mirrored : bool
         The scene was found mirrored (the finger opening on the model's -x
         side) and its mirror image was scored: the opposite of ``--mirror``.
+    measured : Landmarks, optional
+        The demonstration's landmarks measured on better data than the
+        observation holds (a 3D recording's own speed and aperture, on the
+        observation's clock); otherwise they are measured on the observation.
     """
 
     clip: str
@@ -119,6 +125,7 @@ class Recognition:
     transport_familiarity: float = float("nan")
     unfamiliar_threshold: float = UNFAMILIAR_THRESHOLD
     mirrored: bool = False
+    measured: Landmarks | None = field(default=None, repr=False)
 
     def score(self, rule: str | None = None) -> np.ndarray:
         """(M, N) cumulative score under ``rule`` (default: the winner's rule)."""
@@ -155,7 +162,9 @@ class Recognition:
         opening late, or re-opening) is ``abnormal`` even when the models find
         it familiar, or find its transport like no reach of theirs (a hand
         that waits at the object for a late grip); otherwise ``unfamiliar``
-        when even its transport is no human reach, or when it would be
+        when even its transport is no human reach, or the digits start more
+        than :data:`VALIDATED_REST_APERTURE` apart (a whole-hand grasp, which
+        the verdict was not made for), or when it would be
         ``normal`` but a digit was lost for longer than
         :data:`~perception.landmarks.MAX_GAP` during the movement (the gap
         may hide a second opening, and the models' filters coast over it as
@@ -163,6 +172,8 @@ class Recognition:
         """
         if self.shape is not None:
             d = self.shape.decision
+            if d.verdict is not None and self._whole_hand:
+                return Verdict("unfamiliar", d.best, d.familiarity, d.margin)
             if d.verdict in ("normal", "abnormal") and grip_departs(self.landmarks[0]):
                 return Verdict("abnormal", d.best, d.familiarity, d.margin)
             if d.verdict is not None and self.transport_familiarity < self.unfamiliar_threshold:
@@ -189,6 +200,10 @@ class Recognition:
         """
         v = self.verdict
         if v == "unfamiliar":
+            if self._whole_hand:
+                return (f"not a precision grip: the digits start "
+                        f"{self.observation.marker_separation * 100:.0f} cm apart (the "
+                        "verdict knows grasps whose digits start closed)")
             if self.transport_familiarity < self.unfamiliar_threshold:
                 return (f"not a human reach: its transport fits the reach models worse than "
                         f"{1 - self.unfamiliar_threshold:.0%} of their own reaches")
@@ -198,6 +213,11 @@ class Recognition:
                 return "the grip opens late or twice (the field's landmarks)"
             return "no model explains the movement as well as 95 % of its own movements"
         return None
+
+    @property
+    def _whole_hand(self) -> bool:
+        """The digits start apart, as in a whole-hand grasp: out of the verdict's depth."""
+        return self.observation.marker_separation > VALIDATED_REST_APERTURE
 
     def _longest_loss(self) -> str:
         """The digit lost longest during the movement, for how long and where."""
@@ -209,7 +229,9 @@ class Recognition:
                 continue
             gap = longest_gap(obs.time, values[:, 0])
             seen = obs.time[np.isfinite(values[:, 0])]
-            if gap > worst[0] and len(seen):
+            if gap == worst[0] and worst[1]:
+                worst = (gap, "digits", worst[2])
+            elif gap > worst[0] and len(seen):
                 steps = np.diff(np.r_[obs.time[0], seen, obs.time[-1]])
                 k = int(np.argmax(steps))
                 start = float(np.r_[obs.time[0], seen][k])
@@ -222,7 +244,8 @@ class Recognition:
             a = (start - lm.onset_time) / lm.movement_time
             b = (start + gap - lm.onset_time) / lm.movement_time
             where = f" at {max(a, 0):.0%}-{min(b, 1):.0%} of the movement"
-        return f"the {name} lost {gap:.2f} s{where} (a gap over {MAX_GAP:.2f} s may hide a " \
+        lost = "the digits were" if name == "digits" else f"the {name} was"
+        return f"{lost} lost {gap:.2f} s{where} (a gap over {MAX_GAP:.2f} s may hide a " \
                "second opening)"
 
     @property
@@ -304,7 +327,9 @@ class Recognition:
     def landmarks(self) -> tuple[Landmarks, Landmarks | None]:
         """The demonstration's landmarks and the reference grasp model's own (None without one)."""
         ref = self.reference_model
-        return (observed_landmarks(self.observation),
+        observed = self.measured if self.measured is not None else observed_landmarks(
+            self.observation)
+        return (observed,
                 self.own_landmarks(ref) if ref is not None else None)
 
     @property
@@ -374,8 +399,10 @@ class Recognition:
             (:func:`~perception.report.figures.paths_figure`, ``<clip>.paths.png``).
         """
         from perception.report.figures import confidence_figure, paths_figure
+        from perception.report.kinematics import kinematics_figure
 
-        figures = {"confidence": confidence_figure, "paths": paths_figure}
+        figures = {"confidence": confidence_figure, "paths": paths_figure,
+                   "kinematics": kinematics_figure}
         if kind not in figures:
             raise ValueError(f"Recognition.plot: kind must be one of {sorted(figures)}, "
                              f"not {kind!r}")

@@ -17,3 +17,4 @@ from .figures import confidence_all_figure as confidence_all_figure
 from .figures import confidence_figure as confidence_figure
 from .figures import confidence_single_figure as confidence_single_figure
 from .figures import paths_figure as paths_figure
+from .kinematics import kinematics_figure as kinematics_figure

@@ -69,6 +69,7 @@ table.t td,table.t th{padding:3px 9px;border-bottom:1px solid #ddd;text-align:le
 table.t td.n,table.t th.n{text-align:right}
 .scroll{max-width:100%;overflow-x:auto}
 figure{margin:0} figure img,.clip img{width:100%;height:auto;border:1px solid #eee}
+.clip img.thumb{width:480px;max-width:100%}
 .grid{display:grid;grid-template-columns:1fr 1fr;gap:14px} .grid figure.wide{grid-column:1/-1}
 figcaption,.note{font-size:90%;color:#555}
 .v-normal{color:#1b6e20;font-weight:bold} .v-reach{color:#1f4e99;font-weight:bold}
@@ -220,8 +221,11 @@ def _clip_section(rec: ClipSummary, out: Path, anchor: str, condition,
             f" (familiarity {_num(rec.familiarity, '.2f')}, margin {_num(rec.margin, '.1f')})"
             f"; winner {_e(rec.winner)} ({_e(rec.rule)} rule); condition "
             f"{_e(condition) or 'unlabelled'}; files: {links}")
+    # each figure links to itself at full size; the kinematics one shows as a thumbnail
+    thumb = files["kinematics_png"].name
     figs = "".join(f'<a href="{html.escape(quote(p.name), quote=True)}">'
-                   f'<img src="{html.escape(quote(p.name), quote=True)}" loading="lazy" '
+                   f'<img{" class=thumb" if p.name == thumb else ""} '
+                   f'src="{html.escape(quote(p.name), quote=True)}" loading="lazy" '
                    f'alt="{_e(p.name)}"></a>' for p in clip_figures(out, rec.clip, names))
     return f'<div class="clip"><h3 id="{anchor}">{_e(rec.clip)}</h3><p>{line}</p>{figs}</div>'
 

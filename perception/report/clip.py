@@ -1,4 +1,4 @@
-"""One clip's report: ``<clip>.recognition.json``, the per-step CSV and two figures.
+"""One clip's report: ``<clip>.recognition.json``, the per-step CSV and three figures.
 
 :class:`ClipSummary` is what a batch keeps of a scored clip: built from the
 :class:`~perception.recognition.result.Recognition` in memory for a clip
@@ -30,12 +30,16 @@ __all__ = ["KINEMATICS_COLUMNS", "ClipSummary", "clip_figures", "clip_outputs", 
 RECOGNITION_KEYS = frozenset({
     "clip", "models", "winner", "rule", "verdict", "familiarity", "margin",
     "familiarity_threshold", "reference_model", "time", "confidence", "transport_confidence",
-    "aperture", "verdict_detail", "kinematics", "shape", "mirrored"})
+    "aperture", "verdict_detail", "verdict_reason", "warnings", "kinematics", "shape",
+    "mirrored"})
 
 #: The observed landmarks a batch's ``summary.csv`` shows, one column each
 #: (:attr:`ClipSummary.kinematics`; units in docs/recognition.md §9).
 KINEMATICS_COLUMNS = ("movement_time", "peak_speed", "peak_speed_time", "mga", "mga_time",
                       "aperture_peaks")
+
+#: The clip's own figures (keys of :func:`clip_outputs`), in the order a report shows them.
+FIGURE_KEYS = ("confidence_png", "paths_png", "kinematics_png")
 
 
 def _floats(values, n: int | None = None) -> np.ndarray:
@@ -222,11 +226,12 @@ def clip_outputs(out: Path, clip: str) -> dict[str, Path]:
         "csv": out / f"{stem}.confidence.csv",
         "confidence_png": out / f"{stem}.confidence.png",
         "paths_png": out / f"{stem}.paths.png",
+        "kinematics_png": out / f"{stem}.kinematics.png",
     }
 
 
 def clip_figures(out: Path, clip: str, names: Sequence[str] | None = None) -> list[Path]:
-    """Every figure of ``clip`` in ``out``: its two own, then any other ``<clip>.<name>.png``.
+    """Every figure of ``clip`` in ``out``: its three own, then any other ``<clip>.<name>.png``.
 
     A figure another step adds beside the clip's report (one ``<name>``, no
     dots) is shown with the clip in ``report.html``.
@@ -243,7 +248,7 @@ def clip_figures(out: Path, clip: str, names: Sequence[str] | None = None) -> li
     """
     if names is None:
         names = sorted(os.listdir(out)) if out.is_dir() else []
-    own = [clip_outputs(out, clip)[k].name for k in ("confidence_png", "paths_png")]
+    own = [clip_outputs(out, clip)[k].name for k in FIGURE_KEYS]
     prefix = f"{output_stem(clip)}."
     mine = []
     # the names starting with the prefix are one run of the sorted list
@@ -281,7 +286,7 @@ def remove_output(path: Path) -> None:
 
 def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,
                       figures: bool = True) -> dict[str, Path]:
-    """Write ``<clip>.recognition.json``, the per-step CSV and the two figures.
+    """Write ``<clip>.recognition.json``, the per-step CSV and the three figures.
 
     Parameters
     ----------
@@ -293,8 +298,10 @@ def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,
         More keys for the JSON (e.g. the batch's input fingerprint).
     figures : bool
         Draw the figures (matplotlib, imported here: see
-        :mod:`perception.report.figures`); without them, figures of an earlier
-        run are removed, since they would show another result.
+        :mod:`perception.report.figures`): the confidence, the paths and the
+        kinematics (:func:`~perception.report.kinematics.kinematics_figure`);
+        without them, figures of an earlier run are removed, since they would
+        show another result.
 
     Returns
     -------
@@ -304,12 +311,14 @@ def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,
     paths = clip_outputs(Path(out), rec.clip)
     if figures:
         from perception.report.figures import confidence_figure, paths_figure
+        from perception.report.kinematics import kinematics_figure
 
         save_figure(paths["confidence_png"], confidence_figure(rec))
         save_figure(paths["paths_png"], paths_figure(rec))
+        save_figure(paths["kinematics_png"], kinematics_figure(rec))
     else:
-        remove_output(paths["confidence_png"])
-        remove_output(paths["paths_png"])
+        for key in FIGURE_KEYS:
+            remove_output(paths[key])
     write_csv(paths["csv"], rec.columns())
     # the JSON last: its presence marks the clip's report complete
     write_json(paths["json"], {**rec.to_dict(), **(extra or {})})

@@ -13,10 +13,14 @@ the peak transport speed), with ``s`` the share of that movement:
   opening, from the moment it began to the end, is replayed compressed
   into what is left (the thesis's "delayed opening", chapter 5, after
   Gangitano et al. 2004);
-* :func:`reopening` — a closing and re-opening inserted: around ``at``
-  (default mid-movement) the aperture closes by ``depth`` (default 80 %)
-  of the opening it had when the closing began, and opens again, a raised-cosine dip over ``width`` (default 30 %) of the movement
-  (the thesis's open-close-open).
+* :func:`reopening` — a closing and re-opening inserted: when the grip has
+  first opened to ``level`` (default 60 %) of its opening, the real profile
+  pauses while the aperture closes by ``depth`` (default 80 %) of that
+  opening and opens again (a raised-cosine dip over ``width``, default 30 %
+  of the movement); then the rest of the real profile is replayed,
+  compressed into what is left (the thesis's open-close-open). A grip that
+  has not yet opened has nothing to close, so the dip is placed by the
+  grip's own progress rather than at a fixed share of the movement.
 
 docs/mocap.md describes both, for those who evaluate the verdict this way.
 """

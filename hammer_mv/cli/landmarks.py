@@ -1,0 +1,92 @@
+"""``hammer-mv landmarks``: the field's kinematics of every movement in some files, as a table."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from hammer_mv.cli.flags import FPS_HELP
+
+
+def register(sub) -> None:
+    """Add the ``landmarks`` subcommand to ``sub`` (an argparse subparsers action).
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The top-level parser's subparsers.
+    """
+    from hammer_mv.cli.options import add_mocap_options
+
+    p = sub.add_parser("landmarks", help="measure reach-to-grasp landmarks, no models (CSV)",
+                       description="Measure the landmarks of every movement in each INPUT "
+                       "(motion-capture recordings: every reach; tracks, pose files or "
+                       "videos: the movement) by the field's definitions: onset and end where "
+                       "the transport speed crosses a share of its peak (or an absolute speed), "
+                       "after a zero-lag low-pass filter. Writes one CSV row per movement "
+                       "(docs/mocap.md lists the columns and their units).")
+    p.add_argument("inputs", type=Path, nargs="+", metavar="INPUT",
+                   help="motion-capture recordings, tracks or pose files, or videos")
+    p.add_argument("-o", "--output", type=Path, required=True, metavar="TABLE.csv",
+                   help="the table to write")
+    g = p.add_argument_group("definitions")
+    g.add_argument("--threshold", type=float, default=0.05, metavar="SHARE",
+                   help="onset and end where the speed crosses this share of its peak "
+                        "(default 0.05)")
+    g.add_argument("--speed", type=float, default=None, metavar="M/S",
+                   help="an absolute speed bound instead of the share")
+    g.add_argument("--hold", type=float, default=0.0, metavar="S",
+                   help="the speed must stay beyond the bound this long (default 0)")
+    g.add_argument("--cutoff", type=float, default=10.0, metavar="HZ",
+                   help="zero-lag Butterworth low-pass cutoff (default 10 Hz; 0: none)")
+    g = p.add_argument_group("scale of pixel tracks")
+    g.add_argument("--px-per-m", type=float, default=None, metavar="X",
+                   help="image scale of tracks, pose files and videos, px/m")
+    g.add_argument("--object-diameter", type=float, default=None, metavar="M",
+                   help="the object's real diameter, m, to scale tracks by its apparent one")
+    g.add_argument("--fps", type=float, default=None, metavar="F", help=FPS_HELP)
+    add_mocap_options(p)
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Execute ``hammer-mv landmarks`` with parsed ``args``; return the exit status.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments.
+    """
+    import pandas as pd
+
+    from hammer_mv.cli.options import mocap_import
+    from perception.errors import InputError
+    from perception.io.atomic import write_text
+    from perception.landmarks import LandmarkParams
+    from perception.measure import landmarks
+
+    try:
+        params = LandmarkParams(threshold=args.threshold, speed=args.speed, hold=args.hold,
+                                cutoff=args.cutoff or None)
+    except ValueError as exc:
+        raise InputError(str(exc).split(": ", 1)[-1], field="--threshold/--speed/--hold/"
+                         "--cutoff") from None
+    mocap = mocap_import(args)
+    pose = None
+    if args.fps is not None:
+        from perception.io.pose import PoseImport
+
+        pose = PoseImport(fps=args.fps)
+    tables = []
+    for path in args.inputs:
+        if not path.is_file():
+            raise InputError("input not found (or not a file)", path)
+        tables.append(landmarks(path, params=params, mocap=mocap, px_per_m=args.px_per_m,
+                                object_diameter=args.object_diameter, pose=pose))
+    table = pd.concat(tables, ignore_index=True)
+    write_text(args.output, table.to_csv(index=False))
+    if not args.quiet:
+        done = int((table["status"] == "complete").sum())
+        print(f"{len(table)} movement(s), {done} complete -> {args.output}", file=sys.stdout)
+    return 0
