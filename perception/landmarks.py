@@ -26,8 +26,9 @@ import numpy as np
 if TYPE_CHECKING:
     from perception.observation import Observation
 
-__all__ = ["DETAILS", "MODEL_SPAN_FRACTION", "Landmarks", "count_peaks", "grip_departs",
-           "longest_gap", "movement_landmarks", "movement_time", "observed_landmarks",
+__all__ = ["DETAILS", "MAX_GAP", "MAX_GAP_SHARE", "MODEL_SPAN_FRACTION", "LandmarkParams",
+           "Landmarks", "count_peaks", "grip_departs", "hides_a_reopening", "longest_gap",
+           "movement_bounds", "movement_landmarks", "movement_time", "observed_landmarks",
            "verdict_detail", "wrist_movement_time"]
 
 
@@ -51,8 +52,32 @@ PEAK_PROMINENCE = 0.25
 PEAK_MIN_PROMINENCE = 0.005
 #: The aperture has started to open when it first exceeds rest + this share of the opening.
 OPENING_LEVEL = 0.10
-#: A gap in the aperture longer than this, s, may hide a dip: no peak count.
-MAX_GAP = 0.25
+#: A gap in the aperture may hide a closing and re-opening when it is longer than
+#: this, s, and than :data:`MAX_GAP_SHARE` of the movement: a closing and
+#: re-opening takes a share of the movement (the chapter 5 stimuli a third of
+#: it), while real trackers drop digits for 0.1-0.2 s of slow, 1-2 s grasps.
+MAX_GAP = 0.1
+#: ... and this share of the movement time.
+MAX_GAP_SHARE = 0.2
+
+
+def hides_a_reopening(gap: float, movement_time: float) -> bool:
+    """Whether a gap of ``gap`` s in the aperture could hide a closing and re-opening.
+
+    Longer than :data:`MAX_GAP` and than :data:`MAX_GAP_SHARE` of the
+    movement time (than :data:`MAX_GAP` alone where that is unknown).
+
+    Parameters
+    ----------
+    gap : float
+        The gap, s.
+    movement_time : float
+        The movement time, s (NaN if unknown).
+    """
+    limit = MAX_GAP
+    if math.isfinite(movement_time) and movement_time > 0:
+        limit = max(MAX_GAP, MAX_GAP_SHARE * movement_time)
+    return gap > limit + 1e-9
 #: The reference model's movement ends when no hand point moves faster than
 #: this, m/s (``ObserveParams.end_speed``: the observation's end rule without
 #: tracking noise).
@@ -225,7 +250,8 @@ class Landmarks:
         Maxima of the aperture with a prominence of at least
         :data:`PEAK_PROMINENCE` of the opening and :data:`PEAK_MIN_PROMINENCE`
         (see :func:`count_peaks`); None where the aperture is missing for
-        longer than :data:`MAX_GAP` or has fewer than 3 samples.
+        long enough to hide a second opening (:func:`hides_a_reopening`) or
+        has fewer than 3 samples.
     rest_aperture : float
         Grip aperture at the movement's onset, m.
     opening_time : float
@@ -506,7 +532,7 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
     ts = time[seen]
     gaps = np.r_[ts[0] - time[lo], np.diff(ts), time[hi] - ts[-1]]
     peaks = None
-    if gaps.max() <= MAX_GAP + 1e-9:
+    if not hides_a_reopening(float(gaps.max()), T):
         peaks = count_peaks(g[seen], max(PEAK_PROMINENCE * opening, PEAK_MIN_PROMINENCE))
     rate = np.gradient(g, time)
     widening = rate[lo:j + 1][np.isfinite(rate[lo:j + 1])]

@@ -133,7 +133,7 @@ def test_the_start_posture_follows_the_reach(distance):
 def test_a_grip_lost_long_enough_to_hide_a_second_opening_is_not_called_normal(
         lost_frames, verdict):
     # at 30 fps, 1 frame lost leaves a 0.07 s gap (peaks still counted), 9 frames 0.33 s
-    # (over MAX_GAP, 0.25 s: long enough to hide a closing and re-opening)
+    # (over 0.1 s and 20 % of the 0.9 s movement: long enough to hide a closing and re-opening)
     tracks, truth = demo_tracks("normal", 0)
     start = truth["onset_frame"] + 12  # the grip is opening
     lost = demo_tracks("normal", 0, lost={"finger": slice(start, start + lost_frames)})[0]

@@ -11,8 +11,10 @@ import numpy as np
 
 from perception.landmarks import (
     MAX_GAP,
+    MAX_GAP_SHARE,
     Landmarks,
     grip_departs,
+    hides_a_reopening,
     longest_gap,
     model_landmarks,
     observed_landmarks,
@@ -165,10 +167,9 @@ class Recognition:
         when even its transport is no human reach, or the digits start more
         than :data:`VALIDATED_REST_APERTURE` apart (a whole-hand grasp, which
         the verdict was not made for), or when it would be
-        ``normal`` but a digit was lost for longer than
-        :data:`~perception.landmarks.MAX_GAP` during the movement (the gap
-        may hide a second opening, and the models' filters coast over it as
-        if the grip had stayed open).
+        ``normal`` but a digit was lost long enough during the movement to
+        hide a second opening (:func:`~perception.landmarks.hides_a_reopening`:
+        the models' filters coast over a gap as if the grip had stayed open).
         """
         if self.shape is not None:
             d = self.shape.decision
@@ -179,7 +180,8 @@ class Recognition:
             if d.verdict is not None and self.transport_familiarity < self.unfamiliar_threshold:
                 return Verdict("unfamiliar", d.best, d.familiarity, d.margin)
             obs = self.observation
-            if d.verdict == "normal" and longest_gap(obs.time, obs.g) > MAX_GAP + 1e-9:
+            if d.verdict == "normal" and hides_a_reopening(longest_gap(obs.time, obs.g),
+                                                           self.landmarks[0].movement_time):
                 return Verdict("unfamiliar", d.best, d.familiarity, d.margin)
             return d
         return decide(self.kinds, self.log_likelihood[:, -1], self.familiarity,
@@ -245,8 +247,8 @@ class Recognition:
             b = (start + gap - lm.onset_time) / lm.movement_time
             where = f" at {max(a, 0):.0%}-{min(b, 1):.0%} of the movement"
         lost = "the digits were" if name == "digits" else f"the {name} was"
-        return f"{lost} lost {gap:.2f} s{where} (a gap over {MAX_GAP:.2f} s may hide a " \
-               "second opening)"
+        return (f"{lost} lost {gap:.2f} s{where} (a gap over {MAX_GAP:.2f} s and "
+                f"{MAX_GAP_SHARE:.0%} of the movement may hide a second opening)")
 
     @property
     def warnings(self) -> list[str]:
