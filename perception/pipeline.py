@@ -349,9 +349,12 @@ def recognize_tracks(tracks: Tracks, repertoire: Repertoire,
         Their scene cannot be planned (out of the models' reach: often a wrong scale).
     """
     from perception.recognition.shape import is_mirrored
+    from perception.settling import settle_start
 
     settings = RecognitionSettings() if settings is None else settings
     try:
+        # a clip that does not start still is scored from the scene its data give
+        tracks, settled = settle_start(tracks, settings.observe, clip=clip)
         obs = observe(tracks, settings.observe, clip=clip)
         mirrored = is_mirrored(obs)
         if mirrored:  # the other hand, or the camera on the other side: score its mirror image
@@ -374,7 +377,8 @@ def recognize_tracks(tracks: Tracks, repertoire: Repertoire,
     rec = _scored(obs, models, repertoire, settings.hammer)
     shape, transport = _shape_pass(shape_obs, repertoire, settings, plan_cache)
     return dataclasses.replace(rec, shape=shape, normalisation=norm,
-                               transport_familiarity=transport, mirrored=mirrored)
+                               transport_familiarity=transport, mirrored=mirrored,
+                               notes=(settled,) if settled else ())
 
 
 def _canonical(obs, repertoire: Repertoire, source):

@@ -379,6 +379,9 @@ def _scene_observation(monkeypatch):
 
     obs = pipeline.observe(demo_tracks("normal", 0)[0], clip="c")
     monkeypatch.setattr(pipeline, "observe", lambda tracks, params, clip=None: obs)
+    # no tracks at all: the start needs no settling either
+    monkeypatch.setattr("perception.settling.settle_start",
+                        lambda tracks, params, clip=None: (tracks, None))
     return pipeline
 
 

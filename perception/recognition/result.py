@@ -103,6 +103,9 @@ class Recognition:
         The demonstration's landmarks measured on better data than the
         observation holds (a 3D recording's own speed and aperture, on the
         observation's clock); otherwise they are measured on the observation.
+    notes : tuple of str
+        What was done to the clip before it was scored (a start without
+        rest: :func:`perception.settling.settle_start`).
     """
 
     clip: str
@@ -128,6 +131,7 @@ class Recognition:
     unfamiliar_threshold: float = UNFAMILIAR_THRESHOLD
     mirrored: bool = False
     measured: Landmarks | None = field(default=None, repr=False)
+    notes: tuple[str, ...] = ()
 
     def score(self, rule: str | None = None) -> np.ndarray:
         """(M, N) cumulative score under ``rule`` (default: the winner's rule)."""
@@ -430,6 +434,7 @@ class Recognition:
             "verdict_detail": self.verdict_detail,
             "verdict_reason": self.verdict_reason,
             "warnings": self.warnings,
+            "notes": list(self.notes),
             "familiarity": _num(d.familiarity),
             "margin": _num(d.margin),
             "familiarity_threshold": float(self.familiarity_threshold),

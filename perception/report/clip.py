@@ -30,7 +30,7 @@ __all__ = ["KINEMATICS_COLUMNS", "ClipSummary", "clip_figures", "clip_outputs", 
 RECOGNITION_KEYS = frozenset({
     "clip", "models", "winner", "rule", "verdict", "familiarity", "margin",
     "familiarity_threshold", "reference_model", "time", "confidence", "transport_confidence",
-    "aperture", "verdict_detail", "verdict_reason", "warnings", "kinematics", "shape",
+    "aperture", "verdict_detail", "verdict_reason", "warnings", "notes", "kinematics", "shape",
     "mirrored"})
 
 #: The observed landmarks a batch's ``summary.csv`` shows, one column each
