@@ -29,7 +29,7 @@ if TYPE_CHECKING:
 __all__ = ["DETAILS", "MAX_GAP", "MAX_GAP_SHARE", "MODEL_SPAN_FRACTION", "LandmarkParams",
            "Landmarks", "count_peaks", "grip_departs", "hides_a_reopening", "longest_gap",
            "movement_bounds", "movement_landmarks", "movement_time", "observed_landmarks",
-           "verdict_detail", "wrist_movement_time"]
+           "speed_bound", "verdict_detail", "wrist_movement_time"]
 
 
 #: The wrist covers the middle 80 % of its path (10 % to 90 %) in this
@@ -116,6 +116,11 @@ class LandmarkParams:
         An absolute speed, m/s, instead of the share.
     hold : float
         The speed must stay beyond the bound this long for a crossing to count, s.
+    noise_factor : float
+        The share-of-peak bound is raised to this many times the speed's
+        noise floor (its 10th percentile over the recording: the still
+        stretches' jitter), so that tracking noise of a few pixels neither
+        starts a movement early nor keeps it from ending. 0: the share alone.
     cutoff : float, optional
         Low-pass cutoff, Hz (capped below the Nyquist frequency); None: no filter.
     order : int
@@ -125,6 +130,7 @@ class LandmarkParams:
     threshold: float = 0.05
     speed: float | None = None
     hold: float = 0.0
+    noise_factor: float = 2.0
     cutoff: float | None = 10.0
     order: int = 2
 
@@ -138,6 +144,9 @@ class LandmarkParams:
                 raise ValueError(f"LandmarkParams.{name}: expected a positive number, got {v!r}")
         if not (math.isfinite(self.hold) and self.hold >= 0):
             raise ValueError(f"LandmarkParams.hold: expected a time >= 0, got {self.hold!r}")
+        if not (math.isfinite(self.noise_factor) and self.noise_factor >= 0):
+            raise ValueError(f"LandmarkParams.noise_factor: expected a number >= 0, got "
+                             f"{self.noise_factor!r}")
         if not (isinstance(self.order, int) and 1 <= self.order <= 8):
             raise ValueError(f"LandmarkParams.order: expected 1-8, got {self.order!r}")
 
@@ -199,7 +208,7 @@ def movement_bounds(time: np.ndarray, speed: np.ndarray, peak: int,
     params : LandmarkParams, optional
     """
     params = LandmarkParams() if params is None else params
-    bound = params.speed if params.speed is not None else params.threshold * speed[peak]
+    bound = speed_bound(speed, peak, params)
     below = np.isfinite(speed) & (speed < bound)
     edges = np.diff(np.r_[0, below.astype(np.int8), 0])
     runs = [(a, b) for a, b in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1))
@@ -207,6 +216,24 @@ def movement_bounds(time: np.ndarray, speed: np.ndarray, peak: int,
     before = [b for a, b in runs if b <= peak]
     after = [a for a, b in runs if a > peak]
     return (int(before[-1]) if before else None, int(after[0]) - 1 if after else None)
+
+
+def speed_bound(speed: np.ndarray, peak: int, params: LandmarkParams) -> float:
+    """The speed that bounds a movement, m/s (see :class:`LandmarkParams`).
+
+    Parameters
+    ----------
+    speed : (N,) array
+        Transport speed, m/s (NaN where lost).
+    peak : int
+        Row of the movement's peak speed.
+    params : LandmarkParams
+    """
+    if params.speed is not None:
+        return float(params.speed)
+    seen = speed[np.isfinite(speed)]
+    floor = float(np.percentile(seen, 10)) if len(seen) else 0.0
+    return max(params.threshold * float(speed[peak]), params.noise_factor * floor)
 
 
 def _cross_time(time, speed, row, bound, rising) -> float:
@@ -511,7 +538,7 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
         return Landmarks()
     peak = int(np.nanargmax(speed))
     onset, end = movement_bounds(time, speed, peak, params)
-    bound = params.speed if params.speed is not None else params.threshold * speed[peak]
+    bound = speed_bound(speed, peak, params)
     t_on = _cross_time(time, speed, onset, bound, True) if onset is not None else math.nan
     t_end = _cross_time(time, speed, end, bound, False) if end is not None else math.nan
     T = t_end - t_on

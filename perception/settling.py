@@ -26,7 +26,13 @@ from __future__ import annotations
 import numpy as np
 
 from perception.errors import InputError
-from perception.observation import NEEDED_MARKERS, ObserveParams, check_hand, rest_scene
+from perception.observation import (
+    NEEDED_MARKERS,
+    ObserveParams,
+    check_hand,
+    movement_span,
+    rest_scene,
+)
 
 __all__ = ["SEARCH", "settle_start"]
 
@@ -35,13 +41,15 @@ SEARCH = 0.5
 
 
 def _at_rest(tracks, params: ObserveParams, start: int) -> bool:
-    """Whether the frames from ``start`` show a still, visible hand with its digits together."""
+    """Whether the frames from ``start`` show a still, visible hand with its digits
+    together, before the movement (not a slow stretch of it)."""
     n = 2 * params.rest_frames
     try:
         check_hand(rest_scene(tracks.rows(start, start + n), params), params)
+        span = movement_span(tracks.rows(start, len(tracks.time)), params)
     except InputError:
         return False
-    return True
+    return span.start >= params.rest_frames
 
 
 def _check_hand(scene, params: ObserveParams, clip: str | None,

@@ -248,3 +248,19 @@ def test_recognize_prints_the_kind_of_an_abnormal_verdict(tmp_path):
                           capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.startswith("d: abnormal (delayed-opening), winner grasp-")
+
+
+@pytest.mark.parametrize("noise_px", [1.0, 2.0])
+def test_the_bounds_survive_deeplabcut_level_noise(noise_px):
+    """At 1-2 px of jitter no clip is refused and the movement still ends where it does
+    (the bound rises above the speed's noise floor; tools/landmark_noise.py measures it)."""
+    for seed in range(4):
+        p = IndependentParams(condition="normal", object_size=0.03)
+        tracks, truth = independent_tracks(p, seed, noise_px=noise_px)
+        w = truth["world"]
+        want = movement_landmarks(tracks.time, w["wrist"],
+                                  np.linalg.norm(w["finger"] - w["thumb"], axis=1))
+        got = observed_landmarks(observe(tracks, ObserveParams(object_diameter=p.object_size)))
+        assert got.movement_time == pytest.approx(want.movement_time, abs=0.25)
+        assert got.opening_time == pytest.approx(want.opening_time, abs=0.12)
+        assert got.mga == pytest.approx(want.mga, abs=0.005)

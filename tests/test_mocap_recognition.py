@@ -271,3 +271,21 @@ def test_batch_scores_every_reach_of_a_recording(tmp_path):
                            capture_output=True, text=True, timeout=300)
     assert again.returncode == 0
     assert pd.read_csv(tmp_path / "report" / "summary.csv")["reused"].all()
+
+
+def test_a_reach_recorded_at_1000_hz_is_scored_like_the_same_at_85(optotrak_reaches):
+    from types import SimpleNamespace
+
+    trial = read_mocap(OPTOTRAK, rate=RATE)[1]
+    t = np.arange(0, trial.time[-1], 1e-3)
+    markers = {m: np.stack([np.interp(t, trial.time, p[:, k]) for k in range(3)], axis=1)
+               for m, p in trial.markers.items()}
+    fast = SimpleNamespace(name="fast", source="fast.tsv", time=t, markers=markers, notes=())
+    reach = recording_reaches(fast, MarkerMap("thumb", "index"))[0]
+    rep = default_repertoire()
+    rec, info = recognize_reach(reach, rep)
+    slow, _ = recognize_reach(optotrak_reaches[1], rep)
+    assert info["rate"] == pytest.approx(1000, rel=1e-3)
+    assert rec.verdict == slow.verdict == "normal"
+    assert rec.landmarks[0].movement_time == pytest.approx(slow.landmarks[0].movement_time,
+                                                           abs=0.02)
