@@ -142,19 +142,18 @@ def recognize_reach(reach: Reach, repertoire, settings=None,
     options = MocapImport() if options is None else options
     settings = RecognitionSettings() if settings is None else settings
     tracks, info, transport, aperture = reach_tracks(reach, options.reaches)
+    at_rest = aperture[:2 * settings.observe.rest_frames]
+    widest = float(np.max(at_rest, initial=0.0, where=np.isfinite(at_rest)))
     observe = dataclasses.replace(
         settings.observe, px_per_m=PX_PER_M, object_diameter=info["object_size"],
         # a whole-hand grasp may rest with the digits apart: the rest
         # aperture is taken off like the markers' separation at rest
-        max_rest_aperture=max(settings.observe.max_rest_aperture,
-                              float(np.max(aperture[:2 * settings.observe.rest_frames],
-                                           initial=0.0, where=np.isfinite(
-                                               aperture[:2 * settings.observe.rest_frames])))
-                              + 0.01))
+        max_rest_aperture=max(settings.observe.max_rest_aperture, widest + 0.01))
     rec = recognize_tracks(tracks, repertoire, dataclasses.replace(settings, observe=observe),
                            clip=reach.name, source=reach.source, plan_cache=plan_cache)
-    # the landmarks from the 3D speed and aperture, on the observation's clock
-    clock = rec.observation.clip_time
+    # the landmarks from the 3D speed and aperture, on the observation's clock (its
+    # last row is the tracks' last: settling only ever trims or holds the first)
+    clock = tracks.time - (tracks.time[-1] - rec.observation.clip_time[-1])
     rec = dataclasses.replace(rec, measured=movement_landmarks(clock, transport, aperture,
                                                                options.reaches.landmarks))
     info = {**info, "trial": reach.name, "source": reach.source,
