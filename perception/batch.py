@@ -533,6 +533,7 @@ def summary_table(results: list[ClipResult], reference: str | None = None) -> pd
     (``verdict, familiarity, margin, winner_log_likelihood``),
     ``reference_model`` and ``reference_confidence`` (its final thesis-rule
     confidence, m), ``verdict_detail`` (the kind of an ``abnormal`` verdict),
+    ``verdict_rule`` (the rule that gave the verdict),
     the observed landmarks (``movement_time`` s, ``peak_speed`` m/s,
     ``peak_speed_time``, ``mga`` m, ``mga_time``, ``aperture_peaks``:
     :data:`~perception.report.clip.KINEMATICS_COLUMNS`), ``conf_<model>``
@@ -569,6 +570,7 @@ def summary_table(results: list[ClipResult], reference: str | None = None) -> pd
         entry["reference_confidence"] = (_model_value(s, reference, s.confidence[:, -1])
                                          if s is not None and reference else float("nan"))
         entry["verdict_detail"] = s.verdict_detail if s is not None else None
+        entry["verdict_rule"] = s.verdict_rule if s is not None else None
         for column in KINEMATICS_COLUMNS:
             entry[column] = s.landmark(column) if s is not None else float("nan")
         for n in names:

@@ -122,7 +122,7 @@ def test_a_long_session_is_split_into_its_reaches():
 def test_a_whole_hand_grasp_is_out_of_the_verdicts_depth_and_says_so():
     reach = read_reaches(QUALISYS)[0]
     rec, info = recognize_reach(reach, default_repertoire())
-    assert rec.verdict == "unfamiliar"
+    assert (rec.verdict, rec.verdict_rule) == ("unfamiliar", "not-a-precision-grip")
     assert rec.verdict_reason.startswith("not a precision grip: the digits start")
     assert math.isfinite(rec.landmarks[0].movement_time)   # its landmarks are still measured
 

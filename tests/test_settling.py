@@ -55,3 +55,19 @@ def test_a_gap_hides_a_reopening_by_its_length_and_its_share_of_the_movement():
     assert hides_a_reopening(0.2, 0.5)                             # 40 % of a fast one
     assert hides_a_reopening(MAX_GAP_SHARE * 2.0 + 0.01, 2.0)
     assert hides_a_reopening(0.15, math.nan)                       # unknown: the 0.1 s alone
+
+
+def test_the_report_names_the_rule_that_gave_the_verdict(normal):
+    from perception.recognition.result import VERDICT_RULES
+
+    rep = default_repertoire()
+    rec = recognize_tracks(normal[0], rep)
+    d = rec.to_dict()
+    assert d["verdict_rule"] == "familiarity" and rec.verdict_reason is None
+    assert d["verdict_rules"]["late_opening"] == 0.55
+    late = recognize_tracks(demo_tracks("delayed", 0)[0], rep)
+    assert (late.verdict, late.verdict_rule) == ("abnormal", "grip-departs")
+    lost = demo_tracks("normal", 0, lost={"finger": slice(21, 30)})[0]
+    gap = recognize_tracks(lost, rep)
+    assert (gap.verdict, gap.verdict_rule) == ("unfamiliar", "insufficient-data")
+    assert {rec.verdict_rule, late.verdict_rule, gap.verdict_rule} <= set(VERDICT_RULES)

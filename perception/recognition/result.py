@@ -10,8 +10,14 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from perception.landmarks import (
+    LATE_MGA,
+    LATE_OPENING,
     MAX_GAP,
     MAX_GAP_SHARE,
+    NO_OPENING,
+    OPENING_LEVEL,
+    PEAK_MIN_PROMINENCE,
+    PEAK_PROMINENCE,
     Landmarks,
     grip_departs,
     hides_a_reopening,
@@ -36,9 +42,15 @@ if TYPE_CHECKING:
     from perception.recognition.models import MotorModel
     from perception.recognition.shape import Normalisation
 
-__all__ = ["Recognition"]
+__all__ = ["VERDICT_RULES", "Recognition"]
 
 
+#: The rules that can give a verdict (:attr:`Recognition.verdict_rule`), in the order
+#: they are tried: a whole-hand grasp; a grip that opens late or twice; a transport
+#: no reach model makes; a digit lost long enough to hide a second opening; and the
+#: best model's familiarity.
+VERDICT_RULES = ("not-a-precision-grip", "grip-departs", "not-a-human-reach",
+                 "insufficient-data", "familiarity")
 #: The movement times (onset to end by the field's rule, s) the verdict was
 #: validated on: the synthetic populations' 0.45-1.2 s grasps and a lab's real
 #: Optotrak grasps (1.05-2.06 s).
@@ -159,6 +171,16 @@ class Recognition:
 
     @property
     def decision(self) -> Verdict:
+        """The verdict (see :attr:`verdict_rule` for the rule that gave it)."""
+        return self._judged[0]
+
+    @property
+    def verdict_rule(self) -> str | None:
+        """The rule that gave the verdict (one of :data:`VERDICT_RULES`; None without one)."""
+        return self._judged[1] if self.verdict is not None else None
+
+    @cached_property
+    def _judged(self) -> tuple[Verdict, str]:
         """The verdict, from the best model by log-likelihood and its familiarity.
 
         With a :attr:`shape` pass, the verdict is that pass's: the movement's
@@ -177,19 +199,23 @@ class Recognition:
         """
         if self.shape is not None:
             d = self.shape.decision
+
+            def given(verdict: str, rule: str) -> tuple[Verdict, str]:
+                return Verdict(verdict, d.best, d.familiarity, d.margin), rule
+
             if d.verdict is not None and self._whole_hand:
-                return Verdict("unfamiliar", d.best, d.familiarity, d.margin)
+                return given("unfamiliar", "not-a-precision-grip")
             if d.verdict in ("normal", "abnormal") and grip_departs(self.landmarks[0]):
-                return Verdict("abnormal", d.best, d.familiarity, d.margin)
+                return given("abnormal", "grip-departs")
             if d.verdict is not None and self.transport_familiarity < self.unfamiliar_threshold:
-                return Verdict("unfamiliar", d.best, d.familiarity, d.margin)
+                return given("unfamiliar", "not-a-human-reach")
             obs = self.observation
             if d.verdict == "normal" and hides_a_reopening(longest_gap(obs.time, obs.g),
                                                            self.landmarks[0].movement_time):
-                return Verdict("unfamiliar", d.best, d.familiarity, d.margin)
-            return d
+                return given("unfamiliar", "insufficient-data")
+            return d, "familiarity"
         return decide(self.kinds, self.log_likelihood[:, -1], self.familiarity,
-                      self.familiarity_threshold)
+                      self.familiarity_threshold), "familiarity"
 
     @property
     def verdict(self) -> str | None:
@@ -204,21 +230,33 @@ class Recognition:
         like none of the reach models' own) or "insufficient data" naming
         the digit lost longest and where; ``abnormal`` names the rule.
         """
-        v = self.verdict
-        if v == "unfamiliar":
-            if self._whole_hand:
-                return (f"not a precision grip: the digits start "
-                        f"{self.observation.marker_separation * 100:.0f} cm apart (the "
-                        "verdict knows grasps whose digits start closed)")
-            if self.transport_familiarity < self.unfamiliar_threshold:
-                return (f"not a human reach: its transport fits the reach models worse than "
-                        f"{1 - self.unfamiliar_threshold:.0%} of their own reaches")
+        rule = self.verdict_rule
+        if rule == "not-a-precision-grip":
+            return (f"not a precision grip: the digits start "
+                    f"{self.observation.marker_separation * 100:.0f} cm apart (the "
+                    "verdict knows grasps whose digits start closed)")
+        if rule == "not-a-human-reach":
+            return (f"not a human reach: its transport fits the reach models worse than "
+                    f"{1 - self.unfamiliar_threshold:.0%} of their own reaches")
+        if rule == "insufficient-data":
             return "insufficient data: " + self._longest_loss()
-        if v == "abnormal":
-            if self.shape is not None and grip_departs(self.landmarks[0]):
-                return "the grip opens late or twice (the field's landmarks)"
-            return "no model explains the movement as well as 95 % of its own movements"
+        if rule == "grip-departs":
+            return "the grip opens late or twice (the field's landmarks)"
+        if self.verdict == "abnormal":
+            return (f"no model explains the movement as well as "
+                    f"{1 - self.familiarity_threshold:.0%} of its own movements")
         return None
+
+    @property
+    def verdict_rules(self) -> dict:
+        """Every threshold the verdict's rules read, by name (the report's ``verdict_rules``)."""
+        return {"familiarity_threshold": float(self.familiarity_threshold),
+                "unfamiliar_threshold": float(self.unfamiliar_threshold),
+                "late_opening": LATE_OPENING, "late_mga": LATE_MGA, "no_opening": NO_OPENING,
+                "opening_level": OPENING_LEVEL, "peak_prominence": PEAK_PROMINENCE,
+                "peak_min_prominence": PEAK_MIN_PROMINENCE, "max_gap": MAX_GAP,
+                "max_gap_share": MAX_GAP_SHARE,
+                "precision_grip_rest_aperture": VALIDATED_REST_APERTURE}
 
     @property
     def _whole_hand(self) -> bool:
@@ -432,6 +470,8 @@ class Recognition:
             "rule": self.rule,
             "verdict": d.verdict,
             "verdict_detail": self.verdict_detail,
+            "verdict_rule": self.verdict_rule,
+            "verdict_rules": self.verdict_rules,
             "verdict_reason": self.verdict_reason,
             "warnings": self.warnings,
             "notes": list(self.notes),

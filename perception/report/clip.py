@@ -30,8 +30,8 @@ __all__ = ["KINEMATICS_COLUMNS", "ClipSummary", "clip_figures", "clip_outputs", 
 RECOGNITION_KEYS = frozenset({
     "clip", "models", "winner", "rule", "verdict", "familiarity", "margin",
     "familiarity_threshold", "reference_model", "time", "confidence", "transport_confidence",
-    "aperture", "verdict_detail", "verdict_reason", "warnings", "notes", "kinematics", "shape",
-    "mirrored"})
+    "aperture", "verdict_detail", "verdict_rule", "verdict_rules", "verdict_reason", "warnings",
+    "notes", "kinematics", "shape", "mirrored"})
 
 #: The observed landmarks a batch's ``summary.csv`` shows, one column each
 #: (:attr:`ClipSummary.kinematics`; units in docs/recognition.md §9).
@@ -74,6 +74,10 @@ class ClipSummary:
     verdict_detail : str or None
         The kind of an ``abnormal`` verdict (``delayed-opening``,
         ``re-opening``, ``no-opening``, ``other``); None for any other.
+    verdict_rule : str or None
+        The rule that gave the verdict
+        (:data:`~perception.recognition.result.VERDICT_RULES`; None in
+        reports written before it was recorded).
     familiarity : float
         The best model's familiarity, 0..1.
     margin : float
@@ -113,6 +117,7 @@ class ClipSummary:
     extras: dict = field(default_factory=dict)
     verdict_detail: str | None = None
     kinematics: dict | None = None
+    verdict_rule: str | None = None
 
     @property
     def tracking(self) -> dict | None:
@@ -172,6 +177,7 @@ class ClipSummary:
             extras={k: v for k, v in d.items() if k not in RECOGNITION_KEYS},
             verdict_detail=d.get("verdict_detail"),
             kinematics=d.get("kinematics"),
+            verdict_rule=d.get("verdict_rule"),
         )
 
     @classmethod
@@ -193,7 +199,7 @@ class ClipSummary:
                    reference_model=rec.reference_model,
                    transport=np.cumsum(rec.dC_r, axis=1), aperture=rec.observation.g,
                    extras=dict(extras or {}), verdict_detail=rec.verdict_detail,
-                   kinematics=rec.kinematics)
+                   kinematics=rec.kinematics, verdict_rule=rec.verdict_rule)
 
     def index(self, model: str) -> int:
         """Row of ``model`` in the per-model arrays.
