@@ -46,12 +46,16 @@ def test_alpha_beta_one_frame_at_a_time_is_the_offline_filter():
     np.testing.assert_array_equal(online, alpha_beta(z, dt, 0.5, 0.15))
 
 
-def test_step_scorer_gives_the_engine_columns_frame_by_frame(rep):
+@pytest.mark.parametrize("params", [
+    HammerParams(), HammerParams(thesis_sign="printed"), HammerParams(w_r=1.0, w_g=0.25),
+    HammerParams(filter_gain=0.5, thesis_sign="printed")], ids=["default", "printed",
+                                                                "weights", "gain-printed"])
+def test_step_scorer_gives_the_engine_columns_frame_by_frame(rep, params):
     rec = recognize_tracks(_tracks("normal", fps=60.0), rep)
     obs = rec.observation
     models = rep.for_scene(SceneSpec.of(obs))
-    offline = recognize(obs, models)
-    scorer = StepScorer(models, HammerParams())
+    offline = recognize(obs, models, params)
+    scorer = StepScorer(models, params)
     for n in range(obs.n_frames):
         scorer.step(obs.time[n], obs.wrist[n], obs.finger[n], obs.thumb[n])
         np.testing.assert_array_equal(scorer.log_likelihood, offline.log_likelihood[:, n])

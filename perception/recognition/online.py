@@ -126,7 +126,7 @@ class StepScorer:
         dC_r, dC_g = thesis_rule(np.r_[prev[3], r], np.r_[prev[4], g],
                                  np.hstack([nan, r_pred]), np.hstack([nan, g_pred]),
                                  self._grasp, np.hstack([nan == 0, valid]),
-                                 self.params.w_r, self.params.w_g)
+                                 self.params.w_r, self.params.w_g, self.params.thesis_sign)
         dll, maha = likelihood_rule(r, g, p_mid, p_open, pred.cov, valid, self.params.obs_sd)
         self.confidence += dC_r[:, 1] + dC_g[:, 1]
         self.log_likelihood += dll[:, 0]
