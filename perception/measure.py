@@ -79,7 +79,8 @@ def _tracks_movement(tracks, px_per_m: float) -> tuple[np.ndarray, np.ndarray, n
 
 
 def landmarks(source, *, params: LandmarkParams | None = None, mocap=None,
-              px_per_m: float | None = None, object_diameter: float | None = None, pose=None):
+              px_per_m: float | None = None, object_diameter: float | None = None, pose=None,
+              tracks_out=None):
     """The landmarks of every movement in ``source``, as a table.
 
     Parameters
@@ -97,6 +98,8 @@ def landmarks(source, *, params: LandmarkParams | None = None, mocap=None,
         The object's real diameter, m, with its apparent one in the tracks.
     pose : PoseImport, optional
         How a pose file becomes tracks.
+    tracks_out : str or os.PathLike, optional
+        Where a video's tracks are written (default: beside the video).
 
     Returns
     -------
@@ -129,7 +132,7 @@ def landmarks(source, *, params: LandmarkParams | None = None, mocap=None,
         from perception.pipeline import clip_name, load_clip
 
         name = clip_name(source)[0]
-        tracks = load_clip(source, pose=pose)
+        tracks = load_clip(source, pose=pose, tracks_out=tracks_out)
     else:
         tracks = source
         name = str(tracks.attrs.get("clip", "tracks"))

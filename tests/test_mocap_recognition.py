@@ -289,3 +289,23 @@ def test_a_reach_recorded_at_1000_hz_is_scored_like_the_same_at_85(optotrak_reac
     assert rec.verdict == slow.verdict == "normal"
     assert rec.landmarks[0].movement_time == pytest.approx(slow.landmarks[0].movement_time,
                                                            abs=0.02)
+
+
+def test_landmarks_of_a_video_write_nothing_beside_it(tmp_path):
+    from perception.synthetic.demos import render_demo_clip
+
+    clips = tmp_path / "clips"
+    clips.mkdir()
+    video = render_demo_clip(clips, "clip.mp4", n=60)[0].video
+    before = sorted(p.name for p in clips.iterdir())
+    out = tmp_path / "out" / "table.csv"
+    res = subprocess.run([sys.executable, "-m", "hammer_mv", "landmarks", str(video),
+                          "--object-diameter", "0.1", "-o", str(out)], capture_output=True,
+                         text=True, timeout=300)
+    assert res.returncode == 0, res.stderr
+    assert sorted(p.name for p in clips.iterdir()) == before     # the user's folder untouched
+    assert (tmp_path / "out" / "tracks" / "clip.tracks.h5").is_file()
+    import pandas as pd
+
+    row = pd.read_csv(out).iloc[0]
+    assert row["status"] == "complete" and 0.5 < row["movement_time"] < 1.5

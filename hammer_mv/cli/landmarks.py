@@ -78,12 +78,21 @@ def run(args: argparse.Namespace) -> int:
         from perception.io.pose import PoseImport
 
         pose = PoseImport(fps=args.fps)
+    from perception.io.names import output_folder, output_stem
+    from perception.pipeline import TRACKS_SUFFIX, clip_name
+
     tables = []
     for path in args.inputs:
         if not path.is_file():
             raise InputError("input not found (or not a file)", path)
+        # a video's tracks go beside the table, never beside the user's video
+        tracks_out = None
+        if clip_name(path)[1] == "video":
+            tracks_out = (output_folder(args.output.parent, "tracks")
+                          / f"{output_stem(clip_name(path)[0])}{TRACKS_SUFFIX}")
         tables.append(landmarks(path, params=params, mocap=mocap, px_per_m=args.px_per_m,
-                                object_diameter=args.object_diameter, pose=pose))
+                                object_diameter=args.object_diameter, pose=pose,
+                                tracks_out=tracks_out))
     table = pd.concat(tables, ignore_index=True)
     write_text(args.output, table.to_csv(index=False))
     if not args.quiet:
