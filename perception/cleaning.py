@@ -28,7 +28,7 @@ import numpy as np
 from scipy.interpolate import PchipInterpolator
 from scipy.ndimage import median_filter
 
-__all__ = ["CleaningParams", "Repairs", "clean_path", "gaps"]
+__all__ = ["CleaningParams", "Repairs", "clean_path"]
 
 
 @dataclass(frozen=True)
@@ -115,25 +115,6 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
     """(start, stop) of each run of True in ``mask`` (stop exclusive)."""
     edges = np.diff(np.r_[0, mask.astype(np.int8), 0])
     return list(zip(np.flatnonzero(edges == 1).tolist(), np.flatnonzero(edges == -1).tolist()))
-
-
-def gaps(time: np.ndarray, lost: np.ndarray) -> list[tuple[float, float]]:
-    """(first lost time, duration s) of each gap, a gap's duration from the last seen
-    sample before it to the first after it (or to the recording's end).
-
-    Parameters
-    ----------
-    time : (N,) array
-        Sample times, s.
-    lost : (N,) bool array
-        Lost samples.
-    """
-    out = []
-    for a, b in _runs(np.asarray(lost, dtype=bool)):
-        t0 = time[a - 1] if a > 0 else time[a]
-        t1 = time[b] if b < len(time) else time[-1]
-        out.append((float(time[a]), float(t1 - t0)))
-    return out
 
 
 def _spikes(time: np.ndarray, path: np.ndarray, ok: np.ndarray,

@@ -43,13 +43,14 @@ from typing import NamedTuple
 
 import numpy as np
 
-from perception.cleaning import CleaningParams, Repairs, clean_path
+from perception.cleaning import CleaningParams, clean_path
 from perception.errors import InputError
 from perception.io.tracks import Status, Tracks
 from perception.landmarks import LandmarkParams, movement_bounds
 
-__all__ = ["MIN_REST", "PX_PER_M", "WRIST_BEHIND", "MarkerMap", "Reach", "ReachParams",
-           "find_reaches", "reach_tracks", "recording_reaches"]
+__all__ = ["APPROACH", "MIN_REST", "PX_PER_M", "WRIST_BEHIND", "MarkerMap", "PlaneFit", "Reach",
+           "ReachParams", "ReachTracks", "find_reaches", "fit_plane", "reach_tracks",
+           "recording_reaches"]
 
 #: The scale of the tracks a reach becomes: one "pixel" per millimetre.
 PX_PER_M = 1000.0
@@ -473,5 +474,3 @@ def reach_tracks(reach: Reach, params: ReachParams | None = None) -> ReachTracks
             "rest_aperture": rest_g}
     return ReachTracks(tracks, info, solid[:, :3], solid[:, 3])
 
-
-__all__ += ["PlaneFit", "ReachTracks", "Repairs", "fit_plane"]

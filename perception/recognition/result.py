@@ -26,6 +26,7 @@ from perception.landmarks import (
     observed_landmarks,
     verdict_detail,
 )
+from perception.observation import ObserveParams
 from perception.recognition.verdict import (
     DEFAULT_THRESHOLD,
     UNFAMILIAR_THRESHOLD,
@@ -55,8 +56,9 @@ VERDICT_RULES = ("not-a-precision-grip", "grip-departs", "not-a-human-reach",
 #: validated on: the synthetic populations' 0.45-1.2 s grasps and a lab's real
 #: Optotrak grasps (1.05-2.06 s).
 VALIDATED_MOVEMENT_TIME = (0.4, 2.1)
-#: The widest digit separation at rest, m, of the grasps it was validated on.
-VALIDATED_REST_APERTURE = 0.04
+#: The widest digit separation at rest, m, of the grasps it was validated on: the
+#: observation's own rest rule for clips (digits together), declared once there.
+VALIDATED_REST_APERTURE = ObserveParams.max_rest_aperture
 #: The reach distances (wrist at rest to the object's centre, m) it was validated on.
 VALIDATED_DISTANCE = (0.1, 0.7)
 
