@@ -292,6 +292,14 @@ class OnlineRecognizer:
         return (self._progress >= progress and evidence >= rule.margin
                 and since - self._verdicts[-1][0] >= rule.hold)
 
+    @property
+    def last_row(self) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """The last row received: positions (M, 2) px, likelihood (M,), status (M,); None before one."""
+        rows = self._rows
+        if not rows["time"]:
+            return None
+        return rows["position"][-1], rows["likelihood"][-1], rows["status"][-1]
+
     # -- the end ----------------------------------------------------------------
     @property
     def decision(self) -> Decision | None:

@@ -250,9 +250,8 @@ class _Drawer:
             self.writer = VideoWriter(self.path, self.fps,
                                       (frame.shape[1], frame.shape[0])).__enter__()
             self.labeller = Labeller(rec.markers, [(0, 255, 255)] * len(rec.markers))
-        rows = rec._rows
-        img = frame.copy() if not rows["position"] else self.labeller.draw(
-            frame, rows["position"][-1], rows["likelihood"][-1], rows["status"][-1])
+        row = rec.last_row
+        img = frame.copy() if row is None else self.labeller.draw(frame, *row)
         ll = np.asarray(state.log_likelihood, dtype=float)
         share = np.exp(ll - ll.max()) / np.exp(ll - ll.max()).sum() if ll.size else ll
         # stacked above the verdict line: the top left holds the markers' legend
