@@ -1,4 +1,4 @@
-"""The standard reach-to-grasp landmarks of a movement, and what kind of abnormal it is.
+"""The standard reach-to-grasp landmarks of a movement.
 
 The prehension literature describes a reach-to-grasp movement by a handful
 of landmarks (Jeannerod 1984; Castiello 2005): its movement time, the
@@ -10,10 +10,8 @@ speed crosses 5 % of its peak, after a zero-lag Butterworth filter), the
 same for video, pose files and motion capture: :func:`movement_landmarks`
 on any sampled movement, :func:`observed_landmarks` on an
 :class:`~perception.observation.Observation`, :func:`model_landmarks` on a
-model's own. :func:`verdict_detail` names the kind of an abnormal grasp
-from them, in the field's terms and free of scale: times are fractions of
-the movement time, apertures fractions of the reference model's opening
-(docs/recognition.md §5; docs/mocap.md for the definitions).
+model's own. The verdict's rules read them
+(:mod:`perception.recognition.rules`; docs/mocap.md for the definitions).
 
 :func:`movement_time` is another quantity: the duration a *model* would
 take for a demonstration (from the wrist's middle 80 % of its path), which
@@ -31,10 +29,9 @@ import numpy as np
 if TYPE_CHECKING:
     from perception.observation import Observation
 
-__all__ = ["DETAILS", "MAX_GAP", "MAX_GAP_SHARE", "MODEL_SPAN_FRACTION", "LandmarkParams",
-           "Landmarks", "count_peaks", "grip_departs", "hides_a_reopening", "longest_gap",
+__all__ = ["MODEL_SPAN_FRACTION", "LandmarkParams", "Landmarks", "count_peaks", "longest_gap",
            "model_landmarks", "movement_bounds", "movement_landmarks", "movement_time",
-           "observed_landmarks", "speed_bound", "verdict_detail", "wrist_movement_time"]
+           "observed_landmarks", "speed_bound", "wrist_movement_time"]
 
 
 #: The wrist covers the middle 80 % of its path (10 % to 90 %) in this
@@ -43,55 +40,6 @@ __all__ = ["DETAILS", "MAX_GAP", "MAX_GAP_SHARE", "MODEL_SPAN_FRACTION", "Landma
 #: on test clips. The span between two fractions does not depend on where
 #: the onset is placed, which the start of a movement leaves uncertain.
 MODEL_SPAN_FRACTION = 0.467
-#: Kinds of an abnormal verdict (:func:`verdict_detail`).
-DETAILS = ("delayed-opening", "re-opening", "no-opening", "other")
-
-#: An aperture peak counts if its prominence is at least this share of the opening...
-PEAK_PROMINENCE = 0.25
-#: ... and at least this much, m (a few times the tracking noise of an aperture).
-PEAK_MIN_PROMINENCE = 0.005
-#: The aperture has started to open when it first exceeds rest + this share of the opening.
-OPENING_LEVEL = 0.10
-#: A gap in the aperture may hide a closing and re-opening when it is longer than
-#: this, s, and than :data:`MAX_GAP_SHARE` of the movement: a closing and
-#: re-opening takes a share of the movement (the chapter 5 stimuli a third of
-#: it), while real trackers drop digits for 0.1-0.2 s of slow, 1-2 s grasps.
-MAX_GAP = 0.1
-#: ... and this share of the movement time.
-MAX_GAP_SHARE = 0.2
-
-
-def hides_a_reopening(gap: float, movement_time: float) -> bool:
-    """Whether a gap of ``gap`` s in the aperture could hide a closing and re-opening.
-
-    Longer than :data:`MAX_GAP` and than :data:`MAX_GAP_SHARE` of the
-    movement time (than :data:`MAX_GAP` alone where that is unknown).
-
-    Parameters
-    ----------
-    gap : float
-        The gap, s.
-    movement_time : float
-        The movement time, s (NaN if unknown).
-    """
-    limit = MAX_GAP
-    if math.isfinite(movement_time) and movement_time > 0:
-        limit = max(MAX_GAP, MAX_GAP_SHARE * movement_time)
-    return gap > limit + 1e-9
-
-# -- the rule of verdict_detail (docs/recognition.md §5, with its sources) --------------
-#: no-opening: the observed opening is below this share of the reference model's.
-NO_OPENING = 0.30
-#: delayed-opening: the aperture starts to open (exceeds :data:`OPENING_LEVEL` of its
-#: opening) later than this share of the movement. Real healthy grips start to open at
-#: 3-68 % of the movement by these definitions (a lab's Optotrak grasps: up to 50 % on
-#: all but 2 of the 30 dev trials), the chapter 5 delayed stimuli of both synthetic
-#: generators at 52-70 %: chosen between, on dev sets only (docs/mocap.md)...
-LATE_OPENING = 0.55
-#: ... or its maximum comes later than this share (while the reference's comes earlier).
-LATE_MGA = 0.95
-
-
 @dataclass(frozen=True)
 class LandmarkParams:
     """The field's definitions of a movement's bounds, and the filter before them.
@@ -122,6 +70,18 @@ class LandmarkParams:
         Low-pass cutoff, Hz (capped below the Nyquist frequency); None: no filter.
     order : int
         The Butterworth filter's order (run twice: zero lag, twice the roll-off).
+    opening_level : float
+        The grip has started to open when the aperture first exceeds rest +
+        this share of the opening.
+    peak_prominence, peak_min_prominence : float
+        An aperture peak counts if it stands out by at least this share of
+        the opening and this much, m (a few times an aperture's tracking noise).
+    max_gap, max_gap_share : float
+        A gap in the aperture may hide a closing and re-opening when it is
+        longer than ``max_gap`` s and than ``max_gap_share`` of the movement:
+        a closing and re-opening takes a share of the movement (the chapter 5
+        stimuli a third of it), while real trackers drop digits for 0.1-0.2 s
+        of slow, 1-2 s grasps.
     """
 
     threshold: float = 0.05
@@ -130,6 +90,11 @@ class LandmarkParams:
     noise_factor: float = 2.0
     cutoff: float | None = 10.0
     order: int = 2
+    opening_level: float = 0.10
+    peak_prominence: float = 0.25
+    peak_min_prominence: float = 0.005
+    max_gap: float = 0.1
+    max_gap_share: float = 0.2
 
     def __post_init__(self):
         if not (0 < self.threshold < 1):
@@ -146,6 +111,29 @@ class LandmarkParams:
                              f"{self.noise_factor!r}")
         if not (isinstance(self.order, int) and 1 <= self.order <= 8):
             raise ValueError(f"LandmarkParams.order: expected 1-8, got {self.order!r}")
+        for name in ("opening_level", "peak_prominence", "peak_min_prominence", "max_gap",
+                     "max_gap_share"):
+            v = getattr(self, name)
+            if not (math.isfinite(v) and v >= 0 and (name == "max_gap" or v <= 1)):
+                raise ValueError(f"LandmarkParams.{name}: expected a share 0-1, got {v!r}")
+
+    def hides_a_reopening(self, gap: float, movement_time: float) -> bool:
+        """Whether a gap of ``gap`` s in the aperture could hide a closing and re-opening.
+
+        Longer than ``max_gap`` and than ``max_gap_share`` of the movement
+        time (than ``max_gap`` alone where that is unknown).
+
+        Parameters
+        ----------
+        gap : float
+            The gap, s.
+        movement_time : float
+            The movement time, s (NaN if unknown).
+        """
+        limit = self.max_gap
+        if math.isfinite(movement_time) and movement_time > 0:
+            limit = max(self.max_gap, self.max_gap_share * movement_time)
+        return gap > limit + 1e-9
 
     def lowpass(self, time: np.ndarray, values: np.ndarray) -> np.ndarray:
         """``values`` (N, ...) low-passed without lag; NaN stays NaN.
@@ -272,14 +260,15 @@ class Landmarks:
         Grip aperture at the movement's end, m.
     aperture_peaks : int or None
         Maxima of the aperture with a prominence of at least
-        :data:`PEAK_PROMINENCE` of the opening and :data:`PEAK_MIN_PROMINENCE`
-        (see :func:`count_peaks`); None where the aperture is missing for
-        long enough to hide a second opening (:func:`hides_a_reopening`) or
+        :attr:`LandmarkParams.peak_prominence` of the opening and
+        ``peak_min_prominence`` (see :func:`count_peaks`); None where the
+        aperture is missing for long enough to hide a second opening
+        (:meth:`LandmarkParams.hides_a_reopening`) or
         has fewer than 3 samples.
     rest_aperture : float
         Grip aperture at the movement's onset, m.
     opening_time : float
-        When the aperture first exceeds ``rest_aperture`` + :data:`OPENING_LEVEL`
+        When the aperture first exceeds ``rest_aperture`` + ``opening_level``
         of the opening: the grip starts to open, share.
     peak_opening_speed : float
         The aperture's fastest widening before the MGA, m/s.
@@ -356,14 +345,11 @@ def _num(x) -> float | None:
 def count_peaks(values: np.ndarray, min_prominence: float) -> int:
     """Maxima of a sequence whose topographic prominence is at least ``min_prominence``.
 
-    A (plateau-aware) local maximum, the first and last samples included, is
-    as prominent as its height above the higher of the lowest points that
-    separate it from higher samples on either side; the highest one above
-    the lowest sample. (Unlike ``scipy.signal.find_peaks``, a side that
-    never reaches a higher sample does not count: a grasp's MGA stands only
-    a few cm above the aperture at contact, but the whole opening above its
-    rest. numpy only: importing scipy.signal would cost ``recognize`` a
-    quarter of a second.)
+    ``scipy.signal.find_peaks`` on the sequence padded with its minimum at
+    both ends: the first and last samples can be peaks, and a side that
+    never reaches a higher sample does not lower a peak's base (a grasp's
+    MGA stands only a few cm above the aperture at contact, but the whole
+    opening above its rest).
 
     Parameters
     ----------
@@ -372,30 +358,13 @@ def count_peaks(values: np.ndarray, min_prominence: float) -> int:
     min_prominence : float
         Least prominence of a peak that counts.
     """
+    from scipy.signal import find_peaks  # noqa: PLC0415 (scipy.signal as lowpass takes it)
+
     x = np.asarray(values, dtype=float)
-    n = len(x)
-    if n == 0:
+    if not x.size:
         return 0
-    # runs of equal values: a plateau is one candidate
-    starts = np.flatnonzero(np.r_[True, x[1:] != x[:-1]])
-    ends = np.r_[starts[1:], n] - 1
-    count = 0
-    lowest = x.min()
-    for a, b in zip(starts, ends):
-        h = x[a]
-        if (a > 0 and x[a - 1] > h) or (b < n - 1 and x[b + 1] > h):
-            continue
-        cols = []
-        left = np.flatnonzero(x[:a] > h)
-        if len(left):
-            cols.append(x[left[-1]:a].min())
-        right = np.flatnonzero(x[b + 1:] > h)
-        if len(right):
-            cols.append(x[b + 1:b + 2 + right[0]].min())
-        prominence = h - (max(cols) if cols else lowest)
-        if prominence >= min_prominence:
-            count += 1
-    return count
+    low = x.min()
+    return len(find_peaks(np.r_[low, x, low], prominence=min_prominence)[0])
 
 
 def _crossing(time: np.ndarray, values: np.ndarray, level: float) -> float:
@@ -530,15 +499,16 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
     ts = time[seen]
     gaps = np.r_[ts[0] - time[lo], np.diff(ts), time[hi] - ts[-1]]
     peaks = None
-    if not hides_a_reopening(float(gaps.max()), T):
-        peaks = count_peaks(g[seen], max(PEAK_PROMINENCE * opening, PEAK_MIN_PROMINENCE))
+    if not params.hides_a_reopening(float(gaps.max()), T):
+        peaks = count_peaks(g[seen], max(params.peak_prominence * opening,
+                                         params.peak_min_prominence))
     rate = np.gradient(g, time)
     widening = rate[lo:j + 1][np.isfinite(rate[lo:j + 1])]
     return Landmarks(
         **base, mga=mga, mga_time=share(time[j]), contact_aperture=float(g[seen[-1]]),
         aperture_peaks=peaks, rest_aperture=rest,
         opening_time=share(_crossing(time[lo:hi + 1], g[lo:hi + 1],
-                                     rest + OPENING_LEVEL * opening)),
+                                     rest + params.opening_level * opening)),
         peak_opening_speed=float(widening.max()) if len(widening) else math.nan,
         closing_time=t_end - float(time[j]))
 
@@ -593,58 +563,3 @@ def model_landmarks(time: np.ndarray, wrist: np.ndarray, finger: np.ndarray,
                                      np.asarray(a, dtype=float)])
     return movement_landmarks(t, rest(wrist),
                               np.linalg.norm(rest(finger) - rest(thumb), axis=1), params)
-
-
-def verdict_detail(observed: Landmarks, reference: Landmarks | None) -> str:
-    """What kind of abnormal grasp the landmarks describe (one of :data:`DETAILS`).
-
-    In this order (docs/recognition.md §5 gives the sources):
-
-    * ``no-opening``: the observed opening (MGA − rest aperture) is below
-      :data:`NO_OPENING` (30 %) of the reference model's;
-    * ``re-opening``: the aperture has 2 or more peaks (:func:`count_peaks`:
-      each stands out by at least 25 % of the opening and 5 mm);
-    * ``delayed-opening``: the aperture starts to open (exceeds 10 % of its
-      opening) after :data:`LATE_OPENING` (55 %) of the movement, or its MGA
-      comes after :data:`LATE_MGA` (95 %) while the reference's comes earlier;
-    * ``other``: none of these (or not measurable).
-
-    Parameters
-    ----------
-    observed : Landmarks
-        The demonstration's.
-    reference : Landmarks, optional
-        The reference grasp model's own movement's (None without one: then
-        no ``no-opening``, and a late MGA counts on its own).
-    """
-    ref_opening = reference.opening if reference is not None else math.nan
-    if math.isfinite(observed.opening) and math.isfinite(ref_opening) and ref_opening > 0:
-        if observed.opening < NO_OPENING * ref_opening:
-            return "no-opening"
-    if observed.aperture_peaks is not None and observed.aperture_peaks >= 2:
-        return "re-opening"
-    ref_mga_time = reference.mga_time if reference is not None else math.nan
-    late_mga = observed.mga_time > LATE_MGA and not ref_mga_time > LATE_MGA
-    if observed.opening_time > LATE_OPENING or late_mga:
-        return "delayed-opening"
-    return "other"
-
-
-def grip_departs(observed: Landmarks) -> bool:
-    """Whether the grip departs from the transport the way abnormal grasps do.
-
-    The grip starts to open (exceeds 10 % of its opening) after
-    :data:`LATE_OPENING` (55 %) of the movement — real healthy adults start
-    anywhere up to about half-way (a lab's Optotrak grasps; docs/mocap.md) —
-    or the aperture has two or more peaks (:func:`count_peaks`; a normal grasp
-    opens once). Either makes a grasp ``abnormal`` even when the models'
-    familiarity would pass it: the one-step predictions weigh a late or a
-    second opening weakly once the model's filter has followed it.
-
-    Parameters
-    ----------
-    observed : Landmarks
-        The demonstration's landmarks.
-    """
-    peaks = observed.aperture_peaks
-    return bool((peaks is not None and peaks >= 2) or observed.opening_time > LATE_OPENING)

@@ -461,7 +461,7 @@ def _rest_noise(raw: np.ndarray, params: ObserveParams, name: str) -> tuple[floa
 
 
 def onset_time(filtered: np.ndarray, time: np.ndarray, noise: float, params: ObserveParams,
-               name: str) -> float:
+               name: str, rest: np.ndarray | None = None) -> float:
     """When the movement's command began, s: the wrist's crossing less the model's latency.
 
     The crossing is where the wrist's displacement from rest first exceeds
@@ -481,6 +481,9 @@ def onset_time(filtered: np.ndarray, time: np.ndarray, noise: float, params: Obs
         The onset rule's settings.
     name : str
         What an error names.
+    rest : (2,) array, optional
+        The wrist's rest position, m (default: the median of the first
+        ``rest_frames``): given, the rows may be the latest few of a stream.
 
     Raises
     ------
@@ -488,7 +491,8 @@ def onset_time(filtered: np.ndarray, time: np.ndarray, noise: float, params: Obs
         The wrist never leaves its rest position.
     """
     w = filtered[:, 0]
-    disp = np.linalg.norm(w - np.median(w[: params.rest_frames], axis=0), axis=1)
+    rest = np.median(w[: params.rest_frames], axis=0) if rest is None else rest
+    disp = np.linalg.norm(w - rest, axis=1)
     threshold = max(params.onset_displacement, params.onset_noise_factor * noise)
     above = np.nan_to_num(disp, nan=0.0) > threshold
     hold = params.onset_hold_frames

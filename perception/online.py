@@ -2,24 +2,27 @@
 
 :class:`OnlineRecognizer` takes one frame at a time (tracked here, frame by
 frame, as ``hammer-mv track`` does) or one row of marker positions, and
-after each returns an :class:`OnlineState`. What it knows when (docs/online.md):
+after each returns an :class:`OnlineState`. It drives the offline engine
+and rules, causally (docs/online.md):
 
-* **the scene**, once the first ``2 x rest_frames`` rows are in: the
-  pixel-to-model transform, the scale, the rest posture, the tracking noise
-  and the frame period — the same functions and the same frames as the
-  offline observation (:mod:`perception.observation`); the repertoire is
-  planned for it then, once, before the movement begins;
-* **the onset**, the first frame at which the offline onset rule can
-  already be applied: the wrist held beyond its threshold for
-  ``onset_hold_frames`` frames (a few frames' delay, none of guessing);
-* **every model's score so far**, from the onset on
-  (:class:`~perception.recognition.online.StepScorer`): the offline
-  arrays' columns, frame by frame;
-* **a provisional verdict**: the offline verdict rule on what has been seen
-  (see :func:`provisional`), and **settled** once the :class:`SettleRule`
-  holds. What the offline verdict needs the whole movement for — its end,
-  its movement time (the time scale of the shape pass), its landmarks —
-  the provisional one does without; that is why it is provisional.
+* **the scene**, once the first ``2 x rest_frames`` rows are in: the same
+  functions on the same frames as the offline observation
+  (:mod:`perception.observation`); the repertoire is planned for it then,
+  once, before the movement begins;
+* **the onset**: the offline rule, applied as each row arrives;
+* **the reference pass**: the movement brought to the repertoire's
+  reference scale as the offline shape pass brings it
+  (:mod:`perception.recognition.shape`), resampled frame by frame, and
+  scored by :class:`~perception.recognition.engine.StepScorer` — against
+  the grasp models, the reach models, and (digits held closed) the reach
+  models again for the transport's familiarity. Its two unknowns until
+  the movement is over — whether the scene is mirrored and the movement
+  time's scale — are estimated as they become known (the side the finger
+  opens on; the wrist's 10 %-90 % crossings of its way to the models'
+  goal), and the pass is replayed from the onset whenever the estimate
+  changes: with the offline scene and scale, its scores are the offline ones;
+* **a provisional verdict**: :func:`perception.recognition.rules.judge`
+  on the evidence so far, **settled** once the :class:`SettleRule` holds.
 
 When the stream ends, :meth:`OnlineRecognizer.finish` runs the offline
 computation (:func:`perception.pipeline.recognize_tracks`) on the rows
@@ -37,22 +40,82 @@ import numpy as np
 from perception.errors import InputError
 from perception.filtering import AlphaBeta
 from perception.io.tracks import Status, Tracks
+from perception.landmarks import MODEL_SPAN_FRACTION, Landmarks, count_peaks
 from perception.observation import DIGIT_MARKERS, check_hand, onset_time, rest_scene
 from perception.pipeline import RecognitionSettings, recognize_tracks
+from perception.recognition.engine import StepScorer
 from perception.recognition.models import SceneSpec
-from perception.recognition.online import StepScorer
 from perception.recognition.provisional import (
     Decision,
     OnlineState,
     SettleRule,
     decision_summary,
-    provisional,
 )
 from perception.recognition.repertoire import PlanCache, Repertoire
 from perception.recognition.result import Recognition
-from perception.recognition.shape import MIN_TRANSPORT, WRIST_GOAL_OFFSET
+from perception.recognition.rules import Evidence, judge
+from perception.recognition.shape import WRIST_GOAL_OFFSET, mirror_votes
 
 __all__ = ["Decision", "OnlineRecognizer", "OnlineState", "SettleRule", "decision_summary"]
+
+#: The share of a minimum-jerk movement's time (Flash & Hogan 1985) at which it has
+#: covered each share of its way: the causal estimate of "when, in the movement" the
+#: grip starts to open, from how far the wrist has come by then.
+_TAU = np.linspace(0.0, 1.0, 201)
+_WAY = 10 * _TAU**3 - 15 * _TAU**4 + 6 * _TAU**5
+
+
+class _ReferencePass:
+    """The shape pass of :mod:`perception.pipeline`, frame by frame, for one scene guess.
+
+    Parameters
+    ----------
+    models : list of MotorModel
+        The repertoire's models at the reference scene.
+    hammer : HammerParams
+        The engine's settings (the clip's noise already in ``obs_sd``).
+    scale, tip, hand : float, (2,) array, (2,) array
+        The transport's scale about the wrist's goal, the digits' shift to the
+        reference hand, and the reference hand's rest offset ahead of the wrist.
+    alpha, step : float
+        Time scale and the reference frame period, s.
+    sign : float
+        -1 for a mirrored scene.
+    """
+
+    def __init__(self, models, hammer, scale, tip, hand, alpha, step, sign):
+        grasp = [m for m in models if m.kind == "grasp"] or models
+        reach = [m for m in models if m.kind == "reach"]
+        self.kinds = {"grasp": StepScorer(grasp, hammer), "reach": StepScorer(reach or models,
+                                                                               hammer)}
+        self.closed = StepScorer(reach, hammer) if reach else None
+        self.scale, self.tip, self.hand = scale, tip, hand
+        self.alpha, self.step, self.sign = alpha, step, sign
+        self.last = None  # (scaled time, wrist, finger, thumb) of the last frame
+
+    def feed(self, t: float, w, f, th) -> None:
+        """The next frame: ``t`` s since the onset, filtered tips (2,) m in the clip's frame."""
+        goal = np.array([0.0, -WRIST_GOAL_OFFSET])
+        flip = np.array([self.sign, 1.0])
+        w, f, th = w * flip, f * flip, th * flip
+        wrist = goal + (w - goal) * self.scale  # as shape.canonical: the transport scaled,
+        now = (t * self.alpha, wrist, f - w + wrist + self.tip, th - w + wrist + self.tip)
+        last, self.last = self.last, now
+        if last is None:
+            self.t0 = now[0]
+        # resampled at the reference frame period as shape.canonical resamples
+        if last is None:  # the grid starts at the first frame, the first point needs two
+            return
+        first = max(math.floor(last[0] / self.step) + 1, math.ceil(self.t0 / self.step))
+        for k in range(first, math.floor(now[0] / self.step) + 1):
+            tk = k * self.step
+            a = (tk - last[0]) / (now[0] - last[0])
+            pos = [p0 + a * (p1 - p0) for p0, p1 in zip(last[1:], now[1:])]
+            for scorer in self.kinds.values():
+                scorer.step(tk, *pos)
+            if self.closed is not None:
+                tips = pos[0] + self.hand
+                self.closed.step(tk, pos[0], tips, tips)
 
 
 class OnlineRecognizer:
@@ -63,7 +126,7 @@ class OnlineRecognizer:
     repertoire : Repertoire
         The models.
     settings : RecognitionSettings, optional
-        Observation, engine and tracking settings (as ``recognize``'s).
+        Observation, engine, verdict and tracking settings (as ``recognize``'s).
     clip : str
         Clip name (the report's).
     markers : sequence of str, optional
@@ -98,13 +161,9 @@ class OnlineRecognizer:
         self._rows: dict[str, list] = {k: [] for k in ("frame", "time", "position",
                                                        "likelihood", "status")}
         self._scene = None  # SimpleNamespace once fixed
-        self._scorer: StepScorer | None = None
         self._onset: float | None = None
-        self._obs: list[np.ndarray] = []  # (3, 2) m per row: wrist, finger tip, thumb tip
-        self._aperture: list[float] = []
-        self._walked: list[float] = []  # progress at each scored frame
+        self._moving: list[tuple] = []  # (since onset, wrist, finger tip, thumb tip) from the onset
         self._verdicts: list[tuple[float, str]] = []  # (since onset, verdict) since it changed
-        self._progress = 0.0
         self._decision: Decision | None = None
         self.state: OnlineState | None = None
 
@@ -154,25 +213,27 @@ class OnlineRecognizer:
             state = self._row(i, ti, *tracker.update(img, ti))
         return state
 
-    def _waiting(self, index: int, t: float) -> OnlineState:
-        zeros = np.zeros(len(self.repertoire.names))
-        self.state = OnlineState(index, t, "start", list(self.repertoire.names), zeros, zeros)
+    def _waiting(self, index: int, t: float, phase: str = "start") -> OnlineState:
+        names = self._scene.names if self._scene is not None else list(self.repertoire.names)
+        zeros = np.zeros(len(names))
+        self.state = OnlineState(index, t, phase, names, zeros, zeros)
         return self.state
 
     # -- the stream -------------------------------------------------------------
     def _row(self, index: int, t: float, position, likelihood, status) -> OnlineState:
         for key, value in zip(self._rows, (index, t, position, likelihood, status)):
             self._rows[key].append(value)
-        params = self.settings.observe
         if self._scene is None:
-            if len(self._rows["time"]) < 2 * params.rest_frames:
+            if len(self._rows["time"]) < 2 * self.settings.observe.rest_frames:
                 return self._waiting(index, t)
             self._fix_scene()
         self._filter(len(self._rows["time"]) - 1)
         if self._onset is None:
             self._find_onset()
-        elif self._scorer is not None:
-            self._score(len(self._obs) - 1)
+        else:
+            self._score(len(self._scene.filtered) - 1)
+        if self._onset is None:
+            return self._waiting(index, t, "rest")
         return self._judge(index, t)
 
     def tracks(self, video: dict | None = None) -> Tracks:
@@ -196,105 +257,175 @@ class OnlineRecognizer:
 
     def _fix_scene(self) -> None:
         """Scene, rest posture, noise and models from the rest frames, as offline; plan once."""
-        params = self.settings.observe
+        params, rules = self.settings.observe, self.settings.rules
         first = rest_scene(self.tracks(), params, clip=self.clip)
         check_hand(first, params)
-        transform, rest, noise, dt = first.transform, first.rest, first.noise, first.dt
+        rest = first.rest
         half = 0.5 * (rest[1] - rest[2])
         scene = SceneSpec(distance=float(np.linalg.norm(rest[0])),
-                          object_size=params.object_diameter, frame_period=dt,
+                          object_size=params.object_diameter, frame_period=first.dt,
                           tip_start=float((0.5 * (rest[1] + rest[2]) - rest[0])[1]))
-        # planned for the scene now, before the movement: the final, offline
-        # pass finds them planned
+        way = scene.distance - WRIST_GOAL_OFFSET
+        if way < rules.min_transport:  # as the offline shape pass refuses it
+            raise InputError(f"starts {scene.distance * 1000:.0f} mm from the object: too near "
+                             "to judge a reach", self.clip, field="wrist")
+        # planned for the scene now, before the movement: the final pass finds them planned
         self.repertoire.for_scene(scene, cache=self.plan_cache)
-        # the provisional verdict judges the movement as the shape pass does, at
-        # the repertoire's reference scale (perception.recognition.shape)
-        ref, _ = self.repertoire.reference()
+        ref, durations = self.repertoire.reference()
         ref = dataclasses.replace(ref, object_size=params.object_diameter)
         models = self.repertoire.for_scene(ref, cache=self.plan_cache)
         cols = [self.markers.index(m) for m in DIGIT_MARKERS]
-        hand = 0.5 * (rest[1] + rest[2]) - rest[0]
-        self._scene = SimpleNamespace(
-            transform=transform, cols=cols, noise=noise, rest=rest, half=half, dt=dt,
-            models=models, kinds=[m.kind for m in models],
-            filt=AlphaBeta((3, 2), params.alpha, params.beta), filtered=[],
-            way=max(scene.distance - WRIST_GOAL_OFFSET, 1e-6),
-            scale=(ref.distance - WRIST_GOAL_OFFSET) / max(scene.distance - WRIST_GOAL_OFFSET,
-                                                           MIN_TRANSPORT),
-            tip=np.array([0.0, ref.tip_start]) - hand)
+        scale = (ref.distance - WRIST_GOAL_OFFSET) / way
         hammer = self.settings.hammer  # the clip's own noise, as the shape pass
-        self._scene.scorer = StepScorer(models, dataclasses.replace(  # built before the onset
-            hammer, obs_sd=max(hammer.obs_sd, noise * self._scene.scale)))
+        hammer = dataclasses.replace(hammer, obs_sd=max(hammer.obs_sd, first.noise * scale))
+        self._scene = SimpleNamespace(
+            first=first, cols=cols, half=half, way=way, durations=durations, ref=ref,
+            models=models, names=[m.name for m in models], hammer=hammer, scale=scale,
+            filt=AlphaBeta((3, 2), params.alpha, params.beta), filtered=[],
+            separation=float(np.linalg.norm(2 * half)), guess=None, reference=None,
+            rest_wrist=None, votes=[0, 0], peak_speed=0.0, slowed=0.0, walked=[], aperture=[],
+            # past three times the longest model's movement the movement is over: the
+            # evidence is kept as it was, and no frame costs more than the one before
+            window=math.ceil(3 * durations[1] / first.dt), judged=None, t10=math.nan,
+            t90=math.nan, gap=(math.nan, 0.0))
 
     def _filter(self, upto: int) -> None:
         """Filter the rows not filtered yet, up to row ``upto``, in the model frame."""
         sc, rows = self._scene, self._rows
         for i in range(len(sc.filtered), upto + 1):
-            z = sc.transform.to_model(np.asarray(rows["position"][i], dtype=float)[sc.cols])
-            dt = sc.dt if i == 0 else rows["time"][i] - rows["time"][i - 1]
-            f = sc.filt(z, dt)
-            sc.filtered.append(f)
-            self._obs.append(np.stack([f[0], f[1] - sc.half, f[2] + sc.half]))
+            z = sc.first.transform.to_model(np.asarray(rows["position"][i], dtype=float)[sc.cols])
+            dt = sc.first.dt if i == 0 else rows["time"][i] - rows["time"][i - 1]
+            sc.filtered.append(sc.filt(z, dt))
 
     def _find_onset(self) -> None:
-        """The offline onset rule on the rows so far; once it holds, score from the onset."""
+        """The offline onset rule on the latest rows; once it holds, score from the onset."""
         sc, params = self._scene, self.settings.observe
-        time = np.asarray(self._rows["time"], dtype=float)
+        if sc.rest_wrist is None:  # the wrist's rest, as the offline rule takes it
+            sc.rest_wrist = np.median(np.asarray(sc.filtered[:params.rest_frames])[:, 0], axis=0)
+        k = max(0, len(sc.filtered) - params.onset_hold_frames - 1)
+        time = np.asarray(self._rows["time"][k:], dtype=float)
         try:
-            onset = onset_time(np.asarray(sc.filtered), time, sc.noise, params, self.clip)
+            onset = onset_time(np.asarray(sc.filtered[k:]), time, sc.first.noise, params,
+                               self.clip, rest=sc.rest_wrist)
         except InputError:  # no movement yet
             return
         self._onset = onset
-        self._start = int(np.searchsorted(time, onset))
-        self._scorer = sc.scorer
-        for i in range(self._start, len(time)):
+        first = int(np.searchsorted(np.asarray(self._rows["time"], dtype=float), onset))
+        for i in range(first, len(sc.filtered)):
             self._score(i)
 
     def _score(self, i: int) -> None:
-        w, f, th = self._obs[i]
         sc = self._scene
-        goal = np.array([0.0, -WRIST_GOAL_OFFSET])
-        wrist = goal + (w - goal) * sc.scale  # as shape.canonical: the transport scaled,
-        self._scorer.step(self._rows["time"][i] - self._onset, wrist,  # the grip kept
-                          f - w + wrist + sc.tip, th - w + wrist + sc.tip)
-        self._aperture.append(float(np.linalg.norm(f - th)))
-        self._progress = max(self._progress, float(
-            np.nan_to_num(np.linalg.norm(w - sc.rest[0]) / sc.way)))
-        self._walked.append(self._progress)
+        f = sc.filtered[i]
+        row = (self._rows["time"][i] - self._onset, f[0], f[1] - sc.half, f[2] + sc.half)
+        self._moving.append(row)
+        sc.aperture.append(float(np.linalg.norm(row[2] - row[3])))
+        if math.isfinite(sc.aperture[-1]):
+            sc.gap = (row[0], sc.gap[1] if math.isnan(sc.gap[0]) else max(sc.gap[1],
+                                                                           row[0] - sc.gap[0]))
+        progress = np.linalg.norm(row[1] - sc.first.rest[0]) / sc.way
+        sc.walked.append(max(float(np.nan_to_num(progress)), sc.walked[-1] if sc.walked else 0.0))
+        if len(self._moving) > 1:  # the transport's speed, against its peak so far
+            prev = self._moving[-2]
+            speed = float(np.linalg.norm(row[1] - prev[1]) / max(row[0] - prev[0], 1e-9))
+            if math.isfinite(speed):
+                sc.peak_speed = max(sc.peak_speed, speed)
+                sc.slowed = 1.0 - speed / sc.peak_speed if sc.peak_speed > speed else 0.0
+        if math.isnan(sc.t10) and progress >= 0.1:
+            sc.t10 = row[0]
+        if math.isnan(sc.t90) and progress >= 0.9:
+            sc.t90 = row[0]
+        guess = self._guess()
+        if guess != sc.guess:  # replayed from the onset under the new guess
+            sc.guess = guess
+            mirror, alpha = guess
+            sc.reference = _ReferencePass(
+                sc.models, sc.hammer, sc.scale, np.array([0.0, sc.ref.tip_start])
+                - (0.5 * (sc.first.rest[1] + sc.first.rest[2]) - sc.first.rest[0])
+                * [-1.0 if mirror else 1.0, 1.0], np.array([0.0, sc.ref.tip_start]), alpha,
+                sc.ref.frame_period, -1.0 if mirror else 1.0)
+            for r in self._moving:
+                sc.reference.feed(*r)
+        else:
+            sc.reference.feed(*row)
+
+    def _guess(self) -> tuple[bool, float]:
+        """The scene's mirroring and the time scale, as far as the movement shows them."""
+        sc = self._scene
+        rules = self.settings.rules
+        vote = mirror_votes((self._moving[-1][2] - self._moving[-1][3])[None], rules)
+        if vote is not None:  # a frame with the grip open wide enough to read its side
+            sc.votes[int(vote)] += 1
+        mirror = sc.votes[1] > rules.mirror_majority * sum(sc.votes)
+        mt = (sc.t90 - sc.t10) / MODEL_SPAN_FRACTION
+        alpha = float(np.clip(mt, *sc.durations) / mt) if mt > 0 else 1.0
+        if sc.guess is not None and abs(alpha / sc.guess[1] - 1) < 0.02:
+            alpha = sc.guess[1]
+        return mirror, alpha
+
+    def _evidence(self) -> tuple[Evidence, SimpleNamespace]:
+        """What the verdict is judged on so far, and the grip's course."""
+        sc, rules = self._scene, self.settings.rules
+        ref = sc.reference
+        g = np.asarray(sc.aperture)
+        seen = np.isfinite(g)
+        grip = SimpleNamespace(opened=False, peaks=0, closing=0.0, open_at=math.nan,
+                               mt=(sc.t90 - sc.t10) / MODEL_SPAN_FRACTION,
+                               opening=0.0, slowed=sc.slowed)
+        if seen.sum() >= 3:
+            gs = g[seen]
+            rest = float(gs[:rules.grasp_rest_frames].mean())
+            opening = grip.opening = float(gs.max() - rest)
+            grip.opened = opening >= rules.grasp_opening * self.settings.observe.object_diameter
+            lp = rules.landmarks
+            # as the landmarks count them: not across a gap that may hide one
+            grip.peaks = None if lp.hides_a_reopening(sc.gap[1], grip.mt) else count_peaks(
+                gs, max(lp.peak_prominence * opening, lp.peak_min_prominence))
+            walked = np.asarray(sc.walked)[seen]
+            grip.open_at = float(np.interp(walked[np.argmax(gs > rest + lp.opening_level
+                                                            * opening)], _WAY, _TAU))
+            grip.closing = (float(gs.max() - gs[-1]) / opening) if opening > 0 else 0.0
+        scorer = ref.kinds["grasp" if grip.opened else "reach"]
+        fam = scorer.familiarity(sc.ref.frame_period)
+        transport = math.nan
+        if ref.closed is not None and ref.closed.frames > 1:
+            ll = ref.closed.log_likelihood
+            transport = float(ref.closed.familiarity(sc.ref.frame_period)[int(np.argmax(ll))])
+        # what is known before the end: when the grip started to open, how often it did
+        observed = Landmarks(movement_time=grip.mt, aperture_peaks=grip.peaks,
+                             opening_time=grip.open_at if grip.opened else math.nan)
+        evidence = Evidence([m.kind for m in scorer.models], scorer.log_likelihood, fam,
+                            transport, sc.separation, observed, None, sc.gap[1])
+        return evidence, grip
 
     def _judge(self, index: int, t: float) -> OnlineState:
-        sc, names = self._scene, [m.name for m in self._scene.models]
-        if self._scorer is None:
-            zeros = np.zeros(len(names))
-            self.state = OnlineState(index, t, "rest", names, zeros, zeros)
-            return self.state
+        sc, rules = self._scene, self.settings.rules
         since = t - self._onset
-        hammer = self.settings.hammer
-        best, verdict, detail, fam = provisional(
-            sc.kinds, self._scorer, np.asarray(self._aperture), np.asarray(self._walked),
-            self.settings.observe.object_diameter, sc.dt, hammer.familiarity_threshold)
+        if sc.judged is None or len(self._moving) <= sc.window:
+            sc.judged = self._evidence()
+        evidence, grip = sc.judged
+        d = judge(evidence, rules)
+        verdict, detail = d.verdict or "abnormal", d.detail
         if not self._verdicts or self._verdicts[-1][1] != verdict:
             self._verdicts.append((since, verdict))
-        evidence = (math.inf if detail else abs(math.log(max(fam, 1e-300)
-                                                         / hammer.familiarity_threshold))
-                    if math.isfinite(fam) else 0.0)
-        if self._decision is None and self._settles(since, verdict, evidence):
+        progress = min(sc.walked[-1], 1.0)
+        sure = self.settle.sure(d, evidence, grip, rules, progress)
+        if self._decision is None and sure and since - self._verdicts[-1][0] >= self.settle.hold:
             self._decision = Decision(verdict, detail, t, since, index)
+        scorer = sc.reference.kinds["grasp" if grip.opened else "reach"]
+        by_name = dict(zip([m.name for m in scorer.models],
+                           zip(scorer.confidence, scorer.log_likelihood)))
+        conf = np.array([by_name.get(n, (0.0, 0.0))[0] for n in sc.names])
+        ll = np.array([by_name.get(n, (0.0, -np.inf))[1] for n in sc.names])
         self.state = OnlineState(
-            index, t, "moving", names, self._scorer.confidence.copy(),
-            self._scorer.log_likelihood.copy(), since, min(self._progress, 1.0),
-            names[best], verdict, detail, fam, evidence, self._decision)
+            index, t, "moving", sc.names, conf, ll, since, progress,
+            scorer.models[d.best].name, verdict, detail, d.familiarity,
+            self.settle.evidence(d, evidence, rules), self._decision)
         return self.state
-
-    def _settles(self, since: float, verdict: str, evidence: float) -> bool:
-        rule = self.settle
-        progress = rule.reach_progress if verdict == "reach" else rule.min_progress
-        return (self._progress >= progress and evidence >= rule.margin
-                and since - self._verdicts[-1][0] >= rule.hold)
 
     @property
     def last_row(self) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-        """The last row received: positions (M, 2) px, likelihood (M,), status (M,); None before one."""
+        """The last row: positions (M, 2) px, likelihood (M,), status (M,); None before one."""
         rows = self._rows
         if not rows["time"]:
             return None
@@ -332,4 +463,3 @@ class OnlineRecognizer:
             raise InputError("no frames received", source or self.clip)
         return recognize_tracks(self.tracks(video), self.repertoire, self.settings,
                                 clip=self.clip, source=source, plan_cache=self.plan_cache)
-

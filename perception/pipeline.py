@@ -38,6 +38,7 @@ from perception.recognition.engine import HammerParams, recognize
 from perception.recognition.models import SceneSpec
 from perception.recognition.repertoire import PlanCache, Repertoire
 from perception.recognition.result import Recognition
+from perception.recognition.rules import VerdictRules
 
 if TYPE_CHECKING:  # the tracker (OpenCV) and movement are imported only when needed
     from perception.io.frame_sample import FrameSample
@@ -76,6 +77,8 @@ class RecognitionSettings:
         Tracks -> observation settings.
     hammer : HammerParams
         Rule and weights of the engine.
+    rules : VerdictRules
+        Every threshold of the verdict (``--verdict-rules``).
     tracking : TrackingSetup, optional
         Colour models and marker sizes for tracking videos (``--setup``).
     pose : PoseImport, optional
@@ -93,6 +96,7 @@ class RecognitionSettings:
 
     observe: ObserveParams = field(default_factory=ObserveParams)
     hammer: HammerParams = field(default_factory=HammerParams)
+    rules: VerdictRules = field(default_factory=VerdictRules)
     tracking: TrackingSetup | None = None
     pose: PoseImport | None = None
     keep_truncated: bool = False
@@ -106,7 +110,7 @@ class RecognitionSettings:
     def fingerprint(self) -> dict:
         """JSON-able settings that change results."""
         out = {"observe": dataclasses.asdict(self.observe),
-               "hammer": dataclasses.asdict(self.hammer)}
+               "hammer": dataclasses.asdict(self.hammer), "rules": self.rules.to_dict()}
         # only when set, so that reports made without them stay current
         if self.tracking is not None:
             out["tracking"] = self.tracking.to_dict()
@@ -356,7 +360,7 @@ def recognize_tracks(tracks: Tracks, repertoire: Repertoire,
         # a clip that does not start still is scored from the scene its data give
         tracks, settled = settle_start(tracks, settings.observe, clip=clip)
         obs = observe(tracks, settings.observe, clip=clip)
-        mirrored = is_mirrored(obs)
+        mirrored = is_mirrored(obs, settings.rules)
         if mirrored:  # the other hand, or the camera on the other side: score its mirror image
             obs = observe(tracks, dataclasses.replace(settings.observe,
                                                       mirror=not settings.observe.mirror),
@@ -368,20 +372,20 @@ def recognize_tracks(tracks: Tracks, repertoire: Repertoire,
         raise type(exc)(exc.problem, source, field=exc.field) from None
     # brought to the reference scale first: a clip that cannot be judged is
     # refused before its scene is planned
-    shape_obs, norm = _canonical(obs, repertoire, source)
+    shape_obs, norm = _canonical(obs, repertoire, source, settings.rules)
     try:
         models = repertoire.for_scene(SceneSpec.of(obs), cache=plan_cache)
     except PlanningError as exc:  # the scene, not the software: name the clip and the scale
         raise PlanningError(f"{exc.problem} (check the scale: --px-per-m, --object-diameter)",
                             source or obs.clip, field=exc.field) from None
-    rec = _scored(obs, models, repertoire, settings.hammer)
+    rec = _scored(obs, models, repertoire, settings.hammer, settings.rules)
     shape, transport = _shape_pass(shape_obs, repertoire, settings, plan_cache)
     return dataclasses.replace(rec, shape=shape, normalisation=norm,
                                transport_familiarity=transport, mirrored=mirrored,
                                notes=(settled,) if settled else ())
 
 
-def _canonical(obs, repertoire: Repertoire, source):
+def _canonical(obs, repertoire: Repertoire, source, rules: VerdictRules):
     """``obs`` at the repertoire's reference scale (see :mod:`perception.recognition.shape`).
 
     The reference scene keeps the clip's object size (the grip's targets
@@ -392,7 +396,7 @@ def _canonical(obs, repertoire: Repertoire, source):
     scene, durations = repertoire.reference()
     scene = dataclasses.replace(scene, object_size=obs.object_diameter)
     try:
-        return canonical(obs, scene, durations)
+        return canonical(obs, scene, durations, rules)
     except InputError as exc:
         raise type(exc)(exc.problem, source or obs.clip, field=exc.field) from None
 
@@ -411,25 +415,32 @@ def _shape_pass(shape_obs, repertoire: Repertoire, settings: RecognitionSettings
 
     scene = SceneSpec.of(shape_obs)
     every = repertoire.for_scene(scene, cache=plan_cache)
-    kind = "grasp" if opens(shape_obs) else "reach"
+    kind = "grasp" if opens(shape_obs, settings.rules) else "reach"
     models = [m for m in every if m.kind == kind] or every
     # the clip's own tracking noise, where it exceeds what the rule assumes
     hammer = dataclasses.replace(settings.hammer,
                                  obs_sd=max(settings.hammer.obs_sd, shape_obs.noise))
-    shape = _scored(shape_obs, models, repertoire, hammer)
+    shape = _scored(shape_obs, models, repertoire, hammer, settings.rules)
     reach = [m for m in every if m.kind == "reach"]
     if not reach:
         return shape, float("nan")
-    return shape, _scored(closed_hand(shape_obs), reach, repertoire, hammer).decision.familiarity
+    return shape, _scored(closed_hand(shape_obs), reach, repertoire, hammer,
+                          settings.rules).decision.familiarity
 
 
-def _scored(obs, models: list, repertoire: Repertoire, params: HammerParams) -> Recognition:
-    """:func:`recognize`, with the best model calibrated first if it has no calibration yet
-    (the default repertoire calibrates only the models a verdict rests on)."""
-    rec = recognize(obs, models, params)
-    if rec.verdict is None:
-        rec = recognize(obs, repertoire.calibrated(models, rec.decision.best), params)
-    return rec
+def _scored(obs, models: list, repertoire: Repertoire, params: HammerParams,
+            rules: VerdictRules) -> Recognition:
+    """:func:`recognize`, with the best model's familiarity read off its calibration made
+    now if it has none yet (the default repertoire calibrates only the models a verdict
+    rests on)."""
+    rec = recognize(obs, models, params, rules)
+    best = rec.decision.best
+    if rec.verdict is not None:
+        return rec
+    models = repertoire.calibrated(rec.models, best)
+    familiarity = rec.familiarity.copy()
+    familiarity[best] = models[best].calibration.familiarity(float(rec.misfit[best]), obs.dt)
+    return dataclasses.replace(rec, models=models, familiarity=familiarity)
 
 
 def recognize_clip(source: str | os.PathLike | Tracks, repertoire: Repertoire,

@@ -10,7 +10,7 @@ from _demos import default_repertoire, demo_tracks
 
 from perception.batch import ClipResult, summary_table
 from perception.pipeline import recognize_clip
-from perception.recognition.verdict import Verdict
+from perception.recognition.rules import Verdict
 from perception.report import ClipSummary, write_batch_report, write_clip_report
 from perception.report.clip import clip_figures, clip_outputs
 from perception.report.kinematics import kinematic_traces, kinematics_figure, kinematics_title

@@ -8,7 +8,7 @@ import pytest
 from _demos import default_repertoire, demo_tracks
 
 from perception.errors import InputError
-from perception.landmarks import MAX_GAP, MAX_GAP_SHARE, hides_a_reopening
+from perception.landmarks import LandmarkParams
 from perception.observation import observe
 from perception.pipeline import recognize_tracks
 
@@ -50,11 +50,12 @@ def test_a_clip_starting_with_the_grip_open_cannot_be_judged(normal):
 
 
 def test_a_gap_hides_a_reopening_by_its_length_and_its_share_of_the_movement():
-    assert not hides_a_reopening(MAX_GAP, 0.3)                     # never at 0.1 s or less
-    assert not hides_a_reopening(0.2, 1.5)                         # 13 % of a slow grasp
-    assert hides_a_reopening(0.2, 0.5)                             # 40 % of a fast one
-    assert hides_a_reopening(MAX_GAP_SHARE * 2.0 + 0.01, 2.0)
-    assert hides_a_reopening(0.15, math.nan)                       # unknown: the 0.1 s alone
+    lp = LandmarkParams()
+    assert not lp.hides_a_reopening(lp.max_gap, 0.3)                # never at 0.1 s or less
+    assert not lp.hides_a_reopening(0.2, 1.5)                       # 13 % of a slow grasp
+    assert lp.hides_a_reopening(0.2, 0.5)                           # 40 % of a fast one
+    assert lp.hides_a_reopening(lp.max_gap_share * 2.0 + 0.01, 2.0)
+    assert lp.hides_a_reopening(0.15, math.nan)                     # unknown: the 0.1 s alone
 
 
 def test_the_report_names_the_rule_that_gave_the_verdict(normal):

@@ -18,7 +18,7 @@ from _demos import default_repertoire, demo_tracks
 from hammer_mv.cli import main
 from minvar import GraspTask, shoulder_for
 from perception.errors import InputError
-from perception.landmarks import LATE_OPENING, movement_time
+from perception.landmarks import movement_time
 from perception.observation import observe
 from perception.pipeline import recognize_tracks
 from perception.recognition.models import SceneSpec
@@ -58,9 +58,18 @@ def test_a_fast_delayed_grasp_opens_where_real_people_do_and_is_not_confidently_
     """A known limit, measured: the model's 0.7 s delayed grasp starts to open at 52 % of
     its movement (the muscles' lag), inside the 3-68 % real healthy grips open at
     (docs/mocap.md), so the landmark rule cannot call it late; its fit is poor."""
-    rec = recognize_tracks(demo_tracks("delayed", 0, duration=0.7)[0], default_repertoire())
-    assert 0.45 < rec.landmarks[0].opening_time < LATE_OPENING
-    assert rec.verdict in ("normal", "abnormal") and rec.decision.familiarity < 0.5
+    rep = default_repertoire()
+    rec = recognize_tracks(demo_tracks("delayed", 0, duration=0.7)[0], rep)
+    opening = rec.landmarks[0].opening_time
+    assert 0.45 < opening < 0.55  # measured: 0.524
+    assert 0.03 <= opening <= 0.68  # where real healthy grips start to open
+    # so no landmark rule calls it abnormal: the verdict is the familiarity's, no detail
+    assert rec.verdict == "normal" and rec.verdict_detail is None
+    # and its fit is poor: measured 0.08, against 0.90 for the normal grasp of the same
+    # speed, seed and scene, which starts to open at a fifth of its movement
+    normal = recognize_tracks(demo_tracks("normal", 0, duration=0.7)[0], rep)
+    assert normal.verdict == "normal" and normal.landmarks[0].opening_time < 0.3
+    assert rec.decision.familiarity < 0.2 * normal.decision.familiarity
 
 
 def test_canonical_scales_time_and_transport_but_not_the_grip():

@@ -13,13 +13,16 @@ from perception.recognition import ModelSpec, Repertoire, SceneSpec, build_model
 from perception.recognition.calibration import calibrate, own_demonstration
 from perception.recognition.engine import HammerParams
 from perception.recognition.rollout import rollout
-from perception.recognition.verdict import (
-    DEFAULT_THRESHOLD,
-    Calibration,
-    CalibrationParams,
-    decide,
-)
+from perception.recognition.rules import Evidence, VerdictRules, judge
+from perception.recognition.verdict import Calibration, CalibrationParams
 from perception.synthetic.independent import draw_independent, independent_tracks
+
+DEFAULT_THRESHOLD = VerdictRules().familiarity_threshold
+
+
+def decide(kinds, ll, familiarity):
+    return judge(Evidence(kinds, ll, familiarity))
+
 
 EXPECTED = {"normal": "normal", "delayed": "abnormal", "open-close-open": "abnormal",
             "reach": "reach"}
@@ -70,7 +73,9 @@ def test_bad_calibration_input_is_refused():
     with pytest.raises(ValueError, match="time_scale"):
         CalibrationParams(time_scale=0.7)
     with pytest.raises(ValueError, match="familiarity_threshold"):
-        HammerParams(familiarity_threshold=1.5)
+        VerdictRules(familiarity_threshold=1.5)
+    with pytest.raises(ValueError, match="late_opening"):
+        VerdictRules(late_opening=-0.1)
 
 
 # -- calibration in the repertoire --------------------------------------------------------

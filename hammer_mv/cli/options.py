@@ -16,10 +16,12 @@ from pathlib import Path
 from hammer_mv.cli.checks import options
 from hammer_mv.cli.flags import FPS_HELP, add_video_options
 from perception.errors import InputError
+from perception.io.config import check_keys, read_toml
 from perception.observation import ObserveParams
 from perception.pipeline import RecognitionSettings
 from perception.recognition.engine import RULES, HammerParams
 from perception.recognition.repertoire import Repertoire
+from perception.recognition.rules import VerdictRules
 from perception.recognition.scoring import THESIS_SIGNS
 
 _OBSERVE = ObserveParams()
@@ -63,6 +65,10 @@ def add_recognition_options(p: argparse.ArgumentParser) -> None:
                    help="image scale (default: from the object's apparent size)")
     g.add_argument("--mirror", action="store_true",
                    help="mirror the image so the finger lies on the model's +x side")
+    g.add_argument("--verdict-rules", type=Path, metavar="RULES.toml",
+                   help="the verdict's thresholds: a TOML file with a [verdict] table of "
+                        "VerdictRules fields (and [verdict.landmarks]); the report's "
+                        "verdict_rules lists them all (docs/recognition.md)")
     add_pose_options(p)
     add_mocap_options(p)
     add_video_options(p, fps=False)
@@ -223,7 +229,12 @@ def recognition_settings(args: argparse.Namespace) -> RecognitionSettings:
     if any(getattr(args, k, None) is not None for k in ("markers", "rate", "units",
                                                         "trial_column", "object_size")):
         mocap = mocap_import(args)
-    return RecognitionSettings(observe=observe, hammer=hammer, tracking=tracking,
+    rules = VerdictRules()
+    if getattr(args, "verdict_rules", None) is not None:
+        data = read_toml(args.verdict_rules, "verdict rules")
+        check_keys(data, ["verdict"], "the top level", args.verdict_rules)
+        rules = VerdictRules.from_dict(data.get("verdict", {}), args.verdict_rules)
+    return RecognitionSettings(observe=observe, hammer=hammer, rules=rules, tracking=tracking,
                                pose=pose_import(args), keep_truncated=args.keep_truncated,
                                fps=args.fps, mocap=mocap)
 

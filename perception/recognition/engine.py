@@ -34,10 +34,15 @@ from perception.observation import Observation
 from perception.recognition.leaves import Leaves, forward_kinematics
 from perception.recognition.models import ChainModel, MotorModel
 from perception.recognition.result import Recognition
+from perception.recognition.rules import VerdictRules
 from perception.recognition.scoring import RULES, THESIS_SIGNS, likelihood_rule, thesis_rule
-from perception.recognition.verdict import DEFAULT_THRESHOLD, UNFAMILIAR_THRESHOLD, misfit
+from perception.recognition.verdict import misfit
 
-__all__ = ["HammerParams", "RULES", "recognize"]
+__all__ = ["HammerParams", "RULES", "StepScorer", "recognize"]
+
+#: Model steps a :class:`StepScorer`'s stacked gains are first made for (doubled when
+#: a movement lasts longer; past a plan's horizon its gains stay the last ones).
+FIRST_STEPS = 256
 
 
 @dataclass(frozen=True)
@@ -52,15 +57,6 @@ class HammerParams:
         Weights of the transport and grip terms of the thesis rule (w_r/w_g = 1/2).
     obs_sd : float
         SD of the tracked positions after filtering, m (likelihood rule).
-    familiarity_threshold : float
-        Lowest familiarity (0..1) of the best model for the verdict ``normal``
-        (or ``reach``); below it the verdict is ``abnormal``
-        (:mod:`perception.recognition.verdict`).
-    unfamiliar_threshold : float
-        Lowest familiarity (0..1) of the movement's transport alone (digits
-        held closed) to the best reach model; below it nothing in the
-        repertoire explains the movement as a human reach or grasp and the
-        verdict is ``unfamiliar``.
     filter_gain : float
         How strongly observed positions correct each model's own estimate of
         velocity and force: 1 applies the plan's Kalman gains as designed, 0
@@ -84,8 +80,6 @@ class HammerParams:
     w_g: float = 2.0
     obs_sd: float = 0.001
     filter_gain: float = 0.3
-    familiarity_threshold: float = DEFAULT_THRESHOLD
-    unfamiliar_threshold: float = UNFAMILIAR_THRESHOLD
     thesis_sign: str = "text"
 
     def __post_init__(self):
@@ -102,12 +96,6 @@ class HammerParams:
             raise ValueError(f"filter_gain: expected a value in [0, 1], got {self.filter_gain}")
         if not (np.isfinite(self.obs_sd) and self.obs_sd > 0):
             raise ValueError(f"obs_sd: expected a positive SD in m, got {self.obs_sd}")
-        if not 0 <= self.familiarity_threshold <= 1:
-            raise ValueError("familiarity_threshold: expected a value in [0, 1], got "
-                             f"{self.familiarity_threshold}")
-        if not 0 <= self.unfamiliar_threshold <= 1:
-            raise ValueError("unfamiliar_threshold: expected a value in [0, 1], got "
-                             f"{self.unfamiliar_threshold}")
 
 
 def _clamp_reach(p: np.ndarray, l1: float, l2: float) -> np.ndarray:
@@ -134,25 +122,15 @@ def _unwrap_to(q: np.ndarray, ref: np.ndarray) -> np.ndarray:
     return q
 
 
-def _model_steps(time: np.ndarray, dt: float) -> np.ndarray:
-    """Model step of each frame, from the clip's real time stamps.
-
-    Dropped frames and jitter land on the right step; every frame is at
-    least one step after the one before.
-    """
-    s_of = np.round(time / dt).astype(int)
-    idx = np.arange(len(time))
-    return np.maximum.accumulate(s_of - idx) + idx
-
-
-def _observed_angles(obs: Observation, chains: list[ChainModel]) -> np.ndarray:
-    """(N, L, 2) joint angles of every leaf for the observed positions; NaN where lost.
+def _observed_angles(w: np.ndarray, f: np.ndarray, t: np.ndarray,
+                     chains: list[ChainModel]) -> np.ndarray:
+    """(N, L, 2) joint angles of every leaf for wrist, finger and thumb positions (N, 2);
+    NaN where lost.
 
     The arm's tip is the wrist about the shoulder; a digit's is its tip
     about the wrist.
     """
-    w, f, t = obs.wrist, obs.finger, obs.thumb
-    q = np.empty((obs.n_frames, len(chains), 2))
+    q = np.empty((len(w), len(chains), 2))
     cache: dict[tuple, np.ndarray] = {}
     for i, c in enumerate(chains):
         key = (c.role, c.l1, c.l2, tuple(c.base), c.elbow)
@@ -193,24 +171,6 @@ def _advance(leaves: Leaves, x: np.ndarray, y: np.ndarray, s0: int, s1: int,
     for s in range(s0 + 1, s1):
         both = leaves.step(both, s)
     return both[:, 0, :2], both[:, 1]
-
-
-def _predict(leaves: Leaves, q_obs: np.ndarray, s_of: np.ndarray,
-             gain: float) -> tuple[np.ndarray, np.ndarray]:
-    """One-step predictions of every leaf's joint angles and their covariance.
-
-    Returns ``q_pred`` (N, L, 2) rad (NaN at n = 0) and ``P_pred`` (N, L, 2, 2).
-    """
-    N = len(s_of)
-    # Each model's estimate starts from its plan's start, run on its own up to
-    # the first frame's step (a fraction of a frame after the onset).
-    x = _start(leaves, int(s_of[0]))
-    q_pred = np.full((N, leaves.count, 2), np.nan)
-    P_pred = np.zeros((N, leaves.count, 2, 2))
-    for n in range(1, N):
-        q_pred[n], x = _advance(leaves, x, q_obs[n - 1], int(s_of[n - 1]), int(s_of[n]), gain)
-        P_pred[n] = leaves.P[int(s_of[n])]
-    return q_pred, P_pred
 
 
 class _Predicted(NamedTuple):
@@ -265,10 +225,157 @@ def _refuse_non_finite(models: Sequence[MotorModel], scores: dict[str, np.ndarra
                              "predictions overflow (rebuild the repertoire)", field="repertoire")
 
 
+def _terms(r_obs: np.ndarray, g_obs: np.ndarray, pred: _Predicted, valid: np.ndarray,
+           grasp: np.ndarray, params: HammerParams):
+    """Both rules' per-step terms (M, N): ``dC_r, dC_g, log-likelihood, Mahalanobis``."""
+    midpoint = 0.5 * (pred.finger + pred.thumb)
+    opening = pred.finger - pred.thumb
+    valid = valid & np.isfinite(np.linalg.norm(midpoint, axis=-1)) \
+        & np.isfinite(np.linalg.norm(opening, axis=-1))
+    dC_r, dC_g = thesis_rule(r_obs, g_obs, np.linalg.norm(midpoint, axis=-1),
+                             np.linalg.norm(opening, axis=-1), grasp, valid, params.w_r,
+                             params.w_g, params.thesis_sign)
+    dll, maha = likelihood_rule(r_obs, g_obs, midpoint, opening, pred.cov, valid, params.obs_sd)
+    return dC_r, dC_g, dll, maha, valid
+
+
+class StepScorer:
+    """Every model's one-step predictions and scores, one frame at a time.
+
+    The engine's only implementation of a step: :func:`recognize` runs it
+    over a whole observation (the predictions frame by frame, their scoring
+    vectorised), :class:`perception.online.OnlineRecognizer` frame by frame
+    as they arrive (:meth:`step`); after frame *n* the sums equal
+    :func:`recognize`'s arrays' column *n*. Each step costs the same however
+    long the stream has run: the state is the filters' estimate and the
+    last frame, never the history.
+
+    Parameters
+    ----------
+    models : sequence of MotorModel
+        The models, planned for the clip's scene (one time step).
+    params : HammerParams, optional
+        Rule weights, observation noise and filter gain.
+    steps : int
+        Model steps to stack the gains for at first.
+
+    Attributes
+    ----------
+    confidence, log_likelihood : (M,) arrays
+        Thesis-rule confidence and log-likelihood so far.
+    mahalanobis : (M,) array
+        Sum of the squared Mahalanobis distances of the scored steps.
+    scored : (M,) int array
+        Steps scored so far, per model.
+    """
+
+    def __init__(self, models: Sequence[MotorModel], params: HammerParams | None = None,
+                 steps: int = FIRST_STEPS):
+        self.models = list(models)
+        self.params = HammerParams() if params is None else params
+        dts = {round(m.dt, 12) for m in self.models}
+        if len(dts) != 1:
+            raise ValueError(f"models disagree on their time step: {sorted(dts)} s")
+        self.dt = self.models[0].dt
+        self.leaves = Leaves(self.models, max(int(steps), 1))
+        self.grasp = np.array([m.kind == "grasp" for m in self.models])
+        M = len(self.models)
+        self.confidence = np.zeros(M)
+        self.log_likelihood = np.zeros(M)
+        self.mahalanobis = np.zeros(M)
+        self.scored = np.zeros(M, dtype=int)
+        self.frames = 0
+        self._shift = None  # the largest (model step - frame index) so far
+        self._x = None
+        self._prev = None  # (model step, angles, all three seen) of the last frame
+        self._rg = None  # its (r, g)
+
+    @property
+    def misfit(self) -> np.ndarray:
+        """(M,) mean squared Mahalanobis distance per scored step so far (NaN before any)."""
+        return np.where(self.scored > 0, self.mahalanobis / np.maximum(self.scored, 1), np.nan)
+
+    def familiarity(self, frame_period: float) -> np.ndarray:
+        """(M,) each model's familiarity of the movement so far (NaN without calibration).
+
+        Parameters
+        ----------
+        frame_period : float
+            The clip's frame period, s.
+        """
+        return np.array([np.nan if m.calibration is None
+                         else m.calibration.familiarity(float(x), frame_period)
+                         for m, x in zip(self.models, self.misfit)])
+
+    def model_step(self, time: float) -> int:
+        """The model step of the next frame at ``time`` s since the onset.
+
+        Dropped frames and jitter land on the right step; every frame is at
+        least one step after the one before.
+        """
+        s = int(np.round(time / self.dt)) - self.frames
+        self._shift = s if self._shift is None else max(self._shift, s)
+        self.frames += 1
+        step = self._shift + self.frames - 1
+        if step >= len(self.leaves.P):
+            self.leaves = Leaves(self.models, 2 * step)
+        return step
+
+    def predict(self, step: int, angles: np.ndarray, seen: bool) -> np.ndarray | None:
+        """Every leaf's prediction (L, 2) of model step ``step`` from the last frame's angles,
+        and the filters advanced to it; then ``angles`` (L, 2) are this frame's.
+
+        None at the first frame (nothing to predict from).
+        """
+        prev, self._prev = self._prev, (step, angles, seen)
+        if prev is None:
+            self._x = _start(self.leaves, step)
+            return None
+        q_pred, self._x = _advance(self.leaves, self._x, prev[1], prev[0], step,
+                                   self.params.filter_gain)
+        return q_pred
+
+    def step(self, time: float, wrist, finger, thumb) -> None:
+        """Score the next frame: ``time`` s since the onset, positions (2,) m in the model frame.
+
+        Parameters
+        ----------
+        time : float
+            Time since the movement's onset, s.
+        wrist, finger, thumb : (2,) arrays
+            Filtered positions (the digit tips), m; NaN where lost.
+        """
+        rows = [np.asarray(p, dtype=float)[None] for p in (wrist, finger, thumb)]
+        s = self.model_step(time)
+        q = _observed_angles(*rows, self.leaves.chains)[0]
+        r = np.linalg.norm(0.5 * (rows[1] + rows[2]), axis=-1)
+        g = np.linalg.norm(rows[1] - rows[2], axis=-1)
+        seen = bool(np.isfinite(np.concatenate(rows)).all())
+        last = self._prev[2] if self._prev is not None else False
+        r_g, self._rg = self._rg, (r, g)
+        q_pred = self.predict(s, q, seen)
+        if q_pred is None:
+            return
+        pred = _to_cartesian(self.leaves, q_pred[None], self.leaves.P[s][None], len(self.models))
+        pred = _Predicted(*(np.concatenate([np.full_like(a, np.nan), a], axis=1) for a in pred))
+        # as recognize: the state predicted from was seen (all three markers), and
+        # so were r and g then and now
+        ok = last and bool(np.isfinite([r_g[0][0], r_g[1][0], r[0], g[0]]).all())
+        valid = np.zeros((len(self.models), 2), dtype=bool)
+        valid[:, 1] = ok
+        dC_r, dC_g, dll, maha, valid = _terms(np.r_[r_g[0], r], np.r_[r_g[1], g], pred, valid,
+                                              self.grasp, self.params)
+        self.confidence += dC_r[:, 1] + dC_g[:, 1]
+        self.log_likelihood += dll[:, 1]
+        self.mahalanobis += maha[:, 1]
+        self.scored += valid[:, 1]
+
+
 def recognize(
     observation: Observation,
     models: Sequence[MotorModel],
     params: HammerParams | None = None,
+    rules: VerdictRules | None = None,
 ) -> Recognition:
     """Score a demonstration against every model.
 
@@ -282,38 +389,38 @@ def recognize(
         :meth:`~perception.recognition.repertoire.Repertoire.for_scene` returns).
     params : HammerParams, optional
         Rule and weights.
+    rules : VerdictRules, optional
+        The verdict's rules (the result's :attr:`~Recognition.rules`).
 
     Returns
     -------
     Recognition
     """
-    params = HammerParams() if params is None else params
-    obs = observation
-    models = list(models)
-    dts = {round(m.dt, 12) for m in models}
-    if len(dts) != 1:
-        raise ValueError(f"models disagree on their time step: {sorted(dts)} s")
-    s_of = _model_steps(obs.time, models[0].dt)
-    leaves = Leaves(models, int(s_of[-1]) + 1)
-    q_pred, P_pred = _predict(leaves, _observed_angles(obs, leaves.chains), s_of,
-                              params.filter_gain)
-    pred = _to_cartesian(leaves, q_pred, P_pred, len(models))
-    midpoint = 0.5 * (pred.finger + pred.thumb)
-    opening = pred.finger - pred.thumb
-    r_pred, g_pred = np.linalg.norm(midpoint, axis=-1), np.linalg.norm(opening, axis=-1)
-    r_obs, g_obs = obs.r, obs.g
+    obs, models = observation, list(models)
+    # gains stacked once for the whole clip
+    scorer = StepScorer(models, params, steps=int(round(obs.time[-1] / models[0].dt))
+                        + obs.n_frames + 1)
+    params = scorer.params
+    q_obs = _observed_angles(obs.wrist, obs.finger, obs.thumb, scorer.leaves.chains)
+    N = obs.n_frames
     # A step counts only if the state it predicts from was observed (all three
     # markers at n-1: the wrist anchors every chain) and the outcome is (the
     # digits at n).
     seen = np.isfinite(np.stack([obs.wrist, obs.finger, obs.thumb], axis=1)).all(axis=(1, 2))
+    q_pred = np.full((N, scorer.leaves.count, 2), np.nan)
+    P_pred = np.zeros((N, scorer.leaves.count, 2, 2))
+    for n in range(N):  # the filters run frame by frame; the scoring below is vectorised
+        s = scorer.model_step(float(obs.time[n]))
+        q = scorer.predict(s, q_obs[n], bool(seen[n]))
+        if q is not None:
+            q_pred[n], P_pred[n] = q, scorer.leaves.P[s]
+    pred = _to_cartesian(scorer.leaves, q_pred, P_pred, len(models))
+    r_obs, g_obs = obs.r, obs.g
     observed = np.concatenate([[False], seen[:-1]]) & np.isfinite(r_obs) & np.isfinite(g_obs)
     prev_ok = np.concatenate([[False], np.isfinite(r_obs[:-1]) & np.isfinite(g_obs[:-1])])
-    valid = (observed & prev_ok)[None] & np.isfinite(r_pred) & np.isfinite(g_pred)
+    dC_r, dC_g, dll, maha, valid = _terms(r_obs, g_obs, pred, (observed & prev_ok)[None]
+                                          .repeat(len(models), 0), scorer.grasp, params)
     _refuse_broken_models(models, observed & prev_ok, valid)
-    grasp = np.array([m.kind == "grasp" for m in models])
-    dC_r, dC_g = thesis_rule(r_obs, g_obs, r_pred, g_pred, grasp, valid, params.w_r, params.w_g,
-                             params.thesis_sign)
-    dll, maha = likelihood_rule(r_obs, g_obs, midpoint, opening, pred.cov, valid, params.obs_sd)
     _refuse_non_finite(models, {"confidence": dC_r + dC_g, "log-likelihood": dll})
     mis = misfit(maha, valid)
     familiarity = np.array([np.nan if m.calibration is None
@@ -336,6 +443,5 @@ def recognize(
         observation=obs,
         models=models,
         rule=params.rule,
-        familiarity_threshold=params.familiarity_threshold,
-        unfamiliar_threshold=params.unfamiliar_threshold,
+        rules=VerdictRules() if rules is None else rules,
     )

@@ -1,7 +1,7 @@
-"""The provisional verdict of a movement still being seen, and when it is settled.
+"""When the provisional verdict of a movement still being seen is settled.
 
-:func:`provisional` applies the offline verdict rule to what has been seen
-so far; :class:`SettleRule` says when that verdict is trusted;
+:class:`SettleRule` says when the verdict :func:`perception.recognition.rules.judge`
+gives on what has been seen so far is trusted;
 :class:`OnlineState` is what :class:`perception.online.OnlineRecognizer`
 returns after every frame. See docs/online.md.
 """
@@ -10,51 +10,50 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from types import SimpleNamespace
 
 import numpy as np
 
 from perception.errors import InputError
-from perception.landmarks import (
-    OPENING_LEVEL,
-    PEAK_MIN_PROMINENCE,
-    PEAK_PROMINENCE,
-    count_peaks,
-)
-from perception.recognition.online import StepScorer
 from perception.recognition.result import Recognition
-from perception.recognition.shape import opens
+from perception.recognition.rules import Evidence, Verdict, VerdictRules
 
-__all__ = ["LATE_OPENING_PROGRESS", "Decision", "OnlineState", "SettleRule", "decision_summary",
-           "provisional"]
+__all__ = ["Decision", "OnlineState", "SettleRule", "decision_summary"]
 
 
 @dataclass(frozen=True)
 class SettleRule:
-    """When a provisional verdict is trusted: it is *settled* at the first frame where
+    """When a provisional verdict is trusted: *settled* at the first frame where it has
+    stood for ``hold`` s and
 
-    * the wrist has covered at least ``min_progress`` of its way from rest to
-      where the models' wrists stop (``start distance - 0.06 m``) —
-      ``reach_progress`` for a ``reach``: a grasp that opens late looks like
-      a reach until it opens —, and
-    * the leading model's familiarity is at least ``margin`` natural-log
-      units from the familiarity threshold (``|ln(familiarity / threshold)|``;
-      a second opening of the grip counts as decisive), and
-    * the provisional verdict has not changed for ``hold`` s.
+    * a grip seen to depart from the transport (``grip-departs``): the wrist
+      has covered ``min_progress`` of its way to the models' goal, and the
+      grip has opened twice, or started to open after ``late_opening +
+      late_margin`` of the movement (estimated from how far the wrist had come);
+    * a verdict resting on familiarity: the transport has slowed by
+      ``slowed`` from its peak speed (the movement is in its last phase), the
+      leading model's familiarity and the transport's are each at least
+      ``margin`` natural-log units from their thresholds, and either the grip
+      has opened — once, starting before ``late_opening - late_margin`` of
+      the movement, and closed ``closing`` of its opening since its maximum
+      (a second opening comes before that) — or it has not opened by even
+      ``reach_opening`` m while the wrist has covered ``reach_progress`` of
+      its way and slowed by ``reach_slowed`` (a late opener has started by then);
+    * the other rules (``unfamiliar``) settle at the end.
 
     The defaults were chosen on the dev population (seeds 1000 + k,
-    ``tools/evaluate_online.py --set dev``), never on the held-out one: there
-    no finite margin let a verdict resting on familiarity alone settle
-    before the end without disagreeing with the offline verdict on some
-    clip (the provisional verdict does not know the movement time yet), so
-    the default ``margin`` is infinite — only a grip seen to depart
-    (``re-opening``, ``delayed-opening``) settles early; ``normal``,
-    ``reach`` and the other ``abnormal`` verdicts are decided at the end.
+    ``tools/evaluate_online.py --set dev``), never on the held-out one.
 
     Parameters
     ----------
     min_progress, reach_progress : float
-        Share of the transport, 0..1.
+        Share of the wrist's way, 0..1.
+    late_margin : float
+        Share of the movement kept from ``late_opening`` (the online estimate
+        of when the grip opened is not the offline landmark).
+    slowed, reach_slowed, closing : float
+        Share of the peak speed, of the opening, 0..1.
+    reach_opening : float
+        Most a grip may have opened and still count as not opening, m.
     margin : float
         Evidence margin, natural-log units of familiarity.
     hold : float
@@ -62,15 +61,70 @@ class SettleRule:
     """
 
     min_progress: float = 0.5
-    reach_progress: float = 0.98
-    margin: float = math.inf
+    late_margin: float = 0.12
+    slowed: float = 0.6
+    closing: float = 0.02
+    margin: float = 1.0
+    reach_progress: float = 0.7
+    reach_slowed: float = 0.9
+    reach_opening: float = 0.01
     hold: float = 0.0
 
     def __post_init__(self):
-        if not (0 <= self.min_progress <= 1 and 0 <= self.reach_progress <= 1
-                and self.margin >= 0 and self.hold >= 0):
-            raise InputError("expected 0 <= min_progress, reach_progress <= 1, margin >= 0, "
-                             f"hold >= 0, got {self}", field="SettleRule")
+        shares = (self.min_progress, self.reach_progress, self.slowed, self.reach_slowed,
+                  self.closing)
+        if not (all(0 <= v <= 1 for v in shares) and self.late_margin >= 0
+                and self.margin >= 0 and self.reach_opening >= 0 and self.hold >= 0):
+            raise InputError("expected 0 <= min_progress, reach_progress, slowed, reach_slowed, "
+                             "closing <= 1, late_margin, margin, reach_opening, hold >= 0, got "
+                             f"{self}", field="SettleRule")
+
+    @staticmethod
+    def evidence(verdict: Verdict, evidence: Evidence, rules: VerdictRules) -> float:
+        """How far the leading familiarity is from its threshold, natural-log units (inf for
+        a grip seen to depart; 0 without a familiarity)."""
+        if verdict.rule == "grip-departs":
+            return math.inf
+        fam = verdict.familiarity
+        return abs(math.log(max(fam, 1e-300) / rules.familiarity_threshold)) \
+            if math.isfinite(fam) else 0.0
+
+    def sure(self, verdict: Verdict, evidence: Evidence, grip, rules: VerdictRules,
+             progress: float) -> bool:
+        """Whether ``verdict`` on ``evidence`` is settled (see the class docstring).
+
+        Parameters
+        ----------
+        verdict : Verdict
+            The provisional verdict.
+        evidence : Evidence
+            What it was judged on.
+        grip : namespace
+            The movement's course so far: ``opened``, ``peaks``, ``opening``
+            (m), ``closing`` (share of the opening closed since its maximum),
+            ``slowed`` (share of the transport's peak speed lost since).
+        rules : VerdictRules
+        progress : float
+            The wrist's share of its way covered.
+        """
+        lm = evidence.observed
+        if verdict.verdict is None or lm is None:
+            return False
+        if verdict.rule == "grip-departs":
+            return progress >= self.min_progress and (
+                (grip.peaks or 0) >= 2 or lm.opening_time > rules.late_opening + self.late_margin)
+        if verdict.rule != "familiarity" or grip.slowed < self.slowed:
+            return False
+        tf = evidence.transport_familiarity
+        if self.evidence(verdict, evidence, rules) < self.margin or (
+                math.isfinite(tf) and abs(math.log(max(tf, 1e-300) / rules.unfamiliar_threshold))
+                < self.margin):
+            return False
+        if grip.opened:  # the maximum is past, and with it the time for a second opening
+            return (grip.closing >= self.closing and grip.peaks == 1
+                    and lm.opening_time <= rules.late_opening - self.late_margin)
+        return (progress >= self.reach_progress and grip.slowed >= self.reach_slowed
+                and grip.opening < self.reach_opening)
 
 
 @dataclass(frozen=True)
@@ -158,64 +212,6 @@ class OnlineState:
     def settled(self) -> bool:
         """Whether a verdict has settled."""
         return self.decision is not None
-
-
-#: The grip starts to open late (``delayed-opening``) when the wrist has covered more than
-#: this share of its way by then: the causal stand-in for the landmarks' 40 % of the
-#: movement time (:data:`perception.landmarks.LATE_OPENING`), whose end is not known yet.
-LATE_OPENING_PROGRESS = 0.5
-
-
-def provisional(kinds: list[str], scorer: StepScorer, aperture: np.ndarray, progress: np.ndarray,
-                object_size: float, frame_period: float,
-                threshold: float) -> tuple[int, str, str | None, float]:
-    """The offline verdict rule on the movement so far: leading model, verdict, detail,
-    familiarity.
-
-    As the shape pass (:func:`perception.pipeline._shape_pass`): the models of
-    the kind the grip shows (grasp once it has opened as a grasp must,
-    :func:`~perception.recognition.shape.opens`; reach until then), the best
-    of them by log-likelihood, and its familiarity against ``threshold``. A
-    grip seen to open twice (two aperture peaks, :func:`~perception.landmarks.count_peaks`,
-    as the landmarks count them), or to start opening only once the wrist has
-    covered :data:`LATE_OPENING_PROGRESS` of its way, is ``abnormal`` whatever
-    the familiarity.
-    Unlike the shape pass, the movement is judged in its own scene and time
-    (its movement time is not known yet).
-
-    Parameters
-    ----------
-    kinds : list of str
-        Kind of each model.
-    scorer : StepScorer
-        The scores so far.
-    aperture : (N,) array
-        Grip aperture from the onset, m.
-    progress : (N,) array
-        The wrist's share of its way covered, at each of those frames.
-    object_size : float
-        Object diameter, m.
-    frame_period : float
-        The clip's frame period, s.
-    threshold : float
-        Lowest familiarity called familiar.
-    """
-    grasp = opens(SimpleNamespace(g=aperture, object_diameter=object_size))
-    want = "grasp" if grasp else "reach"
-    idx = [i for i, k in enumerate(kinds) if k == want] or list(range(len(kinds)))
-    best = idx[int(np.argmax(scorer.log_likelihood[idx]))]
-    fam = scorer.familiarity(best, frame_period)
-    if grasp:
-        g = aperture[np.isfinite(aperture)]
-        prominence = max(PEAK_PROMINENCE * (g.max() - g[0]), PEAK_MIN_PROMINENCE)
-        if count_peaks(g, prominence) >= 2:
-            return best, "abnormal", "re-opening", fam
-        level = g[0] + OPENING_LEVEL * (g.max() - g[0])
-        if progress[np.isfinite(aperture)][np.argmax(g > level)] > LATE_OPENING_PROGRESS:
-            return best, "abnormal", "delayed-opening", fam
-    if not fam >= threshold:  # NaN (no calibration) is not familiar
-        return best, "abnormal", None, fam
-    return best, want if want == "reach" else "normal", None, fam
 
 
 def decision_summary(rec: Recognition, decision: Decision | None) -> dict:

@@ -36,7 +36,7 @@ from perception.recognition.models import CHAIN_ARRAYS, ChainModel, ModelSpec, M
 from perception.recognition.planning import DEFAULT_DURATIONS, build_models, default_specs
 from perception.recognition.verdict import Calibration, CalibrationParams
 
-__all__ = ["PlanCache", "Repertoire"]
+__all__ = ["LazyRepertoire", "PlanCache", "Repertoire"]
 
 log = logging.getLogger(__name__)
 
@@ -58,7 +58,7 @@ class Repertoire:
     """
 
     def __init__(self, models: Iterable[MotorModel], config: dict | None = None):
-        self.models = list(models)
+        self._models: list[MotorModel] | None = list(models)
         names = [m.name for m in self.models]
         if len(set(names)) != len(names):
             raise ValueError(f"repertoire: duplicate model names in {names}")
@@ -77,7 +77,12 @@ class Repertoire:
         directly, not for the default scene and then again for its own. The
         models a clip is scored against are those of ``build()`` either way.
         """
-        return _DefaultRepertoire()
+        return LazyRepertoire()
+
+    @property
+    def models(self) -> list[MotorModel]:
+        """The models, planned for the repertoire's own scene."""
+        return self._models
 
     def __iter__(self) -> Iterator[MotorModel]:
         return iter(self.models)
@@ -298,9 +303,14 @@ def _shipped_calibrations() -> dict[str, Calibration]:
         return {}
 
 
-class _DefaultRepertoire(Repertoire):
-    """:meth:`Repertoire.default`: the default models, planned on first use, their verdict
-    calibrated by the shipped calibration (transferred to each clip's scene)."""
+class LazyRepertoire(Repertoire):
+    """The default repertoire (:meth:`Repertoire.default`), planned on first use.
+
+    Its models are planned when first asked for (:attr:`models`), or directly
+    for a clip's scene (:meth:`for_scene`); their verdict is calibrated by the
+    shipped calibration, and a model without one is calibrated in an explicit
+    step, when a verdict asks for it (:meth:`~Repertoire.calibrated`).
+    """
 
     def __init__(self):
         self._specs = default_specs()
@@ -312,7 +322,7 @@ class _DefaultRepertoire(Repertoire):
         self._calibrations = {}
 
     @property
-    def models(self) -> list[MotorModel]:  # type: ignore[override]
+    def models(self) -> list[MotorModel]:
         if self._models is None:
             shipped = _shipped_calibrations()
             self._models = _calibrated(build_models(self._specs, self._scene),

@@ -9,31 +9,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from perception.landmarks import (
-    LATE_MGA,
-    LATE_OPENING,
-    MAX_GAP,
-    MAX_GAP_SHARE,
-    NO_OPENING,
-    OPENING_LEVEL,
-    PEAK_MIN_PROMINENCE,
-    PEAK_PROMINENCE,
-    Landmarks,
-    grip_departs,
-    hides_a_reopening,
-    longest_gap,
-    model_landmarks,
-    observed_landmarks,
-    verdict_detail,
-)
-from perception.observation import ObserveParams
-from perception.recognition.verdict import (
-    DEFAULT_THRESHOLD,
-    UNFAMILIAR_THRESHOLD,
-    Verdict,
-    decide,
-    misfit,
-)
+from perception.landmarks import Landmarks, longest_gap, model_landmarks, observed_landmarks
+from perception.recognition.rules import VERDICT_RULES, Evidence, Verdict, VerdictRules, judge
+from perception.recognition.verdict import misfit
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -46,19 +24,10 @@ if TYPE_CHECKING:
 __all__ = ["VERDICT_RULES", "Recognition"]
 
 
-#: The rules that can give a verdict (:attr:`Recognition.verdict_rule`), in the order
-#: they are tried: a whole-hand grasp; a grip that opens late or twice; a transport
-#: no reach model makes; a digit lost long enough to hide a second opening; and the
-#: best model's familiarity.
-VERDICT_RULES = ("not-a-precision-grip", "grip-departs", "not-a-human-reach",
-                 "insufficient-data", "familiarity")
 #: The movement times (onset to end by the field's rule, s) the verdict was
 #: validated on: the synthetic populations' 0.45-1.2 s grasps and a lab's real
 #: Optotrak grasps (1.05-2.06 s).
 VALIDATED_MOVEMENT_TIME = (0.4, 2.1)
-#: The widest digit separation at rest, m, of the grasps it was validated on: the
-#: observation's own rest rule for clips (digits together), declared once there.
-VALIDATED_REST_APERTURE = ObserveParams.max_rest_aperture
 #: The reach distances (wrist at rest to the object's centre, m) it was validated on.
 VALIDATED_DISTANCE = (0.1, 0.7)
 
@@ -97,8 +66,8 @@ class Recognition:
         The models scored (for their nominal movements).
     rule : str
         The rule that picks the winner.
-    familiarity_threshold : float
-        Lowest familiarity of the best model called familiar (the verdict).
+    rules : VerdictRules
+        The verdict's rules (:mod:`perception.recognition.rules`).
     shape : Recognition or None
         The same demonstration brought to the repertoire's reference scale
         and scored against its models there (:mod:`perception.recognition.shape`):
@@ -108,8 +77,6 @@ class Recognition:
     transport_familiarity : float
         Familiarity of the movement's transport alone (digits held closed, at
         the reference scale) to the best reach model; NaN if not measured.
-    unfamiliar_threshold : float
-        Below this transport familiarity the verdict is ``unfamiliar``.
     mirrored : bool
         The scene was found mirrored (the finger opening on the model's -x
         side) and its mirror image was scored: the opposite of ``--mirror``.
@@ -138,11 +105,10 @@ class Recognition:
     observation: Observation = field(repr=False)
     models: list[MotorModel] = field(repr=False)
     rule: str = "likelihood"
-    familiarity_threshold: float = DEFAULT_THRESHOLD
+    rules: VerdictRules = field(default_factory=VerdictRules, repr=False)
     shape: Recognition | None = field(default=None, repr=False)
     normalisation: Normalisation | None = None
     transport_familiarity: float = float("nan")
-    unfamiliar_threshold: float = UNFAMILIAR_THRESHOLD
     mirrored: bool = False
     measured: Landmarks | None = field(default=None, repr=False)
     notes: tuple[str, ...] = ()
@@ -172,52 +138,41 @@ class Recognition:
         return misfit(self.mahalanobis, self.scored)
 
     @property
-    def decision(self) -> Verdict:
-        """The verdict (see :attr:`verdict_rule` for the rule that gave it)."""
-        return self._judged[0]
+    def familiarity_threshold(self) -> float:
+        """Lowest familiarity of the best model called familiar (``rules``')."""
+        return self.rules.familiarity_threshold
+
+    @property
+    def unfamiliar_threshold(self) -> float:
+        """Below this transport familiarity the verdict is ``unfamiliar`` (``rules``')."""
+        return self.rules.unfamiliar_threshold
 
     @property
     def verdict_rule(self) -> str | None:
         """The rule that gave the verdict (one of :data:`VERDICT_RULES`; None without one)."""
-        return self._judged[1] if self.verdict is not None else None
+        return self.decision.rule
+
+    @property
+    def evidence(self) -> Evidence:
+        """What the verdict is judged on: the reference pass's scores and the movement's
+        own landmarks, rest aperture and gaps (a lone pass, without a :attr:`shape`:
+        its scores alone)."""
+        if self.shape is None:
+            return Evidence(self.kinds, self.log_likelihood[:, -1], self.familiarity)
+        obs, shape = self.observation, self.shape
+        return Evidence(shape.kinds, shape.log_likelihood[:, -1], shape.familiarity,
+                        self.transport_familiarity, obs.marker_separation, *self.landmarks,
+                        longest_gap(obs.time, obs.g))
 
     @cached_property
-    def _judged(self) -> tuple[Verdict, str]:
-        """The verdict, from the best model by log-likelihood and its familiarity.
+    def decision(self) -> Verdict:
+        """The verdict, judged once (:func:`perception.recognition.rules.judge`).
 
-        With a :attr:`shape` pass, the verdict is that pass's: the movement's
-        coordination judged at the repertoire's reference scale, not its speed,
-        size or camera; a grasp whose grip departs from the transport in the
-        field's own measures (:func:`perception.landmarks.grip_departs`:
-        opening late, or re-opening) is ``abnormal`` even when the models find
-        it familiar, or find its transport like no reach of theirs (a hand
-        that waits at the object for a late grip); otherwise ``unfamiliar``
-        when even its transport is no human reach, or the digits start more
-        than :data:`VALIDATED_REST_APERTURE` apart (a whole-hand grasp, which
-        the verdict was not made for), or when it would be
-        ``normal`` but a digit was lost long enough during the movement to
-        hide a second opening (:func:`~perception.landmarks.hides_a_reopening`:
-        the models' filters coast over a gap as if the grip had stayed open).
+        With a :attr:`shape` pass, the scores are that pass's: the movement's
+        coordination judged at the repertoire's reference scale, not its
+        speed, size or camera.
         """
-        if self.shape is not None:
-            d = self.shape.decision
-
-            def given(verdict: str, rule: str) -> tuple[Verdict, str]:
-                return Verdict(verdict, d.best, d.familiarity, d.margin), rule
-
-            if d.verdict is not None and self._whole_hand:
-                return given("unfamiliar", "not-a-precision-grip")
-            if d.verdict in ("normal", "abnormal") and grip_departs(self.landmarks[0]):
-                return given("abnormal", "grip-departs")
-            if d.verdict is not None and self.transport_familiarity < self.unfamiliar_threshold:
-                return given("unfamiliar", "not-a-human-reach")
-            obs = self.observation
-            if d.verdict == "normal" and hides_a_reopening(longest_gap(obs.time, obs.g),
-                                                           self.landmarks[0].movement_time):
-                return given("unfamiliar", "insufficient-data")
-            return d, "familiarity"
-        return decide(self.kinds, self.log_likelihood[:, -1], self.familiarity,
-                      self.familiarity_threshold), "familiarity"
+        return judge(self.evidence, self.rules)
 
     @property
     def verdict(self) -> str | None:
@@ -249,21 +204,6 @@ class Recognition:
                     f"{1 - self.familiarity_threshold:.0%} of its own movements")
         return None
 
-    @property
-    def verdict_rules(self) -> dict:
-        """Every threshold the verdict's rules read, by name (the report's ``verdict_rules``)."""
-        return {"familiarity_threshold": float(self.familiarity_threshold),
-                "unfamiliar_threshold": float(self.unfamiliar_threshold),
-                "late_opening": LATE_OPENING, "late_mga": LATE_MGA, "no_opening": NO_OPENING,
-                "opening_level": OPENING_LEVEL, "peak_prominence": PEAK_PROMINENCE,
-                "peak_min_prominence": PEAK_MIN_PROMINENCE, "max_gap": MAX_GAP,
-                "max_gap_share": MAX_GAP_SHARE,
-                "precision_grip_rest_aperture": VALIDATED_REST_APERTURE}
-
-    @property
-    def _whole_hand(self) -> bool:
-        """The digits start apart, as in a whole-hand grasp: out of the verdict's depth."""
-        return self.observation.marker_separation > VALIDATED_REST_APERTURE
 
     def _longest_loss(self) -> str:
         """The digit lost longest during the movement, for how long and where."""
@@ -291,8 +231,9 @@ class Recognition:
             b = (start + gap - lm.onset_time) / lm.movement_time
             where = f" at {max(a, 0):.0%}-{min(b, 1):.0%} of the movement"
         lost = "the digits were" if name == "digits" else f"the {name} was"
-        return (f"{lost} lost {gap:.2f} s{where} (a gap over {MAX_GAP:.2f} s and "
-                f"{MAX_GAP_SHARE:.0%} of the movement may hide a second opening)")
+        lp = self.rules.landmarks
+        return (f"{lost} lost {gap:.2f} s{where} (a gap over {lp.max_gap:.2f} s and "
+                f"{lp.max_gap_share:.0%} of the movement may hide a second opening)")
 
     @property
     def warnings(self) -> list[str]:
@@ -367,14 +308,15 @@ class Recognition:
 
         m = self.models[self.names.index(model)]
         run = rollout([m], int(np.ceil(1.5 * m.duration / m.dt)) + 1)
-        return model_landmarks(run.time, run.wrist[0, 0], run.finger[0, 0], run.thumb[0, 0])
+        return model_landmarks(run.time, run.wrist[0, 0], run.finger[0, 0], run.thumb[0, 0],
+                               self.rules.landmarks)
 
     @cached_property
     def landmarks(self) -> tuple[Landmarks, Landmarks | None]:
         """The demonstration's landmarks and the reference grasp model's own (None without one)."""
         ref = self.reference_model
         observed = self.measured if self.measured is not None else observed_landmarks(
-            self.observation)
+            self.observation, self.rules.landmarks)
         return (observed,
                 self.own_landmarks(ref) if ref is not None else None)
 
@@ -388,13 +330,11 @@ class Recognition:
 
     @property
     def verdict_detail(self) -> str | None:
-        """The kind of an ``abnormal`` verdict (:func:`perception.landmarks.verdict_detail`).
+        """The kind of an ``abnormal`` verdict; None for any other.
 
-        None for any other verdict.
+        :func:`perception.recognition.rules.verdict_detail`.
         """
-        if self.verdict != "abnormal":
-            return None
-        return verdict_detail(*self.landmarks)
+        return self.decision.detail
 
     @property
     def predicted_r(self) -> np.ndarray:
@@ -473,7 +413,7 @@ class Recognition:
             "verdict": d.verdict,
             "verdict_detail": self.verdict_detail,
             "verdict_rule": self.verdict_rule,
-            "verdict_rules": self.verdict_rules,
+            "verdict_rules": self.rules.to_dict(),
             "verdict_reason": self.verdict_reason,
             "warnings": self.warnings,
             "notes": list(self.notes),
@@ -482,6 +422,7 @@ class Recognition:
             "familiarity_threshold": float(self.familiarity_threshold),
             "reference_model": self.reference_model,
             "shape": _shape_summary(self),
+            "passes": _passes(self),
             "mirrored": bool(self.mirrored),
             "time": [float(t) for t in self.time],
             "confidence": {n: [float(c) for c in row]
@@ -501,6 +442,19 @@ def _shape_summary(rec: Recognition) -> dict | None:
            "margin": _num(d.margin), "transport_familiarity": _num(rec.transport_familiarity)}
     if rec.normalisation is not None:
         out.update({k: _num(v) for k, v in rec.normalisation.to_dict().items()})
+    return out
+
+
+def _passes(rec: Recognition) -> dict:
+    """Which scoring pass gave what: ``winner`` and the profiles come from the clip's own
+    scene, the verdict from the reference pass (the scene's without one)."""
+    out = {"scene": {"models": list(rec.names), "winner": rec.winner},
+           "winner_from": "scene", "verdict_from": "scene" if rec.shape is None else "reference"}
+    if rec.shape is not None:
+        d = rec.decision
+        out["reference"] = {"models": list(rec.shape.names), "best": rec.shape.names[d.best],
+                            "familiarity": _num(d.familiarity)}
+        out["transport"] = {"familiarity": _num(rec.transport_familiarity)}
     return out
 
 

@@ -36,18 +36,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from minvar.grasp_task import GraspTask
 from perception.errors import InputError
 from perception.landmarks import movement_time
 from perception.observation import Observation
 from perception.recognition.models import SceneSpec
+from perception.recognition.rules import VerdictRules
 
-__all__ = ["GRASP_OPENING", "Normalisation", "canonical", "closed_hand", "is_mirrored", "opens"]
+__all__ = ["WRIST_GOAL_OFFSET", "Normalisation", "canonical", "closed_hand", "is_mirrored",
+           "mirror_votes", "opens"]
 
-#: Where the models' wrists stop: this far short of the object centre, m
-#: (:class:`minvar.GraspTask` ``wrist_offset``).
-WRIST_GOAL_OFFSET = 0.06
-#: Least transport (start to goal) a demonstration must show to be scaled, m.
-MIN_TRANSPORT = 0.02
+#: Where the models' wrists stop: this far short of the object centre, m (the
+#: grasp task's own ``wrist_offset``).
+WRIST_GOAL_OFFSET: float = GraspTask.wrist_offset
 
 
 @dataclass(frozen=True)
@@ -86,8 +87,8 @@ def _resample(t_new: np.ndarray, t: np.ndarray, xy: np.ndarray) -> np.ndarray:
     return out
 
 
-def canonical(obs: Observation, scene: SceneSpec, durations: tuple[float, float]
-              ) -> tuple[Observation, Normalisation]:
+def canonical(obs: Observation, scene: SceneSpec, durations: tuple[float, float],
+              rules: VerdictRules | None = None) -> tuple[Observation, Normalisation]:
     """``obs`` brought to ``scene`` and the range of ``durations`` (see the module docstring).
 
     Parameters
@@ -98,6 +99,8 @@ def canonical(obs: Observation, scene: SceneSpec, durations: tuple[float, float]
         The reference scene: its distance, hand (``tip_start``) and frame period.
     durations : (float, float)
         The shortest and longest reference movement time, s.
+    rules : VerdictRules, optional
+        Its ``min_transport``.
 
     Returns
     -------
@@ -110,7 +113,7 @@ def canonical(obs: Observation, scene: SceneSpec, durations: tuple[float, float]
     ------
     InputError
         Too little of the movement is seen to measure its time, or the wrist
-        travels less than :data:`MIN_TRANSPORT`.
+        travels less than ``rules.min_transport``.
     """
     mt = movement_time(obs)
     if not (np.isfinite(mt) and mt > 0):
@@ -118,7 +121,7 @@ def canonical(obs: Observation, scene: SceneSpec, durations: tuple[float, float]
                          obs.clip, field="wrist")
     alpha = float(np.clip(mt, *durations)) / mt
     transport = obs.start_distance - WRIST_GOAL_OFFSET
-    if transport < MIN_TRANSPORT:
+    if transport < (VerdictRules() if rules is None else rules).min_transport:
         raise InputError(f"starts {obs.start_distance * 1000:.0f} mm from the object: too near "
                          "to judge a reach", obs.clip, field="wrist")
     s = (scene.distance - WRIST_GOAL_OFFSET) / transport
@@ -157,42 +160,47 @@ def closed_hand(obs: Observation) -> Observation:
     return dataclasses.replace(obs, finger=tips.copy(), thumb=tips.copy())
 
 
-#: Least grip opening, m, at which the side the finger is on is read.
-MIRROR_OPENING = 0.02
-
-
-def is_mirrored(obs: Observation) -> bool:
+def is_mirrored(obs: Observation, rules: VerdictRules | None = None) -> bool:
     """Whether the finger opens on the model's -x side: a mirrored scene.
 
     The models put the finger at +x of the approach (a right hand filmed
     from its thumb's side, or a left hand from the other side, is the
     mirror image). Read over the frames where the grip is open by at least
-    :data:`MIRROR_OPENING`: mirrored if in most of them the finger is on
-    -x. A movement that never opens (a reach) is never mirrored.
+    ``rules.mirror_opening``: mirrored if in more than ``mirror_majority``
+    of them the finger is on -x. A movement that never opens (a reach) is
+    never mirrored.
 
     Parameters
     ----------
     obs : Observation
         The demonstration.
+    rules : VerdictRules, optional
     """
-    opening = obs.finger - obs.thumb
-    wide = np.linalg.norm(opening, axis=1) >= MIRROR_OPENING
+    return mirror_votes(obs.finger - obs.thumb, rules) is True
+
+
+def mirror_votes(opening: np.ndarray, rules: VerdictRules | None = None) -> bool | None:
+    """:func:`is_mirrored` on grip openings; None where none is wide enough to read.
+
+    Parameters
+    ----------
+    opening : (N, 2) array
+        Finger minus thumb, m, in the model frame.
+    rules : VerdictRules, optional
+    """
+    rules = VerdictRules() if rules is None else rules
+    wide = np.linalg.norm(opening, axis=1) >= rules.mirror_opening
     if not wide.any():
-        return False
-    return bool(np.mean(opening[wide, 0] < 0) > 0.5)
+        return None
+    return bool(np.mean(opening[wide, 0] < 0) > rules.mirror_majority)
 
 
-#: A hand that grasps an object opens its grip by at least this share of the
-#: object's diameter beyond its closed rest aperture (it must pass around
-#: the object: healthy adults open 1.5-3.5 cm *beyond* it, Jeannerod 1984).
-GRASP_OPENING = 0.5
-
-
-def opens(obs: Observation) -> bool:
+def opens(obs: Observation, rules: VerdictRules | None = None) -> bool:
     """Whether the grip opens as a grasp of the object must: a grasp, not a reach.
 
-    The observed aperture must exceed its rest value (the first frames)
-    by :data:`GRASP_OPENING` × the object's diameter at some frame. The
+    The observed aperture must exceed its rest value (the first
+    ``rules.grasp_rest_frames`` seen frames) by ``rules.grasp_opening`` ×
+    the object's diameter at some frame. The
     verdict is then judged against the repertoire's grasp models, otherwise
     against its reach models: whether the hand opens is what tells the two
     kinds apart, and the one-step likelihood weighs it weakly (a grasp
@@ -202,10 +210,11 @@ def opens(obs: Observation) -> bool:
     ----------
     obs : Observation
         The demonstration.
+    rules : VerdictRules, optional
     """
-    g = obs.g
-    seen = np.isfinite(g)
-    if not seen.any():
+    rules = VerdictRules() if rules is None else rules
+    g = obs.g[np.isfinite(obs.g)]
+    if not g.size:
         return False
-    rest = float(g[seen][: max(1, min(5, int(seen.sum())))].mean())
-    return bool(np.nanmax(g) - rest >= GRASP_OPENING * obs.object_diameter)
+    rest = float(g[:rules.grasp_rest_frames].mean())
+    return bool(g.max() - rest >= rules.grasp_opening * obs.object_diameter)

@@ -1,7 +1,7 @@
 """The verdict on a clip: normal, abnormal or reach, from calibrated familiarity.
 
-(``unfamiliar``, the fourth, is decided beside it:
-:attr:`perception.recognition.result.Recognition.decision`.)
+(``unfamiliar``, the fourth, and the rules around familiarity are
+:mod:`perception.recognition.rules`'.)
 
 The likelihood rule says which model explains a demonstration *best*; it
 does not say whether the best is any good. Familiarity does:
@@ -20,7 +20,7 @@ does not say whether the best is any good. Familiarity does:
   them, 0.5 like the typical one, near 0 worse than nearly all;
 * **verdict** — take the model with the highest log-likelihood (the best
   grasp or reach model). If its familiarity is at least the threshold
-  (``HammerParams.familiarity_threshold``, 0.05: a one-sided test at the 5 %
+  (``VerdictRules.familiarity_threshold``, 0.05: a one-sided test at the 5 %
   level that the clip is one of the model's own movements), the clip is
   ``normal`` (a grasp model) or ``reach`` (a reach model); otherwise no model
   explains it as well as 95 % of the models' own demonstrations and the
@@ -40,18 +40,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["DEFAULT_THRESHOLD", "UNFAMILIAR_THRESHOLD", "VERDICTS", "Calibration",
-           "CalibrationParams", "Verdict", "decide", "misfit"]
+__all__ = ["VERDICTS", "Calibration", "CalibrationParams", "misfit"]
 
 #: The four verdicts.
 VERDICTS = ("normal", "abnormal", "reach", "unfamiliar")
-#: Lowest familiarity called normal (or reach): fits better than the worst 5 % of the
-#: model's own demonstrations.
-DEFAULT_THRESHOLD = 0.05
-#: Lowest familiarity of a movement's transport (digits held closed) to the
-#: best reach model that still counts as a human reach: below it the movement
-#: is ``unfamiliar`` (worse than 99 % of the reach models' own reaches).
-UNFAMILIAR_THRESHOLD = 0.01
 
 
 @dataclass(frozen=True)
@@ -201,51 +193,3 @@ def misfit(mahalanobis: np.ndarray, scored: np.ndarray) -> np.ndarray:
     n = scored.sum(axis=1)
     total = np.where(scored, mahalanobis, 0.0).sum(axis=1)
     return np.where(n > 0, total / np.maximum(n, 1), np.nan)
-
-
-@dataclass(frozen=True)
-class Verdict:
-    """What the calibrated likelihood says about one clip.
-
-    Attributes
-    ----------
-    verdict : str or None
-        ``normal``, ``abnormal`` or ``reach``; None if the best model has no calibration.
-    best : int
-        Index of the model with the highest log-likelihood.
-    familiarity : float
-        The best model's familiarity (NaN without calibration).
-    margin : float
-        Its log-likelihood minus the runner-up's (NaN with one model).
-    """
-
-    verdict: str | None
-    best: int
-    familiarity: float
-    margin: float
-
-
-def decide(kinds: list[str], final_log_likelihood: np.ndarray, familiarity: np.ndarray,
-           threshold: float = DEFAULT_THRESHOLD) -> Verdict:
-    """The verdict from each model's final log-likelihood and familiarity.
-
-    Parameters
-    ----------
-    kinds : list of str
-        ``grasp`` or ``reach`` per model.
-    final_log_likelihood : (M,) array
-        Likelihood-rule score of each model at the end.
-    familiarity : (M,) array
-        Each model's familiarity (NaN where it has no calibration).
-    threshold : float
-        Lowest familiarity called familiar.
-    """
-    ll = np.asarray(final_log_likelihood, dtype=float)
-    best = int(np.argmax(ll))
-    margin = float(ll[best] - np.max(np.delete(ll, best))) if ll.size > 1 else float("nan")
-    fam = float(familiarity[best])
-    if not np.isfinite(fam):
-        return Verdict(None, best, fam, margin)
-    if fam < threshold:
-        return Verdict("abnormal", best, fam, margin)
-    return Verdict("reach" if kinds[best] == "reach" else "normal", best, fam, margin)

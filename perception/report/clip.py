@@ -31,7 +31,7 @@ RECOGNITION_KEYS = frozenset({
     "clip", "models", "winner", "rule", "verdict", "familiarity", "margin",
     "familiarity_threshold", "reference_model", "time", "confidence", "transport_confidence",
     "aperture", "verdict_detail", "verdict_rule", "verdict_rules", "verdict_reason", "warnings",
-    "notes", "kinematics", "shape", "mirrored"})
+    "notes", "kinematics", "shape", "passes", "mirrored"})
 
 #: The observed landmarks a batch's ``summary.csv`` shows, one column each
 #: (:attr:`ClipSummary.kinematics`; units in docs/recognition.md §9).

@@ -1,0 +1,319 @@
+"""The verdict as one declared policy: every threshold in :class:`VerdictRules`, one :func:`judge`.
+
+A verdict is judged from :class:`Evidence` — each model's score and
+familiarity, the movement's transport familiarity, its landmarks and how
+long its digits went unseen — by an ordered table of rules
+(:data:`RULE_TABLE`); the first that fires gives the verdict and names
+itself (``verdict_rule`` in the report). The offline recognition
+(:attr:`perception.recognition.result.Recognition.decision`) and the online
+one (:class:`perception.online.OnlineRecognizer`) judge through the same
+:func:`judge` with the same :class:`VerdictRules` (``RecognitionSettings.rules``,
+written to the report as ``verdict_rules``; ``--verdict-rules FILE.toml``).
+docs/recognition.md §5 gives each rule's source.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from perception.errors import InputError
+from perception.landmarks import LandmarkParams, Landmarks
+from perception.observation import ObserveParams
+
+__all__ = ["DETAILS", "RULE_TABLE", "VERDICT_RULES", "Evidence", "Verdict", "VerdictRules",
+           "grip_departs", "judge", "verdict_detail"]
+
+#: Kinds of an abnormal verdict (:func:`verdict_detail`).
+DETAILS = ("delayed-opening", "re-opening", "no-opening", "other")
+
+
+@dataclass(frozen=True)
+class VerdictRules:
+    """Every threshold that decides a verdict.
+
+    Parameters
+    ----------
+    familiarity_threshold : float
+        Lowest familiarity (0..1) of the best model for ``normal`` (or
+        ``reach``); below it ``abnormal``: a one-sided test at this level
+        that the movement is one of the model's own.
+    unfamiliar_threshold : float
+        Lowest familiarity of the movement's transport alone (digits held
+        closed) to the best reach model; below it the verdict is
+        ``unfamiliar`` (no human reach).
+    late_opening : float
+        ``delayed-opening``: the grip starts to open (exceeds
+        ``landmarks.opening_level`` of its opening) after this share of the
+        movement. Real healthy grips start at 3-68 % by the field's
+        definitions (a lab's Optotrak grasps: up to 50 % on all but 2 of 30
+        dev trials), the chapter 5 delayed stimuli at 52-70 %: chosen
+        between, on dev sets only (docs/mocap.md).
+    late_mga : float
+        ... or the MGA comes after this share while the reference model's
+        comes earlier.
+    no_opening : float
+        ``no-opening``: the opening is below this share of the reference model's.
+    grasp_opening : float
+        The grip opens as a grasp must when it exceeds its rest aperture by
+        this share of the object's diameter (healthy adults open 1.5-3.5 cm
+        beyond the object, Jeannerod 1984): judged against the grasp
+        models, otherwise against the reach models.
+    grasp_rest_frames : int
+        The rest aperture is the mean of this many first seen frames.
+    mirror_opening : float
+        Least grip opening, m, at which the side the finger is on is read.
+    mirror_majority : float
+        The scene is mirrored when more than this share of those frames
+        have the finger on the model's -x side.
+    min_transport : float
+        Least wrist travel, m, of a movement that can be judged as a reach.
+    precision_grip_aperture : float
+        Digits further apart at rest than this, m, make a whole-hand grasp
+        (``unfamiliar``: the verdict knows precision grips). By default the
+        observation's own rest rule for clips (``ObserveParams.max_rest_aperture``).
+    landmarks : LandmarkParams
+        How the landmarks the rules read are measured: the movement's
+        bounds, the aperture's peaks and opening, the gaps that may hide a
+        second opening.
+    """
+
+    familiarity_threshold: float = 0.05
+    unfamiliar_threshold: float = 0.01
+    late_opening: float = 0.55
+    late_mga: float = 0.95
+    no_opening: float = 0.30
+    grasp_opening: float = 0.5
+    grasp_rest_frames: int = 5
+    mirror_opening: float = 0.02
+    mirror_majority: float = 0.5
+    min_transport: float = 0.02
+    precision_grip_aperture: float = ObserveParams.max_rest_aperture
+    landmarks: LandmarkParams = field(default_factory=LandmarkParams)
+
+    def __post_init__(self):
+        shares = ("familiarity_threshold", "unfamiliar_threshold", "late_opening", "late_mga",
+                  "no_opening", "mirror_majority")
+        for f in dataclasses.fields(self):
+            v = getattr(self, f.name)
+            if f.name == "landmarks":
+                if not isinstance(v, LandmarkParams):
+                    raise InputError(f"expected LandmarkParams, got {v!r}", field="landmarks")
+            elif f.name == "grasp_rest_frames":
+                if not (isinstance(v, int) and not isinstance(v, bool) and v >= 1):
+                    raise InputError(f"expected an integer >= 1, got {v!r}", field=f.name)
+            elif not (isinstance(v, (int, float)) and not isinstance(v, bool)
+                      and math.isfinite(v) and v >= 0 and (f.name not in shares or v <= 1)):
+                limit = "a share 0-1" if f.name in shares else "a finite number >= 0"
+                raise InputError(f"expected {limit}, got {v!r}", field=f.name)
+
+    def to_dict(self) -> dict:
+        """The rules as the report's ``verdict_rules`` (landmark settings nested)."""
+        return dataclasses.asdict(self)
+
+    @classmethod
+    def from_dict(cls, d: dict, path=None) -> VerdictRules:
+        """From :meth:`to_dict`'s output or a TOML ``[verdict]`` table (unknown keys are errors).
+
+        Parameters
+        ----------
+        d : dict
+            The rules; ``landmarks`` a nested table of :class:`LandmarkParams`.
+        path : str or os.PathLike, optional
+            The file, named in errors.
+        """
+        from perception.io.config import check_keys
+
+        d = dict(d)
+        check_keys(d, [f.name for f in dataclasses.fields(cls)], "[verdict]", path)
+        lm = d.pop("landmarks", None) or {}
+        check_keys(lm, [f.name for f in dataclasses.fields(LandmarkParams)],
+                   "[verdict.landmarks]", path)
+        try:
+            return cls(landmarks=LandmarkParams(**lm), **d)
+        except InputError as exc:
+            raise InputError(exc.problem, path, field=f"[verdict] {exc.field}") from None
+        except ValueError as exc:
+            raise InputError(str(exc), path, field="[verdict.landmarks]") from None
+        except TypeError:
+            raise InputError(f"expected numbers, got {lm}", path,
+                             field="[verdict.landmarks]") from None
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """A judged verdict.
+
+    Attributes
+    ----------
+    verdict : str or None
+        ``normal``, ``abnormal``, ``reach`` or ``unfamiliar``; None if the
+        best model has no calibration.
+    best : int
+        Index of the model with the highest log-likelihood.
+    familiarity : float
+        The best model's familiarity (NaN without calibration).
+    margin : float
+        Its log-likelihood minus the runner-up's (NaN with one model).
+    rule : str or None
+        The rule that gave it (one of :data:`VERDICT_RULES`).
+    detail : str or None
+        The kind of an ``abnormal`` verdict (one of :data:`DETAILS`).
+    """
+
+    verdict: str | None
+    best: int
+    familiarity: float
+    margin: float
+    rule: str | None = None
+    detail: str | None = None
+
+
+@dataclass(frozen=True)
+class Evidence:
+    """What a verdict is judged on (offline: the whole movement; online: what is seen so far).
+
+    Attributes
+    ----------
+    kinds : list of str
+        Kind of each model judged.
+    log_likelihood : (M,) array
+        Each model's log-likelihood.
+    familiarity : (M,) array
+        Each model's familiarity (NaN without calibration).
+    transport_familiarity : float
+        The transport's alone to the best reach model (NaN: not measured).
+    rest_aperture : float
+        Digit separation at rest, m (NaN: not measured).
+    observed, reference : Landmarks, optional
+        The movement's landmarks and the reference grasp model's own.
+    aperture_gap : float
+        Longest stretch without an aperture during the movement, s.
+    """
+
+    kinds: list[str]
+    log_likelihood: np.ndarray
+    familiarity: np.ndarray
+    transport_familiarity: float = math.nan
+    rest_aperture: float = math.nan
+    observed: Landmarks | None = None
+    reference: Landmarks | None = None
+    aperture_gap: float = 0.0
+
+
+def grip_departs(observed: Landmarks, rules: VerdictRules | None = None) -> bool:
+    """Whether the grip opens late (after ``late_opening`` of the movement) or twice.
+
+    Real healthy adults start to open anywhere up to about half-way; a
+    normal grasp opens once. The one-step predictions weigh a late or a
+    second opening weakly once the model's filter has followed it.
+
+    Parameters
+    ----------
+    observed : Landmarks
+        The movement's landmarks.
+    rules : VerdictRules, optional
+    """
+    rules = VerdictRules() if rules is None else rules
+    peaks = observed.aperture_peaks
+    return bool((peaks is not None and peaks >= 2) or observed.opening_time > rules.late_opening)
+
+
+def verdict_detail(observed: Landmarks, reference: Landmarks | None,
+                   rules: VerdictRules | None = None) -> str:
+    """What kind of abnormal grasp the landmarks describe (one of :data:`DETAILS`).
+
+    In this order: ``no-opening`` (the opening is below ``no_opening`` of
+    the reference model's); ``re-opening`` (two or more aperture peaks);
+    ``delayed-opening`` (the grip starts to open after ``late_opening`` of
+    the movement, or its MGA comes after ``late_mga`` while the reference's
+    comes earlier); ``other``.
+
+    Parameters
+    ----------
+    observed : Landmarks
+        The movement's.
+    reference : Landmarks, optional
+        The reference grasp model's own movement's (None: no ``no-opening``,
+        and a late MGA counts on its own).
+    rules : VerdictRules, optional
+    """
+    rules = VerdictRules() if rules is None else rules
+    ref_opening = reference.opening if reference is not None else math.nan
+    if math.isfinite(observed.opening) and math.isfinite(ref_opening) and ref_opening > 0:
+        if observed.opening < rules.no_opening * ref_opening:
+            return "no-opening"
+    if observed.aperture_peaks is not None and observed.aperture_peaks >= 2:
+        return "re-opening"
+    ref_mga_time = reference.mga_time if reference is not None else math.nan
+    late_mga = observed.mga_time > rules.late_mga and not ref_mga_time > rules.late_mga
+    if observed.opening_time > rules.late_opening or late_mga:
+        return "delayed-opening"
+    return "other"
+
+
+def _familiar(e: Evidence, rules: VerdictRules, best: int) -> str | None:
+    fam = float(e.familiarity[best])
+    if not math.isfinite(fam):
+        return None
+    if fam < rules.familiarity_threshold:
+        return "abnormal"
+    return "reach" if e.kinds[best] == "reach" else "normal"
+
+
+def _movement_time(e: Evidence) -> float:
+    return e.observed.movement_time if e.observed is not None else math.nan
+
+
+#: The rules in the order they are tried: (name, verdict, fires(evidence, rules, base)),
+#: ``base`` being the familiarity's verdict. The first that fires gives the verdict.
+RULE_TABLE: tuple[tuple[str, str, Callable[[Evidence, VerdictRules, str], bool]], ...] = (
+    # a whole-hand grasp: out of the verdict's depth
+    ("not-a-precision-grip", "unfamiliar",
+     lambda e, r, base: e.rest_aperture > r.precision_grip_aperture),
+    # opening late or twice, in the field's landmarks, even where the models find it familiar
+    ("grip-departs", "abnormal",
+     lambda e, r, base: base in ("normal", "abnormal") and e.observed is not None
+     and grip_departs(e.observed, r)),
+    # even the transport is like no reach model's own
+    ("not-a-human-reach", "unfamiliar",
+     lambda e, r, base: e.transport_familiarity < r.unfamiliar_threshold),
+    # normal, but a digit was lost long enough to hide a second opening
+    ("insufficient-data", "unfamiliar",
+     lambda e, r, base: base == "normal"
+     and r.landmarks.hides_a_reopening(e.aperture_gap, _movement_time(e))),
+    ("familiarity", "", lambda e, r, base: True),
+)
+#: The rules' names (:attr:`Verdict.rule`), in the order they are tried.
+VERDICT_RULES = tuple(name for name, _, _ in RULE_TABLE)
+
+
+def judge(evidence: Evidence, rules: VerdictRules | None = None) -> Verdict:
+    """The verdict: the best model by log-likelihood, then the first rule of
+    :data:`RULE_TABLE` that fires.
+
+    Parameters
+    ----------
+    evidence : Evidence
+    rules : VerdictRules, optional
+    """
+    rules = VerdictRules() if rules is None else rules
+    ll = np.asarray(evidence.log_likelihood, dtype=float)
+    best = int(np.argmax(ll))
+    margin = float(ll[best] - np.max(np.delete(ll, best))) if ll.size > 1 else math.nan
+    fam = float(evidence.familiarity[best])
+    base = _familiar(evidence, rules, best)
+    if base is None:
+        return Verdict(None, best, fam, margin)
+    for name, verdict, fires in RULE_TABLE:
+        if fires(evidence, rules, base):
+            verdict = verdict or base
+            detail = None
+            if verdict == "abnormal" and evidence.observed is not None:
+                detail = verdict_detail(evidence.observed, evidence.reference, rules)
+            return Verdict(verdict, best, fam, margin, name, detail)
+    raise AssertionError("the familiarity rule always fires")
