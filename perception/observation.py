@@ -447,9 +447,11 @@ def _rest_noise(raw: np.ndarray, params: ObserveParams, name: str) -> tuple[floa
     Refuses a clip whose hand is not still over the rest frames.
     """
     rest = raw[: params.rest_frames]
-    steps = np.diff(rest, axis=0).ravel()
-    # A frame-to-frame change carries the noise of two frames: divide by sqrt 2.
-    noise = MAD_TO_SD * np.median(np.abs(steps - np.median(steps))) / np.sqrt(2)
+    steps = np.diff(rest, axis=0).reshape(-1, 2)
+    # A frame-to-frame change carries the noise of two frames: divide by sqrt 2. Each
+    # axis about its own median: the estimate must not change with the x axis's sign
+    # (a mirrored scene's onset would move).
+    noise = MAD_TO_SD * np.median(np.abs(steps - np.median(steps, axis=0))) / np.sqrt(2)
     mean = rest.mean(axis=0)
     drift = np.linalg.norm(rest - mean, axis=-1).max()
     if noise > params.max_rest_noise or drift > max(params.max_rest_drift,

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import numpy as np
@@ -12,9 +13,10 @@ from perception.errors import InputError
 from perception.filtering import AlphaBeta, alpha_beta
 from perception.observation import movement_span
 from perception.online import OnlineRecognizer, SettleRule
-from perception.pipeline import recognize_tracks
+from perception.pipeline import RecognitionSettings, recognize_tracks
 from perception.recognition.engine import HammerParams, StepScorer, recognize
 from perception.recognition.models import SceneSpec
+from perception.recognition.rules import VerdictRules
 from perception.synthetic.independent import draw_independent, independent_tracks
 
 
@@ -112,3 +114,100 @@ def test_bad_rows_and_rules_are_input_errors(rep):
         SettleRule(min_progress=2.0)
     with pytest.raises(InputError, match="no frames"):
         OnlineRecognizer(rep).finish()
+
+
+def _replayed(rec, final):
+    """The online reference pass fed the offline scene and scale, up to the offline end."""
+    from perception.online import _ReferencePass
+
+    sc, sign = rec._scene, -1.0 if final.mirrored else 1.0
+    hand = 0.5 * (sc.first.rest[1] + sc.first.rest[2]) - sc.first.rest[0]
+    tip = np.array([0.0, sc.ref.tip_start])
+    ref = _ReferencePass(sc.models, sc.hammer, sc.scale, tip - hand * [sign, 1.0], tip,
+                         final.normalisation.time_scale, sc.ref.frame_period, sign)
+    for row in rec._moving:
+        if row[0] <= final.observation.time[-1] + 1e-9:
+            ref.feed(*row)
+    return ref
+
+
+@pytest.mark.parametrize("condition, flip", [("normal", False), ("delayed", False),
+                                             ("normal", True), ("reach", False)])
+def test_the_online_reference_pass_is_the_offline_shape_pass(rep, condition, flip):
+    """Fed the scene and time scale the offline pass found, the causal pass (rescaled and
+    resampled frame by frame) scores exactly what the offline shape pass scores."""
+    tracks = _tracks(condition, seed=5)
+    if flip:  # a left hand: the finger opens on the model's -x side
+        tracks = dataclasses.replace(tracks, position=tracks.position * [-1, 1] + [640, 0])
+    rec, _ = _feed(rep, tracks)
+    final = rec.finish()
+    assert final.mirrored == flip
+    ref = _replayed(rec, final)
+    scorer = ref.kinds["grasp" if final.shape.kinds[0] == "grasp" else "reach"]
+    assert scorer.frames == final.shape.time.size
+    np.testing.assert_allclose(scorer.log_likelihood, final.shape.log_likelihood[:, -1],
+                               rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(scorer.familiarity(final.shape.observation.dt),
+                               final.shape.familiarity, rtol=1e-9)
+
+
+def test_a_mirrored_scene_is_found_online_and_settles_as_offline(rep):
+    """Before, the online path never looked for a mirrored scene: a left hand's normal grasp
+    was abnormal (familiarity 0.001) throughout while offline said normal."""
+    tracks = _tracks("normal", seed=3)
+    flipped = dataclasses.replace(tracks, position=tracks.position * [-1, 1] + [640, 0])
+    rec, states = _feed(rep, flipped)
+    final = rec.finish()
+    assert final.mirrored and final.verdict == "normal"
+    assert rec._scene.guess[0] is True
+    assert rec.decision is not None and rec.decision.verdict == "normal"
+    assert states[-1].verdict == "normal" and states[-1].familiarity > 0.05
+    plain, _ = _feed(rep, tracks)
+    assert plain.decision.verdict == "normal"
+    # the same movement, mirrored: the same scores once the side is read
+    assert states[-1].log_likelihood == pytest.approx(plain.state.log_likelihood, rel=1e-9)
+
+
+@pytest.mark.parametrize("condition", ["normal", "reach"])
+def test_normal_and_reach_settle_while_the_stream_runs(rep, condition):
+    tracks = _tracks(condition, seed=11)
+    rec, states = _feed(rep, tracks)
+    final = rec.finish()
+    d = rec.decision
+    assert d is not None and d.verdict == final.verdict == condition
+    assert d.frame < tracks.frame[-1]
+    if condition == "normal":  # once the grip has passed its maximum and the hand slows
+        assert d.since_onset < final.observation.time[-1]
+
+
+def test_a_stream_too_near_the_object_is_refused_as_offline(rep):
+    tracks = _tracks("normal", seed=3)
+    with pytest.raises(InputError) as offline:
+        recognize_tracks(tracks, rep, dataclasses.replace(
+            RecognitionSettings(), rules=VerdictRules(min_transport=0.5)))
+    with pytest.raises(InputError) as online:
+        _feed(rep, tracks, settings=dataclasses.replace(
+            RecognitionSettings(), rules=VerdictRules(min_transport=0.5)))
+    assert "too near" in str(offline.value) and "too near" in str(online.value)
+
+
+def test_per_frame_cost_does_not_grow_with_the_stream(rep):
+    """The scorer's step and the judgement cost the same at the end of a long stream as
+    at its start: nothing recomputes the stream's history."""
+    import time
+
+    tracks = _tracks("normal", seed=3)
+    rec, _ = _feed(rep, tracks)
+    last = tracks.position[-1]
+    t0 = float(tracks.time[-1])
+    dt = float(np.median(np.diff(tracks.time)))
+
+    def cost(n, start):
+        tic = time.perf_counter()
+        for k in range(n):
+            rec.update(last, start + k * dt)
+        return time.perf_counter() - tic
+
+    early = cost(100, t0 + dt)
+    late = cost(100, t0 + dt * 2000) if cost(1800, t0 + dt * 101) >= 0 else 0.0
+    assert late < 3 * early + 0.05

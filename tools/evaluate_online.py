@@ -79,18 +79,19 @@ def markdown(set_name: str, seeds: range, rows: list[dict]) -> str:
              f"{seeds.stop - 1}, {len(rows)} clips, tracked from video)", "",
              "`decision_fraction`: of the scored movement (onset to end of activity) when the "
              "verdict settled; `decision_time`: s after the onset; median (range). Settled before "
-             "the end: clips whose verdict settled while the movement was still being seen "
+             "the end: clips whose verdict settled before the scored movement ended "
              "(the others settle on the final, offline, result). Agrees: the first settled "
              "verdict equals the offline verdict.", "",
              "| condition | n | offline right | settled before the end | decision_fraction "
              "| decision_time, s | agrees with offline |", "|---|---|---|---|---|---|---|"]
-    for cond in (*CONDITIONS, "all"):
-        sub = [r for r in rows if cond == "all" or r["condition"] == cond]
+    pooled = {"all": CONDITIONS, "normal + reach": ("normal", "reach")}
+    for cond in (*CONDITIONS, *pooled):
+        sub = [r for r in rows if r["condition"] in pooled.get(cond, (cond,))]
         if not sub:
             continue
         ok = [r for r in sub if "settled_verdict" in r]
         right = sum(r["offline"] == EXPECTED[r["condition"]] for r in sub)
-        early = sum(bool(r.get("settled_early")) for r in ok)
+        early = sum(bool(r.get("settled_before_end")) for r in ok)
         agree = sum(bool(r["agrees"]) for r in ok)
         lines.append(f"| {cond} | {len(sub)} | {right} / {len(sub)} | {early} / {len(ok)} | "
                      f"{_median(r['decision_fraction'] for r in ok)} | "

@@ -220,7 +220,8 @@ def decision_summary(rec: Recognition, decision: Decision | None) -> dict:
     ``decision_time`` is s after the offline movement onset, ``decision_fraction``
     its share of the scored movement (onset to end of activity). A stream that
     ends before a verdict settles is decided by the offline result at its end
-    (``settled_early`` false).
+    (``settled_early`` false); ``settled_before_end`` says whether it settled
+    before the scored movement's end.
 
     Parameters
     ----------
@@ -237,5 +238,6 @@ def decision_summary(rec: Recognition, decision: Decision | None) -> dict:
         t, verdict, detail = decision.since_onset, decision.verdict, decision.detail
     return {"settled_verdict": verdict, "settled_detail": detail,
             "settled_early": decision is not None,
+            "settled_before_end": decision is not None and t < span,
             "decision_time": float(t), "decision_fraction": float(t / span) if span > 0 else None,
             "agrees": verdict == rec.verdict}
