@@ -1,19 +1,33 @@
 """Benchmark ``hammer-mv watch``'s per-frame latency beside plain decoding.
 
-Renders 640 x 480 30 fps clips of a reach-to-grasp, decodes each (the
-baseline: an OpenCV read loop) and feeds its frames to
+Renders 640 x 480 30 fps clips of a reach-to-grasp and feeds their frames,
+as decoded (the baseline: an OpenCV read loop, timed frame by frame), to
 :class:`perception.online.OnlineRecognizer`, timing every ``update`` —
 frame received to state updated, tracking included — with the default
 repertoire already planned for the scene (planning happens once, at the
-rest frames: its one frame is reported on its own). The issue's target:
-median <= 5 ms, 99th percentile <= 15 ms on 2 cores.
+rest frames: that frame is reported on its own).
 
-Run: ``.venv/bin/python tools/bench_online.py [--clips 6]`` or ``tools/bench.py --only online``.
+* **Three runs** over the same clips, each with its own decoding baseline:
+  each run's median and 99th percentile, and the median of the three. The
+  slow frames are named apart: the tracker's first detection (the first
+  frame after its look-ahead, found as the first update that brings a row)
+  and the scene fix (the first update past the ``start`` phase).
+* **A 30 s stream** (the reach, then the hand resting on the object): the
+  per-frame cost in each 5 s of it. A frame that costs more the longer the
+  stream has run shows as a later 5 s slower than an earlier one.
+
+The issue's targets on 2 cores: median <= 2 ms; 99th percentile <= 10 ms in
+the median of the three runs and <= 15 ms in each; no growth with the
+stream's length.
+
+Run: ``.venv/bin/python tools/bench_online.py [--clips 6] [--runs 3] [--stream 30]``
+or ``tools/bench.py --only online``.
 """
 
 from __future__ import annotations
 
 import argparse
+import statistics
 import sys
 import tempfile
 import time
@@ -28,60 +42,147 @@ sys.path.insert(0, str(ROOT / "tools"))
 from bench import table  # noqa: E402
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Time decoding and online updates; print a table."""
+def _stream(rep, video: Path, fps: float = 30.0) -> dict:
+    """Decode ``video`` frame by frame into a fresh recogniser; every step's time, s."""
     import cv2
 
     from perception.online import OnlineRecognizer
+
+    rec = OnlineRecognizer(rep)
+    cap = cv2.VideoCapture(str(video))
+    out = {"decode": [], "update": [], "cpu": [], "first": None, "scene": None}
+    try:
+        while True:
+            t0 = time.perf_counter()
+            ok, frame = cap.read()
+            if not ok:
+                break
+            i = len(out["update"])
+            t1, c1 = time.perf_counter(), time.thread_time()
+            state = rec.update(frame, i / fps)
+            out["update"].append(time.perf_counter() - t1)
+            out["cpu"].append(time.thread_time() - c1)
+            out["decode"].append(t1 - t0)
+            if out["first"] is None and rec.last_row is not None:
+                out["first"] = i  # the tracker's first detection
+            if out["scene"] is None and state.phase != "start":
+                out["scene"] = i  # the scene fixed, the models fetched
+    finally:
+        cap.release()
+    return out
+
+
+def _ms(a, q: float) -> float:
+    return float(np.percentile(a, q)) * 1e3
+
+
+def _run(rep, videos: list[Path]) -> dict:
+    """One run over the clips: the per-frame times, the one-off frames apart."""
+    run = {k: [] for k in ("decode", "update", "cpu", "steady", "first", "catch_up", "scene")}
+    for video in videos:
+        s = _stream(rep, video)
+        i, j = s["first"], s["scene"]
+        run["decode"] += s["decode"]
+        run["first"].append(s["update"][i])
+        run["catch_up"] += s["update"][i + 1:i + 5]
+        run["scene"].append(s["update"][j])
+        keep = [k for k in range(len(s["update"])) if k != j]
+        run["update"] += [s["update"][k] for k in keep]
+        run["cpu"] += [s["cpu"][k] for k in keep]
+        run["steady"] += [s["update"][k] for k in keep if k != i]
+    return run
+
+
+def _long_stream(rep, folder: str, seconds: float) -> list[tuple[str, str, str, str]]:
+    """The per-frame cost in each 5 s of a stream ``seconds`` long (the scene-fix frame apart)."""
+    from perception.geometry import DEFAULT_OBJECT_DIAMETER
+    from perception.synthetic.demos import render_demo_clip
+    from perception.synthetic.scene import Scene
+
+    n = int(round(seconds * 30))
+    scene = Scene.reach_to_grasp(n, 30.0, onset=0.2, duration=2.4,
+                                 object_diameter=DEFAULT_OBJECT_DIAMETER)
+    s = _stream(rep, render_demo_clip(folder, "long.mp4", n=n, scene=scene, seed=7)[0].video)
+    upd, cpu, dec = (np.array(s[k]) for k in ("update", "cpu", "decode"))
+    keep = np.ones(len(upd), bool)
+    keep[s["scene"]] = False
+    rows, meds = [], []
+    for start in range(0, int(seconds), 5):
+        span = slice(start * 30, (start + 5) * 30)
+        part, own = upd[span][keep[span]], cpu[span][keep[span]]
+        meds.append(np.median(own) * 1e3)
+        rows.append((f"  {start}-{start + 5} s ({len(part)} frames)",
+                     f"{np.median(part) * 1e3:.2f} ms median, p99 {_ms(part, 99):.2f}",
+                     f"CPU median {meds[-1]:.3f} ms; decode {_ms(dec[span], 50):.2f} ms", ""))
+    grows = meds[-1] / meds[0]
+    # per-second medians from 5 s on (the movement over, the hand at rest): their trend
+    secs = np.arange(5, int(seconds))
+    per_s = [np.median(cpu[k * 30:(k + 1) * 30][keep[k * 30:(k + 1) * 30]]) for k in secs]
+    slope = np.polyfit(secs, per_s, 1)[0] * 1e6 * 10 if len(secs) > 2 else float("nan")
+    rows += [("  last 5 s over first 5 s (CPU medians)", f"{grows:.2f} x",
+              "target: no growth (~1 x)", "ok" if grows <= 1.1 else "GROWS"),
+             ("  trend of the per-second CPU medians after 5 s", f"{slope:+.0f} us per 10 s",
+              f"{per_s[0] * 1e3:.3f} ms at 5 s, {per_s[-1] * 1e3:.3f} ms at the end", "")]
+    rows.insert(0, (f"{n} frames fed at increasing times (wall; CPU time of the update)",
+                    "", "", ""))
+    return rows
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Time decoding and online updates; print the tables."""
+    import cv2
+
     from perception.recognition.repertoire import Repertoire
     from perception.synthetic.demos import render_demo_clip
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--clips", type=int, default=6, help="clips of 90 frames")
+    ap.add_argument("--clips", type=int, default=6, help="clips of 90 frames per run")
+    ap.add_argument("--runs", type=int, default=3, help="runs over the clips")
+    ap.add_argument("--stream", type=float, default=30.0,
+                    help="length of the long stream, s (0: none)")
     args = ap.parse_args([] if argv is None and __name__ != "__main__" else argv)
     cv2.setNumThreads(1)  # as hammer-mv watch runs
     rep = Repertoire.default()
-    decode, update, cpu, first = [], [], [], []
     with tempfile.TemporaryDirectory(prefix="bench_online_") as tmp:
-        for k in range(args.clips + 1):  # the first one plans the scene: warm-up, not timed
-            video = render_demo_clip(tmp, f"c{k}.mp4", n=90, seed=k)[0].video
-            cap = cv2.VideoCapture(str(video))
-            frames = []
-            while True:
-                t0 = time.perf_counter()
-                ok, frame = cap.read()
-                if not ok:
-                    break
-                if k:
-                    decode.append(time.perf_counter() - t0)
-                frames.append(frame)
-            rec = OnlineRecognizer(rep)
-            times, own = [], []
-            for i, frame in enumerate(frames):
-                t0, c0 = time.perf_counter(), time.thread_time()
-                rec.update(frame, i / 30.0)
-                times.append(time.perf_counter() - t0)
-                own.append(time.thread_time() - c0)
-            if k:
-                first.append(times[9])  # the scene fixed, the models fetched
-                update += times[:9] + times[10:]
-                cpu += own[:9] + own[10:]
-    ms = lambda a, q: np.percentile(a, q) * 1e3  # noqa: E731
-    med, p99 = ms(update, 50), ms(update, 99)
-    table("online recognition: per-frame latency, 640x480 30 fps", [
-        ("decode (cv2 read), per frame", f"{ms(decode, 50):.2f} ms median",
-         f"p99 {ms(decode, 99):.2f} ms", "baseline"),
-        (f"update (track + score + judge), {len(update)} frames", f"{med:.2f} ms median",
-         "target <= 5 ms", "ok" if med <= 5 else "MISSED"),
-        ("  99th percentile", f"{p99:.2f} ms", "target <= 15 ms", "ok" if p99 <= 15 else "MISSED"),
+        videos = [render_demo_clip(tmp, f"c{k}.mp4", n=90, seed=k)[0].video
+                  for k in range(args.clips + 1)]
+        _stream(rep, videos[0])  # plans the scene: warm-up, not timed
+        runs = [_run(rep, videos[1:]) for _ in range(args.runs)]
+        long_rows = _long_stream(rep, tmp, args.stream) if args.stream >= 10 else []
+    med = statistics.median(_ms(r["update"], 50) for r in runs)
+    p99s = [_ms(r["update"], 99) for r in runs]
+    rows = []
+    for k, r in enumerate(runs, 1):
+        rows += [(f"run {k}: decode (cv2 read), per frame", f"{_ms(r['decode'], 50):.2f} ms median",
+                  f"p99 {_ms(r['decode'], 99):.2f} ms", "baseline"),
+                 (f"run {k}: update (track + score + judge), {len(r['update'])} frames",
+                  f"{_ms(r['update'], 50):.2f} ms median, p99 {p99s[k - 1]:.2f} ms",
+                  "p99 target <= 15 ms each", "ok" if p99s[k - 1] <= 15 else "MISSED")]
+    first = [x for r in runs for x in r["first"]]
+    catch = [x for r in runs for x in r["catch_up"]]
+    rows += [
+        (f"median of the {len(runs)} runs: median", f"{med:.2f} ms", "target <= 2 ms",
+         "ok" if med <= 2 else "MISSED"),
+        (f"median of the {len(runs)} runs: 99th percentile", f"{statistics.median(p99s):.2f} ms",
+         "target <= 10 ms", "ok" if statistics.median(p99s) <= 10 else "MISSED"),
         ("  CPU time of the update (what the code costs on an idle core)",
-         f"{ms(cpu, 50):.2f} ms median", f"p99 {ms(cpu, 99):.2f} ms", ""),
+         f"{statistics.median(_ms(r['cpu'], 50) for r in runs):.2f} ms median",
+         f"p99 {statistics.median(_ms(r['cpu'], 99) for r in runs):.2f} ms", ""),
         ("  p99 without the tracker's first detection (one frame per stream)",
-         f"{np.percentile(np.delete(update, np.arange(4, len(update), 89)), 99) * 1e3:.2f} ms",
-         "", ""),
-        ("  scene-fix frame (models already planned)", f"{np.median(first) * 1e3:.1f} ms",
-         "once per stream", ""),
-    ])
+         f"{statistics.median(_ms(r['steady'], 99) for r in runs):.2f} ms", "", ""),
+        ("  first-detection frame (look-ahead + first frame)",
+         f"{np.median(first) * 1e3:.2f} ms median", f"max {max(first) * 1e3:.2f} ms",
+         "once per stream"),
+        ("  the 4 frames after it (catching up, 2 frames tracked each)",
+         f"{np.median(catch) * 1e3:.2f} ms median", f"max {max(catch) * 1e3:.2f} ms", ""),
+        ("  scene-fix frame (models already planned; not in the figures above)",
+         f"{np.median([x for r in runs for x in r['scene']]) * 1e3:.1f} ms", "once per stream",
+         ""),
+    ]
+    table("online recognition: per-frame latency, 640x480 30 fps", rows)
+    if long_rows:
+        table(f"online recognition: a {args.stream:.0f} s stream, per-frame cost by 5 s",
+              long_rows)
     return 0
 
 

@@ -156,6 +156,11 @@ def describe(hsv: np.ndarray, colour: MarkerColour, min_area: float,
     x0, y0 = (roi[0], roi[1]) if roi is not None else (0, 0)
     region = hsv if roi is None else hsv[y0:y0 + roi[3], x0:x0 + roi[2]]
     mask = colour.backproject(region)
+    # Labelled within the box of the colour's pixels, from an even corner: the
+    # same blobs in the same order as over the region, in a fraction of the time.
+    bx, by, bw, bh = cv2.boundingRect(mask)
+    bx, by = bx - bx % 2, by - by % 2
+    mask, region = mask[by:by + bh + 1, bx:bx + bw + 1], region[by:by + bh + 1, bx:bx + bw + 1]
     n, labels, stats, cents = cv2.connectedComponentsWithStats(
         mask, connectivity=8, ltype=label_type(mask.shape))
     order = [k for k in np.argsort(-stats[1:, cv2.CC_STAT_AREA], kind="stable") + 1
@@ -169,8 +174,9 @@ def describe(hsv: np.ndarray, colour: MarkerColour, min_area: float,
         major, minor, angle = principal_axes(sub.astype(np.uint8))
         roundness = math.sqrt(max(minor, 0.0) / major) if major > 0 else 1.0
         axis = math.cos(angle), math.sin(angle)
-        blob = Blob((float(cents[k][0]) + x0, float(cents[k][1]) + y0), float(area),
-                    (x + x0, y + y0, w, h))
+        # OpenCV's centroid over the region: its exact pixel sum over the area
+        cx, cy = ((round(c * area) + b * area) / area for c, b in zip(cents[k], (bx, by)))
+        blob = Blob((cx + x0, cy + y0), float(area), (x + bx + x0, y + by + y0, w, h))
         moved = _moved(later, colour, blob, size_change) if later is not None else math.nan
         sat, val = float(np.median(pix[:, 1])), float(np.median(pix[:, 2]))
         purity = (min(sat / max(ref_s, 1), 1.0) + min(val / max(ref_v, 1), 1.0)) / 2

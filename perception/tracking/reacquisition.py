@@ -1,14 +1,13 @@
 """Finding a lost marker again: a search of the whole frame where the hand puts it.
 
 Only once the local search around its prediction has failed, and while the
-marker stays lost: :func:`search_blobs` lists the blobs of plausible area in
+marker stays lost: :func:`reacquire` takes the blobs of plausible area in
 the thresholded back-projection of a downscaled full frame
 (:func:`downscaled_hsv`, computed once per frame for all lost markers),
-nearest the expected position first; :func:`reacquire` refines them at full
-resolution and takes the first whose refined mass — and whatever else the
-caller checks (shape, colour, place in the hand) — is plausible. First
-detection is in :mod:`perception.tracking.candidates` and
-:mod:`perception.tracking.hand`.
+nearest the expected position first, refines them at full resolution and
+keeps the first whose refined mass — and whatever else the caller checks
+(shape, colour, place in the hand) — is plausible. First detection is in
+:mod:`perception.tracking.candidates` and :mod:`perception.tracking.hand`.
 """
 
 from __future__ import annotations
@@ -19,7 +18,7 @@ from collections.abc import Callable, Sequence
 import cv2
 import numpy as np
 
-from perception.tracking.blobs import Blob, by_distance, find_blobs
+from perception.tracking.blobs import by_distance, find_blobs
 from perception.tracking.markers import MarkerColour
 from perception.tracking.measurement import Measurement, measure
 from perception.tracking.params import TrackerParams
@@ -73,44 +72,6 @@ def downscaled_hsv(frame: np.ndarray, scale: int) -> tuple[np.ndarray, float, fl
     return cv2.cvtColor(small, cv2.COLOR_BGR2HSV), w / sw, h / sh
 
 
-def search_blobs(
-    small: tuple[np.ndarray, float, float],
-    colour: MarkerColour,
-    ref: float,
-    pred: Sequence[float],
-    params: TrackerParams,
-) -> list[Blob]:
-    """Blobs of plausible area in a downscaled frame, nearest the prediction first.
-
-    Parameters
-    ----------
-    small : (hsv, fx, fy)
-        As :func:`downscaled_hsv` returns.
-    colour : MarkerColour
-        The marker's colour model.
-    ref : float
-        Reference mass, px; areas from ``search_min_ratio`` to
-        ``max_area_ratio`` times it are plausible.
-    pred : (float, float)
-        Predicted position (x, y), px.
-    params : TrackerParams
-        The search settings.
-
-    Returns
-    -------
-    list of Blob
-        At most ``search_tries``, in full-resolution px.
-    """
-    hsv, fx, fy = small
-    blobs = find_blobs(
-        colour.backproject(hsv),
-        min_area=params.search_min_ratio * ref,
-        max_area=params.max_area_ratio * ref,
-        scale=(fx, fy),
-    )
-    return by_distance(blobs, pred)[: params.search_tries]
-
-
 def reacquire(
     frame: np.ndarray,
     small: tuple[np.ndarray, float, float],
@@ -132,7 +93,9 @@ def reacquire(
     colour : MarkerColour
         The marker's colour model.
     ref : float
-        Reference mass, px.
+        Reference mass, px; downscaled blobs of ``search_min_ratio`` to
+        ``max_area_ratio`` times it are refined, the ``search_tries``
+        nearest ``pred``.
     pred : (float, float)
         Predicted position (x, y), px.
     window : (int, int)
@@ -150,7 +113,10 @@ def reacquire(
         to ``max_area_ratio`` times ``ref`` that ``accept`` accepts; None if
         no candidate has one.
     """
-    for blob in search_blobs(small, colour, ref, pred, params):
+    hsv, fx, fy = small  # plausible blobs of the downscaled frame, the nearest first
+    blobs = find_blobs(colour.backproject(hsv), min_area=params.search_min_ratio * ref,
+                       max_area=params.max_area_ratio * ref, scale=(fx, fy))
+    for blob in by_distance(blobs, pred)[: params.search_tries]:
         meas = measure(frame, colour, blob.centre, window, ref, params.search_margin_px, params)
         if meas is None or meas.merged:
             continue

@@ -58,6 +58,7 @@ import logging
 import math
 import os
 import sys
+from collections import deque
 from collections.abc import Iterable, Mapping
 from dataclasses import asdict
 from pathlib import Path
@@ -105,13 +106,18 @@ class Tracker:
     ambiguities : dict of str to list of (float, float)
         Markers found ambiguous on their first detection and the positions
         (px) of their rival blobs.
+    catch_up : int
+        Frames :meth:`feed` tracks at most per call once started.
 
     Examples
     --------
     >>> tracker = Tracker()                                   # doctest: +SKIP
     >>> for index, time, frame in FrameSource("clip.mp4"):    # doctest: +SKIP
-    ...     position, likelihood, status = tracker.update(frame, time)
+    ...     rows = tracker.feed(frame, time, index)  # (index, time, position, ...)
+    >>> rows = tracker.flush()                                # doctest: +SKIP
     """
+
+    catch_up = 2
 
     def __init__(
         self,
@@ -134,6 +140,7 @@ class Tracker:
         ]
         self._first = FirstDetection(self._tracks, self.params)
         self.n_frames = 0
+        self._queue: deque[tuple[int, float, np.ndarray]] = deque()  # fed, not tracked yet
         self._frame_shape: tuple[int, int] | None = None
         self._small: tuple[np.ndarray, float, float] | None = None
         self._time = 0.0
@@ -199,6 +206,29 @@ class Tracker:
         for key, value in asdict(p).items():
             out[key] = json.dumps(value) if isinstance(value, tuple) else value
         return out
+
+    def feed(self, frame: np.ndarray, time_s: float, index: int) -> list[tuple]:
+        """Take a stream's next frame; return the rows tracked meanwhile, in order.
+
+        The first ``params.init_frames`` frames wait for the last of them
+        (:meth:`look_ahead`); the call that brings it tracks the first frame
+        (first detection), each later call at most :attr:`catch_up` frames:
+        no call carries the whole look-ahead. A row is ``(index, time_s,
+        position, likelihood, status, frame)``, with :meth:`update`'s results;
+        :func:`track_frames` is this and :meth:`flush`.
+        """
+        self._queue.append((index, time_s, frame))
+        if self.n_frames or len(self._queue) >= self.params.init_frames:
+            return self.flush(self.catch_up if self.n_frames else 1)
+        return []
+
+    def flush(self, most: int | None = None) -> list[tuple]:
+        """Track the frames :meth:`feed` holds (at most ``most``; all: the stream ended); rows."""
+        if self.n_frames == 0 and len(self._queue) > 1:
+            self.look_ahead(self._queue[-1][2])
+        n = len(self._queue) if most is None else min(most, len(self._queue))
+        todo = [self._queue.popleft() for _ in range(n)]
+        return [(index, t, *self.update(frame, t), frame) for index, t, frame in todo]
 
     def look_ahead(self, frame: np.ndarray) -> None:
         """Show the tracker a later frame of the clip's rest before the first :meth:`update`.
@@ -466,9 +496,10 @@ def track_frames(
 ) -> Tracker:
     """Track a stream of frames into an open :class:`TracksWriter`.
 
-    The first ``tracker.params.init_frames`` frames are read ahead (the
-    hand at rest) so that first detection can reject candidates that move
-    (:meth:`Tracker.look_ahead`); memory holds those few frames only.
+    The frames go through :meth:`Tracker.feed` and :meth:`Tracker.flush`:
+    the first ``tracker.params.init_frames`` are read ahead (the hand at
+    rest) so that first detection can reject candidates that move; memory
+    holds those few frames only.
 
     Parameters
     ----------
@@ -489,17 +520,14 @@ def track_frames(
     Tracker
         ``tracker``, for chaining.
     """
-    it = iter(frames)
-    ahead = list(itertools.islice(it, max(tracker.params.init_frames, 1)))
-    if len(ahead) > 1 and tracker.n_frames == 0:
-        tracker.look_ahead(ahead[-1][2])
-    for index, time_s, frame in itertools.chain(ahead, it):
-        position, likelihood, status = tracker.update(frame, time_s)
-        writer.append(index, time_s, position, likelihood, status)
-        if each_frame is not None:
-            each_frame(index, time_s, frame, position, likelihood, status)
-        if progress is not None:
-            progress()
+    for item in itertools.chain(frames, [None]):
+        rows = tracker.flush() if item is None else tracker.feed(item[2], item[1], item[0])
+        for index, time_s, *marks, frame in rows:  # marks: position, likelihood, status
+            writer.append(index, time_s, *marks)
+            if each_frame is not None:
+                each_frame(index, time_s, frame, *marks)
+            if progress is not None:
+                progress()
     return tracker
 
 
