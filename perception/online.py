@@ -157,9 +157,9 @@ class OnlineRecognizer:
             markers = (MARKER_NAMES if self.settings.tracking is None
                        else self.settings.tracking.markers.names)
         self.markers = tuple(markers)
-        self._ahead: list[tuple[int, float, np.ndarray]] = []
         self._rows: dict[str, list] = {k: [] for k in ("frame", "time", "position",
                                                        "likelihood", "status")}
+        self._received = 0  # frames or rows given to update
         self._scene = None  # SimpleNamespace once fixed
         self._onset: float | None = None
         self._moving: list[tuple] = []  # (since onset, wrist, finger tip, thumb tip) from the onset
@@ -183,7 +183,8 @@ class OnlineRecognizer:
             Its frame index (default: rows received so far).
         """
         data = np.asarray(frame_or_points)
-        index = len(self._rows["time"]) + len(self._ahead) if index is None else int(index)
+        index = self._received if index is None else int(index)
+        self._received += 1
         if data.ndim == 3:
             return self._frame(data, float(t), index)
         if data.shape != (len(self.markers), 2):
@@ -195,22 +196,15 @@ class OnlineRecognizer:
                          np.where(seen, Status.TRACKED, Status.LOST).astype(np.int8))
 
     def _frame(self, image: np.ndarray, t: float, index: int) -> OnlineState:
-        """Track a frame; the first ``init_frames`` wait for the tracker's look-ahead."""
+        """Track a frame (the tracker's look-ahead spread over the next frames)."""
         if self._tracker is None:
             from perception.tracking.tracker import Tracker  # OpenCV only for frames
 
             setup = self.settings.tracking
             self._tracker = (Tracker() if setup is None else Tracker(setup.markers, setup.params))
-        tracker = self._tracker
-        if tracker.n_frames == 0 and len(self._ahead) < max(tracker.params.init_frames, 1):
-            self._ahead.append((index, t, image))
-            if len(self._ahead) < max(tracker.params.init_frames, 1):
-                return self._waiting(index, t)
-            if len(self._ahead) > 1:
-                tracker.look_ahead(self._ahead[-1][2])
-        todo, self._ahead = self._ahead or [(index, t, image)], []
-        for i, ti, img in todo:
-            state = self._row(i, ti, *tracker.update(img, ti))
+        state = self.state if self.state is not None else self._waiting(index, t)
+        for row in self._tracker.feed(image, t, index):
+            state = self._row(*row[:5])
         return state
 
     def _waiting(self, index: int, t: float, phase: str = "start") -> OnlineState:
@@ -453,12 +447,9 @@ class OnlineRecognizer:
             As :func:`perception.pipeline.recognize_tracks` (a stream without a
             movement, too short, ...).
         """
-        if self._ahead:  # a stream shorter than the tracker's look-ahead
-            todo, self._ahead = self._ahead, []
-            if len(todo) > 1:
-                self._tracker.look_ahead(todo[-1][2])
-            for i, ti, img in todo:
-                self._row(i, ti, *self._tracker.update(img, ti))
+        if self._tracker is not None:  # the frames the tracker still holds
+            for row in self._tracker.flush():
+                self._row(*row[:5])
         if not self._rows["time"]:
             raise InputError("no frames received", source or self.clip)
         return recognize_tracks(self.tracks(video), self.repertoire, self.settings,

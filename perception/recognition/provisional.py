@@ -35,9 +35,11 @@ class SettleRule:
       ``margin`` natural-log units from their thresholds, and either the grip
       has opened — once, starting before ``late_opening - late_margin`` of
       the movement, and closed ``closing`` of its opening since its maximum
-      (a second opening comes before that) — or it has not opened by even
-      ``reach_opening`` m while the wrist has covered ``reach_progress`` of
-      its way and slowed by ``reach_slowed`` (a late opener has started by then);
+      while the wrist has covered ``arrived`` of its way: the hand is at the
+      object, and a second opening comes on the way there — or it has not
+      opened by even ``reach_opening`` m while the wrist has covered
+      ``reach_progress`` of its way and slowed by ``reach_slowed`` (a late
+      opener has started by then);
     * the other rules (``unfamiliar``) settle at the end.
 
     The defaults were chosen on the dev population (seeds 1000 + k,
@@ -45,7 +47,7 @@ class SettleRule:
 
     Parameters
     ----------
-    min_progress, reach_progress : float
+    min_progress, arrived, reach_progress : float
         Share of the wrist's way, 0..1.
     late_margin : float
         Share of the movement kept from ``late_opening`` (the online estimate
@@ -63,7 +65,8 @@ class SettleRule:
     min_progress: float = 0.5
     late_margin: float = 0.12
     slowed: float = 0.6
-    closing: float = 0.02
+    closing: float = 0.05
+    arrived: float = 0.95
     margin: float = 1.0
     reach_progress: float = 0.7
     reach_slowed: float = 0.9
@@ -72,12 +75,12 @@ class SettleRule:
 
     def __post_init__(self):
         shares = (self.min_progress, self.reach_progress, self.slowed, self.reach_slowed,
-                  self.closing)
+                  self.closing, self.arrived)
         if not (all(0 <= v <= 1 for v in shares) and self.late_margin >= 0
                 and self.margin >= 0 and self.reach_opening >= 0 and self.hold >= 0):
-            raise InputError("expected 0 <= min_progress, reach_progress, slowed, reach_slowed, "
-                             "closing <= 1, late_margin, margin, reach_opening, hold >= 0, got "
-                             f"{self}", field="SettleRule")
+            raise InputError("expected 0 <= min_progress, arrived, reach_progress, slowed, "
+                             "reach_slowed, closing <= 1, late_margin, margin, reach_opening, "
+                             f"hold >= 0, got {self}", field="SettleRule")
 
     @staticmethod
     def evidence(verdict: Verdict, evidence: Evidence, rules: VerdictRules) -> float:
@@ -122,6 +125,7 @@ class SettleRule:
             return False
         if grip.opened:  # the maximum is past, and with it the time for a second opening
             return (grip.closing >= self.closing and grip.peaks == 1
+                    and progress >= self.arrived
                     and lm.opening_time <= rules.late_opening - self.late_margin)
         return (progress >= self.reach_progress and grip.slowed >= self.reach_slowed
                 and grip.opening < self.reach_opening)
