@@ -18,8 +18,9 @@ import pytest
 from _demos import default_repertoire
 from _reports import assert_json_close
 
-from hammer_mv.cli import main, watch
+from hammer_mv.cli import main
 from perception.errors import InputError
+from perception.io import capture as live
 from perception.online import OnlineRecognizer
 from perception.synthetic.demos import render_demo_clip
 
@@ -51,7 +52,7 @@ class FakeCamera:
     """A camera that serves ``frames`` on its own clock, then blocks in ``read``.
 
     Frame k comes ``warmup + k / fps`` s after the camera opened by
-    :meth:`monotonic`, the clock ``watch`` reads in the real one's place (on
+    :meth:`monotonic`, the clock the live source reads in the real one's place (on
     the real one the times, and the verdict with them, would depend on how
     busy the machine is); the frames themselves come at once. After the last
     one ``read`` blocks until ``unblock`` is set, as a stalled driver's may.
@@ -88,7 +89,7 @@ class FakeCamera:
 
 
 class _CameraClock:
-    """The ``time`` module as ``watch`` sees it: ``monotonic`` is the camera's clock."""
+    """The ``time`` module as the live source sees it: ``monotonic`` is the camera's clock."""
 
     def __init__(self, cam: FakeCamera):
         self.monotonic = cam.monotonic
@@ -114,7 +115,8 @@ def camera(monkeypatch):
 
         cams.append(cam)
         monkeypatch.setattr(cv2, "VideoCapture", capture)
-        monkeypatch.setattr(watch, "time", _CameraClock(cam))
+        monkeypatch.setattr(live, "time", _CameraClock(cam))
+        monkeypatch.setattr(live, "READ_AHEAD", 2 * N)  # it serves its frames at once: keep all
         return opened
 
     yield install
@@ -147,7 +149,7 @@ def test_a_camera_is_recognised_on_its_own_clock_until_it_stalls(clip, camera, t
     out = capsys.readouterr().out
     assert rc == 0 and opened == [3]
     # ended by the stall timeout: after the last frame, not before, and not much later
-    assert cam.served == N and STALL + watch.STALL_GRACE <= returned - cam.last_served < STALL + 20
+    assert cam.served == N and STALL + live.STALL_GRACE <= returned - cam.last_served < STALL + 20
     online = json.loads((tmp_path / "camera3.recognition.json").read_text())
     assert online["clip"] == "camera3" and online["input"] == "3"
     info = online["online"]

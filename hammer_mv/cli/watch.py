@@ -3,11 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import math
-import queue
-import re
-import sys
-import threading
 import time
 from pathlib import Path
 
@@ -52,107 +47,6 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def _frames(source: str, settings, args):
-    """``(kind, header fps, iterator of (index, time s, frame), info)`` of ``source``."""
-    from perception.errors import InputError
-
-    kind = _device(source)
-    if kind is not None:  # a camera's frames are timed by this clock, a stream's by its own
-        camera = kind == "camera"
-        return kind, *_capture(int(source) if camera else source, args, clock=camera)
-    path = Path(source)
-    if not path.exists():
-        raise InputError("no such file (nor a camera index or stream URL)", path)
-    from perception.io.video import FrameSource
-
-    src = FrameSource(path, keep_truncated=settings.keep_truncated, fps=settings.fps)
-    return "file", src.header.fps_nominal, iter(src), src
-
-
-def _device(source: str) -> str | None:
-    """``"camera"`` or ``"stream"`` for a camera index or a URL; None for a file."""
-    if re.fullmatch(r"\d+", source):
-        return "camera"
-    return "stream" if "://" in source else None
-
-
-def _capture(target, args, *, clock: bool):
-    """Frames of a camera or stream, read in a thread so that the source is drained.
-
-    Times are the stream's own (its time stamps) or, for a camera, this
-    process's clock when the frame came: never an index over a frame rate.
-    """
-    import cv2
-
-    from perception.errors import InputError
-    from perception.io.video import TimeResolver
-
-    stall = args.stall_timeout
-    if not (math.isfinite(stall) and stall > 0):
-        raise InputError(f"expected a positive number of seconds, got {stall}",
-                         field="--stall-timeout")
-    ms = int(stall * 1000)
-    cap = cv2.VideoCapture(target, cv2.CAP_ANY if clock else cv2.CAP_FFMPEG,
-                           [cv2.CAP_PROP_OPEN_TIMEOUT_MSEC, max(ms, 10000),
-                            cv2.CAP_PROP_READ_TIMEOUT_MSEC, ms])
-    if not cap.isOpened():
-        raise InputError("cannot open the camera or stream", str(target))
-    fps = cap.get(cv2.CAP_PROP_FPS)
-    fps = float(fps) if math.isfinite(fps) and 0 < fps < 1000 else 0.0
-    times = TimeResolver(fps or 30.0)
-    out: queue.SimpleQueue = queue.SimpleQueue()
-    stop = threading.Event()  # set when the frames are no longer wanted
-
-    def read() -> None:
-        t0, n = time.monotonic(), 0
-        try:
-            while not stop.is_set():
-                ok, frame = cap.read()
-                if not ok or frame is None:
-                    break
-                t = time.monotonic() - t0 if clock else times(cap.get(cv2.CAP_PROP_POS_MSEC))
-                out.put((n, t, frame))
-                n += 1
-        finally:  # a read that raised ends the stream too, not the wait for it
-            out.put(None)
-            cap.release()
-
-    threading.Thread(target=read, name="watch-reader", daemon=True).start()
-    return fps, _received(out, stall, stop), None
-
-
-#: Seconds past ``--stall-timeout`` before the wait for a stuck reader ends.
-STALL_GRACE = 1.0
-
-
-def _received(out: queue.SimpleQueue, stall: float, stop: threading.Event):
-    """The reader's frames until it ends or sends none for ``stall`` s.
-
-    The backend's read timeout does not hold everywhere (a camera's driver
-    may block in ``read`` for good): the wait ends here too, whatever the
-    reader is stuck in, :data:`STALL_GRACE` s later, once FFmpeg, where its
-    timeout holds, has ended the stream and handed over the frames its
-    decoder still held.
-    """
-    try:
-        while True:
-            try:
-                item = out.get(timeout=stall + STALL_GRACE)
-            except queue.Empty:
-                return
-            if item is None:
-                return
-            yield item
-    finally:
-        stop.set()
-
-
-def _clip(source: str, kind: str, name: str | None) -> str:
-    if name:
-        return name
-    return {"camera": f"camera{source}", "stream": "stream"}.get(kind) or Path(source).stem
-
-
 def run(args: argparse.Namespace) -> int:
     """Execute ``hammer-mv watch`` with parsed ``args``; return the exit status.
 
@@ -166,6 +60,8 @@ def run(args: argparse.Namespace) -> int:
     from hammer_mv.cli.checks import output_folder
     from hammer_mv.cli.options import load_repertoire, recognition_settings
     from perception.io.atomic import check_output
+    from perception.io.capture import source_kind
+    from perception.io.video import open_source
     from perception.online import OnlineRecognizer, decision_summary
     from perception.pipeline import clip_fingerprint
     from perception.report.clip import write_clip_report
@@ -173,50 +69,47 @@ def run(args: argparse.Namespace) -> int:
 
     output_folder(args.output)
     if args.labelled_video is not None:  # refused before the first frame, not after
-        files = [args.repertoire, None if _device(args.source) else args.source]
+        files = [args.repertoire, args.source if source_kind(args.source) == "file" else None]
         check_output(args.labelled_video, [f for f in files if f is not None])
     settings = recognition_settings(args)
     rep, rep_id = load_repertoire(args)
-    kind, fps, frames, src = _frames(args.source, settings, args)
-    clip = _clip(args.source, kind, args.clip)
-    rec = OnlineRecognizer(rep, settings, clip=clip)
-    say = (lambda line: None) if args.quiet else (lambda line: print(line, flush=True))
-    draw = _Drawer(args.labelled_video, fps) if args.labelled_video else None
-    pace = kind == "file" and not args.as_fast_as_possible
-    latency, dropped, last_t, decided, interrupted = [], 0, None, None, False
-    start = time.monotonic()
-    try:
-        for index, t, frame in frames:
-            if pace:  # played at its own rate
-                time.sleep(max(0.0, t - (time.monotonic() - start)))
-            if last_t is not None and fps > 0 and t - last_t > GAP_PERIODS / fps:
-                dropped += int(round((t - last_t) * fps)) - 1
-            last_t = t
-            t0 = time.perf_counter()
-            state = rec.update(frame, t, index)
-            latency.append(time.perf_counter() - t0)
-            if draw is not None:
+    latency, dropped, last, decided, interrupted = [], 0, None, None, False
+    with (open_source(args.source, stall_timeout=args.stall_timeout, fps=settings.fps,
+                      keep_truncated=settings.keep_truncated) as src,
+          _Drawer(args.labelled_video, src.fps) as draw):  # a failed run leaves no video
+        kind, fps = src.kind, src.fps
+        clip = args.clip or {"camera": f"camera{args.source}", "stream": "stream"}.get(kind) \
+            or Path(args.source).stem
+        rec = OnlineRecognizer(rep, settings, clip=clip)
+        say = (lambda line: None) if args.quiet else (lambda line: print(line, flush=True))
+        pace, start = kind == "file" and not args.as_fast_as_possible, time.monotonic()
+        try:
+            for index, t, frame in src:
+                if pace:  # played at its own rate
+                    time.sleep(max(0.0, t - (time.monotonic() - start)))
+                if last is not None:  # frames the read-ahead dropped, or never sent
+                    gap = fps > 0 and t - last[1] > GAP_PERIODS / fps
+                    dropped += max(index - last[0], round((t - last[1]) * fps) if gap else 1) - 1
+                last = index, t
+                t0 = time.perf_counter()
+                state = rec.update(frame, t, index)
+                latency.append(time.perf_counter() - t0)
                 draw(frame, state, rec)
-            if args.live:
-                say(f"{t:8.3f} s  {state.phase:<6}  {state.leading or '-':<12} "
-                    f"{state.verdict or '-':<9} {'settled' if state.settled else ''}")
-            if state.decision is not None and decided is None:
-                decided = state.decision
-                detail = f" ({decided.detail})" if decided.detail else ""
-                say(f"{clip}: settled {decided.verdict}{detail} at {decided.time:.3f} s "
-                    f"({decided.since_onset:.3f} s after the onset)")
-    except KeyboardInterrupt:  # the outputs of what was seen
-        interrupted = True
-    except BaseException:  # a failed run leaves no labelled video behind
-        if draw is not None:
-            draw.close(*sys.exc_info())
-        raise
-    if draw is not None:
-        draw.close()
-    video = src.attrs() if src is not None else {"source": args.source, "fps": fps}
+                if args.live:
+                    say(f"{t:8.3f} s  {state.phase:<6}  {state.leading or '-':<12} "
+                        f"{state.verdict or '-':<9} {'settled' if state.settled else ''}")
+                if state.decision is not None and decided is None:
+                    decided = state.decision
+                    detail = f" ({decided.detail})" if decided.detail else ""
+                    say(f"{clip}: settled {decided.verdict}{detail} at {decided.time:.3f} s "
+                        f"({decided.since_onset:.3f} s after the onset)")
+        except KeyboardInterrupt:  # the outputs of what was seen
+            interrupted = True
+    video = src.attrs()
     result = rec.finish(video, source=args.source)
     online = {**decision_summary(result, rec.decision), "source": kind,
-              "frames": len(latency), "dropped_frames": dropped, "interrupted": interrupted,
+              "frames": len(latency), "dropped_frames": dropped,
+              "read_ahead_dropped": src.dropped, "interrupted": interrupted,
               "latency_ms": {"median": float(np.median(latency) * 1e3),
                              "p99": float(np.percentile(latency, 99) * 1e3)}}
     tracks = rec.tracks(video)
@@ -233,12 +126,17 @@ def run(args: argparse.Namespace) -> int:
 
 
 class _Drawer:
-    """The labelled video: markers (as ``track --labelled-video``) and a bar per model."""
+    """The labelled video (none if ``path`` is None): markers (as ``track``'s) and model bars."""
 
-    def __init__(self, path: Path, fps: float):
+    def __init__(self, path: Path | None, fps: float):
         self.path, self.fps, self.writer, self.labeller = path, fps or 30.0, None, None
 
+    def __enter__(self) -> _Drawer:
+        return self
+
     def __call__(self, frame, state, rec) -> None:
+        if self.path is None:
+            return
         import cv2
         import numpy as np
 
@@ -265,8 +163,8 @@ class _Drawer:
                     (255, 255, 255), 1)
         self.writer.write(img)
 
-    def close(self, *exc_info) -> None:
-        """Finish the video; given an exception's ``sys.exc_info()``, discard it instead."""
+    def __exit__(self, *exc_info) -> None:
+        """Finish the video; when the block raised, discard it instead."""
         writer, self.writer = self.writer, None
         if writer is not None:
-            writer.__exit__(*(exc_info or (None, None, None)))
+            writer.__exit__(*exc_info)

@@ -13,7 +13,8 @@ frame count its header claims is kept with a warning and the true count.
 
 What a file's container says before decoding, and how OpenCV is handed a
 file (:func:`opencv_name`, :func:`quiet_native_stderr`), live in
-:mod:`perception.io.video_files`; both names are importable from here too.
+:mod:`perception.io.video_files` (importable from here too). :func:`open_source`
+opens a file, a camera or a stream; :mod:`perception.io.capture` reads the latter.
 """
 
 from __future__ import annotations
@@ -23,10 +24,7 @@ import hashlib
 import logging
 import math
 import os
-import queue
-import threading
 from collections.abc import Iterable, Iterator, Mapping
-from concurrent.futures import Future
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from types import MappingProxyType
@@ -36,7 +34,9 @@ import cv2
 import numpy as np
 
 from perception.errors import InputError
+from perception.io import capture
 from perception.io.atomic import atomic_path
+from perception.io.capture import LiveSource, TimeResolver
 from perception.io.files import input_file
 from perception.io.video_files import (
     avi_header_rate,
@@ -74,24 +74,6 @@ def sha256_file(path: str | os.PathLike, chunk: int = 1 << 20) -> str:
     return h.hexdigest()
 
 
-def _sha256_in_background(path: Path) -> Future:
-    """:func:`sha256_file` of a file in a background thread; ``result()`` waits for it.
-
-    Reading and hashing release the GIL, so the digest costs a clip's
-    tracking no time where a core is free.
-    """
-    digest: Future = Future()
-
-    def run() -> None:
-        try:
-            digest.set_result(sha256_file(path))
-        except BaseException as exc:  # raised again by result(), in the caller's thread
-            digest.set_exception(exc)
-
-    threading.Thread(target=run, name=f"sha256:{path.name}", daemon=True).start()
-    return digest
-
-
 @dataclass(frozen=True)
 class VideoInfo:
     """What the container says about a video.
@@ -121,52 +103,7 @@ class VideoInfo:
     fourcc: str
 
 
-class TimeResolver:
-    """Turn per-frame container timestamps into a strictly increasing time axis.
-
-    A container time is used when it is finite, non-negative and later than the
-    previous frame's; otherwise the frame gets ``previous + 1/fps`` (``0`` for
-    the first frame), and the fallback is counted.
-
-    Parameters
-    ----------
-    fps : float
-        Nominal frame rate, frames/s, for the fallback.
-    use_container : bool
-        Use the container's times at all (False: every frame at ``index / fps``).
-    """
-
-    def __init__(self, fps: float, *, use_container: bool = True):
-        self.fps = fps
-        self.use_container = use_container
-        self.previous: float | None = None
-        self.n_container = 0
-        self.n_fallback = 0
-
-    def __call__(self, pos_msec: float) -> float:
-        """Return the time (s) of the next frame given its ``CAP_PROP_POS_MSEC``."""
-        t = pos_msec / 1000.0
-        if (self.use_container and math.isfinite(t) and t >= 0
-                and (self.previous is None or t > self.previous)):
-            self.n_container += 1
-        else:
-            if not (self.fps > 0 and math.isfinite(self.fps)):
-                raise InputError("the container gives neither frame timestamps nor a frame rate")
-            t = 0.0 if self.previous is None else self.previous + 1.0 / self.fps
-            self.n_fallback += 1
-        self.previous = t
-        return t
-
-    @property
-    def source(self) -> str:
-        """``"container"``, ``"index/fps"`` (no frame had a usable time) or ``"mixed"``."""
-        if self.n_fallback == 0:
-            return "container"
-        # A lone first frame at t=0 says nothing about the container.
-        return "index/fps" if self.n_container <= 1 else "mixed"
-
-
-class FrameSource:
+class FrameSource(capture.Source):
     """Lazy, sequential frames of one video file.
 
     Opening checks the file and decodes the first frame; iterating yields
@@ -248,13 +185,13 @@ class FrameSource:
         if not ok or first is None:
             cap.release()
             raise InputError("no decodable frames (empty, truncated or corrupt video)", self.path)
-        self._cap = cap
-        self._first = first
-        self._first_msec = cap.get(cv2.CAP_PROP_POS_MSEC)
+        self._cap, self._first, self._first_msec = cap, first, cap.get(cv2.CAP_PROP_POS_MSEC)
         height, width = first.shape[:2]
         n_header = cap.get(cv2.CAP_PROP_FRAME_COUNT)
         fps = cap.get(cv2.CAP_PROP_FPS)
-        self._sha256 = _sha256_in_background(self.path) if hash else None
+        # read and hashed in a thread (both release the GIL): no time taken from tracking
+        self._sha256 = capture.ReadAhead(lambda: iter((sha256_file(self.path),)), 1,
+                                 name=f"sha256:{self.path.name}") if hash else None
         self._info = VideoInfo(
             path=os.fspath(path),
             sha256="",
@@ -269,77 +206,26 @@ class FrameSource:
         else:
             self._check_rate()
             self._times = TimeResolver(self._info.fps_nominal)
-        self.n_decoded = 0
-        self.complete = False
-        self._started = False
-        self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
-        self._tokens: queue.SimpleQueue | None = None
+        self.n_decoded, self.complete, self._started = 0, False, False
+        self._ahead: capture.ReadAhead | None = None
 
     # -- iteration ---------------------------------------------------------
-    def __iter__(self) -> Iterator[tuple[int, float, np.ndarray]]:
-        if self._started:
-            raise RuntimeError(f"{self.path}: a FrameSource can be iterated only once")
-        self._started = True
-        return self._frames()
-
     def _frames(self) -> Iterator[tuple[int, float, np.ndarray]]:
         try:
             yield 0, self._times(self._first_msec), self._first
             self._first = None
             self.n_decoded = 1
-            reader = self._threaded() if self.prefetch > 0 else self._direct()
-            for frame, msec in reader:
-                index = self.n_decoded
-                t = self._times(msec)
+            if self.prefetch > 0:  # decoded in a thread, overlapping the caller's work
+                self._ahead = capture.ReadAhead(lambda: capture.read_frames(self._cap),
+                                                self.prefetch, name=f"decode:{self.path.name}")
+            for frame, msec in (iter(self._ahead.next, None) if self._ahead
+                                else capture.read_frames(self._cap)):
                 self.n_decoded += 1
-                yield index, t, frame
+                yield self.n_decoded - 1, self._times(msec), frame
             self.complete = True
             self._check_count()
         finally:
             self.close()
-
-    def _direct(self) -> Iterator[tuple[np.ndarray, float]]:
-        cap = self._cap
-        while True:
-            ok, frame = cap.read()
-            if not ok or frame is None:
-                return
-            yield frame, cap.get(cv2.CAP_PROP_POS_MSEC)
-
-    def _threaded(self) -> Iterator[tuple[np.ndarray, float]]:
-        # Frames come back through one queue; the decoder takes a token from
-        # another before each frame and the consumer returns one per frame
-        # taken, so at most ``prefetch`` frames wait. C-level SimpleQueues
-        # keep the per-frame handover to two calls that wait without the GIL.
-        frames: queue.SimpleQueue = queue.SimpleQueue()
-        tokens: queue.SimpleQueue = queue.SimpleQueue()
-        for _ in range(self.prefetch):
-            tokens.put(True)
-        self._tokens = tokens
-        done = object()
-
-        def run() -> None:
-            try:
-                reader = self._direct()
-                while tokens.get() and not self._stop.is_set():
-                    item = next(reader, done)
-                    frames.put(item)
-                    if item is done:
-                        return
-            except BaseException as exc:  # surfaced in the consumer thread
-                frames.put(exc)
-
-        self._thread = threading.Thread(target=run, name=f"decode:{self.path.name}", daemon=True)
-        self._thread.start()
-        while True:
-            item = frames.get()
-            if item is done:
-                return
-            if isinstance(item, BaseException):
-                raise item
-            tokens.put(True)
-            yield item
 
     def _check_rate(self) -> None:
         """Refuse a header frame rate no camera films a hand at (it would rescale time).
@@ -393,9 +279,14 @@ class FrameSource:
     def info(self) -> VideoInfo:
         """Header metadata and the file's SHA-256 (waits for the hash to be read)."""
         if self._sha256 is not None:
-            self._info = replace(self._info, sha256=self._sha256.result())
+            self._info = replace(self._info, sha256=self._sha256.next())
             self._sha256 = None
         return self._info
+
+    @property
+    def fps(self) -> float:
+        """The rate frames are timed by, frames/s: ``fps`` if given, else the header's."""
+        return self.fps_override or self._info.fps_nominal
 
     @property
     def time_source(self) -> str:
@@ -417,38 +308,36 @@ class FrameSource:
     # -- lifetime ------------------------------------------------------------
     def close(self) -> None:
         """Stop the decoding thread and release the file."""
-        self._stop.set()
-        if self._tokens is not None:
-            self._tokens.put(False)  # wakes a decoder waiting for room
-        if self._thread is not None:
-            self._thread.join()
-            self._thread = None
+        if self._ahead is not None:
+            self._ahead.close()
         if self._cap is not None:
             self._cap.release()
             self._cap = None
 
-    def __enter__(self) -> FrameSource:
-        return self
 
-    def __exit__(self, *exc: object) -> None:
-        self.close()
+def open_source(source: str, *, stall_timeout: float = 5.0, keep_truncated: bool = False,
+                fps: float | None = None, read_ahead: int | None = None) -> capture.Source:
+    """Open ``source``: a camera index (``"0"``), a video file or a URL FFmpeg opens.
 
-    def __del__(self) -> None:
-        with contextlib.suppress(Exception):
-            self.close()
-
-
-def open_video(path: str | os.PathLike, **kwargs: Any) -> FrameSource:
-    """Open the video at ``path`` for sequential reading; see :class:`FrameSource`.
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-        The video file.
-    **kwargs
-        Passed to :class:`FrameSource` (``prefetch``, ``hash``).
+    A file gives a :class:`FrameSource` (``keep_truncated`` and ``fps`` are
+    its), a camera or stream a :class:`LiveSource`, ended by ``stall_timeout``
+    s without a frame. Both yield ``(index, time_s, frame)`` (times: a file's
+    container's, a stream's own, a camera's this clock's at arrival), have
+    ``kind``, ``fps``, ``dropped`` and ``attrs()``, and close as context
+    managers. At most ``read_ahead`` frames (:data:`~perception.io.capture.READ_AHEAD`)
+    wait: a file's reader waits for room, a live one drops the oldest. Raises
+    :class:`InputError`: no such file, camera or stream, or a bad timeout.
     """
-    return FrameSource(path, **kwargs)
+    if capture.source_kind(source) != "file":
+        return LiveSource(source, stall_timeout=stall_timeout, read_ahead=read_ahead)
+    if not Path(source).exists():
+        raise InputError("no such file (nor a camera index or stream URL)", source)
+    return FrameSource(source, prefetch=read_ahead or capture.READ_AHEAD,
+                       keep_truncated=keep_truncated, fps=fps)
+
+
+#: ``open_video(path, **kwargs)``: the video at ``path`` for sequential reading.
+open_video = FrameSource
 
 
 def codec_for(path: str | os.PathLike, codec: str | None = None) -> str:
