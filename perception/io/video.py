@@ -317,16 +317,29 @@ class FrameSource(capture.Source):
 
 def open_source(source: str, *, stall_timeout: float = 5.0, keep_truncated: bool = False,
                 fps: float | None = None, read_ahead: int | None = None) -> capture.Source:
-    """Open ``source``: a camera index (``"0"``), a video file or a URL FFmpeg opens.
+    """Open ``source`` for reading frame by frame, as a context manager.
 
-    A file gives a :class:`FrameSource` (``keep_truncated`` and ``fps`` are
-    its), a camera or stream a :class:`LiveSource`, ended by ``stall_timeout``
-    s without a frame. Both yield ``(index, time_s, frame)`` (times: a file's
-    container's, a stream's own, a camera's this clock's at arrival), have
-    ``kind``, ``fps``, ``dropped`` and ``attrs()``, and close as context
-    managers. At most ``read_ahead`` frames (:data:`~perception.io.capture.READ_AHEAD`)
-    wait: a file's reader waits for room, a live one drops the oldest. Raises
-    :class:`InputError`: no such file, camera or stream, or a bad timeout.
+    Both kinds yield ``(index, time_s, frame)`` (times: a file's container's,
+    a stream's own, a camera's this clock's at arrival) and have ``kind``,
+    ``fps``, ``dropped`` and ``attrs()``. A file's reader waits for room, a
+    live one drops the oldest frame and counts it.
+
+    Parameters
+    ----------
+    source : str
+        A camera index (``"0"``), a video file or a URL FFmpeg opens: a file
+        gives a :class:`FrameSource`, a camera or stream a :class:`LiveSource`.
+    stall_timeout : float
+        A camera or stream that sends no frame for this long has ended, s.
+    keep_truncated, fps
+        As :class:`FrameSource` (files only).
+    read_ahead : int, optional
+        Most frames waiting (:data:`~perception.io.capture.READ_AHEAD`).
+
+    Raises
+    ------
+    InputError
+        No such file, camera or stream, or a bad timeout.
     """
     if capture.source_kind(source) != "file":
         return LiveSource(source, stall_timeout=stall_timeout, read_ahead=read_ahead)
