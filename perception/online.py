@@ -72,6 +72,9 @@ class _ReferencePass:
     ----------
     models : list of MotorModel
         The repertoire's models at the reference scene.
+    scorers : (StepScorer, StepScorer or None), optional
+        The scorers of all models and of the reach models (with the digits
+        closed) to start over with (default: new ones).
     hammer : HammerParams
         The engine's settings (the clip's noise already in ``obs_sd``).
     scale, tip, hand : float, (2,) array, (2,) array
@@ -83,39 +86,50 @@ class _ReferencePass:
         -1 for a mirrored scene.
     """
 
-    def __init__(self, models, hammer, scale, tip, hand, alpha, step, sign):
-        grasp = [m for m in models if m.kind == "grasp"] or models
+    def __init__(self, models, hammer, scale, tip, hand, alpha, step, sign, scorers=None):
         reach = [m for m in models if m.kind == "reach"]
-        self.kinds = {"grasp": StepScorer(grasp, hammer), "reach": StepScorer(reach or models,
-                                                                               hammer)}
-        self.closed = StepScorer(reach, hammer) if reach else None
+        if scorers is None:
+            scorers = StepScorer(models, hammer), StepScorer(reach, hammer) if reach else None
+        for scorer in scorers:  # a replay reuses the stacked gains
+            if scorer is not None:
+                scorer.restart()
+        self.scorer, self.closed = scorers
+        every = list(range(len(models)))
+        self.kinds = {k: [i for i in every if models[i].kind == k] or every
+                      for k in ("grasp", "reach")}
         self.scale, self.tip, self.hand = scale, tip, hand
         self.alpha, self.step, self.sign = alpha, step, sign
         self.last = None  # (scaled time, wrist, finger, thumb) of the last frame
+        self.fed = 0  # rows fed
 
-    def feed(self, t: float, w, f, th) -> None:
-        """The next frame: ``t`` s since the onset, filtered tips (2,) m in the clip's frame."""
+    def feed(self, rows: list[tuple]) -> None:
+        """The next rows: ``(t s since the onset, wrist, finger, thumb)``, filtered tips (2,) m
+        in the clip's frame; scored together (a replay is one vectorised pass)."""
         goal = np.array([0.0, -WRIST_GOAL_OFFSET])
         flip = np.array([self.sign, 1.0])
-        w, f, th = w * flip, f * flip, th * flip
-        wrist = goal + (w - goal) * self.scale  # as shape.canonical: the transport scaled,
-        now = (t * self.alpha, wrist, f - w + wrist + self.tip, th - w + wrist + self.tip)
-        last, self.last = self.last, now
-        if last is None:
-            self.t0 = now[0]
-        # resampled at the reference frame period as shape.canonical resamples
-        if last is None:  # the grid starts at the first frame, the first point needs two
+        grid: list[tuple] = []
+        for t, w, f, th in rows:
+            w, f, th = w * flip, f * flip, th * flip
+            wrist = goal + (w - goal) * self.scale  # as shape.canonical: the transport scaled,
+            now = (t * self.alpha, wrist, f - w + wrist + self.tip, th - w + wrist + self.tip)
+            last, self.last = self.last, now
+            if last is None:  # the grid starts at the first frame, its points need two
+                self.t0 = now[0]
+                continue
+            # resampled at the reference frame period as shape.canonical resamples
+            first = max(math.floor(last[0] / self.step) + 1, math.ceil(self.t0 / self.step))
+            for k in range(first, math.floor(now[0] / self.step) + 1):
+                a = (k * self.step - last[0]) / (now[0] - last[0])
+                grid.append((k * self.step, *(p0 + a * (p1 - p0)
+                                              for p0, p1 in zip(last[1:], now[1:]))))
+        self.fed += len(rows)
+        if not grid:
             return
-        first = max(math.floor(last[0] / self.step) + 1, math.ceil(self.t0 / self.step))
-        for k in range(first, math.floor(now[0] / self.step) + 1):
-            tk = k * self.step
-            a = (tk - last[0]) / (now[0] - last[0])
-            pos = [p0 + a * (p1 - p0) for p0, p1 in zip(last[1:], now[1:])]
-            for scorer in self.kinds.values():
-                scorer.step(tk, *pos)
-            if self.closed is not None:
-                tips = pos[0] + self.hand
-                self.closed.step(tk, pos[0], tips, tips)
+        t, w, f, th = (np.array(c) for c in zip(*grid))
+        self.scorer.score(t, w, f, th)
+        if self.closed is not None:
+            tips = w + self.hand
+            self.closed.score(t, w, tips, tips)
 
 
 class OnlineRecognizer:
@@ -225,9 +239,10 @@ class OnlineRecognizer:
         if self._onset is None:
             self._find_onset()
         else:
-            self._score(len(self._scene.filtered) - 1)
+            self._take(len(self._scene.filtered) - 1)
         if self._onset is None:
             return self._waiting(index, t, "rest")
+        self._score()
         return self._judge(index, t)
 
     def tracks(self, video: dict | None = None) -> Tracks:
@@ -282,6 +297,7 @@ class OnlineRecognizer:
             # evidence is kept as it was, and no frame costs more than the one before
             window=math.ceil(3 * durations[1] / first.dt), judged=None, t10=math.nan,
             t90=math.nan, gap=(math.nan, 0.0))
+        self._reference((False, 1.0))  # its gains stacked now, before the movement
 
     def _filter(self, upto: int) -> None:
         """Filter the rows not filtered yet, up to row ``upto``, in the model frame."""
@@ -306,9 +322,10 @@ class OnlineRecognizer:
         self._onset = onset
         first = int(np.searchsorted(np.asarray(self._rows["time"], dtype=float), onset))
         for i in range(first, len(sc.filtered)):
-            self._score(i)
+            self._take(i)
 
-    def _score(self, i: int) -> None:
+    def _take(self, i: int) -> None:
+        """Row ``i`` into the movement: its grip, progress and speed, and the scene guess."""
         sc = self._scene
         f = sc.filtered[i]
         row = (self._rows["time"][i] - self._onset, f[0], f[1] - sc.half, f[2] + sc.half)
@@ -329,19 +346,28 @@ class OnlineRecognizer:
             sc.t10 = row[0]
         if math.isnan(sc.t90) and progress >= 0.9:
             sc.t90 = row[0]
-        guess = self._guess()
-        if guess != sc.guess:  # replayed from the onset under the new guess
-            sc.guess = guess
-            mirror, alpha = guess
-            sc.reference = _ReferencePass(
-                sc.models, sc.hammer, sc.scale, np.array([0.0, sc.ref.tip_start])
-                - (0.5 * (sc.first.rest[1] + sc.first.rest[2]) - sc.first.rest[0])
-                * [-1.0 if mirror else 1.0, 1.0], np.array([0.0, sc.ref.tip_start]), alpha,
-                sc.ref.frame_period, -1.0 if mirror else 1.0)
-            for r in self._moving:
-                sc.reference.feed(*r)
-        else:
-            sc.reference.feed(*row)
+        sc.guess = self._guess()
+
+    def _score(self) -> None:
+        """The reference pass up to the last row; replayed from the onset, in one vectorised
+        pass, when the scene guess has changed."""
+        sc = self._scene
+        if sc.reference.guess != sc.guess:
+            self._reference(sc.guess)
+        sc.reference.feed(self._moving[sc.reference.fed:])
+
+    def _reference(self, guess: tuple[bool, float]) -> None:
+        """A reference pass from the onset for a scene guess (the scorers' gains kept)."""
+        sc = self._scene
+        mirror, alpha = guess
+        sign = -1.0 if mirror else 1.0
+        tip = np.array([0.0, sc.ref.tip_start])
+        hand = 0.5 * (sc.first.rest[1] + sc.first.rest[2]) - sc.first.rest[0]
+        old = sc.reference
+        sc.reference = _ReferencePass(sc.models, sc.hammer, sc.scale, tip - hand * [sign, 1.0],
+                                      tip, alpha, sc.ref.frame_period, sign,
+                                      None if old is None else (old.scorer, old.closed))
+        sc.reference.guess = guess
 
     def _guess(self) -> tuple[bool, float]:
         """The scene's mirroring and the time scale, as far as the movement shows them."""
@@ -379,8 +405,9 @@ class OnlineRecognizer:
             grip.open_at = float(np.interp(walked[np.argmax(gs > rest + lp.opening_level
                                                             * opening)], _WAY, _TAU))
             grip.closing = (float(gs.max() - gs[-1]) / opening) if opening > 0 else 0.0
-        scorer = ref.kinds["grasp" if grip.opened else "reach"]
-        fam = scorer.familiarity(sc.ref.frame_period)
+        # the models of the kind the grip shows, as the offline pass takes them
+        grip.models = idx = ref.kinds["grasp" if grip.opened else "reach"]
+        fam = ref.scorer.familiarity(sc.ref.frame_period)[idx]
         transport = math.nan
         if ref.closed is not None and ref.closed.frames > 1:
             ll = ref.closed.log_likelihood
@@ -388,8 +415,8 @@ class OnlineRecognizer:
         # what is known before the end: when the grip started to open, how often it did
         observed = Landmarks(movement_time=grip.mt, aperture_peaks=grip.peaks,
                              opening_time=grip.open_at if grip.opened else math.nan)
-        evidence = Evidence([m.kind for m in scorer.models], scorer.log_likelihood, fam,
-                            transport, sc.separation, observed, None, sc.gap[1])
+        evidence = Evidence([sc.models[i].kind for i in idx], ref.scorer.log_likelihood[idx],
+                            fam, transport, sc.separation, observed, None, sc.gap[1])
         return evidence, grip
 
     def _judge(self, index: int, t: float) -> OnlineState:
@@ -406,14 +433,10 @@ class OnlineRecognizer:
         sure = self.settle.sure(d, evidence, grip, rules, progress)
         if self._decision is None and sure and since - self._verdicts[-1][0] >= self.settle.hold:
             self._decision = Decision(verdict, detail, t, since, index)
-        scorer = sc.reference.kinds["grasp" if grip.opened else "reach"]
-        by_name = dict(zip([m.name for m in scorer.models],
-                           zip(scorer.confidence, scorer.log_likelihood)))
-        conf = np.array([by_name.get(n, (0.0, 0.0))[0] for n in sc.names])
-        ll = np.array([by_name.get(n, (0.0, -np.inf))[1] for n in sc.names])
+        scorer = sc.reference.scorer
         self.state = OnlineState(
-            index, t, "moving", sc.names, conf, ll, since, progress,
-            scorer.models[d.best].name, verdict, detail, d.familiarity,
+            index, t, "moving", sc.names, scorer.confidence.copy(), scorer.log_likelihood.copy(),
+            since, progress, sc.names[grip.models[d.best]], verdict, detail, d.familiarity,
             self.settle.evidence(d, evidence, rules), self._decision)
         return self.state
 

@@ -127,7 +127,7 @@ def _replayed(rec, final):
                          final.normalisation.time_scale, sc.ref.frame_period, sign)
     for row in rec._moving:
         if row[0] <= final.observation.time[-1] + 1e-9:
-            ref.feed(*row)
+            ref.feed([row])
     return ref
 
 
@@ -143,11 +143,12 @@ def test_the_online_reference_pass_is_the_offline_shape_pass(rep, condition, fli
     final = rec.finish()
     assert final.mirrored == flip
     ref = _replayed(rec, final)
-    scorer = ref.kinds["grasp" if final.shape.kinds[0] == "grasp" else "reach"]
-    assert scorer.frames == final.shape.time.size
-    np.testing.assert_allclose(scorer.log_likelihood, final.shape.log_likelihood[:, -1],
+    idx = ref.kinds["grasp" if final.shape.kinds[0] == "grasp" else "reach"]
+    assert [rec._scene.names[i] for i in idx] == final.shape.names
+    assert ref.scorer.frames == final.shape.time.size
+    np.testing.assert_allclose(ref.scorer.log_likelihood[idx], final.shape.log_likelihood[:, -1],
                                rtol=1e-9, atol=1e-9)
-    np.testing.assert_allclose(scorer.familiarity(final.shape.observation.dt),
+    np.testing.assert_allclose(ref.scorer.familiarity(final.shape.observation.dt)[idx],
                                final.shape.familiarity, rtol=1e-9)
 
 

@@ -279,6 +279,10 @@ class StepScorer:
         self.dt = self.models[0].dt
         self.leaves = Leaves(self.models, max(int(steps), 1))
         self.grasp = np.array([m.kind == "grasp" for m in self.models])
+        self.restart()
+
+    def restart(self) -> None:
+        """Start over, from before the first frame (the stacked gains are kept)."""
         M = len(self.models)
         self.confidence = np.zeros(M)
         self.log_likelihood = np.zeros(M)
@@ -288,7 +292,7 @@ class StepScorer:
         self._shift = None  # the largest (model step - frame index) so far
         self._x = None
         self._prev = None  # (model step, angles, all three seen) of the last frame
-        self._rg = None  # its (r, g)
+        self._last = (np.nan, np.nan, False)  # its r, g and whether all three were seen
 
     @property
     def misfit(self) -> np.ndarray:
@@ -336,39 +340,66 @@ class StepScorer:
         return q_pred
 
     def step(self, time: float, wrist, finger, thumb) -> None:
-        """Score the next frame: ``time`` s since the onset, positions (2,) m in the model frame.
+        """:meth:`score` one frame: ``time`` s since the onset, positions (2,) m."""
+        self.score(np.atleast_1d(time), *(np.asarray(p, dtype=float)[None]
+                                          for p in (wrist, finger, thumb)))
+
+    def score(self, time: np.ndarray, wrist: np.ndarray, finger: np.ndarray,
+              thumb: np.ndarray) -> _Steps:
+        """Score the next frames, adding them to the sums; their per-step terms.
+
+        The filters run frame by frame; the kinematics and the rules are
+        vectorised over the frames given. A step counts only if the state it
+        predicts from was observed (all three markers at n-1: the wrist
+        anchors every chain) and the outcome is (the digits at n).
 
         Parameters
         ----------
-        time : float
-            Time since the movement's onset, s.
-        wrist, finger, thumb : (2,) arrays
+        time : (N,) array
+            Times since the movement's onset, s.
+        wrist, finger, thumb : (N, 2) arrays
             Filtered positions (the digit tips), m; NaN where lost.
         """
-        rows = [np.asarray(p, dtype=float)[None] for p in (wrist, finger, thumb)]
-        s = self.model_step(time)
-        q = _observed_angles(*rows, self.leaves.chains)[0]
-        r = np.linalg.norm(0.5 * (rows[1] + rows[2]), axis=-1)
-        g = np.linalg.norm(rows[1] - rows[2], axis=-1)
-        seen = bool(np.isfinite(np.concatenate(rows)).all())
-        last = self._prev[2] if self._prev is not None else False
-        r_g, self._rg = self._rg, (r, g)
-        q_pred = self.predict(s, q, seen)
-        if q_pred is None:
-            return
-        pred = _to_cartesian(self.leaves, q_pred[None], self.leaves.P[s][None], len(self.models))
-        pred = _Predicted(*(np.concatenate([np.full_like(a, np.nan), a], axis=1) for a in pred))
-        # as recognize: the state predicted from was seen (all three markers), and
-        # so were r and g then and now
-        ok = last and bool(np.isfinite([r_g[0][0], r_g[1][0], r[0], g[0]]).all())
-        valid = np.zeros((len(self.models), 2), dtype=bool)
-        valid[:, 1] = ok
-        dC_r, dC_g, dll, maha, valid = _terms(np.r_[r_g[0], r], np.r_[r_g[1], g], pred, valid,
-                                              self.grasp, self.params)
-        self.confidence += dC_r[:, 1] + dC_g[:, 1]
-        self.log_likelihood += dll[:, 1]
-        self.mahalanobis += maha[:, 1]
-        self.scored += valid[:, 1]
+        M, N = len(self.models), len(time)
+        steps = [self.model_step(float(t)) for t in time]
+        q_obs = _observed_angles(wrist, finger, thumb, self.leaves.chains)
+        seen = np.isfinite(np.stack([wrist, finger, thumb], axis=1)).all(axis=(1, 2))
+        q_pred = np.full((N, self.leaves.count, 2), np.nan)
+        P_pred = np.zeros((N, self.leaves.count, 2, 2))
+        for n, s in enumerate(steps):
+            q = self.predict(s, q_obs[n], bool(seen[n]))
+            if q is not None:
+                q_pred[n], P_pred[n] = q, self.leaves.P[s]
+        pred = _to_cartesian(self.leaves, q_pred, P_pred, M)
+        # the frame before these, for the changes the rules score
+        r = np.r_[self._last[0], np.linalg.norm(0.5 * (finger + thumb), axis=-1)]
+        g = np.r_[self._last[1], np.linalg.norm(finger - thumb, axis=-1)]
+        seen = np.r_[self._last[2], seen]
+        self._last = (r[-1], g[-1], seen[-1])
+        ok = np.isfinite(r) & np.isfinite(g)
+        observable = np.r_[False, seen[:-1] & ok[:-1] & ok[1:]]
+        pred = _Predicted(*(np.concatenate([np.full_like(a[:, :1], np.nan), a], axis=1)
+                            for a in pred))
+        terms = _terms(r, g, pred, observable[None].repeat(M, 0), self.grasp, self.params)
+        terms = _Steps(*(x[:, 1:] for x in terms), _Predicted(*(a[:, 1:] for a in pred)),
+                       observable[1:])
+        self.confidence += (terms.dC_r + terms.dC_g).sum(axis=1)
+        self.log_likelihood += terms.log_likelihood.sum(axis=1)
+        self.mahalanobis += terms.mahalanobis.sum(axis=1)
+        self.scored += terms.valid.sum(axis=1)
+        return terms
+
+
+class _Steps(NamedTuple):
+    """Per-step terms (M, N) of :meth:`StepScorer.score`; ``observable``: (N,) the hand seen."""
+
+    dC_r: np.ndarray
+    dC_g: np.ndarray
+    log_likelihood: np.ndarray
+    mahalanobis: np.ndarray
+    valid: np.ndarray
+    predicted: _Predicted
+    observable: np.ndarray
 
 
 def recognize(
@@ -401,26 +432,9 @@ def recognize(
     scorer = StepScorer(models, params, steps=int(round(obs.time[-1] / models[0].dt))
                         + obs.n_frames + 1)
     params = scorer.params
-    q_obs = _observed_angles(obs.wrist, obs.finger, obs.thumb, scorer.leaves.chains)
-    N = obs.n_frames
-    # A step counts only if the state it predicts from was observed (all three
-    # markers at n-1: the wrist anchors every chain) and the outcome is (the
-    # digits at n).
-    seen = np.isfinite(np.stack([obs.wrist, obs.finger, obs.thumb], axis=1)).all(axis=(1, 2))
-    q_pred = np.full((N, scorer.leaves.count, 2), np.nan)
-    P_pred = np.zeros((N, scorer.leaves.count, 2, 2))
-    for n in range(N):  # the filters run frame by frame; the scoring below is vectorised
-        s = scorer.model_step(float(obs.time[n]))
-        q = scorer.predict(s, q_obs[n], bool(seen[n]))
-        if q is not None:
-            q_pred[n], P_pred[n] = q, scorer.leaves.P[s]
-    pred = _to_cartesian(scorer.leaves, q_pred, P_pred, len(models))
-    r_obs, g_obs = obs.r, obs.g
-    observed = np.concatenate([[False], seen[:-1]]) & np.isfinite(r_obs) & np.isfinite(g_obs)
-    prev_ok = np.concatenate([[False], np.isfinite(r_obs[:-1]) & np.isfinite(g_obs[:-1])])
-    dC_r, dC_g, dll, maha, valid = _terms(r_obs, g_obs, pred, (observed & prev_ok)[None]
-                                          .repeat(len(models), 0), scorer.grasp, params)
-    _refuse_broken_models(models, observed & prev_ok, valid)
+    terms = scorer.score(obs.time, obs.wrist, obs.finger, obs.thumb)
+    dC_r, dC_g, dll, maha, valid, pred, _ = terms
+    _refuse_broken_models(models, terms.observable, valid)
     _refuse_non_finite(models, {"confidence": dC_r + dC_g, "log-likelihood": dll})
     mis = misfit(maha, valid)
     familiarity = np.array([np.nan if m.calibration is None

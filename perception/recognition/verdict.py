@@ -37,6 +37,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -145,12 +146,12 @@ class Calibration:
                              f"frame period, got {m.size} misfits, {self.frame_period!r} s")
         object.__setattr__(self, "misfit", m)
 
-    @property
+    @cached_property  # read at every frame of a stream
     def log_centre(self) -> float:
         """Median of the log misfits (the fitted log-normal's location)."""
         return float(np.median(np.log(self.misfit)))
 
-    @property
+    @cached_property
     def log_scale(self) -> float:
         """Interquartile range of the log misfits / 1.349 (the fitted log-normal's scale)."""
         q1, q3 = np.percentile(np.log(self.misfit), [25, 75])
