@@ -36,7 +36,6 @@ from perception.recognition.models import ChainModel, MotorModel
 from perception.recognition.result import Recognition
 from perception.recognition.rules import VerdictRules
 from perception.recognition.scoring import RULES, THESIS_SIGNS, likelihood_rule, thesis_rule
-from perception.recognition.verdict import misfit
 
 __all__ = ["HammerParams", "RULES", "StepScorer", "recognize"]
 
@@ -436,10 +435,6 @@ def recognize(
     dC_r, dC_g, dll, maha, valid, pred, _ = terms
     _refuse_broken_models(models, terms.observable, valid)
     _refuse_non_finite(models, {"confidence": dC_r + dC_g, "log-likelihood": dll})
-    mis = misfit(maha, valid)
-    familiarity = np.array([np.nan if m.calibration is None
-                            else m.calibration.familiarity(float(x), obs.dt)
-                            for m, x in zip(models, mis)])
     return Recognition(
         clip=obs.clip,
         time=obs.time,
@@ -452,7 +447,7 @@ def recognize(
         log_likelihood=np.cumsum(dll, axis=1),
         mahalanobis=maha,
         scored=valid,
-        familiarity=familiarity,
+        familiarity=scorer.familiarity(obs.dt),
         predicted={"wrist": pred.wrist, "finger": pred.finger, "thumb": pred.thumb},
         observation=obs,
         models=models,
