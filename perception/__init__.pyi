@@ -27,6 +27,10 @@ from .api import Repertoire as Repertoire
 from .api import Scene as Scene
 from .api import SceneSpec as SceneSpec
 from .api import SettleRule as SettleRule
+from .api import StepScorer as StepScorer
+from .api import VerdictRules as VerdictRules
+from .api import judge as judge
+from .api import open_source as open_source
 from .api import SimilarityTransform as SimilarityTransform
 from .api import Status as Status
 from .api import Tracker as Tracker

@@ -20,7 +20,7 @@ from perception.batch import BatchItem, discover, run_batch
 from perception.errors import HammerMVError, InputError, PlanningError, TrackingError
 from perception.geometry import DEFAULT_OBJECT_DIAMETER, SimilarityTransform
 from perception.io.tracks import Status, Tracks, TracksWriter
-from perception.io.video import FrameSource, open_video, write_video
+from perception.io.video import FrameSource, open_source, open_video, write_video
 from perception.landmarks import LandmarkParams, Landmarks
 from perception.measure import landmarks
 from perception.observation import MovementSpan, Observation, ObserveParams, movement_span, observe
@@ -36,6 +36,8 @@ from perception.recognition import (
     SceneSpec,
     recognize,
 )
+from perception.recognition.engine import StepScorer
+from perception.recognition.rules import VerdictRules, judge
 from perception.recordings import MocapImport, read_reaches, recognize_reach
 from perception.report import write_batch_report, write_clip_report
 from perception.synthetic.demos import demo_tracks
@@ -73,6 +75,10 @@ __all__ = [
     "Scene",
     "SceneSpec",
     "SettleRule",
+    "StepScorer",
+    "VerdictRules",
+    "judge",
+    "open_source",
     "SimilarityTransform",
     "Status",
     "Tracker",
