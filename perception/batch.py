@@ -13,6 +13,8 @@ Clips run in local processes (``jobs``) or on a dask.distributed cluster
 
 from __future__ import annotations
 
+import contextlib
+import dataclasses
 import json
 import logging
 import os
@@ -62,13 +64,13 @@ COMPANION_SUFFIXES = (".truth.h5", ".recognition.json", ".confidence.csv", ".con
 #: for it only when it is current (checked when the video is loaded), so the
 #: video is the clip.
 _PREFERENCE = {"mocap": 4, "pose": 3, "video": 2, "tracks": 1, "unknown": 0}
-COMPANION_NAMES = ("manifest.csv", "README.md", "recipe.toml", "summary.csv", "statistics.csv",
-                   "condition_profiles.csv", "condition_profiles.png", "report.html",
-                   "batch.json", "repertoire.h5", "aperture_profiles.csv",
-                   "aperture_profiles.png", "confidence_single.png", "confidence_all.png",
-                   "errors.log")
 #: Tracebacks of the clips that failed through a bug (not their input).
 ERRORS_LOG = "errors.log"
+#: What a batch writes beside its clips' reports: one run's set, never a mix (:func:`run_batch`).
+REPORT_SET = ("summary.csv", "statistics.csv", "condition_profiles.csv", "condition_profiles.png",
+              "report.html", "batch.json", "aperture_profiles.csv", "aperture_profiles.png",
+              "confidence_single.png", "confidence_all.png", ERRORS_LOG)
+COMPANION_NAMES = ("manifest.csv", "README.md", "recipe.toml", "repertoire.h5", *REPORT_SET)
 #: A clip name becomes file names in the report folder: no separators, no
 #: leading dot, nothing that is not printable.
 _CLIP_NAME = re.compile(r"[^/\\\x00-\x1f\x7f]+")
@@ -450,8 +452,7 @@ class _Job:
                         repertoire_id=self.repertoire_id, plan_cache=self.plan_cache)
 
     def lost(self, item: BatchItem, message: str) -> ClipResult:
-        """A clip lost to a worker process that died (it, or another clip, crashed the
-        pool): failed, its outputs removed."""
+        """A clip whose worker process died running it: failed, its outputs removed."""
         log.error("%s: %s", item.clip, message)
         _remove_outputs(item, self.out)
         return ClipResult(item.clip, item.condition, "failed", f"{item.path}: {message}",
@@ -631,7 +632,9 @@ def run_batch(
     Returns
     -------
     pandas.DataFrame
-        The summary (see :func:`summary_table`).
+        The summary (see :func:`summary_table`). The report files
+        (:data:`REPORT_SET`) come from one run: the last run's are removed
+        first, and this run's again if one of them cannot be written.
     """
     from tqdm import tqdm
 
@@ -640,8 +643,10 @@ def run_batch(
     settings = RecognitionSettings() if settings is None else settings
     if jobs < 1:
         raise InputError(f"expected at least 1, got {jobs}", field="--jobs")
-    items = expand_recordings(items, settings)
-    out = Path(out)
+    # absolute: a worker, a dask one above all, may run in another folder
+    items = expand_recordings([dataclasses.replace(i, path=Path(i.path).absolute())
+                               for i in items], settings)
+    out = Path(out).absolute()
     out.mkdir(parents=True, exist_ok=True)
     for sub in ("tracks", PLANS_FOLDER):  # a link leading out of the report: refused now
         output_folder(out, sub)
@@ -656,18 +661,27 @@ def run_batch(
             bar.update()
     done.sort(key=lambda r: r.clip)
     summary = summary_table(done)
-    write_batch_report(summary, {r.clip: r.summary for r in done if r.summary is not None}, out,
-                       models=repertoire.models)
     bugs = [f"== {r.clip} ({r.error})\n{r.traceback}" for r in done if r.traceback]
-    if bugs:
-        write_text(out / ERRORS_LOG, "\n".join(bugs))
-    else:
-        (out / ERRORS_LOG).unlink(missing_ok=True)
-    write_json(out / "batch.json", {"clips": len(done),
-                                    "ok": int((summary["status"] == "ok").sum()),
-                                    "failed": int((summary["status"] != "ok").sum()),
-                                    "skipped": [{"file": n, "reason": why} for n, why in skipped],
-                                    "settings": settings.fingerprint(),
-                                    "repertoire": repertoire_id,
-                                    "code": code_digest()})
+    _remove_report(out)  # the last run's set: a kill or a full disk below leaves no mix
+    try:
+        write_batch_report(summary, {r.clip: r.summary for r in done if r.summary is not None},
+                           out, models=repertoire.models)
+        if bugs:
+            write_text(out / ERRORS_LOG, "\n".join(bugs))
+        write_json(out / "batch.json", {
+            "clips": len(done), "ok": int((summary["status"] == "ok").sum()),
+            "failed": int((summary["status"] != "ok").sum()),
+            "skipped": [{"file": n, "reason": why} for n, why in skipped],
+            "settings": settings.fingerprint(), "repertoire": repertoire_id,
+            "code": code_digest()})
+    except BaseException:  # none of the set rather than part of it
+        _remove_report(out)
+        raise
     return summary
+
+
+def _remove_report(out: Path) -> None:
+    """Remove the batch report set (:data:`REPORT_SET`) from ``out``, as far as it can."""
+    for name in REPORT_SET:
+        with contextlib.suppress(OSError):
+            (out / name).unlink(missing_ok=True)

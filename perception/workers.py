@@ -13,14 +13,22 @@ receives what every item shares (a repertoire) once. BLAS/OpenMP read
 their thread counts from the environment when numpy loads, so those are
 the application's to set before anything starts: ``hammer-mv`` sets one
 thread each unless the user chose otherwise.
+
+Each worker is a one-process executor handed one item at a time, so a
+worker that dies (killed, out of memory) loses only the item it held; a new
+worker takes its place. A worker ends when this process ends, even killed
+by SIGKILL: it watches its end of multiprocessing's pipe from this process.
 """
 
 from __future__ import annotations
 
 import multiprocessing
+import os
 import pickle
+import threading
+from collections import deque
 from collections.abc import Callable, Iterable, Iterator
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, Protocol
 
@@ -31,8 +39,8 @@ class Job(Protocol):
     """What :func:`run_pool` runs: picklable, its ``run`` importable in a worker.
 
     A job may also have ``lost(item, message)``: the result of an item whose
-    worker died before the item finished (a crash in a library, or the
-    kernel's out-of-memory killer). Without it, such a death ends the run
+    worker died running it (killed, the out-of-memory killer, a crash in a
+    library); the other items go on. Without it, such a death ends the run
     with a :class:`ChildProcessError` (an ``OSError``).
     """
 
@@ -44,7 +52,8 @@ _WORKER: dict = {}
 
 
 def init_worker(job_and_shared: bytes) -> None:
-    """A worker process's initialiser: one OpenCV, FFmpeg and planning thread; the job.
+    """A worker process's initialiser: one OpenCV, FFmpeg and planning thread; the job;
+    a thread that ends the worker when its parent ends.
 
     The job and the shared object come pickled once (bytes), so that the
     parent's write to a starting worker does not wait while the worker
@@ -64,6 +73,15 @@ def init_worker(job_and_shared: bytes) -> None:
     video.decoder_threads = 1
     planning.threads = 1
     _WORKER["job"], _WORKER["shared"] = pickle.loads(job_and_shared)
+    parent = multiprocessing.parent_process()
+    if parent is not None:
+        threading.Thread(target=_exit_with, args=(parent,), daemon=True).start()
+
+
+def _exit_with(parent) -> None:
+    """Exit once ``parent`` has ended: its end of a pipe to this process closes."""
+    parent.join()
+    os._exit(1)
 
 
 def _run(item: Any) -> Any:
@@ -110,29 +128,36 @@ def run_pool(items: Iterable, job: Job, jobs: int, *, shared: Any = None,
             yield job.run(item, shared)
         return
     state = pickle.dumps((job, shared), protocol=pickle.HIGHEST_PROTOCOL)
-    pool = ProcessPoolExecutor(max_workers=min(jobs, len(items)), mp_context=_context(),
-                               initializer=init_worker, initargs=(state,))
-    broken = False
+
+    def worker() -> ProcessPoolExecutor:  # starts its process when first given an item
+        return ProcessPoolExecutor(1, mp_context=_context(), initializer=init_worker,
+                                   initargs=(state,))
+
+    todo, idle = deque(items), [worker() for _ in range(min(jobs, len(items)))]
+    running: dict = {}  # future: (its worker, its item)
     try:
-        futures = {pool.submit(_run, item): item for item in items}
-        for future in as_completed(futures):
-            try:
-                result = future.result()
-            except BrokenProcessPool as exc:  # a worker died: every unfinished item is lost
-                broken = True
-                result = _lost(job, futures[future], exc)
-            yield result
-    finally:
-        # Interrupted (or a consumer that stops early): drop what has not
-        # started. A broken pool has failed its futures itself (cancelling
-        # them too raises InvalidStateError in its thread, in Python 3.11).
-        pool.shutdown(wait=True, cancel_futures=not broken)
+        while todo or running:
+            while todo and idle:
+                w, item = idle.pop(), todo.popleft()
+                running[w.submit(_run, item)] = w, item
+            for future in wait(running, return_when=FIRST_COMPLETED).done:
+                w, item = running.pop(future)
+                try:
+                    result = future.result()
+                except BrokenProcessPool as exc:  # that worker died: a new one for the rest
+                    w.shutdown()
+                    w, result = worker(), _lost(job, item, exc)
+                idle.append(w)
+                yield result
+    finally:  # interrupted, or a consumer that stops early: nothing more starts
+        for w in idle + [w for w, _ in running.values()]:
+            w.shutdown(wait=True)
 
 
 def _lost(job: Job, item: Any, exc: BaseException) -> Any:
-    """The result of an item whose worker pool broke before it finished, or (a job
-    without ``lost``) an error a command reports in one line."""
-    why = "a worker process ended abruptly (a crash in a library, or out of memory)"
+    """The result of an item whose worker died running it, or (a job without ``lost``)
+    an error a command reports in one line."""
+    why = "the worker process running it died (killed, out of memory or a crash in a library)"
     if not hasattr(job, "lost"):
         raise ChildProcessError(why) from exc
-    return job.lost(item, f"{why} before it finished; rerun to retry it")
+    return job.lost(item, f"{why}; rerun to retry it")

@@ -290,14 +290,14 @@ class _CrashesInAWorker(Repertoire):
         os._exit(3)
 
 
-def test_a_killed_worker_fails_its_clips_in_one_clear_line_and_the_batch_ends(tracks_folder,
-                                                                              tmp_path):
+def test_clips_that_kill_every_worker_fail_in_one_clear_line_and_the_batch_ends(tracks_folder,
+                                                                               tmp_path):
     rep = _CrashesInAWorker(default_repertoire().models)
     out = tmp_path / "out"
     summary = run_batch(discover(tracks_folder), out, rep, quiet=True, jobs=2)
     assert (summary["status"] == "failed").all()
     for clip, error in zip(summary["clip"], summary["error"]):
         assert error.startswith(str(tracks_folder / f"{clip}.tracks.h5"))
-        assert "worker process ended abruptly" in error and "rerun" in error
+        assert "worker process running it died" in error and "rerun" in error
     assert json.loads((out / "batch.json").read_text())["failed"] == 2
     assert not list(out.glob("*.recognition.json"))

@@ -73,18 +73,20 @@ class _DiesReported(_Dies):
         return message, item
 
 
-def test_a_dead_worker_loses_the_unfinished_items_and_nothing_hangs():
-    # item 0 goes last (smallest): the others are done before its worker dies
-    results = list(run_pool(range(4), _DiesReported(os.getpid()), 2, size=lambda i: i))
+@pytest.mark.parametrize("first", [False, True])
+def test_a_dead_worker_loses_only_its_item_and_nothing_hangs(first):
+    # item 0 first (largest) or last: while its worker dies the other one runs
+    results = list(run_pool(range(6), _DiesReported(os.getpid()), 2,
+                            size=lambda i: -i if first else i))
     lost = [r for r in results if isinstance(r, tuple)]
-    assert sorted(r for r in results if isinstance(r, int)) == [1, 2, 3]
+    assert sorted(r for r in results if isinstance(r, int)) == [1, 2, 3, 4, 5]
     assert [r[1] for r in lost] == [0]
-    assert "worker process ended abruptly" in lost[0][0] and "rerun" in lost[0][0]
+    assert "worker process running it died" in lost[0][0] and "rerun" in lost[0][0]
 
 
 def test_a_dead_worker_ends_a_job_without_lost_with_an_oserror():
     # an OSError: a command reports it in one line (not BrokenProcessPool's traceback)
-    with pytest.raises(ChildProcessError, match="worker process ended abruptly"):
+    with pytest.raises(ChildProcessError, match="worker process running it died"):
         list(run_pool(range(4), _Dies(os.getpid()), 2))
 
 

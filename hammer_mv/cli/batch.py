@@ -92,7 +92,7 @@ def failure_reasons(summary, items) -> str:
     items : list of BatchItem
         The clips (their paths).
     """
-    paths = {item.clip: str(item.path) for item in items}
+    paths = {item.clip: str(item.path.absolute()) for item in items}  # as run_batch has them
     reasons = Counter()
     for clip, status, error in zip(summary["clip"], summary["status"], summary["error"]):
         if status == "ok":
