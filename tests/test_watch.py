@@ -47,6 +47,7 @@ def test_watch_a_file_writes_what_recognize_writes(clip, tmp_path):
     info = online.pop("online")
     assert online == offline  # identical, key for key, bit for bit
     assert info["frames"] == 75 and info["dropped_frames"] == 0 and not info["interrupted"]
+    assert info["signal"] is None and info["labelled_video_error"] is None
     assert 0 < info["decision_fraction"] <= 1 and info["decision_time"] > 0
     assert (tmp_path / "clip.confidence.csv").read_bytes() == \
         (d / "offline" / "clip.confidence.csv").read_bytes()

@@ -12,6 +12,7 @@ from __future__ import annotations
 import os
 import re
 import sys
+import tempfile
 from collections.abc import Iterator, Mapping
 from contextlib import contextmanager, suppress
 from pathlib import Path
@@ -19,7 +20,7 @@ from pathlib import Path
 from perception.errors import HammerMVError, InputError
 
 __all__ = ["WORKER_BYTES", "cap_jobs", "check_seed", "free_memory", "option", "options",
-           "output_folder", "usable_cores"]
+           "output_folder", "usable_cores", "writable_folder"]
 
 #: Memory one worker process may need (a clip's frames, tracks and models), bytes.
 WORKER_BYTES = 600 * 2**20
@@ -122,6 +123,20 @@ def output_folder(path: Path, field: str = "--output") -> Path:
     if path.exists() and not path.is_dir():
         raise InputError("exists and is not a folder (expected an output folder)", path,
                          field=field)
+    return path
+
+
+def writable_folder(path: Path, field: str = "--output") -> Path:
+    """``path`` (the output folder ``field`` names), refused at once unless it is or can be
+    made a folder this process writes in: its nearest folder that exists is tried."""
+    output_folder(path, field)
+    nearest = path
+    while not nearest.exists() and nearest.parent != nearest:
+        nearest = nearest.parent
+    try:
+        tempfile.TemporaryFile(dir=nearest).close()
+    except OSError as exc:
+        raise InputError(f"cannot write here: {exc.strerror or exc}", path, field=field) from None
     return path
 
 

@@ -3,10 +3,16 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
+import signal
+import sys
+import threading
 import time
 from pathlib import Path
 
+from hammer_mv.cli import _user_error
 from hammer_mv.cli.options import add_recognition_options
+from perception.errors import HammerMVError
 
 #: A frame period longer than this many nominal periods means frames were dropped.
 GAP_PERIODS = 1.5
@@ -50,36 +56,61 @@ def register(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     """Execute ``hammer-mv watch`` with parsed ``args``; return the exit status.
 
+    SIGINT, SIGTERM and SIGHUP end the watch with the report of what was seen, exit
+    status 128 + the signal's number; their handlers are the watch's only (restored
+    when it ends).
+
     Parameters
     ----------
     args : argparse.Namespace
         Parsed arguments.
     """
+    with _Signals() as signals:
+        try:
+            return _watch(args, signals)
+        except (KeyboardInterrupt, HammerMVError) as exc:
+            if isinstance(exc, HammerMVError) and signals.received is None:
+                raise
+            # before the first frame, or too few frames to report
+            why = f", no report: {exc}" if isinstance(exc, HammerMVError) else ""
+            print(f"hammer-mv watch: interrupted ({signals.name or 'SIGINT'}){why}",
+                  file=sys.stderr)
+            return 128 + (signals.received or signal.SIGINT)
+
+
+def _watch(args: argparse.Namespace, signals: _Signals) -> int:
+    """:func:`run`'s watch, ``signals`` its handlers."""
     import numpy as np
 
-    from hammer_mv.cli.checks import output_folder
+    from hammer_mv.cli.checks import writable_folder
     from hammer_mv.cli.options import load_repertoire, recognition_settings
     from perception.io.atomic import check_output
     from perception.io.capture import source_kind
-    from perception.io.video import open_source
+    from perception.io.video import codec_for, open_source
     from perception.online import OnlineRecognizer, decision_summary
     from perception.pipeline import clip_fingerprint
-    from perception.report.clip import write_clip_report
+    from perception.report import clip as report
     from perception.report.tracking import write_tracking_report
 
-    output_folder(args.output)
-    if args.labelled_video is not None:  # refused before the first frame, not after
-        files = [args.repertoire, args.source if source_kind(args.source) == "file" else None]
-        check_output(args.labelled_video, [f for f in files if f is not None])
+    kind = source_kind(args.source)
+    clip = args.clip or {"camera": f"camera{args.source}", "stream": "stream"}.get(kind) \
+        or Path(args.source).stem
+    # every output refused before the source opens if it cannot be written or is an input
+    # (the source named as a path or as FFmpeg's file: URL)
+    source = [] if kind == "camera" else [args.source, args.source.removeprefix("file:")]
+    inputs = [f for f in (args.repertoire, *source) if f is not None]
+    for path in report.clip_outputs(writable_folder(args.output), clip).values():
+        check_output(path, inputs)
+    if args.labelled_video is not None:
+        codec_for(check_output(args.labelled_video, inputs))
+        writable_folder(args.labelled_video.parent, "--labelled-video")
     settings = recognition_settings(args)
     rep, rep_id = load_repertoire(args)
     latency, dropped, last, decided, interrupted = [], 0, None, None, False
-    with (open_source(args.source, stall_timeout=args.stall_timeout, fps=settings.fps,
-                      keep_truncated=settings.keep_truncated) as src,
-          _Drawer(args.labelled_video, src.fps) as draw):  # a failed run leaves no video
-        kind, fps = src.kind, src.fps
-        clip = args.clip or {"camera": f"camera{args.source}", "stream": "stream"}.get(kind) \
-            or Path(args.source).stem
+    with (_Drawer(args.labelled_video) as draw,  # a watch that fails leaves no video
+          open_source(args.source, stall_timeout=args.stall_timeout, fps=settings.fps,
+                      keep_truncated=settings.keep_truncated) as src):
+        fps = draw.fps = src.fps
         rec = OnlineRecognizer(rep, settings, clip=clip)
         say = (lambda line: None) if args.quiet else (lambda line: print(line, flush=True))
         pace, start = kind == "file" and not args.as_fast_as_possible, time.monotonic()
@@ -91,10 +122,14 @@ def run(args: argparse.Namespace) -> int:
                     gap = fps > 0 and t - last[1] > GAP_PERIODS / fps
                     dropped += max(index - last[0], round((t - last[1]) * fps) if gap else 1) - 1
                 last = index, t
+                signals.holding = True  # a frame is judged and drawn whole, or not at all
                 t0 = time.perf_counter()
                 state = rec.update(frame, t, index)
                 latency.append(time.perf_counter() - t0)
                 draw(frame, state, rec)
+                signals.holding = False
+                if signals.received:  # one came meanwhile
+                    raise KeyboardInterrupt
                 if args.live:
                     say(f"{t:8.3f} s  {state.phase:<6}  {state.leading or '-':<12} "
                         f"{state.verdict or '-':<9} {'settled' if state.settled else ''}")
@@ -105,38 +140,89 @@ def run(args: argparse.Namespace) -> int:
                         f"({decided.since_onset:.3f} s after the onset)")
         except KeyboardInterrupt:  # the outputs of what was seen
             interrupted = True
-    video = src.attrs()
-    result = rec.finish(video, source=args.source)
-    online = {**decision_summary(result, rec.decision), "source": kind,
-              "frames": len(latency), "dropped_frames": dropped,
-              "read_ahead_dropped": src.dropped, "interrupted": interrupted,
-              "latency_ms": {"median": float(np.median(latency) * 1e3),
-                             "p99": float(np.percentile(latency, 99) * 1e3)}}
-    tracks = rec.tracks(video)
-    extra = {"fingerprint": clip_fingerprint(args.source, settings, rep_id)} if kind == "file" \
-        else {}
-    extra.update({"condition": None, "input": args.source,
-                  "tracking": write_tracking_report(tracks, args.output, clip, sheet=False),
-                  "online": online})
-    paths = write_clip_report(result, args.output, extra=extra, figures=not args.no_figures)
+        signals.holding = True  # from here on a signal waits for the outputs
+        src.close()
+        video = src.attrs()
+        result = rec.finish(video, source=args.source)
+        online = {**decision_summary(result, rec.decision), "source": kind,
+                  "frames": len(latency), "dropped_frames": dropped,
+                  "read_ahead_dropped": src.dropped, "interrupted": interrupted,
+                  "signal": signals.name if interrupted else None,
+                  "labelled_video_error": draw.finish(),
+                  "latency_ms": {"median": float(np.median(latency) * 1e3),
+                                 "p99": float(np.percentile(latency, 99) * 1e3)}}
+        tracks = rec.tracks(video)
+        extra = {"fingerprint": clip_fingerprint(args.source, settings, rep_id)} \
+            if kind == "file" else {}
+        extra.update({"condition": None, "input": args.source,
+                      "tracking": write_tracking_report(tracks, args.output, clip, sheet=False),
+                      "online": online})
+        paths = report.write_clip_report(result, args.output, extra=extra,
+                                         figures=not args.no_figures)
     detail = f" ({result.verdict_detail})" if result.verdict_detail else ""
     say(f"{clip}: {result.verdict or 'no verdict'}{detail}, winner {result.winner} "
         f"({len(latency)} frames, {dropped} dropped) -> {paths['json']}")
-    return 130 if interrupted else 0
+    if draw.error is not None:  # the user's disk or folder: the report is kept, status 2
+        print(f"hammer-mv watch: error: labelled video not written: {draw.error}",
+              file=sys.stderr)
+    return 128 + signals.received if signals.received else 2 if draw.error else 0
+
+
+class _Signals:
+    """SIGINT, SIGTERM and SIGHUP while a watch runs (set from the main thread only; one
+    the process ignores, as under ``nohup``, stays ignored).
+
+    The first ends the watch: a ``KeyboardInterrupt`` at once, or, while the watch is
+    ``holding`` (a frame, the outputs), when that is done. Later ones change nothing.
+    """
+
+    def __init__(self):
+        self.received, self.holding, self.previous = None, False, {}
+
+    def __enter__(self) -> _Signals:
+        if threading.current_thread() is threading.main_thread():
+            for number in (signal.SIGINT, signal.SIGTERM, getattr(signal, "SIGHUP", None)):
+                if number is not None and signal.getsignal(number) is not signal.SIG_IGN:
+                    self.previous[number] = signal.signal(number, self._received)
+        return self
+
+    def _received(self, number: int, frame) -> None:
+        first, self.received = self.received is None, self.received or number
+        if first and not self.holding:
+            raise KeyboardInterrupt
+
+    @property
+    def name(self) -> str | None:
+        """The first signal's name (``"SIGTERM"``), or None."""
+        return None if self.received is None else signal.Signals(self.received).name
+
+    def __exit__(self, *exc_info) -> None:
+        for number, handler in self.previous.items():
+            signal.signal(number, signal.SIG_DFL if handler is None else handler)
 
 
 class _Drawer:
-    """The labelled video (none if ``path`` is None): markers (as ``track``'s) and model bars."""
+    """The labelled video (none if ``path`` is None): markers (as ``track``'s) and model bars.
 
-    def __init__(self, path: Path | None, fps: float):
-        self.path, self.fps, self.writer, self.labeller = path, fps or 30.0, None, None
+    A failure to write it (a full disk) costs the video only: it is discarded, the
+    watch goes on, and ``error`` tells it. A watch that fails leaves none.
+    """
+
+    def __init__(self, path: Path | None):
+        self.path, self.fps, self.writer, self.error, self.done = path, 0.0, None, None, False
 
     def __enter__(self) -> _Drawer:
         return self
 
     def __call__(self, frame, state, rec) -> None:
-        if self.path is None:
-            return
+        if self.path is not None and self.error is None:
+            try:
+                self._draw(frame, state, rec)
+            except (OSError, HammerMVError) as exc:
+                self.error = _user_error(exc)
+                self.__exit__(type(exc), exc, exc.__traceback__)
+
+    def _draw(self, frame, state, rec) -> None:
         import cv2
         import numpy as np
 
@@ -145,7 +231,7 @@ class _Drawer:
 
         if self.writer is None:
             # kept only once entered: close() must not finish a writer that never opened
-            self.writer = VideoWriter(self.path, self.fps,
+            self.writer = VideoWriter(self.path, self.fps or 30.0,
                                       (frame.shape[1], frame.shape[0])).__enter__()
             self.labeller = Labeller(rec.markers, [(0, 255, 255)] * len(rec.markers))
         row = rec.last_row
@@ -163,8 +249,22 @@ class _Drawer:
                     (255, 255, 255), 1)
         self.writer.write(img)
 
-    def __exit__(self, *exc_info) -> None:
-        """Finish the video; when the block raised, discard it instead."""
+    def finish(self) -> str | None:
+        """Finish the video (under its own name); the error that cost it, if one did."""
         writer, self.writer = self.writer, None
-        if writer is not None:
-            writer.__exit__(*exc_info)
+        try:
+            if writer is not None:
+                writer.__exit__(None, None, None)
+                self.done = True
+        except (OSError, HammerMVError) as exc:  # its temporary file is removed
+            self.error = _user_error(exc)
+        return self.error
+
+    def __exit__(self, *exc_info) -> None:
+        """When the block raised, discard the video (remove it if already finished)."""
+        writer, self.writer = self.writer, None
+        if exc_info[0] is not None and writer is not None:
+            with contextlib.suppress(OSError):  # an OSError is raised again, renamed
+                writer.__exit__(*exc_info)
+        elif exc_info[0] is not None and self.done:
+            self.path.unlink(missing_ok=True)
