@@ -28,7 +28,7 @@ import numpy as np
 from scipy.interpolate import PchipInterpolator
 from scipy.ndimage import median_filter
 
-__all__ = ["CleaningParams", "Repairs", "clean_path"]
+__all__ = ["CleaningParams", "Repairs", "clean_path", "spikes"]
 
 
 @dataclass(frozen=True)
@@ -117,9 +117,23 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
     return list(zip(np.flatnonzero(edges == 1).tolist(), np.flatnonzero(edges == -1).tolist()))
 
 
-def _spikes(time: np.ndarray, path: np.ndarray, ok: np.ndarray,
-            params: CleaningParams) -> np.ndarray:
-    """Samples off the running median of the seen samples around them."""
+def spikes(time: np.ndarray, path: np.ndarray, ok: np.ndarray | None = None,
+           params: CleaningParams | None = None) -> np.ndarray:
+    """(N,) samples off the running median of the seen samples around them: spikes.
+
+    Parameters
+    ----------
+    time : (N,) array
+        Sample times, s.
+    path : (N, D) array
+        Positions, m (NaN where lost).
+    ok : (N,) bool array, optional
+        The samples to read (default: the finite ones).
+    params : CleaningParams, optional
+        Its ``spike_distance`` and ``spike_window``.
+    """
+    params = CleaningParams() if params is None else params
+    ok = np.isfinite(path).all(axis=1) if ok is None else ok
     dt = float(np.median(np.diff(time))) if len(time) > 1 else 1.0
     half = max(1, int(round(params.spike_window / dt)))
     idx = np.flatnonzero(ok)
@@ -157,8 +171,8 @@ def clean_path(time: np.ndarray, path: np.ndarray,
     path = np.array(path, dtype=float)
     missing = ~np.isfinite(path).all(axis=1)
     held = _held(np.where(missing[:, None], np.nan, path), params.held_samples) & ~missing
-    spikes = _spikes(time, path, ~missing & ~held, params)
-    lost = missing | held | spikes
+    spiked = spikes(time, path, ~missing & ~held, params)
+    lost = missing | held | spiked
     path[lost] = np.nan
     bridged = 0
     longest = 0.0
@@ -174,5 +188,5 @@ def clean_path(time: np.ndarray, path: np.ndarray,
             else:
                 longest = max(longest, float(span if inside else
                                              time[min(b, len(time) - 1)] - time[max(a - 1, 0)]))
-    return path, Repairs(int(spikes.sum()), int(held.sum()), int(missing.sum()), bridged,
+    return path, Repairs(int(spiked.sum()), int(held.sum()), int(missing.sum()), bridged,
                          longest)

@@ -76,6 +76,9 @@ class LandmarkParams:
     peak_prominence, peak_min_prominence : float
         An aperture peak counts if it stands out by at least this share of
         the opening and this much, m (a few times an aperture's tracking noise).
+    second_movement : float
+        Outside the movement (before its onset, after its end), the transport
+        going faster than this share of its peak speed is another movement.
     max_gap, max_gap_share : float
         A gap in the aperture may hide a closing and re-opening when it is
         longer than ``max_gap`` s and than ``max_gap_share`` of the movement:
@@ -95,6 +98,7 @@ class LandmarkParams:
     peak_min_prominence: float = 0.005
     max_gap: float = 0.1
     max_gap_share: float = 0.2
+    second_movement: float = 0.5
 
     def __post_init__(self):
         if not (0 < self.threshold < 1):
@@ -112,7 +116,7 @@ class LandmarkParams:
         if not (isinstance(self.order, int) and 1 <= self.order <= 8):
             raise ValueError(f"LandmarkParams.order: expected 1-8, got {self.order!r}")
         for name in ("opening_level", "peak_prominence", "peak_min_prominence", "max_gap",
-                     "max_gap_share"):
+                     "max_gap_share", "second_movement"):
             v = getattr(self, name)
             if not (math.isfinite(v) and v >= 0 and (name == "max_gap" or v <= 1)):
                 raise ValueError(f"LandmarkParams.{name}: expected a share 0-1, got {v!r}")
@@ -269,11 +273,16 @@ class Landmarks:
         Grip aperture at the movement's onset, m.
     opening_time : float
         When the aperture first exceeds ``rest_aperture`` + ``opening_level``
-        of the opening: the grip starts to open, share.
+        of the opening: the grip starts to open, share (NaN where the digits
+        were unseen for more than ``max_gap`` then).
     peak_opening_speed : float
         The aperture's fastest widening before the MGA, m/s.
     closing_time : float
         From the MGA to the movement's end, s.
+    movements : int or None
+        Movements in the recording: 1, plus each stretch outside this one in
+        which the transport goes faster than ``second_movement`` of its peak
+        (None without a speed).
     """
 
     movement_time: float = math.nan
@@ -290,6 +299,7 @@ class Landmarks:
     deceleration_time: float = math.nan
     peak_opening_speed: float = math.nan
     closing_time: float = math.nan
+    movements: int | None = None
 
     @property
     def opening(self) -> float:
@@ -330,7 +340,7 @@ class Landmarks:
         kw = {}
         for f in fields(cls):
             v = d.get(f.name)
-            if f.name == "aperture_peaks":
+            if f.name in ("aperture_peaks", "movements"):
                 kw[f.name] = None if v is None else int(v)
             else:
                 kw[f.name] = math.nan if v is None else float(v)
@@ -367,8 +377,10 @@ def count_peaks(values: np.ndarray, min_prominence: float) -> int:
     return len(find_peaks(np.r_[low, x, low], prominence=min_prominence)[0])
 
 
-def _crossing(time: np.ndarray, values: np.ndarray, level: float) -> float:
-    """First time ``values`` exceed ``level``, interpolated between samples (NaN if never)."""
+def _crossing(time: np.ndarray, values: np.ndarray, level: float,
+              max_gap: float = math.inf) -> float:
+    """First time ``values`` exceed ``level``, interpolated between samples (NaN if never,
+    or if it happened unseen: more than ``max_gap`` s after the sample seen before it)."""
     ok = np.isfinite(values)
     t, v = time[ok], values[ok]
     above = np.flatnonzero(v > level)
@@ -377,6 +389,8 @@ def _crossing(time: np.ndarray, values: np.ndarray, level: float) -> float:
     i = int(above[0])
     if i == 0:
         return float(t[0])
+    if t[i] - t[i - 1] > max_gap + 1e-9:
+        return math.nan
     return float(t[i - 1] + (level - v[i - 1]) / (v[i] - v[i - 1]) * (t[i] - t[i - 1]))
 
 
@@ -430,7 +444,8 @@ def wrist_movement_time(time: np.ndarray, wrist: np.ndarray) -> float:
 
 
 def longest_gap(time: np.ndarray, values: np.ndarray) -> float:
-    """The longest time between two consecutive seen samples of ``values``, s.
+    """The longest time ``values`` go unseen, s: between two seen samples, or from the
+    first sample to the first seen one, or from the last seen one to the last sample.
 
     Parameters
     ----------
@@ -440,10 +455,12 @@ def longest_gap(time: np.ndarray, values: np.ndarray) -> float:
         Values, NaN where lost (none seen: the whole span).
     """
     time = np.asarray(time, dtype=float)
+    if not len(time):
+        return 0.0
     ts = time[np.isfinite(np.asarray(values, dtype=float))]
-    if len(ts) < 2:
-        return float(time[-1] - time[0]) if len(time) else 0.0
-    return float(np.diff(ts).max())
+    if not len(ts):
+        return float(time[-1] - time[0])
+    return float(np.diff(np.r_[time[0], ts, time[-1]]).max())
 
 
 def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.ndarray,
@@ -485,7 +502,11 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
     lo = onset if onset is not None else 0
     hi = end if end is not None else len(time) - 1
     share = (lambda t: float(np.clip((t - t_on) / T, 0, 1))) if T > 0 else (lambda t: math.nan)
-    base = {"onset_time": t_on, "end_time": t_end, "movement_time": T,
+    # another movement: a stretch outside this one going faster than a share of its peak
+    fast = np.nan_to_num(speed) > params.second_movement * speed[peak]
+    fast[lo:hi + 1] = False
+    others = int(np.count_nonzero(np.diff(np.r_[0, fast.astype(np.int8)]) == 1))
+    base = {"onset_time": t_on, "end_time": t_end, "movement_time": T, "movements": 1 + others,
             "peak_speed": float(speed[peak]), "peak_speed_time": share(time[peak]),
             "deceleration_time": t_end - float(time[peak])}
     g = params.lowpass(time, g_raw)
@@ -508,7 +529,7 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
         **base, mga=mga, mga_time=share(time[j]), contact_aperture=float(g[seen[-1]]),
         aperture_peaks=peaks, rest_aperture=rest,
         opening_time=share(_crossing(time[lo:hi + 1], g[lo:hi + 1],
-                                     rest + params.opening_level * opening)),
+                                     rest + params.opening_level * opening, params.max_gap)),
         peak_opening_speed=float(widening.max()) if len(widening) else math.nan,
         closing_time=t_end - float(time[j]))
 
@@ -516,11 +537,13 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
 def observed_landmarks(obs: Observation, params: LandmarkParams | None = None) -> Landmarks:
     """The landmarks of a demonstration, by the field's definitions (:func:`movement_landmarks`).
 
-    Measured on the whole clip's unfiltered positions (``obs.clip_raw``),
-    not only the span the models score: the field's end of a slow approach
-    may come after it. The transport is the wrist's; the aperture is the
-    tip-to-tip distance of the digit markers, as a lab reports it (the
-    rest-subtracted opening is :attr:`Landmarks.opening`). Times are on
+    Measured on the whole clip's unfiltered positions (``obs.clip_raw``;
+    a sample off its neighbours' path, a glitch, is taken as lost:
+    :func:`perception.cleaning.spikes`), not only the span the models
+    score: the field's end of a slow approach may come after it. The
+    transport is the wrist's; the aperture is the tip-to-tip distance of
+    the digit markers, as a lab reports it (the rest-subtracted opening is
+    :attr:`Landmarks.opening`). Times are on
     the observation's clock (0 at the scored span's onset).
 
     Parameters
@@ -538,6 +561,11 @@ def observed_landmarks(obs: Observation, params: LandmarkParams | None = None) -
                                       obs.g + obs.marker_separation, params)
         time = obs.time
         raw = np.stack([r[k] for k in ("wrist", "finger", "thumb")], axis=1)
+    from perception.cleaning import spikes  # noqa: PLC0415 (scipy.ndimage)
+
+    raw = np.array(raw, dtype=float)  # a one-frame glitch is lost, not a movement's peak
+    for k in range(raw.shape[1]):
+        raw[spikes(time, raw[:, k]), k] = np.nan
     return movement_landmarks(time, raw[:, 0], np.linalg.norm(raw[:, 1] - raw[:, 2], axis=1),
                               params)
 

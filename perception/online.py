@@ -292,7 +292,9 @@ class OnlineRecognizer:
             models=models, names=[m.name for m in models], hammer=hammer, scale=scale,
             filt=AlphaBeta((3, 2), params.alpha, params.beta), filtered=[],
             separation=float(np.linalg.norm(2 * half)), guess=None, reference=None,
-            rest_wrist=None, votes=[0, 0], peak_speed=0.0, slowed=0.0, walked=[], aperture=[],
+            rest_wrist=None, votes=[0, 0], peak_speed=0.0, slowed=0.0, arrived=0.0, walked=[],
+            aperture=[],
+            digits_seen=[],
             # past three times the longest model's movement the movement is over: the
             # evidence is kept as it was, and no frame costs more than the one before
             window=math.ceil(3 * durations[1] / first.dt), judged=None, t10=math.nan,
@@ -306,6 +308,7 @@ class OnlineRecognizer:
             z = sc.first.transform.to_model(np.asarray(rows["position"][i], dtype=float)[sc.cols])
             dt = sc.first.dt if i == 0 else rows["time"][i] - rows["time"][i - 1]
             sc.filtered.append(sc.filt(z, dt))
+            sc.digits_seen.append(bool(np.isfinite(z[1:]).all()))  # the filter coasts
 
     def _find_onset(self) -> None:
         """The offline onset rule on the latest rows; once it holds, score from the onset."""
@@ -331,7 +334,7 @@ class OnlineRecognizer:
         row = (self._rows["time"][i] - self._onset, f[0], f[1] - sc.half, f[2] + sc.half)
         self._moving.append(row)
         sc.aperture.append(float(np.linalg.norm(row[2] - row[3])))
-        if math.isfinite(sc.aperture[-1]):
+        if sc.digits_seen[i]:
             sc.gap = (row[0], sc.gap[1] if math.isnan(sc.gap[0]) else max(sc.gap[1],
                                                                            row[0] - sc.gap[0]))
         progress = np.linalg.norm(row[1] - sc.first.rest[0]) / sc.way
@@ -339,9 +342,11 @@ class OnlineRecognizer:
         if len(self._moving) > 1:  # the transport's speed, against its peak so far
             prev = self._moving[-2]
             speed = float(np.linalg.norm(row[1] - prev[1]) / max(row[0] - prev[0], 1e-9))
-            if math.isfinite(speed):
-                sc.peak_speed = max(sc.peak_speed, speed)
-                sc.slowed = 1.0 - speed / sc.peak_speed if sc.peak_speed > speed else 0.0
+            if math.isfinite(speed) and speed >= sc.peak_speed:  # a new peak
+                sc.peak_speed, sc.slowed, sc.arrived = speed, 0.0, 0.0
+            elif math.isfinite(speed):  # as rules.slowed reads the movement so far
+                sc.slowed = 1.0 - speed / sc.peak_speed
+                sc.arrived = max(sc.arrived, sc.slowed)
         if math.isnan(sc.t10) and progress >= 0.1:
             sc.t10 = row[0]
         if math.isnan(sc.t90) and progress >= 0.9:
@@ -388,7 +393,8 @@ class OnlineRecognizer:
         sc, rules = self._scene, self.settings.rules
         ref = sc.reference
         g = np.asarray(sc.aperture)
-        seen = np.isfinite(g)
+        # the markers' own: the filter coasts through a loss
+        seen = np.asarray(sc.digits_seen[-len(g):]) & np.isfinite(g) if len(g) else g > 0
         grip = SimpleNamespace(opened=False, peaks=0, closing=0.0, open_at=math.nan,
                                mt=(sc.t90 - sc.t10) / MODEL_SPAN_FRACTION,
                                opening=0.0, slowed=sc.slowed)
@@ -401,9 +407,11 @@ class OnlineRecognizer:
             # as the landmarks count them: not across a gap that may hide one
             grip.peaks = None if lp.hides_a_reopening(sc.gap[1], grip.mt) else count_peaks(
                 gs, max(lp.peak_prominence * opening, lp.peak_min_prominence))
-            walked = np.asarray(sc.walked)[seen]
-            grip.open_at = float(np.interp(walked[np.argmax(gs > rest + lp.opening_level
-                                                            * opening)], _WAY, _TAU))
+            walked, ts = np.asarray(sc.walked)[seen], np.array([r[0] for r in self._moving])[seen]
+            k = int(np.argmax(gs > rest + lp.opening_level * opening))
+            # as the landmark: a start of the opening that was not seen is not known
+            unseen = k > 0 and ts[k] - ts[k - 1] > lp.max_gap + 1e-9
+            grip.open_at = math.nan if unseen else float(np.interp(walked[k], _WAY, _TAU))
             grip.closing = (float(gs.max() - gs[-1]) / opening) if opening > 0 else 0.0
         # the models of the kind the grip shows, as the offline pass takes them
         grip.models = idx = ref.kinds["grasp" if grip.opened else "reach"]
@@ -415,8 +423,13 @@ class OnlineRecognizer:
         # what is known before the end: when the grip started to open, how often it did
         observed = Landmarks(movement_time=grip.mt, aperture_peaks=grip.peaks,
                              opening_time=grip.open_at if grip.opened else math.nan)
+        # the digits unseen since they were last seen count too, as offline at the end
+        now = self._moving[-1][0]
+        gap = max(sc.gap[1], now - (self._moving[0][0] if math.isnan(sc.gap[0]) else sc.gap[0]))
+        scored = ref.scorer.scored.max() / max(ref.scorer.frames - 1, 1)
         evidence = Evidence([sc.models[i].kind for i in idx], ref.scorer.log_likelihood[idx],
-                            fam, transport, sc.separation, observed, None, sc.gap[1])
+                            fam, transport, sc.separation, observed, None, gap, sc.arrived,
+                            float(scored))
         return evidence, grip
 
     def _judge(self, index: int, t: float) -> OnlineState:

@@ -230,7 +230,10 @@ def test_landmarks_command_writes_one_row_per_trial(tmp_path):
     assert list(table["trial"]) == [f"optotrak-trials-trial{k}" for k in range(4)]
     assert (table["status"] == "complete").all()
     assert table["movement_time"].between(1.0, 2.5).all()
-    assert (table[["peak_speed_time", "mga_time", "opening_time"]] <= 1).all().all()
+    shares = table[["peak_speed_time", "mga_time", "opening_time"]]
+    # within 0-1, or missing: trial 2's digits are unseen when its grip starts to open
+    assert (shares.isna() | shares.ge(0) & shares.le(1)).all().all()
+    assert shares[["peak_speed_time", "mga_time"]].notna().all().all()
     # the raw MGA is the rest-subtracted opening plus the aperture at rest
     assert np.allclose(table["mga"], table["opening"] + table["rest_aperture"])
 

@@ -27,10 +27,12 @@ class SettleRule:
 
     * a grip seen to depart from the transport (``grip-departs``): the wrist
       has covered ``min_progress`` of its way to the models' goal, and the
-      grip has opened twice, or started to open after ``late_opening +
-      late_margin`` of the movement (estimated from how far the wrist had come);
-    * a verdict resting on familiarity: the transport has slowed by
-      ``slowed`` from its peak speed (the movement is in its last phase), the
+      grip has opened twice, or — the hand arrived (below) — started to open
+      after ``late_opening + late_margin`` of the movement (estimated from
+      how far the wrist had come);
+    * a verdict resting on familiarity: the hand has arrived — the transport
+      has slowed by ``slowed`` (at least the rules' ``arrival``) from its peak
+      speed: a stream cut after that is no longer ``incomplete`` —, the
       leading model's familiarity and the transport's are each at least
       ``margin`` natural-log units from their thresholds, and either the grip
       has opened — once, starting before ``late_opening - late_margin`` of
@@ -113,10 +115,13 @@ class SettleRule:
         lm = evidence.observed
         if verdict.verdict is None or lm is None:
             return False
+        # the hand must have arrived for anything but a second opening: a stream cut
+        # before then is `incomplete` at its end
+        arrived = grip.slowed >= max(self.slowed, rules.arrival)
         if verdict.rule == "grip-departs":
-            return progress >= self.min_progress and (
-                (grip.peaks or 0) >= 2 or lm.opening_time > rules.late_opening + self.late_margin)
-        if verdict.rule != "familiarity" or grip.slowed < self.slowed:
+            return progress >= self.min_progress and ((grip.peaks or 0) >= 2 or (
+                arrived and lm.opening_time > rules.late_opening + self.late_margin))
+        if verdict.rule != "familiarity" or not arrived:
             return False
         tf = evidence.transport_familiarity
         if self.evidence(verdict, evidence, rules) < self.margin or (
@@ -243,5 +248,7 @@ def decision_summary(rec: Recognition, decision: Decision | None) -> dict:
     return {"settled_verdict": verdict, "settled_detail": detail,
             "settled_early": decision is not None,
             "settled_before_end": decision is not None and t < span,
-            "decision_time": float(t), "decision_fraction": float(t / span) if span > 0 else None,
+            # settled after the scored movement ended: at its end
+            "decision_time": float(t),
+            "decision_fraction": float(min(t / span, 1.0)) if span > 0 else None,
             "agrees": verdict == rec.verdict}

@@ -10,7 +10,14 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from perception.landmarks import Landmarks, longest_gap, model_landmarks, observed_landmarks
-from perception.recognition.rules import VERDICT_RULES, Evidence, Verdict, VerdictRules, judge
+from perception.recognition.rules import (
+    VERDICT_RULES,
+    Evidence,
+    Verdict,
+    VerdictRules,
+    judge,
+    slowed,
+)
 from perception.recognition.verdict import misfit
 
 if TYPE_CHECKING:
@@ -123,9 +130,9 @@ class Recognition:
         return self.names[int(np.argmax(self.score(rule)[:, n]))]
 
     @property
-    def winner(self) -> str:
-        """Best model at the end of the demonstration, by :attr:`rule`."""
-        return self.winner_at(-1)
+    def winner(self) -> str | None:
+        """Best model at the end of the demonstration, by :attr:`rule` (None: no step scored)."""
+        return self.winner_at(-1) if self.scored.any() else None
 
     @property
     def final_confidence(self) -> dict[str, float]:
@@ -160,9 +167,13 @@ class Recognition:
         if self.shape is None:
             return Evidence(self.kinds, self.log_likelihood[:, -1], self.familiarity)
         obs, shape = self.observation, self.shape
+        scored = shape.scored.sum(axis=1).max() / max(shape.scored.shape[1] - 1, 1)
+        raw = obs.raw or {}  # the filtered aperture coasts through a gap: the markers' own
+        g = (np.linalg.norm(raw["finger"] - raw["thumb"], axis=1) if "finger" in raw
+             and "thumb" in raw else obs.g)
         return Evidence(shape.kinds, shape.log_likelihood[:, -1], shape.familiarity,
                         self.transport_familiarity, obs.marker_separation, *self.landmarks,
-                        longest_gap(obs.time, obs.g))
+                        longest_gap(obs.time, g), slowed(obs.time, obs.wrist), float(scored))
 
     @cached_property
     def decision(self) -> Verdict:
@@ -183,9 +194,10 @@ class Recognition:
     def verdict_reason(self) -> str | None:
         """Why an ``unfamiliar`` or ``abnormal`` verdict was given, in words (None otherwise).
 
-        ``unfamiliar`` is either "not a human reach" (even the transport is
-        like none of the reach models' own) or "insufficient data" naming
-        the digit lost longest and where; ``abnormal`` names the rule.
+        ``unfamiliar`` is "not a human reach" (even the transport is like
+        none of the reach models' own), "insufficient data" naming the digit
+        lost longest and where (or the movements seen), or "incomplete";
+        ``abnormal`` names the rule.
         """
         rule = self.verdict_rule
         if rule == "not-a-precision-grip":
@@ -195,8 +207,19 @@ class Recognition:
         if rule == "not-a-human-reach":
             return (f"not a human reach: its transport fits the reach models worse than "
                     f"{1 - self.unfamiliar_threshold:.0%} of their own reaches")
+        if rule == "insufficient-data" and self.verdict_detail == "several-movements":
+            return (f"insufficient data: {self.landmarks[0].movements} movements in the clip "
+                    "(the verdict judges one)")
+        if rule == "insufficient-data" and self.evidence.scored_share < self.rules.min_scored:
+            return (f"insufficient data: the digits are seen in two frames running on "
+                    f"{self.evidence.scored_share:.0%} of the movement's steps (a verdict "
+                    f"needs {self.rules.min_scored:.0%})")
         if rule == "insufficient-data":
             return "insufficient data: " + self._longest_loss()
+        if rule == "incomplete":
+            return (f"incomplete: the clip ends before the hand arrives (its transport slowed "
+                    f"by {self.evidence.slowed:.0%} of its peak speed, not "
+                    f"{self.rules.arrival:.0%})")
         if rule == "grip-departs":
             return "the grip opens late or twice (the field's landmarks)"
         if self.verdict == "abnormal":

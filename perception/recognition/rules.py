@@ -25,8 +25,8 @@ from perception.errors import InputError
 from perception.landmarks import LandmarkParams, Landmarks
 from perception.observation import ObserveParams
 
-__all__ = ["DETAILS", "RULE_TABLE", "VERDICT_RULES", "Evidence", "Verdict", "VerdictRules",
-           "grip_departs", "judge", "verdict_detail"]
+__all__ = ["DETAILS", "REASONS", "RULE_TABLE", "VERDICT_RULES", "Evidence", "Verdict",
+           "VerdictRules", "grip_departs", "judge", "slowed", "verdict_detail"]
 
 #: Kinds of an abnormal verdict (:func:`verdict_detail`).
 DETAILS = ("delayed-opening", "re-opening", "no-opening", "other")
@@ -72,6 +72,12 @@ class VerdictRules:
         have the finger on the model's -x side.
     min_transport : float
         Least wrist travel, m, of a movement that can be judged as a reach.
+    arrival : float
+        The hand has arrived when the transport, after its peak speed, has
+        slowed by this share of it; a clip that ends before is ``incomplete``.
+    min_scored : float
+        Least share of the movement's steps scored (the digits seen in two
+        frames running) for a verdict; fewer: ``digits-unseen``.
     precision_grip_aperture : float
         Digits further apart at rest than this, m, make a whole-hand grasp
         (``unfamiliar``: the verdict knows precision grips). By default the
@@ -92,12 +98,14 @@ class VerdictRules:
     mirror_opening: float = 0.02
     mirror_majority: float = 0.5
     min_transport: float = 0.02
+    arrival: float = 0.6
+    min_scored: float = 0.5
     precision_grip_aperture: float = ObserveParams.max_rest_aperture
     landmarks: LandmarkParams = field(default_factory=LandmarkParams)
 
     def __post_init__(self):
         shares = ("familiarity_threshold", "unfamiliar_threshold", "late_opening", "late_mga",
-                  "no_opening", "mirror_majority")
+                  "no_opening", "mirror_majority", "arrival", "min_scored")
         for f in dataclasses.fields(self):
             v = getattr(self, f.name)
             if f.name == "landmarks":
@@ -193,6 +201,11 @@ class Evidence:
         The movement's landmarks and the reference grasp model's own.
     aperture_gap : float
         Longest stretch without an aperture during the movement, s.
+    slowed : float
+        How far the transport slowed after its peak speed, as a share of it
+        (:func:`slowed`; 1: the hand came to rest).
+    scored_share : float
+        Share of the movement's steps scored.
     """
 
     kinds: list[str]
@@ -203,6 +216,30 @@ class Evidence:
     observed: Landmarks | None = None
     reference: Landmarks | None = None
     aperture_gap: float = 0.0
+    slowed: float = 1.0
+    scored_share: float = 1.0
+
+
+def slowed(time: np.ndarray, wrist: np.ndarray) -> float:
+    """How far the wrist's speed fell after its peak, as a share of the peak: 0..1.
+
+    The speed between consecutive samples (NaN skipped), as the online
+    recogniser reads it frame by frame: a clip cut while the hand still
+    travels gives little, one that ends with the hand at rest nearly 1.
+
+    Parameters
+    ----------
+    time : (N,) array
+        Times, s.
+    wrist : (N, 2) array
+        Positions, m (the observation's filtered wrist).
+    """
+    speed = np.linalg.norm(np.diff(wrist, axis=0), axis=1) / np.maximum(np.diff(time), 1e-9)
+    speed = speed[np.isfinite(speed)]
+    if not speed.size or speed.max() <= 0:
+        return 0.0
+    peak = int(np.argmax(speed))
+    return float(1.0 - speed[peak:].min() / speed[peak])
 
 
 def grip_departs(observed: Landmarks, rules: VerdictRules | None = None) -> bool:
@@ -269,27 +306,45 @@ def _movement_time(e: Evidence) -> float:
     return e.observed.movement_time if e.observed is not None else math.nan
 
 
+def _unseen(e: Evidence, r: VerdictRules, base: str | None) -> str | None:
+    """Why the movement was not seen well enough to judge, if it was not."""
+    if e.scored_share < r.min_scored or r.landmarks.hides_a_reopening(e.aperture_gap,
+                                                                        _movement_time(e)):
+        return "digits-unseen"
+    if e.observed is not None and (e.observed.movements or 1) > 1:
+        return "several-movements"
+    return None
+
+
 #: The rules in the order they are tried: (name, verdict, fires(evidence, rules, base)),
-#: ``base`` being the familiarity's verdict. The first that fires gives the verdict.
-RULE_TABLE: tuple[tuple[str, str, Callable[[Evidence, VerdictRules, str], bool]], ...] = (
+#: ``base`` being the familiarity's verdict (None without a calibration: then only the
+#: rules about the data are tried). The first that fires gives the verdict; a rule that
+#: fires with a string names the verdict's detail.
+RULE_TABLE: tuple[tuple[str, str, Callable[[Evidence, VerdictRules, str | None],
+                                           bool | str | None]], ...] = (
     # a whole-hand grasp: out of the verdict's depth
     ("not-a-precision-grip", "unfamiliar",
      lambda e, r, base: e.rest_aperture > r.precision_grip_aperture),
-    # opening late or twice, in the field's landmarks, even where the models find it familiar
+    # opening late or twice, seen in the field's landmarks (a start of the opening that
+    # was not seen is no landmark), even where the models find it familiar, and even in
+    # a movement cut short after it
     ("grip-departs", "abnormal",
      lambda e, r, base: base in ("normal", "abnormal") and e.observed is not None
      and grip_departs(e.observed, r)),
+    # the digits unseen through the opening (lost long enough to hide an opening, or
+    # too rarely seen to score), or more than one movement
+    ("insufficient-data", "unfamiliar", _unseen),
+    # the clip ends before the hand arrives: its transport never slowed by `arrival`
+    ("incomplete", "unfamiliar", lambda e, r, base: e.slowed < r.arrival and "incomplete"),
     # even the transport is like no reach model's own
     ("not-a-human-reach", "unfamiliar",
      lambda e, r, base: e.transport_familiarity < r.unfamiliar_threshold),
-    # normal, but a digit was lost long enough to hide a second opening
-    ("insufficient-data", "unfamiliar",
-     lambda e, r, base: base == "normal"
-     and r.landmarks.hides_a_reopening(e.aperture_gap, _movement_time(e))),
-    ("familiarity", "", lambda e, r, base: True),
+    ("familiarity", "", lambda e, r, base: base is not None),
 )
 #: The rules' names (:attr:`Verdict.rule`), in the order they are tried.
 VERDICT_RULES = tuple(name for name, _, _ in RULE_TABLE)
+#: Why the data cannot carry a verdict (the ``verdict_detail`` of an ``unfamiliar`` one).
+REASONS = ("digits-unseen", "several-movements", "incomplete")
 
 
 def judge(evidence: Evidence, rules: VerdictRules | None = None) -> Verdict:
@@ -307,13 +362,14 @@ def judge(evidence: Evidence, rules: VerdictRules | None = None) -> Verdict:
     margin = float(ll[best] - np.max(np.delete(ll, best))) if ll.size > 1 else math.nan
     fam = float(evidence.familiarity[best])
     base = _familiar(evidence, rules, best)
-    if base is None:
-        return Verdict(None, best, fam, margin)
     for name, verdict, fires in RULE_TABLE:
-        if fires(evidence, rules, base):
+        if name not in ("not-a-precision-grip", "insufficient-data") and base is None:
+            continue  # no calibration: only the rules about the data
+        why = fires(evidence, rules, base)
+        if why:
             verdict = verdict or base
-            detail = None
+            detail = why if isinstance(why, str) else None
             if verdict == "abnormal" and evidence.observed is not None:
                 detail = verdict_detail(evidence.observed, evidence.reference, rules)
             return Verdict(verdict, best, fam, margin, name, detail)
-    raise AssertionError("the familiarity rule always fires")
+    return Verdict(None, best, fam, margin)

@@ -1,0 +1,143 @@
+"""Never confidently wrong about what it did not see (issue 33 items 1-2): lost digits, a
+movement cut short, several movements, a glitch, a clip read at the wrong frame rate."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from _demos import default_repertoire, demo_tracks
+
+from perception.batch import ClipResult, summary_table
+from perception.online import OnlineRecognizer, decision_summary
+from perception.pipeline import recognize_tracks
+from perception.recognition.rules import REASONS, Evidence, judge, slowed
+from perception.report import ClipSummary
+
+
+def _cut(tracks, seconds):
+    n = int(np.searchsorted(tracks.time, seconds))
+    return dataclasses.replace(tracks, time=tracks.time[:n], frame=tracks.frame[:n],
+                               position=tracks.position[:n],
+                               likelihood=tracks.likelihood[:n], status=tracks.status[:n])
+
+
+def _rec(tracks):
+    return recognize_tracks(tracks, default_repertoire())
+
+
+@pytest.mark.parametrize("condition", ["normal", "delayed"])
+@pytest.mark.parametrize("lost", [slice(16, 40), slice(25, 40)])
+def test_digits_unseen_through_the_opening_are_no_reach_and_no_normal(condition, lost):
+    """Before: `reach` (or `normal`) at familiarity 0.83-0.999."""
+    tracks = demo_tracks(condition, 0, lost={"thumb": lost, "finger": lost})[0]
+    rec = _rec(tracks)
+    assert (rec.verdict, rec.verdict_rule, rec.verdict_detail) == (
+        "unfamiliar", "insufficient-data", "digits-unseen")
+    assert rec.verdict_reason.startswith("insufficient data: the digits")
+
+
+def test_digits_seen_too_rarely_to_score_give_a_reason_not_an_empty_verdict():
+    """Before: no verdict, `winner` the first model, margin 0, and `ok` in a batch."""
+    tracks = demo_tracks("normal", 0)[0]
+    pos = tracks.position.copy()
+    pos[1::2, :2] = np.nan  # thumb and finger in every other row only
+    rec = _rec(dataclasses.replace(tracks, position=pos))
+    assert (rec.verdict, rec.verdict_detail) == ("unfamiliar", "digits-unseen")
+    assert rec.winner is None and rec.to_dict()["winner"] is None
+    table = summary_table([ClipResult("c", None, "ok", summary=ClipSummary.from_dict(
+        rec.to_dict()))]).set_index("clip")
+    assert table.loc["c", "verdict"] == "unfamiliar"
+    assert table.loc["c", "verdict_detail"] == "digits-unseen"
+
+
+@pytest.mark.parametrize("condition, seconds", [("normal", 0.6), ("normal", 0.9),
+                                                ("delayed", 0.8)])
+def test_a_movement_cut_before_the_hand_arrives_is_incomplete(condition, seconds):
+    """Before: `reach`, `normal` at familiarity 0.998, `reach` at 0.946."""
+    tracks = demo_tracks(condition, 0)[0]
+    rec = _rec(_cut(tracks, seconds))
+    assert (rec.verdict, rec.verdict_rule, rec.verdict_detail) == (
+        "unfamiliar", "incomplete", "incomplete")
+    assert rec.evidence.slowed < rec.rules.arrival
+    assert _rec(tracks).evidence.slowed > 0.9  # whole: the hand came to rest
+
+
+def test_a_second_movement_is_detected_not_averaged_in():
+    tracks = demo_tracks("normal", 0)[0]
+    pos = np.concatenate([tracks.position, tracks.position[::-1], tracks.position])
+    n = len(pos)
+    twice = dataclasses.replace(tracks, time=np.arange(n) / 30.0, frame=np.arange(n),
+                                position=pos, likelihood=np.tile(tracks.likelihood, (3, 1)),
+                                status=np.tile(tracks.status, (3, 1)))
+    rec = _rec(twice)
+    assert (rec.verdict, rec.verdict_detail) == ("unfamiliar", "several-movements")
+    lm = rec.landmarks[0]
+    assert lm.movements == 3
+    assert all(0 <= v <= 1 for v in (lm.peak_speed_time, lm.mga_time, lm.opening_time))
+    assert _rec(tracks).landmarks[0].movements == 1
+
+
+def test_a_one_frame_glitch_is_not_the_movements_peak():
+    tracks = demo_tracks("normal", 0)[0]
+    pos = tracks.position.copy()
+    pos[30, :3] += 500  # every hand marker 500 px off for one frame
+    clean, glitch = _rec(tracks).landmarks[0], _rec(dataclasses.replace(tracks,
+                                                                        position=pos))
+    got = glitch.landmarks[0]
+    for name in ("peak_speed", "peak_speed_time", "mga", "mga_time", "movement_time"):
+        assert getattr(got, name) == pytest.approx(getattr(clean, name), rel=0.05), name
+    assert glitch.verdict != "normal"  # the models saw it: never confidently normal
+
+
+@pytest.mark.parametrize("factor", [0.5, 2.0])
+def test_shares_stay_within_0_and_1_at_a_wrong_frame_rate(factor):
+    tracks = demo_tracks("normal", 0)[0]
+    lm = _rec(dataclasses.replace(tracks, time=tracks.time * factor)).landmarks[0]
+    for name in ("peak_speed_time", "mga_time", "opening_time"):
+        assert 0 <= getattr(lm, name) <= 1, name
+
+
+def test_the_reasons_come_before_a_familiar_verdict():
+    e = dict(kinds=["grasp"], log_likelihood=np.array([1.0]), familiarity=np.array([0.99]))
+    assert judge(Evidence(**e)).verdict == "normal"
+    assert judge(Evidence(**e, slowed=0.3)).detail == "incomplete"
+    assert judge(Evidence(**e, scored_share=0.2)).detail == "digits-unseen"
+    # without a calibration the data can still be said to be insufficient
+    none = dict(e, familiarity=np.array([np.nan]))
+    assert judge(Evidence(**none)).verdict is None
+    assert judge(Evidence(**none, scored_share=0.0)).detail == "digits-unseen"
+    assert set(REASONS) == {"digits-unseen", "several-movements", "incomplete"}
+
+
+def test_slowed_reads_the_speed_after_its_peak():
+    t = np.arange(5.0)
+    path = np.c_[[0.0, 1.0, 3.0, 4.0, 4.5], np.zeros(5)]  # speeds 1, 2, 1, 0.5
+    assert slowed(t, path) == pytest.approx(0.75)
+    assert slowed(t[:3], path[:3]) == pytest.approx(0.0)  # cut at its peak
+
+
+def _feed(tracks):
+    rec = OnlineRecognizer(default_repertoire(), markers=tracks.markers,
+                           tracker_attrs=dict(tracks.tracker))
+    for i in range(tracks.n_frames):
+        rec.update(tracks.position[i], tracks.time[i])
+    return rec
+
+
+@pytest.mark.parametrize("case", ["cut", "lost"])
+def test_online_nothing_settles_that_the_final_result_overturns(case):
+    """Before: a stream cut mid-movement settled `normal` at familiarity 1.0; digits lost
+    through the opening settled `abnormal (delayed-opening)` and ended `reach`."""
+    if case == "cut":
+        tracks = _cut(demo_tracks("normal", 0)[0], 0.9)
+    else:
+        tracks = demo_tracks("delayed", 0, lost={"thumb": slice(25, 40),
+                                                  "finger": slice(25, 40)})[0]
+    rec = _feed(tracks)
+    final = rec.finish()
+    assert final.verdict == "unfamiliar"
+    assert rec.decision is None
+    summary = decision_summary(final, rec.decision)
+    assert summary["agrees"] and 0 <= summary["decision_fraction"] <= 1
