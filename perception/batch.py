@@ -508,7 +508,7 @@ def _run_dask(items: list[BatchItem], repertoire: Repertoire, job: _Job,
                          field="--scheduler") from None
     # largest first: the cluster's last clips are its shortest
     return run_on_cluster(sorted(items, key=_file_size, reverse=True), job.run, repertoire,
-                          scheduler, while_waiting=_prepare_report)
+                          scheduler, while_waiting=_prepare_report, lost=job.lost)
 
 
 def _model_value(s: ClipSummary, name: str, values: np.ndarray) -> float:

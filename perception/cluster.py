@@ -17,7 +17,7 @@ import os
 from collections.abc import Iterator
 from concurrent.futures import ThreadPoolExecutor
 
-from distributed import Client, WorkerPlugin
+from distributed import Client, KilledWorker, WorkerPlugin
 from distributed import as_completed as dask_completed
 from distributed.comm import connect
 
@@ -128,8 +128,8 @@ def check_scheduler(address: str) -> None:
                          field="--scheduler")
 
 
-def run_on_cluster(items: list, run, repertoire, scheduler: str, *, while_waiting=None
-                   ) -> Iterator:
+def run_on_cluster(items: list, run, repertoire, scheduler: str, *, while_waiting=None,
+                   lost=None) -> Iterator:
     """``run(item, repertoire)`` for every item on the cluster at ``scheduler``, as they finish.
 
     Parameters
@@ -144,16 +144,28 @@ def run_on_cluster(items: list, run, repertoire, scheduler: str, *, while_waitin
         The scheduler's address.
     while_waiting : callable, optional
         Called once the work is submitted, while the cluster works.
+    lost : callable, optional
+        ``lost(item, message)``: the result of an item whose workers died
+        running it (dask retried it on others first); without it such an
+        item ends the run (``distributed.KilledWorker``).
     """
     check_scheduler(scheduler)
     with Client(scheduler, timeout=SCHEDULER_TIMEOUT_S) as client:
         client.register_plugin(OneThreadPerWorker())
         try:
             shared = client.scatter(repertoire, broadcast=True)
-            futures = [client.submit(run, it, shared, pure=False) for it in items]
+            futures = {client.submit(run, it, shared, pure=False): it for it in items}
             if while_waiting is not None:
                 while_waiting()
-            for fut in dask_completed(futures):
-                yield fut.result()
+            for fut in dask_completed(list(futures)):
+                try:
+                    result = fut.result()
+                except KilledWorker:  # the others go on
+                    if lost is None:
+                        raise
+                    result = lost(futures[fut], "the dask workers running it died (killed, out "
+                                                "of memory or a crash in a library); rerun to "
+                                                "retry it")
+                yield result
         finally:
             client.unregister_worker_plugin(OneThreadPerWorker.name)

@@ -146,3 +146,35 @@ def test_a_report_set_is_never_half_replaced(clips, tmp_path, monkeypatch, fails
     now = {p.name: p.read_bytes() for p in out.iterdir() if p.name in REPORT_SET}
     assert now in ({}, old)  # never a mix of two runs
     assert not list(out.glob(".*part*"))
+
+
+class _KillsEveryWorker(Repertoire):
+    """A clip that kills every worker that plans its models."""
+
+    distance: float
+
+    def for_scene(self, scene, cache=None):
+        if abs(scene.distance - self.distance) < 0.02:  # the clip at 0.3 m, as measured
+            os.kill(os.getpid(), signal.SIGKILL)
+        return super().for_scene(scene, cache)
+
+
+def test_a_clip_that_kills_its_dask_workers_fails_alone(tmp_path):
+    """Before, dask's KilledWorker ended the whole batch without a report."""
+    import dask
+    from dask.distributed import LocalCluster
+
+    src = tmp_path / "src"
+    src.mkdir()
+    for k, distance in enumerate((0.25, 0.25, 0.3)):
+        demo_tracks("normal", k, distance=distance)[0].save(src / f"c{k}.tracks.h5")
+    rep = _KillsEveryWorker(default_repertoire().models)
+    rep.distance = 0.3
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}), \
+            LocalCluster(n_workers=2, threads_per_worker=1, processes=True, protocol="tcp",
+                         host="127.0.0.1", dashboard_address=None) as cluster:
+        summary = run_batch(discover(src), tmp_path / "out", rep, quiet=True,
+                            scheduler=cluster.scheduler_address)
+    status = dict(zip(summary["clip"], summary["status"]))
+    assert status == {"c0": "ok", "c1": "ok", "c2": "failed"}, summary["error"]
+    assert "dask workers running it died" in summary.set_index("clip").loc["c2", "error"]
