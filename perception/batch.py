@@ -18,7 +18,6 @@ import dataclasses
 import json
 import logging
 import os
-import re
 import sys
 import traceback
 from collections.abc import Callable, Iterable, Iterator
@@ -29,16 +28,24 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 import perception.workers as workers
+from perception.discovery import (
+    ERRORS_LOG,
+    REPORT_SET,
+    BatchItem,
+    Discovery,
+    discover,
+    expand_recordings,
+    find_clips,
+)
 from perception.errors import HammerMVError, InputError
 from perception.io.atomic import write_json, write_text
-from perception.io.files import input_file, is_regular_file
+from perception.io.files import input_file
 from perception.io.frame_sample import FrameSample
 from perception.io.names import output_folder, output_stem
 from perception.pipeline import (
     TRACKS_SUFFIX,
     RecognitionSettings,
     clip_fingerprint,
-    clip_name,
     load_clip,
     recognize_tracks,
 )
@@ -50,227 +57,10 @@ from perception.report.tracking import tracking_columns, write_tracking_report
 if TYPE_CHECKING:
     import pandas as pd
 
-__all__ = ["BatchItem", "ClipResult", "Discovery", "discover", "find_clips", "process_clip",
-           "run_batch", "summary_table"]
+__all__ = ["REPORT_SET", "BatchItem", "ClipResult", "Discovery", "discover",
+           "expand_recordings", "find_clips", "process_clip", "run_batch", "summary_table"]
 
 log = logging.getLogger(__name__)
-
-#: Files that sit beside clips and are not inputs: ground truth, the synth
-#: manifest, and what a batch writes (so a report folder can be its own input).
-COMPANION_SUFFIXES = (".truth.h5", ".recognition.json", ".confidence.csv", ".confidence.png",
-                      ".paths.png", ".tracking.png", ".status.csv")
-#: Which file stands for a clip found more than once: a pose file beside its
-#: video is what the lab tracked it with; a tracks file beside a video stands
-#: for it only when it is current (checked when the video is loaded), so the
-#: video is the clip.
-_PREFERENCE = {"mocap": 4, "pose": 3, "video": 2, "tracks": 1, "unknown": 0}
-#: Tracebacks of the clips that failed through a bug (not their input).
-ERRORS_LOG = "errors.log"
-#: What a batch writes beside its clips' reports: one run's set, never a mix (:func:`run_batch`).
-REPORT_SET = ("summary.csv", "statistics.csv", "condition_profiles.csv", "condition_profiles.png",
-              "report.html", "batch.json", "aperture_profiles.csv", "aperture_profiles.png",
-              "confidence_single.png", "confidence_all.png", ERRORS_LOG)
-COMPANION_NAMES = ("manifest.csv", "README.md", "recipe.toml", "repertoire.h5", *REPORT_SET)
-#: A clip name becomes file names in the report folder: no separators, no
-#: leading dot, nothing that is not printable.
-_CLIP_NAME = re.compile(r"[^/\\\x00-\x1f\x7f]+")
-
-
-@dataclass(frozen=True)
-class BatchItem:
-    """One clip of a batch.
-
-    Attributes
-    ----------
-    clip : str
-        Clip name (file stem; the file name when two files share a stem).
-    path : Path
-        Video, tracks or pose file.
-    kind : str
-        ``video``, ``tracks``, ``pose`` or ``mocap`` (a manifest row may name
-        a file of another kind: ``unknown``, recorded as a failure).
-    condition : str or None
-        Stimulus condition, when a manifest gives it.
-    reach : int or None
-        Which reach of a motion-capture recording (:func:`expand_recordings`).
-    """
-
-    clip: str
-    path: Path
-    kind: str
-    condition: str | None = None
-    reach: int | None = None
-
-
-def check_clip_name(name: str, where: str) -> str:
-    """``name`` if it can name a clip's report files inside the report folder.
-
-    Parameters
-    ----------
-    name : str
-        The clip name (from a manifest or a file name).
-    where : str
-        Where it comes from, for the message.
-
-    Raises
-    ------
-    InputError
-        An empty name, one with a path separator or control character, one
-        starting with a dot (``..`` included) or longer than 200 characters.
-    """
-    if (not name or len(name) > 200 or name.startswith(".")
-            or not _CLIP_NAME.fullmatch(name)):
-        raise InputError(f"clip name {name!r} cannot name report files (no path separators, "
-                         "no leading dot, printable, at most 200 characters)", where)
-    return name
-
-
-def _from_manifest(source: Path) -> list[BatchItem]:
-    import pandas as pd  # not at the top: a worker process never needs pandas
-
-    try:
-        man = pd.read_csv(source, dtype=str, keep_default_na=False)
-    except (OSError, ValueError, pd.errors.ParserError) as exc:
-        raise InputError(f"unreadable manifest: {exc}", source) from None
-    if "clip" not in man.columns or "video" not in man.columns:
-        raise InputError("manifest needs columns clip and video", source)
-    rows: dict[str, int] = {}
-    items = []
-    for i, row in enumerate(man.itertuples(index=False), start=2):  # row 1: the header
-        clip = check_clip_name(str(row.clip), f"{source} row {i}")
-        if clip in rows:
-            raise InputError(f"clip {clip!r} appears twice (rows {rows[clip]} and {i}); "
-                             "clip names must be unique", source)
-        rows[clip] = i
-        path = (source.parent / str(row.video)).resolve()
-        cond = str(getattr(row, "condition", "") or "") or None
-        items.append(BatchItem(clip, path, clip_name(path)[1], cond))
-    return sorted(items, key=lambda i: i.clip)
-
-
-@dataclass(frozen=True)
-class Discovery:
-    """What a batch input holds.
-
-    Attributes
-    ----------
-    items : list of BatchItem
-        The clips, sorted by name.
-    skipped : list of (str, str)
-        Files of a folder that are not clips, with why: ``(file name, reason)``.
-    """
-
-    items: list[BatchItem]
-    skipped: list[tuple[str, str]]
-
-
-def discover(source: str | os.PathLike) -> list[BatchItem]:
-    """List the clips of a batch input (:func:`find_clips`, without the skipped files).
-
-    Parameters
-    ----------
-    source : str or os.PathLike
-        A folder or a ``manifest.csv``.
-    """
-    return find_clips(source).items
-
-
-def find_clips(source: str | os.PathLike) -> Discovery:
-    """List the clips of a batch input, and the files of a folder that are not clips.
-
-    Parameters
-    ----------
-    source : str or os.PathLike
-        A folder, or a ``manifest.csv`` with columns ``clip``, ``condition`` and
-        ``video`` (path relative to the manifest) as written by ``hammer-mv synth``.
-
-    Returns
-    -------
-    Discovery
-        Clips sorted by name. A clip found as several files uses its pose
-        file before its video (what the lab tracked it with), and its video
-        before a tracks file of the same name: such tracks are reused only
-        if they are current for that very video and these settings
-        (:func:`~perception.pipeline.current_tracks`), as ``recognize`` does.
-        Two files of equal standing with one stem (``dup.avi``, ``dup.mp4``)
-        are both clips, named by their file names. Files that are not clips
-        (notes, setups, FIFOs, devices or links to them) are skipped, never
-        opened.
-
-    Raises
-    ------
-    InputError
-        If the source does not exist, a manifest is unreadable, or a manifest's
-        clip names are not unique or would name files outside the report folder.
-    """
-    source = Path(source)
-    if not source.exists():
-        raise InputError("batch input not found", source)
-    if not source.is_dir():
-        if source.suffix.lower() != ".csv":
-            raise InputError("batch input must be a folder or a manifest.csv", source)
-        return Discovery(_from_manifest(input_file(source, "manifest")), [])
-    conditions = {}
-    manifest = source / "manifest.csv"
-    if is_regular_file(manifest):
-        conditions = {i.clip: i.condition for i in _from_manifest(manifest)}
-    by_stem: dict[str, list[BatchItem]] = {}
-    skipped = []
-    for path in sorted(source.iterdir()):
-        if path.name.startswith(".") or path.name in COMPANION_NAMES:
-            continue
-        if path.name.endswith(COMPANION_SUFFIXES) or path.is_dir():
-            continue
-        clip, kind = clip_name(path)
-        if kind == "unknown":
-            skipped.append((path.name, "not a video, tracks or pose file"))
-        elif not is_regular_file(path):
-            skipped.append((path.name, "not a regular file (a FIFO, device, socket or a "
-                                       "broken link)"))
-        else:
-            by_stem.setdefault(clip, []).append(BatchItem(clip, path, kind, conditions.get(clip)))
-    items = []
-    for found in by_stem.values():
-        best = max(_PREFERENCE[i.kind] for i in found)
-        chosen = [i for i in found if _PREFERENCE[i.kind] == best]
-        if len(chosen) > 1:  # the stem alone would not tell them apart
-            chosen = [BatchItem(i.path.name, i.path, i.kind, i.condition) for i in chosen]
-        items += chosen
-    for name, why in skipped:
-        log.info("%s: skipped: %s", source / name, why)
-    return Discovery(sorted(items, key=lambda i: i.clip), skipped)
-
-
-def expand_recordings(items: Iterable[BatchItem], settings: RecognitionSettings
-                      ) -> list[BatchItem]:
-    """Each motion-capture recording as one item per reach in it (other items as they are).
-
-    A recording that cannot be read stays one item, which fails with its
-    error when processed.
-
-    Parameters
-    ----------
-    items : iterable of BatchItem
-        Clips (see :func:`discover`).
-    settings : RecognitionSettings
-        Their ``mocap`` settings say how recordings are read.
-    """
-    from perception.recordings import cached_reaches
-
-    out = []
-    for item in items:
-        if item.kind != "mocap" or item.reach is not None:
-            out.append(item)
-            continue
-        try:
-            reaches = cached_reaches(item.path, settings.mocap)
-        except (HammerMVError, OSError):
-            out.append(item)
-            continue
-        out += [BatchItem(check_clip_name(r.name, str(item.path)), item.path, "mocap",
-                          item.condition, k) for k, r in enumerate(reaches)]
-    return out
-
 
 def _recognized(item: BatchItem, out: Path, repertoire: Repertoire,
                 settings: RecognitionSettings, fp: str, progress: bool,

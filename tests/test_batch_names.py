@@ -5,7 +5,7 @@ import sys
 
 import pytest
 
-from perception.batch import check_clip_name, discover
+from perception.discovery import check_clip_name, discover
 from perception.errors import InputError
 
 
