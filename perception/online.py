@@ -182,8 +182,9 @@ class OnlineRecognizer:
         self.state: OnlineState | None = None
 
     # -- input ----------------------------------------------------------------
-    def update(self, frame_or_points: np.ndarray, t: float,
-               index: int | None = None) -> OnlineState:
+    def update(self, frame_or_points: np.ndarray, t: float, index: int | None = None, *,
+               likelihood: np.ndarray | None = None, status: np.ndarray | None = None
+               ) -> OnlineState:
         """Take the next frame (H, W, 3) uint8 BGR, or marker positions (M, 2) px; the state.
 
         Parameters
@@ -195,6 +196,9 @@ class OnlineRecognizer:
             Its time, s (increasing).
         index : int, optional
             Its frame index (default: rows received so far).
+        likelihood, status : (M,) arrays, optional
+            A row's own likelihood and status (a pose file's; default: 1 and
+            tracked where seen, 0 and lost where not).
         """
         data = np.asarray(frame_or_points)
         index = self._received if index is None else int(index)
@@ -206,8 +210,10 @@ class OnlineRecognizer:
                              f" got shape {data.shape}", field="frame_or_points")
         pos = data.astype(float)
         seen = np.isfinite(pos).all(axis=1)
-        return self._row(index, float(t), pos, seen.astype(np.float32),
-                         np.where(seen, Status.TRACKED, Status.LOST).astype(np.int8))
+        return self._row(index, float(t), pos,
+                         seen.astype(np.float32) if likelihood is None else likelihood,
+                         np.where(seen, Status.TRACKED, Status.LOST).astype(np.int8)
+                         if status is None else status)
 
     def _frame(self, image: np.ndarray, t: float, index: int) -> OnlineState:
         """Track a frame (the tracker's look-ahead spread over the next frames)."""

@@ -33,8 +33,9 @@ def register(sub) -> None:
                        "report `recognize` writes, DIR/<clip>.recognition.json and its CSV, "
                        "with an `online` entry: when the verdict settled, dropped frames.")
     p.add_argument("source", metavar="SOURCE",
-                   help="camera index (0), video file, or stream URL FFmpeg opens "
-                        "(udp://127.0.0.1:5000, tcp://HOST:PORT, rtsp://...)")
+                   help="camera index (0), video file, stream URL FFmpeg opens "
+                        "(udp://127.0.0.1:5000, tcp://HOST:PORT, rtsp://...), or a pose "
+                        "file (DeepLabCut, SLEAP, ...) fed row by row")
     p.add_argument("-o", "--output", type=Path, required=True, metavar="DIR",
                    help="folder for the clip's report")
     p.add_argument("--clip", metavar="NAME",
@@ -84,23 +85,29 @@ def _watch(args: argparse.Namespace, signals: _Signals) -> int:
 
     from hammer_mv.cli.checks import writable_folder
     from hammer_mv.cli.options import load_repertoire, recognition_settings
+    from perception.errors import InputError
     from perception.io.atomic import check_output
-    from perception.io.capture import source_kind
+    from perception.io.capture import RowsSource, source_kind
     from perception.io.video import codec_for, open_source
     from perception.online import OnlineRecognizer, decision_summary
-    from perception.pipeline import clip_fingerprint
+    from perception.pipeline import clip_fingerprint, clip_name, load_clip
     from perception.report import clip as report
     from perception.report.tracking import write_tracking_report
 
     kind = source_kind(args.source)
+    if kind == "file" and clip_name(args.source)[1] == "pose":
+        kind = "pose"  # a pose file's keypoints, row by row
     clip = args.clip or {"camera": f"camera{args.source}", "stream": "stream"}.get(kind) \
-        or Path(args.source).stem
+        or clip_name(args.source)[0]
     # every output refused before the source opens if it cannot be written or is an input
     # (the source named as a path or as FFmpeg's file: URL)
     source = [] if kind == "camera" else [args.source, args.source.removeprefix("file:")]
     inputs = [f for f in (args.repertoire, *source) if f is not None]
     for path in report.clip_outputs(writable_folder(args.output), clip).values():
         check_output(path, inputs)
+    if args.labelled_video is not None and kind == "pose":
+        raise InputError("a pose file has no frames to label (track the video instead)",
+                         args.labelled_video, field="--labelled-video")
     if args.labelled_video is not None:
         codec_for(check_output(args.labelled_video, inputs))
         writable_folder(args.labelled_video.parent, "--labelled-video")
@@ -108,12 +115,17 @@ def _watch(args: argparse.Namespace, signals: _Signals) -> int:
     rep, rep_id = load_repertoire(args)
     latency, dropped, last, decided, interrupted = [], 0, None, None, False
     with (_Drawer(args.labelled_video) as draw,  # a watch that fails leaves no video
-          open_source(args.source, stall_timeout=args.stall_timeout, fps=settings.fps,
-                      keep_truncated=settings.keep_truncated) as src):
+          (RowsSource(load_clip(args.source, pose=settings.pose, **settings.video_options()),
+                      args.source) if kind == "pose" else
+           open_source(args.source, stall_timeout=args.stall_timeout, fps=settings.fps,
+                       keep_truncated=settings.keep_truncated)) as src):
         fps = draw.fps = src.fps
-        rec = OnlineRecognizer(rep, settings, clip=clip)
+        rows = getattr(src, "tracks", None)
+        rec = OnlineRecognizer(rep, settings, clip=clip) if rows is None else OnlineRecognizer(
+            rep, settings, clip=clip, markers=rows.markers, tracker_attrs=dict(rows.tracker))
         say = (lambda line: None) if args.quiet else (lambda line: print(line, flush=True))
-        pace, start = kind == "file" and not args.as_fast_as_possible, time.monotonic()
+        pace = kind in ("file", "pose") and not args.as_fast_as_possible
+        start = time.monotonic()
         try:
             for index, t, frame in src:
                 if pace:  # played at its own rate
@@ -124,15 +136,16 @@ def _watch(args: argparse.Namespace, signals: _Signals) -> int:
                 last = index, t
                 signals.holding = True  # a frame is judged and drawn whole, or not at all
                 t0 = time.perf_counter()
-                state = rec.update(frame, t, index)
+                state = (rec.update(frame, t, index) if rows is None else
+                         rec.update(frame[0], t, index, likelihood=frame[1], status=frame[2]))
                 latency.append(time.perf_counter() - t0)
                 draw(frame, state, rec)
                 signals.holding = False
                 if signals.received:  # one came meanwhile
                     raise KeyboardInterrupt
-                if args.live:
+                if args.live:  # a settled verdict in capitals, a provisional one with a ?
                     say(f"{t:8.3f} s  {state.phase:<6}  {state.leading or '-':<12} "
-                        f"{state.verdict or '-':<9} {'settled' if state.settled else ''}")
+                        f"{_shown(state):<22}")
                 if state.decision is not None and decided is None:
                     decided = state.decision
                     detail = f" ({decided.detail})" if decided.detail else ""
@@ -153,7 +166,7 @@ def _watch(args: argparse.Namespace, signals: _Signals) -> int:
                                  "p99": float(np.percentile(latency, 99) * 1e3)}}
         tracks = rec.tracks(video)
         extra = {"fingerprint": clip_fingerprint(args.source, settings, rep_id)} \
-            if kind == "file" else {}
+            if kind in ("file", "pose") else {}
         extra.update({"condition": None, "input": args.source,
                       "tracking": write_tracking_report(tracks, args.output, clip, sheet=False),
                       "online": online})
@@ -166,6 +179,17 @@ def _watch(args: argparse.Namespace, signals: _Signals) -> int:
         print(f"hammer-mv watch: error: labelled video not written: {draw.error}",
               file=sys.stderr)
     return 128 + signals.received if signals.received else 2 if draw.error else 0
+
+
+def _shown(state) -> str:
+    """A state's verdict as the live lines and the labelled video show it: the settled one in
+    capitals (it stays), else the provisional one with a question mark."""
+    d = state.decision
+    if d is not None:
+        return f"SETTLED {d.verdict.upper()}" + (f" ({d.detail})" if d.detail else "")
+    if state.verdict is None:
+        return "-"
+    return f"{state.verdict}?" + (f" ({state.verdict_detail})" if state.verdict_detail else "")
 
 
 class _Signals:
@@ -244,7 +268,7 @@ class _Drawer:
             y = bottom + 14 * i
             cv2.rectangle(img, (8, y - 9), (8 + int(120 * p), y + 1), (80, 200, 80), -1)
             cv2.putText(img, name, (132, y), cv2.FONT_HERSHEY_PLAIN, 0.9, (255, 255, 255))
-        text = f"{state.verdict or '-'}{' (settled)' if state.settled else ''}"
+        text = _shown(state)
         cv2.putText(img, text, (8, img.shape[0] - 10), cv2.FONT_HERSHEY_PLAIN, 1.2,
                     (255, 255, 255), 1)
         self.writer.write(img)

@@ -13,6 +13,8 @@ import time
 from collections.abc import Callable, Iterator
 from typing import Any
 
+import numpy as np
+
 from perception.errors import InputError
 
 #: Frames a source holds ahead of its consumer: a second at 30 frames/s (the
@@ -151,6 +153,39 @@ class Source(contextlib.AbstractContextManager):
     def __del__(self) -> None:
         with contextlib.suppress(Exception):
             self.close()
+
+
+class RowsSource(Source):
+    """Marker positions as a stream: ``(index, time_s, (positions (M, 2) px, likelihood (M,),
+    status (M,)))`` per row of ``tracks`` (a pose file's, read whole: ``kind`` ``"pose"``).
+
+    Parameters
+    ----------
+    tracks : Tracks
+        The rows, with their ``markers`` and ``tracker`` attributes.
+    path : str
+        What it was read from.
+    """
+
+    kind = "pose"
+
+    def __init__(self, tracks: Any, path: str):
+        self.tracks, self.path, self._started = tracks, str(path), False
+        steps = np.diff(np.asarray(tracks.time, dtype=float))
+        self.fps = float(1 / np.median(steps)) if steps.size else 0.0
+
+    def _frames(self) -> Iterator[tuple[int, float, Any]]:
+        t = self.tracks
+        for i in range(t.n_frames):
+            yield int(t.frame[i]), float(t.time[i]), (t.position[i], t.likelihood[i],
+                                                      t.status[i])
+
+    def attrs(self) -> dict[str, Any]:
+        """The ``/video`` attributes the tracks carry."""
+        return dict(self.tracks.video)
+
+    def close(self) -> None:
+        """Nothing to release: the rows were read whole."""
 
 
 def read_frames(cap: Any) -> Iterator[tuple[Any, float]]:

@@ -1,0 +1,59 @@
+"""`watch` from a pose file: its keypoints fed row by row score as `recognize` on the file."""
+
+from __future__ import annotations
+
+import filecmp
+import json
+import subprocess
+import sys
+
+import pytest
+from _demos import default_repertoire, demo_tracks
+
+from perception.io.exports import export_tracks
+
+
+@pytest.fixture(scope="module")
+def pose(tmp_path_factory):
+    d = tmp_path_factory.mktemp("pose")
+    tracks = demo_tracks("delayed", 2)[0]
+    path = d / "trial.tracks.h5"
+    tracks.save(path)
+    dlc = d / "trialDLC_resnet50_labJan1shuffle1_1000.h5"
+    export_tracks(tracks, dlc, "dlc")
+    rep = default_repertoire().save(d / "rep.h5")
+    return dlc, rep, tracks.object_diameter_px()
+
+
+def _cli(*args):
+    return subprocess.run([sys.executable, "-m", "hammer_mv", *map(str, args)],
+                          capture_output=True, text=True, timeout=300)
+
+
+def test_a_pose_file_watched_is_the_pose_file_recognised(pose, tmp_path):
+    dlc, rep, diameter = pose
+    opts = ["--fps", "30", "--object-diameter-px", diameter, "--repertoire", rep, "--no-figures"]
+    a = _cli("recognize", dlc, "-o", tmp_path / "a", *opts)
+    b = _cli("watch", dlc, "-o", tmp_path / "b", "--as-fast-as-possible", "--live", *opts)
+    assert a.returncode == 0 and b.returncode == 0, a.stderr + b.stderr
+    name = f"{dlc.stem}.recognition.json"
+    off = json.loads((tmp_path / "a" / name).read_text())
+    on = json.loads((tmp_path / "b" / name).read_text())
+    online = on.pop("online")
+    assert on == off and online["source"] == "pose" and online["agrees"]
+    assert filecmp.cmp(tmp_path / "a" / f"{dlc.stem}.confidence.csv",
+                       tmp_path / "b" / f"{dlc.stem}.confidence.csv", shallow=False)
+    # the live lines tell a provisional verdict (?) from the settled one (capitals)
+    lines = [line for line in b.stdout.splitlines() if " s  moving " in line]
+    assert any(line.rstrip().endswith("?") or "?" in line for line in lines)
+    if online["settled_early"]:
+        settled = [line for line in lines if "SETTLED" in line]
+        assert settled and all("SETTLED" in line for line in lines[lines.index(settled[0]):])
+
+
+def test_a_pose_file_has_no_frames_to_label(pose, tmp_path):
+    dlc, rep, diameter = pose
+    res = _cli("watch", dlc, "-o", tmp_path / "o", "--fps", "30", "--object-diameter-px",
+               diameter, "--repertoire", rep, "--labelled-video", tmp_path / "v.mp4")
+    assert res.returncode == 2 and len(res.stderr.strip().splitlines()) == 1
+    assert "--labelled-video" in res.stderr and not (tmp_path / "v.mp4").exists()
