@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 
 from perception.errors import HammerMVError, InputError
 from perception.io.files import input_file, is_regular_file
+from perception.io.pose import pose_output
 from perception.pipeline import clip_name
 
 if TYPE_CHECKING:
@@ -172,9 +173,12 @@ def find_clips(source: str | os.PathLike) -> Discovery:
         if they are current for that very video and these settings
         (:func:`~perception.pipeline.current_tracks`), as ``recognize`` does.
         Two files of equal standing with one stem (``dup.avi``, ``dup.mp4``)
-        are both clips, named by their file names. Files that are not clips
-        (notes, setups, FIFOs, devices or links to them) are skipped, never
-        opened.
+        are both clips, named by their file names. What DeepLabCut and SLEAP
+        write beside a video is that video's clip (``trial01DLC_….h5``:
+        ``trial01``), read from its best pose file
+        (:func:`~perception.io.pose.pose_output`). Files that are not clips
+        (notes, setups, labelled videos, metadata, the other pose files of a
+        clip, FIFOs, devices or links to them) are skipped, never opened.
 
     Raises
     ------
@@ -195,30 +199,38 @@ def find_clips(source: str | os.PathLike) -> Discovery:
         listed = {i.clip: i for i in _from_manifest(manifest)}
     by_stem: dict[str, list[BatchItem]] = {}
     skipped = []
+    rank: dict[Path, int] = {}  # of the pose files DeepLabCut or SLEAP wrote for one video
     for path in sorted(source.iterdir()):
         if path.name.startswith(".") or path.name in COMPANION_NAMES:
             continue
         if path.name.endswith(COMPANION_SUFFIXES) or path.is_dir():
             continue
         clip, kind = clip_name(path)
-        if kind == "unknown":
+        output = pose_output(path.name)
+        if output is not None and isinstance(output[1], str):  # a labelled video, metadata
+            skipped.append((path.name, output[1]))
+        elif kind == "unknown":
             skipped.append((path.name, "not a video, tracks or pose file"))
         elif not is_regular_file(path):
             skipped.append((path.name, "not a regular file (a FIFO, device, socket or a "
                                        "broken link)"))
         else:
+            rank[path] = output[1] if output is not None and kind == "pose" else 0
             row = listed.get(clip)
             by_stem.setdefault(clip, []).append(BatchItem(
                 clip, path, kind, row.condition if row else None,
                 factors=row.factors if row else ()))
     items = []
     for found in by_stem.values():
-        best = max(_PREFERENCE[i.kind] for i in found)
-        chosen = [i for i in found if _PREFERENCE[i.kind] == best]
+        best = max((_PREFERENCE[i.kind], rank[i.path]) for i in found)
+        chosen = [i for i in found if (_PREFERENCE[i.kind], rank[i.path]) == best]
+        skipped += [(i.path.name, f"clip {i.clip!r} is read from {chosen[0].path.name}")
+                    for i in found if i.kind == "pose" and i not in chosen]
         if len(chosen) > 1:  # the stem alone would not tell them apart
             chosen = [BatchItem(i.path.name, i.path, i.kind, i.condition, factors=i.factors)
                       for i in chosen]
         items += chosen
+    skipped.sort()
     for name, why in skipped:
         log.info("%s: skipped: %s", source / name, why)
     return Discovery(sorted(items, key=lambda i: i.clip), skipped)

@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING
 
 from perception.errors import InputError, PlanningError
 from perception.io.mocap import is_mocap_file
+from perception.io.pose import pose_output
 from perception.io.tracks import Tracks, tracks_path_for
 from perception.observation import ObserveParams, observe
 from perception.provenance import code_digest
@@ -125,7 +126,7 @@ class RecognitionSettings:
 
 def clip_name(path: str | os.PathLike) -> tuple[str, str]:
     """Clip name and input kind (``video``, ``tracks``, ``pose``, ``mocap`` or ``unknown``) of a
-    file.
+    file (a DeepLabCut or SLEAP output is named after its video: ``trial01DLC_….h5``, ``trial01``).
 
     Parameters
     ----------
@@ -141,7 +142,8 @@ def clip_name(path: str | os.PathLike) -> tuple[str, str]:
     if is_mocap_file(path):
         return path.stem, "mocap"
     if path.suffix.lower() in POSE_SUFFIXES:
-        return path.stem, "pose"
+        output = pose_output(name)  # DeepLabCut's and SLEAP's: the clip is their video's
+        return (output[0] if output else path.stem), "pose"
     return path.stem, "unknown"
 
 

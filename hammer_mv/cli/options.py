@@ -99,8 +99,9 @@ def add_pose_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--individual", metavar="NAME",
                    help="the individual to score in a multi-individual file")
     g.add_argument("--fps", type=float, default=None, metavar="F",
-                   help=FPS_HELP + "; pose files that carry none (DeepLabCut, Lightning Pose) "
-                        "need it")
+                   help=FPS_HELP + "; a pose file that carries none (DeepLabCut, SLEAP "
+                        "analysis, Lightning Pose) takes the rate of the video of its name "
+                        "beside it, else needs this")
     g.add_argument("--object-diameter-px", type=float, default=None, metavar="D",
                    help="the object's apparent diameter in pixels: sets the metric scale of "
                         "a pose file (or give --px-per-m)")

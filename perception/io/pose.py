@@ -8,6 +8,8 @@ turns one of them into tracks of the four markers recognition needs — thumb,
 finger, wrist and object — by a keypoint mapping (:class:`PoseImport`);
 points below the likelihood cutoff (DeepLabCut's ``pcutoff``, 0.6 by default)
 count as lost. :func:`write_dlc` and :func:`write_movement` go the other way.
+Files DeepLabCut and SLEAP name after their video (:func:`pose_output`) without
+a frame rate take that video's (:func:`video_beside`).
 
 ``movement`` pulls in many packages (xarray, netCDF4, PyTables, pynwb,
 sleap-io), so it is an optional extra: ``pip install 'hammer-mv[pose]'``.
@@ -21,6 +23,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -45,7 +48,9 @@ __all__ = [
     "PoseImport",
     "is_pose_file",
     "load_pose_config",
+    "pose_output",
     "read_pose",
+    "video_beside",
     "write_dlc",
     "write_movement",
 ]
@@ -58,6 +63,26 @@ POSE_SUFFIXES = (".h5", ".csv", ".slp", ".nc", ".nwb")
 DLC_KEY = "df_with_missing"
 #: ``movement``'s name for each source, by how the file is recognised.
 _SOURCES = {"dlc": "DeepLabCut", "sleap": "SLEAP", "lp": "LightningPose", "nwb": "NWB"}
+#: Endings of the video a pose file was made from (as ``perception.pipeline.VIDEO_SUFFIXES``).
+_VIDEO_SUFFIXES = (".mp4", ".avi", ".mkv", ".mov", ".m4v")
+_VIDEO = r"\.(?:mp4|avi|mkv|mov|m4v)"
+#: ``<video stem>`` and a DeepLabCut scorer (``DLC_…``; ``DeepCut_…`` before DeepLabCut 2.1).
+_DLC = r"(?P<video>.+?)(?-i:DLC|DeepCut)_.+?"
+#: What DeepLabCut and SLEAP write beside a video (docs/pose-files.md), first match
+#: wins: the rank of a pose file among those of its video (the highest is scored), or
+#: why the file is not one.
+_OUTPUTS = tuple((re.compile(pattern, re.IGNORECASE), what) for pattern, what in (
+    (_DLC + r"_?filtered\.h5", 3),
+    (_DLC + r"_?filtered\.csv", 2),
+    (_DLC + r"_skeleton\.(?:h5|csv)", "DeepLabCut's bone lengths (analyzeskeleton), not poses"),
+    (_DLC + r"\.h5", 1),
+    (_DLC + r"\.csv", 0),
+    (_DLC + r"\.nwb", -1),
+    (_DLC + r"\.pickle", "DeepLabCut's metadata or raw detections, not poses"),
+    (_DLC + r"(?:labeled|_full)" + _VIDEO, "DeepLabCut's labelled video, not a trial"),
+    (r"(?:.*\.\d{3}_)?(?P<video>.+?)(?:" + _VIDEO + r")?(?:\.predictions)?\.analysis\.h5", 1),
+    (r"(?P<video>.+?)(?:" + _VIDEO + r")?\.predictions\.slp", 0),
+))
 
 
 @dataclass(frozen=True)
@@ -77,7 +102,9 @@ class PoseImport:
         default plotting cutoff, 0.6).
     fps : float, optional
         Frame rate, frames/s, for files that carry none (DeepLabCut and
-        Lightning Pose tables); a file's own rate wins when it has one.
+        Lightning Pose tables, SLEAP analysis files); a file's own rate wins
+        when it has one. Without it, the rate the header of the video beside
+        the file states (:func:`video_beside`).
     object_diameter_px : float, optional
         The object's apparent diameter in pixels, which sets the metric
         scale with ``--object-diameter`` (a pose file cannot carry it); or
@@ -204,6 +231,59 @@ def is_pose_file(path: str | os.PathLike) -> bool:
     """
     name = Path(path).name.lower()
     return name.endswith(POSE_SUFFIXES) and not name.endswith(".tracks.h5")
+
+
+def pose_output(name: str) -> tuple[str, int | str] | None:
+    """``(video stem, rank)`` of a pose file DeepLabCut or SLEAP named after its video (a
+    video's highest is scored), ``(video stem, why not)`` of their other outputs, else None.
+
+    Parameters
+    ----------
+    name : str
+        A file name (``trial01DLC_resnet50_reachJan1shuffle1_100000.h5``: ``trial01``).
+    """
+    for pattern, what in _OUTPUTS:
+        if found := pattern.fullmatch(name):
+            return found["video"], what
+    return None
+
+
+def video_beside(path: str | os.PathLike) -> Path | None:
+    """The video a pose file was made from: ``<video stem>.mp4`` (``.avi``, …) beside it.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A pose file; its video stem is its own (``trial01.h5``) or that of
+        its DeepLabCut or SLEAP name (:func:`pose_output`).
+    """
+    stem = _video_stem(Path(path))
+    videos = (Path(path).with_name(stem + s) for e in _VIDEO_SUFFIXES for s in (e, e.upper()))
+    return next((v for v in videos if v.is_file()), None)
+
+
+def _video_stem(path: Path) -> str:
+    found = pose_output(path.name)
+    return found[0] if found else path.stem
+
+
+def _video_rate(path: Path) -> float:
+    """The frame rate the header of the video beside a pose file states."""
+    video = video_beside(path)
+    if video is None:
+        raise InputError(f"the pose file has no frame rate, and there is no video "
+                         f"{_video_stem(path)}.mp4 (.avi, .mkv, .mov, .m4v) beside it: give it "
+                         "with --fps", path, field="--fps")
+    from perception.io.video import FrameSource  # OpenCV only when there is a video
+
+    try:
+        source = FrameSource(video, prefetch=0, hash=False)
+    except InputError as exc:
+        raise InputError(f"the pose file has no frame rate, nor has its video {video.name}: "
+                         f"{exc.problem.removesuffix('; give the true rate with --fps')}; "
+                         "give it with --fps", path, field="--fps") from None
+    source.close()
+    return source.header.fps_nominal
 
 
 def _source(path: Path) -> str:
@@ -406,10 +486,7 @@ def _frame_times(ds, options: PoseImport, path: Path,
         if not np.all(np.isfinite(coords)):
             raise InputError("time stamps are not finite", path, field="time")
         return np.rint(coords * fps).astype(np.int64), coords, fps
-    fps = fps or options.fps
-    if fps is None:
-        raise InputError("the pose file has no frame rate: give it with --fps", path,
-                         field="--fps")
+    fps = fps or options.fps or _video_rate(path)
     if own is not None:
         frames = own
     elif len(coords) == n and np.all(np.isfinite(coords)) and np.all(np.abs(coords) < 2 ** 53):
@@ -474,7 +551,8 @@ def read_pose(path: str | os.PathLike, options: PoseImport | None = None) -> Tra
     ------
     InputError
         Missing or unreadable file, an unknown format, a keypoint or individual
-        not in the file, no frame rate, or the ``pose`` extra not installed.
+        not in the file, no frame rate (nor video beside it), or the ``pose`` extra
+        not installed.
     """
     options = PoseImport() if options is None else options
     path = Path(path)
