@@ -7,11 +7,10 @@ frames of the clip (the scene): the object's position, its known diameter
 (or a given pixel scale), and the direction from the wrist's rest position
 to the object.
 
-The movement is scored over its :class:`MovementSpan`: from its onset (found
-from the wrist's displacement from rest, less the model's own latency) to
-the end of activity. :func:`movement_span` is the one detector of it: the
-recognition and ``hammer-mv tracks export --trim`` both use it. The trimmed
-frames stay in the tracks file. Marker positions are smoothed by a causal
+The movement is scored over its :class:`MovementSpan`: from its onset (the
+wrist's displacement from rest, less the model's own latency) to the end of
+activity; :func:`movement_span` is its one detector (recognition and
+``tracks export --trim``). Marker positions are smoothed by a causal
 alpha-beta filter (:mod:`perception.filtering`) before their changes are
 compared with predictions: with raw tracks half a pixel of noise randomises
 the sign of the small per-frame changes the thesis's confidence rule counts
@@ -29,6 +28,7 @@ import numpy as np
 from perception.errors import InputError
 from perception.filtering import alpha_beta
 from perception.geometry import DEFAULT_OBJECT_DIAMETER, SimilarityTransform
+from perception.io.pose import is_pose_file
 
 __all__ = [
     "DIGIT_MARKERS",
@@ -430,8 +430,9 @@ def _scene_transform(px: dict[str, np.ndarray], tracks, params: ObserveParams,
     if scale is None:
         dpx = tracks.object_diameter_px()
         if dpx is None:
-            raise InputError("image scale unknown: the tracks carry no object size; "
-                             "give px_per_m (--px-per-m)", name)
+            pose = "--object-diameter-px (the object in pixels) or " if is_pose_file(name) else ""
+            raise InputError(f"image scale unknown: the tracks carry no object size; give "
+                             f"{pose}--px-per-m", name)
         scale = dpx / params.object_diameter
     d = np.median(px["wrist"][rest], axis=0) - origin
     approach = np.array([-d[0], d[1]])  # from wrist toward object, in y-up image coordinates
@@ -625,8 +626,10 @@ def check_hand(scene: RestScene, params: ObserveParams | None = None) -> None:
     if apart > params.max_rest_aperture or not lo <= size <= hi:
         raise InputError(f"the hand at rest does not look like a hand: finger and thumb "
                          f"markers {apart * 100:.1f} cm apart, {size * 100:.1f} cm from the "
-                         "wrist (a same-coloured object taken for a marker? give --roi when "
-                         "tracking, or check --px-per-m)", scene.source)
+                         + ("wrist (keypoints on the wrong markers? check --keypoints, and "
+                            "--object-diameter-px or --px-per-m)" if is_pose_file(scene.source)
+                            else "wrist (a same-coloured object taken for a marker? give --roi "
+                            "when tracking, or check --px-per-m)"), scene.source)
 
 
 def observe(tracks, params: ObserveParams | None = None, *, clip: str | None = None) -> Observation:

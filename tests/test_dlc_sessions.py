@@ -172,14 +172,12 @@ def test_a_missing_keypoint_names_keypoints(session):
 # The two below need the change to perception/observation.py proposed with issue 34
 # item 1 (the scale and hand messages of a pose file name its options, not --roi);
 # remove these marks with it.
-@pytest.mark.xfail(reason="observation.py: the scale message names --px-per-m only", strict=True)
 def test_an_unknown_scale_names_object_diameter_px(session):
     tracks = read_pose(session / f"trial02{SCORER}.h5")
     message = _error(lambda: observe(tracks))
     assert "--object-diameter-px" in message and "--px-per-m" in message
 
 
-@pytest.mark.xfail(reason="observation.py: the hand check advises --roi", strict=True)
 def test_a_pose_file_that_is_no_hand_gets_no_colour_tracking_advice(session):
     tracks = read_pose(session / f"trial02{SCORER}.h5")
     assert "--keypoints" in _error(lambda: observe(tracks, ObserveParams(px_per_m=8000)))
