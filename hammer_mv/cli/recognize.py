@@ -31,8 +31,36 @@ def register(sub) -> None:
                    help="folder for the clip's report")
     p.add_argument("--no-figures", action="store_true",
                    help="write the JSON and CSV only, not the figures (faster)")
+    add_figure_options(p)
     add_recognition_options(p)
     p.set_defaults(func=run)
+
+
+def _dpi(text: str) -> int:
+    try:
+        dpi = int(text)
+    except ValueError:
+        dpi = 0
+    if dpi < 1:
+        raise argparse.ArgumentTypeError(f"expected a positive whole number, got {text!r}")
+    return dpi
+
+
+def add_figure_options(p: argparse.ArgumentParser) -> None:
+    """Add ``--figure-format`` and ``--dpi``: how every figure of the command is written.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser.
+    """
+    from perception.report.figures import DPI, FIGURE_FORMATS
+
+    p.add_argument("--figure-format", choices=FIGURE_FORMATS, default=FIGURE_FORMATS[0],
+                   help="format of the figures: png, or svg / pdf (vector, for a paper; "
+                        f"default: {FIGURE_FORMATS[0]})")
+    p.add_argument("--dpi", type=_dpi, default=DPI, metavar="N",
+                   help=f"resolution of PNG figures, dots per inch (default: {DPI})")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -88,7 +116,8 @@ def run(args: argparse.Namespace) -> int:
              "input": str(path),
              "tracking": write_tracking_report(tracks, args.output, clip,
                                                sheet=not args.no_figures, frames=frames)}
-    paths = write_clip_report(rec, args.output, extra=extra, figures=not args.no_figures)
+    paths = write_clip_report(rec, args.output, extra=extra, figures=not args.no_figures,
+                              figure_format=args.figure_format, dpi=args.dpi)
     if not args.quiet:
         detail = f" ({rec.verdict_detail})" if rec.verdict_detail else ""
         mirror = ""
@@ -116,7 +145,8 @@ def _run_mocap(args: argparse.Namespace, path: Path) -> int:
         rec, info = recognize_reach(reach, rep, settings, options)
         extra = {"fingerprint": fingerprint, "condition": None, "input": str(path),
                  "mocap": info}
-        paths = write_clip_report(rec, args.output, extra=extra, figures=not args.no_figures)
+        paths = write_clip_report(rec, args.output, extra=extra, figures=not args.no_figures,
+                                  figure_format=args.figure_format, dpi=args.dpi)
         for warning in rec.warnings:
             print(f"{reach.name}: warning: {warning}", file=sys.stderr)
         if not args.quiet:

@@ -18,9 +18,10 @@ from pathlib import Path
 
 import numpy as np
 
-from perception.io.atomic import save_figure, write_csv, write_json
+from perception.io.atomic import write_csv, write_json
 from perception.io.names import output_stem, printable
 from perception.recognition.result import Recognition
+from perception.report.figures import DPI, FIGURE_FORMATS
 
 __all__ = ["KINEMATICS_COLUMNS", "ClipSummary", "clip_figures", "clip_outputs", "remove_output",
            "write_clip_report"]
@@ -38,7 +39,8 @@ RECOGNITION_KEYS = frozenset({
 KINEMATICS_COLUMNS = ("movement_time", "peak_speed", "peak_speed_time", "mga", "mga_time",
                       "aperture_peaks")
 
-#: The clip's own figures (keys of :func:`clip_outputs`), in the order a report shows them.
+#: The clip's own figures (keys of :func:`clip_outputs`, named ``_png`` whatever their
+#: format), in the order a report shows them.
 FIGURE_KEYS = ("confidence_png", "paths_png", "kinematics_png")
 
 
@@ -212,7 +214,7 @@ class ClipSummary:
         return self.names.index(model)
 
 
-def clip_outputs(out: Path, clip: str) -> dict[str, Path]:
+def clip_outputs(out: Path, clip: str, figure_format: str = "png") -> dict[str, Path]:
     """Paths of the files :func:`write_clip_report` writes for ``clip`` in ``out``.
 
     They are named by the clip's :func:`~perception.io.names.output_stem`:
@@ -225,22 +227,23 @@ def clip_outputs(out: Path, clip: str) -> dict[str, Path]:
         Report folder.
     clip : str
         Clip name.
+    figure_format : str
+        The figures' format, their suffix (:data:`~perception.report.figures.FIGURE_FORMATS`).
     """
     stem = output_stem(clip)
     return {
         "json": out / f"{stem}.recognition.json",
         "csv": out / f"{stem}.confidence.csv",
-        "confidence_png": out / f"{stem}.confidence.png",
-        "paths_png": out / f"{stem}.paths.png",
-        "kinematics_png": out / f"{stem}.kinematics.png",
+        **{key: out / f"{stem}.{key[:-4]}.{figure_format}" for key in FIGURE_KEYS},
     }
 
 
 def clip_figures(out: Path, clip: str, names: Sequence[str] | None = None) -> list[Path]:
     """Every figure of ``clip`` in ``out``: its three own, then any other ``<clip>.<name>.png``.
 
-    A figure another step adds beside the clip's report (one ``<name>``, no
-    dots) is shown with the clip in ``report.html``.
+    The own figures are found in whichever format they were written (PNG,
+    SVG or PDF). A figure another step adds beside the clip's report (one
+    ``<name>``, no dots; PNG or SVG) is shown with the clip in ``report.html``.
 
     Parameters
     ----------
@@ -254,7 +257,7 @@ def clip_figures(out: Path, clip: str, names: Sequence[str] | None = None) -> li
     """
     if names is None:
         names = sorted(os.listdir(out)) if out.is_dir() else []
-    own = [clip_outputs(out, clip)[k].name for k in FIGURE_KEYS]
+    own = [clip_outputs(out, clip, f)[k].name for k in FIGURE_KEYS for f in FIGURE_FORMATS]
     prefix = f"{output_stem(clip)}."
     mine = []
     # the names starting with the prefix are one run of the sorted list
@@ -262,7 +265,7 @@ def clip_figures(out: Path, clip: str, names: Sequence[str] | None = None) -> li
         if not name.startswith(prefix):
             break
         mine.append(name)
-    others = [n for n in mine if n not in own and n.endswith(".png")
+    others = [n for n in mine if n not in own and n.endswith((".png", ".svg"))
               and n[len(prefix):].count(".") == 1
               and printable(n) == n]  # not a file name that is not UTF-8 text
     return [out / n for n in own if n in mine] + [out / n for n in others]
@@ -291,7 +294,8 @@ def remove_output(path: Path) -> None:
 
 
 def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,
-                      figures: bool = True) -> dict[str, Path]:
+                      figures: bool = True, figure_format: str = "png",
+                      dpi: int = DPI) -> dict[str, Path]:
     """Write ``<clip>.recognition.json``, the per-step CSV and the three figures.
 
     Parameters
@@ -307,24 +311,29 @@ def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,
         :mod:`perception.report.figures`): the confidence, the paths and the
         kinematics (:func:`~perception.report.kinematics.kinematics_figure`);
         without them, figures of an earlier run are removed, since they would
-        show another result.
+        show another result (as are, with them, those in other formats).
+    figure_format : str
+        ``png``, ``svg`` or ``pdf`` (:func:`~perception.report.figures.write_figure`).
+    dpi : int
+        The figures' resolution, dots per inch.
 
     Returns
     -------
     dict of Path
         The files written (see :func:`clip_outputs`).
     """
-    paths = clip_outputs(Path(out), rec.clip)
+    paths = clip_outputs(Path(out), rec.clip, figure_format)
     if figures:
-        from perception.report.figures import confidence_figure, paths_figure
+        from perception.report.figures import confidence_figure, paths_figure, write_figure
         from perception.report.kinematics import kinematics_figure
 
-        save_figure(paths["confidence_png"], confidence_figure(rec))
-        save_figure(paths["paths_png"], paths_figure(rec))
-        save_figure(paths["kinematics_png"], kinematics_figure(rec))
-    else:
-        for key in FIGURE_KEYS:
-            remove_output(paths[key])
+        for key, draw in (("confidence_png", confidence_figure), ("paths_png", paths_figure),
+                          ("kinematics_png", kinematics_figure)):
+            write_figure(draw(rec), paths[key].with_suffix(""), figure_format, dpi)
+    for fmt in FIGURE_FORMATS:
+        if not figures or fmt != figure_format:
+            for key in FIGURE_KEYS:
+                remove_output(clip_outputs(Path(out), rec.clip, fmt)[key])
     write_csv(paths["csv"], rec.columns())
     # the JSON last: its presence marks the clip's report complete
     write_json(paths["json"], {**rec.to_dict(), **(extra or {})})

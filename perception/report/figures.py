@@ -10,9 +10,11 @@ clip per condition (:func:`confidence_single_figure`, Fig. 5.8a) and on
 every clip (:func:`confidence_all_figure`, Fig. 5.8b), and mean ± SD per
 condition at select points (:func:`condition_figure`, Fig. 5.8c).
 
-Each is a :class:`matplotlib.figure.Figure` on an Agg canvas, never through
-pyplot (no global figure registry; safe in worker processes); save one with
-:func:`perception.io.atomic.save_figure`. matplotlib is imported when the
+The thesis's figure numbers are in these docstrings and in the captions of
+``report.html``, not in the figures' titles. Each is a
+:class:`matplotlib.figure.Figure` on an Agg canvas, never through pyplot (no
+global figure registry; safe in worker processes); :func:`write_figure` saves
+one as PNG, SVG or PDF (:data:`FIGURE_FORMATS`). matplotlib is imported when the
 first figure is drawn, not with this module: it costs about 0.4 s, which
 ``import perception`` and ``recognize --no-figures`` do not pay. Texts from
 the outside world (clip, model and condition names) are drawn as they are: a
@@ -23,10 +25,12 @@ Confidence is drawn in cm (weighted), ×100 of its value in the files.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
+from perception.io.atomic import save_figure
 from perception.io.names import printable
 
 if TYPE_CHECKING:
@@ -37,8 +41,16 @@ if TYPE_CHECKING:
     from perception.recognition.result import Recognition
     from perception.report.clip import ClipSummary
 
-__all__ = ["aperture_figure", "condition_colour", "condition_figure", "confidence_all_figure",
-           "confidence_figure", "confidence_single_figure", "paths_figure"]
+__all__ = ["DPI", "FIGURE_FORMATS", "aperture_figure", "condition_colour", "condition_figure",
+           "confidence_all_figure", "confidence_figure", "confidence_single_figure",
+           "paths_figure", "write_figure"]
+
+#: The formats :func:`write_figure` writes, the first the default; and its default resolution.
+FIGURE_FORMATS = ("png", "svg", "pdf")
+DPI = 120
+#: Vector text: SVG text stays text (editable, searchable), PDF fonts are TrueType (Type 42),
+#: which journals' checks take where they refuse Type 3.
+_VECTOR_TEXT = {"svg.fonttype": "none", "pdf.fonttype": 42, "svg.hashsalt": "hammer-mv"}
 
 
 CM = 100.0
@@ -250,7 +262,7 @@ def condition_figure(profiles: pd.DataFrame, model: str) -> Figure:
         _panel(ax, f"{title}: mean ± SD", MOVEMENT_TIME, f"{title} (cm, weighted)", zero=True)
         if ax is axes[0]:
             _legend(ax, means)
-    _title(fig, f"{model}'s confidence by condition (Fig. 5.8c)")
+    _title(fig, f"{model}'s confidence by condition")
     return fig
 
 
@@ -281,7 +293,7 @@ def aperture_figure(profiles: pd.DataFrame, model: pd.DataFrame | None = None,
         x, mean, sd = (g[c].to_numpy(dtype=float) * 100 for c in ("phase", "mean", "sd"))
         ax.fill_between(x, mean - sd, mean + sd, color=colour, alpha=alpha, lw=0)
         ax.plot(x, mean, style, color=colour, lw=1.8, label=label)
-    _panel(ax, "grip aperture, mean ± SD (Fig. 5.4d)", MOVEMENT_TIME, "grip aperture (cm)")
+    _panel(ax, "grip aperture, mean ± SD", MOVEMENT_TIME, "grip aperture (cm)")
     _legend(ax, ax.get_lines())
     return fig
 
@@ -314,7 +326,7 @@ def confidence_single_figure(clips: Sequence[ClipSummary], conditions: Sequence[
     model : str
         The model whose confidence is drawn.
     """
-    return _confidence_panel(model, "one clip per condition (Fig. 5.8a)", [
+    return _confidence_panel(model, "one clip per condition", [
         (rec, condition_colour(cond, conditions), 1.8, f"{cond}: {rec.clip}")
         for rec, cond in zip(clips, conditions)])
 
@@ -340,4 +352,37 @@ def confidence_all_figure(clips: Sequence[ClipSummary], conditions: Sequence[str
         lines.append((rec, condition_colour(cond, conditions), 1.0,
                       None if cond in labelled else cond))
         labelled.add(cond)
-    return _confidence_panel(model, f"every clip ({len(clips)}; Fig. 5.8b)", lines)
+    return _confidence_panel(model, f"every clip ({len(clips)})", lines)
+
+
+def write_figure(fig: Figure, path_stem: str | Path, fmt: str = "png", dpi: int = DPI) -> Path:
+    """Save ``fig`` as ``<path_stem>.<fmt>``, atomically: PNG at ``dpi``, or vector SVG or PDF.
+
+    SVG and PDF hold the lines, bands and text as vectors (SVG as text,
+    editable; PDF with TrueType fonts), with no embedded image; ``dpi`` sets
+    only their nominal size in pixels.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    path_stem : str or Path
+        The file's path without its format's suffix (a clip's stem may hold dots).
+    fmt : str
+        ``png``, ``svg`` or ``pdf`` (:data:`FIGURE_FORMATS`).
+    dpi : int
+        Dots per inch, positive.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
+    from matplotlib import rc_context
+
+    if fmt not in FIGURE_FORMATS:
+        raise ValueError(f"figure format must be one of {', '.join(FIGURE_FORMATS)}, not {fmt!r}")
+    if not (isinstance(dpi, int | np.integer) and dpi > 0):
+        raise ValueError(f"dpi must be a positive whole number, not {dpi!r}")
+    with rc_context(_VECTOR_TEXT):
+        return save_figure(Path(f"{path_stem}.{fmt}"), fig, dpi=int(dpi))

@@ -8,7 +8,9 @@ shaded between them), the peak speed, the maximum grip aperture (MGA, with
 its value) and where the grip starts to open. The curves are the ones the
 landmarks are measured on (:class:`~perception.landmarks.LandmarkParams`'s
 low-pass filter of the clip's unfiltered markers), so every mark sits on
-its curve. The report writes it as ``<clip>.kinematics.png``.
+its curve. It is the lab's per-trial figure, in mm and mm/s, each landmark
+labelled with its value; the report writes it as ``<clip>.kinematics.png``
+(or ``.svg``, ``.pdf``: :func:`~perception.report.figures.write_figure`).
 
 Drawn as :mod:`perception.report.figures` draws: a matplotlib ``Figure`` on
 an Agg canvas, never through pyplot, matplotlib imported with the first figure.
@@ -129,7 +131,7 @@ def kinematics_figure(rec: Recognition) -> Figure:
     whole clip, on the observation's clock (s). The movement, onset to end,
     is shaded and bounded by dashed lines across both panels (the bound's
     speed, 5 % of the peak, dotted); the peak speed and the MGA are dots on
-    their curves (the MGA with its value), the grip's start to open a
+    their curves, labelled with their values, the grip's start to open a
     triangle. A landmark that could not be measured (NaN) is not drawn. The
     title gives the clip, its verdict (with the kind of an abnormal one) and
     the familiarity.
@@ -187,7 +189,7 @@ def kinematics_figure(rec: Recognition) -> Figure:
         y = lm.peak_speed * MM
         handles += top.plot([t_peak], [y], "o", color=SPEED_COLOUR, ms=7, mec="k", mew=0.8,
                             zorder=3, gid="peak_speed", label="peak speed")
-        _note(top, t_peak, y, f"{y:.0f} mm/s", SPEED_COLOUR, dy=-4.0)
+        _note(top, t_peak, y, f"peak {y:.0f} mm/s", SPEED_COLOUR, dy=-4.0)
     t_open = _at(lm, lm.opening_time)
     seen = np.isfinite(aperture)
     if _finite(t_open) and seen.any():
