@@ -118,6 +118,8 @@ class ClipResult:
         The scored clip (None if it failed).
     traceback : str
         The traceback of a failure that is a bug, not bad input (empty otherwise).
+    factors : tuple of (str, str)
+        The manifest's other columns for this clip (:attr:`BatchItem.factors`).
     """
 
     clip: str
@@ -127,6 +129,7 @@ class ClipResult:
     rule: str = "likelihood"
     summary: ClipSummary | None = None
     traceback: str = ""
+    factors: tuple[tuple[str, str], ...] = ()
 
     @property
     def winner(self) -> str | None:
@@ -163,7 +166,8 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
         for this input, settings and repertoire; ``failed`` with the error of
         a bad clip (its stale outputs removed).
     """
-    base = dict(clip=item.clip, condition=item.condition, rule=settings.hammer.rule)
+    base = dict(clip=item.clip, condition=item.condition, rule=settings.hammer.rule,
+                factors=item.factors)
     try:
         input_file(item.path, "clip")  # before hashing: a FIFO or device would never end
         fp = clip_fingerprint(item.path, settings, repertoire_id + (
@@ -221,7 +225,8 @@ def _guarded(item: BatchItem, out: Path, **kwargs) -> ClipResult:
         return ClipResult(item.clip, item.condition, "failed",
                           f"{item.path}: unexpected {type(exc).__name__} (a bug in hammer-mv; "
                           f"see errors.log): {_first_line(exc)}",
-                          kwargs["settings"].hammer.rule, traceback=traceback.format_exc())
+                          kwargs["settings"].hammer.rule, traceback=traceback.format_exc(),
+                          factors=item.factors)
 
 
 @dataclass(frozen=True)
@@ -246,7 +251,7 @@ class _Job:
         log.error("%s: %s", item.clip, message)
         _remove_outputs(item, self.out)
         return ClipResult(item.clip, item.condition, "failed", f"{item.path}: {message}",
-                          self.settings.hammer.rule)
+                          self.settings.hammer.rule, factors=item.factors)
 
 
 #: Folder of the plan cache inside a report folder.
@@ -320,7 +325,9 @@ CLIP_COLUMNS: list[tuple[str, Callable[[ClipSummary], object]]] = [
 def summary_table(results: list[ClipResult], reference: str | None = None) -> pd.DataFrame:
     """The batch summary, one row per clip (``summary.csv``).
 
-    Columns: ``clip, condition, winner, rule``, the :data:`CLIP_COLUMNS`
+    Columns: ``clip, condition``, the manifest's other columns (:attr:`ClipResult.factors`;
+    one named like a column here gets ``manifest_`` before it), ``winner, rule``, the
+    :data:`CLIP_COLUMNS`
     (``verdict, familiarity, margin, winner_log_likelihood``),
     ``reference_model`` and ``reference_confidence`` (its final thesis-rule
     confidence, m), ``verdict_detail`` (the kind of an ``abnormal`` verdict),
@@ -332,7 +339,9 @@ def summary_table(results: list[ClipResult], reference: str | None = None) -> pd
     m), the tracking quality
     (``track_<marker>``, ``minlik_<marker>``, ``reacquisitions``,
     ``ambiguous_frames``), ``status`` (``ok`` or ``failed``), ``reused`` (the
-    report was already current), ``error``.
+    report was already current), ``error``; beside each column whose name R
+    cannot take unquoted, its alias (``conf_grasp_0_5s``:
+    :func:`~perception.report.tables.with_r_aliases`).
 
     Parameters
     ----------
@@ -346,14 +355,16 @@ def summary_table(results: list[ClipResult], reference: str | None = None) -> pd
 
     from perception.report.clip import KINEMATICS_COLUMNS
     from perception.report.conditions import reference_model
+    from perception.report.tables import with_r_aliases
 
     scored = [r for r in results if r.summary is not None]
     names = scored[0].summary.names if scored else []
     if reference is None:
         reference = reference_model([r.summary for r in scored], [r.condition for r in scored])
+    factors = list(dict.fromkeys(f for r in results for f, _ in r.factors))
     table = []
     for r in results:
-        entry = {"clip": r.clip, "condition": r.condition, "winner": r.winner, "rule": r.rule}
+        entry = {"winner": r.winner, "rule": r.rule}
         s = r.summary
         for column, value in CLIP_COLUMNS:
             entry[column] = value(s) if s is not None else None
@@ -371,11 +382,14 @@ def summary_table(results: list[ClipResult], reference: str | None = None) -> pd
         entry["status"] = "failed" if r.status == "failed" else "ok"
         entry["reused"] = r.status == "reused"
         entry["error"] = r.error
-        table.append(entry)
+        given = dict(r.factors)
+        table.append({"clip": r.clip, "condition": r.condition, **{
+            f"manifest_{f}" if f in entry or f in ("clip", "condition") else f: given.get(f)
+            for f in factors}, **entry})
     table = pd.DataFrame(table)
     if "aperture_peaks" in table:  # a count: 1, not 1.0 (empty where unknown)
         table["aperture_peaks"] = table["aperture_peaks"].astype("Int64")
-    return table
+    return with_r_aliases(table)
 
 
 def run_batch(
@@ -472,6 +486,8 @@ def run_batch(
 
 def _remove_report(out: Path) -> None:
     """Remove the batch report set (:data:`REPORT_SET`) from ``out``, as far as it can."""
-    for name in REPORT_SET:
+    from perception.report.tables import TABLES  # in REPORT_SET too, once discovery lists them
+
+    for name in dict.fromkeys((*REPORT_SET, *TABLES)):
         with contextlib.suppress(OSError):
             (out / name).unlink(missing_ok=True)

@@ -40,6 +40,12 @@ from perception.report.figures import (
     confidence_all_figure,
     confidence_single_figure,
 )
+from perception.report.statistics import (
+    landmark_statistics,
+    measure_table,
+    participant_means,
+)
+from perception.report.tables import TABLES, landmark_table, r_aliases
 
 __all__ = ["BatchReport", "write_batch_report"]
 
@@ -170,7 +176,8 @@ def _main_table(summary: pd.DataFrame, anchors: dict[str, str], reference: str |
 
 
 def _models_table(summary: pd.DataFrame) -> str:
-    cols = [c for c in summary.columns if c.startswith("conf_")]
+    aliases = r_aliases(summary.columns)
+    cols = [c for c in summary.columns if c.startswith("conf_") and c not in aliases]
     if not cols:
         return ""
     rows = [[_e(r["clip"])] + [_num(r[c] * 100, ".2f") for c in cols]
@@ -190,7 +197,8 @@ _SHOWN = {"clip", "condition", "winner", "rule", "verdict", "verdict_detail", "f
 
 def _other_columns_table(summary: pd.DataFrame) -> str:
     """summary.csv's other columns (the tracking quality, …), folded away."""
-    cols = [c for c in summary.columns if c not in _SHOWN and not c.startswith("conf_")]
+    cols = [c for c in summary.columns if c not in _SHOWN | r_aliases(summary.columns)
+            and not c.startswith("conf_")]
     if not cols:
         return ""
     rows = [[_e(r["clip"])] + [_num(r[c], ".3g") if isinstance(r[c], int | float | np.number)
@@ -280,7 +288,9 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
                        out: Path, *, profile_model: str | None = None,
                        title: str = "hammer-mv recognition report",
                        models: Sequence | None = None) -> BatchReport:
-    """Write ``summary.csv``, the chapter 5 figures and statistics, and ``report.html``.
+    """Write ``summary.csv``, the chapter 5 figures and statistics, the tidy tables
+    (``landmarks.csv``, ``participant_means.csv``, ``landmark_statistics.csv``) and
+    ``report.html``.
 
     Parameters
     ----------
@@ -303,6 +313,11 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     write_csv(out / "summary.csv", _printable_table(summary))
+    landmarks = landmark_table(summary, recognitions)
+    measures = measure_table(landmarks, summary)
+    for name, table in zip(TABLES, (landmarks, participant_means(measures),
+                                    landmark_statistics(measures))):
+        write_csv(out / name, _printable_table(table))
     ok = summary[summary["status"] == "ok"]
     recs = [recognitions[c] for c in ok["clip"] if c in recognitions]
     condition_of = ok.set_index("clip")["condition"]
@@ -329,9 +344,8 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
     names = sorted(os.listdir(out))  # once, not once per clip
     clips = [_clip_section(rec, out, anchors[rec.clip], condition_of.get(rec.clip), names)
              for rec in recs]
-    tables = ['<a href="summary.csv">summary.csv</a>']
-    if len(stats_df):
-        tables.append('<a href="statistics.csv">statistics.csv</a>')
+    tables = [_link(n, n) for n in ("summary.csv", *(["statistics.csv"] if len(stats_df)
+                                                      else []), *TABLES)]
     body = "\n".join([
         f"<h1>{_e(title)}</h1>",
         f"<p>{len(summary)} clips: {len(ok)} scored, {len(failed)} failed. Tables: "

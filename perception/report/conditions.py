@@ -16,7 +16,8 @@ import pandas as pd
 from perception.report.clip import ClipSummary
 
 __all__ = ["PROFILE_POINTS", "aperture_profiles", "condition_profiles", "condition_statistics",
-           "default_profile_model", "model_aperture", "reference_model", "typical_clips"]
+           "default_profile_model", "model_aperture", "plain_tests", "reference_model",
+           "typical_clips"]
 
 #: Samples of normalised movement time for per-condition mean profiles.
 PROFILE_POINTS = 101
@@ -138,7 +139,7 @@ def condition_statistics(summary: pd.DataFrame, model: str) -> pd.DataFrame:
 
     One-way ANOVA (``scipy.stats.f_oneway``) across all conditions with at
     least 2 scored clips and a Welch t-test (``scipy.stats.ttest_ind`` with
-    ``equal_var=False``) for each pair of them.
+    ``equal_var=False``) for each pair of them (:func:`plain_tests`).
 
     Parameters
     ----------
@@ -156,13 +157,31 @@ def condition_statistics(summary: pd.DataFrame, model: str) -> pd.DataFrame:
         ``Hedges' g``), effect_size, n_per_group (``a=10, b=3``) and note
         (``a group has fewer than 3 clips``, or empty).
     """
+    col = f"conf_{model}"
+    ok = summary[(summary["status"] == "ok") & summary["condition"].notna()]
+    groups = {c: g[col].to_numpy(float) for c, g in ok.groupby("condition", sort=False)}
+    return pd.DataFrame(plain_tests(groups), columns=_STAT_COLUMNS[1:]).assign(model=model)[
+        _STAT_COLUMNS]
+
+
+def plain_tests(groups: dict[str, np.ndarray]) -> list[dict]:
+    """The one-way ANOVA across the groups of 2 or more values and a Welch t-test per pair.
+
+    Parameters
+    ----------
+    groups : dict of str to array
+        The values of each condition.
+
+    Returns
+    -------
+    list of dict
+        One per test: the :func:`condition_statistics` columns, and ``se``
+        (of a t-test's mean difference), ``df1``, ``df2`` (F's; t's in ``df1``).
+    """
     import warnings
 
     from scipy import stats  # here: a second of import, only for batches with conditions
 
-    col = f"conf_{model}"
-    ok = summary[(summary["status"] == "ok") & summary["condition"].notna()]
-    groups = {c: g[col].to_numpy(float) for c, g in ok.groupby("condition", sort=False)}
     testable = {c: v for c, v in groups.items() if len(v) >= 2}
     rows = []
     with warnings.catch_warnings():
@@ -173,8 +192,9 @@ def condition_statistics(summary: pd.DataFrame, model: str) -> pd.DataFrame:
             k, n = len(testable), sum(len(v) for v in testable.values())
             rows.append({"test": "one-way ANOVA", "groups": " / ".join(testable), "n": n,
                          "statistic_type": "F", "statistic": float(r.statistic),
-                         "df": f"{k - 1}, {n - k}", "p_value": float(r.pvalue),
-                         "mean_difference": np.nan, "effect_size_type": "eta^2",
+                         "df": f"{k - 1}, {n - k}", "df1": k - 1, "df2": n - k,
+                         "p_value": float(r.pvalue), "mean_difference": np.nan,
+                         "se": np.nan, "effect_size_type": "eta^2",
                          "effect_size": _eta_squared(list(testable.values())),
                          **_sizes(testable)})
         names = list(testable)
@@ -185,11 +205,13 @@ def condition_statistics(summary: pd.DataFrame, model: str) -> pd.DataFrame:
                 rows.append({"test": "Welch t-test", "groups": f"{a} vs {b}",
                              "n": len(x) + len(y), "statistic_type": "t",
                              "statistic": float(r.statistic), "df": f"{r.df:.1f}",
-                             "p_value": float(r.pvalue),
+                             "df1": float(r.df), "df2": np.nan, "p_value": float(r.pvalue),
                              "mean_difference": float(x.mean() - y.mean()),
+                             "se": float(np.sqrt(x.var(ddof=1) / len(x)
+                                                 + y.var(ddof=1) / len(y))),
                              "effect_size_type": "Hedges' g", "effect_size": _hedges_g(x, y),
                              **_sizes({a: x, b: y})})
-    return pd.DataFrame(rows, columns=_STAT_COLUMNS[1:]).assign(model=model)[_STAT_COLUMNS]
+    return rows
 
 
 def default_profile_model(recs: list[ClipSummary]) -> str | None:
