@@ -43,7 +43,8 @@ ERRORS_LOG = "errors.log"
 #: What a batch writes beside its clips' reports: one run's set, never a mix (:func:`run_batch`).
 REPORT_SET = ("summary.csv", "statistics.csv", "condition_profiles.csv", "condition_profiles.png",
               "report.html", "batch.json", "aperture_profiles.csv", "aperture_profiles.png",
-              "confidence_single.png", "confidence_all.png", ERRORS_LOG)
+              "confidence_single.png", "confidence_all.png", ERRORS_LOG,
+              "landmarks.csv", "participant_means.csv", "landmark_statistics.csv")
 COMPANION_NAMES = ("manifest.csv", "README.md", "recipe.toml", "repertoire.h5", *REPORT_SET)
 #: A clip name becomes file names in the report folder: no separators, no
 #: leading dot, nothing that is not printable.

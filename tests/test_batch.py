@@ -65,7 +65,8 @@ def test_batch_jobs_1_and_2_agree_and_resume(clips, repfile, tmp_path):
     assert _batch(clips / "manifest.csv", one, repfile).returncode == 0
     assert _batch(clips, two, repfile, "--jobs", "2").returncode == 0
     s1 = pd.read_csv(one / "summary.csv")
-    assert list(s1.columns[:4]) == ["clip", "condition", "winner", "rule"]
+    assert list(s1.columns[:7]) == ["clip", "condition", "seed", "truth", "parameters",
+                                    "winner", "rule"]  # the manifest's columns carried
     assert {"status", "error"} <= set(s1.columns)
     assert (s1["status"] == "ok").all()
     _same_reports(one, two, input_spelled_alike=False)
