@@ -52,6 +52,7 @@ from perception.pipeline import (
 from perception.provenance import code_digest
 from perception.recognition.repertoire import PlanCache, Repertoire
 from perception.report.clip import ClipSummary, clip_outputs, remove_output, write_clip_report
+from perception.report.figures import DPI, FIGURE_FORMATS
 from perception.report.tracking import tracking_columns, write_tracking_report
 
 if TYPE_CHECKING:
@@ -86,9 +87,11 @@ def _recognized(item: BatchItem, out: Path, repertoire: Repertoire,
                  "tracking": tracking}
 
 
-def _current_report(item: BatchItem, out: Path, fingerprint: str) -> dict | None:
-    """The clip's finished report if it was made from this input and these settings."""
-    p = clip_outputs(out, item.clip)
+def _current_report(item: BatchItem, out: Path, fingerprint: str,
+                    figure_format: str = "png") -> dict | None:
+    """The clip's finished report if it was made from this input and these settings
+    (its figures in ``figure_format``)."""
+    p = clip_outputs(out, item.clip, figure_format)
     if not all(path.exists() for path in p.values()):
         return None
     try:
@@ -139,7 +142,8 @@ class ClipResult:
 
 def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
                  settings: RecognitionSettings, repertoire_id: str = "", *,
-                 progress: bool = False, plan_cache: PlanCache | None = None) -> ClipResult:
+                 progress: bool = False, plan_cache: PlanCache | None = None,
+                 figure_format: str = "png", dpi: int = DPI) -> ClipResult:
     """Recognise one clip through the pipeline (:mod:`perception.pipeline`) and report it.
 
     Parameters
@@ -158,6 +162,11 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
         Show a progress bar while tracking a video.
     plan_cache : PlanCache, optional
         Models re-planned for a scene, shared with the batch's other processes.
+    figure_format : str
+        The clip's figures' format, ``png``, ``svg`` or ``pdf`` (a report with
+        its figures in another format is not current: they are drawn again).
+    dpi : int
+        Their resolution, dots per inch.
 
     Returns
     -------
@@ -172,11 +181,11 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
         input_file(item.path, "clip")  # before hashing: a FIFO or device would never end
         fp = clip_fingerprint(item.path, settings, repertoire_id + (
             f"#reach{item.reach}" if item.reach is not None else ""))
-        done = _current_report(item, out, fp)
+        done = _current_report(item, out, fp, figure_format)
         if done is not None:
             return ClipResult(**base, status="reused", summary=ClipSummary.from_dict(done))
         rec, extra = _recognized(item, out, repertoire, settings, fp, progress, plan_cache)
-        write_clip_report(rec, out, extra=extra)
+        write_clip_report(rec, out, extra=extra, figure_format=figure_format, dpi=dpi)
         return ClipResult(**base, status="ok", summary=ClipSummary.from_recognition(rec, extra))
     except (HammerMVError, OSError) as exc:  # the clip's fault; anything else is a bug
         msg = _first_line(exc)
@@ -199,7 +208,8 @@ def _remove_outputs(item: BatchItem, out: Path) -> None:
     for the file system, a read-only folder) and must not end the batch.
     """
     try:
-        paths = list(clip_outputs(out, item.clip).values())
+        paths = list(dict.fromkeys(p for fmt in FIGURE_FORMATS
+                                   for p in clip_outputs(out, item.clip, fmt).values()))
     except (OSError, ValueError) as exc:
         log.warning("%s: cannot list its outputs to remove them: %s", item.clip, exc)
         return
@@ -236,6 +246,8 @@ class _Job:
     out: Path
     settings: RecognitionSettings
     repertoire_id: str
+    figure_format: str = "png"
+    dpi: int = DPI
 
     @property
     def plan_cache(self) -> PlanCache:
@@ -244,7 +256,8 @@ class _Job:
 
     def run(self, item: BatchItem, repertoire: Repertoire) -> ClipResult:
         return _guarded(item, self.out, repertoire=repertoire, settings=self.settings,
-                        repertoire_id=self.repertoire_id, plan_cache=self.plan_cache)
+                        repertoire_id=self.repertoire_id, plan_cache=self.plan_cache,
+                        figure_format=self.figure_format, dpi=self.dpi)
 
     def lost(self, item: BatchItem, message: str) -> ClipResult:
         """A clip whose worker process died running it: failed, its outputs removed."""
@@ -403,6 +416,8 @@ def run_batch(
     repertoire_id: str = "",
     quiet: bool = False,
     skipped: Iterable[tuple[str, str]] = (),
+    figure_format: str = "png",
+    dpi: int = DPI,
 ) -> pd.DataFrame:
     """Process every clip and write the batch report.
 
@@ -432,6 +447,10 @@ def run_batch(
     skipped : iterable of (str, str)
         Files of the input that are not clips, with why (:attr:`Discovery.skipped`),
         listed in ``batch.json``.
+    figure_format : str
+        Format of every figure, the clips' and the batch's: ``png``, ``svg`` or ``pdf``.
+    dpi : int
+        Their resolution, dots per inch.
 
     Returns
     -------
@@ -447,6 +466,9 @@ def run_batch(
     settings = RecognitionSettings() if settings is None else settings
     if jobs < 1:
         raise InputError(f"expected at least 1, got {jobs}", field="--jobs")
+    if figure_format not in FIGURE_FORMATS:
+        raise InputError(f"expected one of {', '.join(FIGURE_FORMATS)}, got {figure_format!r}",
+                         field="--figure-format")
     # absolute: a worker, a dask one above all, may run in another folder
     items = expand_recordings([dataclasses.replace(i, path=Path(i.path).absolute())
                                for i in items], settings)
@@ -454,7 +476,7 @@ def run_batch(
     out.mkdir(parents=True, exist_ok=True)
     for sub in ("tracks", PLANS_FOLDER):  # a link leading out of the report: refused now
         output_folder(out, sub)
-    job = _Job(out, settings, repertoire_id)
+    job = _Job(out, settings, repertoire_id, figure_format, dpi)
     results = (_run_dask(items, repertoire, job, scheduler) if scheduler
                else _run_local(items, repertoire, job, jobs))
     done: list[ClipResult] = []
@@ -469,7 +491,7 @@ def run_batch(
     _remove_report(out)  # the last run's set: a kill or a full disk below leaves no mix
     try:
         write_batch_report(summary, {r.clip: r.summary for r in done if r.summary is not None},
-                           out, models=repertoire.models)
+                           out, models=repertoire.models, figure_format=figure_format, dpi=dpi)
         if bugs:
             write_text(out / ERRORS_LOG, "\n".join(bugs))
         write_json(out / "batch.json", {

@@ -31,8 +31,10 @@ log = logging.getLogger(__name__)
 
 #: Files that sit beside clips and are not inputs: ground truth, the synth
 #: manifest, and what a batch writes (so a report folder can be its own input).
-COMPANION_SUFFIXES = (".truth.h5", ".recognition.json", ".confidence.csv", ".confidence.png",
-                      ".paths.png", ".tracking.png", ".status.csv")
+COMPANION_SUFFIXES = (".truth.h5", ".recognition.json", ".confidence.csv", ".tracking.png",
+                      ".status.csv", *(f".{name}.{fmt}" for name in ("confidence", "paths",
+                                                                     "kinematics")
+                                       for fmt in ("png", "svg", "pdf")))
 #: Which file stands for a clip found more than once: a pose file beside its
 #: video is what the lab tracked it with; a tracks file beside a video stands
 #: for it only when it is current (checked when the video is loaded), so the
@@ -40,11 +42,14 @@ COMPANION_SUFFIXES = (".truth.h5", ".recognition.json", ".confidence.csv", ".con
 _PREFERENCE = {"mocap": 4, "pose": 3, "video": 2, "tracks": 1, "unknown": 0}
 #: Tracebacks of the clips that failed through a bug (not their input).
 ERRORS_LOG = "errors.log"
+#: The batch's figures, by stem; each in one of the figure formats (png, svg, pdf).
+BATCH_FIGURES = ("aperture_profiles", "confidence_single", "confidence_all", "condition_profiles",
+                 "kinematic_profiles", "landmark_strips")
 #: What a batch writes beside its clips' reports: one run's set, never a mix (:func:`run_batch`).
-REPORT_SET = ("summary.csv", "statistics.csv", "condition_profiles.csv", "condition_profiles.png",
-              "report.html", "batch.json", "aperture_profiles.csv", "aperture_profiles.png",
-              "confidence_single.png", "confidence_all.png", ERRORS_LOG,
-              "landmarks.csv", "participant_means.csv", "landmark_statistics.csv")
+REPORT_SET = ("summary.csv", "statistics.csv", "condition_profiles.csv", "report.html",
+              "batch.json", "aperture_profiles.csv", "kinematic_profiles.csv", ERRORS_LOG,
+              "landmarks.csv", "participant_means.csv", "landmark_statistics.csv",
+              *(f"{stem}.{fmt}" for stem in BATCH_FIGURES for fmt in ("png", "svg", "pdf")))
 COMPANION_NAMES = ("manifest.csv", "README.md", "recipe.toml", "repertoire.h5", *REPORT_SET)
 #: A clip name becomes file names in the report folder: no separators, no
 #: leading dot, nothing that is not printable.

@@ -193,7 +193,7 @@ def test_a_failure_while_recording_a_failure_does_not_end_the_batch(tracks_folde
                                                                      monkeypatch):
     import perception.batch as batch
 
-    def broken(out, clip):
+    def broken(out, clip, *figure_format):
         raise OSError(36, "File name too long")
 
     (tracks_folder / "empty.tracks.h5").write_bytes(b"")  # fails: its error handler runs

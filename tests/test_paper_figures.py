@@ -222,3 +222,40 @@ def test_svg_and_png_figures_render_in_a_browser(trials, tmp_path):
     dom = _run(browser, tmp_path / "profile", "--dump-dom", page.as_uri())
     widths = [int(w) for w in dom.split('<pre id="probe">')[1].split("</pre>")[0].split(",")]
     assert len(widths) == 3 and all(w > 0 for w in widths), widths
+
+
+def test_a_batch_writes_every_figure_in_its_format_and_shows_them(tmp_path):
+    rep = default_repertoire().save(tmp_path / "rep.h5")
+    src = tmp_path / "clips"
+    src.mkdir()
+    rows = ["clip,video,condition,participant"]
+    for cond in CONDITIONS:
+        for i in range(2):
+            demo_tracks(cond, i)[0].save(src / f"{cond}-{i}.tracks.h5")
+            rows.append(f"{cond}-{i},{cond}-{i}.tracks.h5,{cond},p{i}")
+    (src / "manifest.csv").write_text("\n".join(rows) + "\n")
+    out = tmp_path / "out"
+    batch = ["kinematic_profiles", "landmark_strips", "aperture_profiles", "confidence_single",
+             "confidence_all", "condition_profiles"]
+    for fmt in ("svg", "pdf"):  # the second run's figures replace the first's
+        assert main(["batch", str(src / "manifest.csv"), "-o", str(out), "--repertoire",
+                     str(rep), "--figure-format", fmt, "--dpi", "90", "--quiet"]) == 0
+        figures = {p.name for p in out.iterdir() if p.suffix in (".png", ".svg", ".pdf")}
+        assert figures == {f"{s}.{fmt}" for s in batch} | {
+            f"{c}-{i}.{k}.{fmt}" for c in CONDITIONS for i in range(2)
+            for k in ("confidence", "paths", "kinematics")}
+        page = (out / "report.html").read_text()
+        if fmt == "svg":
+            assert '<img src="kinematic_profiles.svg"' in page
+            assert '<img class=thumb src="normal-0.kinematics.svg" loading="lazy"' in page
+        else:  # no <img> shows a PDF: a link
+            assert '<a href="landmark_strips.pdf">landmark_strips.pdf (PDF)</a>' in page
+            assert "<img" not in page
+    # rerun: every clip reused, its speed read back from its report's traces
+    assert main(["batch", str(src / "manifest.csv"), "-o", str(out), "--repertoire", str(rep),
+                 "--figure-format", "pdf", "--quiet"]) == 0
+    import pandas as pd
+
+    assert pd.read_csv(out / "summary.csv")["reused"].all()
+    prof = pd.read_csv(out / "kinematic_profiles.csv")
+    assert set(prof["condition"]) == set(CONDITIONS) and (prof["speed_n"] == 2).all()

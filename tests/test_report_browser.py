@@ -111,8 +111,9 @@ def test_the_page_loads_with_its_figures_and_the_main_table_fits(report, tmp_pat
     assert m["viewport"] == WIDTH
     assert 0 < m["table_right"] <= WIDTH, m  # the main table fits a 1280 px window
     assert m["page"] <= WIDTH, m  # and nothing else widens the page
-    # every figure: 4 of the batch, 3 per clip (confidence, paths, kinematics)
-    assert m["images"] == 4 + 3 * 5 and m["loaded"] == m["images"], m
+    # every figure: 2 kinematics and 4 chapter 5 of the batch, 3 per clip (confidence, paths,
+    # kinematics)
+    assert m["images"] == 6 + 3 * 5 and m["loaded"] == m["images"], m
     assert m["injected"] == 0 and m["alerts"] == 0, m
     assert {NASTY, PERCENT, TAG} <= set(m["clip_ids"]), m["clip_ids"]
 

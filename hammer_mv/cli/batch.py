@@ -9,6 +9,7 @@ from pathlib import Path
 
 from hammer_mv.cli.checks import cap_jobs, output_folder
 from hammer_mv.cli.options import add_recognition_options, load_repertoire, recognition_settings
+from hammer_mv.cli.recognize import add_figure_options
 from perception.batch import find_clips, run_batch
 
 
@@ -35,6 +36,7 @@ def register(sub) -> None:
                    "process)")
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="run on a dask.distributed scheduler, e.g. tcp://host:8786")
+    add_figure_options(p)
     add_recognition_options(p)
     p.set_defaults(func=run)
 
@@ -65,7 +67,8 @@ def run(args: argparse.Namespace) -> int:
     rep, rep_id = load_repertoire(args)
     summary = run_batch(items, args.output, rep, recognition_settings(args), jobs=jobs,
                         scheduler=args.scheduler, repertoire_id=rep_id, quiet=args.quiet,
-                        skipped=found.skipped)
+                        skipped=found.skipped, figure_format=args.figure_format,
+                        dpi=args.dpi)
     failed = int((summary["status"] != "ok").sum())
     reused = int(summary["reused"].sum())
     if not args.quiet:

@@ -23,7 +23,7 @@ from urllib.parse import quote
 import numpy as np
 import pandas as pd
 
-from perception.io.atomic import save_figure, write_csv, write_text
+from perception.io.atomic import write_csv, write_text
 from perception.io.names import printable
 from perception.report.clip import ClipSummary, clip_figures, clip_outputs
 from perception.report.conditions import (
@@ -35,10 +35,17 @@ from perception.report.conditions import (
     typical_clips,
 )
 from perception.report.figures import (
+    DPI,
     aperture_figure,
     condition_figure,
     confidence_all_figure,
     confidence_single_figure,
+    write_figure,
+)
+from perception.report.paper import (
+    condition_kinematics_figure,
+    kinematic_profiles,
+    landmark_strip_figure,
 )
 from perception.report.statistics import (
     landmark_statistics,
@@ -49,21 +56,22 @@ from perception.report.tables import TABLES, landmark_table, r_aliases
 
 __all__ = ["BatchReport", "write_batch_report"]
 
-#: The chapter 5 figures of a batch: file name, thesis figure, caption.
+#: The chapter 5 figures of a batch: file name without its format's suffix, thesis figure,
+#: caption.
 FIGURES = (
-    ("aperture_profiles.png", "Fig. 5.4(d)",
+    ("aperture_profiles", "Fig. 5.4(d)",
      "grip aperture per condition, mean ± SD over normalised movement time, against the "
      "reference model's own (dashed)"),
-    ("confidence_single.png", "Fig. 5.8(a)",
+    ("confidence_single", "Fig. 5.8(a)",
      "the reference model's confidence on one clip per condition (the clip with the "
      "condition's median final confidence)"),
-    ("confidence_all.png", "Fig. 5.8(b)", "the reference model's confidence on every clip"),
-    ("condition_profiles.png", "Fig. 5.8(c)",
+    ("confidence_all", "Fig. 5.8(b)", "the reference model's confidence on every clip"),
+    ("condition_profiles", "Fig. 5.8(c)",
      "mean ± SD confidence per condition at select points, with its transport and grip terms"),
 )
 
-#: The figure drawn across the page (three panels).
-WIDE = "condition_profiles.png"
+#: The figures drawn across the page.
+WIDE = ("condition_profiles", "kinematic_profiles", "landmark_strips")
 
 _CSS = """
 body{font-family:system-ui,sans-serif;max-width:1240px;margin:1.5em auto;padding:0 12px;
@@ -112,6 +120,15 @@ def _e(value) -> str:
 
 def _link(path: str, text: str) -> str:
     return f'<a href="{html.escape(quote(path), quote=True)}">{_e(text)}</a>'
+
+
+def _image(name: str, alt: str, cls: str = "", lazy: bool = False) -> str:
+    """A figure file as an image that links to itself; a PDF (no ``<img>`` shows one) as a link."""
+    if name.endswith(".pdf"):
+        return _link(name, f"{name} (PDF)")
+    src = html.escape(quote(name), quote=True)
+    attrs = (f" class={cls}" if cls else "") + f' src="{src}"' + (' loading="lazy"' if lazy else "")
+    return f'<a href="{src}"><img{attrs} alt="{_e(alt)}"></a>'
 
 
 def _table(headers: Sequence[str], rows: Sequence[Sequence[str]], numeric: set[int] = frozenset(),
@@ -230,16 +247,14 @@ def _clip_section(rec: ClipSummary, out: Path, anchor: str, condition,
             f"; winner {_e(rec.winner)} ({_e(rec.rule)} rule); condition "
             f"{_e(condition) or 'unlabelled'}; files: {links}")
     # each figure links to itself at full size; the kinematics one shows as a thumbnail
-    thumb = files["kinematics_png"].name
-    figs = "".join(f'<a href="{html.escape(quote(p.name), quote=True)}">'
-                   f'<img{" class=thumb" if p.name == thumb else ""} '
-                   f'src="{html.escape(quote(p.name), quote=True)}" loading="lazy" '
-                   f'alt="{_e(p.name)}"></a>' for p in clip_figures(out, rec.clip, names))
+    thumb = files["kinematics_png"].with_suffix("").name
+    figs = "".join(_image(p.name, p.name, "thumb" if p.with_suffix("").name == thumb else "",
+                          lazy=True) for p in clip_figures(out, rec.clip, names))
     return f'<div class="clip"><h3 id="{anchor}">{_e(rec.clip)}</h3><p>{line}</p>{figs}</div>'
 
 
-def _chapter5(recs: list[ClipSummary], conds: list[str], reference: str, models, out: Path
-              ) -> None:
+def _chapter5(recs: list[ClipSummary], conds: list[str], reference: str, models, out: Path,
+              fmt: str, dpi: int) -> None:
     """The four chapter 5 figures (matplotlib) and their tables."""
     model = next((m for m in models or () if m.name == reference), None)
     own = model_aperture(model) if model is not None else None
@@ -249,24 +264,41 @@ def _chapter5(recs: list[ClipSummary], conds: list[str], reference: str, models,
                        ignore_index=True)[["condition", "phase", "mean", "sd", "n"]]
     write_csv(out / "aperture_profiles.csv", ap)
     observed = ap[~ap["condition"].astype(str).str.startswith("model:")]
-    save_figure(out / "aperture_profiles.png", aperture_figure(observed, own, reference))
+    write_figure(aperture_figure(observed, own, reference), out / "aperture_profiles", fmt, dpi)
     single, single_conds = typical_clips(recs, conds, reference)
-    save_figure(out / "confidence_single.png",
-                confidence_single_figure(single, single_conds, reference))
-    save_figure(out / "confidence_all.png", confidence_all_figure(recs, conds, reference))
+    write_figure(confidence_single_figure(single, single_conds, reference),
+                 out / "confidence_single", fmt, dpi)
+    write_figure(confidence_all_figure(recs, conds, reference), out / "confidence_all", fmt, dpi)
     prof = condition_profiles(recs, conds, reference)
     write_csv(out / "condition_profiles.csv", prof)
-    save_figure(out / "condition_profiles.png", condition_figure(prof, reference))
+    write_figure(condition_figure(prof, reference), out / "condition_profiles", fmt, dpi)
 
 
-def _figures_html(reference: str) -> str:
-    """The chapter 5 figures in a grid, each a link to itself at full size."""
-    figures = "".join(
-        f'<figure{" class=wide" if name == WIDE else ""}><a href="{name}">'
-        f'<img src="{name}" alt="{fig}"></a><figcaption>{fig}: {html.escape(caption)} '
-        "(click for full size)</figcaption></figure>" for name, fig, caption in FIGURES)
+def _grid(figures: Sequence[tuple[str, str]], fmt: str) -> str:
+    """Figures (file stem, caption) in a grid, each a link to itself at full size."""
+    return "<div class=grid>" + "".join(
+        f'<figure{" class=wide" if stem in WIDE else ""}>{_image(f"{stem}.{fmt}", stem)}'
+        f"<figcaption>{html.escape(caption)} (click for full size)</figcaption></figure>"
+        for stem, caption in figures) + "</div>"
+
+
+def _figures_html(reference: str, fmt: str) -> str:
+    """The chapter 5 figures, their thesis figure numbers in their captions."""
     return (f"<h2>Chapter 5, read on the reference grasp model {_e(reference)}</h2>"
-            f"<div class=grid>{figures}</div>")
+            + _grid([(stem, f"{fig}: {caption}") for stem, fig, caption in FIGURES], fmt))
+
+
+def _kinematics(recs: list[ClipSummary], conds: list[str], landmarks: pd.DataFrame, out: Path,
+                fmt: str, dpi: int) -> str:
+    """The kinematics per condition: its table, its two figures and their HTML."""
+    write_csv(out / "kinematic_profiles.csv", kinematic_profiles(recs, conds))
+    write_figure(condition_kinematics_figure(recs, conds), out / "kinematic_profiles", fmt, dpi)
+    write_figure(landmark_strip_figure(landmarks), out / "landmark_strips", fmt, dpi)
+    return "<h2>Kinematics per condition</h2>" + _grid([
+        ("kinematic_profiles", "wrist speed (mm/s) and grip aperture (mm) per condition, "
+         "mean ± SD, from each trial's onset to its end (kinematic_profiles.csv)"),
+        ("landmark_strips", "each landmark of every trial, per condition (coloured by "
+         "participant where the manifest names them), with the condition's mean ± SD")], fmt)
 
 
 def _statistics_html(stats_df: pd.DataFrame) -> str:
@@ -287,7 +319,8 @@ def _statistics_html(stats_df: pd.DataFrame) -> str:
 def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummary],
                        out: Path, *, profile_model: str | None = None,
                        title: str = "hammer-mv recognition report",
-                       models: Sequence | None = None) -> BatchReport:
+                       models: Sequence | None = None, figure_format: str = "png",
+                       dpi: int = DPI) -> BatchReport:
     """Write ``summary.csv``, the chapter 5 figures and statistics, the tidy tables
     (``landmarks.csv``, ``participant_means.csv``, ``landmark_statistics.csv``) and
     ``report.html``.
@@ -309,6 +342,12 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
     models : sequence of MotorModel, optional
         The repertoire's models: the reference model's own aperture is drawn
         from it in Fig. 5.4(d).
+    figure_format : str
+        Format of the figures: ``png``, ``svg`` or ``pdf``
+        (:func:`~perception.report.figures.write_figure`; ``report.html``
+        links a PDF rather than showing it).
+    dpi : int
+        Their resolution, dots per inch.
     """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -328,11 +367,13 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
     if recs and profile_model is None:
         profile_model = reference_model(recs, [condition_of.get(r.clip) for r in recs])
     sections, stats_df = [], pd.DataFrame()
+    if recs:
+        sections.append(_kinematics(recs, conds, landmarks, out, figure_format, dpi))
     if recs and profile_model:
-        _chapter5(recs, conds, profile_model, models, out)
+        _chapter5(recs, conds, profile_model, models, out, figure_format, dpi)
         stats_df = condition_statistics(summary, profile_model)
         write_csv(out / "statistics.csv", stats_df)
-        sections.append(_figures_html(profile_model))
+        sections.append(_figures_html(profile_model, figure_format))
         if len(stats_df):
             sections.append("<h2>Statistics of the reference model's final confidence</h2>"
                             + _statistics_html(stats_df))

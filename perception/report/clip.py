@@ -23,8 +23,8 @@ from perception.io.names import output_stem, printable
 from perception.recognition.result import Recognition
 from perception.report.figures import DPI, FIGURE_FORMATS
 
-__all__ = ["KINEMATICS_COLUMNS", "ClipSummary", "clip_figures", "clip_outputs", "remove_output",
-           "write_clip_report"]
+__all__ = ["KINEMATICS_COLUMNS", "ClipSummary", "clip_figures", "clip_outputs", "clip_traces",
+           "remove_output", "write_clip_report"]
 
 #: Keys of ``<clip>.recognition.json`` that :meth:`Recognition.to_dict` writes;
 #: any other key is an extra (see :attr:`ClipSummary.extras`).
@@ -32,7 +32,7 @@ RECOGNITION_KEYS = frozenset({
     "clip", "models", "winner", "rule", "verdict", "familiarity", "margin",
     "familiarity_threshold", "reference_model", "time", "confidence", "transport_confidence",
     "aperture", "verdict_detail", "verdict_rule", "verdict_rules", "verdict_reason", "warnings",
-    "notes", "kinematics", "shape", "passes", "mirrored"})
+    "notes", "kinematics", "shape", "passes", "mirrored", "traces"})
 
 #: The observed landmarks a batch's ``summary.csv`` shows, one column each
 #: (:attr:`ClipSummary.kinematics`; units in docs/recognition.md §9).
@@ -42,6 +42,24 @@ KINEMATICS_COLUMNS = ("movement_time", "peak_speed", "peak_speed_time", "mga", "
 #: The clip's own figures (keys of :func:`clip_outputs`, named ``_png`` whatever their
 #: format), in the order a report shows them.
 FIGURE_KEYS = ("confidence_png", "paths_png", "kinematics_png")
+
+
+def clip_traces(rec: Recognition) -> dict[str, np.ndarray]:
+    """The curves the clip's landmarks are measured on: the report's ``traces``.
+
+    ``time`` (s, on the landmarks' clock), ``wrist_speed`` (m/s) and
+    ``aperture`` (m, marker to marker) over the whole clip
+    (:func:`~perception.report.kinematics.kinematic_traces`), to the µm.
+
+    Parameters
+    ----------
+    rec : Recognition
+        A scored clip.
+    """
+    from perception.report.kinematics import kinematic_traces
+
+    return dict(zip(("time", "wrist_speed", "aperture"),
+                    (np.round(x, 6) for x in kinematic_traces(rec.observation))))
 
 
 def _floats(values, n: int | None = None) -> np.ndarray:
@@ -96,6 +114,9 @@ class ClipSummary:
         The JSON's ``kinematics``: the ``observed`` landmarks, the
         ``reference`` model's own and its name (None in reports written
         before they existed).
+    traces : dict or None
+        The JSON's ``traces`` (:func:`clip_traces`; lists, None for NaN, in
+        a summary read from a report; None in reports written before them).
     extras : dict
         The JSON's other keys (``fingerprint``, ``condition``, ``input``,
         ``tracking``, …).
@@ -120,6 +141,7 @@ class ClipSummary:
     verdict_detail: str | None = None
     kinematics: dict | None = None
     verdict_rule: str | None = None
+    traces: dict | None = None
 
     @property
     def tracking(self) -> dict | None:
@@ -180,6 +202,7 @@ class ClipSummary:
             verdict_detail=d.get("verdict_detail"),
             kinematics=d.get("kinematics"),
             verdict_rule=d.get("verdict_rule"),
+            traces=d.get("traces"),
         )
 
     @classmethod
@@ -201,7 +224,8 @@ class ClipSummary:
                    reference_model=rec.reference_model,
                    transport=np.cumsum(rec.dC_r, axis=1), aperture=rec.observation.g,
                    extras=dict(extras or {}), verdict_detail=rec.verdict_detail,
-                   kinematics=rec.kinematics, verdict_rule=rec.verdict_rule)
+                   kinematics=rec.kinematics, verdict_rule=rec.verdict_rule,
+                   traces=clip_traces(rec))
 
     def index(self, model: str) -> int:
         """Row of ``model`` in the per-model arrays.
@@ -336,5 +360,5 @@ def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,
                 remove_output(clip_outputs(Path(out), rec.clip, fmt)[key])
     write_csv(paths["csv"], rec.columns())
     # the JSON last: its presence marks the clip's report complete
-    write_json(paths["json"], {**rec.to_dict(), **(extra or {})})
+    write_json(paths["json"], {**rec.to_dict(), "traces": clip_traces(rec), **(extra or {})})
     return paths
