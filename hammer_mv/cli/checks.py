@@ -149,11 +149,11 @@ def usable_cores() -> int:
 
 
 def free_memory() -> int | None:
-    """Memory available to new processes, bytes (``MemAvailable``), or None if unknown."""
-    with suppress(OSError, ValueError, IndexError), open("/proc/meminfo") as fh:
-        for line in fh:
-            if line.startswith("MemAvailable:"):
-                return int(line.split()[1]) * 1024  # kB
+    """Memory available to new processes, bytes (psutil's ``available``), or None if unknown."""
+    import psutil
+
+    with suppress(OSError, RuntimeError):
+        return int(psutil.virtual_memory().available)
     return None
 
 
