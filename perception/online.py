@@ -54,7 +54,7 @@ from perception.recognition.provisional import (
 from perception.recognition.repertoire import PlanCache, Repertoire
 from perception.recognition.result import Recognition
 from perception.recognition.rules import Evidence, judge
-from perception.recognition.shape import WRIST_GOAL_OFFSET, mirror_votes
+from perception.recognition.shape import WRIST_GOAL_OFFSET, mirror_votes, rest_and_opening
 
 __all__ = ["Decision", "OnlineRecognizer", "OnlineState", "SettleRule", "decision_summary"]
 
@@ -299,8 +299,7 @@ class OnlineRecognizer:
             filt=AlphaBeta((3, 2), params.alpha, params.beta), filtered=[],
             separation=float(np.linalg.norm(2 * half)), guess=None, reference=None,
             rest_wrist=None, votes=[0, 0], peak_speed=0.0, slowed=0.0, arrived=0.0, walked=[],
-            aperture=[],
-            digits_seen=[],
+            aperture=[], times=[], digits_seen=[],
             # past three times the longest model's movement the movement is over: the
             # evidence is kept as it was, and no frame costs more than the one before
             window=math.ceil(3 * durations[1] / first.dt), judged=None, t10=math.nan,
@@ -339,6 +338,7 @@ class OnlineRecognizer:
         f = sc.filtered[i]
         row = (self._rows["time"][i] - self._onset, f[0], f[1] - sc.half, f[2] + sc.half)
         self._moving.append(row)
+        sc.times.append(row[0])
         sc.aperture.append(float(np.linalg.norm(row[2] - row[3])))
         if sc.digits_seen[i]:
             sc.gap = (row[0], sc.gap[1] if math.isnan(sc.gap[0]) else max(sc.gap[1],
@@ -406,14 +406,14 @@ class OnlineRecognizer:
                                opening=0.0, slowed=sc.slowed)
         if seen.sum() >= 3:
             gs = g[seen]
-            rest = float(gs[:rules.grasp_rest_frames].mean())
-            opening = grip.opening = float(gs.max() - rest)
+            rest, opening = rest_and_opening(gs, rules)  # as shape.opens reads it offline
+            grip.opening = opening
             grip.opened = opening >= rules.grasp_opening * self.settings.observe.object_diameter
             lp = rules.landmarks
             # as the landmarks count them: not across a gap that may hide one
             grip.peaks = None if lp.hides_a_reopening(sc.gap[1], grip.mt) else count_peaks(
                 gs, max(lp.peak_prominence * opening, lp.peak_min_prominence))
-            walked, ts = np.asarray(sc.walked)[seen], np.array([r[0] for r in self._moving])[seen]
+            walked, ts = np.asarray(sc.walked)[seen], np.asarray(sc.times)[seen]
             k = int(np.argmax(gs > rest + lp.opening_level * opening))
             # as the landmark: a start of the opening that was not seen is not known
             unseen = k > 0 and ts[k] - ts[k - 1] > lp.max_gap + 1e-9

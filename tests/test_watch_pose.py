@@ -44,11 +44,12 @@ def test_a_pose_file_watched_is_the_pose_file_recognised(pose, tmp_path):
     assert filecmp.cmp(tmp_path / "a" / "trial.confidence.csv",
                        tmp_path / "b" / "trial.confidence.csv", shallow=False)
     # the live lines tell a provisional verdict (?) from the settled one (capitals)
-    lines = [line for line in b.stdout.splitlines() if " s  moving " in line]
-    assert any(line.rstrip().endswith("?") or "?" in line for line in lines)
-    if online["settled_early"]:
-        settled = [line for line in lines if "SETTLED" in line]
-        assert settled and all("SETTLED" in line for line in lines[lines.index(settled[0]):])
+    lines = [line.rstrip() for line in b.stdout.splitlines() if " s  moving " in line]
+    first = next((k for k, line in enumerate(lines) if "SETTLED" in line), len(lines))
+    # before the decision every verdict is provisional (?), from it on the settled one
+    assert first > 0 and all("?" in line and "SETTLED" not in line for line in lines[:first])
+    assert all("SETTLED" in line for line in lines[first:])
+    assert online["settled_early"] == (first < len(lines))
 
 
 def test_a_pose_file_has_no_frames_to_label(pose, tmp_path):

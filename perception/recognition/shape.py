@@ -44,7 +44,7 @@ from perception.recognition.models import SceneSpec
 from perception.recognition.rules import VerdictRules
 
 __all__ = ["WRIST_GOAL_OFFSET", "Normalisation", "canonical", "closed_hand", "is_mirrored",
-           "mirror_votes", "opens"]
+           "mirror_votes", "opens", "rest_and_opening"]
 
 #: Where the models' wrists stop: this far short of the object centre, m (the
 #: grasp task's own ``wrist_offset``).
@@ -213,8 +213,22 @@ def opens(obs: Observation, rules: VerdictRules | None = None) -> bool:
     rules : VerdictRules, optional
     """
     rules = VerdictRules() if rules is None else rules
-    g = obs.g[np.isfinite(obs.g)]
-    if not g.size:
-        return False
-    rest = float(g[:rules.grasp_rest_frames].mean())
-    return bool(g.max() - rest >= rules.grasp_opening * obs.object_diameter)
+    _, opening = rest_and_opening(obs.g[np.isfinite(obs.g)], rules)
+    return bool(opening >= rules.grasp_opening * obs.object_diameter)
+
+
+def rest_and_opening(g: np.ndarray, rules: VerdictRules | None = None) -> tuple[float, float]:
+    """The grip's rest aperture (the mean of its first ``rules.grasp_rest_frames`` samples)
+    and how far it opened beyond it, m (NaN, 0 without a sample).
+
+    Parameters
+    ----------
+    g : (N,) array
+        The aperture where it was seen, m (the offline verdict's and the online one's).
+    rules : VerdictRules, optional
+    """
+    rules = VerdictRules() if rules is None else rules
+    if not len(g):
+        return float("nan"), 0.0
+    rest = float(np.mean(g[:rules.grasp_rest_frames]))
+    return rest, float(np.max(g) - rest)
