@@ -180,6 +180,7 @@ def _chain_plan(name, chain, elbow, p_start, p_goal, vias, fractions, task: Gras
         r=task.r,
         w_v=task.w_v,
         w_f=task.w_f,
+        form=task.form,
     )
     problem = reach_problem(jtask, task.plant)
     cv = task.execution_cv

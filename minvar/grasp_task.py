@@ -41,7 +41,7 @@ import numpy as np
 
 from .kinematics import TwoLinkChain
 from .limits import check_position, check_steps
-from .plant import PointMassPlant
+from .plant import PointMassPlant, check_form
 
 __all__ = ["CHAINS", "DEFAULT_SHOULDER", "GraspTask", "GripVia", "shoulder_for"]
 
@@ -212,6 +212,10 @@ class GraspTask:
     w_v, w_f : float
         Final velocity and force weights of every chain's goal cost (the
         reach defaults).
+    form : {"project", "thesis"}
+        Every chain's model: the project's Euler filter and ``R = r dt / T I``
+        (default), or the thesis's printed exponential filter and
+        ``R = r / T I`` (:class:`minvar.task.ReachTask`).
     """
 
     object_size: float = 0.04
@@ -233,9 +237,11 @@ class GraspTask:
     r: float = 2e-4
     w_v: float = 0.2
     w_f: float = 0.01
+    form: str = "project"
 
     def __post_init__(self):
         own = "GraspTask"
+        check_form(self.form, f"{own}.form")
         setv = object.__setattr__
         setv(self, "object_size",
              _finite(own, "object_size", self.object_size, low=0.0, length=True))

@@ -11,6 +11,19 @@ State ``[p(2), v(2), f(2), g(2), then a pair of constant 1s per positional
 target]``; the 1s let a quadratic state cost express ``(p - target)^2``.
 The same plant serves in joint space for the grasp model (angles in rad,
 unit inertia).
+
+That Euler form is the project's (``form="project"``, the default). The thesis
+prints another (lines 520-524; ``form="thesis"``): exact exponential decay,
+the muscle state f~ taking the command at unit gain, and f taking f~ at the
+gain ``exp(-dt/tau)``::
+
+    f'  = exp(-dt/tau2) f + exp(-dt/tau2) g
+    g'  = exp(-dt/tau1) g + u
+
+(the thesis writes tau1 in both lines; the two are equal, 0.04 s). Its steady
+force per unit command is ``e^-a / (1 - e^-a)^2`` with ``a = dt/tau`` (15.9
+here) where the Euler form's is 1, so the same effort weight buys far more
+force: the two forms differ in what ``r`` means (docs/thesis.md).
 """
 
 from __future__ import annotations
@@ -19,7 +32,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["PointMassPlant", "POSITION", "VELOCITY", "FORCE", "FILTER", "N_BASE"]
+__all__ = ["PointMassPlant", "POSITION", "VELOCITY", "FORCE", "FILTER", "N_BASE", "FORMS",
+           "check_form"]
 
 #: Indices of the plant's physical states within the state vector.
 POSITION = slice(0, 2)
@@ -28,6 +42,16 @@ FORCE = slice(4, 6)
 FILTER = slice(6, 8)
 #: Number of physical states before the constant 1s.
 N_BASE = 8
+#: Forms of the model: the project's Euler filter and effort integral (default),
+#: and the thesis's printed exponential filter and effort mean (lines 520-524, 558).
+FORMS = ("project", "thesis")
+
+
+def check_form(form, owner: str) -> str:
+    """``form`` if it is one of :data:`FORMS`; raise ``ValueError`` naming ``owner`` if not."""
+    if form not in FORMS:
+        raise ValueError(f"{owner}: form must be one of {FORMS}, got {form!r}")
+    return form
 
 
 @dataclass(frozen=True)
@@ -87,18 +111,36 @@ class PointMassPlant:
         """State dimension with ``targets`` positional targets."""
         return N_BASE + 2 * targets
 
-    def dynamics(self, targets: int) -> tuple[np.ndarray, np.ndarray]:
-        """``A`` (n, n) and ``B`` (n, 2) for ``targets`` positional targets."""
+    def dynamics(self, targets: int, form: str = "project") -> tuple[np.ndarray, np.ndarray]:
+        """``A`` (n, n) and ``B`` (n, 2) for ``targets`` positional targets.
+
+        Parameters
+        ----------
+        targets : int
+            Number of positional targets (pairs of constant 1s).
+        form : {"project", "thesis"}
+            The Euler muscle filter (default), or the thesis's printed
+            exponential one with the command entering f~ at unit gain (module
+            docstring).
+        """
+        check_form(form, "PointMassPlant.dynamics")
         n = self.n_states(targets)
         dt = self.dt
         A = np.eye(n)
         I2 = np.eye(2)
         A[POSITION, VELOCITY] = dt * I2
         A[VELOCITY, FORCE] = dt / self.mass * I2
+        B = np.zeros((n, 2))
+        if form == "thesis":
+            decay_f, decay_g = np.exp(-dt / self.tau2), np.exp(-dt / self.tau1)
+            A[FORCE, FORCE] = decay_f * I2
+            A[FORCE, FILTER] = decay_f * I2
+            A[FILTER, FILTER] = decay_g * I2
+            B[FILTER] = I2
+            return A, B
         A[FORCE, FORCE] = (1 - dt / self.tau2) * I2
         A[FORCE, FILTER] = dt / self.tau2 * I2
         A[FILTER, FILTER] = (1 - dt / self.tau1) * I2
-        B = np.zeros((n, 2))
         B[FILTER] = dt / self.tau1 * I2
         return A, B
 

@@ -4,8 +4,10 @@ For P positional targets (via-points in the order given, then the goal) the
 task error is scaled by ``1/(P+2)``; each via-point costs only position, at its
 own step; the goal adds ``(w_v v)^2 + (w_f f)^2`` at the final step. Effort is
 ``R = r dt / T I``, T the number of steps: the effort term as a time integral.
-The target coordinates live in ``Q`` against a pair of constant 1s appended to
-the state per target (thesis 3.2.3).
+``form="thesis"`` takes the thesis's printed model instead: ``R = r / T I``
+(eq. 3.22, line 558) on the printed exponential muscle filter
+(:mod:`minvar.plant`). The target coordinates live in ``Q`` against a pair
+of constant 1s appended to the state per target (thesis 3.2.3).
 
 The default weights, ``r = 2e-4``, ``w_v = 0.2``, ``w_f = 0.01``, are not the
 thesis's printed ``r = 0.002``, ``w_v = 0.1``: run through Todorov's own code
@@ -24,7 +26,7 @@ import numpy as np
 
 from .limits import check_position, check_problem, check_steps
 from .lqg import LQGProblem
-from .plant import FORCE, N_BASE, POSITION, VELOCITY, PointMassPlant
+from .plant import FORCE, N_BASE, POSITION, VELOCITY, PointMassPlant, check_form
 
 __all__ = ["ViaPoint", "ReachTask", "reach_problem"]
 
@@ -114,6 +116,12 @@ class ReachTask:
     w_v, w_f : float
         Weights of the final velocity and force in the goal cost (default
         ``w_v`` 0.2, not the thesis's 0.1, for the same reason).
+    form : {"project", "thesis"}
+        ``"project"`` (default): the Euler muscle filter and ``R = r dt / T I``.
+        ``"thesis"``: the thesis's printed model, the exponential filter with
+        the command entering f~ at unit gain (lines 520-524) and
+        ``R = r / T I`` (lines 382, 558). docs/thesis.md says why the default
+        is the project's.
     """
 
     start: tuple[float, float]
@@ -123,8 +131,10 @@ class ReachTask:
     r: float = 2e-4
     w_v: float = 0.2
     w_f: float = 0.01
+    form: str = "project"
 
     def __post_init__(self):
+        check_form(self.form, "ReachTask.form")
         object.__setattr__(self, "start", _point("ReachTask", "start", self.start))
         object.__setattr__(self, "goal", _point("ReachTask", "goal", self.goal))
         vias = tuple(self.via_points)
@@ -185,7 +195,7 @@ def reach_problem(task: ReachTask, plant: PointMassPlant | None = None) -> LQGPr
     P = len(targets)
     n = plant.n_states(P)
     check_problem(T, n, "ReachTask")  # before Q, (T+1) x n x n, is allocated
-    A, B = plant.dynamics(P)
+    A, B = plant.dynamics(P, task.form)
     H, D0 = plant.observation(P)
     # Divide by (P + 2) rather than multiply by its reciprocal: the same
     # rounding as Todorov's code, so the reference inputs match bit for bit.
@@ -216,7 +226,7 @@ def reach_problem(task: ReachTask, plant: PointMassPlant | None = None) -> LQGPr
         D0=D0,
         E0=np.zeros((n, 1)),
         Q=Q,
-        R=task.r * plant.dt / T * np.eye(2),
+        R=task.r * (1.0 if task.form == "thesis" else plant.dt) / T * np.eye(2),
         X1=X1,
         S1=np.zeros((n, n)),
     )

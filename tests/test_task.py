@@ -48,6 +48,56 @@ def test_plant_discretisation():
     assert B[6, 0] == pytest.approx(0.25) and B[:6].sum() == 0
 
 
+def test_thesis_form_step_response_is_the_printed_filter():
+    """Lines 520-524: g' = a g + u, f' = a f + a g, a = exp(-dt/tau). A unit command
+    held from rest gives g_k = (1 - a^k)/(1 - a) and
+    f_k = (a (1 - a^k)/(1 - a) - k a^k)/(1 - a), rising to a/(1 - a)^2 = 15.9."""
+    plant = PointMassPlant()
+    A, B = plant.dynamics(1, form="thesis")
+    a = np.exp(-0.01 / 0.04)
+    x, u = np.zeros(10), np.array([1.0, 0.0])
+    for k in range(1, 60):
+        x = A @ x + B @ u
+        g = (1 - a**k) / (1 - a)
+        f = (a * (1 - a**k) / (1 - a) - k * a**k) / (1 - a)
+        assert x[6] == pytest.approx(g, rel=1e-12) and x[4] == pytest.approx(f, rel=1e-12)
+        assert x[7] == x[5] == 0.0
+    assert f == pytest.approx(a / (1 - a) ** 2, rel=1e-3) and a / (1 - a) ** 2 == pytest.approx(
+        15.92, abs=0.01)
+    # the Euler form's steady force per unit command is 1
+    A, B = plant.dynamics(1)
+    x = np.zeros(10)
+    for _ in range(400):
+        x = A @ x + B @ u
+    assert x[4] == pytest.approx(1.0, rel=1e-9)
+
+
+def test_thesis_form_effort_is_r_over_the_number_of_steps():
+    """Eq. 3.22 (line 558): R = r/T I, T the number of steps, so R halves when T doubles;
+    the project's form is r dt/T, 100 times smaller at dt = 0.01 s."""
+    for duration, T in ((0.5, 50), (1.0, 100)):
+        task = ReachTask((0, 0), (0.1, 0), duration, r=0.002, form="thesis")
+        np.testing.assert_allclose(reach_problem(task).R, 0.002 / T * np.eye(2), rtol=1e-15)
+        ours = reach_problem(ReachTask((0, 0), (0.1, 0), duration, r=0.002))
+        np.testing.assert_allclose(ours.R, 0.002 * 0.01 / T * np.eye(2), rtol=1e-15)
+    thesis = reach_problem(ReachTask((0, 0), (0.1, 0), 0.5, form="thesis"))
+    ours = reach_problem(ReachTask((0, 0), (0.1, 0), 0.5))
+    # only A, B and R change: the cost of the task, the noise and the sensing are the same
+    for name in ("Q", "H", "D0", "X1"):
+        assert np.array_equal(getattr(thesis, name), getattr(ours, name)), name
+    assert np.array_equal(thesis.B[6:8], np.eye(2))
+
+
+def test_grasp_form_reaches_every_chain():
+    from minvar import GraspTask, plan_grasp
+
+    plan = plan_grasp(GraspTask(form="thesis", r=0.002, w_v=0.1))
+    for chain in plan.chains.values():
+        assert chain.task.form == "thesis"
+        assert np.array_equal(chain.problem.B[6:8], np.eye(2))
+        np.testing.assert_allclose(chain.problem.R, 0.002 / 100 * np.eye(2))
+
+
 @pytest.mark.parametrize(
     "make, message",
     [
@@ -65,6 +115,9 @@ def test_plant_discretisation():
         (lambda: PointMassPlant(sigma_s=np.inf), "sigma_s"),
         (lambda: PointMassPlant(dt=0.1), "dt"),
         (lambda: ReachTask((0, 0), (0.1, 0), 1.0, r=-1), "ReachTask.r"),
+        (lambda: ReachTask((0, 0), (0.1, 0), 1.0, form="printed"), "ReachTask.form"),
+        (lambda: PointMassPlant().dynamics(1, form="exact"), "dynamics"),
+        (lambda: __import__("minvar").GraspTask(form="Thesis"), "GraspTask.form"),
     ],
 )
 def test_bad_input_is_a_value_error_naming_the_argument(make, message):
