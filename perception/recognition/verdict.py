@@ -15,7 +15,8 @@ does not say whether the best is any good. Familiarity does:
   stored gains with human-scale variability, tracked and observed like a
   clip) that fit it worse than the clip does: 1 − F(misfit), with F the
   log-normal distribution fitted to their misfits (centre: the median of the
-  log misfits; scale: their interquartile range / 1.349, so that a few
+  log misfits; scale: their interquartile range in a normal distribution's
+  standard deviations, ``scipy.stats.iqr(scale="normal")``, so that a few
   extreme demonstrations do not stretch the tail). 1 fits better than all of
   them, 0.5 like the typical one, near 0 worse than nearly all;
 * **verdict** — take the model with the highest log-likelihood (the best
@@ -153,9 +154,11 @@ class Calibration:
 
     @cached_property
     def log_scale(self) -> float:
-        """Interquartile range of the log misfits / 1.349 (the fitted log-normal's scale)."""
-        q1, q3 = np.percentile(np.log(self.misfit), [25, 75])
-        return float(max(q3 - q1, 1e-6) / 1.349)
+        """Interquartile range of the log misfits in standard deviations of a normal
+        distribution (``scipy.stats.iqr(scale="normal")``: the fitted log-normal's scale)."""
+        from scipy.stats import iqr
+
+        return float(max(iqr(np.log(self.misfit), scale="normal"), 1e-6))
 
     def familiarity(self, misfit: float, frame_period: float | None = None) -> float:
         """Share of the model's own demonstrations that fit worse than ``misfit`` (fitted).
@@ -172,8 +175,10 @@ class Calibration:
             return float("nan")
         if frame_period:
             misfit = misfit * (self.frame_period / frame_period) ** 2
+        from scipy.stats import norm
+
         z = (math.log(max(misfit, 1e-300)) - self.log_centre) / self.log_scale
-        return 0.5 * math.erfc(z / math.sqrt(2))  # the normal upper tail
+        return float(norm.sf(z))
 
 
 def misfit(mahalanobis: np.ndarray, scored: np.ndarray) -> np.ndarray:
