@@ -257,7 +257,7 @@ def test_hostile_clip_names_are_escaped_in_the_page_and_their_links_resolve(tmp_
             assert name + suffix in {unquote(u) for u in targets}, (name, suffix)
 
 
-def test_a_clip_table_written_without_pandas_reads_back_in_pandas(tmp_path):
+def test_a_table_written_by_write_csv_reads_back_the_same(tmp_path):
     from perception.io.atomic import write_csv
 
     rng = np.random.default_rng(0)
@@ -265,10 +265,8 @@ def test_a_clip_table_written_without_pandas_reads_back_in_pandas(tmp_path):
                         [np.nan, np.inf, -np.inf, -0.0, 1e-5, 0.1, 1 / 3, 1e16]])
     cols = {"time": x, "frame": np.arange(x.size), "ok": np.arange(x.size) % 2 == 0,
             "model": np.array(["a,b", 'say "x"', "é ü"] * 16), "C": x[::-1].copy()}
-    write_csv(tmp_path / "ours.csv", cols)
-    pd.DataFrame(cols).to_csv(tmp_path / "pandas.csv", index=False)
+    write_csv(tmp_path / "ours.csv", pd.DataFrame(cols))
     back = pd.read_csv(tmp_path / "ours.csv")
-    pd.testing.assert_frame_equal(back, pd.read_csv(tmp_path / "pandas.csv"))
     pd.testing.assert_frame_equal(back, pd.DataFrame(cols))  # round trip, NaN and -0.0 included
     np.testing.assert_array_equal(np.signbit(back["time"]), np.signbit(x))
 

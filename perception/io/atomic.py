@@ -27,7 +27,6 @@ or at interpreter exit, where they cannot be caught (and crash h5py).
 from __future__ import annotations
 
 import contextlib
-import csv
 import glob
 import hashlib
 import os
@@ -36,7 +35,7 @@ import socket
 import stat
 import tempfile
 import warnings
-from collections.abc import Iterable, Iterator, Mapping
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 import numpy as np
@@ -331,30 +330,19 @@ def write_json(path: str | os.PathLike, obj) -> Path:
 
 
 def write_csv(path: str | os.PathLike, frame) -> Path:
-    """Write a table to CSV at ``path`` atomically (no index).
+    """Write a pandas DataFrame to CSV at ``path`` atomically (no index).
 
-    ``frame`` is a pandas DataFrame (written by pandas), or a mapping of
-    column name to 1-D array, written by the :mod:`csv` module without
-    importing pandas (0.4 s a process): floats in their shortest round-trip
-    form (``repr``), NaN as an empty field, quoting only where needed, so
-    ``pandas.read_csv`` reads back the same table.
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Output file.
+    frame : pandas.DataFrame
+        The table; a column name Python could not decode (a surrogate) is
+        written escaped, not lost.
     """
     with atomic_path(path) as tmp:
-        if isinstance(frame, Mapping):
-            _write_columns(tmp, frame)
-        else:
-            # a name Python could not decode (a surrogate) is written escaped, not lost
-            frame.to_csv(tmp, index=False, errors="backslashreplace")
+        frame.to_csv(tmp, index=False, errors="backslashreplace")
     return Path(path)
-
-
-def _write_columns(path: Path, columns: Mapping) -> None:
-    # csv writes a value as str() (a float's repr) and None as an empty field
-    cells = [[None if v != v else v for v in np.asarray(c).tolist()] for c in columns.values()]
-    with open(path, "w", newline="", encoding="utf-8", errors="backslashreplace") as f:
-        out = csv.writer(f, lineterminator="\n")
-        out.writerow(columns)
-        out.writerows(zip(*cells))
 
 
 def save_figure(path: str | os.PathLike, fig, *, dpi: int = 120) -> Path:

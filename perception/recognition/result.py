@@ -390,7 +390,6 @@ class Recognition:
 
     def to_pandas(self) -> pd.DataFrame:
         """Per-step terms, one row per model and sample (:meth:`columns`)."""
-        # pandas costs 0.4 s to import: `recognize` writes its CSV without it
         import pandas as pd
 
         return pd.DataFrame(self.columns())
