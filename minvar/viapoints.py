@@ -14,7 +14,7 @@ of Figs. 3.8, 3.9 and A.3 is one such movement (:func:`letter_a`).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -343,7 +343,7 @@ class ViaPointMovement:
         Parameters
         ----------
         **weights
-            ``r``, ``w_v``, ``w_f`` passed to :class:`~minvar.task.ReachTask`
+            ``r``, ``w_v``, ``w_f``, ``form`` passed to :class:`~minvar.task.ReachTask`
             (default: its defaults).
         """
         vias = tuple(
@@ -404,7 +404,8 @@ def replay(movement: ViaPointMovement, *, plant: PointMassPlant | None = None, *
     plant : PointMassPlant, optional
         Plant and noise parameters.
     **weights
-        Cost weights ``r``, ``w_v``, ``w_f`` for :class:`~minvar.task.ReachTask`.
+        Cost weights ``r``, ``w_v``, ``w_f`` and ``form`` for
+        :class:`~minvar.task.ReachTask`.
 
     Returns
     -------
@@ -453,6 +454,7 @@ def compare_criteria(
     chain: TwoLinkChain | None = None,
     plant: PointMassPlant | None = None,
     unit: float = 1.0,
+    weights: Mapping[str, object] | None = None,
 ) -> CriteriaComparison:
     """Extract via-points by each criterion, replay, and score the replays (Fig. A.1).
 
@@ -481,6 +483,9 @@ def compare_criteria(
     unit : float
         Length unit of eq. A.1, m (curvature only; see
         :func:`spatiotemporal_curvature`).
+    weights : mapping, optional
+        Cost weights and form of the replays' :class:`~minvar.task.ReachTask`
+        (``r``, ``w_v``, ``w_f``, ``form``; default: its defaults).
 
     Returns
     -------
@@ -503,7 +508,7 @@ def compare_criteria(
         for c in criteria:
             idx = extract_via_points(p, t, c, prominence=prominence, unit=unit)
             movement = ViaPointMovement.from_samples(p, t, idx)
-            _, copy = replay(movement, plant=plant)
+            _, copy = replay(movement, plant=plant, **dict(weights or {}))
             d = joint_msd(p, copy, chain=chain)
             n = min(len(p), len(copy))
             rows.append(

@@ -70,11 +70,19 @@ def test_speed_accuracy_sweep_monte_carlo():
 
 
 def test_s_movement_passes_via_points_and_reaches_goal():
+    # thesis line 652: the 's' passes its via-points. Judged as numbers.md judges it: the
+    # expected path's miss against 2 SD of the repetitions' scatter where each is due
     r = simulate_reach(S_TASK, 200, seed=3)
-    mean = r.mean_position
+    expected = solve(reach_problem(S_TASK)).mean_states[:, POSITION]
     for v in S_TASK.via_points:
-        assert closest_approach(mean, v.position) < 0.005  # docs/model.md: within 5 mm
-    assert np.linalg.norm(mean[-1] - S_TASK.goal) < 0.01
+        k = int(round(v.fraction * (r.time.size - 1)))
+        scatter = np.sqrt(r.position[:, k].var(axis=0, ddof=1).sum())
+        assert closest_approach(expected, v.position) < 2 * scatter
+    # the number, and why it is not 0: the via-point cost is soft, so the path cuts the
+    # corners by about 5 mm (4.8 and 4.4 mm; a 5 mm limit was our own rule, not a claim)
+    miss = [closest_approach(expected, v.position) * 1000 for v in S_TASK.via_points]
+    assert miss == pytest.approx([4.8, 4.4], abs=0.1)
+    assert np.linalg.norm(r.mean_position[-1] - S_TASK.goal) < 0.01
     assert count_speed_peaks(r.mean_speed) == 3  # three strokes of the 's'
 
 

@@ -99,7 +99,7 @@ def test_quick_run_writes_every_figure_and_the_claims_table(tmp_path, capsys):
     assert (claims["location"].str.len() > 0).all() and (claims["measure"].str.len() > 0).all()
     assert (thesis["line"].astype(str).str.len() > 0).all()
     assert (thesis["quote"].str.len() > 0).all() and (thesis["at_thesis"].str.len() > 0).all()
-    assert set(claims["verdict"]) <= set(reproduce_thesis.VERDICTS)
+    assert set(claims["verdict"]) <= {*reproduce_thesis.VERDICTS, "conditional"}
     human = claims[claims["claim"].str.contains("closest to minimum jerk")].iloc[0]
     assert "15/8" in human["ours"] and human["verdict"] == "by construction"  # closed form
     assert "human" in human["thesis"]  # 1.875 is the thesis's human value
@@ -109,9 +109,10 @@ def test_quick_run_writes_every_figure_and_the_claims_table(tmp_path, capsys):
     for needle in ("Fig. 3.2(b)", "Fig. 3.5", "Fig. 3.7", "Fig. 3.6(a,c)", "Fig. 3.8(b)",
                    "Fig. A.1(b)", "Fig. A.2", "Fig. 3.4(c)", "Fig. 3.4(a)", "line 481"):
         assert claims["location"].str.contains(needle, regex=False).any(), needle
-    # the thesis's cost weights: the reach ends short of its goal (line 552)
+    # line 552's claim is about the thesis's settings, so it is judged at them in both
+    # columns: with the printed plant the reach ends 5 mm short, still moving
     goal = claims[claims["claim"].str.startswith("The cost weights give")].iloc[0]
-    assert goal["verdict"] == "agree" and goal["at_thesis"].startswith("differs")
+    assert goal["verdict"] == "differs" and goal["at_thesis"].startswith("differs")
     lines = thesis_text()
     if lines is not None:
         for _, c in thesis.iterrows():

@@ -43,6 +43,13 @@ def test_digit_distance_is_lowest_with_the_viapoints_level():
     d = [_distance(replace(GraspTask(), viapoint_height=h)) for h in HEIGHTS]
     assert np.argmin(d) == 2
     assert d[0] > d[1] > d[2] < d[3] < d[4]
+    # for each digit (Fig. 4.3(b) is the thumb's); the thumb's systematic miss is larger
+    # (97.7 against 81.7 µm at level): the digits mirror each other, the arm does not
+    t = [end_distance(_moments(task), "thumb", task.thumb_target)
+         for task in (replace(GraspTask(), viapoint_height=h) for h in HEIGHTS)]
+    assert t[0] > t[1] > t[2] < t[3] < t[4]
+    assert t[2] * 1e6 == pytest.approx(97.7, abs=0.1) and d[2] * 1e6 == pytest.approx(81.7,
+                                                                                       abs=0.1)
 
 
 def test_mga_comes_at_60_to_80_percent_for_every_object_size():
@@ -54,16 +61,21 @@ def test_mga_comes_at_60_to_80_percent_for_every_object_size():
     assert np.all(np.diff(times) >= 0)  # and later for larger objects (line 903)
 
 
-def test_viapoint_timing_sd_is_u_shaped_with_its_minimum_within_50_to_80_percent():
-    # thesis line 834, Fig. 4.5(c,d): lowest near 70 %, rising below it
+def test_viapoint_timing_sd_is_lowest_near_60_percent_in_either_frame():
+    # thesis line 834, Fig. 4.5(c,d): lowest near 70 %, rising below it. Ours does not rise
+    # below 70 % (numbers.md: differs; test_sd_does_not_rise_below_70_percent). The number
+    # pinned here: the exact SD is lowest for a via-point at 55-60 %, in the world frame and
+    # about the wrist (the hand frame, which removes the wrist's 95 % share). A U shape with
+    # its minimum within 50-80 % was our own former rule, not the thesis's claim.
     times = np.round(np.arange(0.5, 0.851, 0.05), 2)
-    sd = []
+    world, hand = [], []
     for f in times:
         m = _moments(replace(GraspTask(), viapoint_time=f))
-        sd.append(np.sqrt(np.trace(m.finger_cov[-1])))
-    i = int(np.argmin(sd))
-    assert 0 < i < len(times) - 1  # interior: the SD rises on both sides
-    assert 0.5 <= times[i] <= 0.8
+        world.append(np.sqrt(np.trace(m.finger_cov[-1])))
+        hand.append(np.sqrt(np.trace(m.finger_cov[-1] - m.wrist_cov[-1])))
+    for sd in (world, hand):
+        assert times[int(np.argmin(sd))] in (0.55, 0.6)
+    assert hand[times.tolist().index(0.6)] < 0.95 * hand[times.tolist().index(0.7)]
 
 
 def test_with_the_tips_on_the_target_line_the_trends_fail():

@@ -38,6 +38,10 @@ from perception.io.atomic import save_figure, write_csv
 #: test was built, so it says nothing about the model; ``thesis inconsistent``:
 #: the thesis says two different things (both locations are cited).
 VERDICTS = ("agree", "differs", "by construction", "thesis inconsistent")
+#: A verdict that flips with a choice the thesis leaves open (durations, tip_start, ...):
+#: the row says over which range it holds. Accepted by :func:`claim`; numbers.md's tallies
+#: count it once :data:`VERDICTS` lists it.
+CONDITIONAL = "conditional"
 
 #: Kinds of row: a statement of the thesis, or a check of the project's own.
 KINDS = ("thesis", "own")
@@ -55,9 +59,11 @@ OWN_HEADINGS = ("check", "basis", "measure", "ours", "verdict", "why")
 CLAIM_KEYS = ("section", "kind", "claim", "line", "quote", "location", "measure", "thesis",
               "ours", "verdict", "at_thesis", "agrees", "why")
 
-#: The thesis's cost weights (r: line 552; w_v, w_f: line 537). Ours are the
+#: The thesis's model and cost weights: its printed plant and effort form
+#: (``form="thesis"``: exponential muscle filter, u into f~ at unit gain, lines 520-524;
+#: R = r/T, lines 382, 558), r (line 552), w_v and w_f (line 537). Ours are the
 #: defaults of :class:`minvar.task.ReachTask` and :class:`minvar.grasp.GraspTask`.
-THESIS_SETTINGS = {"r": 0.002, "w_v": 0.1, "w_f": 0.01}
+THESIS_SETTINGS = {"r": 0.002, "w_v": 0.1, "w_f": 0.01, "form": "thesis"}
 #: Where the thesis text is looked for, after ``$HAMMER_MV_THESIS``: a ``shared/seed``
 #: folder inside the checkout, then beside it.
 _ROOT = Path(__file__).resolve().parents[1]
@@ -141,8 +147,9 @@ def claim(
         if agrees is None:
             raise ValueError(f"claim {claim!r}: give agrees or verdict")
         verdict = "agree" if agrees else "differs"
-    if verdict not in VERDICTS:
-        raise ValueError(f"claim {claim!r}: verdict must be one of {VERDICTS}, got {verdict!r}")
+    if verdict not in (*VERDICTS, CONDITIONAL):
+        raise ValueError(f"claim {claim!r}: verdict must be one of {VERDICTS} or "
+                         f"{CONDITIONAL!r}, got {verdict!r}")
     if kind not in KINDS:
         raise ValueError(f"claim {claim!r}: kind must be one of {KINDS}, got {kind!r}")
     values = (section, kind, claim, "" if line is None else int(line), quote,
@@ -401,6 +408,10 @@ def settings_rows() -> list[list[str]]:
         return "same" if getattr(reach, name) == THESIS_SETTINGS[name] else "**differs**"
 
     return [
+        ["model form", "exponential muscle filter, u entering f~ at unit gain (lines "
+         "520-524); R = r/T, T the number of steps (lines 382, 558)", "Euler filter; "
+         "R = r dt/T (Todorov's code; **differs**)", "the thesis's settings column of "
+         "chapters 3, 4 and A uses the thesis's form (docs/thesis.md)"],
         ["r (effort weight)", "0.002 ('provided a good tradeoff between error and effort', "
          "line 552)", f"{reach.r:g} ({same('r')})",
          "chapters 3, 4 and A computed at both; chapter 5's models use ours"],
