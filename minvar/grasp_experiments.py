@@ -64,6 +64,8 @@ __all__ = [
     "check_trials",
     "run_experiment",
     "run_sweep",
+    "Sweep",
+    "SWEEPS",
     "viapoint_height_experiment",
     "viapoint_time_experiment",
     "viapoint_distance_experiment",
@@ -382,66 +384,6 @@ def _with_intervals(summary: pd.DataFrame, boot: pd.DataFrame) -> pd.DataFrame:
     return out
 
 
-def _experiment(name, parameter, values, trials, seed, base, extra=None, *, draws=0,
-                axis=None) -> GraspExperiment:
-    sweep = run_sweep(parameter, values, trials=trials, seed=seed, base=base, bootstrap=draws)
-    summary = _with_intervals(sweep.summary, sweep.bootstrap)
-    stats = extra(summary, sweep.trials) if extra else {}
-    if draws:
-        stats.update(_peak_effects(summary, sweep.bootstrap))
-    return GraspExperiment(
-        name=name, parameter=parameter, base=GraspTask() if base is None else base,
-        summary=summary, trials=sweep.trials, curves=sweep.curves, stats=stats,
-        bootstrap=sweep.bootstrap, moments=sweep.moments, axis=axis,
-    )
-
-
-def viapoint_height_experiment(
-    heights: Sequence[float] = VIAPOINT_HEIGHTS,
-    *,
-    trials: int = THESIS_TRIALS,
-    seed: int | np.random.SeedSequence = 0,
-    base: GraspTask | None = None,
-) -> GraspExperiment:
-    """Via-point vertical position vs digit end-point accuracy (thesis 4.2.1.1, Figs. 4.2-4.3).
-
-    Parameters
-    ----------
-    heights : sequence of float
-        Via-point heights relative to the target line, m (default -2 to +2 cm).
-    trials : int
-        Repetitions per setting.
-    seed : int or numpy.random.SeedSequence
-        Root seed; setting ``i`` uses its child ``i``.
-    base : GraspTask, optional
-        Task the settings modify.
-    """
-    return _experiment("viapoint-height", "viapoint_height", heights, trials, seed, base)
-
-
-def viapoint_time_experiment(
-    fractions: Sequence[float] = VIAPOINT_TIMES,
-    *,
-    trials: int = THESIS_TRIALS,
-    seed: int | np.random.SeedSequence = 0,
-    base: GraspTask | None = None,
-) -> GraspExperiment:
-    """Via-point timing vs digit end-point accuracy (thesis 4.2.1.2, Figs. 4.4-4.5).
-
-    Parameters
-    ----------
-    fractions : sequence of float
-        Via-point times, fractions of the movement (default 50 % to 95 %).
-    trials : int
-        Repetitions per setting.
-    seed : int or numpy.random.SeedSequence
-        Root seed; setting ``i`` uses its child ``i``.
-    base : GraspTask, optional
-        Task the settings modify.
-    """
-    return _experiment("viapoint-time", "viapoint_time", fractions, trials, seed, base)
-
-
 def _mga_stats(parameter):
     def stats(summary, trials):
         from scipy import stats as sps
@@ -464,144 +406,163 @@ def _mga_stats(parameter):
     return stats
 
 
-def viapoint_distance_experiment(
-    offsets: Sequence[float] = VIAPOINT_DISTANCES,
+class Sweep(NamedTuple):
+    """One chapter-4 experiment: the parameter it sweeps and how it is reported.
+
+    Attributes
+    ----------
+    parameter : str
+        The :class:`~minvar.grasp.GraspTask` field swept.
+    values : tuple of float
+        The thesis's settings (SI units).
+    title : str
+        What it measures, with the thesis's section and figures.
+    values_doc : str
+        What the values are (the experiment function's first parameter).
+    stats : callable, optional
+        ``(summary, trials) -> dict`` of extra statistics (the MGA regressions).
+    draws : int
+        Bootstrap resamples of the peak SDs (0: none).
+    moved : bool
+        The values are how far the wrist travels (line 953): each setting's
+        ``distance`` is the value plus ``base.wrist_offset``, and the tables gain
+        a ``transport_distance`` column, which the figures show.
+    """
+
+    parameter: str
+    values: tuple[float, ...]
+    title: str
+    values_doc: str
+    stats: Callable | None = None
+    draws: int = 0
+    moved: bool = False
+
+
+#: The seven experiments, in thesis order: what each sweeps and reports.
+SWEEPS: dict[str, Sweep] = {
+    "viapoint-height": Sweep(
+        "viapoint_height", VIAPOINT_HEIGHTS,
+        "Via-point vertical position vs digit end-point accuracy (thesis 4.2.1.1, "
+        "Figs. 4.2-4.3).", "Via-point heights relative to the target line, m (default -2 "
+        "to +2 cm)."),
+    "viapoint-time": Sweep(
+        "viapoint_time", VIAPOINT_TIMES,
+        "Via-point timing vs digit end-point accuracy (thesis 4.2.1.2, Figs. 4.4-4.5).",
+        "Via-point times, fractions of the movement (default 50 % to 95 %)."),
+    "viapoint-distance": Sweep(
+        "viapoint_offset", VIAPOINT_DISTANCES,
+        "Via-point distance from the object vs MGA and its timing (thesis 4.2.2.1, "
+        "Figs. 4.7-4.8).", "Via-point distances outside the object surface, m (default 0 "
+        "to 2.25 cm).", _mga_stats("viapoint_offset")),
+    "object-size": Sweep(
+        "object_size", OBJECT_SIZES,
+        "Object size vs MGA (regression slope) and its timing (thesis 4.2.2.2, "
+        "Figs. 4.9-4.10).", "Object diameters, m (default 0 to 8 cm in 1 cm steps).",
+        _mga_stats("object_size")),
+    "movement-time": Sweep(
+        "duration", MOVEMENT_TIMES,
+        "Wrist and aperture variability vs movement time (thesis 4.2.3.1, Figs. "
+        "4.11-4.12).", "Movement times, s (default 0.6 to 1.2 s).", draws=BOOTSTRAP_DRAWS),
+    "variability-size": Sweep(
+        "object_size", VARIABILITY_SIZES,
+        "Wrist and aperture variability vs object size (thesis 4.2.3.2, Figs. "
+        "4.13-4.14).", "Object diameters, m (default 0 to 8 cm in 2 cm steps).",
+        draws=BOOTSTRAP_DRAWS),
+    "variability-distance": Sweep(
+        "distance", TRANSPORT_DISTANCES,
+        "Wrist and aperture variability vs transport distance (thesis 4.2.3.3, Figs. "
+        "4.15-4.16).", "How far the wrist travels, m (default 8-24 cm; the object "
+        "centre is ``base.wrist_offset`` further: the thesis's 'distance to be moved', "
+        "line 953).", draws=BOOTSTRAP_DRAWS, moved=True),
+}
+
+
+def run_experiment(
+    name: str,
+    values: Sequence[float] | None = None,
     *,
     trials: int = THESIS_TRIALS,
     seed: int | np.random.SeedSequence = 0,
     base: GraspTask | None = None,
 ) -> GraspExperiment:
-    """Via-point distance from the object vs MGA and its timing (thesis 4.2.2.1, Figs. 4.7-4.8).
+    """Run one chapter-4 experiment by name (:data:`SWEEPS`), over the thesis's settings
+    or ``values``.
 
     Parameters
     ----------
-    offsets : sequence of float
-        Via-point distances outside the object surface, m (default 0 to 2.25 cm).
+    name : str
+        One of :data:`SWEEPS` (the keys of :data:`EXPERIMENTS`).
+    values : sequence of float, optional
+        The settings (default: the thesis's, ``SWEEPS[name].values``).
     trials : int
-        Repetitions per setting.
+        Repetitions per setting (thesis: :data:`THESIS_TRIALS`, 500).
     seed : int or numpy.random.SeedSequence
         Root seed; setting ``i`` uses its child ``i``.
     base : GraspTask, optional
         Task the settings modify.
     """
-    return _experiment(
-        "viapoint-distance", "viapoint_offset", offsets, trials, seed, base,
-        _mga_stats("viapoint_offset"),
-    )
-
-
-def object_size_experiment(
-    sizes: Sequence[float] = OBJECT_SIZES,
-    *,
-    trials: int = THESIS_TRIALS,
-    seed: int | np.random.SeedSequence = 0,
-    base: GraspTask | None = None,
-) -> GraspExperiment:
-    """Object size vs MGA (regression slope) and its timing (thesis 4.2.2.2, Figs. 4.9-4.10).
-
-    Parameters
-    ----------
-    sizes : sequence of float
-        Object diameters, m (default 0 to 8 cm in 1 cm steps).
-    trials : int
-        Repetitions per setting.
-    seed : int or numpy.random.SeedSequence
-        Root seed; setting ``i`` uses its child ``i``.
-    base : GraspTask, optional
-        Task the settings modify.
-    """
-    return _experiment(
-        "object-size", "object_size", sizes, trials, seed, base,
-        _mga_stats("object_size"),
-    )
-
-
-def _variability(name, parameter, values, trials, seed, base, axis=None):
-    return _experiment(name, parameter, values, trials, seed, base, draws=BOOTSTRAP_DRAWS,
-                       axis=axis)
-
-
-def movement_time_experiment(
-    durations: Sequence[float] = MOVEMENT_TIMES,
-    *,
-    trials: int = THESIS_TRIALS,
-    seed: int | np.random.SeedSequence = 0,
-    base: GraspTask | None = None,
-) -> GraspExperiment:
-    """Wrist and aperture variability vs movement time (thesis 4.2.3.1, Figs. 4.11-4.12).
-
-    Parameters
-    ----------
-    durations : sequence of float
-        Movement times, s (default 0.6 to 1.2 s).
-    trials : int
-        Repetitions per setting.
-    seed : int or numpy.random.SeedSequence
-        Root seed; setting ``i`` uses its child ``i``.
-    base : GraspTask, optional
-        Task the settings modify.
-    """
-    return _variability("movement-time", "duration", durations, trials, seed, base)
-
-
-def variability_size_experiment(
-    sizes: Sequence[float] = VARIABILITY_SIZES,
-    *,
-    trials: int = THESIS_TRIALS,
-    seed: int | np.random.SeedSequence = 0,
-    base: GraspTask | None = None,
-) -> GraspExperiment:
-    """Wrist and aperture variability vs object size (thesis 4.2.3.2, Figs. 4.13-4.14).
-
-    Parameters
-    ----------
-    sizes : sequence of float
-        Object diameters, m (default 0 to 8 cm in 2 cm steps).
-    trials : int
-        Repetitions per setting.
-    seed : int or numpy.random.SeedSequence
-        Root seed; setting ``i`` uses its child ``i``.
-    base : GraspTask, optional
-        Task the settings modify.
-    """
-    return _variability("variability-size", "object_size", sizes, trials, seed, base)
-
-
-def variability_distance_experiment(
-    distances: Sequence[float] = TRANSPORT_DISTANCES,
-    *,
-    trials: int = THESIS_TRIALS,
-    seed: int | np.random.SeedSequence = 0,
-    base: GraspTask | None = None,
-) -> GraspExperiment:
-    """Wrist and aperture variability vs transport distance (thesis 4.2.3.3, Figs. 4.15-4.16).
-
-    The thesis gives "the distance to be moved" (line 953): each setting's
-    object centre is ``base.wrist_offset`` beyond where the wrist stops, i.e.
-    :class:`~minvar.grasp.GraspTask` ``distance = d + wrist_offset``. The tables
-    hold both ``distance`` and ``transport_distance``; figures show the latter.
-
-    Parameters
-    ----------
-    distances : sequence of float
-        How far the wrist travels, m (default 8-24 cm).
-    trials : int
-        Repetitions per setting.
-    seed : int or numpy.random.SeedSequence
-        Root seed; setting ``i`` uses its child ``i``.
-    base : GraspTask, optional
-        Task the settings modify.
-    """
+    if name not in SWEEPS:
+        raise ValueError(f"experiment: unknown name {name!r}; expected one of "
+                         f"{', '.join(SWEEPS)}")
+    trials = check_trials(trials)
+    spec = SWEEPS[name]
     base = GraspTask() if base is None else base
-    moved = [float(d) for d in distances]
-    exp = _variability("variability-distance", "distance",
-                       [d + base.wrist_offset for d in moved], trials, seed, base,
-                       axis="transport_distance")
-    by_setting = dict(enumerate(moved))
-    for table in (exp.summary, exp.trials, exp.curves):
-        table.insert(2, "transport_distance", table["setting"].map(by_setting))
+    given = [float(v) for v in (spec.values if values is None else values)]
+    swept = [v + base.wrist_offset for v in given] if spec.moved else given
+    sweep = run_sweep(spec.parameter, swept, trials=trials, seed=seed, base=base,
+                      bootstrap=spec.draws)
+    summary = _with_intervals(sweep.summary, sweep.bootstrap)
+    stats = spec.stats(summary, sweep.trials) if spec.stats else {}
+    if spec.draws:
+        stats.update(_peak_effects(summary, sweep.bootstrap))
+    exp = GraspExperiment(
+        name=name, parameter=spec.parameter, base=base, summary=summary,
+        trials=sweep.trials, curves=sweep.curves, stats=stats, bootstrap=sweep.bootstrap,
+        moments=sweep.moments, axis="transport_distance" if spec.moved else None,
+    )
+    if spec.moved:
+        by_setting = dict(enumerate(given))
+        for table in (exp.summary, exp.trials, exp.curves):
+            table.insert(2, "transport_distance", table["setting"].map(by_setting))
     return exp
 
+
+_DOC = """{title}
+
+    Parameters
+    ----------
+    values : sequence of float
+        {values_doc}
+    trials : int
+        Repetitions per setting.
+    seed : int or numpy.random.SeedSequence
+        Root seed; setting ``i`` uses its child ``i``.
+    base : GraspTask, optional
+        Task the settings modify.
+    """
+
+
+def _experiment_function(name: str) -> Callable[..., GraspExperiment]:
+    """The public function of one experiment: :func:`run_experiment` with its name."""
+    spec = SWEEPS[name]
+
+    def experiment(values: Sequence[float] = spec.values, *, trials: int = THESIS_TRIALS,
+                   seed: int | np.random.SeedSequence = 0,
+                   base: GraspTask | None = None) -> GraspExperiment:
+        return run_experiment(name, values, trials=trials, seed=seed, base=base)
+
+    experiment.__name__ = experiment.__qualname__ = f"{name.replace('-', '_')}_experiment"
+    experiment.__doc__ = _DOC.format(title=spec.title, values_doc=spec.values_doc)
+    return experiment
+
+
+viapoint_height_experiment = _experiment_function("viapoint-height")
+viapoint_time_experiment = _experiment_function("viapoint-time")
+viapoint_distance_experiment = _experiment_function("viapoint-distance")
+object_size_experiment = _experiment_function("object-size")
+movement_time_experiment = _experiment_function("movement-time")
+variability_size_experiment = _experiment_function("variability-size")
+variability_distance_experiment = _experiment_function("variability-distance")
 
 #: Experiment functions by CLI name, in thesis order.
 EXPERIMENTS: dict[str, Callable[..., GraspExperiment]] = {
@@ -613,29 +574,3 @@ EXPERIMENTS: dict[str, Callable[..., GraspExperiment]] = {
     "variability-size": variability_size_experiment,
     "variability-distance": variability_distance_experiment,
 }
-
-
-def run_experiment(
-    name: str,
-    *,
-    trials: int = THESIS_TRIALS,
-    seed: int | np.random.SeedSequence = 0,
-    base: GraspTask | None = None,
-) -> GraspExperiment:
-    """Run one chapter-4 experiment by name with the thesis's settings.
-
-    Parameters
-    ----------
-    name : str
-        One of :data:`EXPERIMENTS`.
-    trials : int
-        Repetitions per setting (thesis: :data:`THESIS_TRIALS`, 500).
-    seed : int or numpy.random.SeedSequence
-        Root seed; setting ``i`` uses its child ``i``.
-    base : GraspTask, optional
-        Task the settings modify.
-    """
-    if name not in EXPERIMENTS:
-        raise ValueError(f"experiment: unknown name {name!r}; expected one of "
-                         f"{', '.join(EXPERIMENTS)}")
-    return EXPERIMENTS[name](trials=check_trials(trials), seed=seed, base=base)
