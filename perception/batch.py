@@ -432,12 +432,10 @@ def run_batch(
     settings : RecognitionSettings, optional
         Observation and engine settings.
     jobs : int
-        Worker processes working on clips, one OpenCV/FFmpeg thread each
-        (:mod:`perception.workers`; 1: in this process; ignored with
-        ``scheduler``). Scripts that use ``jobs > 1`` need the usual
-        ``if __name__ == "__main__":`` guard of multiprocessing, and should set
-        ``OMP_NUM_THREADS=1`` (and OpenBLAS's, MKL's) before numpy loads, as
-        ``hammer-mv`` does: the workers inherit it.
+        Worker processes working on clips, one OpenCV, FFmpeg, planning and
+        BLAS thread each (:mod:`perception.workers`; 1: in this process;
+        ignored with ``scheduler``). Scripts that use ``jobs > 1`` need the
+        usual ``if __name__ == "__main__":`` guard of multiprocessing.
     scheduler : str, optional
         Address of a dask.distributed scheduler (``tcp://host:8786``) to run on.
     repertoire_id : str
@@ -476,7 +474,10 @@ def run_batch(
     out.mkdir(parents=True, exist_ok=True)
     for sub in ("tracks", PLANS_FOLDER):  # a link leading out of the report: refused now
         output_folder(out, sub)
-    job = _Job(out, settings, repertoire_id, figure_format, dpi)
+    # each worker one decoding and one planning thread: the parallelism is the workers'
+    parallel = scheduler is not None or min(jobs, len(items)) > 1
+    job = _Job(out, dataclasses.replace(settings, decoder_threads=1, planning_threads=1)
+               if parallel else settings, repertoire_id, figure_format, dpi)
     results = (_run_dask(items, repertoire, job, scheduler) if scheduler
                else _run_local(items, repertoire, job, jobs))
     done: list[ClipResult] = []

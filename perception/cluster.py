@@ -6,14 +6,15 @@ this module is imported only when a batch is given a scheduler.
 A cluster's workers are shared: a batch sets each worker up for its clips
 through a :class:`OneThreadPerWorker` plugin that it registers before the
 first clip and removes after the last, and the plugin puts back what it
-changed — never a permanent change to another user's workers.
+changed — never a permanent change to another user's workers. How the
+workers' processes start (glibc's allocator thresholds among them) is the
+cluster owner's to set, in dask's nanny configuration: docs/recognition.md
+says what a batch's clips want.
 """
 
 from __future__ import annotations
 
 import asyncio
-import ctypes
-import os
 from collections.abc import Iterator
 from concurrent.futures import ThreadPoolExecutor
 
@@ -28,31 +29,14 @@ __all__ = ["SCHEDULER_TIMEOUT_S", "OneThreadPerWorker", "check_scheduler", "run_
 #: Seconds to wait for a dask scheduler to answer before giving up.
 SCHEDULER_TIMEOUT_S = 10.0
 
-#: glibc's ``mallopt`` parameters and the thresholds a plain process's dynamic
-#: ones grow to (``mallopt(3)``: mmap at most 32 MiB, trim at twice that).
-_M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3
-_MMAP_THRESHOLD, _TRIM_THRESHOLD = 32 << 20, 64 << 20
-#: glibc's default mmap threshold, where ``MALLOC_TRIM_THRESHOLD_`` fixes it.
-_DEFAULT_MMAP_THRESHOLD = 128 << 10
-
-
-def _mallopt():
-    try:
-        return ctypes.CDLL(None).mallopt
-    except (OSError, AttributeError):  # not glibc: its allocator is not the one tuned
-        return None
-
-
 class OneThreadPerWorker(WorkerPlugin):
-    """Set a dask worker up as a batch's local workers are, and put it back after.
+    """Set a dask worker's OpenCV thread pool to one thread, and put it back after.
 
-    While registered: one OpenCV thread, one FFmpeg decoding thread and one
-    planning thread (the cluster's other workers use the other cores); and,
-    on a worker that dask's nanny started with ``MALLOC_TRIM_THRESHOLD_``
-    (which fixes glibc's mmap threshold at 128 KiB, so that every
-    frame-sized array is a fresh ``mmap``: 40,000 page faults and a third
-    more time per clip), glibc's thresholds at what a plain process grows
-    to. ``teardown`` restores all of it.
+    The cluster's other workers use the other cores. FFmpeg's decoding and
+    planning threads are settings the clips carry (a batch gives them one
+    each); BLAS has one thread on a worker that dask's nanny started
+    (its ``distributed.nanny.pre-spawn-environ``). ``teardown`` restores
+    OpenCV's pool.
     """
 
     name = "hammer-mv-one-thread-per-worker"
@@ -60,30 +44,13 @@ class OneThreadPerWorker(WorkerPlugin):
     def setup(self, **_) -> None:  # noqa: D102 - dask's API (it passes worker=, not needed)
         import cv2
 
-        from perception.io import video
-        from perception.recognition import planning
-
-        self._before = cv2.getNumThreads(), video.decoder_threads, planning.threads
+        self._before = cv2.getNumThreads()
         cv2.setNumThreads(1)
-        video.decoder_threads = 1
-        planning.threads = 1
-        trim = os.environ.get("MALLOC_TRIM_THRESHOLD_")
-        mallopt = _mallopt() if trim is not None else None
-        self._trim = trim if mallopt and mallopt(_M_MMAP_THRESHOLD, _MMAP_THRESHOLD) and \
-            mallopt(_M_TRIM_THRESHOLD, _TRIM_THRESHOLD) else None
 
     def teardown(self, **_) -> None:  # noqa: D102 - dask's API
         import cv2
 
-        from perception.io import video
-        from perception.recognition import planning
-
-        cv2.setNumThreads(self._before[0])
-        video.decoder_threads, planning.threads = self._before[1:]
-        mallopt = _mallopt() if self._trim is not None else None
-        if mallopt:  # what the variable had set (it fixes the mmap threshold at glibc's default)
-            mallopt(_M_TRIM_THRESHOLD, int(self._trim))
-            mallopt(_M_MMAP_THRESHOLD, _DEFAULT_MMAP_THRESHOLD)
+        cv2.setNumThreads(self._before)
 
 
 def check_scheduler(address: str) -> None:

@@ -93,6 +93,12 @@ class RecognitionSettings:
     mocap : MocapImport, optional
         How motion-capture recordings become reaches (markers, rate, units,
         object size); default: :class:`~perception.recordings.MocapImport`.
+    decoder_threads : int
+        Threads FFmpeg decodes a video with (0: FFmpeg's choice; a batch's
+        worker processes use 1). Changes no result.
+    planning_threads : int, optional
+        Threads that plan a scene's models (default: the cores this process
+        may use, at most 4; a batch's worker processes use 1). Changes no result.
     """
 
     observe: ObserveParams = field(default_factory=ObserveParams)
@@ -103,10 +109,13 @@ class RecognitionSettings:
     keep_truncated: bool = False
     fps: float | None = None
     mocap: MocapImport | None = None
+    decoder_threads: int = 0
+    planning_threads: int | None = None
 
     def video_options(self) -> dict:
         """How to read videos, as keyword arguments of :func:`load_clip`."""
-        return {"keep_truncated": self.keep_truncated, "fps": self.fps}
+        return {"keep_truncated": self.keep_truncated, "fps": self.fps,
+                "decoder_threads": self.decoder_threads}
 
     def fingerprint(self) -> dict:
         """JSON-able settings that change results."""
@@ -120,7 +129,7 @@ class RecognitionSettings:
         if self.mocap is not None:
             out["mocap"] = self.mocap.to_dict()
         if self.keep_truncated or self.fps is not None:
-            out["video"] = self.video_options()
+            out["video"] = {"keep_truncated": self.keep_truncated, "fps": self.fps}
         return out
 
 
@@ -199,7 +208,8 @@ def _sha256(key: tuple[Path, int, int]) -> str:
 def load_clip(source: str | os.PathLike | Tracks, *, tracks_out: str | os.PathLike | None = None,
               progress: bool = False, setup: TrackingSetup | None = None,
               pose: PoseImport | None = None, keep_truncated: bool = False,
-              fps: float | None = None, frames: FrameSample | None = None) -> Tracks:
+              fps: float | None = None, frames: FrameSample | None = None,
+              decoder_threads: int = 0) -> Tracks:
     """The tracks of a clip: tracked from a video, read from a tracks or pose file, or as given.
 
     Parameters
@@ -227,6 +237,8 @@ def load_clip(source: str | os.PathLike | Tracks, *, tracks_out: str | os.PathLi
         Keeps a few frames of a video as it is tracked, for the contact sheet
         (:func:`~perception.report.tracking.contact_sheet`); left empty when
         the tracks are not tracked now.
+    decoder_threads : int
+        Threads FFmpeg decodes a video with (0: FFmpeg's choice).
 
     Raises
     ------
@@ -259,7 +271,8 @@ def load_clip(source: str | os.PathLike | Tracks, *, tracks_out: str | os.PathLi
 
     kw = {} if setup is None else {"markers": setup.markers, "params": setup.params}
     return Tracks.load(track_video(path, out, progress=progress, keep_truncated=keep_truncated,
-                                   fps=fps, frames=frames, **kw))
+                                   fps=fps, frames=frames, decoder_threads=decoder_threads,
+                                   **kw))
 
 
 #: ``/tracker`` attributes that describe what a tracker learned from the clip
@@ -376,7 +389,8 @@ def recognize_tracks(tracks: Tracks, repertoire: Repertoire,
     # refused before its scene is planned
     shape_obs, norm = _canonical(obs, repertoire, source, settings.rules)
     try:
-        models = repertoire.for_scene(SceneSpec.of(obs), cache=plan_cache)
+        models = repertoire.for_scene(SceneSpec.of(obs), cache=plan_cache,
+                                      threads=settings.planning_threads)
     except PlanningError as exc:  # the scene, not the software: name the clip and the scale
         raise PlanningError(f"{exc.problem} (check the scale: --px-per-m, --object-diameter)",
                             source or obs.clip, field=exc.field) from None
@@ -416,7 +430,7 @@ def _shape_pass(shape_obs, repertoire: Repertoire, settings: RecognitionSettings
     from perception.recognition.shape import closed_hand, opens
 
     scene = SceneSpec.of(shape_obs)
-    every = repertoire.for_scene(scene, cache=plan_cache)
+    every = repertoire.for_scene(scene, cache=plan_cache, threads=settings.planning_threads)
     kind = "grasp" if opens(shape_obs, settings.rules) else "reach"
     models = [m for m in every if m.kind == kind] or every
     # the clip's own tracking noise, where it exceeds what the rule assumes

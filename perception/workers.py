@@ -7,12 +7,12 @@ multiprocessing's fork server where there is one (POSIX), else spawned:
 never forked from this process, whose OpenCV/BLAS thread pools would
 deadlock a forked child.
 
-Each worker's initialiser makes that process single-threaded in OpenCV,
-FFmpeg decoding and planning (the parallelism is the processes') and
-receives what every item shares (a repertoire) once. BLAS/OpenMP read
-their thread counts from the environment when numpy loads, so those are
-the application's to set before anything starts: ``hammer-mv`` sets one
-thread each unless the user chose otherwise.
+Each worker's initialiser makes that process single-threaded in OpenCV and
+BLAS (``threadpoolctl.threadpool_limits``; the parallelism is the
+processes') and receives what every item shares (a repertoire) once;
+FFmpeg's decoding and planning threads are settings the job carries
+(:class:`~perception.pipeline.RecognitionSettings`: a batch gives its
+workers one each).
 
 Each worker is a one-process executor handed one item at a time, so a
 worker that dies (killed, out of memory) loses only the item it held; a new
@@ -52,8 +52,8 @@ _WORKER: dict = {}
 
 
 def init_worker(job_and_shared: bytes) -> None:
-    """A worker process's initialiser: one OpenCV, FFmpeg and planning thread; the job;
-    a thread that ends the worker when its parent ends.
+    """A worker process's initialiser: one OpenCV and BLAS thread; the job; a thread
+    that ends the worker when its parent ends.
 
     The job and the shared object come pickled once (bytes), so that the
     parent's write to a starting worker does not wait while the worker
@@ -65,14 +65,11 @@ def init_worker(job_and_shared: bytes) -> None:
         ``pickle.dumps((job, shared))``.
     """
     import cv2
-
-    from perception.io import video
-    from perception.recognition import planning
+    from threadpoolctl import threadpool_limits
 
     cv2.setNumThreads(1)
-    video.decoder_threads = 1
-    planning.threads = 1
     _WORKER["job"], _WORKER["shared"] = pickle.loads(job_and_shared)
+    threadpool_limits(1)  # numpy's BLAS, and OpenCV's: loaded by now
     parent = multiprocessing.parent_process()
     if parent is not None:
         threading.Thread(target=_exit_with, args=(parent,), daemon=True).start()

@@ -107,11 +107,11 @@ class _KillsOneWorker(Repertoire):
 
     token: Path
 
-    def for_scene(self, scene, cache=None):
+    def for_scene(self, scene, cache=None, **kwargs):
         try:
             self.token.unlink()  # once, in whichever worker gets here first
         except FileNotFoundError:
-            return super().for_scene(scene, cache)
+            return super().for_scene(scene, cache, **kwargs)
         os.kill(os.getpid(), signal.SIGKILL)
 
 
@@ -153,10 +153,10 @@ class _KillsEveryWorker(Repertoire):
 
     distance: float
 
-    def for_scene(self, scene, cache=None):
+    def for_scene(self, scene, cache=None, **kwargs):
         if abs(scene.distance - self.distance) < 0.02:  # the clip at 0.3 m, as measured
             os.kill(os.getpid(), signal.SIGKILL)
-        return super().for_scene(scene, cache)
+        return super().for_scene(scene, cache, **kwargs)
 
 
 def test_a_clip_that_kills_its_dask_workers_fails_alone(tmp_path):

@@ -1,7 +1,7 @@
-"""Start-up, per-clip and batch speed features: lazy CLI, tracks reuse, plan cache, synth --jobs."""
+"""Per-clip and batch speed features: lazy CLI, tracks reuse, plan cache, synth --jobs.
 
-import subprocess
-import sys
+Start-up itself is measured, not asserted: ``tools/bench_speed.py``."""
+
 import threading
 import time
 
@@ -13,34 +13,6 @@ from hammer_mv.cli import COMMANDS, build_parser
 from perception.recognition.models import SceneSpec
 from perception.recognition.planning import default_specs
 from perception.recognition.repertoire import PlanCache, Repertoire
-
-
-def _imported(*args):
-    """Top-level modules a ``hammer-mv ARGS`` process imports."""
-    code = ("import sys; from hammer_mv.cli import main\n"
-            "try:\n    main(sys.argv[1:])\nexcept SystemExit:\n    pass\n"
-            "print(' '.join(sorted({m.split('.')[0] for m in sys.modules})))")
-    out = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True,
-                         check=True)
-    return set(out.stdout.split()[-1].split()) | set(out.stdout.splitlines()[-1].split())
-
-
-@pytest.mark.parametrize("args", [["--version"], ["--help"], ["track", "--help"]])
-def test_start_up_imports_nothing_heavy(args):
-    heavy = {"numpy", "scipy", "pandas", "matplotlib", "cv2", "h5py", "dask"}
-    assert not _imported(*args) & heavy
-
-
-def test_recognize_imports_no_pandas_matplotlib_or_dask(tmp_path):
-    from perception.synthetic.demos import demo_tracks
-
-    tracks = demo_tracks("normal", 0)[0].save(tmp_path / "c.tracks.h5")
-    loaded = _imported("recognize", str(tracks), "-o", str(tmp_path / "out"), "--quiet",
-                       "--no-figures")
-    assert (tmp_path / "out" / "c.confidence.csv").exists()  # the command did run
-    # scipy.signal filters the landmarks as the field does (a zero-lag Butterworth);
-    # pandas, matplotlib and dask stay out of a recognition without figures
-    assert not loaded & {"pandas", "matplotlib", "dask"}
 
 
 def test_command_list_matches_the_command_modules():
@@ -175,67 +147,12 @@ def test_synth_jobs_give_the_same_clips(tmp_path):
         assert (tmp_path / "one" / name).read_bytes() == (tmp_path / "two" / name).read_bytes()
 
 
-def test_models_planned_on_threads_are_the_same(monkeypatch):
+def test_models_planned_on_threads_are_the_same():
     from perception.recognition.planning import build_models
 
     scene = SceneSpec(distance=0.28)
-    monkeypatch.setenv("HAMMER_MV_PLAN_THREADS", "2")
-    two = build_models(_specs(), scene)
-    monkeypatch.setenv("HAMMER_MV_PLAN_THREADS", "1")
-    one = build_models(_specs(), scene)
+    two = build_models(_specs(), scene, threads=2)
+    one = build_models(_specs(), scene, threads=1)
     for a, b in zip(one, two):
         for ca, cb in zip(a.chains, b.chains):
             np.testing.assert_array_equal(ca.L, cb.L)
-
-
-@pytest.mark.parametrize("modules", [
-    "perception.tracking.tracker, perception.io.tracks, hammer_mv.cli.track",
-    # what a spawned batch worker imports before its first clip (0.35 s, not 0.85 s)
-    "perception.batch, perception.recognition.repertoire",
-    # what a worker process imports to start (its initialiser's module)
-    "perception.workers",
-])
-def test_tracking_and_batch_workers_start_without_pandas_scipy_or_matplotlib(modules):
-    code = (f"import sys, {modules}\n"
-            "print(sorted({'pandas', 'scipy', 'matplotlib', 'dask'} & set(sys.modules)))")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         check=True)
-    assert out.stdout.strip() == "[]"
-
-
-_FAULTS = """
-import resource, numpy as np
-from perception.cluster import OneThreadPerWorker
-
-def faults():
-    before = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
-    for _ in range(50):
-        frame = np.ones((480, 640, 3), np.uint8)  # touches every page
-        del frame
-    return resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before
-
-plugin = OneThreadPerWorker()
-slow = faults()
-plugin.setup(worker=None)
-fast = faults()
-plugin.teardown(worker=None)
-print(plugin._trim is not None, slow, fast, faults())
-"""
-
-
-@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's allocator")
-def test_a_cluster_worker_reuses_freed_frames_while_a_batch_runs_and_then_is_put_back():
-    import os
-
-    env = {**os.environ, "MALLOC_TRIM_THRESHOLD_": "65536"}  # dask's nanny sets this
-    out = subprocess.run([sys.executable, "-c", _FAULTS], capture_output=True, text=True,
-                         check=True, env=env).stdout.split()
-    changed, slow, fast, after = out[0], int(out[1]), int(out[2]), int(out[3])
-    assert changed == "True"
-    assert slow > 50 * 200  # a fresh mmap per frame: every page faults
-    assert fast < slow / 20
-    assert after > 50 * 200  # teardown put the worker's own thresholds back
-    env.pop("MALLOC_TRIM_THRESHOLD_")
-    plain = subprocess.run([sys.executable, "-c", _FAULTS], capture_output=True, text=True,
-                           check=True, env=env).stdout.split()
-    assert plain[0] == "False"  # glibc's own adaptive thresholds are left alone

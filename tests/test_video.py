@@ -71,14 +71,11 @@ def test_prefetch_and_direct_reading_agree_and_early_stop_is_clean(tmp_path):
 
 
 @pytest.mark.parametrize("ext", [".mp4", ".mkv"])
-def test_one_decoder_thread_gives_the_same_frames(tmp_path, monkeypatch, ext):
-    from perception.io import video
-
+def test_one_decoder_thread_gives_the_same_frames(tmp_path, ext):
     path = tmp_path / f"clip{ext}"
     write_video(_frames(20), path, 30)
     default = list(FrameSource(path))
-    monkeypatch.setattr(video, "decoder_threads", 1)  # as a batch worker decodes
-    src = FrameSource(path)
+    src = FrameSource(path, threads=1)  # as a batch worker decodes
     assert src._cap.get(cv2.CAP_PROP_N_THREADS) == 1  # FFmpeg was told
     single = list(src)
     assert [(i, t) for i, t, _ in default] == [(i, t) for i, t, _ in single]

@@ -76,16 +76,17 @@ def _alone(items, out: Path, rep, ready, results) -> None:
     import cv2
     import pandas  # noqa: F401  (the report's imports: a batch's main process has them)
     import scipy.special  # noqa: F401
+    from threadpoolctl import threadpool_limits
 
-    from perception.io import video
-    from perception.recognition import planning
+    from perception.pipeline import RecognitionSettings
 
-    # as a batch's worker process runs (perception.workers.init_worker)
+    # as a batch's worker process runs (perception.workers.init_worker, and the
+    # settings a batch gives its workers)
     cv2.setNumThreads(1)
-    video.decoder_threads = planning.threads = 1
+    threadpool_limits(1)
     ready.wait(timeout=300)  # a sibling that died before it would otherwise hang us
     t0 = time.perf_counter()
-    _batch(items, out, rep)
+    _batch(items, out, rep, settings=RecognitionSettings(decoder_threads=1, planning_threads=1))
     results.put((t0, time.perf_counter()))
 
 

@@ -47,8 +47,8 @@ COMMANDS = {
 
 _EVERY = object()
 
-#: Thread-pool sizes of numpy's BLAS and OpenMP, read when they load (here, and in
-#: the worker processes of ``--jobs``, which inherit this process's environment).
+#: Thread-pool sizes of BLAS and OpenMP a user may set: where one is set, the
+#: command leaves the thread pools as the libraries read it (:func:`one_blas_thread`).
 THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
                     "VECLIB_MAXIMUM_THREADS")
 
@@ -71,6 +71,25 @@ def serial_opencv() -> None:
     import cv2
 
     cv2.setNumThreads(1)
+
+
+def one_blas_thread() -> None:
+    """One BLAS/OpenMP thread in this process (``threadpoolctl.threadpool_limits``),
+    unless the user set one of :data:`THREAD_VARIABLES`.
+
+    Every matrix here is small, and waking a BLAS thread pool costs more than
+    it saves (planning a repertoire: 0.17 s with one thread, 0.25 s with two).
+    The limit reaches the thread pools loaded when it is set: numpy's BLAS
+    (loaded here) and, for the commands that track, OpenCV's
+    (:func:`serial_opencv` runs first). The worker processes of ``--jobs``
+    limit their own (:func:`perception.workers.init_worker`).
+    """
+    if any(os.environ.get(name) for name in THREAD_VARIABLES):
+        return
+    import numpy  # noqa: F401 - its BLAS loaded, so that the limit reaches it
+    from threadpoolctl import threadpool_limits
+
+    threadpool_limits(1)
 
 
 #: What ``hammer-mv --help`` says before the commands.
@@ -188,10 +207,12 @@ def _run(args: argparse.Namespace) -> int:
     long run is not buried in numpy's RuntimeWarnings, yet none goes unseen.
     A command that fails prints its one line only. Our own warnings go
     through ``logging`` and show as always. The commands that track run
-    with OpenCV's thread pool off (:func:`serial_opencv`).
+    with OpenCV's thread pool off (:func:`serial_opencv`), every command with
+    one BLAS thread (:func:`one_blas_thread`).
     """
     if args.command in TRACKING_COMMANDS:
         serial_opencv()
+    one_blas_thread()
     if args.verbose:
         return int(args.func(args) or 0)
     with warnings.catch_warnings(record=True) as caught:
@@ -212,11 +233,6 @@ def main(argv: list[str] | None = None) -> int:
     # we report those files in one line ourselves. Set before any video opens.
     os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "-8")
     os.environ.setdefault("OPENCV_LOG_LEVEL", "ERROR")
-    # One BLAS/OpenMP thread unless the user says otherwise: every matrix here
-    # is small, and waking a BLAS thread pool costs more than it saves (planning
-    # a repertoire: 0.17 s with one thread, 0.25 s with two). Set before numpy loads.
-    for name in THREAD_VARIABLES:
-        os.environ.setdefault(name, "1")
     argv = sys.argv[1:] if argv is None else list(argv)
     parser = build_parser(_command(argv))
     args = parser.parse_args(argv)

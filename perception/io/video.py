@@ -58,13 +58,6 @@ TIME_SOURCES = ("container", "index/fps", "mixed")
 #: frames) short of the count its header claims.
 TRUNCATION_TOLERANCE = 0.02
 
-#: Threads FFmpeg decodes a video with (0: FFmpeg's choice, about one per
-#: core). A process working beside others (a batch worker) sets 1: its
-#: parallelism is theirs, and one decoding thread spends the least CPU per
-#: frame. Read when a :class:`FrameSource` opens its file.
-decoder_threads = 0
-
-
 def sha256_file(path: str | os.PathLike, chunk: int = 1 << 20) -> str:
     """Hex SHA-256 of the file at ``path``, read in ``chunk``-byte pieces (memory stays flat)."""
     h = hashlib.sha256()
@@ -128,6 +121,11 @@ class FrameSource(capture.Source):
     fps : float, optional
         The true frame rate, frames/s: frame times become ``index / fps``,
         whatever the container says (for files whose header is wrong).
+    threads : int
+        Threads FFmpeg decodes with (0: FFmpeg's choice, about one per core).
+        A process working beside others (a batch worker) passes 1: its
+        parallelism is theirs, and one decoding thread spends the least CPU
+        per frame.
 
     Raises
     ------
@@ -147,7 +145,7 @@ class FrameSource(capture.Source):
     """
 
     def __init__(self, path: str | os.PathLike, *, prefetch: int = 8, hash: bool = True,
-                 keep_truncated: bool = False, fps: float | None = None):
+                 keep_truncated: bool = False, fps: float | None = None, threads: int = 0):
         self.path = Path(path)
         self.prefetch = int(prefetch)
         self.keep_truncated = bool(keep_truncated)
@@ -161,9 +159,8 @@ class FrameSource(capture.Source):
         if self.path.stat().st_size == 0:
             raise InputError("empty file (0 bytes)", self.path)
         with opencv_name(self.path) as name:
-            cap = (cv2.VideoCapture(name, cv2.CAP_FFMPEG,
-                                    [cv2.CAP_PROP_N_THREADS, decoder_threads])
-                   if decoder_threads > 0 else cv2.VideoCapture(name, cv2.CAP_FFMPEG))
+            cap = (cv2.VideoCapture(name, cv2.CAP_FFMPEG, [cv2.CAP_PROP_N_THREADS, int(threads)])
+                   if threads > 0 else cv2.VideoCapture(name, cv2.CAP_FFMPEG))
         if not cap.isOpened():
             cap.release()
             raise InputError("not a readable video (FFmpeg could not open it)", self.path)

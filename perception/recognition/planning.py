@@ -94,29 +94,15 @@ def build_model(spec: ModelSpec, scene: SceneSpec) -> MotorModel:
     )
 
 
-#: Environment variable: threads that plan a repertoire's models (see :func:`planning_threads`).
-THREADS_VARIABLE = "HAMMER_MV_PLAN_THREADS"
-#: Threads that plan in this process, where set (before the variable): a worker
-#: process's initialiser sets 1, as its siblings already use every core.
-threads: int | None = None
-
-
 def planning_threads() -> int:
-    """Threads :func:`build_models` uses: :data:`threads` if set, else
-    ``$HAMMER_MV_PLAN_THREADS``, else up to 4.
+    """Threads :func:`build_models` uses by default: the cores this process may use, at most 4.
 
     The solver's compiled passes (two thirds of planning) release the GIL, so
     several models plan at once (on 2 idle cores a new scene's 10 default
     models took 144 ms, against 165-197 ms on one thread; on a busy machine
-    threads gain nothing). The default is the cores this process may
-    use, at most 4 (past that the Python third, which holds the GIL, is all
-    that is left). A batch's workers use one each: they already use every core.
+    threads gain nothing). Past 4, the Python third, which holds the GIL, is
+    all that is left. A batch's workers pass 1: they already use every core.
     """
-    if threads is not None:
-        return threads
-    value = os.environ.get(THREADS_VARIABLE, "")
-    if value.strip().isdigit() and int(value) >= 1:
-        return int(value)
     try:
         cores = len(os.sched_getaffinity(0))
     except AttributeError:  # not on every platform
@@ -124,8 +110,9 @@ def planning_threads() -> int:
     return max(1, min(4, cores))
 
 
-def build_models(specs: Iterable[ModelSpec], scene: SceneSpec) -> list[MotorModel]:
-    """:func:`build_model` of every spec, in order, on :func:`planning_threads` threads.
+def build_models(specs: Iterable[ModelSpec], scene: SceneSpec, *,
+                 threads: int | None = None) -> list[MotorModel]:
+    """:func:`build_model` of every spec, in order, on ``threads`` threads.
 
     Parameters
     ----------
@@ -133,9 +120,12 @@ def build_models(specs: Iterable[ModelSpec], scene: SceneSpec) -> list[MotorMode
         The movements.
     scene : SceneSpec
         The scene.
+    threads : int, optional
+        Threads that plan (default: :func:`planning_threads`); the models are
+        the same whatever the number.
     """
     specs = list(specs)
-    threads = min(planning_threads(), len(specs))
+    threads = min(planning_threads() if threads is None else max(1, int(threads)), len(specs))
     if threads <= 1:
         return [build_model(s, scene) for s in specs]
     from concurrent.futures import ThreadPoolExecutor

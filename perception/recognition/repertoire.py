@@ -186,7 +186,8 @@ class Repertoire:
         except PlanningError as exc:  # a model the config's scene cannot hold
             raise PlanningError(exc.problem, path, field=exc.field) from None
 
-    def for_scene(self, scene: SceneSpec, cache: PlanCache | None = None) -> list[MotorModel]:
+    def for_scene(self, scene: SceneSpec, cache: PlanCache | None = None, *,
+                  threads: int | None = None) -> list[MotorModel]:
         """The models, re-planned for ``scene`` where their stored scene differs.
 
         Parameters
@@ -196,11 +197,13 @@ class Repertoire:
         cache : PlanCache, optional
             Plans shared with other processes (a batch's workers): models
             another process has re-planned for this scene are read, not planned.
+        threads : int, optional
+            Threads that plan (see :func:`~perception.recognition.planning.build_models`).
         """
-        return self._for_scene(self.models, scene, cache)
+        return self._for_scene(self.models, scene, cache, threads)
 
     def _for_scene(self, models: list[MotorModel], scene: SceneSpec,
-                   cache: PlanCache | None) -> list[MotorModel]:
+                   cache: PlanCache | None, threads: int | None = None) -> list[MotorModel]:
         grid = scene.quantized()
         todo = [m for m in models
                 if not m.scene.matches(scene) and (m.name, grid) not in self._replanned]
@@ -211,7 +214,7 @@ class Repertoire:
                          grid.tip_start, 1 / grid.frame_period)
                 # a re-planned model keeps its source's calibration (it transfers
                 # across scenes: docs/recognition.md)
-                return _calibrated(build_models([m.spec for m in todo], grid),
+                return _calibrated(build_models([m.spec for m in todo], grid, threads=threads),
                                    [getattr(m, "calibration", None) for m in todo],
                                    compute=False)
 
@@ -330,9 +333,12 @@ class LazyRepertoire(Repertoire):
 
     @property
     def models(self) -> list[MotorModel]:
+        return self._planned()
+
+    def _planned(self, threads: int | None = None) -> list[MotorModel]:
         if self._models is None:
             shipped = _shipped_calibrations()
-            self._models = _calibrated(build_models(self._specs, self._scene),
+            self._models = _calibrated(build_models(self._specs, self._scene, threads=threads),
                                        [shipped.get(s.name) for s in self._specs],
                                        compute=False)  # any other calibrated when asked
         return self._models
@@ -349,13 +355,14 @@ class LazyRepertoire(Repertoire):
     def __len__(self) -> int:
         return len(self._specs)
 
-    def for_scene(self, scene: SceneSpec, cache: PlanCache | None = None) -> list[MotorModel]:
+    def for_scene(self, scene: SceneSpec, cache: PlanCache | None = None, *,
+                  threads: int | None = None) -> list[MotorModel]:
         if self._models is None and not self._scene.matches(scene):
             # the stored (default-scene) plans would all be re-planned: plan the
             # clip's scene only, as the placeholder models below stand for
             stand_ins = [_Unplanned(s, self._scene) for s in self._specs]
-            return self._for_scene(stand_ins, scene, cache)
-        return super().for_scene(scene, cache)
+            return self._for_scene(stand_ins, scene, cache, threads)
+        return self._for_scene(self._planned(threads), scene, cache, threads)
 
 
 @dataclasses.dataclass(frozen=True)

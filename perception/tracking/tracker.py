@@ -544,6 +544,7 @@ def track_video(
     keep_truncated: bool = False,
     fps: float | None = None,
     frames: FrameSample | None = None,
+    decoder_threads: int = 0,
 ) -> Path:
     """Track a video file into a tracks file (``<stem>.tracks.h5`` beside it by default).
 
@@ -571,6 +572,9 @@ def track_video(
         is written at this rate too).
     frames : FrameSample, optional
         Keeps a few of the frames as they are decoded (for the contact sheet).
+    decoder_threads : int
+        Threads FFmpeg decodes with (0: FFmpeg's choice; a batch worker
+        passes 1, see :class:`~perception.io.video.FrameSource`).
 
     Returns
     -------
@@ -597,7 +601,8 @@ def track_video(
     tracker = Tracker(markers, params, rois)
     with contextlib.ExitStack() as stack:
         src = stack.enter_context(FrameSource(video, prefetch=prefetch,
-                                              keep_truncated=keep_truncated, fps=fps))
+                                              keep_truncated=keep_truncated, fps=fps,
+                                              threads=decoder_threads))
         # /video (with the file's SHA-256, read meanwhile) and /tracker are
         # written when tracking is done; until then only src.header is read.
         w = stack.enter_context(TracksWriter(out_path, markers.names))
