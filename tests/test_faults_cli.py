@@ -10,23 +10,28 @@ is silent on success.
 
 from __future__ import annotations
 
+import os
+import re
 import sys
 import warnings
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pandas as pd
+import psutil
 import pytest
+from _faults import one_line
 
 import hammer_mv.cli.batch as batch_cli
-import hammer_mv.cli.checks as checks
 import hammer_mv.cli.synth as synth_cli
 from hammer_mv.cli import main
+from minvar.task import ReachTask
 from perception.errors import InputError, PlanningError
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-RECIPE = "[conditions]\nnormal = 2\n"
+BUG = "this is a bug in hammer-mv (not in your input); please report it with the traceback above"
 
 
 def _lines(text: str) -> list[str]:
@@ -36,7 +41,7 @@ def _lines(text: str) -> list[str]:
 @pytest.fixture
 def recipe(tmp_path):
     path = tmp_path / "r.toml"
-    path.write_text(RECIPE)
+    path.write_text("[conditions]\nnormal = 2\n")
     return path
 
 
@@ -49,61 +54,50 @@ def _synth(recipe, *extra):
     return main(["synth", str(recipe), "-o", str(recipe.parent / "out"), *extra])
 
 
+def _raise(error, warn=False):
+    def body(*args):
+        if warn:
+            warnings.warn("noise", RuntimeWarning, stacklevel=1)
+        raise error
+    return body
+
+
 # -- a bug against a user's mistake
 
-def test_a_bare_value_error_is_a_bug_with_its_traceback(monkeypatch, recipe, capsys):
-    def body(args):
-        raise ValueError("deep inside: shapes (3,) and (4,) differ")
-
-    _command(monkeypatch, body)
-    assert _synth(recipe) == 1
+@pytest.mark.parametrize("command, error", [
+    ("synth", "deep inside: shapes (3,) and (4,) differ"),
+    ("reach", "ReachTask.shoulder: not a user's option"),  # a field's name, yet no option's
+], ids=["bare ValueError", "ValueError naming no option"])
+def test_a_value_error_is_a_bug_with_its_traceback(command, error, monkeypatch, recipe, capsys):
+    if command == "synth":
+        _command(monkeypatch, _raise(ValueError(error)))
+        assert _synth(recipe) == 1
+    else:
+        monkeypatch.setattr(ReachTask, "steps", _raise(ValueError(error)))
+        assert main(["reach", "-o", str(recipe.parent / "out")]) == 1
     err = capsys.readouterr().err
-    assert "Traceback (most recent call last)" in err
-    assert "ValueError: deep inside: shapes (3,) and (4,) differ" in err
-    assert _lines(err)[-1] == ("hammer-mv synth: this is a bug in hammer-mv (not in your input); "
-                               "please report it with the traceback above")
+    assert "Traceback (most recent call last)" in err and f"ValueError: {error}" in err
+    assert _lines(err)[-1] == f"hammer-mv {command}: {BUG}"
     assert "error:" not in err  # not dressed up as the user's mistake
 
 
-def test_an_input_error_is_one_line_naming_file_and_field(monkeypatch, recipe, capsys):
-    def body(args):
-        raise InputError("expected a number, got 'x'", "r.toml", field="[scene] duration")
-
+@pytest.mark.parametrize("body, status, line", [
+    (_raise(InputError("expected a number, got 'x'", "r.toml", field="[scene] duration")), 2,
+     "hammer-mv synth: error: r.toml: [scene] duration: expected a number, got 'x'"),
+    (_raise(PlanningError("out of the arm's reach", "clip.mp4")), 2,
+     "hammer-mv synth: error: clip.mp4: out of the arm's reach"),
+    (_raise(FileNotFoundError(2, "No such file or directory", "/data/missing.mp4")), 2,
+     "hammer-mv synth: error: /data/missing.mp4: No such file or directory"),
+    (_raise(KeyboardInterrupt), 130, "hammer-mv: interrupted"),
+    (_raise(InputError("bad", "x.toml"), warn=True), 2, "hammer-mv synth: error: x.toml: bad"),
+], ids=["input error names file and field", "planning error is the user's too",
+        "OS error names its file", "interrupted is 130",
+        "a failing command prints its error, not the warnings' summary"])
+def test_a_users_mistake_is_one_line(body, status, line, monkeypatch, recipe, capsys):
     _command(monkeypatch, body)
-    assert _synth(recipe) == 2
+    assert _synth(recipe) == status
     captured = capsys.readouterr()
-    assert _lines(captured.err) == [
-        "hammer-mv synth: error: r.toml: [scene] duration: expected a number, got 'x'"]
-    assert "Traceback" not in captured.err and captured.out == ""
-
-
-def test_a_planning_error_is_the_users_too(monkeypatch, recipe, capsys):
-    def body(args):
-        raise PlanningError("out of the arm's reach", "clip.mp4")
-
-    _command(monkeypatch, body)
-    assert _synth(recipe) == 2
-    assert _lines(capsys.readouterr().err) == [
-        "hammer-mv synth: error: clip.mp4: out of the arm's reach"]
-
-
-def test_an_os_error_names_its_file(monkeypatch, recipe, capsys):
-    def body(args):
-        raise FileNotFoundError(2, "No such file or directory", "/data/missing.mp4")
-
-    _command(monkeypatch, body)
-    assert _synth(recipe) == 2
-    assert _lines(capsys.readouterr().err) == [
-        "hammer-mv synth: error: /data/missing.mp4: No such file or directory"]
-
-
-def test_interrupted_is_130(monkeypatch, recipe, capsys):
-    def body(args):
-        raise KeyboardInterrupt
-
-    _command(monkeypatch, body)
-    assert _synth(recipe) == 130
-    assert _lines(capsys.readouterr().err) == ["hammer-mv: interrupted"]
+    assert _lines(captured.err) == [line] and captured.out == ""
 
 
 # -- library warnings
@@ -115,46 +109,21 @@ def _warns(args):
     return 0
 
 
-def test_warnings_are_summarised_in_one_line(monkeypatch, recipe, capsys):
+@pytest.mark.parametrize("flag, shown, stderr", [
+    ([], [], r"hammer-mv synth: 2 library warning\(s\) hidden \(first: RuntimeWarning: "
+             r"invalid value.*; -v shows them\n"),
+    (["-v"], ["RuntimeWarning", "UserWarning"], r"(?s)(?!.*hidden).*"),
+    (["--quiet"], [], r""),
+], ids=["summarised in one line", "shown with verbose", "silent with quiet"])
+def test_library_warnings(flag, shown, stderr, monkeypatch, recipe, capsys):
     _command(monkeypatch, _warns)
-    with warnings.catch_warnings(record=True) as leaked:
+    with warnings.catch_warnings(record=True) as seen:
         warnings.simplefilter("default")
-        assert _synth(recipe) == 0
+        assert _synth(recipe, *flag) == 0
     captured = capsys.readouterr()
     assert captured.out == "done\n"
-    lines = _lines(captured.err)
-    assert len(lines) == 1, captured.err
-    assert lines[0].startswith("hammer-mv synth: 2 library warning(s) hidden (first: "
-                               "RuntimeWarning: invalid value"), lines[0]
-    assert lines[0].endswith("; -v shows them")
-    assert leaked == []  # none went past the summary
-
-
-def test_warnings_are_shown_with_verbose(monkeypatch, recipe, capsys):
-    _command(monkeypatch, _warns)
-    with warnings.catch_warnings(record=True) as shown:
-        warnings.simplefilter("default")
-        assert _synth(recipe, "-v") == 0
-    assert sorted(w.category.__name__ for w in shown) == ["RuntimeWarning", "UserWarning"]
-    assert "hidden" not in capsys.readouterr().err
-
-
-def test_warnings_are_silent_with_quiet(monkeypatch, recipe, capsys):
-    _command(monkeypatch, _warns)
-    with warnings.catch_warnings(record=True) as leaked:
-        warnings.simplefilter("default")
-        assert _synth(recipe, "--quiet") == 0
-    assert capsys.readouterr().err == "" and leaked == []
-
-
-def test_a_failing_command_prints_its_error_not_the_summary(monkeypatch, recipe, capsys):
-    def body(args):
-        warnings.warn("noise", RuntimeWarning, stacklevel=1)
-        raise InputError("bad", "x.toml")
-
-    _command(monkeypatch, body)
-    assert _synth(recipe) == 2
-    assert _lines(capsys.readouterr().err) == ["hammer-mv synth: error: x.toml: bad"]
+    assert re.fullmatch(stderr, captured.err), captured.err
+    assert sorted(w.category.__name__ for w in seen) == shown  # none went past the summary
 
 
 # -- --jobs
@@ -163,8 +132,9 @@ def test_a_failing_command_prints_its_error_not_the_summary(monkeypatch, recipe,
 def machine(monkeypatch):
     """A machine of 2 cores and 23.1 GiB free; returns a setter for both."""
     state = {"cores": 2, "memory": int(23.1 * 2**30)}
-    monkeypatch.setattr(checks, "usable_cores", lambda: state["cores"])
-    monkeypatch.setattr(checks, "free_memory", lambda: state["memory"])
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: set(range(state["cores"])))
+    monkeypatch.setattr(psutil, "virtual_memory", lambda: SimpleNamespace(
+        available=state["memory"]))
     return state
 
 
@@ -183,47 +153,31 @@ def fake_synthesize(monkeypatch):
     return calls
 
 
-def test_jobs_capped_at_the_cores(machine, fake_synthesize, recipe, capsys):
-    assert _synth(recipe, "--jobs", "1000") == 0
+@pytest.mark.parametrize("cores, gib, extra, stderr", [
+    (2, 23.1, ["--jobs", "1000"], "--jobs 1000 capped at 2 (2 cores, 23.1 GiB free)"),
+    (16, 1.3, ["--jobs", "8"], "--jobs 8 capped at 2 (16 cores, 1.3 GiB free)"),
+    (2, 23.1, ["--jobs", "2"], ""),
+    (2, 23.1, ["--jobs", "1000", "--quiet"], ""),
+], ids=["capped at the cores", "capped at the free memory (two workers' worth)",
+        "within the machine kept silently", "capped quietly with quiet"])
+def test_jobs_capped_at_the_machine(cores, gib, extra, stderr, machine, fake_synthesize, recipe,
+                                    capsys):
+    machine.update(cores=cores, memory=int(gib * 2**30))
+    assert _synth(recipe, *extra) == 0
     assert fake_synthesize == [2]
-    err = _lines(capsys.readouterr().err)
-    assert err == ["hammer-mv synth: --jobs 1000 capped at 2 (2 cores, 23.1 GiB free)"]
+    out, err = capsys.readouterr()
+    assert err == (f"hammer-mv synth: {stderr}\n" if stderr else "")
+    assert out == "" or "--quiet" not in extra
 
 
-def test_jobs_capped_at_the_free_memory(machine, fake_synthesize, recipe, capsys):
-    machine.update(cores=16, memory=int(1.3 * 2**30))  # two workers' worth
-    assert _synth(recipe, "--jobs", "8") == 0
-    assert fake_synthesize == [2]
-    assert "--jobs 8 capped at 2 (16 cores, 1.3 GiB free)" in capsys.readouterr().err
-
-
-def test_jobs_within_the_machine_are_kept_silently(machine, fake_synthesize, recipe, capsys):
-    assert _synth(recipe, "--jobs", "2") == 0
-    assert fake_synthesize == [2] and capsys.readouterr().err == ""
-
-
-def test_jobs_capped_quietly_with_quiet(machine, fake_synthesize, recipe, capsys):
-    assert _synth(recipe, "--jobs", "1000", "--quiet") == 0
-    assert fake_synthesize == [2]
-    assert capsys.readouterr() == ("", "")
-
-
-def test_the_real_machine_caps_too():
-    cores = checks.usable_cores()
-    assert 1 <= cores <= (checks.os.cpu_count() or cores)
-    assert 1 <= checks.cap_jobs(10**6, "batch", quiet=True) <= cores
-    memory = checks.free_memory()
-    assert memory is None or memory > 0
-
-
-@pytest.mark.parametrize("command", ["synth", "batch"])
-@pytest.mark.parametrize("jobs", ["0", "-2"])
-def test_jobs_below_one_refused(command, jobs, recipe, tmp_path, capsys):
-    assert main([command, str(recipe if command == "synth" else tmp_path), "-o",
-                 str(tmp_path / "out"), "--jobs", jobs]) == 2
-    err = _lines(capsys.readouterr().err)
-    assert len(err) == 1 and err[0].startswith(f"hammer-mv {command}: error: --jobs: "), err
-    assert not (tmp_path / "out").exists()
+def test_the_real_machine_caps_too(fake_synthesize, recipe, capsys):
+    assert _synth(recipe, "--jobs", "1000000") == 0
+    (jobs,) = fake_synthesize
+    line = one_line(capsys.readouterr().err)
+    m = re.fullmatch(r"hammer-mv synth: --jobs 1000000 capped at (\d+) \((\d+) cores?"
+                     r"(?:, ([\d.]+) GiB free)?\)", line)
+    assert m and int(m[1]) == jobs and 1 <= jobs <= int(m[2]) <= (os.cpu_count() or jobs), line
+    assert m[3] is None or float(m[3]) > 0
 
 
 def test_batch_caps_jobs_and_names_the_commonest_failure(machine, monkeypatch, tmp_path,
@@ -270,9 +224,7 @@ def test_recognize_into_an_existing_file_fails_before_tracking(monkeypatch, tmp_
 
     monkeypatch.setattr(pipeline, "load_clip", never)
     assert main(["recognize", str(video), "-o", str(taken)]) == 2
-    err = _lines(capsys.readouterr().err)
-    assert len(err) == 1 and str(taken) in err[0] and "--output" in err[0], err
-    assert "not a folder" in err[0]
+    one_line(capsys.readouterr().err, str(taken), "--output", "not a folder")
     assert taken.read_text() == "not a folder"
 
 
@@ -283,13 +235,6 @@ def tracks_file(tmp_path_factory):
     path = tmp_path_factory.mktemp("clip") / "n.tracks.h5"
     demo_tracks("normal", 0)[0].save(path)
     return path
-
-
-def test_recognize_quiet_prints_nothing(tracks_file, tmp_path, capsys):
-    out = tmp_path / "out"
-    assert main(["recognize", str(tracks_file), "-o", str(out), "--no-figures", "--quiet"]) == 0
-    assert capsys.readouterr() == ("", "")
-    assert (out / "n.recognition.json").exists()
 
 
 def test_recognize_says_verdict_and_winner(tracks_file, tmp_path, capsys):
@@ -305,6 +250,19 @@ def test_recognize_says_verdict_and_winner(tracks_file, tmp_path, capsys):
     assert line.endswith(str(out / "n.recognition.json"))
 
 
+@pytest.mark.parametrize("argv, output", [
+    (["reach", "--trials", "5"], "out"),
+    (["grasp", "simulate", "--trials", "2"], "out"),
+    (["repertoire", "build", "--durations", "1.0"], "rep.h5"),
+    (["recognize", "{tracks}", "--no-figures"], "out/n.recognition.json"),
+], ids=["reach", "grasp", "repertoire", "recognize"])
+def test_quiet_commands_print_nothing_on_success(argv, output, tracks_file, tmp_path, capsys):
+    argv = [a.format(tracks=tracks_file) for a in argv]
+    assert main([*argv, "-o", str(tmp_path / output.split("/")[0]), "--quiet"]) == 0
+    assert capsys.readouterr() == ("", "")
+    assert (tmp_path / output).exists()
+
+
 def test_synth_quiet_prints_nothing(fake_synthesize, recipe, capsys):
     assert _synth(recipe, "--quiet") == 0
     assert capsys.readouterr() == ("", "")
@@ -312,7 +270,7 @@ def test_synth_quiet_prints_nothing(fake_synthesize, recipe, capsys):
     assert _lines(capsys.readouterr().out)[0].startswith("wrote 2 clips to ")
 
 
-# -- option values checked at the boundary
+# -- option values checked at the boundary, named by their flag
 
 @pytest.mark.parametrize("argv, field", [
     (["reach", "--r", "-1"], "--r"),
@@ -326,35 +284,21 @@ def test_synth_quiet_prints_nothing(fake_synthesize, recipe, capsys):
     (["reach", "--seed", "-1"], "--seed"),  # numpy's own ValueError, checked first
     (["grasp", "experiment", "object-size", "--seed", "-1"], "--seed"),
     (["synth", "r.toml", "--seed", "-1"], "--seed"),
-])
-def test_option_values_are_named_not_tracebacks(argv, field, tmp_path, capsys):
-    out = tmp_path / ("r.h5" if argv[0] == "repertoire" else "x")
-    assert main([*argv, "-o", str(out)]) == 2
-    err = _lines(capsys.readouterr().err)
-    assert len(err) == 1 and f": error: {field}: " in err[0], err
-    assert not out.exists()
-
-
-@pytest.mark.parametrize("extra, field", [
-    (["--w-g", "-1"], "--w-g"), (["--filter-gain", "2"], "--filter-gain"),
-    (["--px-per-m", "0"], "--px-per-m"), (["--object-diameter", "inf"], "--object-diameter"),
-    (["--pcutoff", "2"], "--pcutoff"), (["--keypoints", "thumb"], "--keypoints"),
-])
-def test_recognition_options_are_named(extra, field, tmp_path, capsys):
+    *[(["recognize", "{clip}", flag, value], flag) for flag, value in [
+        ("--w-g", "-1"), ("--filter-gain", "2"), ("--px-per-m", "0"),
+        ("--object-diameter", "inf"), ("--pcutoff", "2"), ("--keypoints", "thumb")]],
+    *[([command, folder, "--jobs", jobs], "--jobs") for jobs in ["0", "-2"]
+      for command, folder in [("synth", "{recipe}"), ("batch", "{folder}")]],
+], ids=lambda v: " ".join(v) if isinstance(v, list) else None)
+def test_option_values_are_named_not_tracebacks(argv, field, recipe, tmp_path, capsys):
     clip = tmp_path / "a.tracks.h5"
     clip.write_bytes(b"")
-    assert main(["recognize", str(clip), "-o", str(tmp_path / "out"), *extra]) == 2
-    err = _lines(capsys.readouterr().err)
-    assert len(err) == 1 and f"hammer-mv recognize: error: {field}: " in err[0], err
-
-
-def test_checks_option_leaves_a_bug_a_bug():
-    with pytest.raises(InputError) as info, checks.option("--trials"):
-        raise ValueError("--trials: too many")
-    assert str(info.value) == "--trials: too many" and info.value.field == "--trials"
-    with pytest.raises(ValueError) as info, checks.options({"w_v": "--w-v"}):
-        raise ValueError("ReachTask.shoulder: not a user's option")
-    assert not isinstance(info.value, InputError)
+    out = tmp_path / ("r.h5" if argv[0] == "repertoire" else "x")
+    argv = [a.format(clip=clip, recipe=recipe, folder=tmp_path) for a in argv]
+    assert main([*argv, "-o", str(out)]) == 2
+    line = one_line(capsys.readouterr().err)
+    assert line.startswith(f"hammer-mv {argv[0]}: error: {field}: "), line
+    assert not out.exists()
 
 
 # -- planning failures are PlanningErrors at their source
@@ -367,14 +311,13 @@ def test_an_unreachable_scene_is_a_planning_error():
         build_model(default_specs([1.0])[0], SceneSpec(distance=2.0))
 
 
-def _reference(self):
-    from perception.recognition.models import SceneSpec
-
-    return SceneSpec(), (0.6, 1.2)
-
-
-def _scene_observation(monkeypatch):
+@pytest.mark.parametrize("error", [
+    PlanningError("out of the arm's reach", field="distance"),
+    ValueError("operands could not be broadcast together"),
+], ids=["a planning error names the clip", "a bug stays a bug"])
+def test_recognize_tracks_names_the_clip_of_a_planning_error(monkeypatch, error):
     import perception.pipeline as pipeline
+    from perception.recognition.models import SceneSpec
     from perception.synthetic.demos import demo_tracks
 
     obs = pipeline.observe(demo_tracks("normal", 0)[0], clip="c")
@@ -382,46 +325,18 @@ def _scene_observation(monkeypatch):
     # no tracks at all: the start needs no settling either
     monkeypatch.setattr("perception.settling.settle_start",
                         lambda tracks, params, clip=None: (tracks, None))
-    return pipeline
 
+    class Scenes:
+        def reference(self):
+            return SceneSpec(), (0.6, 1.2)
 
-def test_recognize_tracks_names_the_clip_of_a_planning_error(monkeypatch):
-    pipeline = _scene_observation(monkeypatch)
+        def for_scene(self, scene, **kwargs):
+            raise error
 
-    class Unreachable:
-        reference = _reference
-
-        def for_scene(self, scene, cache=None):
-            raise PlanningError("out of the arm's reach", field="distance")
-
-    with pytest.raises(PlanningError) as info:
-        pipeline.recognize_tracks(None, Unreachable(), source="clip.mp4")
-    assert info.value.path == "clip.mp4" and info.value.field == "distance"
-    assert "out of the arm's reach" in str(info.value) and "--px-per-m" in str(info.value)
-
-
-def test_recognize_tracks_leaves_a_bug_a_bug(monkeypatch):
-    pipeline = _scene_observation(monkeypatch)
-
-    class Broken:
-        reference = _reference
-
-        def for_scene(self, scene, cache=None):
-            raise ValueError("operands could not be broadcast together")
-
-    with pytest.raises(ValueError) as info:
-        pipeline.recognize_tracks(None, Broken(), source="clip.mp4")
-    assert not isinstance(info.value, InputError | PlanningError)
-
-
-@pytest.mark.parametrize("argv", [
-    ["reach", "--trials", "5"],
-    ["grasp", "simulate", "--trials", "2"],
-    ["repertoire", "build", "--durations", "1.0"],
-], ids=["reach", "grasp", "repertoire"])
-def test_quiet_commands_print_nothing_on_success(argv, tmp_path, capsys):
-    out = tmp_path / ("rep.h5" if argv[0] == "repertoire" else "out")
-    assert main([*argv, "-o", str(out), "--quiet"]) == 0
-    captured = capsys.readouterr()
-    assert captured.out == "" and captured.err == ""
-    assert out.exists()
+    with pytest.raises(type(error)) as info:
+        pipeline.recognize_tracks(None, Scenes(), source="clip.mp4")
+    if isinstance(error, PlanningError):
+        assert info.value.path == "clip.mp4" and info.value.field == "distance"
+        assert "out of the arm's reach" in str(info.value) and "--px-per-m" in str(info.value)
+    else:
+        assert not isinstance(info.value, InputError | PlanningError)

@@ -1,10 +1,10 @@
 """Files that lie: sizes, values and kinds of file are checked before they are believed.
 
-Each test builds a small file that claims something absurd (a billion rows,
-a position of 1e20 px, gains x 1e200, a header of 0 frames/s) or is not a
-file at all (a FIFO), and checks that reading it ends in one
-:class:`~perception.errors.InputError` naming the file and the field, fast
-and without allocating what the file claims.
+Each case builds a small file that claims something absurd (a billion rows, a
+position of 1e20 px, gains x 1e200, a header of 0 frames/s) or is not a file
+at all (a FIFO); reading it must end, fast and without allocating what the
+file claims, in one :class:`~perception.errors.InputError` naming the file
+and the field.
 """
 
 from __future__ import annotations
@@ -17,22 +17,24 @@ import struct
 import subprocess
 import sys
 import textwrap
-import threading
 import time
-from pathlib import Path
 
 import cv2
 import h5py
 import numpy as np
 import pytest
+from _faults import error_within, refused
 
 from perception.errors import InputError
 from perception.io import atomic
 from perception.io.exports import export_tracks, status_path_for
-from perception.io.pose import PoseImport, read_pose, write_dlc
+from perception.io.pose import PoseImport, _movement, read_pose, write_dlc
 from perception.io.repertoire import read_repertoire
 from perception.io.tracks import Tracks
 from perception.io.video import FrameSource, sha256_file, write_video
+from perception.synthetic.recipes import load_recipe
+from perception.tracking.markers import load_markers
+from perception.tracking.setup import load_setup
 
 MARKERS = ("thumb", "finger", "wrist", "object")
 
@@ -51,42 +53,153 @@ def _frames(n, w=96, h=64):
         yield np.full((h, w, 3), 10 * i % 250, np.uint8)
 
 
-# -- sizes claimed, refused before anything is read --------------------------------------
-def test_tracks_claiming_half_a_billion_rows_is_refused_at_once(tmp_path):
-    path = tmp_path / "huge.tracks.h5"
-    _tracks().save(path)
-    n = 500_000_000
-    with h5py.File(path, "a") as fh:
-        g = fh["tracks"]
-        for name, tail, dtype in (("frame", (), "i8"), ("time", (), "f8"),
-                                  ("position", (4, 2), "f8"), ("likelihood", (4,), "f4"),
-                                  ("status", (4,), "i1")):
-            del g[name]
-            g.create_dataset(name, shape=(n, *tail), chunks=(1024, *tail), dtype=dtype)
-    start = time.perf_counter()
-    with pytest.raises(InputError) as err:
-        Tracks.load(path)
-    assert time.perf_counter() - start < 2.0
-    assert str(path) in str(err.value)
-    assert err.value.field and err.value.field.startswith("/tracks/")
-    assert "claims" in err.value.problem
+def _read_pose(path):
+    return read_pose(path, PoseImport(fps=30))
 
 
-def test_sleap_file_claiming_two_billion_frames_is_refused_at_once(tmp_path):
-    path = tmp_path / "huge.h5"
-    with h5py.File(path, "w") as fh:
+def _read_video(path):
+    return FrameSource(path, hash=False)
+
+
+@pytest.fixture(scope="module")
+def good(tmp_path_factory):
+    """A good tracks file (with colour models) and repertoire file to break."""
+    from perception.recognition.models import ModelSpec
+    from perception.recognition.repertoire import Repertoire
+
+    folder = tmp_path_factory.mktemp("good")
+    rep = Repertoire.build([ModelSpec("g", "grasp", {"duration": 0.5})])
+    return {"rep.h5": rep.save(folder / "rep.h5"),
+            "t.tracks.h5": _tracks(tracker={"colour_models": "{}"}).save(folder / "t.tracks.h5")}
+
+
+# A change breaks one object of an open HDF5 file.
+def _set(key, index, value):
+    def change(fh):
+        fh[key][index] = value
+    return change
+
+
+def _attr(key, name, value):
+    def change(fh):
+        fh[key].attrs[name] = value
+    return change
+
+
+def _scale(key, factor):
+    def change(fh):
+        fh[key][...] = fh[key][()] * factor
+    return change
+
+
+def _claim(fh):  # half a billion rows
+    for name, tail, dtype in (("frame", (), "i8"), ("time", (), "f8"), ("position", (4, 2), "f8"),
+                              ("likelihood", (4,), "f4"), ("status", (4,), "i1")):
+        del fh["tracks"][name]
+        fh["tracks"].create_dataset(name, shape=(500_000_000, *tail), chunks=(1024, *tail),
+                                    dtype=dtype)
+
+
+# A maker writes a file into ``folder`` and returns its path.
+def _sleap(folder):  # two billion frames
+    with h5py.File(folder / "huge.h5", "w") as fh:
         fh.create_dataset("tracks", shape=(1, 2, 4, 2_000_000_000), chunks=(1, 2, 4, 4096),
                           dtype="f4")
         fh["node_names"] = np.array([m.encode() for m in MARKERS])
         fh["track_names"] = np.array([b"a"])
-    from perception.io.pose import _movement
+    return folder / "huge.h5"
 
-    _movement()  # importing movement takes seconds: not what is timed
+
+def _dlc_far(folder):
+    t = _tracks()
+    position = t.position.copy()
+    position[5, 2] = (3.0, 1e20)
+    return write_dlc(t.replace(position=position), folder / "far.csv")
+
+
+def _avi_at_0(folder):
+    path = folder / "zero.avi"
+    write_video(_frames(10), path, 30)
+    data = bytearray(path.read_bytes())
+    i = data.find(b"strh")
+    assert data[i + 8:i + 12] == b"vids"
+    data[i + 32:i + 36] = struct.pack("<I", 0)  # rate
+    j = data.find(b"avih")
+    data[j + 8:j + 12] = struct.pack("<I", 0)  # microseconds per frame
+    path.write_bytes(bytes(data))
+    return path
+
+
+def _mp4_at_1000(folder):
+    write_video(_frames(10), folder / "ms.mp4", 1000.0)
+    return folder / "ms.mp4"
+
+
+def _case(name, make, read, field, match=None):
+    """``make``: a maker, or (good file, change); ``field``: "/x/" is any field under /x/."""
+    return pytest.param(make, read, field, match, id=name)
+
+
+TRACKS, REP = "t.tracks.h5", "rep.h5"
+FILES = [
+    # -- sizes claimed, refused before anything is read
+    _case("tracks claiming half a billion rows", (TRACKS, _claim), Tracks.load, "/tracks/",
+          "claims"),
+    _case("SLEAP file claiming two billion frames", _sleap, _read_pose, "/tracks", "claims"),
+    # -- values: positions, attributes
+    _case("position of 1e20 px", (TRACKS, _set("tracks/position", (3, 1), (1e20, 5.0))),
+          Tracks.load, "/tracks/position", r"(?s)^(?=.*finger).*far outside the frame"),
+    _case("infinite position", (TRACKS, _set("tracks/position", (4, 0), (np.inf, 1.0))),
+          Tracks.load, "/tracks/position", "infinite"),
+    _case("pose position of 1e20 px", _dlc_far, _read_pose, "position", "'wrist' at row 5"),
+    *[_case(f"colour models {value!r}", (TRACKS, _attr("tracker", "colour_models", value)),
+            Tracks.load, "/tracker.colour_models")
+      for value in [["thumb", "finger"], "[1, 2, 3]", "{not json", '{"thumb": {"bgr": [1, 2]}}']],
+    # -- repertoire values no plan has
+    *[_case(f"repertoire {name}", (REP, change), read_repertoire, field)
+      for name, change, field in [
+          ("L x 1e200", _scale("models/g/arm/L", 1e200), "/models/g/arm/L"),
+          ("K x 1e200", _scale("models/g/arm/K", 1e200), "/models/g/arm/K"),
+          ("P x -1", _scale("models/g/arm/P", -1.0), "/models/g/arm/P"),
+          ("P x 0", _scale("models/g/arm/P", 0.0), "/models/g/arm/P"),
+          ("substeps 0", _attr("models/g", "substeps", 0), "/models/g.substeps"),
+          ("substeps -3", _attr("models/g", "substeps", -3), "/models/g.substeps")]],
+    # -- frame rates in headers
+    _case("header of 0 frames/s, not read as 25", _avi_at_0, _read_video, "frame rate",
+          "no frame rate.*--fps"),
+    _case("header of 1000 frames/s", _mp4_at_1000, _read_video, "frame rate",
+          "claims 1000 frames/s.*--fps"),
+]
+
+
+@pytest.mark.parametrize("make, read, field, match", FILES)
+def test_a_file_that_lies_is_refused_naming_file_and_field(make, read, field, match, tmp_path,
+                                                           good):
+    if callable(make):
+        path = make(tmp_path)
+    else:
+        path = shutil.copy(good[make[0]], tmp_path)
+        with h5py.File(path, "a") as fh:
+            make[1](fh)
+    if read is _read_pose:
+        _movement()  # importing movement takes seconds: not what is timed
     start = time.perf_counter()
-    with pytest.raises(InputError) as err:
-        read_pose(path, PoseImport(fps=30))
+    error = refused(read, path, path=path, match=match)
     assert time.perf_counter() - start < 2.0
-    assert err.value.path == str(path) and err.value.field == "/tracks"
+    assert error.field == field or field.endswith("/") and error.field.startswith(field), error
+
+
+def test_good_files_still_read(tmp_path, good):
+    _, models = read_repertoire(good[REP])
+    assert [m.name for m in models] == ["g"] and models[0].substeps >= 1
+    path = shutil.copy(good[TRACKS], tmp_path)
+    with h5py.File(path, "a") as fh:
+        fh["tracks/position"][2, 0] = np.nan  # a NaN position is a lost marker
+    assert Tracks.load(path).n_frames
+    # a header refused is read with the frame rate given
+    times = [t for _, t, _ in FrameSource(_avi_at_0(tmp_path), hash=False, fps=30.0)]
+    np.testing.assert_allclose(times, np.arange(10) / 30.0)
+    assert FrameSource(_mp4_at_1000(tmp_path), hash=False, fps=500.0).header.fps_nominal == 1000.0
 
 
 def test_video_of_16000_px_frames_is_refused_before_decoding(tmp_path, monkeypatch):
@@ -115,40 +228,6 @@ def test_video_of_16000_px_frames_is_refused_before_decoding(tmp_path, monkeypat
     assert err.value.path == str(path) and err.value.field == "frame size"
 
 
-# -- values: positions, attributes ----------------------------------------------------------
-def test_position_of_1e20_px_is_refused(tmp_path):
-    t = _tracks()
-    position = t.position.copy()
-    position[3, 1] = (1e20, 5.0)
-    path = t.replace(position=position).save(tmp_path / "far.tracks.h5")
-    with pytest.raises(InputError, match="far outside the frame") as err:
-        Tracks.load(path)
-    assert err.value.field == "/tracks/position" and err.value.path == str(path)
-    assert "finger" in err.value.problem
-
-
-def test_infinite_position_is_refused_and_nan_is_lost(tmp_path):
-    t = _tracks()
-    position = t.position.copy()
-    position[2, 0] = np.nan
-    assert Tracks.load(t.replace(position=position).save(tmp_path / "ok.tracks.h5")).n_frames
-    position[4, 0] = (np.inf, 1.0)
-    path = t.replace(position=position).save(tmp_path / "inf.tracks.h5")
-    with pytest.raises(InputError, match="infinite"):
-        Tracks.load(path)
-
-
-@pytest.mark.parametrize("value", [["thumb", "finger"], "[1, 2, 3]", "{not json",
-                                   '{"thumb": {"bgr": [1, 2]}}'])
-def test_colour_models_of_the_wrong_kind_are_refused(tmp_path, value):
-    path = _tracks().replace(tracker={"colour_models": "{}"}).save(tmp_path / "c.tracks.h5")
-    with h5py.File(path, "a") as fh:
-        fh["tracker"].attrs["colour_models"] = value
-    with pytest.raises(InputError) as err:
-        Tracks.load(path)
-    assert err.value.field == "/tracker.colour_models" and err.value.path == str(path)
-
-
 def test_pose_tracks_and_options_pickle(tmp_path):
     t = _tracks()
     back = pickle.loads(pickle.dumps(t))
@@ -160,51 +239,6 @@ def test_pose_tracks_and_options_pickle(tmp_path):
     csv = write_dlc(t, tmp_path / "dlc.csv")
     pose = read_pose(csv, PoseImport(fps=30.0))
     assert pickle.loads(pickle.dumps(pose)).n_frames == t.n_frames
-
-
-# -- repertoires ------------------------------------------------------------------------------
-@pytest.fixture(scope="module")
-def repertoire_file(tmp_path_factory):
-    from perception.recognition.models import ModelSpec
-    from perception.recognition.repertoire import Repertoire
-
-    rep = Repertoire.build([ModelSpec("g", "grasp", {"duration": 0.5})])
-    return rep.save(tmp_path_factory.mktemp("rep") / "rep.h5")
-
-
-def _scale(key, factor):
-    def change(g):
-        g[f"arm/{key}"][...] = g[f"arm/{key}"][()] * factor
-    return change
-
-
-def _substeps(value):
-    def change(g):
-        g.attrs["substeps"] = value
-    return change
-
-
-@pytest.mark.parametrize("change, field", [
-    (_scale("L", 1e200), "/models/g/arm/L"),
-    (_scale("K", 1e200), "/models/g/arm/K"),
-    (_scale("P", -1.0), "/models/g/arm/P"),
-    (_scale("P", 0.0), "/models/g/arm/P"),
-    (_substeps(0), "/models/g.substeps"),
-    (_substeps(-3), "/models/g.substeps"),
-])
-def test_repertoire_values_no_plan_has_are_refused(tmp_path, repertoire_file, change, field):
-    path = tmp_path / "bad.h5"
-    shutil.copy(repertoire_file, path)
-    with h5py.File(path, "a") as fh:
-        change(fh["models/g"])
-    with pytest.raises(InputError) as err:
-        read_repertoire(path)
-    assert err.value.field == field and err.value.path == str(path)
-
-
-def test_repertoire_good_file_still_reads(repertoire_file):
-    _, models = read_repertoire(repertoire_file)
-    assert [m.name for m in models] == ["g"] and models[0].substeps >= 1
 
 
 def test_engine_refuses_a_model_that_predicts_nothing_finite():
@@ -220,37 +254,6 @@ def test_engine_refuses_a_model_that_predicts_nothing_finite():
     _refuse_broken_models(models, observable, valid[[0, 0]])  # both fine
     with pytest.raises(InputError, match="log-likelihood of model huge"):
         _refuse_non_finite(models, {"log-likelihood": np.array([[0.0, 1.0], [0.0, np.nan]])})
-
-
-# -- frame rates in headers -------------------------------------------------------------------
-def _avi_with_rate(path: Path, rate: int, usec: int) -> Path:
-    write_video(_frames(10), path, 30)
-    data = bytearray(path.read_bytes())
-    i = data.find(b"strh")
-    assert data[i + 8:i + 12] == b"vids"
-    data[i + 32:i + 36] = struct.pack("<I", rate)
-    j = data.find(b"avih")
-    data[j + 8:j + 12] = struct.pack("<I", usec)
-    path.write_bytes(bytes(data))
-    return path
-
-
-def test_header_of_0_frames_per_second_is_refused_not_read_as_25(tmp_path):
-    path = _avi_with_rate(tmp_path / "zero.avi", 0, 0)
-    with pytest.raises(InputError, match="no frame rate.*--fps") as err:
-        FrameSource(path, hash=False)
-    assert err.value.field == "frame rate" and err.value.path == str(path)
-    times = [t for _, t, _ in FrameSource(path, hash=False, fps=30.0)]
-    np.testing.assert_allclose(times, np.arange(10) / 30.0)
-
-
-def test_header_of_1000_frames_per_second_is_refused(tmp_path):
-    path = tmp_path / "ms.mp4"
-    write_video(_frames(10), path, 1000.0)
-    with pytest.raises(InputError, match="claims 1000 frames/s.*--fps") as err:
-        FrameSource(path, hash=False)
-    assert err.value.field == "frame rate"
-    assert FrameSource(path, hash=False, fps=500.0).header.fps_nominal == 1000.0
 
 
 # -- exports: bounded, and whole or not at all ---------------------------------------------
@@ -322,10 +325,10 @@ def test_render_refuses_a_video_other_than_the_tracked_one(tmp_path, monkeypatch
 def test_two_markers_on_one_keypoint_are_refused():
     with pytest.raises(InputError, match="thumb and finger both map to keypoint 'finger'") as e:
         PoseImport(keypoints={"thumb": "finger"})
-    assert e.value.field == "--keypoints"
+    assert e.value.location == ("PoseImport", "keypoints")  # the CLI's --keypoints
     with pytest.raises(InputError) as e:
         PoseImport(keypoints={"thumb": "tip", "finger": "tip"})
-    assert e.value.field == "--keypoints"
+    assert e.value.location == ("PoseImport", "keypoints")
     swapped = PoseImport(keypoints={"thumb": "finger", "finger": "index"})
     assert swapped.keypoint("thumb") == "finger"
 
@@ -364,47 +367,16 @@ def test_reading_a_pose_file_writes_nothing_under_home_and_prints_nothing(tmp_pa
     assert "movement" not in done.stderr and "deprecated" not in done.stderr, done.stderr
 
 
-# -- not files at all --------------------------------------------------------------------------
-def _raises_within(seconds, fn, *args):
-    outcome = {}
-
-    def run():
-        try:
-            fn(*args)
-        except BaseException as exc:  # noqa: BLE001 - handed to the test
-            outcome["error"] = exc
-
-    thread = threading.Thread(target=run, daemon=True)
-    thread.start()
-    thread.join(seconds)
-    if thread.is_alive():
-        # unblock the reader so the test process can end, then fail
-        with open(args[0], "wb"):
-            pass
-        pytest.fail(f"{fn.__name__} blocked on a FIFO")
-    return outcome.get("error")
-
-
-@pytest.mark.parametrize("reader, name", [
-    (Tracks.load, "fifo.tracks.h5"),
-    (read_repertoire, "fifo.h5"),
-    (lambda p: read_pose(p, PoseImport(fps=30)), "fifo.csv"),
-    (lambda p: FrameSource(p, hash=False), "fifo.mp4"),
-])
+# -- not files at all
 @pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs FIFOs")
-def test_a_fifo_is_refused_within_a_second(tmp_path, reader, name):
+@pytest.mark.parametrize("read, name", [
+    (load_setup, "setup.toml"), (load_markers, "colours.toml"), (load_markers, "colours.json"),
+    (load_recipe, "recipe.toml"), (Tracks.load, "fifo.tracks.h5"), (read_repertoire, "fifo.h5"),
+    (_read_pose, "fifo.csv"), (_read_video, "fifo.mp4"),
+], ids=lambda v: v if isinstance(v, str) else None)
+def test_a_fifo_is_refused_within_a_second(tmp_path, read, name):
     path = tmp_path / name
     os.mkfifo(path)
-    error = _raises_within(1.0, reader, path)
+    error = error_within(read, path)
     assert isinstance(error, InputError), error
     assert "not a regular file" in str(error) and str(path) in str(error)
-
-
-def test_pose_position_of_1e20_px_is_refused(tmp_path):
-    t = _tracks()
-    position = t.position.copy()
-    position[5, 2] = (3.0, 1e20)
-    path = write_dlc(t.replace(position=position), tmp_path / "far.csv")
-    with pytest.raises(InputError, match="'wrist' at row 5") as err:
-        read_pose(path, PoseImport(fps=30.0))
-    assert err.value.field == "position" and err.value.path == str(path)

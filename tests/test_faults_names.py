@@ -58,22 +58,25 @@ def _report(rec, out, tracks):
     return write_clip_report(rec, out, extra=extra)
 
 
-def test_an_undecodable_clip_name_gives_a_report_with_utf8_names(tracks, rep, tmp_path):
-    rec = recognize_clip(tracks, rep, clip=UNDECODABLE)
+@pytest.mark.parametrize("name", [UNDECODABLE, *NON_LATIN], ids=["undecodable", *NON_LATIN])
+def test_any_clip_name_gives_a_report_with_utf8_names_and_figures(tracks, rep, tmp_path, name):
+    rec = recognize_clip(tracks, rep, clip=name)
     paths = _report(rec, tmp_path, tracks)
     names = os.listdir(tmp_path)
-    assert all(_utf8(n) for n in names), names
-    assert not [n for n in names if ".part" in n]
+    assert all(_utf8(n) for n in names) and not [n for n in names if ".part" in n], names
     for path in paths.values():
         assert path.is_file() and path.stat().st_size > 0
     assert Image.open(paths["confidence_png"]).size[0] > 100
-    # the batch report and its table show the name escaped, in valid UTF-8
+    for key in ("confidence_png", "paths_png"):  # the name drawn in the figures
+        assert paths[key].name.startswith(name if _utf8(name) else output_stem(name))
+        assert Image.open(paths[key]).format == "PNG"
+    # the batch report and its table show the name (escaped), in valid UTF-8
     results = [ClipResult(rec.clip, "normal", "ok", summary=ClipSummary.from_recognition(rec))]
     write_batch_report(summary_table(results), {rec.clip: results[0].summary}, tmp_path,
                        models=rep.models)
-    page = (tmp_path / "report.html").read_bytes().decode("utf-8")
-    assert "clip\\xff" in page
-    assert "clip\\xff" in (tmp_path / "summary.csv").read_bytes().decode("utf-8")
+    assert printable(name) in (tmp_path / "report.html").read_bytes().decode("utf-8")
+    assert printable(name) in (tmp_path / "summary.csv").read_bytes().decode("utf-8")
+    assert Image.open(tmp_path / "confidence_single.png").format == "PNG"
     assert not [n for n in os.listdir(tmp_path) if ".part" in n or not _utf8(n)]
 
 
@@ -144,19 +147,6 @@ def test_output_stems_are_utf8_short_and_distinct():
     for s in stems:
         assert _utf8(s) and "/" not in s and "\n" not in s and len(s.encode()) <= 200
     assert printable(UNDECODABLE) == "clip\\xff" and printable("a\nb") == "a\\nb"
-
-
-@pytest.mark.parametrize("name", NON_LATIN)
-def test_non_latin_clip_names_are_drawn_in_the_figures(tracks, rep, tmp_path, name):
-    rec = recognize_clip(tracks, rep, clip=name)
-    paths = write_clip_report(rec, tmp_path)
-    for key in ("confidence_png", "paths_png"):
-        assert paths[key].name.startswith(name)
-        assert Image.open(paths[key]).format == "PNG"
-    results = [ClipResult(name, "normal", "ok", summary=ClipSummary.from_recognition(rec))]
-    write_batch_report(summary_table(results), {name: results[0].summary}, tmp_path,
-                       models=rep.models)
-    assert Image.open(tmp_path / "confidence_single.png").format == "PNG"
 
 
 def test_a_read_only_output_folder_is_one_error_naming_it(tracks, rep, tmp_path, monkeypatch):
