@@ -1,22 +1,28 @@
 """Importing the third-party ``movement`` package without side effects.
 
 ``movement`` reads and writes the pose files of other tools (see
-:mod:`perception.io.pose`), but importing it is not quiet: ``movement``
-creates ``~/.movement/movement.log``, adds a stderr handler and redirects the
+:mod:`perception.io.pose`), but importing it is not quiet: its
+``__init__`` calls ``logger.configure()``, which creates
+``~/.movement/movement.log``, adds a stderr handler and redirects the
 process's warnings into that log, and ``pynwb``, which it imports, creates
 ``~/.cache/pynwb-hdmf/<version>``. A library must write nothing outside the
-output folder it is given, nor need a writable HOME, so :func:`import_movement`
-imports the package with its logging set-up skipped (an import hook,
-:class:`_QuietMovementLogging`), ``platformdirs`` told not to create folders,
-and ``movement``'s ``loguru`` messages disabled. :func:`movement_loaders`
-gives its loaders, or one :class:`~perception.errors.InputError` naming the
-optional extra when ``movement`` is not installed.
+output folder it is given, nor need a writable HOME. movement (0.15, and its
+main branch as of 2026-08) offers no setting to skip that, so
+:func:`import_movement` loads ``movement.utils.logging`` (stdlib and loguru
+only) before the package, with ``configure`` doing nothing while the package
+imports, and tells ``platformdirs`` not to create folders meanwhile. This
+leans on that module's layout: pyproject.toml pins ``movement<0.16``.
+:func:`movement_loaders` gives its loaders, or one
+:class:`~perception.errors.InputError` naming the optional extra when
+``movement`` is not installed.
 """
 
 from __future__ import annotations
 
-import importlib.abc
+import importlib
+import importlib.util
 import sys
+from pathlib import Path
 
 from perception.errors import InputError
 
@@ -27,94 +33,51 @@ POSE_EXTRA = ("reading and writing pose files needs the optional extra: "
               "pip install 'hammer-mv[pose]'")
 
 
-class _QuietMovementLogging(importlib.abc.MetaPathFinder):
-    """Import hook: ``movement.utils.logging`` loads with a ``configure`` that does nothing.
-
-    Importing ``movement`` calls ``logger.configure()``, which creates
-    ``~/.movement/movement.log`` (failing with a read-only or missing HOME),
-    adds a stderr handler and redirects every warning of the process into its
-    log. Only while :func:`import_movement` imports the package, the module
-    is loaded as usual and its ``MovementLogger.configure`` replaced before
-    ``movement/__init__`` calls it; the original is put back afterwards, so a
-    user calling it on purpose gets movement's logging as documented.
-    """
-
-    def __init__(self):
-        self.original = None
-
-    def find_spec(self, name, path=None, target=None):
-        if name != "movement.utils.logging":
-            return None
-        for finder in sys.meta_path:
-            if finder is self or not hasattr(finder, "find_spec"):
-                continue
-            spec = finder.find_spec(name, path, target)
-            if spec is not None and spec.loader is not None:
-                break
-        else:
-            return None
-        hook, loader = self, spec.loader
-        real_exec = loader.exec_module
-
-        def exec_module(module):
-            real_exec(module)
-            hook.original = module.MovementLogger.configure
-            module.MovementLogger.configure = lambda self, *args, **kwargs: None
-
-        spec.loader = _ExecWrapper(loader, exec_module)
-        return spec
-
-
-class _ExecWrapper(importlib.abc.Loader):
-    def __init__(self, loader, exec_module):
-        self._loader, self._exec = loader, exec_module
-
-    def create_module(self, spec):
-        return self._loader.create_module(spec)
-
-    def exec_module(self, module):
-        self._exec(module)
-
-    def __getattr__(self, name):
-        return getattr(self._loader, name)
-
-
 def import_movement() -> None:
-    """Import ``movement`` without writing under HOME (see :class:`_QuietMovementLogging`).
+    """Import ``movement`` without writing under HOME.
 
     Its own messages are disabled in ``loguru`` (the package's loaders log
     every file they read); a user enables them with
-    ``loguru.logger.enable("movement")``.
+    ``loguru.logger.enable("movement")``, and gets movement's log file by
+    calling ``movement.utils.logging.logger.configure()``, as documented.
+
+    Raises
+    ------
+    ImportError
+        ``movement`` is not installed.
     """
     if "movement.io" in sys.modules:
         return
-    hook = _QuietMovementLogging()
-    sys.meta_path.insert(0, hook)
-    dirs = None
-    if "pynwb" not in sys.modules:
-        # pynwb (imported by movement.io) creates ~/.cache/pynwb-hdmf/<version>
-        # at import for a cache of its schema: while it is imported, its
-        # folders are not created (its cache is then skipped if absent)
-        import platformdirs
+    package = importlib.util.find_spec("movement")  # found, not imported
+    if package is None:
+        raise ImportError("movement")
+    name = "movement.utils.logging"
+    spec = importlib.util.spec_from_file_location(
+        name, Path(package.submodule_search_locations[0]) / "utils" / "logging.py")
+    logging = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(logging)
+    configure = logging.MovementLogger.configure
+    logging.MovementLogger.configure = lambda self, *args, **kwargs: None
+    sys.modules[name] = logging
+    import platformdirs
 
-        dirs = platformdirs.PlatformDirs
+    dirs = platformdirs.PlatformDirs
 
-        class _NoCreate(dirs):
-            def __init__(self, *args, **kwargs):
-                kwargs["ensure_exists"] = False
-                super().__init__(*args, **kwargs)
+    class _NoCreate(dirs):  # pynwb's cache folder, made at its import: skipped if absent
+        def __init__(self, *args, **kwargs):
+            kwargs["ensure_exists"] = False
+            super().__init__(*args, **kwargs)
 
-        platformdirs.PlatformDirs = _NoCreate
+    platformdirs.PlatformDirs = _NoCreate
     try:
-        import movement.io  # noqa: F401
+        importlib.import_module("movement.io")
+    except BaseException:
+        sys.modules.pop(name, None)
+        raise
     finally:
-        sys.meta_path.remove(hook)
-        if hook.original is not None:
-            sys.modules["movement.utils.logging"].MovementLogger.configure = hook.original
-        if dirs is not None:
-            import platformdirs
-
-            platformdirs.PlatformDirs = dirs
+        logging.MovementLogger.configure = configure
+        platformdirs.PlatformDirs = dirs
+    importlib.import_module("movement.utils").logging = logging  # as an import would
     from loguru import logger
 
     logger.disable("movement")
