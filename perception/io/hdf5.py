@@ -21,7 +21,8 @@ from perception.errors import InputError
 from perception.io.files import input_file
 from perception.limits import MAX_HDF5_VALUES
 
-__all__ = ["check_dataset", "decode_attrs", "open_hdf5", "read_dataset", "scalar_attr"]
+__all__ = ["check_dataset", "check_schema", "decode_attrs", "open_hdf5", "read_dataset",
+           "scalar_attr"]
 
 #: dtype kinds by what a reader expects.
 _KINDS = {"number": "biuf", "integer": "iu", "string": "SOU"}
@@ -110,20 +111,8 @@ def read_dataset(fh, name: str, kind: str, ndim: int, path: str | os.PathLike, *
                  max_values: int = MAX_HDF5_VALUES) -> np.ndarray:
     """The whole of dataset ``name``, checked by :func:`check_dataset` before it is read.
 
-    Parameters
-    ----------
-    fh : h5py.File or h5py.Group
-        Where to look.
-    name : str
-        Path of the dataset below ``fh``.
-    kind : {"number", "integer", "string"}
-        What its elements must be.
-    ndim : int
-        Its number of dimensions.
-    path : str or os.PathLike
-        The file, for messages.
-    max_values : int
-        Most elements it may hold.
+    ``fh``, ``name``, ``kind``, ``ndim``, ``path`` and ``max_values`` are
+    those of :func:`check_dataset`.
     """
     obj = check_dataset(fh, name, kind, ndim, path, max_values=max_values)
     where = obj.name
@@ -203,3 +192,35 @@ def scalar_attr(values: dict[str, Any], key: str, kind: str, where: str,
         shown = f"an array of shape {value.shape}" if isinstance(value, np.ndarray) else repr(value)
         raise InputError(f"is {shown}, expected one {kind}", path, field=f"{where}.{key}")
     return value
+
+
+def check_schema(root: dict[str, Any], schema: str, version: int, what: str,
+                 path: str | os.PathLike, remedy: str = "") -> None:
+    """Refuse a file whose root ``schema`` or ``schema_version`` attribute is not ours.
+
+    Parameters
+    ----------
+    root : dict
+        The root's attributes, from :func:`decode_attrs`.
+    schema, version : str, int
+        What they must be.
+    what : str
+        The kind of file, for messages (``"tracks file"``).
+    path : str or os.PathLike
+        The file, for messages.
+    remedy : str
+        Said after an unsupported version (``"; rebuild it"``).
+
+    Raises
+    ------
+    InputError
+        Another schema, or another version of ours.
+    """
+    found = scalar_attr(root, "schema", "string", "/", path)
+    if found != schema:
+        raise InputError(f"not a hammer-mv {what} (schema {found!r}, expected {schema!r})",
+                         path)
+    number = scalar_attr(root, "schema_version", "integer", "/", path)
+    if number != version:
+        raise InputError(f"{what.split()[0]} schema_version {number!r} is not supported (this "
+                         f"hammer-mv reads version {version}){remedy}", path)

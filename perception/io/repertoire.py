@@ -28,7 +28,7 @@ import numpy as np
 from perception import __version__
 from perception.errors import InputError
 from perception.io.atomic import atomic_hdf5
-from perception.io.hdf5 import decode_attrs, open_hdf5, read_dataset, scalar_attr
+from perception.io.hdf5 import check_schema, decode_attrs, open_hdf5, read_dataset, scalar_attr
 from perception.limits import MAX_FPS, MAX_GAIN, MAX_SUBSTEPS
 
 __all__ = ["SCHEMA", "SCHEMA_VERSION", "StoredCalibration", "StoredChain", "StoredModel",
@@ -268,14 +268,7 @@ def _read_model(name: str, mg, path: Path) -> StoredModel:
 
 def _read_file(f, path: Path) -> tuple[dict, list[StoredModel]]:
     root = decode_attrs(f.attrs, "/", path)
-    schema = scalar_attr(root, "schema", "string", "/", path)
-    if schema != SCHEMA:
-        raise InputError(f"not a hammer-mv repertoire (schema {schema!r}, "
-                         f"expected {SCHEMA!r})", path)
-    version = scalar_attr(root, "schema_version", "integer", "/", path)
-    if version != SCHEMA_VERSION:
-        raise InputError(f"repertoire schema version {version} is not supported "
-                         f"(this is version {SCHEMA_VERSION}); rebuild it", path)
+    check_schema(root, SCHEMA, SCHEMA_VERSION, "repertoire", path, "; rebuild it")
     config = _json_attr(root, "config", "/", path) if "config" in root else {}
     if "models" not in f:
         raise InputError("missing group /models", path)

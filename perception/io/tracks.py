@@ -41,7 +41,7 @@ if TYPE_CHECKING:  # pragma: no cover
 from minvar import __version__
 from perception.errors import InputError
 from perception.io.atomic import atomic_hdf5
-from perception.io.hdf5 import decode_attrs, open_hdf5, read_dataset, scalar_attr
+from perception.io.hdf5 import check_schema, decode_attrs, open_hdf5, read_dataset, scalar_attr
 from perception.io.tracks_checks import (
     _DATASETS,
     _VIDEO_ATTRS,
@@ -369,14 +369,7 @@ class Tracks:
         p = Path(path)
         with open_hdf5(p, "tracks file") as fh:
             root = decode_attrs(fh.attrs, "/", p)
-            schema = scalar_attr(root, "schema", "string", "/", p)
-            if schema != SCHEMA:
-                raise InputError(f"not a hammer-mv tracks file (schema {schema!r}, expected "
-                                 f"{SCHEMA!r})", p)
-            version = scalar_attr(root, "schema_version", "integer", "/", p)
-            if version != SCHEMA_VERSION:
-                raise InputError(f"tracks schema_version {version!r} is not supported "
-                                 f"(this hammer-mv reads version {SCHEMA_VERSION})", p)
+            check_schema(root, SCHEMA, SCHEMA_VERSION, "tracks file", p)
             for key in ("schema", "schema_version", "software_version"):
                 root.pop(key, None)
             _check_shapes(fh, p)
