@@ -85,16 +85,15 @@ def owner_tag() -> str:
 
 def owner_gone(name: str) -> bool:
     """Whether the writer tagged in ``name`` is a process of this host that has ended."""
+    import psutil
+
     tags = _TAG.findall(name)  # the last: a clip's own name may look like one
     if not tags or tags[-1][0] != _HOST:
         return False
     try:
-        os.kill(int(tags[-1][1]), 0)
-    except ProcessLookupError:
-        return True
-    except (PermissionError, OverflowError):
-        pass  # alive, someone else's
-    return False
+        return not psutil.pid_exists(int(tags[-1][1]))
+    except OverflowError:  # no such process id on this system: not one we can judge
+        return False
 
 
 def remove_stale(folder: str | os.PathLike, pattern: str) -> int:
