@@ -182,16 +182,24 @@ def test_normal_beats_abnormal_on_independent_demonstrations(independent):
         assert np.median(margin) >= 0.10, cond
 
 
+@pytest.mark.xfail(strict=True, reason=(
+    "issue 36: stimuli that close where a normal grasp's aperture is largest (thesis line "
+    "1081) close while the normal model's own aperture is nearly still, so the grip term's "
+    "penalty (|predicted change|) is small and the transport term keeps the confidence "
+    "rising; the thesis's fall (line 1154) is not reproduced (numbers.md, chapter 5)"))
 def test_independent_open_close_open_falls_after_its_closing_then_recovers(independent):
     """The mean profile falls by >= 3 % of its value after the unexpected closing (Fig. 5.8)."""
+    from scipy.signal import find_peaks
+
     phase = np.linspace(0, 1, 101)
     curves, closings = [], []
     for rec in independent["open-close-open"]:
         curves.append(np.interp(phase, rec.time / rec.time[-1], _conf(rec)))
         g, ph = rec.observation.g, rec.time / rec.time[-1]
-        first = np.nanargmax(np.where(ph < 0.55, g, -np.inf))
-        closings.append(ph[first + np.nanargmin(np.where(ph[first:] < ph[first] + 0.4,
-                                                          g[first:], np.inf))])
+        # the closing: the aperture's most prominent interior minimum (the clip's own)
+        ok = np.isfinite(g)
+        dips, props = find_peaks(-np.interp(ph, ph[ok], g[ok]), prominence=0.005)
+        closings.append(ph[dips[np.argmax(props["prominences"])]])
     mean = np.mean(curves, axis=0)
     low = int(round(100 * np.median(closings)))
     top = int(np.argmax(mean[: low + 1]))

@@ -206,8 +206,11 @@ TRACKS = {
                                                 duration=0.8)[0],
     "indep-normal": lambda: _independent("normal"),
     "indep-delayed-mirrored": lambda: _flip(_independent("delayed")),
-    "indep-oco-1200px": lambda: _independent(
-        "open-close-open", camera=Camera(px_per_m=1200.0, origin_px=(320.0, 60.0))),
+    # 0.8 s: an open-close-open hand that arrives closed waits for its re-opening, which
+    # lengthens its movement (0.8 s drawn is about 1.1 s measured, within the repertoire)
+    "indep-oco-1200px": lambda: independent_tracks(
+        draw_independent("open-close-open", np.random.default_rng(3), duration=0.8), 3,
+        camera=Camera(px_per_m=1200.0, origin_px=(320.0, 60.0)))[0],
     "indep-reach-mirrored-120": lambda: _flip(_independent("reach", fps=120.0)),
 }
 

@@ -19,8 +19,10 @@ nothing here imports :mod:`minvar`:
   Fraser 1983).
 * **Conditions** (thesis 5.4.1, after Gangitano et al. 2004): ``normal``;
   ``delayed`` (the digits stay closed until ``delayed_onset``, maximal
-  aperture late); ``open-close-open`` (a first opening, an unexpected closing
-  to ``oco_depth`` of it at ``oco_close_time``, a re-opening); ``reach``
+  aperture late); ``open-close-open`` (a first opening as a normal grasp's,
+  an unexpected closing to ``oco_depth`` of it at ``oco_close_time``, where a
+  normal grasp's maximum aperture is expected, thesis line 1081; a
+  re-opening); ``reach``
   (digits kept closed; the closed tips stop on the object's near surface).
 * **Variability.** :func:`draw_independent` draws every timing and size from
   ranges around those values, and a smooth random wobble (a few mm, below
@@ -114,7 +116,9 @@ class IndependentParams:
     oco_first_fraction : float
         The first peak as a fraction of the maximum aperture.
     oco_close_time : float
-        Time of the deepest point of the unexpected closing.
+        Time of the deepest point of the unexpected closing: where a normal
+        grasp's maximum aperture is expected (thesis line 1081), so by
+        default ``mga_time``'s.
     oco_depth : float
         Aperture at that point as a fraction of the first peak.
     oco_reopen_time : float
@@ -142,11 +146,11 @@ class IndependentParams:
     thumb_share: float = 0.4
     delayed_onset: float = 0.55
     delayed_mga_time: float = 0.88
-    oco_first_time: float = 0.38
+    oco_first_time: float = 0.46
     oco_first_fraction: float = 0.8
-    oco_close_time: float = 0.58
+    oco_close_time: float = 0.68
     oco_depth: float = 0.45
-    oco_reopen_time: float = 0.82
+    oco_reopen_time: float = 0.88
     wobble: float = 0.001
     rest_before: float = 0.3
     rest_after: float = 0.3
@@ -323,11 +327,13 @@ RANGES: dict[str, tuple[float, float]] = {
     "thumb_share": (0.3, 0.5),
     "delayed_onset": (0.48, 0.62),
     "delayed_mga_time": (0.84, 0.92),
-    "oco_first_time": (0.32, 0.44),
+    # open-close-open: closed at the normal grasp's expected maximum aperture (thesis
+    # line 1081), so its closing time is drawn as a normal grasp's mga_time is
+    "oco_first_time": (0.40, 0.52),
     "oco_first_fraction": (0.7, 0.9),
-    "oco_close_time": (0.52, 0.64),
+    "oco_close_time": (0.60, 0.75),
     "oco_depth": (0.3, 0.65),
-    "oco_reopen_time": (0.76, 0.86),
+    "oco_reopen_time": (0.84, 0.92),
 }
 
 

@@ -10,8 +10,9 @@ differing only in the grip channel's via-points:
     The digits stay nearly closed through the first half and open late: the
     maximal aperture comes markedly late (about 85-90 % of the movement).
 ``open-close-open``
-    The digits open, close unexpectedly near the expected maximal aperture,
-    and re-open before closing on the object.
+    The digits open as for a normal grasp, are closed at the normal grasp's
+    expected maximal aperture (its via-point's time, 70 % of the movement;
+    thesis line 1081), and re-open before closing on the object.
 ``reach``
     Not a Gangitano stimulus: the transport alone, digits kept closed (for
     checking that reach-only movements are told from grasps).
@@ -109,8 +110,12 @@ def stimulus_task(p: StimulusParams) -> GraspTask:
         vias = (GripVia(0.003, 0.0, 0.30), GripVia(0.003, 0.0, 0.55),
                 GripVia(radius + 0.02, 0.0, 0.88))
     else:  # open-close-open
-        vias = (GripVia(radius + 0.012, 0.0, 0.40), GripVia(0.3 * radius, 0.0, 0.60),
-                GripVia(radius + 0.015, 0.0, 0.82))
+        # closed at the normal grasp's expected maximum aperture (thesis line 1081: "an
+        # unexpected finger closure at the point of expected maximum finger aperture"),
+        # the normal via-point's time; opening as normal does until then, re-opening after
+        closed_at = GraspTask().viapoint_time
+        vias = (GripVia(radius + 0.012, 0.0, closed_at - 0.22),
+                GripVia(0.3 * radius, 0.0, closed_at), GripVia(radius + 0.015, 0.0, 0.88))
     return GraspTask(grip_via=vias, **common)
 
 
