@@ -218,6 +218,44 @@ static void add(double *out, const double *X, int size) {
     for (int i = 0; i < size; i++) out[i] += X[i];
 }
 
+/* What every recursion sets up first: A, B, H and their transposes in
+ * compressed-row form, and its scratch, `count` blocks of block_size doubles
+ * (after three that hold the dense transposes). */
+typedef struct {
+    csr A, At, B, Bt, H, Ht;
+    size_t blk;
+    double *buf;   /* the dense transposes, then the caller's blocks */
+    double *work;  /* the caller's first block */
+} sparse_t;
+
+static void sparse_close(sparse_t *s) {
+    csr_free(&s->A);
+    csr_free(&s->At);
+    csr_free(&s->B);
+    csr_free(&s->Bt);
+    csr_free(&s->H);
+    csr_free(&s->Ht);
+    free(s->buf);
+}
+
+/* 0, or -1 when memory runs out (sparse_close still frees what was made). */
+static int sparse_open(sparse_t *s, const double *A, const double *B, const double *H, int n,
+                       int m, int k, int count) {
+    memset(s, 0, sizeof *s);
+    s->blk = block_size(n, m, k);
+    s->buf = malloc(sizeof(double) * s->blk * (3 + (size_t)count));
+    if (!s->buf) return -1;
+    double *At = s->buf, *Bt = At + s->blk, *Ht = Bt + s->blk;
+    s->work = Ht + s->blk;
+    transpose(At, A, n, n);
+    transpose(Bt, B, n, m);
+    transpose(Ht, H, k, n);
+    if (csr_make(&s->A, A, n, n) || csr_make(&s->At, At, n, n) || csr_make(&s->B, B, n, m)
+        || csr_make(&s->Bt, Bt, m, n) || csr_make(&s->H, H, k, n) || csr_make(&s->Ht, Ht, n, k))
+        return -1;
+    return 0;
+}
+
 /* Filter gains K (T x n x k) optimal for control gains L (T x m x n), with the
  * moments SiX, SiXE, SiE (Mhh, Mhe, Mee of minvar.moments.Moments) stepped
  * with the optimal filter's shortcut. BC: nc matrices B C_i (n x m); D: nd
@@ -228,22 +266,19 @@ static int lqg_forward(int T, int n, int m, int k, int nc, int nd, const double 
                        const double *S1, const double *X1, const double *L, int flags,
                        double *K) {
     const size_t nn = (size_t)n * n, nk = (size_t)n * k;
-    csr sA = {0}, sAt = {0}, sB = {0}, sH = {0}, sHt = {0};
-    const size_t blk = block_size(n, m, k);
-    double *buf = malloc(sizeof(double) * blk * 24);
+    sparse_t pl;
+    if (sparse_open(&pl, A, B, H, n, m, k, 22)) {
+        sparse_close(&pl);
+        return -1;
+    }
+    const size_t blk = pl.blk;
     int status = -1;
-    if (!buf) return -1;
-    double *At = buf, *Ht = At + blk, *SiE = Ht + blk, *SiX = SiE + blk, *SiXE = SiX + blk;
+    double *SiE = pl.work, *SiX = SiE + blk, *SiXE = SiX + blk;
     double *newE = SiXE + blk, *T1 = newE + blk, *T2 = T1 + blk, *T3 = T2 + blk;
     double *abl = T3 + blk, *akh = abl + blk, *X2 = akh + blk, *tmpS = X2 + blk;
     double *cross = tmpS + blk, *SiEHt = cross + blk, *ASH = SiEHt + blk, *Kt = ASH + blk;
     double *M = Kt + blk, *U = M + blk, *LS = U + blk, *LSL = LS + blk, *HS = LSL + blk;
     double *BCL = HS + blk;
-    transpose(At, A, n, n);
-    transpose(Ht, H, k, n);
-    if (csr_make(&sA, A, n, n) || csr_make(&sAt, At, n, n) || csr_make(&sB, B, n, m)
-        || csr_make(&sH, H, k, n) || csr_make(&sHt, Ht, n, k))
-        goto done;
     memcpy(SiE, S1, sizeof(double) * nn);
     for (int i = 0; i < n; i++)
         for (int j = 0; j < n; j++) SiX[i * n + j] = X1[i] * X1[j];
@@ -251,8 +286,8 @@ static int lqg_forward(int T, int n, int m, int k, int nc, int nd, const double 
     for (int t = 0; t < T; t++) {
         const double *Lt = L + (size_t)t * m * n;
         double *Kout = K + (size_t)t * nk;
-        ds(SiEHt, SiE, &sHt, n, 0);                   /* SiE H' */
-        sd(M, &sH, SiEHt, k, 0);                      /* H SiE H' */
+        ds(SiEHt, SiE, &pl.Ht, n, 0);                   /* SiE H' */
+        sd(M, &pl.H, SiEHt, k, 0);                      /* H SiE H' */
         add(M, DD0, k * k);
         if (flags & HAS_D) {
             for (size_t i = 0; i < nn; i++)
@@ -263,7 +298,7 @@ static int lqg_forward(int T, int n, int m, int k, int nc, int nd, const double 
                 ddt(M, X2, Dd, k, n, k, 1);            /* D temp D' */
             }
         }
-        sd(ASH, &sA, SiEHt, k, 0);                    /* A SiE H' */
+        sd(ASH, &pl.A, SiEHt, k, 0);                    /* A SiE H' */
         transpose(Kt, ASH, n, k);                     /* (k x n) */
         if (chol_solve(M, Kt, U, k, n)) {
             status = 1;
@@ -272,12 +307,12 @@ static int lqg_forward(int T, int n, int m, int k, int nc, int nd, const double 
         transpose(Kout, Kt, k, n);                    /* K = A SiE H' M^-1 */
         /* akh = A - K H */
         memcpy(akh, A, sizeof(double) * nn);
-        ds(akh, Kout, &sH, n, -1);
+        ds(akh, Kout, &pl.H, n, -1);
         /* newE = akh SiE A' = (A SiE - K (H SiE)) A' */
-        sd(T1, &sA, SiE, n, 0);
-        sd(HS, &sH, SiE, n, 0);                       /* (k x n) */
+        sd(T1, &pl.A, SiE, n, 0);
+        sd(HS, &pl.H, SiE, n, 0);                       /* (k x n) */
         dd(T1, Kout, HS, n, k, n, -1);
-        ds(newE, T1, &sAt, n, 0);
+        ds(newE, T1, &pl.At, n, 0);
         if (flags & HAS_C) {
             dd(LS, Lt, SiX, m, n, n, 0);
             ddt(LSL, LS, Lt, m, n, m, 0);             /* L SiX L' */
@@ -293,29 +328,29 @@ static int lqg_forward(int T, int n, int m, int k, int nc, int nd, const double 
         }
         /* abl = A - B L */
         memcpy(abl, A, sizeof(double) * nn);
-        sd(abl, &sB, Lt, n, -1);
+        sd(abl, &pl.B, Lt, n, -1);
         double *SiXnew = T2;
         ddt(SiXnew, Kout, ASH, n, k, n, 0);           /* K (A SiE H')' */
         /* abl SiX abl' = (A SiX - B (L SiX)) (A - B L)' */
         if (!(flags & HAS_C)) dd(LS, Lt, SiX, m, n, n, 0);
-        sd(T1, &sA, SiX, n, 0);
-        sd(T1, &sB, LS, n, -1);                       /* Y = abl SiX */
-        ds(SiXnew, T1, &sAt, n, 1);                   /* + Y A' */
+        sd(T1, &pl.A, SiX, n, 0);
+        sd(T1, &pl.B, LS, n, -1);                       /* Y = abl SiX */
+        ds(SiXnew, T1, &pl.At, n, 1);                   /* + Y A' */
         ddt(T3, T1, Lt, n, n, m, 0);                  /* Y L' (n x m) */
         {
             /* - (Y L') B' */
             for (int i = 0; i < n; i++)
                 for (int j = 0; j < n; j++) {
                     double s = 0.0;
-                    for (int p = sB.start[j]; p < sB.start[j + 1]; p++)
-                        s += T3[i * m + sB.col[p]] * sB.val[p];
+                    for (int p = pl.B.start[j]; p < pl.B.start[j + 1]; p++)
+                        s += T3[i * m + pl.B.col[p]] * pl.B.val[p];
                     SiXnew[i * n + j] -= s;
                 }
         }
         if (flags & TRACK_XE) {
             /* cross = abl SiXE H' K' */
             dd(T1, abl, SiXE, n, n, n, 0);
-            ds(X2, T1, &sHt, n, 0);                   /* (n x k) */
+            ds(X2, T1, &pl.Ht, n, 0);                   /* (n x k) */
             ddt(cross, X2, Kout, n, k, n, 0);
             for (int i = 0; i < n; i++)
                 for (int j = 0; j < n; j++)
@@ -329,12 +364,7 @@ static int lqg_forward(int T, int n, int m, int k, int nc, int nd, const double 
     }
     status = 0;
 done:
-    csr_free(&sA);
-    csr_free(&sAt);
-    csr_free(&sB);
-    csr_free(&sH);
-    csr_free(&sHt);
-    free(buf);
+    sparse_close(&pl);
     return status;
 }
 
@@ -346,25 +376,21 @@ static int lqg_backward(int T, int n, int m, int k, int nc, int nd, const double
                         const double *Q, const double *R, const double *X1, const double *S1,
                         const double *K, int flags, double *L, double *cost_out) {
     const size_t nn = (size_t)n * n, nm = (size_t)n * m;
-    csr sA = {0}, sAt = {0}, sB = {0}, sBt = {0}, sH = {0}, sHt = {0};
-    const size_t blk = block_size(n, m, k);
-    double *buf = malloc(sizeof(double) * blk * 26);
+    sparse_t pl;
+    if (sparse_open(&pl, A, B, H, n, m, k, 23)) {
+        sparse_close(&pl);
+        return -1;
+    }
+    const size_t blk = pl.blk;
     int status = -1;
-    if (!buf) return -1;
-    double *At = buf, *Bt = At + blk, *Ht = Bt + blk, *Sx = Ht + blk, *Se = Sx + blk;
+    char *Qzero = NULL;
+    double *Sx = pl.work, *Se = Sx + blk;
     double *SxNew = Se + blk, *SeNew = SxNew + blk, *AtSx = SeNew + blk, *T1 = AtSx + blk;
     double *T2 = T1 + blk, *ASBL = T2 + blk, *SxB = ASBL + blk, *AtSxB = SxB + blk;
     double *Lt = AtSxB + blk, *SeB = Lt + blk, *SeK = SeB + blk, *KZ = SeK + blk;
     double *BSxB = KZ + blk, *temp = BSxB + blk, *BSeB = temp + blk, *Ctmp = BSeB + blk;
     double *U = Ctmp + blk, *KSeK = U + blk, *Kbuf = KSeK + blk;
     double cost = 0.0;
-    char *Qzero = NULL;
-    transpose(At, A, n, n);
-    transpose(Bt, B, n, m);
-    transpose(Ht, H, k, n);
-    if (csr_make(&sA, A, n, n) || csr_make(&sAt, At, n, n) || csr_make(&sB, B, n, m)
-        || csr_make(&sBt, Bt, m, n) || csr_make(&sH, H, k, n) || csr_make(&sHt, Ht, n, k))
-        goto done;
     Qzero = malloc((size_t)T + 1);
     if (!Qzero) goto done;
     for (int t = 0; t <= T; t++) {
@@ -392,12 +418,12 @@ static int lqg_backward(int T, int n, int m, int k, int nc, int nd, const double
                 for (int i = 0; i < n; i++) s += Kbuf[a * n + i] * Kt[i * k + a];
             cost += s;
         }
-        ds(SxB, Sx, &sB, n, 0);                        /* Sx B */
-        sd(BSxB, &sBt, SxB, m, 0);                     /* B' Sx B */
+        ds(SxB, Sx, &pl.B, n, 0);                        /* Sx B */
+        sd(BSxB, &pl.Bt, SxB, m, 0);                     /* B' Sx B */
         for (int i = 0; i < m * m; i++) temp[i] = R[i] + BSxB[i];
         if (flags & HAS_C) {
-            ds(SeB, Se, &sB, n, 0);
-            sd(BSeB, &sBt, SeB, m, 0);                 /* B' Se B */
+            ds(SeB, Se, &pl.B, n, 0);
+            sd(BSeB, &pl.Bt, SeB, m, 0);                 /* B' Se B */
             for (int i = 0; i < m * m; i++) BSeB[i] += BSxB[i];
             for (int c = 0; c < nc; c++) {
                 const double *Cc = C + (size_t)c * m * m;
@@ -405,8 +431,8 @@ static int lqg_backward(int T, int n, int m, int k, int nc, int nd, const double
                 dd(temp, Ctmp, Cc, m, m, m, 1);        /* ... C */
             }
         }
-        sd(AtSx, &sAt, Sx, n, 0);                      /* A' Sx */
-        ds(AtSxB, AtSx, &sB, n, 0);                    /* A' Sx B (n x m) */
+        sd(AtSx, &pl.At, Sx, n, 0);                      /* A' Sx */
+        ds(AtSxB, AtSx, &pl.B, n, 0);                    /* A' Sx B (n x m) */
         transpose(Lt, AtSxB, n, m);                    /* (m x n) */
         if (chol_solve(temp, Lt, U, m, n)) {
             status = 1;
@@ -416,20 +442,20 @@ static int lqg_backward(int T, int n, int m, int k, int nc, int nd, const double
         dd(ASBL, AtSxB, Lt, n, m, n, 0);               /* A' Sx B L */
         /* Se' = ASBL + akh' Se akh, akh = A - K H:
          * Z = Se akh = Se A - (Se K) H;  akh' Z = A' Z - H' (K' Z) */
-        ds(T1, Se, &sA, n, 0);
+        ds(T1, Se, &pl.A, n, 0);
         for (int a = 0; a < k; a++)                    /* Z = Se A - (Se K) H */
-            for (int p = sH.start[a]; p < sH.start[a + 1]; p++) {
-                const int j = sH.col[p];
-                const double v = sH.val[p];
+            for (int p = pl.H.start[a]; p < pl.H.start[a + 1]; p++) {
+                const int j = pl.H.col[p];
+                const double v = pl.H.val[p];
                 const double *z = SeK + (size_t)a * n;
                 for (int i = 0; i < n; i++) T1[(size_t)i * n + j] -= v * z[i];
             }
-        sd(SeNew, &sAt, T1, n, 0);
+        sd(SeNew, &pl.At, T1, n, 0);
         dtd(KZ, Kt, T1, k, n, n, 0);                   /* K' Z (k x n) */
-        sd(SeNew, &sHt, KZ, n, -1);
+        sd(SeNew, &pl.Ht, KZ, n, -1);
         add(SeNew, ASBL, (int)nn);
         /* Sx' = Q[t] + A' Sx A - ASBL */
-        ds(SxNew, AtSx, &sA, n, 0);
+        ds(SxNew, AtSx, &pl.A, n, 0);
         const double *Qt = Q + (size_t)t * nn;
         if (Qzero[t])  /* most steps cost nothing: leave Q[t] unread */
             for (size_t i = 0; i < nn; i++) SxNew[i] -= ASBL[i];
@@ -463,13 +489,7 @@ static int lqg_backward(int T, int n, int m, int k, int nc, int nd, const double
     status = 0;
 done:
     free(Qzero);
-    csr_free(&sA);
-    csr_free(&sAt);
-    csr_free(&sB);
-    csr_free(&sBt);
-    csr_free(&sH);
-    csr_free(&sHt);
-    free(buf);
+    sparse_close(&pl);
     return status;
 }
 
@@ -488,21 +508,18 @@ static int lqg_error_cov(int T, int n, int m, int k, int nc, int nd, const doubl
                          const double *S1, const double *X1, const double *K, const double *L,
                          double *P) {
     const size_t nn = (size_t)n * n;
-    csr sA = {0}, sAt = {0}, sB = {0}, sH = {0}, sHt = {0};
-    const size_t blk = block_size(n, m, k);
-    double *buf = malloc(sizeof(double) * blk * 20);
+    sparse_t pl;
+    if (sparse_open(&pl, A, B, H, n, m, k, 18)) {
+        sparse_close(&pl);
+        return -1;
+    }
+    const size_t blk = pl.blk;
     int status = -1;
-    if (!buf) return -1;
-    double *At = buf, *Ht = At + blk, *Mhh = Ht + blk, *Mhe = Mhh + blk, *Mee = Mhe + blk;
+    double *Mhh = pl.work, *Mhe = Mhh + blk, *Mee = Mhe + blk;
     double *U1 = Mee + blk, *U2 = U1 + blk, *V = U2 + blk, *VH = V + blk, *W = VH + blk;
     double *Nhh = W + blk, *Nhe = Nhh + blk, *Nee = Nhe + blk, *LP = Nee + blk;
     double *LPL = LP + blk, *BCL = LPL + blk, *HE = BCL + blk, *VL = HE + blk;
     double *Mxx = VL + blk, *X2 = Mxx + blk;
-    transpose(At, A, n, n);
-    transpose(Ht, H, k, n);
-    if (csr_make(&sA, A, n, n) || csr_make(&sAt, At, n, n) || csr_make(&sB, B, n, m)
-        || csr_make(&sH, H, k, n) || csr_make(&sHt, Ht, n, k))
-        goto done;
     for (int i = 0; i < n; i++)
         for (int j = 0; j < n; j++) Mhh[i * n + j] = X1[i] * X1[j];
     memset(Mhe, 0, sizeof(double) * nn);
@@ -527,44 +544,44 @@ static int lqg_error_cov(int T, int n, int m, int k, int nc, int nd, const doubl
         ddt(W, VH, Kt, n, k, n, 0);
         add(W, EE0, (int)nn);
         /* U1 = Y Mhe = A Mhe - B (L Mhe);  U2 = Z Mee = K (H Mee) */
-        sd(U1, &sA, Mhe, n, 0);
+        sd(U1, &pl.A, Mhe, n, 0);
         dd(LP, Lt, Mhe, m, n, n, 0);
-        sd(U1, &sB, LP, n, -1);
-        sd(HE, &sH, Mee, n, 0);
+        sd(U1, &pl.B, LP, n, -1);
+        sd(HE, &pl.H, Mee, n, 0);
         dd(U2, Kt, HE, n, k, n, 0);
         /* V = Y Mhh = A Mhh - B (L Mhh) */
         dd(LP, Lt, Mhh, m, n, n, 0);
-        sd(V, &sA, Mhh, n, 0);
-        sd(V, &sB, LP, n, -1);
+        sd(V, &pl.A, Mhh, n, 0);
+        sd(V, &pl.B, LP, n, -1);
         /* Nhh = V Y' = V A' - (V L') B' */
-        ds(Nhh, V, &sAt, n, 0);
+        ds(Nhh, V, &pl.At, n, 0);
         ddt(VL, V, Lt, n, n, m, 0);
         for (int i = 0; i < n; i++)
             for (int j = 0; j < n; j++) {
                 double s = 0.0;
-                for (int p = sB.start[j]; p < sB.start[j + 1]; p++)
-                    s += VL[i * m + sB.col[p]] * sB.val[p];
+                for (int p = pl.B.start[j]; p < pl.B.start[j + 1]; p++)
+                    s += VL[i * m + pl.B.col[p]] * pl.B.val[p];
                 Nhh[i * n + j] -= s;
             }
         /* + U1 Z' + Z U1' + U2 Z', with V Z' = (V H') K' */
-        ds(VH, U1, &sHt, n, 0);
+        ds(VH, U1, &pl.Ht, n, 0);
         ddt(X2, VH, Kt, n, k, n, 0);                  /* U1 Z' */
         for (int i = 0; i < n; i++)
             for (int j = 0; j < n; j++) Nhh[i * n + j] += X2[i * n + j] + X2[j * n + i];
-        ds(VH, U2, &sHt, n, 0);
+        ds(VH, U2, &pl.Ht, n, 0);
         ddt(Nhh, VH, Kt, n, k, n, 1);
         add(Nhh, W, (int)nn);
         /* Nhe = (U1 + U2) akh' - W, V akh' = V A' - (V H') K' */
         add(U1, U2, (int)nn);
-        ds(Nhe, U1, &sAt, n, 0);
-        ds(VH, U1, &sHt, n, 0);
+        ds(Nhe, U1, &pl.At, n, 0);
+        ds(VH, U1, &pl.Ht, n, 0);
         ddt(Nhe, VH, Kt, n, k, n, -1);
         for (size_t i = 0; i < nn; i++) Nhe[i] -= W[i];
         /* Nee = (A Mee - U2) akh' + noise + W + CC0 */
-        sd(V, &sA, Mee, n, 0);
+        sd(V, &pl.A, Mee, n, 0);
         for (size_t i = 0; i < nn; i++) V[i] -= U2[i];
-        ds(Nee, V, &sAt, n, 0);
-        ds(VH, V, &sHt, n, 0);
+        ds(Nee, V, &pl.At, n, 0);
+        ds(VH, V, &pl.Ht, n, 0);
         ddt(Nee, VH, Kt, n, k, n, -1);
         if (nc) {
             dd(LP, Lt, Mhh, m, n, n, 0);
@@ -582,13 +599,7 @@ static int lqg_error_cov(int T, int n, int m, int k, int nc, int nd, const doubl
         memcpy(P + (size_t)(t + 1) * nn, Mee, sizeof(double) * nn);
     }
     status = 0;
-done:
-    csr_free(&sA);
-    csr_free(&sAt);
-    csr_free(&sB);
-    csr_free(&sH);
-    csr_free(&sHt);
-    free(buf);
+    sparse_close(&pl);
     return status;
 }
 
