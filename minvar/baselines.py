@@ -42,7 +42,8 @@ from scipy.special import betainc
 
 from .kinematics import TwoLinkChain
 from .limits import check_steps
-from .task import ViaPoint, _point
+from .task import ViaPoint
+from .validation import Point, checked
 
 __all__ = [
     "SmoothTrajectory",
@@ -164,14 +165,14 @@ def _sample_times(owner: str, duration: float, dt: float) -> np.ndarray:
 def _knots(owner: str, start, goal, duration: float, via_points: Sequence[ViaPoint]):
     """Knot times (s) and positions (K, 2) of start, via-points and goal."""
     times = [0.0]
-    points = [_point(owner, "start", start)]
+    points = [checked(start, Point, (owner, "start"))]
     for i, v in enumerate(via_points):
         if not isinstance(v, ViaPoint):
             raise ValueError(f"{owner}: via_points[{i}] must be a ViaPoint, got {v!r}")
         times.append(v.time_s(duration))
         points.append(v.position)
     times.append(float(duration))
-    points.append(_point(owner, "goal", goal))
+    points.append(checked(goal, Point, (owner, "goal")))
     times = np.asarray(times)
     if np.any(np.diff(times) <= 0):
         raise ValueError(

@@ -35,13 +35,17 @@ metres. The object is a disk of diameter ``object_size``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
+from typing import Annotated, Literal
 
 import numpy as np
+from pydantic import Field
 
+from .errors import ParameterError
 from .kinematics import TwoLinkChain
-from .limits import check_position, check_steps
-from .plant import PointMassPlant, check_form
+from .limits import check_steps
+from .plant import FORMS, PointMassPlant
+from .validation import Extent, Length, NonNegative, Point, Positive, Span, Tuple, declared
 
 __all__ = ["CHAINS", "DEFAULT_SHOULDER", "GraspTask", "GripVia", "shoulder_for"]
 
@@ -49,36 +53,15 @@ __all__ = ["CHAINS", "DEFAULT_SHOULDER", "GraspTask", "GripVia", "shoulder_for"]
 CHAINS = ("arm", "finger", "thumb")
 
 
-def _finite(owner: str, name: str, value, *, low: float | None = None, strict: bool = False,
-            length: bool = False):
-    """``value`` as a float, checked finite and above ``low``; raise naming ``owner.name``.
-
-    A ``length`` (m) is also checked within :data:`minvar.limits.MAX_POSITION_M`.
-    """
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{owner}.{name}: expected a number, got {value!r}") from None
-    if not np.isfinite(v):
-        raise ValueError(f"{owner}.{name}: expected a finite number, got {value!r}")
-    if low is not None and (v <= low if strict else v < low):
-        op = ">" if strict else ">="
-        raise ValueError(f"{owner}.{name}: expected a value {op} {low}, got {value!r}")
-    if length:
-        check_position(v, f"{owner}.{name}")
-    return v
+def _bad(name: str, problem: str) -> ParameterError:
+    """A relation between :class:`GraspTask`'s fields broken, named by ``name``."""
+    return ParameterError(problem, location=("GraspTask", name))
 
 
-def _pair(owner: str, name: str, value, *, positive: bool = False) -> tuple[float, float]:
-    arr = np.asarray(value, dtype=float)
-    if arr.shape != (2,) or not np.all(np.isfinite(arr)) or (positive and np.any(arr <= 0)):
-        what = "2 positive lengths" if positive else "2 finite coordinates"
-        raise ValueError(f"{owner}.{name}: expected {what}, got {value!r}")
-    check_position(arr, f"{owner}.{name}")
-    return float(arr[0]), float(arr[1])
+_Links = Annotated[tuple[Span, Span], Tuple]
 
 
-@dataclass(frozen=True)
+@declared
 class GripVia:
     """A via-point of the grip channel, shared by both digits (mirrored).
 
@@ -95,21 +78,9 @@ class GripVia:
         Time as a fraction of the movement, strictly between 0 and 1.
     """
 
-    half_aperture: float
-    height: float
-    fraction: float
-
-    def __post_init__(self):
-        object.__setattr__(
-            self, "half_aperture",
-            _finite("GripVia", "half_aperture", self.half_aperture, low=0.0, length=True),
-        )
-        object.__setattr__(self, "height",
-                           _finite("GripVia", "height", self.height, length=True))
-        f = _finite("GripVia", "fraction", self.fraction)
-        if not 0.0 < f < 1.0:
-            raise ValueError(f"GripVia.fraction: expected a time fraction in (0, 1), got {f}")
-        object.__setattr__(self, "fraction", f)
+    half_aperture: Extent
+    height: Length
+    fraction: Annotated[float, Field(gt=0, lt=1)]
 
 
 #: The shoulder relative to the wrist's start for reaches up to about 0.33 m
@@ -149,7 +120,7 @@ def shoulder_for(distance: float, wrist_offset: float = 0.06,
     return (side, -back)
 
 
-@dataclass(frozen=True)
+@declared
 class GraspTask:
     """One reach-to-grasp movement (thesis 4.1.1; geometry in the module docstring).
 
@@ -218,100 +189,64 @@ class GraspTask:
         ``R = r / T I`` (:class:`minvar.task.ReachTask`).
     """
 
-    object_size: float = 0.04
-    distance: float = 0.26
-    duration: float = 1.0
-    viapoint_offset: float = 0.01
-    viapoint_height: float = 0.0
-    viapoint_time: float = 0.7
-    grip_via: tuple[GripVia, ...] | None = None
+    object_size: Extent = 0.04
+    distance: Span = 0.26
+    duration: Positive = 1.0
+    viapoint_offset: Extent = 0.01
+    viapoint_height: Length = 0.0
+    viapoint_time: Annotated[float, Field(gt=0, lt=1)] = 0.7
+    grip_via: Annotated[tuple[GripVia, ...], Tuple] | None = None
     reach_only: bool = False
     plant: PointMassPlant = field(default_factory=PointMassPlant)
-    execution_cv: float = 0.01
-    execution_sigma_s: float = 0.0
-    wrist_offset: float = 0.06
-    tip_start: float = 0.02
-    shoulder_offset: tuple[float, float] = DEFAULT_SHOULDER
-    arm_links: tuple[float, float] = (0.30, 0.30)
-    digit_links: tuple[float, float] = (0.10, 0.10)
-    r: float = 2e-4
-    w_v: float = 0.2
-    w_f: float = 0.01
-    form: str = "project"
+    execution_cv: NonNegative = 0.01
+    execution_sigma_s: NonNegative = 0.0
+    wrist_offset: Span = 0.06
+    tip_start: Length = 0.02
+    shoulder_offset: Point = DEFAULT_SHOULDER
+    arm_links: _Links = (0.30, 0.30)
+    digit_links: _Links = (0.10, 0.10)
+    r: NonNegative = 2e-4
+    w_v: NonNegative = 0.2
+    w_f: NonNegative = 0.01
+    form: Literal[FORMS] = "project"
 
     def __post_init__(self):
-        own = "GraspTask"
-        check_form(self.form, f"{own}.form")
-        setv = object.__setattr__
-        setv(self, "object_size",
-             _finite(own, "object_size", self.object_size, low=0.0, length=True))
-        setv(self, "distance",
-             _finite(own, "distance", self.distance, low=0.0, strict=True, length=True))
-        setv(self, "duration", _finite(own, "duration", self.duration, low=0.0, strict=True))
-        setv(self, "viapoint_offset",
-             _finite(own, "viapoint_offset", self.viapoint_offset, low=0.0, length=True))
-        setv(self, "viapoint_height",
-             _finite(own, "viapoint_height", self.viapoint_height, length=True))
-        vt = _finite(own, "viapoint_time", self.viapoint_time)
-        if not 0.0 < vt < 1.0:
-            raise ValueError(
-                f"{own}.viapoint_time: expected a fraction of the movement in (0, 1), got {vt}"
-            )
-        setv(self, "viapoint_time", vt)
-        for name in ("execution_cv", "execution_sigma_s", "r", "w_v", "w_f"):
-            setv(self, name, _finite(own, name, getattr(self, name), low=0.0))
-        setv(self, "wrist_offset",
-             _finite(own, "wrist_offset", self.wrist_offset, low=0.0, strict=True, length=True))
-        setv(self, "tip_start", _finite(own, "tip_start", self.tip_start, length=True))
-        setv(self, "shoulder_offset", _pair(own, "shoulder_offset", self.shoulder_offset))
-        setv(self, "arm_links", _pair(own, "arm_links", self.arm_links, positive=True))
-        setv(self, "digit_links", _pair(own, "digit_links", self.digit_links, positive=True))
-        if not isinstance(self.plant, PointMassPlant):
-            raise ValueError(f"{own}.plant: expected a PointMassPlant, got {self.plant!r}")
-        setv(self, "reach_only", bool(self.reach_only))
         if self.grip_via is not None:
-            vias = tuple(self.grip_via)
-            for i, v in enumerate(vias):
-                if not isinstance(v, GripVia):
-                    raise ValueError(f"{own}.grip_via[{i}]: expected a GripVia, got {v!r}")
-            fr = [v.fraction for v in vias]
+            fr = [v.fraction for v in self.grip_via]
             if any(b <= a for a, b in zip(fr, fr[1:])):
-                raise ValueError(f"{own}.grip_via: fractions must increase, got {fr}")
-            setv(self, "grip_via", vias)
+                raise _bad("grip_via", f"fractions must increase, got {fr}")
         self._check_timing()
         self._check_reach()
 
     def _check_timing(self) -> None:
         dt = self.plant.dt
-        T = check_steps(self.duration, dt, "GraspTask.duration")  # before any step is counted
+        T = check_steps(self.duration, dt, ("GraspTask", "duration"))  # before steps are counted
         if T < 2:
-            raise ValueError(
-                f"GraspTask.duration: {self.duration} s is shorter than 2 steps of {dt} s"
-            )
+            raise _bad("duration", f"{self.duration} s is shorter than 2 steps of {dt} s")
         used = self.via_schedule
         name = "viapoint_time" if self.grip_via is None else "grip_via"
         steps = [int(round(v.fraction * self.duration / dt)) for v in used]
         for v, n in zip(used, steps):
             if not 0 < n < T:
-                raise ValueError(
-                    f"GraspTask.{name}: via-point at {v.fraction:g} of {self.duration} s falls "
+                raise _bad(
+                    name, f"via-point at {v.fraction:g} of {self.duration} s falls "
                     f"on step {n}, outside the movement's steps 1..{T - 1}"
                 )
         if len(set(steps)) != len(steps):
-            raise ValueError(f"GraspTask.grip_via: two via-points fall on the same step {steps}")
+            raise _bad("grip_via", f"two via-points fall on the same step {steps}")
 
     def _check_reach(self) -> None:
         lo, hi = abs(self.arm_links[0] - self.arm_links[1]), sum(self.arm_links)
         d_start = float(np.hypot(*self.shoulder_offset))
         if not lo <= d_start <= hi:
-            raise ValueError(
-                f"GraspTask.shoulder_offset: the wrist's start is {d_start:.3f} m from the "
+            raise _bad(
+                "shoulder_offset", f"the wrist's start is {d_start:.3f} m from the "
                 f"shoulder, outside the arm's reach [{lo:.3f}, {hi:.3f}] m"
             )
         d_goal = float(np.linalg.norm(np.subtract(self.wrist_target, self.shoulder)))
         if not lo <= d_goal <= hi:
-            raise ValueError(
-                f"GraspTask.distance: an object {self.distance} m away puts the wrist target "
+            raise _bad(
+                "distance", f"an object {self.distance} m away puts the wrist target "
                 f"{d_goal:.3f} m from the shoulder, outside the arm's reach "
                 f"[{lo:.3f}, {hi:.3f}] m"
             )
@@ -320,8 +255,8 @@ class GraspTask:
         def check(point, name, what):
             d = float(np.hypot(*point))
             if not lo <= d <= hi:
-                raise ValueError(
-                    f"GraspTask.{name}: {what} {d:.3f} m from the wrist, outside the "
+                raise _bad(
+                    name, f"{what} {d:.3f} m from the wrist, outside the "
                     f"digits' reach [{lo:.3f}, {hi:.3f}] m"
                 )
 

@@ -7,14 +7,16 @@ Positions in m. All functions broadcast over leading dimensions.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from typing import Annotated
 
 import numpy as np
+
+from minvar.validation import Positive, Tuple, declared
 
 __all__ = ["TwoLinkChain"]
 
 
-@dataclass(frozen=True)
+@declared
 class TwoLinkChain:
     """A planar chain of two rigid links with revolute joints.
 
@@ -26,21 +28,9 @@ class TwoLinkChain:
         Position of the first joint in the parent frame, m.
     """
 
-    l1: float = 0.30
-    l2: float = 0.30
-    base: tuple[float, float] = (0.0, 0.0)
-
-    def __post_init__(self):
-        for name in ("l1", "l2"):
-            value = getattr(self, name)
-            if not (np.isfinite(value) and value > 0):
-                raise ValueError(
-                    f"TwoLinkChain.{name}: expected a positive length in m, got {value}"
-                )
-        b = np.asarray(self.base, dtype=float)
-        if b.shape != (2,) or not np.all(np.isfinite(b)):
-            raise ValueError(f"TwoLinkChain.base: expected 2 finite coordinates, got {self.base!r}")
-        object.__setattr__(self, "base", (float(b[0]), float(b[1])))
+    l1: Positive = 0.30
+    l2: Positive = 0.30
+    base: Annotated[tuple[float, float], Tuple] = (0.0, 0.0)
 
     @property
     def reach(self) -> tuple[float, float]:

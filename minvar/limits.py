@@ -52,6 +52,8 @@ import math
 
 import numpy as np
 
+from minvar.errors import ParameterError
+
 __all__ = [
     "MAX_STEPS",
     "MAX_TRIALS",
@@ -84,6 +86,14 @@ _FLOAT = 8
 _PROBLEM_ARRAYS = 4
 
 
+def _error(what: str | tuple[str, ...], message: str) -> ParameterError:
+    """A :class:`ParameterError` naming ``what``: a field or flag, or a location
+    (``("GraspTask", "duration")``) that a reader renames to its own key or flag."""
+    if isinstance(what, tuple):
+        return ParameterError(message, location=what)
+    return ParameterError(message, field=what)
+
+
 def _gib(nbytes: float) -> str:
     """``nbytes`` in GiB (2^30 bytes), e.g. ``12.3 GiB``; small amounts with more digits."""
     gib = nbytes / 1024**3
@@ -114,11 +124,11 @@ def check_steps(duration: float, dt: float, what: str) -> int:
     """
     ratio = float(duration) / float(dt)
     if not (math.isfinite(ratio) and ratio > 0):
-        raise ValueError(f"{what}: expected a finite, positive time in s, got {duration!r}")
+        raise _error(what, f"expected a finite, positive time in s, got {duration!r}")
     if ratio > MAX_STEPS + 0.5:
         steps = f"{ratio:.0f}" if ratio < 1e9 else f"{ratio:.3g}"
-        raise ValueError(
-            f"{what}: {duration:g} s is {steps} steps of {dt:g} s, more than the "
+        raise _error(
+            what, f"{duration:g} s is {steps} steps of {dt:g} s, more than the "
             f"{MAX_STEPS} steps a movement may have (MAX_STEPS: {MAX_STEPS * dt:.3g} s at "
             f"this step; see docs/model.md, Limits)"
         )
@@ -141,8 +151,8 @@ def check_trials(trials: int, what: str) -> int:
         If there are more than :data:`MAX_TRIALS`.
     """
     if trials > MAX_TRIALS:
-        raise ValueError(
-            f"{what}: {trials} repetitions are more than the {MAX_TRIALS} allowed "
+        raise _error(
+            what, f"{trials} repetitions are more than the {MAX_TRIALS} allowed "
             f"(MAX_TRIALS; see docs/model.md, Limits)"
         )
     return int(trials)
@@ -170,8 +180,8 @@ def check_memory(nbytes: float, what: str, detail: str = "",
     """
     if nbytes > MEMORY_BUDGET:
         detail = f"{detail} " if detail else ""
-        raise ValueError(
-            f"{what}: {detail}would need about {_gib(nbytes)} of memory, more than the "
+        raise _error(
+            what, f"{detail}would need about {_gib(nbytes)} of memory, more than the "
             f"{_gib(MEMORY_BUDGET)} allowed (MEMORY_BUDGET; see docs/model.md, Limits): {hint}"
         )
 
@@ -226,8 +236,8 @@ def check_simulation(trials: int, steps: int, n_states: int, what: str,
     """
     need = simulation_bytes(trials, steps, n_states, n_controls)
     if max_trials is not None and trials > max_trials:
-        raise ValueError(
-            f"{what}: {trials} repetitions are more than the {max_trials} allowed "
+        raise _error(
+            what, f"{trials} repetitions are more than the {max_trials} allowed "
             f"(MAX_TRIALS; they would need about {_gib(need)} of memory; see docs/model.md, "
             f"Limits)"
         )
@@ -294,8 +304,8 @@ def check_position(value, what: str, unit: str = "m") -> None:
     if arr.size and not np.all(arr <= MAX_POSITION_M):  # also catches nan
         flat = ", ".join(f"{v:g}" for v in np.ravel(np.asarray(value, dtype=float)))
         shown = flat if np.ndim(value) == 0 else f"({flat})"
-        raise ValueError(
-            f"{what}: {shown} {unit} lies beyond +-{MAX_POSITION_M:g} {unit}, the most a "
+        raise _error(
+            what, f"{shown} {unit} lies beyond +-{MAX_POSITION_M:g} {unit}, the most a "
             f"position or length may be (MAX_POSITION_M: the metres of a table; see "
             f"docs/model.md, Limits)"
         )

@@ -28,9 +28,12 @@ force: the two forms differ in what ``r`` means (docs/thesis.md).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from typing import Annotated
 
 import numpy as np
+
+from minvar.errors import ParameterError
+from minvar.validation import NonNegative, Positive, Tuple, declared
 
 __all__ = ["PointMassPlant", "POSITION", "VELOCITY", "FORCE", "FILTER", "N_BASE", "FORMS",
            "check_form"]
@@ -54,7 +57,7 @@ def check_form(form, owner: str) -> str:
     return form
 
 
-@dataclass(frozen=True)
+@declared
 class PointMassPlant:
     """A 2-D point mass with a second-order muscle filter and signal-dependent noise.
 
@@ -76,36 +79,20 @@ class PointMassPlant:
         multiplied by ``sigma_s``.
     """
 
-    mass: float = 1.0
-    dt: float = 0.01
-    tau1: float = 0.04
-    tau2: float = 0.04
-    sigma_u: float = 0.4
-    sigma_s: float = 0.4
-    sensory_sd: tuple[float, ...] = (0.01, 0.01, 0.1, 0.1, 1.0, 1.0)
+    mass: Positive = 1.0
+    dt: Positive = 0.01
+    tau1: Positive = 0.04
+    tau2: Positive = 0.04
+    sigma_u: NonNegative = 0.4
+    sigma_s: NonNegative = 0.4
+    sensory_sd: Annotated[tuple[NonNegative, NonNegative, NonNegative, NonNegative, NonNegative,
+                                NonNegative], Tuple] = (0.01, 0.01, 0.1, 0.1, 1.0, 1.0)
 
     def __post_init__(self):
-        for name in ("mass", "dt", "tau1", "tau2"):
-            value = getattr(self, name)
-            if not (np.isfinite(value) and value > 0):
-                raise ValueError(f"PointMassPlant.{name}: expected a positive number, got {value}")
-        for name in ("sigma_u", "sigma_s"):
-            value = getattr(self, name)
-            if not (np.isfinite(value) and value >= 0):
-                raise ValueError(
-                    f"PointMassPlant.{name}: noise scale must be finite and >= 0, got {value}"
-                )
-        sd = tuple(float(s) for s in self.sensory_sd)
-        if len(sd) != 6 or not all(np.isfinite(s) and s >= 0 for s in sd):
-            raise ValueError(
-                f"PointMassPlant.sensory_sd: expected 6 finite values >= 0, got {self.sensory_sd}"
-            )
-        object.__setattr__(self, "sensory_sd", sd)
         if self.dt > min(self.tau1, self.tau2):
-            raise ValueError(
-                f"PointMassPlant.dt: must not exceed the muscle time constants "
-                f"({min(self.tau1, self.tau2)} s) or the filter is unstable, got {self.dt}"
-            )
+            raise ParameterError(f"must not exceed the muscle time constants "
+                                 f"({min(self.tau1, self.tau2)} s) or the filter is unstable, "
+                                 f"got {self.dt}", location=("PointMassPlant", "dt"))
 
     def n_states(self, targets: int) -> int:
         """State dimension with ``targets`` positional targets."""

@@ -20,26 +20,20 @@ docs/model.md for the model, its parameters and this choice.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from typing import Annotated, Literal
 
 import numpy as np
 
-from .limits import check_position, check_problem, check_steps
+from .errors import ParameterError
+from .limits import check_problem, check_steps
 from .lqg import LQGProblem
-from .plant import FORCE, N_BASE, POSITION, VELOCITY, PointMassPlant, check_form
+from .plant import FORCE, FORMS, N_BASE, POSITION, VELOCITY, PointMassPlant
+from .validation import NonNegative, Point, Positive, Tuple, declared
 
 __all__ = ["ViaPoint", "ReachTask", "reach_problem"]
 
 
-def _point(owner: str, name: str, value) -> tuple[float, float]:
-    arr = np.asarray(value, dtype=float)
-    if arr.shape != (2,) or not np.all(np.isfinite(arr)):
-        raise ValueError(f"{owner}.{name}: expected 2 finite coordinates, got {value!r}")
-    check_position(arr, f"{owner}.{name}")
-    return float(arr[0]), float(arr[1])
-
-
-@dataclass(frozen=True)
+@declared
 class ViaPoint:
     """A position the movement should pass through at a given time.
 
@@ -57,17 +51,14 @@ class ViaPoint:
         Time in seconds from the start of the movement.
     """
 
-    position: tuple[float, float]
+    position: Point
     fraction: float | None = None
     seconds: float | None = None
 
     def __post_init__(self):
-        object.__setattr__(self, "position", _point("ViaPoint", "position", self.position))
         if (self.fraction is None) == (self.seconds is None):
-            raise ValueError("ViaPoint: give the time as exactly one of fraction= or seconds=")
-        t = self.fraction if self.fraction is not None else self.seconds
-        if not np.isfinite(t):
-            raise ValueError(f"ViaPoint: time must be finite, got {t}")
+            raise ParameterError("give the time as exactly one of fraction= or seconds=",
+                                 location=("ViaPoint", "fraction"))
 
     def time_s(self, duration: float) -> float:
         """The via-point time in seconds for a movement of ``duration`` s."""
@@ -95,7 +86,7 @@ class ViaPoint:
         return n
 
 
-@dataclass(frozen=True)
+@declared
 class ReachTask:
     """A point-to-point movement, optionally through via-points.
 
@@ -124,32 +115,14 @@ class ReachTask:
         is the project's.
     """
 
-    start: tuple[float, float]
-    goal: tuple[float, float]
-    duration: float
-    via_points: tuple[ViaPoint, ...] = field(default_factory=tuple)
-    r: float = 2e-4
-    w_v: float = 0.2
-    w_f: float = 0.01
-    form: str = "project"
-
-    def __post_init__(self):
-        check_form(self.form, "ReachTask.form")
-        object.__setattr__(self, "start", _point("ReachTask", "start", self.start))
-        object.__setattr__(self, "goal", _point("ReachTask", "goal", self.goal))
-        vias = tuple(self.via_points)
-        for i, v in enumerate(vias):
-            if not isinstance(v, ViaPoint):
-                raise ValueError(f"ReachTask.via_points[{i}]: expected a ViaPoint, got {v!r}")
-        object.__setattr__(self, "via_points", vias)
-        if not (np.isfinite(self.duration) and self.duration > 0):
-            raise ValueError(
-                f"ReachTask.duration: expected a positive time in s, got {self.duration}"
-            )
-        for name in ("r", "w_v", "w_f"):
-            value = getattr(self, name)
-            if not (np.isfinite(value) and value >= 0):
-                raise ValueError(f"ReachTask.{name}: expected a finite weight >= 0, got {value}")
+    start: Point
+    goal: Point
+    duration: Positive
+    via_points: Annotated[tuple[ViaPoint, ...], Tuple] = ()
+    r: NonNegative = 2e-4
+    w_v: NonNegative = 0.2
+    w_f: NonNegative = 0.01
+    form: Literal[FORMS] = "project"
 
     def steps(self, dt: float) -> int:
         """Number of control steps T for time step ``dt``.
@@ -160,11 +133,10 @@ class ReachTask:
             If the movement is shorter than 2 steps, or longer than
             :data:`minvar.limits.MAX_STEPS`.
         """
-        T = check_steps(self.duration, dt, "ReachTask.duration")
+        T = check_steps(self.duration, dt, ("ReachTask", "duration"))
         if T < 2:
-            raise ValueError(
-                f"ReachTask.duration: {self.duration} s is shorter than 2 steps of {dt} s"
-            )
+            raise ParameterError(f"{self.duration} s is shorter than 2 steps of {dt} s",
+                                 location=("ReachTask", "duration"))
         return T
 
     @property

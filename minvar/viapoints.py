@@ -16,16 +16,19 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
+from typing import Annotated
 
 import numpy as np
 import pandas as pd
 from scipy.signal import find_peaks
 
+from .errors import ParameterError
 from .kinematics import TwoLinkChain
 from .lqg import solve
 from .plant import POSITION, PointMassPlant
 from .similarity import joint_msd, path_distance
-from .task import ReachTask, ViaPoint, _point, reach_problem
+from .task import ReachTask, ViaPoint, reach_problem
+from .validation import Point, Positive, Tuple, checked, declared
 
 __all__ = [
     "CRITERIA",
@@ -190,7 +193,7 @@ def extract_via_points(
                          prominence=prominence)
 
 
-@dataclass(frozen=True)
+@declared
 class ViaPointMovement:
     """A movement as start, goal, duration and via-points at normalised times (appendix A.2).
 
@@ -206,36 +209,21 @@ class ViaPointMovement:
         Their times as fractions of the duration, strictly increasing in (0, 1).
     """
 
-    start: tuple[float, float]
-    goal: tuple[float, float]
-    duration: float
-    via_positions: tuple[tuple[float, float], ...] = ()
-    via_fractions: tuple[float, ...] = ()
+    start: Point
+    goal: Point
+    duration: Positive
+    via_positions: Annotated[tuple[Point, ...], Tuple] = ()
+    via_fractions: Annotated[tuple[float, ...], Tuple] = ()
 
     def __post_init__(self):
-        name = "ViaPointMovement"
-        object.__setattr__(self, "start", _point(name, "start", self.start))
-        object.__setattr__(self, "goal", _point(name, "goal", self.goal))
-        if not (np.isfinite(self.duration) and self.duration > 0):
-            raise ValueError(f"{name}.duration: expected a positive time in s, got {self.duration}")
-        object.__setattr__(self, "duration", float(self.duration))
-        vias = tuple(
-            _point(name, f"via_positions[{i}]", v) for i, v in enumerate(self.via_positions)
-        )
-        fractions = tuple(float(f) for f in self.via_fractions)
-        if len(vias) != len(fractions):
-            raise ValueError(
-                f"{name}: {len(vias)} via_positions but {len(fractions)} via_fractions"
-            )
-        f = np.asarray(fractions)
-        ordered = np.all(np.isfinite(f)) and np.all(np.diff(np.r_[0.0, f, 1.0]) > 0)
-        if not ordered:
-            raise ValueError(
-                f"{name}.via_fractions: expected strictly increasing fractions in (0, 1), "
-                f"got {list(fractions)}"
-            )
-        object.__setattr__(self, "via_positions", vias)
-        object.__setattr__(self, "via_fractions", fractions)
+        if len(self.via_positions) != len(self.via_fractions):
+            raise ParameterError(f"{len(self.via_positions)} via_positions but "
+                                 f"{len(self.via_fractions)} via_fractions",
+                                 location=("ViaPointMovement", "via_fractions"))
+        if not np.all(np.diff(np.r_[0.0, self.via_fractions, 1.0]) > 0):
+            raise ParameterError(f"expected strictly increasing fractions in (0, 1), got "
+                                 f"{list(self.via_fractions)}",
+                                 location=("ViaPointMovement", "via_fractions"))
 
     @classmethod
     def from_task(cls, task: ReachTask) -> ViaPointMovement:
@@ -325,7 +313,8 @@ class ViaPointMovement:
         if not (np.isfinite(scale) and scale > 0):
             raise ValueError(f"ViaPointMovement.transform: scale must be > 0, got {scale}")
         s_old = np.asarray(self.start)
-        s_new = s_old if start is None else np.asarray(_point("transform", "start", start))
+        s_new = s_old if start is None else \
+            np.asarray(checked(start, Point, ("transform", "start")))
 
         def move(p):
             return tuple(scale * (np.asarray(p) - s_old) + s_new)
@@ -626,7 +615,7 @@ def letter_a(
         ((0.08, -0.50), 0.84),   # down the stem
     ]
     goal = (0.18, -0.80)  # the tail
-    s = np.asarray(_point("letter_a", "start", start))
+    s = np.asarray(checked(start, Point, ("letter_a", "start")))
     return ViaPointMovement(
         start=tuple(s),
         goal=tuple(s + height * np.asarray(goal)),

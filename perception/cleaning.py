@@ -23,15 +23,19 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Annotated
 
 import numpy as np
+from pydantic import Field
 from scipy.interpolate import PchipInterpolator
 from scipy.ndimage import median_filter
+
+from perception.validation import Int, NonNegative, declared
 
 __all__ = ["CleaningParams", "Repairs", "clean_path", "spikes"]
 
 
-@dataclass(frozen=True)
+@declared
 class CleaningParams:
     """How lost samples are found and which gaps are bridged.
 
@@ -50,20 +54,10 @@ class CleaningParams:
         interpolation, PCHIP); longer ones stay lost, s.
     """
 
-    spike_distance: float = 0.010
-    spike_window: float = 0.05
-    held_samples: int = 3
-    max_bridge: float = 0.05
-
-    def __post_init__(self):
-        for name in ("spike_distance", "spike_window", "max_bridge"):
-            value = getattr(self, name)
-            if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0):
-                raise ValueError(f"CleaningParams.{name}: expected a finite number >= 0, "
-                                 f"got {value!r}")
-        if not (isinstance(self.held_samples, int) and self.held_samples >= 2):
-            raise ValueError(f"CleaningParams.held_samples: expected an integer >= 2, got "
-                             f"{self.held_samples!r}")
+    spike_distance: NonNegative = 0.010
+    spike_window: NonNegative = 0.05
+    held_samples: Annotated[Int, Field(ge=2)] = 3
+    max_bridge: NonNegative = 0.05
 
 
 @dataclass(frozen=True)

@@ -22,9 +22,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Annotated
 
 import numpy as np
+from pydantic import Field
+
+from perception.validation import Int, NonNegative, Positive, Share, declared
 
 if TYPE_CHECKING:
     from perception.observation import Observation
@@ -40,7 +43,9 @@ __all__ = ["MODEL_SPAN_FRACTION", "LandmarkParams", "Landmarks", "count_peaks", 
 #: on test clips. The span between two fractions does not depend on where
 #: the onset is placed, which the start of a movement leaves uncertain.
 MODEL_SPAN_FRACTION = 0.467
-@dataclass(frozen=True)
+
+
+@declared
 class LandmarkParams:
     """The field's definitions of a movement's bounds, and the filter before them.
 
@@ -87,39 +92,18 @@ class LandmarkParams:
         of slow, 1-2 s grasps.
     """
 
-    threshold: float = 0.05
-    speed: float | None = None
-    hold: float = 0.0
-    noise_factor: float = 2.0
-    cutoff: float | None = 10.0
-    order: int = 2
-    opening_level: float = 0.10
-    peak_prominence: float = 0.25
-    peak_min_prominence: float = 0.005
-    max_gap: float = 0.1
-    max_gap_share: float = 0.2
-    second_movement: float = 0.5
-
-    def __post_init__(self):
-        if not (0 < self.threshold < 1):
-            raise ValueError(f"LandmarkParams.threshold: expected 0 < share < 1, got "
-                             f"{self.threshold!r}")
-        for name in ("speed", "cutoff"):
-            v = getattr(self, name)
-            if v is not None and not (math.isfinite(v) and v > 0):
-                raise ValueError(f"LandmarkParams.{name}: expected a positive number, got {v!r}")
-        if not (math.isfinite(self.hold) and self.hold >= 0):
-            raise ValueError(f"LandmarkParams.hold: expected a time >= 0, got {self.hold!r}")
-        if not (math.isfinite(self.noise_factor) and self.noise_factor >= 0):
-            raise ValueError(f"LandmarkParams.noise_factor: expected a number >= 0, got "
-                             f"{self.noise_factor!r}")
-        if not (isinstance(self.order, int) and 1 <= self.order <= 8):
-            raise ValueError(f"LandmarkParams.order: expected 1-8, got {self.order!r}")
-        for name in ("opening_level", "peak_prominence", "peak_min_prominence", "max_gap",
-                     "max_gap_share", "second_movement"):
-            v = getattr(self, name)
-            if not (math.isfinite(v) and v >= 0 and (name == "max_gap" or v <= 1)):
-                raise ValueError(f"LandmarkParams.{name}: expected a share 0-1, got {v!r}")
+    threshold: Annotated[float, Field(gt=0, lt=1)] = 0.05
+    speed: Positive | None = None
+    hold: NonNegative = 0.0
+    noise_factor: NonNegative = 2.0
+    cutoff: Positive | None = 10.0
+    order: Annotated[Int, Field(ge=1, le=8)] = 2
+    opening_level: Share = 0.10
+    peak_prominence: Share = 0.25
+    peak_min_prominence: Share = 0.005
+    max_gap: NonNegative = 0.1
+    max_gap_share: Share = 0.2
+    second_movement: Share = 0.5
 
     def hides_a_reopening(self, gap: float, movement_time: float) -> bool:
         """Whether a gap of ``gap`` s in the aperture could hide a closing and re-opening.

@@ -21,14 +21,16 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass, field
-from typing import NamedTuple
+from typing import Annotated, NamedTuple
 
 import numpy as np
+from pydantic import AfterValidator, Field
 
 from perception.errors import InputError
 from perception.filtering import alpha_beta
 from perception.geometry import DEFAULT_OBJECT_DIAMETER, SimilarityTransform
 from perception.io.pose import is_pose_file
+from perception.validation import Int, Positive, Tuple, declared
 
 __all__ = [
     "DIGIT_MARKERS",
@@ -53,16 +55,24 @@ NEEDED_MARKERS = (*DIGIT_MARKERS, "object")
 MAD_TO_SD = 1.4826
 
 
-def _positive(value) -> bool:
-    return isinstance(value, int | float) and bool(np.isfinite(value)) and value > 0
+def _range(pair: tuple[float, float]) -> tuple[float, float]:
+    if not pair[0] < pair[1]:
+        raise ValueError("(low, high) with low < high")
+    return pair
 
 
-def _range(value) -> bool:
-    return (isinstance(value, tuple) and len(value) == 2 and all(_positive(v) for v in value)
-            and value[0] < value[1])
+def _profile(rows: tuple) -> tuple:
+    prof = np.asarray(rows, dtype=float)
+    if not (len(prof) >= 2 and np.all(np.diff(prof, axis=0) > 0)):
+        raise ValueError("increasing (displacement m, time s) pairs")
+    return rows
 
 
-@dataclass(frozen=True)
+_Range = Annotated[tuple[Positive, Positive], Tuple, AfterValidator(_range)]
+_Frames = Annotated[Int, Field(ge=0)]
+
+
+@declared
 class ObserveParams:
     """How tracks become observations.
 
@@ -129,62 +139,30 @@ class ObserveParams:
         tremor), and the clip is refused rather than scored as a movement.
     """
 
-    object_diameter: float = DEFAULT_OBJECT_DIAMETER
-    px_per_m: float | None = None
+    object_diameter: Positive = DEFAULT_OBJECT_DIAMETER
+    px_per_m: Positive | None = None
     mirror: bool = False
-    rest_frames: int = 5
-    max_rest_noise: float = 0.005
-    max_rest_drift: float = 0.006
-    rest_noise_factor: float = 6.0
-    max_rest_aperture: float = 0.04
-    hand_size_range: tuple[float, float] = (0.01, 0.25)
-    frame_period_range: tuple[float, float] = (0.001, 0.5)
-    onset_displacement: float = 0.002
-    onset_noise_factor: float = 4.0
-    onset_hold_frames: int = 3
-    onset_profile: tuple[tuple[float, float], ...] = (
+    rest_frames: Annotated[_Frames, Field(ge=2)] = 5
+    max_rest_noise: Positive = 0.005
+    max_rest_drift: Positive = 0.006
+    rest_noise_factor: Positive = 6.0
+    max_rest_aperture: Positive = 0.04
+    hand_size_range: _Range = (0.01, 0.25)
+    frame_period_range: _Range = (0.001, 0.5)
+    onset_displacement: Positive = 0.002
+    onset_noise_factor: Positive = 4.0
+    onset_hold_frames: Annotated[_Frames, Field(ge=1)] = 3
+    onset_profile: Annotated[tuple[Annotated[tuple[float, float], Tuple], ...], Tuple,
+                             AfterValidator(_profile)] = (
         (0.001, 0.091), (0.002, 0.110), (0.003, 0.123), (0.004, 0.133),
         (0.006, 0.151), (0.008, 0.166), (0.012, 0.190))
-    end_speed: float = 0.02
-    end_noise_factor: float = 6.0
-    end_pad_frames: int = 2
-    alpha: float = 0.5
-    beta: float = 0.15
-    min_frames: int = 8
-    min_movement: float = 0.02
-
-    def __post_init__(self):
-        object.__setattr__(self, "hand_size_range", tuple(self.hand_size_range))
-        object.__setattr__(self, "frame_period_range", tuple(self.frame_period_range))
-        object.__setattr__(self, "onset_profile",
-                           tuple(tuple(float(v) for v in row) for row in self.onset_profile))
-        for name in ("object_diameter", "max_rest_noise", "max_rest_drift", "rest_noise_factor",
-                     "max_rest_aperture", "onset_displacement", "onset_noise_factor",
-                     "end_speed", "end_noise_factor", "min_movement"):
-            if not _positive(getattr(self, name)):
-                raise InputError(f"expected a positive number, got {getattr(self, name)!r}",
-                                 field=f"ObserveParams.{name}")
-        if self.px_per_m is not None and not _positive(self.px_per_m):
-            raise InputError(f"expected a positive scale, got {self.px_per_m!r}",
-                             field="ObserveParams.px_per_m")
-        for name in ("hand_size_range", "frame_period_range"):
-            if not _range(getattr(self, name)):
-                raise InputError(f"expected (low, high) with 0 < low < high, got "
-                                 f"{getattr(self, name)!r}", field=f"ObserveParams.{name}")
-        for name, least in (("rest_frames", 2), ("onset_hold_frames", 1),
-                            ("end_pad_frames", 0), ("min_frames", 3)):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int) or value < least:
-                raise InputError(f"expected a whole number of frames >= {least}, got {value!r}",
-                                 field=f"ObserveParams.{name}")
-        if not (0 < self.alpha <= 1 and 0 <= self.beta < 2):
-            raise InputError(f"expected 0 < alpha <= 1, 0 <= beta < 2, got {self.alpha}, "
-                             f"{self.beta}", field="ObserveParams.alpha/beta")
-        prof = np.asarray(self.onset_profile, dtype=float)
-        if not (prof.ndim == 2 and prof.shape[1] == 2 and len(prof) >= 2
-                and np.all(np.diff(prof, axis=0) > 0)):
-            raise InputError("expected increasing (displacement m, time s) pairs",
-                             field="ObserveParams.onset_profile")
+    end_speed: Positive = 0.02
+    end_noise_factor: Positive = 6.0
+    end_pad_frames: _Frames = 2
+    alpha: Annotated[float, Field(gt=0, le=1)] = 0.5
+    beta: Annotated[float, Field(ge=0, lt=2)] = 0.15
+    min_frames: Annotated[_Frames, Field(ge=3)] = 8
+    min_movement: Positive = 0.02
 
     def onset_latency(self, displacement: float) -> float:
         """Time after the command onset at which the wrist has moved ``displacement`` m.

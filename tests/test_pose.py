@@ -134,10 +134,11 @@ def test_files_that_are_not_pose_files(tmp_path):
     with pytest.raises(InputError, match="not an HDF5 file"):
         read_pose(bad)
     assert is_pose_file("a.csv") and is_pose_file("b.h5") and not is_pose_file("c.tracks.h5")
-    with pytest.raises(ValueError, match="--keypoints"):
+    with pytest.raises(InputError, match="PoseImport.keypoints: unknown marker 'elbow'"):
         PoseImport(keypoints={"elbow": "x"})
-    with pytest.raises(ValueError, match="--pcutoff"):
+    with pytest.raises(InputError, match="PoseImport.pcutoff") as err:
         PoseImport(pcutoff=2.0)
+    assert err.value.location == ("PoseImport", "pcutoff")  # the CLI names --pcutoff from it
 
 
 @pytest.mark.slow

@@ -151,10 +151,15 @@ def test_rendering_is_fast(tmp_path):
 def test_failed_render_leaves_no_files(tmp_path, monkeypatch):
     scene = Scene.reach_to_grasp(5, 30)
     style = RenderStyle(width=160, height=120)
-    with pytest.raises(ValueError, match="unknown marker"):
-        render_clip(
-            scene, Camera(), RenderStyle(occlusions=(Occlusion("nose", 0, 1),)), tmp_path / "x.mp4"
-        )
+    # A frame fails to draw after the video is opened: nothing is left behind.
+    def no_frames(*args, **kwargs):
+        yield from ()
+        raise ValueError("unknown marker")
+
+    with monkeypatch.context() as m:
+        m.setattr("perception.synthetic.render.render_frames", no_frames)
+        with pytest.raises(ValueError, match="unknown marker"):
+            render_clip(scene, Camera(), style, tmp_path / "x.mp4")
     assert list(tmp_path.iterdir()) == []
 
     # The truth fails after the video is complete: the video is taken back too.

@@ -88,7 +88,7 @@ def test_config_file(tmp_path):
     assert rep.names == ["slow", "late"] and rep.models[0].scene.distance == 0.22
     assert rep.models[1].finger.A.shape[0] == 8 + 2 * 3  # two via-points and the goal
     cfg.write_text('[[model]]\nname = "x"\nkind = "dance"\n')
-    with pytest.raises(InputError, match="kind must be one of"):
+    with pytest.raises(InputError, match="ModelSpec.kind: expected 'grasp' or 'reach'"):
         Repertoire.from_config(cfg)
     cfg.write_text('[[model]]\nname = "x"\nwobble = 3\n')
     with pytest.raises(InputError, match="unknown task field"):

@@ -1,25 +1,25 @@
 """Checks of option values at the command line's boundary.
 
-A value the user typed that a library refuses with a bare ``ValueError``
-would show a traceback (bare ``ValueError``\\ s are bugs: see
-:mod:`perception.errors`). The commands check such values here, or wrap the
-one call that checks them in :func:`option`, and raise
-:class:`~perception.errors.InputError` naming the option.
+A value the user typed that a library refuses must not show a traceback
+(bare ``ValueError``\\ s are bugs: see :mod:`perception.errors`). The
+commands check such values here, or wrap the call that checks them in
+:func:`options`, which renames the error's structured location to the flag
+through a table.
 """
 
 from __future__ import annotations
 
 import os
-import re
 import sys
 import tempfile
 from collections.abc import Iterator, Mapping
 from contextlib import contextmanager, suppress
 from pathlib import Path
 
+from minvar.errors import LocatedError
 from perception.errors import HammerMVError, InputError
 
-__all__ = ["WORKER_BYTES", "cap_jobs", "check_seed", "free_memory", "option", "options",
+__all__ = ["WORKER_BYTES", "cap_jobs", "check_seed", "free_memory", "options",
            "output_folder", "usable_cores", "writable_folder"]
 
 #: Memory one worker process may need (a clip's frames, tracks and models), bytes.
@@ -27,80 +27,42 @@ WORKER_BYTES = 600 * 2**20
 
 
 @contextmanager
-def option(field: str) -> Iterator[None]:
-    """A ``ValueError`` raised inside becomes an :class:`InputError` naming ``field``.
+def options(flags: Mapping[str, str] | str) -> Iterator[None]:
+    """An error about a value the user typed, raised inside, names the flag that gave it.
 
-    Wrap only a call that checks the option's value (a limit check, a
-    constructor's validation), never a computation: a ``ValueError`` from
-    deeper down is a bug.
-
-    Parameters
-    ----------
-    field : str
-        The option, as typed (``"--trials"``).
-    """
-    try:
-        yield
-    except HammerMVError as exc:
-        if exc.path is not None or exc.field == field:
-            raise
-        # a library's own name for the value ("ViaPoint.position") after the option's
-        problem = exc.problem if exc.field is None else f"{exc.field}: {exc.problem}"
-        raise type(exc)(problem.removeprefix(f"{field}: "), field=field) from None
-    except ValueError as exc:
-        raise InputError(str(exc).removeprefix(f"{field}: "), field=field) from None
-
-
-#: ``Owner.attribute[i]: message`` of the minvar and perception validators.
-_ATTRIBUTE = re.compile(r"^\s*(?:[A-Za-z_][\w.]*\.)?([A-Za-z_]\w*)(?:\[\d+\])?: (.*)$", re.S)
-
-
-@contextmanager
-def options(fields: Mapping[str, str]) -> Iterator[None]:
-    """Like :func:`option` for a constructor taking several options.
-
-    The ``ValueError``'s message names the attribute at fault
-    (``"ReachTask.w_v: expected ..."``) or the option itself
-    (``"--pcutoff: expected ..."``); ``fields`` maps attribute names to the
-    options that set them. An error about an attribute no option sets is
-    not the user's: it propagates unchanged (a bug).
+    Wrap only calls that check values (constructors, limit checks), never a
+    computation: a bare ``ValueError`` from deeper down is a bug.
 
     Parameters
     ----------
-    fields : mapping of str to str
-        Attribute name -> option (``{"w_v": "--w-v"}``).
+    flags : mapping of str to str, or str
+        Attribute -> flag (``{"w_v": "--w-v"}``), read off the error's
+        structured ``location`` (:mod:`minvar.validation`); an error about an
+        attribute no flag sets propagates unchanged. A single flag names
+        every error raised inside.
     """
     try:
         yield
-    except HammerMVError as exc:
-        if exc.path is None and exc.field:  # field="ReachTask.w_v" (or "w_v")
-            attribute = exc.field.rsplit(".", 1)[-1]
-            if attribute in fields:
-                raise type(exc)(exc.problem, field=fields[attribute]) from None
-        if exc.path is None and exc.field is None:
-            renamed = _renamed(exc.problem, fields)
-            if renamed is not None:
-                raise type(exc)(renamed[0], field=renamed[1]) from None
-        raise
     except ValueError as exc:
-        renamed = _renamed(str(exc), fields)
-        if renamed is None:
+        error = exc if isinstance(exc, LocatedError) else None
+        if isinstance(flags, str):
+            if error is None:  # a check function's own words, about this one value
+                raise InputError(str(exc), field=flags) from None
+            if error.path is not None and isinstance(error, HammerMVError):
+                raise
+            # a library's own name for the value ("ViaPoint.position") after the flag
+            named = error.field not in (None, flags)
+            raise _user(error)(f"{error.field}: {error.problem}" if named else error.problem,
+                               error.path, field=flags) from None
+        flag = flags.get(error.location[-1]) if error is not None and error.location else None
+        if flag is None:
             raise
-        raise InputError(renamed[0], field=renamed[1]) from None
+        raise _user(error)(error.problem, field=flag, location=error.location) from None
 
 
-def _renamed(message: str, fields: Mapping[str, str]) -> tuple[str, str | None] | None:
-    """(problem, option) for :func:`options`, or None if the message names no option."""
-    flag = next((f for f in fields.values() if message.startswith((f"{f}: ", f"{f} "))), None)
-    if flag is not None:  # the message names the flag itself
-        if message.startswith(f"{flag}: "):
-            return message.removeprefix(f"{flag}: "), flag
-        return message, None  # "--flag VALUE: ..."
-    match = _ATTRIBUTE.match(message)
-    if match is None or match.group(1) not in fields:
-        return None
-    field = fields[match.group(1)]
-    return match.group(2).removeprefix(f"{field}: "), field
+def _user(error: LocatedError) -> type[HammerMVError]:
+    """The user's error class for ``error`` (minvar's ParameterError is an InputError here)."""
+    return type(error) if isinstance(error, HammerMVError) else InputError
 
 
 def check_seed(seed: int, field: str = "--seed") -> int:

@@ -12,7 +12,7 @@ import argparse
 import time
 from pathlib import Path
 
-from hammer_mv.cli.checks import check_seed, option, options, output_folder
+from hammer_mv.cli.checks import check_seed, options, output_folder
 from minvar.grasp import GraspTask, check_grasp_simulation
 from minvar.grasp_experiments import EXPERIMENTS, THESIS_TRIALS, check_trials
 from minvar.limits import MAX_TRIALS, check_position, check_steps
@@ -124,17 +124,17 @@ def run_simulate(args: argparse.Namespace) -> int:
     from minvar.grasp_stats import grasp_moments, summarize_grasp
     from minvar.plotting import grasp_figure, setup_figure
 
-    with option("--trials"):
+    with options("--trials"):
         check_trials(args.trials, name="--trials")
     check_seed(args.seed)
     # Sizes and lengths against minvar.limits, named by their flags, before any work.
     for name in LENGTH_FLAGS:
         flag = "--" + name.replace("_", "-")
-        with option(flag):
+        with options(flag):
             check_position(getattr(args, name), flag)
     with options({"dt": "--dt"}):
         plant = PointMassPlant(dt=args.dt)
-    with option("--duration"):
+    with options("--duration"):
         check_steps(args.duration, args.dt, "--duration")
     out = output_folder(args.output)
     with options(TASK_FIELDS):
@@ -145,7 +145,7 @@ def run_simulate(args: argparse.Namespace) -> int:
             reach_only=args.reach_only, execution_cv=args.execution_cv, plant=plant,
         )
     # the simulation, and the table of trajectories.csv in the same budget
-    with option("--trials"):
+    with options("--trials"):
         check_grasp_simulation(task, args.trials, "--trials", extra_floats=TABLE_COLUMNS,
                                max_trials=MAX_TRIALS)
     plan = plan_grasp(task)
@@ -182,7 +182,7 @@ def run_simulate(args: argparse.Namespace) -> int:
 
 def run_experiment(args: argparse.Namespace) -> int:
     """Execute ``hammer-mv grasp experiment`` with parsed ``args``; return the exit status."""
-    with option("--trials"):
+    with options("--trials"):
         check_trials(args.trials, name="--trials")
     check_seed(args.seed)
     out = output_folder(args.output)

@@ -60,24 +60,24 @@ def run(args: argparse.Namespace) -> int:
     """
     import pandas as pd
 
+    from hammer_mv.cli.checks import options
     from hammer_mv.cli.options import mocap_import
     from perception.errors import InputError
     from perception.io.atomic import write_text
     from perception.landmarks import LandmarkParams
     from perception.measure import landmarks
 
-    try:
+    with options({"threshold": "--threshold", "speed": "--speed", "hold": "--hold",
+                  "cutoff": "--cutoff"}):
         params = LandmarkParams(threshold=args.threshold, speed=args.speed, hold=args.hold,
                                 cutoff=args.cutoff or None)
-    except ValueError as exc:
-        raise InputError(str(exc).split(": ", 1)[-1], field="--threshold/--speed/--hold/"
-                         "--cutoff") from None
     mocap = mocap_import(args)
     pose = None
     if args.fps is not None:
         from perception.io.pose import PoseImport
 
-        pose = PoseImport(fps=args.fps)
+        with options({"fps": "--fps"}):
+            pose = PoseImport(fps=args.fps)
     from perception.io.names import output_folder, output_stem
     from perception.pipeline import TRACKS_SUFFIX, clip_name
 

@@ -26,7 +26,7 @@ from perception.recognition.scoring import THESIS_SIGNS
 
 _OBSERVE = ObserveParams()
 _HAMMER = HammerParams()
-#: The pose options, by the PoseImport fields they set (its messages name the flag).
+#: The pose options, by the PoseImport fields they set.
 POSE_FIELDS = {"keypoints": "--keypoints", "pcutoff": "--pcutoff", "fps": "--fps",
                "object_diameter_px": "--object-diameter-px", "individual": "--individual"}
 
@@ -200,7 +200,7 @@ def pose_import(args: argparse.Namespace):
     base = load_pose_config(config) if config is not None else PoseImport()
     if "keypoints" in given:
         given["keypoints"] = {**base.keypoints, **given["keypoints"]}
-    with options(POSE_FIELDS):  # PoseImport names the flag in its messages
+    with options(POSE_FIELDS):
         return dataclasses.replace(base, **given)
 
 
@@ -215,10 +215,8 @@ def recognition_settings(args: argparse.Namespace) -> RecognitionSettings:
     with options({"object_diameter": "--object-diameter", "px_per_m": "--px-per-m"}):
         observe = ObserveParams(object_diameter=args.object_diameter, px_per_m=args.px_per_m,
                                 mirror=args.mirror)
-    for flag, value in (("--w-r", args.w_r), ("--w-g", args.w_g)):
-        if not (math.isfinite(value) and value >= 0):  # HammerParams names both at once
-            raise InputError(f"expected a finite weight >= 0, got {value}", field=flag)
-    with options({"rule": "--rule", "filter_gain": "--filter-gain"}):
+    with options({"rule": "--rule", "filter_gain": "--filter-gain", "w_r": "--w-r",
+                  "w_g": "--w-g"}):
         hammer = HammerParams(rule=args.rule, w_r=args.w_r, w_g=args.w_g,
                               filter_gain=args.filter_gain, thesis_sign=args.thesis_sign)
     tracking = None

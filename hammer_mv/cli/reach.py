@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from hammer_mv.cli.checks import check_seed, option, options, output_folder
+from hammer_mv.cli.checks import check_seed, options, output_folder
 from minvar.analysis import (
     THESIS_DURATIONS,
     closest_approach,
@@ -84,23 +84,23 @@ def run(args: argparse.Namespace) -> int:
     with options({"sigma_u": "--sigma-u", "sigma_s": "--sigma-s"}):
         plant = PointMassPlant(sigma_u=args.sigma_u, sigma_s=args.sigma_s)
     # Sizes and positions against minvar.limits, named by their flags, before any work.
-    with option("--start"):
+    with options("--start"):
         check_position(args.start, "--start")
-    with option("--goal"):
+    with options("--goal"):
         check_position(args.goal, "--goal")
-    with option("--via"):
+    with options("--via"):
         for x, y, _ in args.via:
             check_position((x, y), "--via")
-    with option("--duration"):
+    with options("--duration"):
         check_steps(args.duration, plant.dt, "--duration")
-    with option("--via"):
+    with options("--via"):
         vias = tuple(ViaPoint((x, y), fraction=f) for x, y, f in args.via)
     with options({"start": "--start", "goal": "--goal", "duration": "--duration",
                   "r": "--r", "w_v": "--w-v", "w_f": "--w-f"}):
         task = ReachTask(tuple(args.start), tuple(args.goal), args.duration, vias,
                          r=args.r, w_v=args.w_v, w_f=args.w_f)
         task.steps(plant.dt)
-    with option("--via"):
+    with options("--via"):
         for v in vias:
             v.step(task.duration, plant.dt)  # reject bad via-point times before any work
     n_states = plant.n_states(len(task.targets))
@@ -111,12 +111,12 @@ def run(args: argparse.Namespace) -> int:
             raise InputError(f"need at least 2 repetitions for a sweep, got {trials}",
                              field="--trials")
         for d in args.durations:
-            with option("--durations"):
+            with options("--durations"):
                 check_steps(d, plant.dt, "--durations")
                 steps = ReachTask(task.start, task.goal, d, vias).steps(plant.dt)
                 for v in vias:
                     v.step(d, plant.dt)
-            with option("--trials"):
+            with options("--trials"):
                 check_simulation(trials, steps, n_states, "--trials", max_trials=MAX_TRIALS)
         sweep = speed_accuracy(task, args.durations, trials, seed=args.seed, plant=plant)
         write_csv(out / "speed_accuracy.csv", sweep.summary)
@@ -131,7 +131,7 @@ def run(args: argparse.Namespace) -> int:
     if trials < 2:
         raise InputError(f"need at least 2 repetitions, got {trials}", field="--trials")
     steps = task.steps(plant.dt)
-    with option("--trials"):
+    with options("--trials"):
         check_simulation(trials, steps, n_states, "--trials", max_trials=MAX_TRIALS)
         # ... and the table of trajectories.csv: TABLE_COLUMNS floats per repetition and step
         check_memory(simulation_bytes(trials, steps, n_states)

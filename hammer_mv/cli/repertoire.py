@@ -6,7 +6,7 @@ import argparse
 import math
 from pathlib import Path
 
-from hammer_mv.cli.checks import option
+from hammer_mv.cli.checks import options
 from minvar.limits import check_position, check_steps
 from perception.errors import InputError, PlanningError
 from perception.limits import MAX_FPS
@@ -56,13 +56,13 @@ def run_build(args: argparse.Namespace) -> int:
         for flag, value in (("--distance", args.distance), ("--object-size", args.object_size)):
             if not (math.isfinite(value) and value > 0):  # what SceneSpec asks
                 raise InputError(f"expected a positive length in m, got {value}", field=flag)
-            with option(flag):
+            with options(flag):
                 check_position(value, flag)
         scene = SceneSpec(distance=args.distance, object_size=args.object_size,
                           frame_period=1.0 / args.fps)
         dt = scene.frame_period / model_substeps(scene.frame_period)
         for duration in args.durations:  # named by the flag, before any planning
-            with option("--durations"):
+            with options("--durations"):
                 check_steps(duration, dt, "--durations")
         # a scene the arm cannot reach is a PlanningError, named by its option here
         try:

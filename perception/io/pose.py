@@ -26,12 +26,13 @@ import os
 import re
 import warnings
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any
+from typing import Annotated, Any
 
 import numpy as np
+from pydantic import Field, PlainValidator
 
 from perception.errors import InputError
 from perception.io.atomic import write_bytes, write_text
@@ -40,6 +41,7 @@ from perception.io.movement_import import POSE_EXTRA as _EXTRA
 from perception.io.movement_import import movement_loaders as _movement
 from perception.io.tracks import Status, Tracks, position_bounds
 from perception.limits import MAX_FPS, MAX_FRAMES, MAX_KEYPOINTS, MAX_MARKERS, MAX_POSE_POINTS
+from perception.validation import Positive, Share, declared
 
 __all__ = [
     "DLC_KEY",
@@ -85,7 +87,25 @@ _OUTPUTS = tuple((re.compile(pattern, re.IGNORECASE), what) for pattern, what in
 ))
 
 
-@dataclass(frozen=True)
+def _keypoints(value: Any) -> Mapping[str, str]:
+    """A pose file's marker -> keypoint mapping, each marker on a keypoint of its own."""
+    mapping = dict(value) if isinstance(value, Mapping) else None
+    if mapping is None or not all(isinstance(v, str) and v for v in mapping.values()):
+        raise InputError("expected marker=KEYPOINT with a keypoint name")
+    unknown = sorted(set(mapping) - set(MARKERS))
+    if unknown:
+        raise InputError(f"unknown marker {unknown[0]!r} (expected {', '.join(MARKERS)})")
+    resolved = {m: mapping.get(m, m) for m in MARKERS}
+    for i, m in enumerate(MARKERS):
+        other = [o for o in MARKERS[:i] if resolved[o] == resolved[m]]
+        if other:
+            raise InputError(f"{other[0]} and {m} both map to keypoint {resolved[m]!r}: "
+                             "each marker needs its own keypoint (markers left out map "
+                             "to a keypoint of their own name)")
+    return MappingProxyType(mapping)
+
+
+@declared
 class PoseImport:
     """How a pose file becomes tracks.
 
@@ -111,44 +131,12 @@ class PoseImport:
         give the scale outright with ``--px-per-m`` when recognising.
     """
 
-    keypoints: Mapping[str, str] = field(default_factory=dict)
+    keypoints: Annotated[Mapping[str, str], PlainValidator(_keypoints)] = field(
+        default_factory=lambda: MappingProxyType({}))
     individual: str | None = None
-    pcutoff: float = 0.6
-    fps: float | None = None
-    object_diameter_px: float | None = None
-
-    def __post_init__(self) -> None:
-        mapping = dict(self.keypoints)
-        unknown = sorted(set(mapping) - set(MARKERS))
-        if unknown:
-            raise InputError(f"unknown marker {unknown[0]!r} (expected {', '.join(MARKERS)})",
-                             field="--keypoints")
-        if not all(isinstance(v, str) and v for v in mapping.values()):
-            raise InputError("expected marker=KEYPOINT with a keypoint name", field="--keypoints")
-        resolved = {m: mapping.get(m, m) for m in MARKERS}
-        for i, m in enumerate(MARKERS):
-            other = [o for o in MARKERS[:i] if resolved[o] == resolved[m]]
-            if other:
-                raise InputError(f"{other[0]} and {m} both map to keypoint {resolved[m]!r}: "
-                                 "each marker needs its own keypoint (markers left out map "
-                                 "to a keypoint of their own name)", field="--keypoints")
-        object.__setattr__(self, "keypoints", MappingProxyType(mapping))
-        if not (isinstance(self.pcutoff, int | float) and not isinstance(self.pcutoff, bool)
-                and 0 <= self.pcutoff <= 1):
-            raise InputError(f"expected a likelihood between 0 and 1, got {self.pcutoff!r}",
-                             field="--pcutoff")
-        if self.individual is not None and not isinstance(self.individual, str):
-            raise InputError(f"expected a name, got {self.individual!r}", field="--individual")
-        for name in ("fps", "object_diameter_px"):
-            value = getattr(self, name)
-            flag = f"--{name.replace('_', '-')}"
-            if value is not None and not (isinstance(value, int | float)
-                                          and not isinstance(value, bool)
-                                          and math.isfinite(value) and value > 0):
-                raise InputError(f"expected a positive number, got {value!r}", field=flag)
-        if self.fps is not None and self.fps > MAX_FPS:
-            raise InputError(f"expected a frame rate up to {MAX_FPS:g} frames/s, got "
-                             f"{self.fps!r}", field="--fps")
+    pcutoff: Share = 0.6
+    fps: Annotated[float, Field(gt=0, le=MAX_FPS)] | None = None
+    object_diameter_px: Positive | None = None
 
     def __reduce__(self):
         # MappingProxyType does not pickle: batch workers get the options sent
@@ -214,8 +202,8 @@ def load_pose_config(path: str | os.PathLike) -> PoseImport:
         return PoseImport(keypoints={k: str(v) for k, v in mapping.items()},
                           **{k: cfg[k] for k in _CONFIG_KEYS if k in cfg})
     except InputError as exc:
-        key = (exc.field or "").lstrip("-").replace("-", "_")
-        where = "[keypoints]" if key == "keypoints" else key or None
+        key = exc.location[-1] if exc.location else None
+        where = "[keypoints]" if key == "keypoints" else key
         raise InputError(f"bad pose config: {exc.problem}", path, field=where) from None
     except (TypeError, ValueError) as exc:
         raise InputError(f"bad pose config: {exc}", path) from None

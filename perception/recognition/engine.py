@@ -23,8 +23,7 @@ is read off its calibration.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
-from typing import NamedTuple
+from typing import Literal, NamedTuple
 
 import numpy as np
 
@@ -36,6 +35,7 @@ from perception.recognition.models import ChainModel, MotorModel
 from perception.recognition.result import Recognition
 from perception.recognition.rules import VerdictRules
 from perception.recognition.scoring import RULES, THESIS_SIGNS, likelihood_rule, thesis_rule
+from perception.validation import NonNegative, Positive, Share, declared
 
 __all__ = ["HammerParams", "RULES", "StepScorer", "recognize"]
 
@@ -44,7 +44,7 @@ __all__ = ["HammerParams", "RULES", "StepScorer", "recognize"]
 FIRST_STEPS = 256
 
 
-@dataclass(frozen=True)
+@declared
 class HammerParams:
     """Settings of the recognition engine.
 
@@ -74,27 +74,12 @@ class HammerParams:
         printed: the observed change's sign alone). See docs/recognition.md.
     """
 
-    rule: str = "likelihood"
-    w_r: float = 1.0
-    w_g: float = 2.0
-    obs_sd: float = 0.001
-    filter_gain: float = 0.3
-    thesis_sign: str = "text"
-
-    def __post_init__(self):
-        if self.rule not in RULES:
-            raise ValueError(f"rule: expected one of {RULES}, got {self.rule!r}")
-        if self.thesis_sign not in THESIS_SIGNS:
-            raise ValueError(f"thesis_sign: expected one of {THESIS_SIGNS}, got "
-                             f"{self.thesis_sign!r}")
-        if not (np.isfinite(self.w_r) and np.isfinite(self.w_g) and self.w_r >= 0
-                and self.w_g >= 0):
-            raise ValueError(f"w_r, w_g: expected finite weights >= 0, got {self.w_r}, "
-                             f"{self.w_g}")
-        if not 0 <= self.filter_gain <= 1:
-            raise ValueError(f"filter_gain: expected a value in [0, 1], got {self.filter_gain}")
-        if not (np.isfinite(self.obs_sd) and self.obs_sd > 0):
-            raise ValueError(f"obs_sd: expected a positive SD in m, got {self.obs_sd}")
+    rule: Literal[RULES] = "likelihood"
+    w_r: NonNegative = 1.0
+    w_g: NonNegative = 2.0
+    obs_sd: Positive = 0.001
+    filter_gain: Share = 0.3
+    thesis_sign: Literal[THESIS_SIGNS] = "text"
 
 
 def _clamp_reach(p: np.ndarray, l1: float, l2: float) -> np.ndarray:

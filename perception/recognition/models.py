@@ -15,13 +15,15 @@ from __future__ import annotations
 import dataclasses
 import re
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Annotated, Literal
 
 import numpy as np
+from pydantic import AfterValidator
 
 from minvar import GraspTask, GripVia, PointMassPlant, shoulder_for
-from perception.errors import PlanningError
+from perception.errors import InputError, PlanningError
 from perception.geometry import DEFAULT_OBJECT_DIAMETER, DEFAULT_TIP_START
+from perception.validation import Positive, declared
 
 if TYPE_CHECKING:
     from perception.observation import Observation
@@ -136,7 +138,7 @@ class ChainModel:
         return self.L.shape[0]
 
 
-@dataclass(frozen=True)
+@declared(error=PlanningError)
 class SceneSpec:
     """The scene a model is planned for.
 
@@ -153,17 +155,10 @@ class SceneSpec:
         demonstrator's hand size, from the first frames.
     """
 
-    distance: float = 0.25
-    object_size: float = DEFAULT_OBJECT_DIAMETER
-    frame_period: float = 1 / 30
-    tip_start: float = DEFAULT_TIP_START
-
-    def __post_init__(self):
-        for name in ("distance", "object_size", "frame_period", "tip_start"):
-            value = getattr(self, name)
-            if not (isinstance(value, int | float) and np.isfinite(value) and value > 0):
-                raise PlanningError(f"expected a positive number, got {value!r}",
-                                    field=f"scene {name}")
+    distance: Positive = 0.25
+    object_size: Positive = DEFAULT_OBJECT_DIAMETER
+    frame_period: Positive = 1 / 30
+    tip_start: Positive = DEFAULT_TIP_START
 
     @classmethod
     def of(cls, observation: Observation) -> SceneSpec:
@@ -199,7 +194,13 @@ class SceneSpec:
                          frame_period=self.frame_period, tip_start=q(self.tip_start))
 
 
-@dataclass(frozen=True)
+def _model_name(name: str) -> str:
+    if not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._+-]*", name):
+        raise InputError(f"model name {name!r}: use letters, digits and . _ + - only")
+    return name
+
+
+@declared
 class ModelSpec:
     """One entry of a repertoire: a kind of movement and its task parameters.
 
@@ -214,16 +215,11 @@ class ModelSpec:
         ``viapoint_offset``, ``grip_via``); the scene supplies distance and size.
     """
 
-    name: str
-    kind: str
+    name: Annotated[str, AfterValidator(_model_name)]
+    kind: Literal[KINDS]
     task: dict = field(default_factory=dict)
 
     def __post_init__(self):
-        if not (isinstance(self.name, str) and re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._+-]*",
-                                                             self.name)):
-            raise ValueError(f"model name {self.name!r}: use letters, digits and . _ + - only")
-        if self.kind not in KINDS:
-            raise ValueError(f"model '{self.name}': kind must be one of {KINDS}, got {self.kind!r}")
         known = {f.name for f in dataclasses.fields(GraspTask)} - SCENE_FIELDS
         bad = sorted(set(self.task) - known)
         if bad:

@@ -13,14 +13,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from perception.errors import InputError
 from perception.recognition.result import Recognition
 from perception.recognition.rules import Evidence, Verdict, VerdictRules
+from perception.validation import NonNegative, Share, declared
 
 __all__ = ["Decision", "OnlineState", "SettleRule", "decision_summary"]
 
 
-@dataclass(frozen=True)
+@declared
 class SettleRule:
     """When a provisional verdict is trusted: *settled* at the first frame where it has
     stood for ``hold`` s and
@@ -64,25 +64,16 @@ class SettleRule:
         Time the verdict must have stood, s.
     """
 
-    min_progress: float = 0.5
-    late_margin: float = 0.12
-    slowed: float = 0.6
-    closing: float = 0.05
-    arrived: float = 0.95
-    margin: float = 1.0
-    reach_progress: float = 0.7
-    reach_slowed: float = 0.9
-    reach_opening: float = 0.01
-    hold: float = 0.0
-
-    def __post_init__(self):
-        shares = (self.min_progress, self.reach_progress, self.slowed, self.reach_slowed,
-                  self.closing, self.arrived)
-        if not (all(0 <= v <= 1 for v in shares) and self.late_margin >= 0
-                and self.margin >= 0 and self.reach_opening >= 0 and self.hold >= 0):
-            raise InputError("expected 0 <= min_progress, arrived, reach_progress, slowed, "
-                             "reach_slowed, closing <= 1, late_margin, margin, reach_opening, "
-                             f"hold >= 0, got {self}", field="SettleRule")
+    min_progress: Share = 0.5
+    late_margin: NonNegative = 0.12
+    slowed: Share = 0.6
+    closing: Share = 0.05
+    arrived: Share = 0.95
+    margin: NonNegative = 1.0
+    reach_progress: Share = 0.7
+    reach_slowed: Share = 0.9
+    reach_opening: NonNegative = 0.01
+    hold: NonNegative = 0.0
 
     @staticmethod
     def evidence(verdict: Verdict, evidence: Evidence, rules: VerdictRules) -> float:

@@ -18,12 +18,14 @@ import dataclasses
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Annotated
 
 import numpy as np
+from pydantic import Field
 
-from perception.errors import InputError
 from perception.landmarks import LandmarkParams, Landmarks
 from perception.observation import ObserveParams
+from perception.validation import Int, NonNegative, Share, declared
 
 __all__ = ["DETAILS", "REASONS", "RULE_TABLE", "VERDICT_RULES", "Evidence", "Verdict",
            "VerdictRules", "grip_departs", "judge", "slowed", "verdict_detail"]
@@ -32,7 +34,7 @@ __all__ = ["DETAILS", "REASONS", "RULE_TABLE", "VERDICT_RULES", "Evidence", "Ver
 DETAILS = ("delayed-opening", "re-opening", "no-opening", "other")
 
 
-@dataclass(frozen=True)
+@declared
 class VerdictRules:
     """Every threshold that decides a verdict.
 
@@ -88,36 +90,20 @@ class VerdictRules:
         second opening.
     """
 
-    familiarity_threshold: float = 0.05
-    unfamiliar_threshold: float = 0.01
-    late_opening: float = 0.55
-    late_mga: float = 0.95
-    no_opening: float = 0.30
-    grasp_opening: float = 0.5
-    grasp_rest_frames: int = 5
-    mirror_opening: float = 0.02
-    mirror_majority: float = 0.5
-    min_transport: float = 0.02
-    arrival: float = 0.6
-    min_scored: float = 0.5
-    precision_grip_aperture: float = ObserveParams.max_rest_aperture
+    familiarity_threshold: Share = 0.05
+    unfamiliar_threshold: Share = 0.01
+    late_opening: Share = 0.55
+    late_mga: Share = 0.95
+    no_opening: Share = 0.30
+    grasp_opening: NonNegative = 0.5
+    grasp_rest_frames: Annotated[Int, Field(ge=1)] = 5
+    mirror_opening: NonNegative = 0.02
+    mirror_majority: Share = 0.5
+    min_transport: NonNegative = 0.02
+    arrival: Share = 0.6
+    min_scored: Share = 0.5
+    precision_grip_aperture: NonNegative = ObserveParams.max_rest_aperture
     landmarks: LandmarkParams = field(default_factory=LandmarkParams)
-
-    def __post_init__(self):
-        shares = ("familiarity_threshold", "unfamiliar_threshold", "late_opening", "late_mga",
-                  "no_opening", "mirror_majority", "arrival", "min_scored")
-        for f in dataclasses.fields(self):
-            v = getattr(self, f.name)
-            if f.name == "landmarks":
-                if not isinstance(v, LandmarkParams):
-                    raise InputError(f"expected LandmarkParams, got {v!r}", field="landmarks")
-            elif f.name == "grasp_rest_frames":
-                if not (isinstance(v, int) and not isinstance(v, bool) and v >= 1):
-                    raise InputError(f"expected an integer >= 1, got {v!r}", field=f.name)
-            elif not (isinstance(v, (int, float)) and not isinstance(v, bool)
-                      and math.isfinite(v) and v >= 0 and (f.name not in shares or v <= 1)):
-                limit = "a share 0-1" if f.name in shares else "a finite number >= 0"
-                raise InputError(f"expected {limit}, got {v!r}", field=f.name)
 
     def to_dict(self) -> dict:
         """The rules as the report's ``verdict_rules`` (landmark settings nested)."""
@@ -134,22 +120,12 @@ class VerdictRules:
         path : str or os.PathLike, optional
             The file, named in errors.
         """
-        from perception.io.config import check_keys
+        from perception.io.config import from_table
 
         d = dict(d)
-        check_keys(d, [f.name for f in dataclasses.fields(cls)], "[verdict]", path)
-        lm = d.pop("landmarks", None) or {}
-        check_keys(lm, [f.name for f in dataclasses.fields(LandmarkParams)],
-                   "[verdict.landmarks]", path)
-        try:
-            return cls(landmarks=LandmarkParams(**lm), **d)
-        except InputError as exc:
-            raise InputError(exc.problem, path, field=f"[verdict] {exc.field}") from None
-        except ValueError as exc:
-            raise InputError(str(exc), path, field="[verdict.landmarks]") from None
-        except TypeError:
-            raise InputError(f"expected numbers, got {lm}", path,
-                             field="[verdict.landmarks]") from None
+        landmarks = from_table(LandmarkParams, d.pop("landmarks", {}), "[verdict.landmarks]",
+                               path)
+        return from_table(cls, d, "[verdict]", path, landmarks=landmarks)
 
 
 @dataclass(frozen=True)

@@ -35,12 +35,15 @@ at one frame rate is applied at another by rescaling the clip's misfit by
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import Annotated
 
 import numpy as np
+from pydantic import Field
+
+from perception.validation import Int, NonNegative, Positive, declared
 
 __all__ = ["VERDICTS", "Calibration", "CalibrationParams", "misfit"]
 
@@ -48,7 +51,7 @@ __all__ = ["VERDICTS", "Calibration", "CalibrationParams", "misfit"]
 VERDICTS = ("normal", "abnormal", "reach", "unfamiliar")
 
 
-@dataclass(frozen=True)
+@declared
 class CalibrationParams:
     """How a model's own demonstrations are made for its calibration.
 
@@ -92,34 +95,19 @@ class CalibrationParams:
         Seed of every draw: a repertoire's calibration is reproducible.
     """
 
-    demonstrations: int = 50
-    execution_cv: float = 0.01
-    time_scale: float = 0.08
-    grip_shift: float = 0.08
-    aperture_scale: float = 0.10
-    path_bow: float = 0.03
-    transport_skew: float = 0.8
-    noise_px: float = 0.4
-    noise_spread: float = 0.5
-    px_per_m: float = 800.0
-    rest: float = 0.3
-    marker_offset: float = 0.0065
-    seed: int = 0
-
-    def __post_init__(self):
-        if not (isinstance(self.demonstrations, int) and self.demonstrations >= 10):
-            raise ValueError(f"demonstrations: expected an integer >= 10, got "
-                             f"{self.demonstrations!r}")
-        for f in dataclasses.fields(self):
-            value = getattr(self, f.name)
-            if f.name != "seed" and not (np.isfinite(value) and value >= 0):
-                raise ValueError(f"{f.name}: expected a finite value >= 0, got {value!r}")
-        if not (self.time_scale < 0.5 and self.grip_shift < 0.25 and self.aperture_scale < 1
-                and self.transport_skew < 1 and self.noise_spread < 1
-                and self.px_per_m > 0 and self.rest > 0):
-            raise ValueError("time_scale < 0.5, grip_shift < 0.25, aperture_scale < 1, "
-                             "transport_skew < 1, noise_spread < 1, px_per_m > 0 and rest > 0 "
-                             "are required")
+    demonstrations: Annotated[Int, Field(ge=10)] = 50
+    execution_cv: NonNegative = 0.01
+    time_scale: Annotated[float, Field(ge=0, lt=0.5)] = 0.08
+    grip_shift: Annotated[float, Field(ge=0, lt=0.25)] = 0.08
+    aperture_scale: Annotated[float, Field(ge=0, lt=1)] = 0.10
+    path_bow: NonNegative = 0.03
+    transport_skew: Annotated[float, Field(ge=0, lt=1)] = 0.8
+    noise_px: NonNegative = 0.4
+    noise_spread: Annotated[float, Field(ge=0, lt=1)] = 0.5
+    px_per_m: Positive = 800.0
+    rest: Positive = 0.3
+    marker_offset: NonNegative = 0.0065
+    seed: Int = 0
 
 
 @dataclass(frozen=True, eq=False)

@@ -14,45 +14,34 @@ import json
 import logging
 import os
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any, Literal
 
 import numpy as np
 import pandas as pd
+from pydantic import Field
 
 from perception.errors import InputError
 from perception.io.atomic import write_csv
-from perception.io.config import Spec, check_keys, check_table, read_toml, sub_table
+from perception.io.config import check_keys, from_table, read_toml, sub_table
 from perception.io.video import CODECS
 from perception.limits import MAX_CLIPS
 from perception.synthetic.footage import load_background
 from perception.synthetic.render import render_clip, render_rows
-from perception.synthetic.scene import (
-    DISTRACTOR_LIMITS,
-    OCCLUSION_LIMITS,
-    RENDER_LIMITS,
-    Camera,
-    Distractor,
-    Occlusion,
-    RenderStyle,
-    Scene,
-)
-from perception.synthetic.stimuli import (
-    CONDITIONS,
-    SCENE_LIMITS,
-    StimulusParams,
-    stimulus_paths,
-    stimulus_task,
-)
-from perception.tracking.markers import MARKER_NAMES
+from perception.synthetic.scene import Camera, Distractor, Occlusion, RenderStyle, Scene
+from perception.synthetic.stimuli import CONDITIONS, StimulusParams, stimulus_paths, stimulus_task
+from perception.validation import Int, Tuple, declared
 
 __all__ = ["Recipe", "load_recipe", "render_style", "clip_plans", "synthesize"]
 
 log = logging.getLogger(__name__)
 
 
-@dataclass(frozen=True)
+_Degrees = Annotated[float, Field(ge=-180, le=180)]
+
+
+@declared
 class Recipe:
     """How to render a set of clips (parsed from a TOML recipe).
 
@@ -61,25 +50,32 @@ class Recipe:
     name : str
         Recipe name (file stem).
     counts : dict
-        Clips per condition.
+        Clips per condition (a recipe's ``[conditions]``).
     stimulus : StimulusParams
         The nominal movement (its condition is replaced per clip).
     duration_sd, distance_sd : float
-        Demonstrator variability between clips (SD, s and m).
+        Demonstrator variability between clips (SD, s and m; ``[variation]``).
     camera_angle_deg : (float, float)
-        Range of camera rotations, degrees, drawn uniformly per clip.
+        Range of camera rotations, degrees, drawn uniformly per clip
+        (``[variation]``).
     style : dict
         :class:`perception.synthetic.render.RenderStyle` fields (fps, width, height, codec,
         hand, noise_sd, blur_sigma, lighting, ...).
     """
 
     name: str
-    counts: dict
+    counts: Annotated[dict[Literal[CONDITIONS], Annotated[Int, Field(ge=0, le=MAX_CLIPS)]],
+                      Field(description=f"clips; at most {MAX_CLIPS} clips per recipe")]
     stimulus: StimulusParams = field(default_factory=StimulusParams)
-    duration_sd: float = 0.0
-    distance_sd: float = 0.0
-    camera_angle_deg: tuple[float, float] = (0.0, 0.0)
+    duration_sd: Annotated[float, Field(ge=0, le=10)] = 0.0
+    distance_sd: Annotated[float, Field(ge=0, le=1)] = 0.0
+    camera_angle_deg: Annotated[tuple[_Degrees, _Degrees], Tuple] = (0.0, 0.0)
     style: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if not 0 < sum(self.counts.values()) <= MAX_CLIPS:
+            raise InputError(f"expected at least 1 and at most {MAX_CLIPS} clips in all, got "
+                             f"{sum(self.counts.values())}", location=("Recipe", "counts"))
 
     @property
     def n_clips(self) -> int:
@@ -91,30 +87,15 @@ class Recipe:
 RECIPE_TABLES = ("conditions", "scene", "variation", "render")
 
 
-#: Type and range of each ``[variation]`` value.
-VARIATION_LIMITS: dict[str, Spec] = {
-    "duration_sd": Spec(float, 0, 10, note="s"),
-    "distance_sd": Spec(float, 0, 1, note="m"),
-    "camera_angle_deg": Spec(float, -180, 180, size=2, note="degrees, [low, high]"),
-}
-#: Of each ``[conditions]`` value (clips of that condition).
-CONDITION_LIMITS: dict[str, Spec] = {
-    c: Spec(int, 0, MAX_CLIPS, note=f"at most {MAX_CLIPS} clips per recipe") for c in CONDITIONS}
-#: Of each ``[[render.occlusions]]`` value: an occlusion hides one of the markers.
-_OCCLUSION_TABLE = {**OCCLUSION_LIMITS, "marker": Spec(str, choices=MARKER_NAMES)}
-#: A distractor's, and a sleeve's, colour names a marker.
-_DISTRACTOR_TABLE = {**DISTRACTOR_LIMITS, "colour": Spec("colour", choices=MARKER_NAMES)}
-_RENDER_TABLE = {**RENDER_LIMITS, "sleeve": Spec("colour", choices=MARKER_NAMES)}
-_REQUIRED = {"distractors": ("colour", "start"), "occlusions": ("marker", "start", "stop")}
+_VARIATION = ("duration_sd", "distance_sd", "camera_angle_deg")
 
 
 def load_recipe(path: str | os.PathLike) -> Recipe:
     """Read a recipe TOML file.
 
-    Every value is checked for its type and range before anything is built
-    (:data:`CONDITION_LIMITS`, :data:`VARIATION_LIMITS`,
-    :data:`perception.synthetic.stimuli.SCENE_LIMITS`,
-    :data:`perception.synthetic.scene.RENDER_LIMITS`, ...).
+    Every value is checked for the type and range its class declares
+    (:class:`Recipe`, :class:`StimulusParams`, :class:`RenderStyle`, ...)
+    before anything is built.
 
     Parameters
     ----------
@@ -132,20 +113,16 @@ def load_recipe(path: str | os.PathLike) -> Recipe:
     try:
         check_keys(cfg, RECIPE_TABLES, "the top level", path)
         tables = {name: sub_table(cfg, name, f"[{name}]", path) for name in RECIPE_TABLES}
-        check_table(tables["conditions"], CONDITION_LIMITS, "[conditions]", path)
-        counts = {str(k): int(v) for k, v in tables["conditions"].items()}
-        if not 0 < sum(counts.values()) <= MAX_CLIPS:
-            raise InputError(f"expected at least 1 and at most {MAX_CLIPS} clips in all, got "
-                             f"{sum(counts.values())}", path, field="[conditions]")
-        check_table(tables["scene"], SCENE_LIMITS, "[scene]", path)
-        check_table(tables["variation"], VARIATION_LIMITS, "[variation]", path)
-        stim = StimulusParams(**tables["scene"])
-        var = tables["variation"]
-        angle = tuple(float(a) for a in var.get("camera_angle_deg", (0.0, 0.0)))
-        recipe = Recipe(name=path.stem, counts=counts, stimulus=stim,
-                        duration_sd=float(var.get("duration_sd", 0.0)),
-                        distance_sd=float(var.get("distance_sd", 0.0)),
-                        camera_angle_deg=angle, style=dict(tables["render"]))
+        check_keys(tables["conditions"], CONDITIONS, "[conditions]", path)
+        check_keys(tables["variation"], _VARIATION, "[variation]", path)
+        stim = from_table(StimulusParams, tables["scene"], "[scene]", path, condition="normal")
+        try:
+            recipe = Recipe(name=path.stem, counts=dict(tables["conditions"]), stimulus=stim,
+                            style=dict(tables["render"]), **tables["variation"])
+        except InputError as exc:  # ("Recipe", "counts", "normal"): [conditions] normal
+            where = ["[variation]" if exc.location[1:2] != ("counts",) else "[conditions]"]
+            raise InputError(exc.problem, path, field=" ".join(where + [
+                k for k in exc.location[1:] if k != "counts"])) from None
         render_style(recipe.style, path)  # validate now, not after rendering half the set
         clip_plans(recipe, seed=0)  # every clip's movement must be plannable
     except InputError as exc:
@@ -167,8 +144,8 @@ def render_style(table: Mapping[str, Any], path: str | os.PathLike | None = None
         (``{colour, start, end, diameter, frames, shape, aspect, angle_deg}``,
         ``{marker, start, stop}``); ``background = "photo:NAME"`` or
         ``"video:PATH"``. An unknown key is refused, naming the nearest valid
-        one; every value is checked against :data:`RENDER_LIMITS` (and
-        :data:`DISTRACTOR_LIMITS`, :data:`OCCLUSION_LIMITS`).
+        one; every value is checked against the ranges :class:`RenderStyle`,
+        :class:`Distractor` and :class:`Occlusion` declare.
     path : str or os.PathLike, optional
         The recipe, for messages.
 
@@ -177,35 +154,15 @@ def render_style(table: Mapping[str, Any], path: str | os.PathLike | None = None
     InputError
         A bad key or value, naming the field (``[render] fps``).
     """
-    check_table(table, _RENDER_TABLE, "[render]", path)
-    fields = dict(table)
-    for key, limits, cls in (("distractors", _DISTRACTOR_TABLE, Distractor),
-                             ("occlusions", _OCCLUSION_TABLE, Occlusion)):
-        if key not in fields:
-            continue
-        items = fields[key]
+    fields = dict(sub_table(table, None, "[render]", path))
+    for key, cls in (("distractors", Distractor), ("occlusions", Occlusion)):
+        items = fields.get(key, ())
         if not isinstance(items, list | tuple) or not all(isinstance(i, Mapping) for i in items):
             raise InputError(f"expected a list of tables ([[render.{key}]]), got "
                              f"{items!r}"[:120], path, field=f"[render] {key}")
-        built = []
-        for i, item in enumerate(items):
-            where = f"[[render.{key}]] #{i + 1}"
-            check_table(item, limits, where, path)
-            missing = [k for k in _REQUIRED[key] if k not in item]
-            if missing:
-                raise InputError(f"missing; give {', '.join(_REQUIRED[key])}", path,
-                                 field=f"{where} {missing[0]}")
-            try:
-                built.append(cls(**item))
-            except InputError as exc:  # between fields: frames = [first, stop]
-                name = (exc.field or "").rpartition(".")[2]
-                raise InputError(exc.problem, path, field=f"{where} {name}") from None
-        fields[key] = tuple(built)
-    try:
-        style = RenderStyle(**fields)
-    except InputError as exc:  # between fields: exposure within a frame period
-        name = (exc.field or "").rpartition(".")[2]
-        raise InputError(exc.problem, path, field=f"[render] {name}") from None
+        fields[key] = tuple(from_table(cls, item, f"[[render.{key}]] #{i + 1}", path)
+                            for i, item in enumerate(items))
+    style = from_table(RenderStyle, fields, "[render]", path)
     if style.background:  # a missing photograph or package: refused before rendering
         next(load_background(style.background, 16, 16))
     return style

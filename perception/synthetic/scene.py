@@ -18,65 +18,30 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
-from typing import Any
+from typing import Annotated, Any, Literal
 
 import numpy as np
+from pydantic import Field
 
 from perception.errors import InputError
 from perception.geometry import DEFAULT_OBJECT_DIAMETER, SimilarityTransform
-from perception.io.config import Spec, check_fields, document_ranges
 from perception.limits import MAX_FPS, MAX_FRAME_SIDE
 from perception.synthetic.footage import check_background
+from perception.tracking.markers import MARKER_NAMES
+from perception.validation import Int, Tuple, declared
 
-__all__ = ["DISTRACTOR_LIMITS", "OCCLUSION_LIMITS", "RENDER_LIMITS", "Camera", "Distractor",
-           "Occlusion", "RenderStyle", "Scene", "visibility"]
+__all__ = ["Camera", "Colour", "Distractor", "Occlusion", "RenderStyle", "Scene", "visibility"]
 
 #: Largest frame index, and largest distance from the object, m, of a distractor.
 _MAX_FRAME = 10_000_000
-_MAX_M = 10.0
-
-#: Type and range of each :class:`Distractor` field (a recipe's ``[[render.distractors]]``).
-DISTRACTOR_LIMITS: dict[str, Spec] = {
-    "colour": Spec("colour"),
-    "start": Spec(float, -_MAX_M, _MAX_M, size=2, note="m"),
-    "end": Spec(float, -_MAX_M, _MAX_M, size=2, note="m"),
-    "diameter": Spec(float, 0, 1, lo_open=True, note="m"),
-    "frames": Spec(int, 0, _MAX_FRAME, size=2),
-    "shape": Spec(str, choices=("disc", "bar")),
-    "aspect": Spec(float, 0, 1, lo_open=True),
-    "angle_deg": Spec(float, -360, 360, note="degrees"),
-}
-#: Of each :class:`Occlusion` field (a recipe's ``[[render.occlusions]]``).
-OCCLUSION_LIMITS: dict[str, Spec] = {
-    "marker": Spec(str),
-    "start": Spec(int, 0, _MAX_FRAME),
-    "stop": Spec(int, 0, _MAX_FRAME),
-}
-#: Of each :class:`RenderStyle` field (a recipe's ``[render]``); ``distractors``
-#: and ``occlusions`` are checked by their own classes.
-RENDER_LIMITS: dict[str, Spec] = {
-    # below MAX_FPS: a header claiming MAX_FPS is read as "no rate stated"
-    "fps": Spec(float, 0, MAX_FPS, lo_open=True, hi_open=True, note="a frame rate, frames/s"),
-    "width": Spec(int, 16, MAX_FRAME_SIDE, note="width and height in px"),
-    "height": Spec(int, 16, MAX_FRAME_SIDE, note="width and height in px"),
-    "codec": Spec(str),
-    "texture": Spec(bool),
-    "hand": Spec(bool),
-    "marker_diameter": Spec(float, 0, 0.5, note="m"),
-    "band_size": Spec(float, 0, 1, lo_open=True, size=2, note="m"),
-    "noise_sd": Spec(float, 0, 255, note="grey levels"),
-    "blur_sigma": Spec(float, 0, 100, note="px"),
-    "lighting": Spec(float, 0, 1, hi_open=True),
-    "lighting_angle_deg": Spec(float, -360, 360, note="degrees"),
-    "distractors": Spec("any"),
-    "occlusions": Spec("any"),
-    "background": Spec(str),
-    "exposure": Spec(float, 0, 1, note="s, at most one frame period"),
-    "motion_samples": Spec(int, 1, 100),
-    "flicker": Spec(float, 0, 1),
-    "shading": Spec(float, 0, 1),
-    "sleeve": Spec("colour"),
-}
+_Frame = Annotated[Int, Field(ge=0, le=_MAX_FRAME)]
+_Metres = Annotated[float, Field(ge=-10, le=10)]
+_Degrees = Annotated[float, Field(ge=-360, le=360)]
+_Byte = Annotated[Int, Field(ge=0, le=255)]
+_Span = Annotated[float, Field(gt=0, le=1)]
+_PX = "width and height in px"
+#: A marker's name (its render colour) or BGR, 0..255 each.
+Colour = Literal[MARKER_NAMES] | Annotated[tuple[_Byte, _Byte, _Byte], Tuple]
 
 
 @dataclass(frozen=True)
@@ -150,14 +115,14 @@ class Camera:
         return self.transform.to_model(px)
 
 
-@dataclass(frozen=True)
+@declared
 class Distractor:
     """A disc of a marker's colour (or any colour) on the table.
 
     Parameters
     ----------
     colour : str or (int, int, int)
-        A marker name (its render colour is used) or BGR.
+        A marker name (its render colour is used) or BGR, 0..255 each.
     start : (float, float)
         World position, m, at the first visible frame.
     end : (float, float), optional
@@ -176,20 +141,19 @@ class Distractor:
         Direction of the long axis in the world frame, degrees from +x.
     """
 
-    colour: str | tuple[int, int, int]
-    start: tuple[float, float]
-    end: tuple[float, float] | None = None
-    diameter: float = 0.02
-    frames: tuple[int, int] | None = None
-    shape: str = "disc"
-    aspect: float = 1.0
-    angle_deg: float = 0.0
+    colour: Colour
+    start: Annotated[tuple[_Metres, _Metres], Tuple]
+    end: Annotated[tuple[_Metres, _Metres], Tuple] | None = None
+    diameter: Annotated[float, Field(gt=0, le=1)] = 0.02
+    frames: Annotated[tuple[_Frame, _Frame], Tuple] | None = None
+    shape: Literal["disc", "bar"] = "disc"
+    aspect: Annotated[float, Field(gt=0, le=1)] = 1.0
+    angle_deg: _Degrees = 0.0
 
     def __post_init__(self) -> None:
-        check_fields(self, DISTRACTOR_LIMITS, "Distractor")
         if self.frames is not None and self.frames[0] > self.frames[1]:
             raise InputError(f"expected [first, stop], got {list(self.frames)}",
-                             field="Distractor.frames")
+                             location=("Distractor", "frames"))
 
     def position(self, index: int, n_frames: int) -> np.ndarray | None:
         """World position (2,) m at frame ``index``, or None when not visible."""
@@ -203,19 +167,16 @@ class Distractor:
         return start + w * (np.asarray(self.end, dtype=np.float64) - start)
 
 
-@dataclass(frozen=True)
+@declared
 class Occlusion:
     """Hide ``marker`` (not drawn) during frames ``[start, stop)``."""
 
-    marker: str
-    start: int
-    stop: int
-
-    def __post_init__(self) -> None:
-        check_fields(self, OCCLUSION_LIMITS, "Occlusion")
+    marker: Literal[MARKER_NAMES]
+    start: _Frame
+    stop: _Frame
 
 
-@dataclass(frozen=True)
+@declared
 class RenderStyle:
     """How a clip looks.
 
@@ -271,38 +232,32 @@ class RenderStyle:
         touching the wrist band: the hardest case for the band.
     """
 
-    fps: float = 30.0
-    width: int = 640
-    height: int = 480
+    # below MAX_FPS: a header claiming MAX_FPS is read as "no rate stated"
+    fps: Annotated[float, Field(gt=0, lt=MAX_FPS, description="a frame rate, frames/s")] = 30.0
+    width: Annotated[Int, Field(ge=16, le=MAX_FRAME_SIDE, description=_PX)] = 640
+    height: Annotated[Int, Field(ge=16, le=MAX_FRAME_SIDE, description=_PX)] = 480
     codec: str | None = None
     texture: bool = True
     hand: bool = False
-    marker_diameter: float = 0.02
-    band_size: tuple[float, float] = (0.07, 0.025)
-    noise_sd: float = 0.0
-    blur_sigma: float = 0.0
-    lighting: float = 0.0
-    lighting_angle_deg: float = 30.0
-    distractors: tuple[Distractor, ...] = ()
-    occlusions: tuple[Occlusion, ...] = ()
+    marker_diameter: Annotated[float, Field(ge=0, le=0.5, description="m")] = 0.02
+    band_size: Annotated[tuple[_Span, _Span], Tuple] = (0.07, 0.025)
+    noise_sd: Annotated[float, Field(ge=0, le=255, description="grey levels")] = 0.0
+    blur_sigma: Annotated[float, Field(ge=0, le=100, description="px")] = 0.0
+    lighting: Annotated[float, Field(ge=0, lt=1)] = 0.0
+    lighting_angle_deg: _Degrees = 30.0
+    distractors: Annotated[tuple[Distractor, ...], Tuple] = ()
+    occlusions: Annotated[tuple[Occlusion, ...], Tuple] = ()
     background: str | None = None
-    exposure: float = 0.0
-    motion_samples: int = 5
-    flicker: float = 0.0
-    shading: float = 0.0
-    sleeve: str | tuple[int, int, int] | None = None
+    exposure: Annotated[float, Field(ge=0, le=1, description="s")] = 0.0
+    motion_samples: Annotated[Int, Field(ge=1, le=100)] = 5
+    flicker: Annotated[float, Field(ge=0, le=1)] = 0.0
+    shading: Annotated[float, Field(ge=0, le=1)] = 0.0
+    sleeve: Colour | None = None
 
     def __post_init__(self) -> None:
-        check_fields(self, RENDER_LIMITS, "RenderStyle")
         if self.exposure > 1 / self.fps:
             raise InputError(f"expected at most one frame period ({1 / self.fps:.4f} s), "
-                             f"got {self.exposure!r}", field="RenderStyle.exposure")
-        for name, kind in (("distractors", Distractor), ("occlusions", Occlusion)):
-            items = getattr(self, name)
-            if not (isinstance(items, list | tuple) and all(isinstance(i, kind) for i in items)):
-                raise InputError(f"expected {kind.__name__}s, got {items!r}"[:120],
-                                 field=f"RenderStyle.{name}")
-            object.__setattr__(self, name, tuple(items))
+                             f"got {self.exposure!r}", location=("RenderStyle", "exposure"))
         check_background(self.background)
 
     def to_dict(self) -> dict[str, Any]:
@@ -407,10 +362,6 @@ class Scene:
         lateral = np.stack([ap / 2, np.zeros_like(ap)], axis=1)
         return cls(wrist, ahead + lateral, ahead - lateral, object_diameter=object_diameter)
 
-
-document_ranges(Distractor, DISTRACTOR_LIMITS)
-document_ranges(Occlusion, OCCLUSION_LIMITS)
-document_ranges(RenderStyle, RENDER_LIMITS)
 
 
 def min_jerk(tau: np.ndarray) -> np.ndarray:

@@ -20,34 +20,21 @@ differing only in the grip channel's via-points:
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from typing import Annotated, Literal
 
 import numpy as np
+from pydantic import Field
 
 from minvar import GraspTask, GripVia, shoulder_for, simulate_grasp
-from perception.errors import InputError
 from perception.geometry import DEFAULT_OBJECT_DIAMETER, DEFAULT_TIP_START
-from perception.io.config import Spec, check_fields, document_ranges
 from perception.limits import MAX_REST_S
+from perception.validation import declared
 
-__all__ = ["CONDITIONS", "SCENE_LIMITS", "StimulusParams", "stimulus_task", "stimulus_paths"]
+__all__ = ["CONDITIONS", "StimulusParams", "stimulus_task", "stimulus_paths"]
 
 CONDITIONS = ("normal", "delayed", "open-close-open", "reach")
 
-#: Type and range of each :class:`StimulusParams` field but ``condition``
-#: (a recipe's ``[scene]``).
-SCENE_LIMITS: dict[str, Spec] = {
-    "object_size": Spec(float, 0, 0.5, lo_open=True, note="m"),
-    "distance": Spec(float, 0, 2, lo_open=True, note="m"),
-    "duration": Spec(float, 0, 10, lo_open=True, note="s"),
-    "execution_cv": Spec(float, 0, 1),
-    "rest_before": Spec(float, 0, MAX_REST_S, note="s"),
-    "rest_after": Spec(float, 0, MAX_REST_S, note="s"),
-    "marker_offset": Spec(float, 0, 0.1, note="m"),
-}
-
-
-@dataclass(frozen=True)
+@declared
 class StimulusParams:
     """One demonstration's movement.
 
@@ -70,23 +57,14 @@ class StimulusParams:
         the model's tips touch at the start, real markers sit side by side.
     """
 
-    condition: str = "normal"
-    object_size: float = DEFAULT_OBJECT_DIAMETER
-    distance: float = 0.25
-    duration: float = 1.0
-    execution_cv: float = 0.03
-    rest_before: float = 0.3
-    rest_after: float = 0.3
-    marker_offset: float = 0.0065
-
-    def __post_init__(self):
-        if self.condition not in CONDITIONS:
-            raise InputError(f"expected one of {', '.join(CONDITIONS)}, got {self.condition!r}",
-                             field="StimulusParams.condition")
-        check_fields(self, SCENE_LIMITS, "StimulusParams")
-
-
-document_ranges(StimulusParams, SCENE_LIMITS)
+    condition: Literal[CONDITIONS] = "normal"
+    object_size: Annotated[float, Field(gt=0, le=0.5)] = DEFAULT_OBJECT_DIAMETER
+    distance: Annotated[float, Field(gt=0, le=2)] = 0.25
+    duration: Annotated[float, Field(gt=0, le=10)] = 1.0
+    execution_cv: Annotated[float, Field(ge=0, le=1)] = 0.03
+    rest_before: Annotated[float, Field(ge=0, le=MAX_REST_S)] = 0.3
+    rest_after: Annotated[float, Field(ge=0, le=MAX_REST_S)] = 0.3
+    marker_offset: Annotated[float, Field(ge=0, le=0.1)] = 0.0065
 
 
 def stimulus_task(p: StimulusParams) -> GraspTask:

@@ -22,16 +22,18 @@ from __future__ import annotations
 import json
 import os
 from collections.abc import Iterator, Mapping
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import field, fields, replace
 from functools import cached_property
-from typing import Any
+from typing import Annotated, Any
 
 import cv2
 import numpy as np
+from pydantic import BeforeValidator, Field
 
 from perception.errors import InputError
-from perception.io.config import Spec, check_fields, check_keys, check_value, read_toml, suggest
+from perception.io.config import check_keys, read_toml, suggest
 from perception.io.files import input_file
+from perception.validation import Int, Tuple, declared
 
 #: Marker names in file order (``/tracks/markers``).
 MARKER_NAMES: tuple[str, ...] = ("thumb", "finger", "wrist", "object")
@@ -39,7 +41,32 @@ MARKER_NAMES: tuple[str, ...] = ("thumb", "finger", "wrist", "object")
 _FIELDS = ("bgr", "rgb", "hue", "sat_min", "val_min")
 
 
-@dataclass(frozen=True)
+def _hue(hue: Any) -> tuple[tuple[int, int], ...]:
+    """Accept ``[lo, hi]`` or ``[[lo, hi], ...]``; return a tuple of int pairs."""
+    bad = ValueError("[lo, hi] or a list of [lo, hi] ranges with integers 0..179 "
+                     "(lo > hi wraps through 0)")
+    try:
+        arr = np.asarray(hue)
+    except (TypeError, ValueError):
+        raise bad from None
+    if arr.dtype == object or arr.size > 2 * 180:
+        raise bad
+    arr = np.atleast_2d(arr)
+    if arr.ndim != 2 or arr.shape[1] != 2 or arr.shape[0] == 0:
+        raise bad
+    if arr.dtype.kind not in "iu" and not (
+        arr.dtype.kind == "f" and np.all(np.isfinite(arr)) and np.all(arr == np.round(arr))
+    ):
+        raise bad
+    if np.any(arr < 0) or np.any(arr > 179):
+        raise bad
+    return tuple((int(lo), int(hi)) for lo, hi in arr)
+
+
+_Byte = Annotated[Int, Field(ge=0, le=255)]
+
+
+@declared
 class MarkerColour:
     """How one marker looks: its render colour and the tracker's colour gate.
 
@@ -58,21 +85,10 @@ class MarkerColour:
     """
 
     name: str
-    bgr: tuple[int, int, int]
-    hue: tuple[tuple[int, int], ...]
-    sat_min: int = 100
-    val_min: int = 50
-
-    def __post_init__(self) -> None:
-        bgr = self.bgr
-        if isinstance(bgr, np.ndarray):
-            bgr = bgr.ravel().tolist()
-        if check_value(bgr, Spec(int, 0, 255, size=3)):
-            raise InputError(f"expected 3 integers 0..255, got {self.bgr!r}",
-                             field=f"{self.name}.bgr")
-        object.__setattr__(self, "bgr", tuple(int(c) for c in bgr))
-        object.__setattr__(self, "hue", _normalise_hue(self.hue, f"{self.name}.hue"))
-        check_fields(self, {"sat_min": Spec(int, 0, 255), "val_min": Spec(int, 0, 255)}, self.name)
+    bgr: Annotated[tuple[_Byte, _Byte, _Byte], Tuple]
+    hue: Annotated[tuple[tuple[int, int], ...], BeforeValidator(_hue)]
+    sat_min: _Byte = 100
+    val_min: _Byte = 50
 
     @cached_property
     def hsv(self) -> tuple[int, int, int]:
@@ -124,32 +140,7 @@ class MarkerColour:
         }
 
 
-def _normalise_hue(hue: Any, field: str) -> tuple[tuple[int, int], ...]:
-    """Accept ``[lo, hi]`` or ``[[lo, hi], ...]``; return a tuple of int pairs."""
-    shown = repr(hue) if len(repr(hue)) <= 60 else repr(hue)[:57] + "..."
-    bad = InputError(
-        "expected [lo, hi] or a list of [lo, hi] ranges with "
-        f"integers 0..179 (lo > hi wraps through 0), got {shown}", field=field
-    )
-    try:
-        arr = np.asarray(hue)
-    except (TypeError, ValueError):
-        raise bad from None
-    if arr.dtype == object or arr.size > 2 * 180:
-        raise bad
-    arr = np.atleast_2d(arr)
-    if arr.ndim != 2 or arr.shape[1] != 2 or arr.shape[0] == 0:
-        raise bad
-    if arr.dtype.kind not in "iu" and not (
-        arr.dtype.kind == "f" and np.all(np.isfinite(arr)) and np.all(arr == np.round(arr))
-    ):
-        raise bad
-    if np.any(arr < 0) or np.any(arr > 179):
-        raise bad
-    return tuple((int(lo), int(hi)) for lo, hi in arr)
-
-
-@dataclass(frozen=True)
+@declared
 class MarkerSet:
     """The colour models of every marker, in file order.
 
@@ -159,14 +150,14 @@ class MarkerSet:
         One per marker; names must be unique.
     """
 
-    markers: tuple[MarkerColour, ...] = field(default_factory=lambda: DEFAULT_MARKERS.markers)
+    markers: Annotated[tuple[MarkerColour, ...], Tuple] = field(
+        default_factory=lambda: DEFAULT_MARKERS.markers)
 
     def __post_init__(self) -> None:
-        markers = tuple(self.markers)
-        names = [m.name for m in markers]
-        if not markers or len(set(names)) != len(names):
-            raise ValueError(f"MarkerSet: expected unique marker names, got {names}")
-        object.__setattr__(self, "markers", markers)
+        names = [m.name for m in self.markers]
+        if not names or len(set(names)) != len(names):
+            raise InputError(f"expected unique marker names, got {names}",
+                             location=("MarkerSet", "markers"))
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -239,10 +230,9 @@ class MarkerSet:
             try:
                 by_name[name] = replace(by_name[name], **changes)
             except InputError as exc:
-                field = exc.field or ""
-                if "rgb" in table:
-                    field = field.replace(".bgr", ".rgb")
-                raise InputError(exc.problem, field=where(field)) from None
+                key = exc.location[-1] if exc.location else ""
+                key = "rgb" if key == "bgr" and "rgb" in table else key
+                raise InputError(exc.problem, field=where(f"{name}.{key}")) from None
         return MarkerSet(tuple(by_name[n] for n in self.names))
 
     @classmethod

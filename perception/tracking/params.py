@@ -12,98 +12,30 @@ against the marker's *reference mass*, the pixel count of the whole marker,
 measured when it is first found and then followed slowly
 (``ref_update``).
 
-Every field has a type and a range (:data:`LIMITS`, listed at the end of
-the :class:`TrackerParams` docstring): a setup file's ``[tracker]`` and
-``[sizes]`` values are checked against it, naming the file and field, and
-so is every ``TrackerParams`` built in Python.
+Every field declares its type and range (:mod:`perception.validation`;
+integers are C ints for OpenCV, floats finite): a setup file's ``[tracker]``
+and ``[sizes]`` values are checked against them, naming the file and field,
+and so is every ``TrackerParams`` built in Python.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from functools import cached_property
+from typing import Annotated
 
 import cv2
+from pydantic import Field
 
 from perception.errors import InputError
 from perception.geometry import DEFAULT_OBJECT_DIAMETER
-from perception.io.config import Spec, check_fields, document_ranges
+from perception.validation import Int32, Tuple, declared
 
 _PX = 4096  # px: a distance or window side no larger than the largest frame side
-
-#: Type and range of every :class:`TrackerParams` field (inclusive bounds
-#: unless open; integers are C ints for OpenCV, floats finite).
-LIMITS: dict[str, Spec] = {
-    "min_window_px": Spec(int, 3, _PX),
-    "search_margin_px": Spec(int, 0, _PX),
-    "initial_margin_px": Spec(int, 0, _PX),
-    "velocity_margin": Spec(float, 0, 100),
-    "alpha": Spec(float, 0, 1, lo_open=True),
-    "beta": Spec(float, 0, 2, hi_open=True),
-    "lost_ratio": Spec(float, 0, 1, lo_open=True),
-    "reacquire_ratio": Spec(float, 0, 1, lo_open=True),
-    "split_ratio": Spec(float, 1, 1000),
-    "merge_ratio": Spec(float, 1, 1000),
-    "max_area_ratio": Spec(float, 1, 1000),
-    "hold_ratio": Spec(float, 0, 1),
-    "still_jump_px": Spec(float, 0, _PX),
-    "still_markers": Spec(str, size=0),
-    "term_eps_px": Spec(float, 0, 100, lo_open=True),
-    "term_max_iter": Spec(int, 1, 1000),
-    "min_area_px": Spec(int, 1, 10_000_000),
-    "search_scale": Spec(int, 0, 64),
-    "ref_update": Spec(float, 0, 1),
-    "lost_velocity_decay": Spec(float, 0, 1),
-    "init_candidates": Spec(int, 1, 20),
-    "search_min_ratio": Spec(float, 0, 1),
-    "search_tries": Spec(int, 1, 100),
-    "search_marker_px": Spec(float, 0, _PX, lo_open=True),
-    "search_max_scale": Spec(int, 1, 64),
-    "ref_update_band": Spec(float, 1, 100),
-    "still_min_rate": Spec(float, 0, 1, lo_open=True),
-    "still_shift_px": Spec(float, 0, _PX),
-    "max_window_ratio": Spec(float, 1, 100),
-    "object_diameter": Spec(float, 0, 10, lo_open=True),
-    "marker_diameter": Spec(float, 0, 1, lo_open=True),
-    "band_size": Spec(float, 0, 1, lo_open=True, size=2),
-    "size_tolerance": Spec(float, 1, 100),
-    "min_roundness": Spec(float, 0, 1, lo_open=True),
-    "band_elongation": Spec(float, 0, 100, lo_open=True, size=2),
-    "min_saturation_ratio": Spec(float, 0, 1),
-    "min_value_ratio": Spec(float, 0, 1),
-    "strict_saturation_ratio": Spec(float, 0, 1),
-    "strict_value_ratio": Spec(float, 0, 1),
-    "own_saturation_margin": Spec(int, 0, 255),
-    "own_value_ratio": Spec(float, 0, 1),
-    "rest_motion_px": Spec(float, 0, _PX, lo_open=True),
-    "init_frames": Spec(int, 1, 1000),
-    "digit_gap": Spec(float, 0, 1, lo_open=True),
-    "hand_span": Spec(float, 0, 2, lo_open=True),
-    "min_band_distance": Spec(float, 0, 1),
-    "ambiguity_margin": Spec(float, 0, 1000),
-    "max_speed": Spec(float, 0, 100, lo_open=True),
-    "merged_likelihood": Spec(float, 0, 0.5, hi_open=True),
-    "clutter_ratio": Spec(float, 0, 1000),
-    "max_merged_frames": Spec(int, 0, 100_000),
-    "hand_drift": Spec(float, 0, 1),
-    "max_drift": Spec(float, 0, 2),
-    "default_fps": Spec(float, 0, 1000, lo_open=True),
-    "table_height_m": Spec(float, 0, 100, lo_open=True),
-    "object_rival_ratio": Spec(float, 0, 1),
-    "max_blobs": Spec(int, 1, 100_000),
-    "rest_area_ratio": Spec(float, 1, 100),
-    "typical_reach": Spec(float, 0, 2, lo_open=True),
-    "colour_weight": Spec(float, 0, 100),
-    "max_band_cos": Spec(float, 0, 1),
-    "rival_separation_px": Spec(float, 0, _PX),
-    "rim_px": Spec(int, 0, _PX),
-    "still_pad_px": Spec(int, 0, _PX),
-    "min_region_px": Spec(int, 1, _PX),
-    "min_soft_contrast": Spec(float, 0, 1000),
-}
+_Metres = Annotated[float, Field(gt=0, le=1)]
+_Ratio = Annotated[float, Field(gt=0, le=100)]
 
 
-@dataclass(frozen=True)
+@declared
 class TrackerParams:
     """Tracker parameters (saved to the ``/tracker`` attributes).
 
@@ -298,75 +230,74 @@ class TrackerParams:
         NaN; its gated area sets the scale).
     """
 
-    min_window_px: int = 8
-    search_margin_px: int = 10
-    initial_margin_px: int = 64
-    velocity_margin: float = 0.5
-    alpha: float = 0.85
-    beta: float = 0.5
-    lost_ratio: float = 0.3
-    reacquire_ratio: float = 0.5
-    split_ratio: float = 1.15
-    merge_ratio: float = 1.5
-    max_area_ratio: float = 4.0
-    hold_ratio: float = 0.97
-    still_jump_px: float = 2.0
-    still_markers: tuple[str, ...] = ("object",)
-    term_eps_px: float = 0.5
-    term_max_iter: int = 10
-    min_area_px: int = 12
-    search_scale: int = 0
-    ref_update: float = 0.05
-    lost_velocity_decay: float = 0.8
-    init_candidates: int = 6
-    search_min_ratio: float = 0.25
-    search_tries: int = 3
-    search_marker_px: float = 5.0
-    search_max_scale: int = 4
-    ref_update_band: float = 1.25
-    still_min_rate: float = 0.1
-    still_shift_px: float = 1.0
-    max_window_ratio: float = 3.0
-    object_diameter: float = DEFAULT_OBJECT_DIAMETER
-    marker_diameter: float = 0.015
-    band_size: tuple[float, float] = (0.07, 0.025)
-    size_tolerance: float = 4.0
-    min_roundness: float = 0.5
-    band_elongation: tuple[float, float] = (1.4, 5.0)
-    min_saturation_ratio: float = 0.55
-    min_value_ratio: float = 0.3
-    strict_saturation_ratio: float = 0.8
-    strict_value_ratio: float = 0.45
-    own_saturation_margin: int = 30
-    own_value_ratio: float = 0.5
-    rest_motion_px: float = 3.0
-    init_frames: int = 5
-    digit_gap: float = 0.05
-    hand_span: float = 0.2
-    min_band_distance: float = 0.02
-    ambiguity_margin: float = 0.3
-    max_speed: float = 6.0
-    merged_likelihood: float = 0.45
-    clutter_ratio: float = 1.0
-    max_merged_frames: int = 3
-    hand_drift: float = 0.01
-    max_drift: float = 0.06
-    default_fps: float = 30.0
-    table_height_m: float = 0.6
-    object_rival_ratio: float = 0.5
-    max_blobs: int = 64
-    rest_area_ratio: float = 2.0
-    typical_reach: float = 0.08
-    colour_weight: float = 2.0
-    max_band_cos: float = 0.6
-    rival_separation_px: float = 4.0
-    rim_px: int = 4
-    still_pad_px: int = 4
-    min_region_px: int = 3
-    min_soft_contrast: float = 10.0
+    min_window_px: Annotated[Int32, Field(ge=3, le=_PX)] = 8
+    search_margin_px: Annotated[Int32, Field(ge=0, le=_PX)] = 10
+    initial_margin_px: Annotated[Int32, Field(ge=0, le=_PX)] = 64
+    velocity_margin: Annotated[float, Field(ge=0, le=100)] = 0.5
+    alpha: Annotated[float, Field(gt=0, le=1)] = 0.85
+    beta: Annotated[float, Field(ge=0, lt=2)] = 0.5
+    lost_ratio: Annotated[float, Field(gt=0, le=1)] = 0.3
+    reacquire_ratio: Annotated[float, Field(gt=0, le=1)] = 0.5
+    split_ratio: Annotated[float, Field(ge=1, le=1000)] = 1.15
+    merge_ratio: Annotated[float, Field(ge=1, le=1000)] = 1.5
+    max_area_ratio: Annotated[float, Field(ge=1, le=1000)] = 4.0
+    hold_ratio: Annotated[float, Field(ge=0, le=1)] = 0.97
+    still_jump_px: Annotated[float, Field(ge=0, le=_PX)] = 2.0
+    still_markers: Annotated[tuple[str, ...], Tuple] = ("object",)
+    term_eps_px: Annotated[float, Field(gt=0, le=100)] = 0.5
+    term_max_iter: Annotated[Int32, Field(ge=1, le=1000)] = 10
+    min_area_px: Annotated[Int32, Field(ge=1, le=10_000_000)] = 12
+    search_scale: Annotated[Int32, Field(ge=0, le=64)] = 0
+    ref_update: Annotated[float, Field(ge=0, le=1)] = 0.05
+    lost_velocity_decay: Annotated[float, Field(ge=0, le=1)] = 0.8
+    init_candidates: Annotated[Int32, Field(ge=1, le=20)] = 6
+    search_min_ratio: Annotated[float, Field(ge=0, le=1)] = 0.25
+    search_tries: Annotated[Int32, Field(ge=1, le=100)] = 3
+    search_marker_px: Annotated[float, Field(gt=0, le=_PX)] = 5.0
+    search_max_scale: Annotated[Int32, Field(ge=1, le=64)] = 4
+    ref_update_band: Annotated[float, Field(ge=1, le=100)] = 1.25
+    still_min_rate: Annotated[float, Field(gt=0, le=1)] = 0.1
+    still_shift_px: Annotated[float, Field(ge=0, le=_PX)] = 1.0
+    max_window_ratio: Annotated[float, Field(ge=1, le=100)] = 3.0
+    object_diameter: Annotated[float, Field(gt=0, le=10)] = DEFAULT_OBJECT_DIAMETER
+    marker_diameter: Annotated[float, Field(gt=0, le=1)] = 0.015
+    band_size: Annotated[tuple[_Metres, _Metres], Tuple] = (0.07, 0.025)
+    size_tolerance: Annotated[float, Field(ge=1, le=100)] = 4.0
+    min_roundness: Annotated[float, Field(gt=0, le=1)] = 0.5
+    band_elongation: Annotated[tuple[_Ratio, _Ratio], Tuple] = (1.4, 5.0)
+    min_saturation_ratio: Annotated[float, Field(ge=0, le=1)] = 0.55
+    min_value_ratio: Annotated[float, Field(ge=0, le=1)] = 0.3
+    strict_saturation_ratio: Annotated[float, Field(ge=0, le=1)] = 0.8
+    strict_value_ratio: Annotated[float, Field(ge=0, le=1)] = 0.45
+    own_saturation_margin: Annotated[Int32, Field(ge=0, le=255)] = 30
+    own_value_ratio: Annotated[float, Field(ge=0, le=1)] = 0.5
+    rest_motion_px: Annotated[float, Field(gt=0, le=_PX)] = 3.0
+    init_frames: Annotated[Int32, Field(ge=1, le=1000)] = 5
+    digit_gap: Annotated[float, Field(gt=0, le=1)] = 0.05
+    hand_span: Annotated[float, Field(gt=0, le=2)] = 0.2
+    min_band_distance: Annotated[float, Field(ge=0, le=1)] = 0.02
+    ambiguity_margin: Annotated[float, Field(ge=0, le=1000)] = 0.3
+    max_speed: Annotated[float, Field(gt=0, le=100)] = 6.0
+    merged_likelihood: Annotated[float, Field(ge=0, lt=0.5)] = 0.45
+    clutter_ratio: Annotated[float, Field(ge=0, le=1000)] = 1.0
+    max_merged_frames: Annotated[Int32, Field(ge=0, le=100_000)] = 3
+    hand_drift: Annotated[float, Field(ge=0, le=1)] = 0.01
+    max_drift: Annotated[float, Field(ge=0, le=2)] = 0.06
+    default_fps: Annotated[float, Field(gt=0, le=1000)] = 30.0
+    table_height_m: Annotated[float, Field(gt=0, le=100)] = 0.6
+    object_rival_ratio: Annotated[float, Field(ge=0, le=1)] = 0.5
+    max_blobs: Annotated[Int32, Field(ge=1, le=100_000)] = 64
+    rest_area_ratio: Annotated[float, Field(ge=1, le=100)] = 2.0
+    typical_reach: Annotated[float, Field(gt=0, le=2)] = 0.08
+    colour_weight: Annotated[float, Field(ge=0, le=100)] = 2.0
+    max_band_cos: Annotated[float, Field(ge=0, le=1)] = 0.6
+    rival_separation_px: Annotated[float, Field(ge=0, le=_PX)] = 4.0
+    rim_px: Annotated[Int32, Field(ge=0, le=_PX)] = 4
+    still_pad_px: Annotated[Int32, Field(ge=0, le=_PX)] = 4
+    min_region_px: Annotated[Int32, Field(ge=1, le=_PX)] = 3
+    min_soft_contrast: Annotated[float, Field(ge=0, le=1000)] = 10.0
 
     def __post_init__(self) -> None:
-        check_fields(self, LIMITS, "TrackerParams")
         # what the ranges alone cannot say
         for names in (("lost_ratio", "reacquire_ratio"),
                       ("split_ratio", "merge_ratio", "max_area_ratio")):
@@ -374,10 +305,10 @@ class TrackerParams:
             if values != sorted(values):
                 raise InputError(f"expected {' <= '.join(names)}, got "
                                  f"{', '.join(map(repr, values))}",
-                                 field=f"TrackerParams.{names[0]}")
+                                 location=("TrackerParams", names[0]))
         if self.band_elongation[0] > self.band_elongation[1]:
             raise InputError(f"expected [low, high], got {list(self.band_elongation)}",
-                             field="TrackerParams.band_elongation")
+                             location=("TrackerParams", "band_elongation"))
 
     @cached_property
     def criteria(self) -> tuple[int, int, float]:
@@ -388,5 +319,3 @@ class TrackerParams:
             float(self.term_eps_px),
         )
 
-
-document_ranges(TrackerParams, LIMITS)

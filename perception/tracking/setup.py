@@ -36,19 +36,21 @@ import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any
 
 import cv2
 import numpy as np
+from pydantic import Field
 
 from perception.errors import InputError
 from perception.io.atomic import write_text
-from perception.io.config import Spec, check_keys, check_table, read_toml, sub_table
+from perception.io.config import check_keys, from_table, read_toml, renamed, sub_table
 from perception.io.files import input_file
 from perception.tracking.blobs import blob_at, principal_axes
 from perception.tracking.markers import MarkerColour, MarkerSet, default_markers
 from perception.tracking.measurement import soft_diameter
-from perception.tracking.params import LIMITS, TrackerParams
+from perception.tracking.params import TrackerParams
+from perception.validation import Int, declared
 
 __all__ = ["TrackingSetup", "calibrate", "load_setup", "write_setup"]
 
@@ -136,21 +138,19 @@ def write_setup(path: str | os.PathLike, setup: TrackingSetup) -> Path:
     return write_text(path, "\n".join(lines))
 
 
-#: Type and range of each ``[setup]`` value.
-SETUP_SPECS = {"source": Spec(str), "frames": Spec(int, 0, 1_000_000)}
-#: Of each ``[markers.NAME]`` value (``hue`` is checked by :class:`MarkerColour`).
-MARKER_SPECS = {"bgr": Spec(int, 0, 255, size=3), "rgb": Spec(int, 0, 255, size=3),
-                "hue": Spec("any"), "sat_min": Spec(int, 0, 255),
-                "val_min": Spec(int, 0, 255)}
+@declared
+class _SetupTable:
+    """A setup file's ``[setup]`` table."""
+
+    source: str = ""
+    frames: Annotated[Int, Field(ge=0, le=1_000_000)] = 0
 
 
 def load_setup(path: str | os.PathLike) -> TrackingSetup:
     """Read a setup file.
 
-    Every value is checked for its type and range (:data:`SETUP_SPECS`,
-    :data:`MARKER_SPECS` and :data:`perception.tracking.params.LIMITS`, the
-    ranges listed in the :class:`TrackerParams` docstring) before anything
-    is built from it.
+    Every value is checked for its type and range (those :class:`TrackerParams`
+    and :class:`MarkerColour` declare) before anything is built from it.
 
     Parameters
     ----------
@@ -168,30 +168,28 @@ def load_setup(path: str | os.PathLike) -> TrackingSetup:
     p = input_file(path, "setup file")
     data = read_toml(p, "setup file")
     check_keys(data, _TABLES, "the top level", p)
-    meta = sub_table(data, "setup", "[setup]", p)
-    check_table(meta, SETUP_SPECS, "[setup]", p)
+    meta = from_table(_SetupTable, data.get("setup", {}), "[setup]", p)
     sizes = sub_table(data, "sizes", "[sizes]", p)
-    check_table(sizes, {k: LIMITS[k] for k in _SIZES}, "[sizes]", p)
+    check_keys(sizes, _SIZES, "[sizes]", p)
     tracker = sub_table(data, "tracker", "[tracker]", p)
-    check_table(tracker, {k: v for k, v in LIMITS.items() if k not in _SIZES}, "[tracker]", p)
+    check_keys(tracker, [k for k in TrackerParams.__dataclass_fields__ if k not in _SIZES],
+               "[tracker]", p)
     markers = sub_table(data, "markers", "[markers]", p)
     for name in markers:
         check_keys({name: None}, default_markers().names, "[markers]", p)
-        where = f"[markers.{name}]"
-        check_table(sub_table(markers, name, where, p), MARKER_SPECS, where, p)
+        sub_table(markers, name, f"[markers.{name}]", p)
     try:
         params = TrackerParams(**{**tracker, **sizes})
-    except InputError as exc:  # a relation between fields (lost_ratio <= reacquire_ratio)
-        name = (exc.field or "").removeprefix("TrackerParams.")
-        table = "[sizes]" if name in _SIZES else "[tracker]"
-        raise InputError(exc.problem, p, field=f"{table} {name}".strip()) from None
+    except InputError as exc:
+        raise renamed(exc, lambda key: f"{'[sizes]' if key in _SIZES else '[tracker]'} {key}",
+                      p) from None
     try:
         colours = default_markers().with_overrides(markers)
-    except InputError as exc:  # the hue, and bgr with rgb; exc.field: "thumb.hue"
+    except InputError as exc:  # exc.field: "thumb.hue"
         name, _, key = (exc.field or "").partition(".")
         field = f"[markers.{name}] {key}".strip() if name else "[markers]"
         raise InputError(exc.problem, p, field=field) from None
-    return TrackingSetup(colours, params, meta.get("source", ""), meta.get("frames", 0))
+    return TrackingSetup(colours, params, meta.source, meta.frames)
 
 
 # -- calibration ------------------------------------------------------------------
