@@ -49,20 +49,22 @@ import dataclasses
 import json
 import math
 import os
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any, Literal
 
 import numpy as np
 import pandas as pd
+from pydantic import Field
 from scipy.ndimage import gaussian_filter1d, maximum_filter1d
 from scipy.special import betainc
 
+from perception.errors import InputError
 from perception.geometry import DEFAULT_OBJECT_DIAMETER
 from perception.io.atomic import write_csv
 from perception.io.tracks import Status, Tracks
 from perception.synthetic.scene import Camera, RenderStyle, Scene, min_jerk
 from perception.tracking.markers import MARKER_NAMES
+from perception.validation import NonNegative, Positive, declared
 
 __all__ = ["CONDITIONS", "RANGES", "IndependentParams", "draw_independent",
            "independent_aperture", "independent_paths", "independent_tracks",
@@ -74,7 +76,10 @@ __all__ = ["CONDITIONS", "RANGES", "IndependentParams", "draw_independent",
 CONDITIONS = ("normal", "delayed", "open-close-open", "reach")
 
 
-@dataclass(frozen=True)
+_Inside = Annotated[float, Field(gt=0, lt=1)]
+
+
+@declared
 class IndependentParams:
     """One demonstration of the independent generator (all times are fractions of the movement).
 
@@ -131,52 +136,39 @@ class IndependentParams:
         How far each digit's marker sits outside its tip, across the grip, m.
     """
 
-    condition: str = "normal"
-    object_size: float = DEFAULT_OBJECT_DIAMETER
-    distance: float = 0.25
-    duration: float = 1.0
-    hand_size: float = 0.06
-    peak_velocity_time: float = 0.40
+    condition: Literal[CONDITIONS] = "normal"
+    object_size: Positive = DEFAULT_OBJECT_DIAMETER
+    distance: Positive = 0.25
+    duration: Positive = 1.0
+    hand_size: Positive = 0.06
+    peak_velocity_time: _Inside = 0.40
     curvature: float = 0.0
     approach_angle_deg: float = 0.0
     grip_axis_deg: float = 0.0
-    mga_excess: float = 0.025
-    mga_time: float = 0.68
-    open_onset: float = 0.05
-    thumb_share: float = 0.4
-    delayed_onset: float = 0.55
-    delayed_mga_time: float = 0.88
-    oco_first_time: float = 0.46
-    oco_first_fraction: float = 0.8
-    oco_close_time: float = 0.68
-    oco_depth: float = 0.45
-    oco_reopen_time: float = 0.88
-    wobble: float = 0.001
-    rest_before: float = 0.3
-    rest_after: float = 0.3
-    marker_offset: float = 0.0065
+    mga_excess: NonNegative = 0.025
+    mga_time: _Inside = 0.68
+    open_onset: NonNegative = 0.05
+    thumb_share: _Inside = 0.4
+    delayed_onset: NonNegative = 0.55
+    delayed_mga_time: _Inside = 0.88
+    oco_first_time: _Inside = 0.46
+    oco_first_fraction: _Inside = 0.8
+    oco_close_time: _Inside = 0.68
+    oco_depth: _Inside = 0.45
+    oco_reopen_time: _Inside = 0.88
+    wobble: NonNegative = 0.001
+    rest_before: NonNegative = 0.3
+    rest_after: NonNegative = 0.3
+    marker_offset: NonNegative = 0.0065
 
     def __post_init__(self):
-        if self.condition not in CONDITIONS:
-            raise ValueError(f"condition: expected one of {CONDITIONS}, got {self.condition!r}")
-        for name in ("object_size", "distance", "duration", "hand_size"):
-            if not (math.isfinite(getattr(self, name)) and getattr(self, name) > 0):
-                raise ValueError(f"{name}: expected a positive value, got {getattr(self, name)!r}")
-        for name in ("peak_velocity_time", "mga_time", "delayed_mga_time", "oco_first_time",
-                     "oco_close_time", "oco_reopen_time", "thumb_share", "oco_first_fraction",
-                     "oco_depth"):
-            if not 0 < getattr(self, name) < 1:
-                raise ValueError(f"{name}: expected a value in (0, 1), got {getattr(self, name)!r}")
         order = {"normal": (self.open_onset, self.mga_time),
                  "delayed": (self.delayed_onset, self.delayed_mga_time),
                  "open-close-open": (self.open_onset, self.oco_first_time, self.oco_close_time,
                                      self.oco_reopen_time)}.get(self.condition, ())
         if order and not (0 <= order[0] and all(a < b for a, b in zip(order, order[1:]))):
-            raise ValueError(f"{self.condition}: aperture key times must increase, got {order}")
-        for name in ("mga_excess", "wobble", "rest_before", "rest_after", "marker_offset",
-                     "open_onset", "delayed_onset"):
-            if not (math.isfinite(getattr(self, name)) and getattr(self, name) >= 0):
-                raise ValueError(f"{name}: expected a value >= 0, got {getattr(self, name)!r}")
+            raise InputError(f"{self.condition}: aperture key times must increase, got {order}",
+                             location=("IndependentParams", "condition"))
 
     @property
     def mga(self) -> float:
