@@ -89,7 +89,7 @@ def test_quick_run_writes_every_figure_and_the_claims_table(tmp_path, capsys):
     assert "## Chapter 3" in md and "## Appendix A" in md and "## Settings" in md
     assert "#### Sensitivity: the length unit of eq. A.1" in md
     assert "skipped (--skip-ch4)" in md
-    assert "thesis claims:" in md and "checks of our own" in md
+    assert "thesis claims, each counted once" in md and "checks of our own" in md
     claims = pd.read_csv(tmp_path / "numbers.csv", keep_default_na=False)
     assert list(claims.columns) == ["chapter", *CLAIM_KEYS]
     thesis = claims[claims["kind"] == "thesis"]
@@ -194,11 +194,14 @@ def test_claims_and_tables_are_grouped_by_chapter():
     assert "| c1 | Fig. 2.6(c); line 276 |  | m1 | t | o | agree |  |  |" in md
     assert "| **thesis inconsistent** |  | both |" in md
     assert "#### Sensitivity: tip_start" in md and "| 6 cm | **no** |" in md
-    assert "1 claims: 1 agree, 0 differ, 0 by construction, 0 thesis inconsistent" in md
+    assert ("1 claims: 1 agree, 0 differ, 0 conditional, 0 by construction, 0 thesis "
+            "inconsistent") in md
     # our own checks are counted apart from the thesis's claims
     own = dict(claim("5.3", "o1", "—", "o", True, kind="own", measure="m"), chapter="Chapter 4")
     md = reproduce_thesis.numbers_markdown([*rows, own], [], ["header"])
-    assert "- 2 thesis claims: 1 agree" in md and "- 1 checks of our own" in md
+    assert "- 2 thesis claims, each counted once" in md and "- 1 checks of our own" in md
+    assert "  - at our settings: 1 agree, 0 differ, 0 conditional, 0 by construction, 1 " \
+        "thesis inconsistent;" in md
     assert "### Our own checks (Chapter 4" in md and "| o1 | 5.3 | m | o | agree |  |" in md
 
 
@@ -236,3 +239,37 @@ def test_bad_options_exit_2(tmp_path):
     with pytest.raises(SystemExit) as e:
         reproduce_thesis.main(["-o", str(tmp_path), "--trials", "1"])
     assert e.value.code == 2
+
+
+def test_by_construction_never_enters_an_agree_tally_in_either_column():
+    # a row made to hold by how the model or test was built says 'agree' at the thesis's
+    # settings when the chapter only dressed its main verdict: it is counted by construction
+    rows = [dict(claim("3.3", "built", "t", "o", verdict="by construction",
+                       at_thesis="agree: o"), chapter="Chapter 3"),
+            dict(claim("5.4", "flips", "t", "o", verdict="differs",
+                       at_thesis="conditional (survives text; not printed): o"),
+                 chapter="Chapter 5"),
+            dict(claim("5.4", "holds", "t", "o", True,
+                       at_thesis="agree (survives text, printed, consecutive): o"),
+                 chapter="Chapter 5")]
+    assert reproduce_thesis.at_thesis_verdict("agree: o", "by construction") == "by construction"
+    md = reproduce_thesis.numbers_markdown(rows, [], ["header"])
+    assert ("  - at the thesis's settings: 1 agree, 0 differ, 1 conditional, 1 by "
+            "construction, 0 thesis inconsistent.") in md
+    assert "| Chapter 3 | built |  | by construction | by construction |" in md
+    assert "| Chapter 5 | flips |  | differs | conditional |" in md
+
+
+def test_a_claim_measured_two_ways_is_counted_once():
+    # the hand frame beside the world frame is one statement of the thesis: one claim,
+    # conditional where the two frames disagree
+    rows = [dict(claim("4.2", "Digit SD is lowest at level", "t", "o", False,
+                       at_thesis="differs: o"), chapter="Chapter 4"),
+            dict(claim("4.2", "Hand frame: digit SD is lowest at level", "t", "o", True,
+                       at_thesis="differs: o"), chapter="Chapter 4"),
+            dict(claim("4.3", "Another", "t", "o", True, at_thesis="agree: o"),
+                 chapter="Chapter 4")]
+    md = reproduce_thesis.numbers_markdown(rows, [], ["header"])
+    assert "- 2 thesis claims (3 rows: a hand-frame row beside" in md
+    assert "  - at our settings: 1 agree, 0 differ, 1 conditional," in md
+    assert "  - at the thesis's settings: 1 agree, 1 differ, 0 conditional," in md

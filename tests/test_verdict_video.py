@@ -60,16 +60,20 @@ def test_chapter5_figures_and_claims(run):
     assert len(mine) == 20 and (mine["verdict"] != "agree").all()
     other = claims[claims["claim"].str.startswith("independent")]
     assert len(other) == 20 and (other["verdict"] != "by construction").all()
-    # every thesis-rule row judged under both readings of eqs. 5.1/5.7
-    thesis_rule = claims[claims["at_thesis"].str.startswith("printed")]
+    # every thesis-rule row judged under every reading of eqs. 5.1/5.7, saying which it
+    # survives; the verdict over them is agree, differs or conditional
+    thesis_rule = claims[claims["why"].str.contains("Readings of eqs. 5.1/5.7", regex=False)]
     assert len(thesis_rule) >= 2 * 10
+    assert thesis_rule["why"].str.contains("survives").all()
+    assert set(other["verdict"]) <= {"agree", "differs", "conditional"}
     # numbers.md: chapter 5's rows with the thesis location, measure and verdict columns
     import reproduce_thesis
 
     md = reproduce_thesis.numbers_markdown(
         [dict(c, chapter="Chapter 5") for c in claims.to_dict("records")], [], [])
     assert "## Chapter 5" in md and "| claim | thesis location (line) |" in md
-    assert "### Thesis claims (Chapter 5)" in md and "| by construction |" in md
+    assert "### Thesis claims (Chapter 5)" in md and "### Our own checks (Chapter 5" in md
+    assert "| **by construction** |" in md  # the model's own stimuli: our own checks
     # what the thesis rule gives on both: normal above delayed and open-close-open
     finals = claims[claims["claim"].str.contains("final confidence")]
     assert len(finals) == 4
