@@ -48,7 +48,10 @@ def test_every_cited_line_holds_the_quoted_words():
             assert quote_is_on_line(lines, line, quote), (name, prefix, line, quote)
             checked += 1
     import reproduce_ch4
+    import reproduce_ch5_cites
 
+    for line, quote, _ in reproduce_ch5_cites.INCONSISTENT.values():
+        assert quote_is_on_line(lines, line, quote), (line, quote)
     for c in reproduce_ch4._inconsistencies():
         assert quote_is_on_line(lines, c["line"], c["quote"]), c["claim"]
     assert checked >= 60

@@ -65,7 +65,12 @@ def test_chapter5_figures_and_claims(run):
     thesis_rule = claims[claims["why"].str.contains("Readings of eqs. 5.1/5.7", regex=False)]
     assert len(thesis_rule) >= 2 * 10
     assert thesis_rule["why"].str.contains("survives").all()
-    assert set(other["verdict"]) <= {"agree", "differs", "conditional"}
+    assert set(other["verdict"]) <= {"agree", "differs", "conditional", "thesis inconsistent"}
+    # line 1139 (no rise over the first half) against line 1125 (equal contributions)
+    first = claims[claims["claim"].str.contains("delayed opening rises little")]
+    assert (first["verdict"] == "thesis inconsistent").all() and len(first) == 2
+    assert first["location"].str.contains("vs line 1125").all()
+    assert first["at_thesis"].str.startswith("thesis inconsistent").all()
     # numbers.md: chapter 5's rows with the thesis location, measure and verdict columns
     import reproduce_thesis
 

@@ -47,7 +47,7 @@ for _p in (ROOT, ROOT / "tools"):
     if str(_p) not in sys.path:
         sys.path.insert(0, str(_p))
 
-from reproduce_ch5_cites import CITES, READING, where  # noqa: E402
+from reproduce_ch5_cites import CITES, INCONSISTENT, READING, where  # noqa: E402
 from reproduce_ch5_fixed import (  # noqa: E402
     ABNORMAL,
     CONDITIONS,
@@ -500,8 +500,7 @@ def _dress(c: dict, generator: str) -> dict:
     c = dict(c, kind="own", why=why + c["why"])
     if c["verdict"] == "agree":
         c.update(verdict="by construction", agrees=False)
-    head = str(c.get("at_thesis", "")).split(":")[0].split(" (")[0]
-    if head == "agree":
+    if at_thesis_head(c.get("at_thesis", "")) == "agree":
         c["at_thesis"] = "by construction" + str(c["at_thesis"])[len("agree"):]
     return c
 
@@ -581,7 +580,19 @@ def _cite(c: dict) -> dict:
         c["location"] = f"{c['location']}; line {line}"
     extra = next((v for p, v in READING.items() if key.startswith(p)), "")
     c["why"] = (c["why"] + (f" Which reading: {extra}." if extra else "")).strip()
+    other = next((v for p, v in INCONSISTENT.items() if key.startswith(p)), None)
+    if other is not None:  # the thesis contradicts itself: so in both columns
+        c.update(verdict="thesis inconsistent", agrees=False,
+                 location=f"{c['location']} vs line {other[0]} ('{other[1]}')",
+                 why=f"{other[2]} {c['why']}",
+                 at_thesis="thesis inconsistent" + str(c["at_thesis"])[
+                     len(at_thesis_head(c["at_thesis"])):])
     return c
+
+
+def at_thesis_head(text: str) -> str:
+    """The verdict word(s) an ``at_thesis`` cell starts with."""
+    return str(text).split(":")[0].split(" (")[0]
 
 
 def generator_claims(b: Batch, rep: Repertoire, rep_t: Repertoire | None, out: Path) -> list:

@@ -83,6 +83,18 @@ READING = {
     "normal's confidence peaks": "the figure's shape (a peak at maximum aperture, a fall "
     "after it) matches the printed reading; the text (line 1070) is ours",
 }
+#: Rows where the thesis says two things that cannot both hold: claim text prefix ->
+#: (the other line, its words, why they contradict). Verdict ``thesis inconsistent`` in
+#: both columns, both lines cited.
+INCONSISTENT = {
+    "delayed opening rises little": (
+        1125, "the relative contribution of each component of the movement to the overall "
+        "confidence is the same",
+        "Line 1125 sets w_r / w_g so that the transport and grip terms contribute the same; a "
+        "delayed grasp's transport is a normal one, and the hand covers most of its path in "
+        "the first half, so with equal contributions its confidence must rise there through "
+        "the transport term, which line 1139 says it does not."),
+}
 #: Not a thesis claim on our clips: line 1109 ("understandably greater for the
 #: non-natural grips") describes the human demonstrator's recordings; on generated
 #: clips the aperture's spread is the generator's, so the row is our own check.
