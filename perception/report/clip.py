@@ -358,7 +358,7 @@ def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,
         if not figures or fmt != figure_format:
             for key in FIGURE_KEYS:
                 remove_output(clip_outputs(Path(out), rec.clip, fmt)[key])
-    write_csv(paths["csv"], rec.to_pandas())
+    write_csv(paths["csv"], rec.columns())
     # the JSON last: its presence marks the clip's report complete
     write_json(paths["json"], {**rec.to_dict(), "traces": clip_traces(rec), **(extra or {})})
     return paths
