@@ -269,6 +269,9 @@ def test_a_table_written_by_write_csv_reads_back_the_same(tmp_path):
     back = pd.read_csv(tmp_path / "ours.csv")
     pd.testing.assert_frame_equal(back, pd.DataFrame(cols))  # round trip, NaN and -0.0 included
     np.testing.assert_array_equal(np.signbit(back["time"]), np.signbit(x))
+    # the columns alone (recognize's confidence table) are written as pandas writes them
+    write_csv(tmp_path / "columns.csv", cols)
+    assert (tmp_path / "columns.csv").read_bytes() == (tmp_path / "ours.csv").read_bytes()
 
 
 def _old_f_oneway(groups):
