@@ -410,11 +410,12 @@ def settings_rows() -> list[list[str]]:
     return [
         ["model form", "exponential muscle filter, u entering f~ at unit gain (lines "
          "520-524); R = r/T, T the number of steps (lines 382, 558)", "Euler filter; "
-         "R = r dt/T (Todorov's code; **differs**)", "the thesis's settings column of "
-         "chapters 3, 4 and A uses the thesis's form (docs/thesis.md)"],
+         "R = r dt/T (Todorov's code; **differs**)", "the thesis's settings column uses the "
+         "thesis's form in every chapter (chapter 5: its repertoire re-planned with it; "
+         "docs/thesis.md)"],
         ["r (effort weight)", "0.002 ('provided a good tradeoff between error and effort', "
          "line 552)", f"{reach.r:g} ({same('r')})",
-         "chapters 3, 4 and A computed at both; chapter 5's models use ours"],
+         "every chapter computed at both (chapter 5: its repertoire planned at each)"],
         ["w_v (final velocity weight)", "0.1 (line 537)", f"{reach.w_v:g} ({same('w_v')})",
          "as r"],
         ["w_f (final force weight)", "0.01 (line 537)", f"{reach.w_f:g} ({same('w_f')})",
@@ -426,10 +427,15 @@ def settings_rows() -> list[list[str]]:
          "they hold (tip_start table)"],
         ["wrist travel", "20 cm ('the distance to be moved', line 953)",
          f"{100 * grasp.transport_distance:g} cm (same)", "transport distance table"],
-        ["w_r / w_g (thesis rule weights)", "1/2 (line 1125)", "1/2 (same)", ""],
+        ["w_r / w_g (thesis rule weights)", "1/2 (line 1125)", "1/2 (same)",
+         "the ratio that gives equal transport and grip shares (0.72-0.75) is reported "
+         "beside it; no verdict is taken from it"],
         ["sign of eqs. 5.1/5.7/5.8", "text: +1 if the changes agree, -1 if not (line 1070); "
-         "as printed: sgn(observed) x (predicted change)", "text (`--thesis-sign text`; "
-         "`printed` selectable)", "chapter 5 rows are scored under both readings"],
+         "as printed: sgn(observed) x (predicted change); the predicted change taken "
+         "between consecutive predictions; to the letter, sgn(r_n - r_n-1) x |predicted "
+         "change| (contradicts line 1070)", "text (`--thesis-sign text`; `printed` "
+         "selectable)", "chapter 5 rows are scored under all four and say which they "
+         "survive; only the three the thesis allows decide a verdict"],
         ["unstated geometry (Fig. 3.2 reach, the 'a' via-points and times, appendix A "
          "trajectory)", "not given", "ours, stated in each row", "rows say so"],
     ]
