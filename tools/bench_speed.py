@@ -130,14 +130,14 @@ def planning_rows() -> list[tuple[str, str, str, str]]:
 
 
 #: What ``recognize --no-figures`` imports: the floor its whole process cannot go below.
-_RECOGNIZE_IMPORTS = ("import numpy, scipy.signal, scipy.stats, pandas, h5py, cv2, "
+_RECOGNIZE_IMPORTS = ("import numpy, scipy.signal, scipy.stats, h5py, cv2, "
                       "hammer_mv.cli.recognize, perception.pipeline, perception.report.clip")
 
 _LOADED = """
 import sys
 from hammer_mv.cli import main
 main(sys.argv[1:])
-print(*[m for m in ('matplotlib', 'statsmodels') if m in sys.modules] or ['none'])
+print(*[m for m in ('matplotlib', 'statsmodels', 'pandas') if m in sys.modules] or ['none'])
 """
 
 
@@ -177,8 +177,8 @@ def clip_rows() -> list[tuple[str, str, str, str]]:
          f"{nofig_cpu:.2f} s; numpy passes {slow:.2f} s", _verdict(nofig, 1.0)),
         ("  same, its tracks file current (reused)", f"{reuse:.2f} s", "", _verdict(reuse, 1.0)),
         ("  same, with figures", f"{fresh:.2f} s", f"CPU {fresh_cpu:.2f} s", ""),
-        ("  loaded by --no-figures of matplotlib, statsmodels",
-         loaded.stdout.split("\n")[-2], "none (figures and statistics stay lazy)",
+        ("  loaded by --no-figures of matplotlib, statsmodels, pandas",
+         loaded.stdout.split("\n")[-2], "none (figures, statistics and tables stay lazy)",
          "ok" if loaded.stdout.split("\n")[-2] == "none" else "MISSED"),
     ]
 
