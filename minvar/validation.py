@@ -79,6 +79,8 @@ NonNegative = Annotated[float, Field(ge=0)]
 Share = Annotated[float, Field(ge=0, le=1)]
 #: Put before a tuple type: a list or array is taken as a tuple.
 Tuple = BeforeValidator(_as_tuple)
+
+
 def _on_table(value: float) -> float:
     if abs(value) > MAX_POSITION_M:
         raise ValueError(f"a coordinate or length within +-{MAX_POSITION_M:g} m "
@@ -126,11 +128,10 @@ _BOUNDS = {"gt": ">", "ge": ">=", "lt": "<", "le": "<="}
 _WORDS = {"int_type": "an integer", "float_type": "a number", "finite_number": "a finite number",
           "bool_type": "true or false", "string_type": "a string", "tuple_type": "a list",
           "too_long": "at most {max_length} values", "missing": "more values",
-          "string_pattern_mismatch": "a string matching {pattern}",
           "is_instance_of": "{class_}", "dataclass_type": "{class_name}"}
 
 
-def input_error(exc: ValidationError, owner: type | str,
+def input_error(exc: ValidationError, owner: type,
                 error: type[LocatedError] = ParameterError) -> LocatedError:
     """The one-line error for pydantic's first error in constructing ``owner``.
 
@@ -145,15 +146,14 @@ def input_error(exc: ValidationError, owner: type | str,
     ----------
     exc : pydantic.ValidationError
         What pydantic raised.
-    owner : type or str
-        The class (or only its name: pydantic's ``exc.title``).
+    owner : type
+        The declared class.
     error : type
         Raised for a bad value (:class:`ParameterError`; perception's
         classes raise its ``InputError``, a scene that cannot be planned for
         its ``PlanningError``).
     """
-    name = owner if isinstance(owner, str) else owner.__name__
-    fields = {} if isinstance(owner, str) else getattr(owner, "__pydantic_fields__", {})
+    name, fields = owner.__name__, owner.__pydantic_fields__
     valid = list(fields)
     first = exc.errors(include_url=False)[0]
     cause = (first.get("ctx") or {}).get("error")
