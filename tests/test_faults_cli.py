@@ -281,6 +281,7 @@ def test_synth_quiet_prints_nothing(fake_synthesize, recipe, capsys):
     (["repertoire", "build", "--object-size", "-1"], "--object-size"),
     (["repertoire", "build", "--distance", "2"], "--distance"),
     (["repertoire", "build", "--durations", "0"], "--durations"),
+    (["repertoire", "build", "--durations", "0.01"], "--durations"),  # under two model steps
     (["reach", "--seed", "-1"], "--seed"),  # numpy's own ValueError, checked first
     (["grasp", "experiment", "object-size", "--seed", "-1"], "--seed"),
     (["synth", "r.toml", "--seed", "-1"], "--seed"),

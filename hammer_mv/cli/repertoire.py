@@ -42,6 +42,11 @@ def register(sub) -> None:
     i.set_defaults(func=run_info)
 
 
+#: The GraspTask fields a planning problem can be about, by the flag that sets them.
+_SCENE_FLAGS = {"distance": "--distance", "object_size": "--object-size",
+                "duration": "--durations"}
+
+
 def run_build(args: argparse.Namespace) -> int:
     """Execute ``repertoire build`` with parsed ``args``; return the exit status."""
     from perception.io.atomic import check_output
@@ -65,24 +70,17 @@ def run_build(args: argparse.Namespace) -> int:
             with options("--durations"):
                 check_steps(duration, dt, "--durations")
         # a scene the arm cannot reach is a PlanningError, named by its option here
+        with options(_SCENE_FLAGS):  # a duration shorter than two model steps
+            specs = default_specs(args.durations)
         try:
-            rep = Repertoire.build(default_specs(args.durations), scene)
+            rep = Repertoire.build(specs, scene)
         except PlanningError as exc:
-            raise PlanningError(exc.problem, field=exc.field or _scene_flag(exc.problem)) \
-                from None
+            flag = _SCENE_FLAGS.get(exc.location[-1]) if exc.location else None
+            raise PlanningError(exc.problem, field=exc.field or flag) from None
     rep.save(args.output)
     if not args.quiet:
         print(f"wrote {args.output}: {len(rep)} models ({', '.join(rep.names)})")
     return 0
-
-
-def _scene_flag(problem: str) -> str | None:
-    """The ``repertoire build`` option a planning problem is about, if one is named."""
-    for attribute, flag in (("distance", "--distance"), ("object_size", "--object-size"),
-                            ("duration", "--durations")):
-        if f"GraspTask.{attribute}" in problem:
-            return flag
-    return None
 
 
 def run_info(args: argparse.Namespace) -> int:

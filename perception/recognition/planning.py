@@ -81,7 +81,8 @@ def build_model(spec: ModelSpec, scene: SceneSpec) -> MotorModel:
     except ValueError as exc:
         raise PlanningError(f"cannot plan model '{spec.name}' for a scene with the object "
                             f"{scene.distance:.3f} m away, {scene.object_size:.3f} m wide, "
-                            f"at {1 / scene.frame_period:.4g} frames/s: {exc}") from None
+                            f"at {1 / scene.frame_period:.4g} frames/s: {exc}", field="",
+                            location=getattr(exc, "location", ())) from None
     plan = plan_grasp(task)
     return MotorModel(
         spec=spec,
