@@ -200,7 +200,8 @@ class MarkerSet:
         ------
         InputError
             Unknown marker or field, or an invalid value; its field is
-            ``marker.field`` (after ``source``).
+            ``marker.field`` (after ``source``), its location
+            ``(marker, field)``.
         """
         def where(field: str | None = None) -> str | None:
             return " ".join(p for p in (source, field) if p) or None
@@ -215,14 +216,16 @@ class MarkerSet:
                                  f"(expected one of {', '.join(self.names)})", field=where())
             if not isinstance(table, Mapping):
                 raise InputError(f"expected a table of fields, got {table!r}"[:120],
-                                 field=where(str(name)))
+                                 field=where(str(name)), location=(str(name),))
             unknown = sorted(set(table) - set(_FIELDS))
             if unknown:
                 raise InputError(f"unknown field{suggest(unknown[0], _FIELDS)} "
                                  f"(expected {', '.join(_FIELDS)})",
-                                 field=where(f"{name}.{unknown[0]}"))
+                                 field=where(f"{name}.{unknown[0]}"),
+                                 location=(str(name), unknown[0]))
             if "bgr" in table and "rgb" in table:
-                raise InputError("give bgr or rgb, not both", field=where(str(name)))
+                raise InputError("give bgr or rgb, not both", field=where(str(name)),
+                                 location=(str(name),))
             changes = {k: v for k, v in table.items() if k != "rgb"}
             if "rgb" in table:
                 rgb = table["rgb"]
@@ -232,7 +235,8 @@ class MarkerSet:
             except InputError as exc:
                 key = exc.location[-1] if exc.location else ""
                 key = "rgb" if key == "bgr" and "rgb" in table else key
-                raise InputError(exc.problem, field=where(f"{name}.{key}")) from None
+                raise InputError(exc.problem, field=where(f"{name}.{key}"),
+                                 location=(str(name), key)) from None
         return MarkerSet(tuple(by_name[n] for n in self.names))
 
     @classmethod

@@ -185,8 +185,8 @@ def load_setup(path: str | os.PathLike) -> TrackingSetup:
                       p) from None
     try:
         colours = default_markers().with_overrides(markers)
-    except InputError as exc:  # exc.field: "thumb.hue"
-        name, _, key = (exc.field or "").partition(".")
+    except InputError as exc:  # exc.location: ("thumb", "hue")
+        name, key = (*exc.location, "", "")[:2]
         field = f"[markers.{name}] {key}".strip() if name else "[markers]"
         raise InputError(exc.problem, p, field=field) from None
     return TrackingSetup(colours, params, meta.source, meta.frames)
