@@ -43,13 +43,13 @@ from reproduce_ch4_sensitivity import (  # noqa: E402
     UM,
     cm,
     level_is_best,
+    mark_conditional,
     pct,
     tip_start_table,
     travel_table,
     u_minimum,
 )
 from reproduce_common import (  # noqa: E402
-    CONDITIONAL,
     THESIS_SETTINGS,
     at_settings,
     cite,
@@ -286,8 +286,9 @@ def _object_size(e: GraspExperiment) -> list[dict]:
               location="Fig. 4.10(b); line 905 (also 973)",
               measure="time of the exact mean aperture's maximum (1 % steps; the "
               "repetitions' mean times are within 1 %); agree if every size is within "
-              "60-80 %", note="depends on where the closed tips start: 56-59 % at 0-1 cm "
-              "with them on the target line (tip_start table)." + edge),
+              "60-80 %", note="depends on where the closed tips start: the smallest "
+              "object's MGA comes earlier as the tips start nearer the target line (tip_start "
+              "tables)." + edge),
         claim("4.2.2.2", "MGA occurs later for larger objects", "later for larger objects",
               f"{pct(t[0])} at {cm(sz[0])} -> {pct(t[-1])} at {cm(sz[-1])}",
               bool(np.all(np.diff(t) >= 0) and t[-1] > t[0]),
@@ -595,23 +596,6 @@ CITES = {
 }
 
 
-def _conditional(claims: list[dict], tip: dict) -> None:
-    """Rows that depend on tip_start: say where they hold across the thesis's 0-6 cm."""
-    for c in claims:
-        col = next((k for p, k in TIP_DEPENDENT.items() if c["claim"].startswith(p)), None)
-        if col is None:
-            continue
-        holds = [r[0].split(" ")[0] + " cm" for r in tip["rows"] if "**" not in r[col]]
-        fails = [r[0].split(" ")[0] + " cm" for r in tip["rows"] if "**" in r[col]]
-        where = (f"holds at {', '.join(holds) or 'none'}, fails at {', '.join(fails) or 'none'}"
-                 " (our weights)")
-        c["at_thesis"] = f"conditional on tip_start (not given; 0-6 cm): {where}. {c['at_thesis']}"
-        if holds and fails:  # the verdict flips with a choice the thesis leaves open
-            c["why"] = (f"{c['why']} Conditional on tip_start: {where}; at our 2 cm it is "
-                        f"'{c['verdict']}'.").strip()
-            c["verdict"], c["agrees"] = CONDITIONAL, False
-
-
 def reproduce(out: Path, *, trials: int = 500, seed: int = 0) -> list[dict]:
     """Run every chapter-4 experiment, save figures and tables, return the claims.
 
@@ -642,14 +626,16 @@ def reproduce(out: Path, *, trials: int = 500, seed: int = 0) -> list[dict]:
     claims, done, children = _claims(base, trials, seed, out)
     typical = simulate_grasp(base, trials, seed=children[-1], plan=plan)
     save_figure(out / "fig4_6_typical_grasp.png", grasp_figure(typical))
-    theirs, _, _ = _claims(replace(base, **THESIS_SETTINGS), trials, seed, None)
+    theirs, done_t, _ = _claims(replace(base, **THESIS_SETTINGS), trials, seed, None)
     cite(theirs, CITES)  # a by-construction row is one in both columns
     at_settings(claims, theirs, "r = 0.002, w_v = 0.1: ")
     t0 = time.perf_counter()
     tip, used = tip_start_table(base, done)
-    tables = [tip, travel_table(base, used)]
+    tip_t, _ = tip_start_table(replace(base, **THESIS_SETTINGS), done_t,
+                               " at the thesis's settings (its model and weights)")
+    tables = [tip, tip_t, travel_table(base, used)]
     log.info("sensitivity: %.1f s", time.perf_counter() - t0)
-    _conditional(claims, tip)
+    mark_conditional(claims, TIP_DEPENDENT, tip, tip_t)
     cite(claims, CITES)
     return claims + _inconsistencies() + tables
 

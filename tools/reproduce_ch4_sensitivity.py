@@ -13,7 +13,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
-from reproduce_common import sensitivity
+from reproduce_common import CONDITIONAL, sensitivity
 
 from minvar.grasp import GraspTask, plan_grasp
 from minvar.grasp_experiments import GraspExperiment
@@ -118,8 +118,13 @@ def _from_experiments(done: dict[str, GraspExperiment]) -> dict:
     return out
 
 
-def tip_start_table(base: GraspTask, done: dict[str, GraspExperiment]) -> tuple[dict, dict]:
-    """The tip_start table, and the default geometry's moments (reused for travel)."""
+def tip_start_table(base: GraspTask, done: dict[str, GraspExperiment],
+                    at: str = "") -> tuple[dict, dict]:
+    """The tip_start table, and the default geometry's moments (reused for travel).
+
+    ``at``: words after "tip_start" in the title naming the settings (``base``'s cost
+    weights and model form) when they are not ours; each column's verdicts come from
+    the table at that column's settings (:func:`mark_conditional`)."""
     rows, used = [], _from_experiments(done)
     for ts in TIP_STARTS:
         mine = abs(ts - base.tip_start) < 1e-12
@@ -128,7 +133,7 @@ def tip_start_table(base: GraspTask, done: dict[str, GraspExperiment]) -> tuple[
             " (on the target line)" if abs(ts - base.wrist_offset) < 1e-12 else "")
         rows.append([f"{cm(ts)}{mark}", *_verdict_cells(moments)])
     table = sensitivity(
-        "tip_start, where the closed digit tips start ahead of the wrist",
+        f"tip_start{at}, where the closed digit tips start ahead of the wrist",
         "not given; Fig. 4.4(a) (line 814) has the digits reach the level of the targets "
         "during the movement, so they start below it (0 < tip_start < wrist_offset = 6 cm)",
         f"We use {cm(base.tip_start)}. Exact moments; via-point heights "
@@ -141,6 +146,33 @@ def tip_start_table(base: GraspTask, done: dict[str, GraspExperiment]) -> tuple[
          "MGA time, sizes 0-8 cm (Fig. 4.10b)",
          "MGA slope (Fig. 4.10a)"], rows)
     return table, used
+
+
+def mark_conditional(claims: list[dict], dependent: dict[str, int], ours: dict,
+                     theirs: dict) -> None:
+    """Rows that depend on tip_start: say where they hold across the thesis's 0-6 cm, in
+    each column from the tip_start table at that column's settings (``ours``, ``theirs``:
+    :func:`tip_start_table`; ``dependent``: claim prefix -> the table's column). A column
+    is ``conditional`` only where the verdict flips within the range; where it holds at
+    every tip_start or at none, the range is reported beside the verdict."""
+    for c in claims:
+        col = next((k for p, k in dependent.items() if c["claim"].startswith(p)), None)
+        if col is None:
+            continue
+        for key, table, whose in (("at_thesis", theirs, "the thesis's model and weights"),
+                                  ("verdict", ours, "our weights")):
+            holds = [r[0].split(" ")[0] + " cm" for r in table["rows"] if "**" not in r[col]]
+            fails = [r[0].split(" ")[0] + " cm" for r in table["rows"] if "**" in r[col]]
+            where = (f"holds at {', '.join(holds) or 'none'}, fails at "
+                     f"{', '.join(fails) or 'none'} ({whose})")
+            flips = bool(holds and fails)  # the verdict turns on a choice the thesis leaves
+            if key == "at_thesis":
+                c[key] = (f"conditional on tip_start (not given; 0-6 cm): {where}. {c[key]}"
+                          if flips else f"{c[key]}; over tip_start 1-6 cm it {where}")
+            elif flips:
+                c["why"] = (f"{c['why']} Conditional on tip_start: {where}; at our 2 cm it "
+                            f"is '{c['verdict']}'.").strip()
+                c["verdict"], c["agrees"] = CONDITIONAL, False
 
 
 def travel_table(base: GraspTask, used: dict) -> dict:
