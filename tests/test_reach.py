@@ -82,7 +82,11 @@ def test_s_movement_passes_via_points_and_reaches_goal():
     # corners by about 5 mm (4.8 and 4.4 mm; a 5 mm limit was our own rule, not a claim)
     miss = [closest_approach(expected, v.position) * 1000 for v in S_TASK.via_points]
     assert miss == pytest.approx([4.8, 4.4], abs=0.1)
-    assert np.linalg.norm(r.mean_position[-1] - S_TASK.goal) < 0.01
+    # its end against 2 SD of the repetitions' end points, as numbers.md judges it (a 1 cm
+    # limit was our own number); the number: 3.4 mm
+    end = np.linalg.norm(expected[-1] - np.asarray(S_TASK.goal))
+    assert end < 2 * np.sqrt(r.position[:, -1].var(axis=0, ddof=1).sum())
+    assert end * 1000 == pytest.approx(3.4, abs=0.1)
     assert count_speed_peaks(r.mean_speed) == 3  # three strokes of the 's'
 
 

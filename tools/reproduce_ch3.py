@@ -227,19 +227,34 @@ def _curved_claim(reach: ReachTask, r, single: float, mean_dev: float) -> dict:
 
 
 def _sd_claim(figure: str, what: str, s: pd.DataFrame, trials: int) -> dict:
-    rho = spearmanr(s["duration"], s["sd_total"]).statistic
+    """Lines 624/664: the end-point SD falls as the movement time grows. The thesis gives
+    no threshold (and calls the 's''s relationship 'less clear', line 664), so the rule
+    is the noise's: the fall from the fastest to the slowest beyond twice the standard
+    error of the difference of two SDs from ``trials`` repetitions, and a rank
+    correlation with movement time negative beyond chance (one-sided p < 0.05)."""
+    trend = spearmanr(s["duration"], s["sd_total"], alternative="less")
     rho_d = spearmanr(s["duration"], s["distance_mean"]).statistic
     first, last = s.iloc[0], s.iloc[-1]
+    fall = first["sd_total"] - last["sd_total"]
+    # an SD from n repetitions has standard error SD / sqrt(2 (n - 1))
+    se = float(np.hypot(first["sd_total"], last["sd_total"]) / np.sqrt(2 * (trials - 1)))
     point = "point" in what
     return claim(
         "3.3.1" if point else "3.3.2", f"End-point SD falls as movement time grows ({what})",
         "decreases (Fitts)" if point else "decreases, less clearly",
         f"SD {first['sd_total'] * 1000:.1f} mm at {first['duration'] * 1000:.0f} ms -> "
-        f"{last['sd_total'] * 1000:.1f} mm at {last['duration'] * 1000:.0f} ms; Spearman ρ "
-        f"{rho:.2f} (SD), {rho_d:.2f} (mean distance); {trials} per time",
-        rho < -0.8, location=f"{figure}; line {624 if point else 664}",
+        f"{last['sd_total'] * 1000:.1f} mm at {last['duration'] * 1000:.0f} ms (fall "
+        f"{fall * 1000:.1f} mm, {fall / se:.1f} standard errors); Spearman ρ "
+        f"{trend.statistic:.2f} (SD; one-sided p = {trend.pvalue:.2g}), {rho_d:.2f} (mean "
+        f"distance); {trials} per time",
+        bool(fall > 2 * se and trend.pvalue < 0.05),
+        location=f"{figure}; line {624 if point else 664}",
         measure="end-point SD of the repetitions at the thesis's 8 movement times "
-        "(500-1200 ms); agree if its Spearman correlation with movement time is below -0.8",
+        "(500-1200 ms); the thesis gives no threshold, so the noise's: agree if the SD at "
+        "the slowest is below the fastest's by more than twice the standard error of the "
+        "difference (an SD from n repetitions: SD / sqrt(2 (n - 1))) and its Spearman "
+        "correlation with movement time is negative beyond chance (one-sided p < 0.05)",
+        note="our former rule (Spearman ρ below -0.8) was our own number, tied to nothing",
     )
 
 
@@ -253,23 +268,24 @@ def _fig3_6_3_7(out: Path | None, claims: list, trials: int, seed: int, w: dict)
     end = np.linalg.norm(expected[-1] - s_task.goal)
     # the repetitions' scatter where each via-point is due: what 'passes' is judged against
     due = [int(round(v.fraction * (r.time.size - 1))) for v in s_task.via_points]
-    scatter = [float(np.sqrt(r.position[:, k].var(axis=0, ddof=1).sum())) for k in due]
+    scatter = [float(np.sqrt(r.position[:, k].var(axis=0, ddof=1).sum())) for k in due + [-1]]
     peaks = count_speed_peaks(r.mean_speed)
     claims += [
         claim("3.3.2", "The 's' passes near its via-points", "passes the via-points",
               "expected path " + ", ".join(f"{m * 1000:.1f}" for m in miss)
               + f" mm from the via-points, {end * 1000:.1f} mm from the goal",
-              all(m < 2 * sd for m, sd in zip(miss, scatter)) and end < 0.01,
+              all(m < 2 * sd for m, sd in zip([*miss, end], scatter)),
               location="Fig. 3.6(a,c); line 652",
               measure="closest approach of the expected (noise-averaged) path to each "
-              "via-point, against the repetitions' positional SD at the via-point's time "
-              "(the scatter the figure's 50 paths show): agree if every miss is below 2 SD; "
-              "and its end within 1 cm of the goal",
+              "via-point, and its end's distance from the goal, against the repetitions' "
+              "positional SD at the via-point's time and at the end (the scatter the "
+              "figure's 50 paths show): agree if every miss is below 2 SD",
               note="positional SD at the via-points' times " + ", ".join(
-                  f"{sd * 1000:.1f}" for sd in scatter) + f" mm; the mean of our {r.trials} "
-              "repetitions passes " + ", ".join(f"{m * 1000:.1f}" for m in miss_mc)
-              + " mm away. The via-point cost is soft, so the path cuts the corners; our own "
-              "former 5 mm rule (docs/model.md) is not the thesis's and judges nothing."),
+                  f"{sd * 1000:.1f}" for sd in scatter[:-1]) + f" mm, at the end "
+              f"{scatter[-1] * 1000:.1f} mm; the mean of our {r.trials} repetitions passes "
+              + ", ".join(f"{m * 1000:.1f}" for m in miss_mc) + " mm away. The via-point "
+              "cost is soft, so the path cuts the corners; our own former rules (5 mm, "
+              "docs/model.md; the end within 1 cm) are not the thesis's and judge nothing."),
         claim("3.3.2", "The 's' speed: a bell per stroke, slowing at the bends",
               "three bells", f"{peaks} speed peaks", peaks == 3,
               location="Fig. 3.6(b,d); line 654",
