@@ -116,3 +116,28 @@ def test_the_letter_keeps_its_shape_only_above_a_movement_time(ch3):
     ch3._fig3_8_3_9(None, claims, 20, 0, {})
     row = next(c for c in claims if c["claim"].startswith("The 'a' keeps its shape"))
     assert row["verdict"] == "conditional" and "down to 1500 ms" in row["ours"]
+
+
+def test_the_s_end_point_sd_falls_beyond_the_noise_at_the_thesis_settings(ch3):
+    # line 664: the SD 'decreased as movement speed decreased, although ... a less clear
+    # relationship'. No threshold in the thesis, so the noise's: the fall beyond 2 standard
+    # errors of an SD from 200 repetitions and a rank trend beyond chance (numbers.md:
+    # agree; rho is -0.76, which our former, untied -0.8 called 'differs')
+    claims = []
+    ch3._fig3_6_3_7(None, claims, 200, 0, ch3.THESIS_SETTINGS)
+    row = next(c for c in claims if c["claim"].endswith("(the 's')"))
+    assert row["verdict"] == "agree" and "standard errors" in row["ours"]
+
+
+def test_the_re_timed_letter_is_conditional_on_how_much_faster(ch3):
+    # Fig. A.3(a), line 1358: 'a much shorter movement time', not given; the shape keeps
+    # within twice the noise for mild re-timings and not for the 2 s -> 1 s we drew
+    sys.path.insert(0, str(TOOLS))
+    try:
+        import reproduce_appendix_a
+    finally:
+        sys.path.remove(str(TOOLS))
+    claims = []
+    reproduce_appendix_a._fig_a3(None, claims, 20, 0, {})
+    row = next(c for c in claims if c["claim"].startswith("Re-timed"))
+    assert row["verdict"] == "conditional" and "within twice the noise from" in row["ours"]

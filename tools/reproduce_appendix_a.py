@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 from reproduce_common import (
+    CONDITIONAL,
     THESIS_SETTINGS,
     Progress,
     at_settings,
@@ -55,6 +56,9 @@ UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001}
 EVENT_TOLERANCE = 0.05
 #: Fig. A.3: the 'a' at its original time, re-timed faster, and scaled by 1/2.
 A3_SLOW, A3_FAST, A3_SCALE = 2.0, 1.0, 0.5
+#: Re-timings of the 2 s 'a' swept (s): 'a much shorter movement time' (line 1358) is not
+#: given, so the verdict is read over these (1.33 to 3.3 times faster).
+A3_RETIMED = (0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2, 1.3, 1.5)
 
 
 def observed(seed: int, repeats: int, w: dict | None = None) -> list[tuple[np.ndarray,
@@ -265,6 +269,12 @@ def _fig_a3(out: Path | None, claims: list, n: int, seed: int, w: dict) -> None:
     s0 = np.asarray(movement.start)
     expected_small = A3_SCALE * (p_slow - s0) + s0
     shape = path_distance(p_slow, p_fast)
+    swept = {t: path_distance(p_slow, replay(movement.retime(t), **w)[1]) for t in A3_RETIMED}
+    holds = [t for t, d in swept.items() if d < 2 * scatter]
+    flips = bool(holds) and len(holds) < len(swept)
+    sweep = (f"; re-timed to {A3_RETIMED[0] * 1000:.0f}-{A3_RETIMED[-1] * 1000:.0f} ms, "
+             + (f"within twice the noise from {min(holds) * 1000:.0f} ms up, not below"
+                if holds else "beyond twice the noise at every re-timing"))
     scaled_err = float(np.linalg.norm(p_small - expected_small, axis=1).max())
     table = pd.DataFrame(
         {"movement": ["original", "re-timed", "scaled"],
@@ -277,14 +287,20 @@ def _fig_a3(out: Path | None, claims: list, n: int, seed: int, w: dict) -> None:
         claim("A.2", "Re-timed (eq. A.3) the 'a' keeps its basic shape",
               "shape retained, cruder when faster",
               f"{A3_SLOW * 1000:.0f} ms -> {A3_FAST * 1000:.0f} ms: expected paths at most "
-              f"{shape * 1000:.1f} mm apart (letter 10 cm high)", shape < 2 * scatter,
+              f"{shape * 1000:.1f} mm apart (letter 10 cm high){sweep}", shape < 2 * scatter,
+              verdict=CONDITIONAL if flips else None,
               location="Fig. A.3(a); lines 1358, 1364",
               measure="Hausdorff distance between the expected paths, against the repetition "
               "noise: agree if below twice the median Hausdorff distance of a single "
               f"repetition of the original from its mean path ({scatter * 1000:.1f} mm; the "
-              "thesis allows 'cruder', so twice what noise alone does)",
-              note="the faster movement cuts the bowl's corners. Our former 20 mm rule was "
-              "our own number." + borderline(shape, 2 * scatter)),
+              "thesis allows 'cruder', so twice what noise alone does); the re-timing is "
+              "swept, and the verdict holds only where it does not turn on it",
+              note="the faster movement cuts the bowl's corners. The thesis gives neither "
+              "the two movement times ('a much shorter movement time', line 1358) nor the "
+              "'a's via-points, and the verdict turns on how much faster"
+              + (f": it holds re-timed to {min(holds) * 1000:.0f} ms or slower, not faster"
+                 if flips else "") + ". Our former 20 mm rule was our own number."
+              + borderline(shape, 2 * scatter)),
         claim("A.2",
               "Scaled by 1/2 (eqs. A.4-A.5) the 'a' is the same letter, half size",
               "same shape, half size",

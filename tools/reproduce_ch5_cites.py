@@ -40,8 +40,9 @@ WHERE = {
                 "rise of C over 50-100 % of the movement, and the final C against normal's"),
     "rate": ("5.4.3, Figs. 5.8(a,c); line 1154", "rise of C over 50-100 %, normal against "
              "each other stimulus"),
-    "follows": ("5.4.3, Fig. 5.8(a); line 1154", "mean C at 40 % of the movement, normal "
-                "against open-close-open"),
+    "follows": ("5.4.3, Fig. 5.8(a); line 1154", "mean C where the closing starts (the "
+                "open-close-open clips' own first aperture peak, median, in time since the "
+                "onset), normal against open-close-open"),
     "weights": ("5.4.2; line 1125", "transport term's share of the summed |dC| on normal "
                 "clips"),
     "selection": ("5.3; lines 1033, 1061", "kind of the model with the highest final thesis-"
