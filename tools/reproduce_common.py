@@ -424,12 +424,13 @@ def settings_rows() -> list[list[str]]:
          "the digits touching', line 730; the targets 6 cm above the wrist target, line 724)",
          f"{100 * grasp.tip_start:g} cm (chosen after the verdicts: not a thesis value)",
          "rows that depend on it are reported as conditional, with the range over which "
-         "they hold (tip_start table)"],
+         "they hold (tip_start tables, one per column's settings)"],
         ["wrist travel", "20 cm ('the distance to be moved', line 953)",
          f"{100 * grasp.transport_distance:g} cm (same)", "transport distance table"],
         ["w_r / w_g (thesis rule weights)", "1/2 (line 1125)", "1/2 (same)",
-         "the ratio that gives equal transport and grip shares (0.72-0.75) is reported "
-         "beside it; no verdict is taken from it"],
+         "the ratio that gives equal transport and grip shares (0.72-0.76, per generator "
+         "and setting: chapter 5's line-1125 rows) is reported beside it; no verdict is "
+         "taken from it"],
         ["sign of eqs. 5.1/5.7/5.8", "text: +1 if the changes agree, -1 if not (line 1070); "
          "as printed: sgn(observed) x (predicted change); the predicted change taken "
          "between consecutive predictions; to the letter, sgn(r_n - r_n-1) x |predicted "
