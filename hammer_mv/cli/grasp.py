@@ -15,16 +15,13 @@ from pathlib import Path
 from hammer_mv.cli.checks import check_seed, options, output_folder
 from minvar.grasp import GraspTask, check_grasp_simulation
 from minvar.grasp_experiments import EXPERIMENTS, THESIS_TRIALS, check_trials
-from minvar.limits import MAX_TRIALS, check_position, check_steps
+from minvar.limits import MAX_TRIALS
 from minvar.plant import PointMassPlant
 from perception.io.atomic import save_figure, write_csv, write_json
 
 #: Columns of trajectories.csv (:meth:`minvar.grasp.GraspResult.to_pandas`).
 TABLE_COLUMNS = 17
 #: The flags of ``grasp simulate`` that are lengths, m (bounded by MAX_POSITION_M).
-LENGTH_FLAGS = ("object_size", "distance", "viapoint_offset", "viapoint_height", "tip_start")
-
-
 def register(sub) -> None:
     """Add the ``grasp`` subcommand to ``sub`` (an argparse subparsers action)."""
     p = sub.add_parser(
@@ -127,16 +124,10 @@ def run_simulate(args: argparse.Namespace) -> int:
     with options("--trials"):
         check_trials(args.trials, name="--trials")
     check_seed(args.seed)
-    # Sizes and lengths against minvar.limits, named by their flags, before any work.
-    for name in LENGTH_FLAGS:
-        flag = "--" + name.replace("_", "-")
-        with options(flag):
-            check_position(getattr(args, name), flag)
     with options({"dt": "--dt"}):
         plant = PointMassPlant(dt=args.dt)
-    with options("--duration"):
-        check_steps(args.duration, args.dt, "--duration")
     out = output_folder(args.output)
+    # every size, length and the movement's steps are the task's fields, named by their flags
     with options(TASK_FIELDS):
         task = GraspTask(
             object_size=args.object_size, distance=args.distance, duration=args.duration,

@@ -20,7 +20,6 @@ from minvar.analysis import (
 from minvar.limits import (
     MAX_TRIALS,
     check_memory,
-    check_position,
     check_simulation,
     check_steps,
     simulation_bytes,
@@ -83,16 +82,6 @@ def run(args: argparse.Namespace) -> int:
     check_seed(args.seed)
     with options({"sigma_u": "--sigma-u", "sigma_s": "--sigma-s"}):
         plant = PointMassPlant(sigma_u=args.sigma_u, sigma_s=args.sigma_s)
-    # Sizes and positions against minvar.limits, named by their flags, before any work.
-    with options("--start"):
-        check_position(args.start, "--start")
-    with options("--goal"):
-        check_position(args.goal, "--goal")
-    with options("--via"):
-        for x, y, _ in args.via:
-            check_position((x, y), "--via")
-    with options("--duration"):
-        check_steps(args.duration, plant.dt, "--duration")
     with options("--via"):
         vias = tuple(ViaPoint((x, y), fraction=f) for x, y, f in args.via)
     with options({"start": "--start", "goal": "--goal", "duration": "--duration",
