@@ -102,7 +102,23 @@ def _shown(value: Any) -> str:
     return text if len(text) <= 60 else text[:57] + "..."
 
 
-def _problem(error: dict[str, Any], valid: list[str], note: str | None) -> str:
+def _range(info: Any) -> str | None:
+    """A numeric field's whole range in words (``"an integer 0..64"``), from its metadata."""
+    if info is None or info.annotation not in (int, float):
+        return None
+    lower = [(m.ge, ">=") if hasattr(m, "ge") else (m.gt, ">") for m in info.metadata
+             if hasattr(m, "ge") or hasattr(m, "gt")]
+    upper = [(m.le, "<=") if hasattr(m, "le") else (m.lt, "<") for m in info.metadata
+             if hasattr(m, "le") or hasattr(m, "lt")]
+    lo, hi = max(lower, default=None), min(upper, default=None)
+    what = "an integer" if info.annotation is int else "a number"
+    if lo and hi and lo[1] == ">=" and hi[1] == "<=":
+        return f"{what} {lo[0]:g}..{hi[0]:g}"
+    parts = ([f"{lo[1]} {lo[0]:g}"] if lo else []) + ([f"{hi[1]} {hi[0]:g}"] if hi else [])
+    return f"{what} {' and '.join(parts)}" if parts else None
+
+
+def _problem(error: dict[str, Any], valid: list[str], info: Any = None) -> str:
     """One pydantic error in the project's words (``"expected ..., got ..."``)."""
     kind, loc = error["type"], error["loc"]
     if kind == "unexpected_keyword_argument":
@@ -110,7 +126,10 @@ def _problem(error: dict[str, Any], valid: list[str], note: str | None) -> str:
                 f"expected one of {', '.join(valid)}")
     ctx = error.get("ctx") or {}
     bound = next(((op, ctx[key]) for key, op in _BOUNDS.items() if key in ctx), None)
-    if bound is not None:
+    note = getattr(info, "description", None)
+    if bound is not None and len(loc) == 1 and _range(info):
+        message = _range(info)
+    elif bound is not None:
         message = f"a number {bound[0]} {bound[1]:g}"
     elif kind in _WORDS:
         message = _WORDS[kind].format(**ctx)
@@ -167,8 +186,8 @@ def input_error(exc: ValidationError, owner: type,
             type(cause)(cause.problem, cause.path, location=(name, *loc))
     if cause is not None and not loc:  # __post_init__'s, about the fields together
         return error(str(cause), location=(name,))
-    note = fields[loc[0]].description if loc and loc[0] in fields else None
-    return error(_problem(first, valid, note), location=(name, *loc))
+    return error(_problem(first, valid, fields.get(loc[0]) if loc else None),
+                 location=(name, *loc))
 
 
 def declared(cls: type | None = None, /, *, frozen: bool = True, eq: bool = True,
@@ -229,5 +248,4 @@ def checked(value: Any, kind: Any, location: tuple[str, ...],
     try:
         return _adapter(kind).validate_python(value)
     except ValidationError as exc:
-        raise error(_problem(exc.errors(include_url=False)[0], [], None),
-                    location=location) from None
+        raise error(_problem(exc.errors(include_url=False)[0], []), location=location) from None
