@@ -163,10 +163,12 @@ class Calibration:
             return float("nan")
         if frame_period:
             misfit = misfit * (self.frame_period / frame_period) ** 2
-        from scipy.stats import norm
+        from scipy.special import ndtr
 
         z = (math.log(max(misfit, 1e-300)) - self.log_centre) / self.log_scale
-        return float(norm.sf(z))
+        # scipy.stats.norm.sf(z) is ndtr(-z); called directly it costs 0.1 us instead of
+        # the distribution object's 20 us, and it is called for every model every frame
+        return float(ndtr(-z))
 
 
 def misfit(mahalanobis: np.ndarray, scored: np.ndarray) -> np.ndarray:
