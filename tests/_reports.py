@@ -1,4 +1,4 @@
-"""Compare parsed JSON reports value by value."""
+"""Shared test helpers for reports: JSON compared value by value, a disk that fills up."""
 
 import math
 
@@ -17,3 +17,20 @@ def assert_json_close(a, b, *, rel: float, abs_: float, path: str = "") -> None:
         assert math.isclose(a, b, rel_tol=rel, abs_tol=abs_), (path, a, b)
     else:
         assert a == b, path
+
+
+def disk_full_at(monkeypatch, name: str) -> None:
+    """Make writing the output file called ``name`` fail as on a full disk (ENOSPC)."""
+    import errno
+    from pathlib import Path
+
+    from perception.io import atomic
+
+    real = atomic.atomic_path
+
+    def full_disk(path, **kwargs):
+        if Path(path).name == name:
+            raise OSError(errno.ENOSPC, f"cannot write {path}: No space left on device")
+        return real(path, **kwargs)
+
+    monkeypatch.setattr(atomic, "atomic_path", full_disk)

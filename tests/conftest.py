@@ -39,3 +39,15 @@ def engine(request):
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv("MINVAR_KERNEL", request.param)
         yield request.param
+
+
+@pytest.fixture
+def camera(monkeypatch):
+    """Install a stand-in for ``cv2.VideoCapture`` (a test's fake camera class); returns it."""
+    import cv2
+
+    def install(cam):
+        monkeypatch.setattr(cv2, "VideoCapture", cam)
+        return cam
+
+    return install

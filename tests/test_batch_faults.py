@@ -11,7 +11,6 @@ run's ``batch.json`` and ``report.html``.
 from __future__ import annotations
 
 import contextlib
-import errno
 import os
 import shutil
 import signal
@@ -24,8 +23,8 @@ import pandas as pd
 import psutil
 import pytest
 from _demos import default_repertoire, demo_tracks
+from _reports import disk_full_at
 
-import perception.io.atomic as atomic
 from perception.batch import REPORT_SET, discover, run_batch
 from perception.recognition.repertoire import Repertoire
 
@@ -133,14 +132,7 @@ def test_a_report_set_is_never_half_replaced(clips, tmp_path, monkeypatch, fails
     run_batch(items, out, default_repertoire(), quiet=True)
     old = {p.name: p.read_bytes() for p in out.iterdir() if p.name in REPORT_SET}
     assert {"summary.csv", "report.html", "batch.json"} <= old.keys()
-    real = atomic.atomic_path
-
-    def full_disk(path, **kwargs):
-        if Path(path).name == fails:
-            raise OSError(errno.ENOSPC, f"cannot write {path}: No space left on device")
-        return real(path, **kwargs)
-
-    monkeypatch.setattr(atomic, "atomic_path", full_disk)
+    disk_full_at(monkeypatch, fails)
     with pytest.raises(OSError, match="No space left"):
         run_batch(items, out, default_repertoire(), quiet=True)  # a rerun: a new summary
     now = {p.name: p.read_bytes() for p in out.iterdir() if p.name in REPORT_SET}

@@ -49,15 +49,6 @@ class FastCamera:
         self.released.set()
 
 
-@pytest.fixture
-def camera(monkeypatch):
-    def install(cam: FastCamera) -> FastCamera:
-        monkeypatch.setattr(cv2, "VideoCapture", cam)
-        return cam
-
-    return install
-
-
 def test_a_live_source_holds_at_most_read_ahead_frames_and_drops_the_oldest(camera):
     cam = camera(FastCamera(200))
     with open_source("0", read_ahead=4) as src:

@@ -1,7 +1,6 @@
 """Tidy batch tables (issue 34): the manifest's columns everywhere, R-safe names, the long
 landmarks.csv, per-participant means and mixed models, checked against statsmodels itself."""
 
-import errno
 import json
 import re
 import shutil
@@ -12,9 +11,9 @@ import numpy as np
 import pandas as pd
 import pytest
 from _demos import default_repertoire, demo_tracks
+from _reports import disk_full_at
 from scipy import stats
 
-import perception.io.atomic as atomic
 from perception.batch import discover, run_batch
 from perception.report.statistics import landmark_statistics
 from perception.report.tables import LANDMARK_UNITS, TABLES, r_name
@@ -234,14 +233,7 @@ def test_the_tables_are_part_of_the_one_run_set(batch, tmp_path, monkeypatch, fa
     src, out, _ = batch
     again = tmp_path / "again"
     shutil.copytree(out, again)
-    real = atomic.atomic_path
-
-    def full_disk(path, **kwargs):
-        if Path(path).name == fails:
-            raise OSError(errno.ENOSPC, f"cannot write {path}: No space left on device")
-        return real(path, **kwargs)
-
-    monkeypatch.setattr(atomic, "atomic_path", full_disk)
+    disk_full_at(monkeypatch, fails)
     with pytest.raises(OSError, match="No space left"):
         run_batch(discover(src / "manifest.csv"), again, default_repertoire(), quiet=True)
     left = {"summary.csv", "statistics.csv", *TABLES} & {p.name for p in again.iterdir()}

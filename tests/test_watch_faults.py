@@ -197,15 +197,6 @@ def test_a_watch_that_fails_after_its_frames_leaves_no_labelled_video(clip, tmp_
 
 
 # -- outputs checked before the source opens ---------------------------------------------
-@pytest.fixture
-def camera(monkeypatch):
-    def install(cam: FastCamera) -> FastCamera:
-        monkeypatch.setattr(cv2, "VideoCapture", cam)
-        return cam
-
-    return install
-
-
 @pytest.mark.parametrize(("output", "options", "words"), [
     ("a-file/out", [], "--output"),
     ("out", ["--labelled-video", "{tmp}/a-file/l.mp4"], "a-file/l.mp4"),
