@@ -28,15 +28,14 @@ force: the two forms differ in what ``r`` means (docs/thesis.md).
 
 from __future__ import annotations
 
-from typing import Annotated
+from typing import Annotated, Literal
 
 import numpy as np
 
 from minvar.errors import ParameterError
-from minvar.validation import NonNegative, Positive, Tuple, declared
+from minvar.validation import NonNegative, Positive, Tuple, checked, declared
 
-__all__ = ["PointMassPlant", "POSITION", "VELOCITY", "FORCE", "FILTER", "N_BASE", "FORMS",
-           "check_form"]
+__all__ = ["PointMassPlant", "POSITION", "VELOCITY", "FORCE", "FILTER", "N_BASE", "FORMS"]
 
 #: Indices of the plant's physical states within the state vector.
 POSITION = slice(0, 2)
@@ -48,13 +47,6 @@ N_BASE = 8
 #: Forms of the model: the project's Euler filter and effort integral (default),
 #: and the thesis's printed exponential filter and effort mean (lines 520-524, 558).
 FORMS = ("project", "thesis")
-
-
-def check_form(form, owner: str) -> str:
-    """``form`` if it is one of :data:`FORMS`; raise ``ValueError`` naming ``owner`` if not."""
-    if form not in FORMS:
-        raise ValueError(f"{owner}: form must be one of {FORMS}, got {form!r}")
-    return form
 
 
 @declared
@@ -110,7 +102,7 @@ class PointMassPlant:
             exponential one with the command entering f~ at unit gain (module
             docstring).
         """
-        check_form(form, "PointMassPlant.dynamics")
+        checked(form, Literal[FORMS], ("PointMassPlant.dynamics", "form"))
         n = self.n_states(targets)
         dt = self.dt
         A = np.eye(n)
