@@ -190,7 +190,7 @@ def input_error(exc: ValidationError, owner: type,
                  location=(name, *loc))
 
 
-def declared(cls: type | None = None, /, *, frozen: bool = True, eq: bool = True,
+def declared(cls: type | None = None, /, *, eq: bool = True,
              error: type[LocatedError] = ParameterError) -> Any:
     """Make ``cls`` a pydantic dataclass whose bad values raise ``error`` in one line.
 
@@ -200,16 +200,15 @@ def declared(cls: type | None = None, /, *, frozen: bool = True, eq: bool = True
     ----------
     cls : type
         The class.
-    frozen : bool
-        Instances are immutable (the default: settings are values).
     eq : bool
         Compared field by field (False: by identity, for classes holding arrays).
     error : type
         Raised for a bad value (see :func:`input_error`).
     """
     if cls is None:
-        return functools.partial(declared, frozen=frozen, eq=eq, error=error)
-    built = _pydantic_dataclass(cls, frozen=frozen, eq=eq, config=CONFIG)
+        return functools.partial(declared, eq=eq, error=error)
+    # frozen: settings are values
+    built = _pydantic_dataclass(cls, frozen=True, eq=eq, config=CONFIG)
     init = built.__init__
 
     @functools.wraps(init)
