@@ -49,8 +49,8 @@ from perception.io.tracks import Status, Tracks
 from perception.landmarks import LandmarkParams, movement_bounds
 
 __all__ = ["APPROACH", "MIN_REST", "PX_PER_M", "WRIST_BEHIND", "MarkerMap", "PlaneFit", "Reach",
-           "ReachParams", "ReachTracks", "find_reaches", "fit_plane", "reach_tracks",
-           "recording_reaches"]
+           "ReachParams", "ReachTracks", "Unscored", "find_reaches", "fit_plane", "reach_tracks",
+           "recording_reaches", "trial_reaches"]
 
 #: The scale of the tracks a reach becomes: one "pixel" per millimetre.
 PX_PER_M = 1000.0
@@ -198,6 +198,38 @@ class Reach:
         return np.linalg.norm(self.finger - self.thumb, axis=1)
 
 
+@dataclass(frozen=True)
+class Unscored:
+    """A trial, or a movement in it, that gives no scored reach, and why.
+
+    Every trial of a recording leaves either reaches or at least one of
+    these, so that nothing is dropped without a word.
+
+    Attributes
+    ----------
+    name : str
+        The trial's name, or ``<trial>-reach<k>`` for one movement of it.
+    source : str
+        The file.
+    status : str
+        A short word for what happened, the outputs' ``status`` column:
+        ``no reach``, ``starts in motion``, ``ends in motion``, ``too short``,
+        ``marker lost``.
+    reason : str
+        The same in a sentence ("no reach: the hand never moved",
+        "too short: 3 samples", "marker lost throughout: index").
+    onset_time, end_time : float
+        Where the movement starts and ends, s, on the trial's clock (NaN if unknown).
+    """
+
+    name: str
+    source: str
+    status: str
+    reason: str
+    onset_time: float = math.nan
+    end_time: float = math.nan
+
+
 def _mean_marker(markers, names, time, params, notes) -> np.ndarray | None:
     if not names:
         return None
@@ -326,6 +358,39 @@ def recording_reaches(trial, markers: MarkerMap | None = None,
             wrist=None if wrist is None else wrist[rows], object=obj_at,
             onset=onset - lo, end=end - lo, notes=tuple(notes)))
     return out
+
+
+def trial_reaches(trial, markers: MarkerMap | None = None,
+                  params: ReachParams | None = None) -> tuple[list[Reach], list[Unscored]]:
+    """Every reach to grasp of one trial, and every trial or movement that gives none, and why.
+
+    Unlike :func:`recording_reaches` this never refuses a trial for what it
+    holds (no reach, too short, a marker lost throughout, a movement that
+    starts or ends in motion): such a trial or movement comes back as an
+    :class:`Unscored` with its reason, so that the caller can account for it.
+
+    Parameters
+    ----------
+    trial : MocapTrial
+    markers : MarkerMap, optional
+    params : ReachParams, optional
+
+    Returns
+    -------
+    list of Reach, list of Unscored
+
+    Raises
+    ------
+    InputError
+        Only for a mapping that names a marker the recording lacks (a mistake
+        that holds for every trial of the file).
+    """
+    markers = MarkerMap.guess(trial.markers) if markers is None else markers
+    markers.check(trial.markers, trial.source)
+    try:
+        return recording_reaches(trial, markers, params), []
+    except InputError as exc:
+        return [], [Unscored(trial.name, str(trial.source), "no reach", exc.problem)]
 
 
 @dataclass(frozen=True)
