@@ -46,6 +46,7 @@ import time as _time
 from pathlib import Path
 
 import numpy as np
+from scipy.ndimage import median_filter
 from scipy.signal import butter, filtfilt
 
 from perception.errors import HammerMVError
@@ -66,20 +67,31 @@ RTMOCAP_COLUMNS = ("object", "thumb", "index", "hand", "wristA", "wristB")
 def reference_landmarks(time, transport, aperture, around: float | None = None) -> dict:
     """Onset, end, movement time (s) and MGA (m) by the field's definitions, plainly.
 
-    Lost samples are filled linearly (as a lab fills gaps before filtering);
-    the movement is the one around the fastest sample (or the fastest after
-    ``around``, s, when given).
+    Lost samples are filled linearly and spikes taken out by a 0.1 s running
+    median (as a lab cleans a table before filtering);
+    the movement is the first whose speed peaks above a third of the
+    fastest (a trial's reach comes before its return), or the one around the
+    fastest sample after ``around``, s, when given.
     """
+    from scipy.signal import find_peaks
+
     t = np.asarray(time, dtype=float)
     ok = np.isfinite(transport).all(axis=1) & np.isfinite(aperture)
     tr = np.stack([np.interp(t, t[ok], transport[ok, k]) for k in range(3)], axis=1)
     g = np.interp(t, t[ok], aperture[ok])
     rate = 1 / np.median(np.diff(t))
+    k = 2 * int(0.05 * rate) + 1
+    tr = median_filter(tr, size=(k, 1), mode="mirror")
+    g = median_filter(g, size=k, mode="mirror")
     b, a = butter(2, min(10 / (0.5 * rate), 0.99))
     tr, g = filtfilt(b, a, tr, axis=0), filtfilt(b, a, g)
     v = np.linalg.norm(np.gradient(tr, t, axis=0), axis=1)
-    lo = 0 if around is None else int(np.searchsorted(t, around))
-    p = lo + int(np.argmax(v[lo:]))
+    if around is None:
+        peaks = find_peaks(v, height=np.max(v) / 3)[0]
+        p = int(peaks[0]) if len(peaks) else int(np.argmax(v))
+    else:
+        lo = int(np.searchsorted(t, around))
+        p = lo + int(np.argmax(v[lo:]))
     below = v < 0.05 * v[p]
     on = p - int(np.argmax(below[p::-1])) + 1
     end = p + int(np.argmax(below[p:])) - 1
@@ -210,11 +222,13 @@ def qualisys(rep) -> dict:
 
 def generated(rep, generator: str, seed: int = 7000) -> dict:
     """Single reaches of each condition, pick-and-place trials and a 12-grasp session."""
-    from mocap_tasks import VERDICT, pick_and_place, session, single_reach
+    from mocap_tasks import VERDICT, drinking, pick_and_place, session, single_reach
 
     made = [single_reach(generator, c, seed + 10 * k + i)
             for k, c in enumerate(VERDICT) for i in range(8)]
     made += [pick_and_place(generator, "normal", seed + 100 + i) for i in range(5)]
+    made += [drinking(generator, c, seed + 150 + i)
+             for i, c in enumerate(["normal"] * 3 + ["whole-hand"] * 3)]
     made.append(session(generator, ["normal"] * 12, seed + 200))
     out = {"trials": len(made), "reaches": [], "unscored": [], "conditions": {}}
     for g in made:
@@ -286,6 +300,7 @@ def summary(res: dict) -> dict:
                 out["conditions"][cond] = {
                     "n": len(got), "right": sum(g["verdict"] == verdict and (
                         detail is None or g["detail"] == detail) for g in got),
+                    "abnormal": sum(g["verdict"] == "abnormal" for g in got),
                     "verdicts": _count(g["verdict"] for g in got)}
         rows_normal = [r for r in rows if r.get("condition") == "normal"]
     else:

@@ -32,7 +32,9 @@ from perception.synthetic.independent import draw_independent, independent_paths
 from perception.synthetic.scene import min_jerk
 
 VERDICT = {"normal": ("normal", None), "delayed": ("abnormal", "delayed-opening"),
-           "open-close-open": ("abnormal", "re-opening")}
+           "open-close-open": ("abnormal", "re-opening"),
+           # a cup taken with extended fingers: honest is "not a precision grip"
+           "whole-hand": ("unfamiliar", None)}
 
 
 @dataclass
@@ -44,7 +46,20 @@ class Generated:
 
 
 def grasp(generator: str, condition: str, rng: np.random.Generator, rate: float):
-    """(t, {wrist, finger, thumb}: (F, 2) m) of one grasp at ``rate``."""
+    """(t, {wrist, finger, thumb}: (F, 2) m) of one grasp at ``rate``.
+
+    A ``whole-hand`` grasp is a normal one whose digits rest 6-8 cm apart
+    (a flat hand) and widen by only 8 % of the normal opening (about 1 cm).
+    """
+    if condition == "whole-hand":
+        t, paths = grasp(generator, "normal", rng, rate)
+        f, th = paths["finger"], paths["thumb"]
+        mid, axis = 0.5 * (f + th), f - th
+        g = np.linalg.norm(axis, axis=1)
+        unit = axis / np.maximum(g, 1e-9)[:, None]
+        wide = rng.uniform(0.06, 0.08) + 0.08 * (g - g[0])
+        return t, {**paths, "finger": mid + 0.5 * wide[:, None] * unit,
+                   "thumb": mid - 0.5 * wide[:, None] * unit}
     if generator == "independent":
         p = draw_independent(condition, rng, rest_before=0.6, rest_after=0.4)
         return independent_paths(p, rate, seed=rng)
@@ -90,7 +105,8 @@ def reference(t, transport, aperture, window) -> dict:
             "mga": float(np.max(g[on:end + 1]))}
 
 
-def _compose(generator, conditions, rng, rate, *, carry: bool, returns: bool, rests):
+def _compose(generator, conditions, rng, rate, *, carry: bool, returns: bool, rests,
+             drink: bool = False):
     """Grasps one after another (each with its return), in the lab frame (mm)."""
     place = _lab_frame(rng)
     parts = {k: [] for k in ("wrist", "finger", "thumb", "object", "lift")}
@@ -124,6 +140,18 @@ def _compose(generator, conditions, rng, rate, *, carry: bool, returns: bool, re
             seg["wrist"].append(np.repeat(hand["wrist"][None], n, 0))
             seg["object"].append(np.repeat(side[None], n, 0))
             seg["lift"].append(np.zeros(n))
+        if drink:  # the cup lifted toward the mouth, held, and put back down
+            up = np.array([0.0, -0.12])
+            n = int(rng.uniform(0.7, 0.9) * rate)
+            n_hold_mouth = int(rng.uniform(0.8, 1.5) * rate)
+            for name, at in hand.items():
+                seg[name] += [np.repeat(at[None], n_hold, 0), _move(at, at + up, n),
+                              np.repeat((at + up)[None], n_hold_mouth, 0),
+                              _move(at + up, at, n)]
+            seg["object"] += [np.zeros((n_hold, 2)), _move(np.zeros(2), up, n),
+                              np.repeat(up[None], n_hold_mouth, 0), _move(up, np.zeros(2), n)]
+            arc = 0.15 * np.sin(0.5 * np.pi * np.linspace(0, 1, n))
+            seg["lift"] += [np.zeros(n_hold), arc, np.full(n_hold_mouth, 0.15), arc[::-1]]
         if returns:  # back to the start, the grip closing to its rest
             n = int(rng.uniform(0.6, 0.8) * rate)
             for name in ("wrist", "finger", "thumb"):
@@ -171,6 +199,14 @@ def pick_and_place(generator: str, condition: str, seed: int,
     t, m, truth = _compose(generator, [condition], rng, rate, carry=True, returns=True,
                            rests=(0.3, 0.5))
     return Generated(_trial(f"{generator}-pnp-{condition}-{seed}", t, m, rate), truth)
+
+
+def drinking(generator: str, condition: str, seed: int, rate: float = 100.0) -> Generated:
+    """A reach to a cup, the cup lifted toward the mouth, held, put back, the hand's return."""
+    rng = np.random.default_rng(seed)
+    t, m, truth = _compose(generator, [condition], rng, rate, carry=False, returns=True,
+                           rests=(0.3, 0.5), drink=True)
+    return Generated(_trial(f"{generator}-drink-{condition}-{seed}", t, m, rate), truth)
 
 
 def session(generator: str, conditions, seed: int, rate: float = 120.0) -> Generated:
