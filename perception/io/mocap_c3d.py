@@ -1,0 +1,130 @@
+"""C3D files -> a trial, through ezc3d (an optional extra: ``pip install 'hammer-mv[mocap]'``).
+
+ezc3d reads what a file holds; a file cut short (a copy that stopped, a
+download that broke) is read as far as it goes, and ezc3d rewrites the frame
+count it reports to match. The count the file's own header states is read
+here from its first bytes, so that a short file is said to be short.
+"""
+
+from __future__ import annotations
+
+import os
+import struct
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+
+from perception.errors import InputError
+from perception.io.mocap_trial import MocapTrial, assemble, header_rate, unique_name
+
+__all__ = ["read_c3d"]
+
+_MOCAP_EXTRA = "reading C3D files needs ezc3d: pip install 'hammer-mv[mocap]'"
+#: C3D point groups that hold modelled outputs (Vicon Plug-in Gait), not markers.
+_C3D_MODELLED = ("ANGLES", "FORCES", "MOMENTS", "POWERS", "SCALARS", "REACTIONS")
+#: The processor type byte of the parameter section: big-endian for MIPS (86).
+_BIG_ENDIAN = 86
+
+
+def _c3d_values(group: Mapping, name: str) -> list:
+    """A C3D parameter's values as a list (empty when the parameter is absent)."""
+    value = group.get(name, {}).get("value", [])
+    return list(value) if isinstance(value, list | tuple) else list(np.atleast_1d(value))
+
+
+def _stated_frames(path: Path) -> tuple[int, int] | None:
+    """``(frames the header states, frames whose bytes the file holds)``, or None if unknown.
+
+    The header (C3D's first 512 bytes) gives the parameter block, the point
+    and analog counts per frame, the first and last frame, the scale (negative:
+    floats) and the block where the data start.
+    """
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(512)
+            fh.seek(0, os.SEEK_END)
+            size = fh.tell()
+            if len(head) < 24:
+                return None
+            fh.seek(max(head[0] - 1, 0) * 512 + 3)
+            processor = fh.read(1)
+    except OSError:
+        return None
+    order = ">" if processor and processor[0] == _BIG_ENDIAN else "<"
+    points, analogs, first, last = struct.unpack(order + "HHHH", head[2:10])
+    scale, data_start = struct.unpack(order + "fH", head[12:18])
+    stated = last - first + 1
+    width = 4 if scale < 0 else 2  # bytes per value
+    frame_bytes = (4 * points + analogs) * width
+    if stated <= 0 or not frame_bytes or not data_start:
+        return None
+    held = max(size - (data_start - 1) * 512, 0) // frame_bytes
+    return stated, held
+
+
+def read_c3d(path: Path, source: str, rate, units) -> list[MocapTrial]:
+    """A C3D file's marker points.
+
+    Parameters
+    ----------
+    path : Path
+        The file.
+    source : str
+        The file as the caller named it.
+    rate, units
+        As :func:`perception.io.mocap.read_mocap` takes them.
+    """
+    try:
+        import ezc3d
+    except ImportError:
+        raise InputError(_MOCAP_EXTRA, path) from None
+    try:
+        c3d = ezc3d.c3d(os.fspath(path))
+    except (OSError, RuntimeError, ValueError, IndexError) as exc:
+        raise InputError(f"not a readable C3D file ({exc})", path) from None
+    point = c3d["parameters"]["POINT"]
+    points = np.asarray(c3d["data"]["points"], dtype=float)[:3]  # (3, n_points, n_frames)
+    residuals = np.asarray(c3d["data"]["meta_points"]["residuals"], dtype=float)
+    notes: list[str] = []
+    counts = _stated_frames(path)
+    if counts is not None and min(counts[1], points.shape[2]) < counts[0]:
+        held = min(counts[1], points.shape[2])
+        if held == 0:
+            raise InputError(f"the file is cut short: its header states {counts[0]} frames "
+                             "and it holds none", path, field="header")
+        notes.append(f"the file is cut short: its header states {counts[0]} frames, it holds "
+                     f"{held}: those {held} are read")
+        points, residuals = points[:, :, :held], residuals[..., :held]
+    labels = [str(x).strip() for x in _c3d_values(point, "LABELS")]
+    labels = [labels[i] if i < len(labels) and labels[i] else f"point{i + 1}"
+              for i in range(points.shape[1])]
+    modelled = {str(x).strip() for g in _C3D_MODELLED for x in _c3d_values(point, g)}
+    own = _c3d_values(point, "RATE") or [c3d["header"]["points"]["frame_rate"]]
+    rate, more = header_rate(rate, float(own[0]), path, "POINT:RATE")
+    notes += more
+    markers = {}
+    renamed = set()
+    for i, label in enumerate(labels):
+        if label in modelled:
+            continue
+        xyz = points[:, i, :].T.copy()
+        lost = ~np.isfinite(residuals[0, i]) | (residuals[0, i] < 0) if residuals.size else False
+        xyz[lost] = np.nan
+        name = unique_name(label, markers)
+        if name != label:
+            renamed.add(label)
+        markers[name] = xyz
+    if renamed:
+        notes.append(f"labels written more than once ({', '.join(map(repr, sorted(renamed)))}): "
+                     "read as NAME, NAME_2, ...")
+    modelled_read = sum(1 for label in labels if label in modelled)
+    if modelled_read:
+        notes.append(f"{modelled_read} modelled points (angles, forces, ...) not read")
+    if not markers:
+        raise InputError("no marker points", path, field="POINT:LABELS")
+    first = int(c3d["header"]["points"].get("first_frame", 0))
+    time = (first + np.arange(points.shape[2])) / rate
+    stated = [str(u).strip() for u in _c3d_values(point, "UNITS") if str(u).strip()]
+    own_units = (stated[0], "POINT:UNITS") if stated else None
+    return assemble(path, source, [("", time, markers, {})], rate, units, own_units, notes)

@@ -1,0 +1,107 @@
+"""Qualisys Track Manager 3D TSV exports -> trials.
+
+A header block of ``KEY<TAB>value...`` lines (``NO_OF_FRAMES``,
+``FREQUENCY``, ``MARKER_NAMES``, ...), then one row per frame: with a column
+header (``Frame  Time  name X  name Y  name Z ...``) in newer exports, without
+one in older ones. QTM writes millimetres.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from perception.errors import InputError
+from perception.io.mocap_tables import table_trials, time_column_of
+from perception.io.mocap_text import TableText, load
+from perception.io.mocap_trial import MocapTrial, check_rate
+
+__all__ = ["is_qtm", "read_qtm"]
+
+_QTM_KEY = re.compile(r"[A-Z][A-Z0-9_]*")
+
+
+def is_qtm(first_line: str) -> bool:
+    """Whether a file's first line is a QTM header key.
+
+    Parameters
+    ----------
+    first_line : str
+        The line.
+    """
+    key = first_line.split("\t", 1)[0].strip()
+    return key == "FILE_VERSION" or key.startswith("NO_OF_")
+
+
+def read_qtm(path: Path, source: str, text: TableText, rate, units, trial_column,
+             time_column) -> list[MocapTrial]:
+    """A QTM 3D TSV export.
+
+    Parameters
+    ----------
+    path : Path
+        The file.
+    source : str
+        The file as the caller named it.
+    text : TableText
+        Its text.
+    rate, units, trial_column, time_column
+        As :func:`perception.io.mocap.read_mocap` takes them.
+    """
+    if trial_column is not None:
+        raise InputError("a Qualisys export holds one recording: it has no trial column",
+                         path, field="--trial-column")
+    lines = text.lines
+    header: dict[str, list[str]] = {}
+    skip = text.skip
+    for line in lines[text.skip:]:
+        fields = [f.strip() for f in line.split("\t")]
+        if not _QTM_KEY.fullmatch(fields[0]):
+            break
+        header.setdefault(fields[0], [f for f in fields[1:] if f])
+        skip += 1
+    names = header.get("MARKER_NAMES")
+    if not names or len(set(names)) < len(names):
+        raise InputError("expected the markers' names, each once", path, field="MARKER_NAMES")
+    included = " ".join(header.get("DATA_INCLUDED", ["3D"]))
+    if included.upper() != "3D":
+        raise InputError(f"expected 3D marker data, got {included!r}", path,
+                         field="DATA_INCLUDED")
+    notes = list(text.notes)
+    own_rate = None
+    if header.get("FREQUENCY"):
+        own_rate = (check_rate(header["FREQUENCY"][0], path, "FREQUENCY"), "FREQUENCY")
+    elif rate is None:
+        raise InputError("no sampling rate: give it with --rate", path, field="FREQUENCY")
+    groups = {m: tuple(f"{m} {a}" for a in "XYZ") for m in names}
+    first = lines[skip].split("\t")[0].strip() if skip < len(lines) else ""
+    titled = bool(first) and not re.fullmatch(r"[-+0-9.eE]+", first)
+    df = load(path, text.raw, "\t", skip, 0 if titled else None)
+    if not titled:  # older exports: X Y Z per marker, perhaps after Frame and Time
+        columns = [c for cols in groups.values() for c in cols]
+        if df.shape[1] not in (len(columns), len(columns) + 2):
+            raise InputError(f"the rows have {df.shape[1]} fields; {len(names)} markers need "
+                             f"{len(columns)} (X Y Z each) or {len(columns) + 2} (after Frame "
+                             "and Time)", path, field="MARKER_NAMES")
+        df.columns = ["Frame", "Time", *columns][len(columns) + 2 - df.shape[1]:]
+    missing = next((c for cols in groups.values() for c in cols if c not in df.columns), None)
+    if missing:
+        raise InputError(f"no column {missing!r} for a marker it lists", path,
+                         field="MARKER_NAMES")
+    listed = {c for cols in groups.values() for c in cols} | {"Frame", "Time"}
+    unlisted = sorted({c.rsplit(" ", 1)[0] for c in df.columns
+                       if c not in listed and not c.startswith("Unnamed: ")})
+    if unlisted:
+        notes.append(f"columns of markers MARKER_NAMES does not list, not read: "
+                     f"{', '.join(map(repr, unlisted[:5]))}")
+    stated = (header.get("NO_OF_FRAMES") or [""])[0]
+    if stated and stated != str(len(df)):
+        notes.append(f"NO_OF_FRAMES says {stated}; the file holds {len(df)} frames")
+    if time_column is None:
+        time_col = "Time" if "Time" in df.columns else None
+    else:
+        time_col = time_column_of(list(df.columns), time_column, path, notes)
+    own_units = ((header.get("UNITS") or ["mm"])[0], "UNITS")  # QTM writes mm
+    return table_trials(path, source, df, groups, time_col, None, rate, units, own_units,
+                        notes, extra=False, own_rate=own_rate)
+
