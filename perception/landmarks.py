@@ -448,7 +448,8 @@ def longest_gap(time: np.ndarray, values: np.ndarray) -> float:
 
 
 def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.ndarray,
-                       params: LandmarkParams | None = None) -> Landmarks:
+                       params: LandmarkParams | None = None,
+                       bounds: tuple[int | None, int | None] | None = None) -> Landmarks:
     """The landmarks of a sampled movement, by the field's definitions (:class:`LandmarkParams`).
 
     The movement is the one around the transport's peak speed, from the
@@ -468,6 +469,13 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
     aperture : (N,) array
         Grip aperture (tip to tip), m; NaN where lost.
     params : LandmarkParams, optional
+    bounds : (int or None, int or None), optional
+        Rows of the movement's onset and end where the caller has found them
+        (:func:`perception.reaches.trial_reaches`: a reach that flows out of
+        the movement before it, or into the object's transport; None where
+        the samples start or end in it); the peak is then the fastest row
+        between them. Default: the movement around the fastest row, bounded
+        here by ``params``.
     """
     params = LandmarkParams() if params is None else params
     time = np.asarray(time, dtype=float)
@@ -477,8 +485,15 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
     speed = params.speed_of(time, np.asarray(transport, dtype=float))
     if not np.isfinite(speed).any():
         return Landmarks()
-    peak = int(np.nanargmax(speed))
-    onset, end = movement_bounds(time, speed, peak, params)
+    if bounds is None:
+        peak = int(np.nanargmax(speed))
+        onset, end = movement_bounds(time, speed, peak, params)
+    else:
+        onset, end = bounds
+        a, b = (0 if onset is None else onset), (len(time) - 1 if end is None else end)
+        if not np.isfinite(speed[a:b + 1]).any():
+            return Landmarks()
+        peak = a + int(np.nanargmax(speed[a:b + 1]))
     bound = speed_bound(speed, peak, params)
     t_on = _cross_time(time, speed, onset, bound, True) if onset is not None else math.nan
     t_end = _cross_time(time, speed, end, bound, False) if end is not None else math.nan
