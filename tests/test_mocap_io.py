@@ -150,11 +150,16 @@ def test_qtm_zeros_and_empty_cells_are_lost(tmp_path):
     assert "1 samples at exactly (0, 0, 0) read as lost" in trial.notes
 
 
-def test_qtm_given_rate_wins_with_a_note():
-    (trial,) = read_mocap(QTM, rate=50)
+def test_qtm_given_rate_against_its_clock_is_refused_naming_the_way_out():
+    # a rate given beside the file's own Time column used to be ignored while a note
+    # said it won (issue 46): disagreeing by more than 1 % it is refused, naming
+    # --time-column none, which times the samples by the given rate
+    with pytest.raises(InputError, match="time-column none") as err:
+        read_mocap(QTM, rate=50)
+    assert err.value.field == "--rate"
+    (trial,) = read_mocap(QTM, rate=50, time_column="none")
     assert trial.rate == 50.0
-    assert "rate 50 samples/s given; the file says 100" in trial.notes
-    np.testing.assert_allclose(trial.time[200], 2.0)  # the Time column is the clock
+    np.testing.assert_allclose(trial.time[200], 4.0)
 
 
 def test_qtm_rate_over_the_limit_names_frequency(tmp_path):
