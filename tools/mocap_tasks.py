@@ -26,6 +26,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.signal import find_peaks
 
 from perception.io.mocap import MocapTrial
 from perception.synthetic.independent import draw_independent, independent_paths
@@ -97,7 +98,10 @@ def reference(t, transport, aperture, window) -> dict:
     inside = (t >= window[0]) & (t <= window[1])
     tt, tr, g = t[inside], transport[inside], aperture[inside]
     v = np.linalg.norm(np.gradient(tr, tt, axis=0), axis=1)
-    p = int(np.argmax(v))
+    # the first movement that peaks above a third of the fastest (a generated grasp's
+    # hand may be pulled back briefly as the digits close, faster than the reach)
+    peaks = find_peaks(v, height=np.max(v) / 3)[0]
+    p = int(peaks[0]) if len(peaks) else int(np.argmax(v))
     below = v < 0.05 * v[p]
     on = p - int(np.argmax(below[p::-1])) + 1
     end = p + int(np.argmax(below[p:])) - 1
@@ -176,10 +180,11 @@ def _compose(generator, conditions, rng, rate, *, carry: bool, returns: bool, re
         z = lift if name != "object" else np.where(
             np.linalg.norm(np.gradient(lab["object"], axis=0), axis=1) > 0, lift, 0.0)
         markers[name] = place(lab[name], z)
-    mid = 0.5 * (markers["finger"] + markers["thumb"]) / 1000
+    # the transport is the hand marker, as the evaluation maps it
+    hand = markers["wrist"] / 1000
     g = np.linalg.norm(markers["finger"] - markers["thumb"], axis=1) / 1000
     for tr in truth:
-        tr.update(reference(time, mid, g, tr["window"]))
+        tr.update(reference(time, hand, g, tr["window"]))
     noisy = {m: xyz + rng.normal(0, 0.1, xyz.shape) for m, xyz in markers.items()}
     return time, noisy, truth
 
