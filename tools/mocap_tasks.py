@@ -46,14 +46,15 @@ class Generated:
     truth: list[dict]  # per reach: condition, window (s), onset, end, mt, mga
 
 
-def grasp(generator: str, condition: str, rng: np.random.Generator, rate: float):
+def grasp(generator: str, condition: str, rng: np.random.Generator, rate: float,
+          rest_after: float = 0.4):
     """(t, {wrist, finger, thumb}: (F, 2) m) of one grasp at ``rate``.
 
     A ``whole-hand`` grasp is a normal one whose digits rest 6-8 cm apart
     (a flat hand) and widen by only 8 % of the normal opening (about 1 cm).
     """
     if condition == "whole-hand":
-        t, paths = grasp(generator, "normal", rng, rate)
+        t, paths = grasp(generator, "normal", rng, rate, rest_after)
         f, th = paths["finger"], paths["thumb"]
         mid, axis = 0.5 * (f + th), f - th
         g = np.linalg.norm(axis, axis=1)
@@ -62,11 +63,11 @@ def grasp(generator: str, condition: str, rng: np.random.Generator, rate: float)
         return t, {**paths, "finger": mid + 0.5 * wide[:, None] * unit,
                    "thumb": mid - 0.5 * wide[:, None] * unit}
     if generator == "independent":
-        p = draw_independent(condition, rng, rest_before=0.6, rest_after=0.4)
+        p = draw_independent(condition, rng, rest_before=0.6, rest_after=rest_after)
         return independent_paths(p, rate, seed=rng)
     from perception.synthetic.stimuli import StimulusParams, stimulus_paths
 
-    p = StimulusParams(condition=condition, rest_before=0.6, rest_after=0.4)
+    p = StimulusParams(condition=condition, rest_before=0.6, rest_after=rest_after)
     return stimulus_paths(p, rate, seed=int(rng.integers(1 << 30)))
 
 
@@ -115,7 +116,10 @@ def _compose(generator, conditions, rng, rate, *, carry: bool, returns: bool, re
     place = _lab_frame(rng)
     parts = {k: [] for k in ("wrist", "finger", "thumb", "object", "lift")}
     truth, t0 = [], 0.0
-    drawn = [grasp(generator, condition, rng, rate) for condition in conditions]
+    # in a task the hand may go on with the object at once
+    after = (0.0, 0.1) if carry or drink else (0.4, 0.4)
+    drawn = [grasp(generator, condition, rng, rate, rng.uniform(*after))
+             for condition in conditions]
     for k, (condition, (t, paths)) in enumerate(zip(conditions, drawn)):
         w, f, th = paths["wrist"], paths["finger"], paths["thumb"]
         # the return leads to where the next grasp starts
@@ -125,7 +129,7 @@ def _compose(generator, conditions, rng, rate, *, carry: bool, returns: bool, re
         obj = np.zeros_like(w)
         seg = {"wrist": [w], "finger": [f], "thumb": [th], "object": [obj], "lift": [lift]}
         hand = {"wrist": w[-1], "finger": f[-1], "thumb": th[-1]}
-        n_hold = int(0.15 * rate)
+        n_hold = int(rng.uniform(0.0, 0.15) * rate)  # the hand may flow on at once
         if carry:  # the object carried sideways, put down, released
             side = np.array([0.15, 0.0]) @ np.array([[0.0, 1.0], [-1.0, 0.0]])
             n = int(rng.uniform(0.45, 0.6) * rate)
