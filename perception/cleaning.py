@@ -11,10 +11,27 @@ three as lost and bridges a gap only when it is short
 (:attr:`CleaningParams.max_bridge`); every repair is counted in a
 :class:`Repairs` so the report can say what was done.
 
+A file whose positions are rounded (a 1 mm export) repeats its samples
+exactly whenever the marker moves less than the rounding step: such a
+*quantised* live marker is not held. :func:`quantum` finds the step ``q``
+from the data (every change of every coordinate is a whole multiple of it),
+and then a run of repeated samples counts as held only where the marker
+would have had to move more than the step during it: where it comes back
+(the nearest of the next few samples) more than 1.5 ``q`` from where it was
+held, or, for a run that lasts to the end, where it entered the run by
+more than that in one sample (it was moving fast, then froze). A run that
+spans the whole path is a still marker, never a held one; a caller that
+knows the other markers (:mod:`perception.track_cleaning`) also spares the
+runs during which every other marker repeats too (the whole scene still: a
+rendered or rounded rest).
+
 The spike test is a Hampel filter: a sample more than
 :attr:`CleaningParams.spike_distance` from the running median of its
 neighbours (:attr:`CleaningParams.spike_window` either side) is off the
-path. A reach's path bends smoothly enough that the median of a 0.1 s
+path, unless it lies within that distance of the path of the neighbours
+not found off (the line between the nearest on either side, within twice
+the window: a spike shifts the median its neighbours are judged by, by a
+frame's motion at video rates). A reach's path bends smoothly enough that the median of a 0.1 s
 window stays within a few millimetres of it (measured on real Optotrak
 reaches at 1 m/s), while the spikes seen in real recordings are 15-80 mm.
 """
@@ -32,7 +49,13 @@ from scipy.ndimage import median_filter
 
 from perception.validation import Int, NonNegative, declared
 
-__all__ = ["CleaningParams", "Repairs", "clean_path", "spikes"]
+__all__ = ["CleaningParams", "Repairs", "clean_path", "held", "quantum", "spikes"]
+
+#: A quantised marker counts as held only if it moved more than this many steps
+#: during the run: a live one steps by one at a time while it is slower than the step.
+HELD_STEPS = 1.5
+#: Fewest changes of a path's coordinates from which its rounding step is read.
+MIN_CHANGES = 10
 
 
 @declared
@@ -52,12 +75,18 @@ class CleaningParams:
     max_bridge : float
         Gaps up to this long are bridged (shape-preserving cubic
         interpolation, PCHIP); longer ones stay lost, s.
+    quantum : float, optional
+        The step the file's positions are rounded to, m (0.001 for a 1 mm
+        export): repeated samples count as held only where the marker would
+        have had to move more than it. Default: found from the data
+        (:func:`quantum`); 0 treats every run of ``held_samples`` as held.
     """
 
     spike_distance: NonNegative = 0.010
     spike_window: NonNegative = 0.05
     held_samples: Annotated[Int, Field(ge=2)] = 3
     max_bridge: NonNegative = 0.05
+    quantum: NonNegative | None = None
 
 
 @dataclass(frozen=True)
@@ -95,13 +124,79 @@ class Repairs:
         return line
 
 
-def _held(path: np.ndarray, run: int) -> np.ndarray:
-    """Samples that repeat the previous one exactly, in runs of ``run`` or more."""
+def quantum(path: np.ndarray) -> float | None:
+    """The step a path's positions are rounded to, if they are: None if not.
+
+    Every change of every coordinate between consecutive samples is then a
+    whole multiple of the smallest one. Positions written with all their
+    digits (or a file's six decimals) give a step far below any motion, for
+    which the held rule is today's; a 1 mm export gives 0.001 m.
+
+    Parameters
+    ----------
+    path : (N, D) array
+        Positions (NaN where lost).
+    """
+    steps = np.abs(np.diff(np.asarray(path, dtype=float), axis=0)).ravel()
+    steps = steps[np.isfinite(steps) & (steps > 0)]
+    if len(steps) < MIN_CHANGES:
+        return None
+    q = float(steps.min())
+    k = steps / q
+    # float error of a rounded value read and rescaled stays far below 1e-3 of a step
+    return q if bool(np.all(np.abs(k - np.round(k)) < 1e-3)) else None
+
+
+def held(path: np.ndarray, run: int, step: float | None = None,
+         still: np.ndarray | None = None) -> np.ndarray:
+    """(N,) samples that repeat the previous one exactly while the marker was lost.
+
+    A run of ``run`` or more identical samples (all coordinates) is held
+    (all but its first, the last real sample), unless
+
+    * it spans every seen sample (a marker that never moves);
+    * ``still`` is true through it (every other marker repeats too: the
+      whole scene is still);
+    * the positions are rounded to ``step`` and the marker would not have
+      had to move more than :data:`HELD_STEPS` steps during it: the nearest
+      of the next ``run`` seen samples lies within that of the held
+      position (or, for a run that lasts to the end, the sample before it
+      does).
+
+    Parameters
+    ----------
+    path : (N, D) array
+        Positions (NaN where lost).
+    run : int
+        Fewest identical samples that can be a held run.
+    step : float, optional
+        The rounding step (:func:`quantum`); None: every run is held.
+    still : (N,) bool array, optional
+        Samples at which every other marker repeats its previous sample too.
+    """
+    path = np.asarray(path, dtype=float)
     same = np.r_[False, (np.diff(path, axis=0) == 0).all(axis=1)]
+    seen = np.flatnonzero(np.isfinite(path).all(axis=1))
     out = np.zeros(len(path), dtype=bool)
     for start, stop in _runs(same):
-        if stop - start + 1 >= run:  # the run's first sample is the last real one
-            out[start:stop] = True
+        first = start - 1  # the run's first sample is the last real one
+        if stop - first < run:
+            continue
+        before = seen[seen < first]
+        after = seen[seen >= stop][:run]
+        if not len(before) and not len(after):
+            continue
+        if still is not None and still[start:stop].all():
+            continue
+        if step is not None:
+            v = path[first]
+            if len(after):
+                moved = float(np.abs(path[after] - v).max(axis=1).min())
+            else:
+                moved = float(np.abs(v - path[before[-1]]).max())
+            if moved <= HELD_STEPS * step:
+                continue
+        out[start:stop] = True
     return out
 
 
@@ -138,13 +233,33 @@ def spikes(time: np.ndarray, path: np.ndarray, ok: np.ndarray | None = None,
     # samples after it, not copies of itself
     med = median_filter(seen, size=(2 * half + 1, 1), mode="mirror")
     off = np.linalg.norm(seen - med, axis=1) > params.spike_distance
+    # A spike in the window shifts its neighbours' median by one sample's motion,
+    # which at video rates (33 ms a frame) is a centimetre of a fast reach: a
+    # sample found off is judged again against the samples around it that are
+    # not (the line between the nearest on either side, within twice the window;
+    # at an end of the path the median of those within the window), and
+    # kept if it lies on their path.
+    ts = np.asarray(time, dtype=float)[idx]
+    for i in np.flatnonzero(off):
+        # the nearest samples not found off, within twice the window either side
+        near = np.arange(max(0, i - 2 * half), min(len(seen), i + 2 * half + 1))
+        near = near[~off[near]]
+        lo, hi = near[near < i], near[near > i]
+        if len(lo) and len(hi):
+            a, b = lo[-1], hi[0]
+            ref = seen[a] + (ts[i] - ts[a]) / (ts[b] - ts[a]) * (seen[b] - seen[a])
+        else:  # at an end of the path: the median of those within the window
+            close = near[np.abs(near - i) <= half]
+            ref = np.median(seen[close], axis=0) if len(close) else None
+        if ref is not None and np.linalg.norm(seen[i] - ref) <= params.spike_distance:
+            off[i] = False
     out = np.zeros(len(path), dtype=bool)
     out[idx[off]] = True
     return out
 
 
-def clean_path(time: np.ndarray, path: np.ndarray,
-               params: CleaningParams | None = None) -> tuple[np.ndarray, Repairs]:
+def clean_path(time: np.ndarray, path: np.ndarray, params: CleaningParams | None = None, *,
+               still: np.ndarray | None = None) -> tuple[np.ndarray, Repairs]:
     """A marker's path with spikes, held and missing samples lost, short gaps bridged.
 
     Parameters
@@ -154,6 +269,9 @@ def clean_path(time: np.ndarray, path: np.ndarray,
     path : (N, D) array
         Positions, m; NaN where the file has none.
     params : CleaningParams, optional
+    still : (N,) bool array, optional
+        Samples at which every other marker repeats its previous sample
+        exactly (see :func:`held`): no evidence that this one was held.
 
     Returns
     -------
@@ -164,9 +282,11 @@ def clean_path(time: np.ndarray, path: np.ndarray,
     time = np.asarray(time, dtype=float)
     path = np.array(path, dtype=float)
     missing = ~np.isfinite(path).all(axis=1)
-    held = _held(np.where(missing[:, None], np.nan, path), params.held_samples) & ~missing
-    spiked = spikes(time, path, ~missing & ~held, params)
-    lost = missing | held | spiked
+    path[missing] = np.nan
+    step = quantum(path) if params.quantum is None else (params.quantum or None)
+    frozen = held(path, params.held_samples, step, still) & ~missing
+    spiked = spikes(time, path, ~missing & ~frozen, params)
+    lost = missing | frozen | spiked
     path[lost] = np.nan
     bridged = 0
     longest = 0.0
@@ -182,5 +302,5 @@ def clean_path(time: np.ndarray, path: np.ndarray,
             else:
                 longest = max(longest, float(span if inside else
                                              time[min(b, len(time) - 1)] - time[max(a - 1, 0)]))
-    return path, Repairs(int(spiked.sum()), int(held.sum()), int(missing.sum()), bridged,
+    return path, Repairs(int(spiked.sum()), int(frozen.sum()), int(missing.sum()), bridged,
                          longest)

@@ -30,6 +30,7 @@ from perception.errors import InputError
 from perception.filtering import alpha_beta
 from perception.geometry import DEFAULT_OBJECT_DIAMETER, SimilarityTransform
 from perception.io.pose import is_pose_file
+from perception.track_cleaning import cleaning_notes
 from perception.validation import Int, Positive, Tuple, declared
 
 __all__ = [
@@ -249,6 +250,9 @@ class Observation:
     clip_raw : (T, 3, 2) array, optional
         Unfiltered wrist, finger and thumb positions over the whole clip, m
         (the landmarks' movement may end after the scored span).
+    notes : tuple of str
+        What was done to the tracks before they were observed: the cleaning's
+        repairs per marker (:func:`perception.track_cleaning.cleaning_notes`).
     """
 
     clip: str
@@ -269,6 +273,7 @@ class Observation:
     noise: float = 0.0
     clip_time: np.ndarray | None = field(default=None, repr=False)
     clip_raw: np.ndarray | None = field(default=None, repr=False)
+    notes: tuple[str, ...] = ()
 
     @property
     def n_frames(self) -> int:
@@ -675,4 +680,5 @@ def observe(tracks, params: ObserveParams | None = None, *, clip: str | None = N
         marker_separation=float(np.linalg.norm(2 * half)),
         clip_time=sc.time - p.span.onset_time,
         clip_raw=sc.raw,
+        notes=cleaning_notes(tracks),
     )

@@ -7,7 +7,10 @@ and ``.csv``), SLEAP (analysis ``.h5``, labels ``.slp``), Lightning Pose
 turns one of them into tracks of the four markers recognition needs — thumb,
 finger, wrist and object — by a keypoint mapping (:class:`PoseImport`);
 points below the likelihood cutoff (DeepLabCut's ``pcutoff``, 0.6 by default)
-count as lost. :func:`write_dlc` and :func:`write_movement` go the other way.
+count as lost, and the tracks are cleaned as motion capture is (DeepLabCut's
+single-frame jumps are spikes: :mod:`perception.track_cleaning`, here where
+the file is read, so that every command reads the same tracks).
+:func:`write_dlc` and :func:`write_movement` go the other way.
 Files DeepLabCut and SLEAP name after their video (:func:`pose_output`) without
 a frame rate take that video's (:func:`video_beside`).
 
@@ -41,6 +44,7 @@ from perception.io.movement_import import POSE_EXTRA as _EXTRA
 from perception.io.movement_import import movement_loaders as _movement
 from perception.io.tracks import Status, Tracks, position_bounds
 from perception.limits import MAX_FPS, MAX_FRAMES, MAX_KEYPOINTS, MAX_MARKERS, MAX_POSE_POINTS
+from perception.track_cleaning import TrackCleaning, clean_tracks
 from perception.validation import Positive, Share, declared
 
 __all__ = [
@@ -129,6 +133,10 @@ class PoseImport:
         The object's apparent diameter in pixels, which sets the metric
         scale with ``--object-diameter`` (a pose file cannot carry it); or
         give the scale outright with ``--px-per-m`` when recognising.
+    cleaning : TrackCleaning, optional
+        How the keypoints' spikes, held samples and gaps are cleaned (the
+        motion-capture rules at the clip's scale: give it the scale the
+        recognition uses, ``TrackCleaning(px_per_m=...)``); None: not cleaned.
     """
 
     keypoints: Annotated[Mapping[str, str], PlainValidator(_keypoints)] = field(
@@ -137,17 +145,19 @@ class PoseImport:
     pcutoff: Share = 0.6
     fps: Annotated[float, Field(gt=0, le=MAX_FPS)] | None = None
     object_diameter_px: Positive | None = None
+    cleaning: TrackCleaning | None = field(default_factory=TrackCleaning)
 
     def __reduce__(self):
         # MappingProxyType does not pickle: batch workers get the options sent
         return PoseImport, (dict(self.keypoints), self.individual, self.pcutoff, self.fps,
-                            self.object_diameter_px)
+                            self.object_diameter_px, self.cleaning)
 
     def to_dict(self) -> dict[str, Any]:
         """The options as JSON-able data (for reports and resume fingerprints)."""
         return {"keypoints": dict(self.keypoints), "individual": self.individual,
                 "pcutoff": self.pcutoff, "fps": self.fps,
-                "object_diameter_px": self.object_diameter_px}
+                "object_diameter_px": self.object_diameter_px,
+                "cleaning": None if self.cleaning is None else self.cleaning.to_dict()}
 
     def keypoint(self, marker: str) -> str:
         """The file's keypoint name for ``marker``.
@@ -533,7 +543,10 @@ def read_pose(path: str | os.PathLike, options: PoseImport | None = None) -> Tra
     -------
     Tracks
         Positions in the file's pixels; a point below ``pcutoff`` (or missing)
-        is lost: NaN, likelihood 0, status lost. ``/tracker`` records the source.
+        is lost: NaN, likelihood 0, status lost. Cleaned by
+        ``options.cleaning`` (:func:`~perception.track_cleaning.clean_tracks`):
+        spikes and held points lost, short gaps bridged (status
+        interpolated). ``/tracker`` records the source and the repairs.
 
     Raises
     ------
@@ -564,10 +577,11 @@ def read_pose(path: str | os.PathLike, options: PoseImport | None = None) -> Tra
                "individual": options.individual or "", "pcutoff": options.pcutoff,
                "diameter_px": diameter}
     video = {"path": os.fspath(path), "fps_nominal": fps, "n_frames": int(len(time))}
-    return Tracks(frame=frames, time=time, markers=MARKERS, position=position,
-                  likelihood=np.where(seen, conf, 0.0).astype(np.float32),
-                  status=np.where(seen, Status.TRACKED, Status.LOST).astype(np.int8),
-                  video=video, tracker=tracker, path=path)
+    tracks = Tracks(frame=frames, time=time, markers=MARKERS, position=position,
+                    likelihood=np.where(seen, conf, 0.0).astype(np.float32),
+                    status=np.where(seen, Status.TRACKED, Status.LOST).astype(np.int8),
+                    video=video, tracker=tracker, path=path)
+    return tracks if options.cleaning is None else clean_tracks(tracks, options.cleaning)
 
 
 def write_dlc(tracks: Tracks, path: str | os.PathLike, *, scorer: str = "hammer-mv") -> Path:
