@@ -337,7 +337,8 @@ def test_two_markers_on_one_keypoint_are_refused():
 def test_deeplabcut_frame_numbers_are_kept(tmp_path, name):
     t = _tracks(n=12, frame0=42150)
     path = write_dlc(t, tmp_path / name)
-    back = read_pose(path, PoseImport(fps=30.0))
+    # random positions read as spikes by the cleaning: read the points as written
+    back = read_pose(path, PoseImport(fps=30.0, cleaning=None))
     np.testing.assert_array_equal(back.frame, np.arange(42150, 42162))
     np.testing.assert_allclose(back.time, back.frame / 30.0)
     np.testing.assert_allclose(back.position, t.position)
