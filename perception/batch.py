@@ -58,8 +58,9 @@ from perception.report.tracking import tracking_columns, write_tracking_report
 if TYPE_CHECKING:
     import pandas as pd
 
-__all__ = ["REPORT_SET", "BatchItem", "ClipResult", "Discovery", "discover",
-           "expand_recordings", "find_clips", "process_clip", "run_batch", "summary_table"]
+__all__ = ["REPORT_SET", "BatchItem", "ClipResult", "Discovery", "count_trials", "discover",
+           "expand_recordings", "find_clips", "process_clip", "remove_stale_reports",
+           "run_batch", "summary_table"]
 
 log = logging.getLogger(__name__)
 
@@ -68,9 +69,13 @@ def _recognized(item: BatchItem, out: Path, repertoire: Repertoire,
                 plan_cache: PlanCache | None):
     """The recognition of one item and its report's extra entries."""
     if item.kind == "mocap":
+        import dataclasses
+
         from perception.recordings import cached_reaches, recognize_reach
 
         reach = cached_reaches(item.path, settings.mocap)[item.reach or 0]
+        if reach.name != item.clip:  # made safe or unique (expand_recordings)
+            reach = dataclasses.replace(reach, name=item.clip)
         rec, info = recognize_reach(reach, repertoire, settings, settings.mocap,
                                     plan_cache=plan_cache)
         return rec, {"fingerprint": fp, "condition": item.condition, "input": str(item.path),
@@ -112,7 +117,9 @@ class ClipResult:
     condition : str or None
         Its stimulus condition, if known.
     status : str
-        ``ok``, ``reused`` (its report was already current) or ``failed``.
+        ``ok``, ``reused`` (its report was already current), ``failed``, or
+        the status of a recording's trial or movement that gives no reach to
+        score (``no reach``, ``starts in motion``, ...: :attr:`BatchItem.unscored`).
     error : str
         One line saying why it failed (empty otherwise).
     rule : str
@@ -123,6 +130,9 @@ class ClipResult:
         The traceback of a failure that is a bug, not bad input (empty otherwise).
     factors : tuple of (str, str)
         The manifest's other columns for this clip (:attr:`BatchItem.factors`).
+    reason : str
+        Why it has no result, in a sentence (a failure's error, or a trial's
+        reason: ``no reach: the hand never moved``); empty for a scored clip.
     """
 
     clip: str
@@ -133,6 +143,12 @@ class ClipResult:
     summary: ClipSummary | None = None
     traceback: str = ""
     factors: tuple[tuple[str, str], ...] = ()
+    reason: str = ""
+
+    @property
+    def scored(self) -> bool:
+        """Whether the clip has a result (``ok`` or ``reused``)."""
+        return self.status in ("ok", "reused")
 
     @property
     def winner(self) -> str | None:
@@ -177,6 +193,10 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
     """
     base = dict(clip=item.clip, condition=item.condition, rule=settings.hammer.rule,
                 factors=item.factors)
+    if item.unscored is not None:  # a trial that gives no reach: its row says why
+        _remove_outputs(item, out)  # an earlier run's report of it is not current
+        status, reason = item.unscored
+        return ClipResult(**base, status=status, reason=reason)
     try:
         input_file(item.path, "clip")  # before hashing: a FIFO or device would never end
         fp = clip_fingerprint(item.path, settings, repertoire_id + (
@@ -193,7 +213,7 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
             msg = f"{item.path}: {msg}"
         log.info("%s failed: %s", item.clip, msg)
         _remove_outputs(item, out)
-        return ClipResult(**base, status="failed", error=msg)
+        return ClipResult(**base, status="failed", error=msg, reason=msg)
 
 
 def _first_line(exc: BaseException) -> str:
@@ -232,11 +252,11 @@ def _guarded(item: BatchItem, out: Path, **kwargs) -> ClipResult:
     except Exception as exc:  # noqa: BLE001 - one clip must not end the batch
         log.exception("%s: unexpected error (a bug in hammer-mv)", item.clip)
         _remove_outputs(item, out)
-        return ClipResult(item.clip, item.condition, "failed",
-                          f"{item.path}: unexpected {type(exc).__name__} (a bug in hammer-mv; "
-                          f"see errors.log): {_first_line(exc)}",
+        msg = (f"{item.path}: unexpected {type(exc).__name__} (a bug in hammer-mv; "
+               f"see errors.log): {_first_line(exc)}")
+        return ClipResult(item.clip, item.condition, "failed", msg,
                           kwargs["settings"].hammer.rule, traceback=traceback.format_exc(),
-                          factors=item.factors)
+                          factors=item.factors, reason=msg)
 
 
 @dataclass(frozen=True)
@@ -264,7 +284,8 @@ class _Job:
         log.error("%s: %s", item.clip, message)
         _remove_outputs(item, self.out)
         return ClipResult(item.clip, item.condition, "failed", f"{item.path}: {message}",
-                          self.settings.hammer.rule, factors=item.factors)
+                          self.settings.hammer.rule, factors=item.factors,
+                          reason=f"{item.path}: {message}")
 
 
 #: Folder of the plan cache inside a report folder.
@@ -351,8 +372,11 @@ def summary_table(results: list[ClipResult], reference: str | None = None) -> pd
     (final thesis-rule confidence of each model of the first scored clip,
     m), the tracking quality
     (``track_<marker>``, ``minlik_<marker>``, ``reacquisitions``,
-    ``ambiguous_frames``), ``status`` (``ok`` or ``failed``), ``reused`` (the
-    report was already current), ``error``; beside each column whose name R
+    ``ambiguous_frames``), ``status`` (``ok``, ``failed``, or a recording's
+    trial that gives no reach: ``no reach``, ``starts in motion``, ...),
+    ``reused`` (the report was already current), ``error`` (a failure's),
+    ``reason`` (why a row has no result: the error, or the trial's reason);
+    beside each column whose name R
     cannot take unquoted, its alias (``conf_grasp_0_5s``:
     :func:`~perception.report.tables.with_r_aliases`).
 
@@ -392,9 +416,10 @@ def summary_table(results: list[ClipResult], reference: str | None = None) -> pd
             entry[f"conf_{n}"] = (_model_value(s, n, s.confidence[:, -1]) if s is not None
                                   else float("nan"))
         entry.update(tracking_columns(s.tracking if s is not None else None))
-        entry["status"] = "failed" if r.status == "failed" else "ok"
+        entry["status"] = "ok" if r.scored else r.status
         entry["reused"] = r.status == "reused"
         entry["error"] = r.error
+        entry["reason"] = r.reason
         given = dict(r.factors)
         table.append({"clip": r.clip, "condition": r.condition, **{
             f"manifest_{f}" if f in entry or f in ("clip", "condition") else f: given.get(f)
@@ -453,7 +478,11 @@ def run_batch(
     Returns
     -------
     pandas.DataFrame
-        The summary (see :func:`summary_table`). The report files
+        The summary (see :func:`summary_table`), a row per clip: per reach of a
+        recording and per trial or movement of it that gives none (its status
+        and reason); ``attrs["trials"]`` the trials read (:func:`count_trials`).
+        Reports of a recording's trials not scored in this run (no longer in
+        the file, or no reach now) are removed from ``out``. The report files
         (:data:`REPORT_SET`) come from one run: the last run's are removed
         first, and this run's again if one of them cannot be written.
     """
@@ -487,7 +516,10 @@ def run_batch(
             done.append(result)
             bar.update()
     done.sort(key=lambda r: r.clip)
+    for path, clips in _recordings(items).items():  # reports of trials no longer in them
+        remove_stale_reports(out, path, [r.clip for r in done if r.scored and r.clip in clips])
     summary = summary_table(done)
+    summary.attrs["trials"] = count_trials(items)
     bugs = [f"== {r.clip} ({r.error})\n{r.traceback}" for r in done if r.traceback]
     _remove_report(out)  # the last run's set: a kill or a full disk below leaves no mix
     try:
@@ -496,8 +528,11 @@ def run_batch(
         if bugs:
             write_text(out / ERRORS_LOG, "\n".join(bugs))
         write_json(out / "batch.json", {
-            "clips": len(done), "ok": int((summary["status"] == "ok").sum()),
-            "failed": int((summary["status"] != "ok").sum()),
+            "clips": len(done), "trials": summary.attrs["trials"],
+            "ok": int((summary["status"] == "ok").sum()),
+            "failed": int((summary["status"] == "failed").sum()),
+            "not_scored": [{"clip": r.clip, "status": r.status, "reason": r.reason}
+                           for r in done if not r.scored],
             "skipped": [{"file": n, "reason": why} for n, why in skipped],
             "settings": settings.fingerprint(), "repertoire": repertoire_id,
             "code": code_digest()})
@@ -505,6 +540,75 @@ def run_batch(
         _remove_report(out)
         raise
     return summary
+
+
+def count_trials(items: Iterable[BatchItem]) -> int:
+    """Trials among ``items``: each trial of a recording once, each other clip as one.
+
+    Parameters
+    ----------
+    items : iterable of BatchItem
+        Clips after :func:`expand_recordings`.
+    """
+    return len({(str(i.path), i.trial) if i.trial is not None else (str(i.path), i.clip)
+                for i in items})
+
+
+def _recordings(items: Iterable[BatchItem]) -> dict[Path, set[str]]:
+    """The motion-capture recordings among ``items``, with their clips' names."""
+    out: dict[Path, set[str]] = {}
+    for i in items:
+        if i.kind == "mocap":
+            out.setdefault(Path(i.path), set()).add(i.clip)
+    return out
+
+
+def remove_stale_reports(out: str | os.PathLike, source: str | os.PathLike,
+                         keep: Iterable[str]) -> list[str]:
+    """Remove the reports in ``out`` of a recording's reaches that are not in ``keep``.
+
+    A rerun after a table lost a trial (or a trial that no longer gives a
+    reach) must not leave that trial's report and figures looking current.
+    Only reaches' reports (those with a ``mocap`` entry) made from ``source``
+    itself (the same file) are touched, and only in ``out``.
+
+    Parameters
+    ----------
+    out : str or os.PathLike
+        The report folder.
+    source : str or os.PathLike
+        The recording.
+    keep : iterable of str
+        The clips scored now.
+
+    Returns
+    -------
+    list of str
+        The stems of the reports removed.
+    """
+    out, source = Path(out), Path(source)
+    keep_stems = {output_stem(c) for c in keep}
+    removed = []
+    suffix = ".recognition.json"
+    for report in sorted(out.glob(f"*{suffix}")):
+        stem = report.name[:-len(suffix)]
+        if stem in keep_stems:
+            continue
+        try:
+            data = json.loads(report.read_text())
+            made_from = data.get("input") if isinstance(data, dict) and "mocap" in data else None
+            same = made_from is not None and os.path.samefile(made_from, source)
+        except (OSError, ValueError):
+            continue
+        if not same:
+            continue
+        log.info("%s: removed: its trial is not scored from %s now", report, source)
+        for path in dict.fromkeys(p for fmt in FIGURE_FORMATS
+                                  for p in clip_outputs(out, stem, fmt).values()):
+            with contextlib.suppress(OSError):
+                remove_output(path)
+        removed.append(stem)
+    return removed
 
 
 def _remove_report(out: Path) -> None:

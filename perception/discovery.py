@@ -8,6 +8,7 @@ recording into one item per reach.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import os
 import re
@@ -20,26 +21,27 @@ from perception.errors import HammerMVError, InputError
 from perception.io.files import input_file, is_regular_file
 from perception.io.pose import pose_output
 from perception.pipeline import clip_name
+from perception.recordings import unknown_layout
 
 if TYPE_CHECKING:
     from perception.pipeline import RecognitionSettings
 
 __all__ = ["COMPANION_NAMES", "ERRORS_LOG", "REPORT_SET", "BatchItem", "Discovery",
-           "check_clip_name", "discover", "expand_recordings", "find_clips"]
+           "check_clip_name", "discover", "expand_recordings", "find_clips", "safe_clip_name"]
 
 log = logging.getLogger(__name__)
 
 #: Files that sit beside clips and are not inputs: ground truth, the synth
 #: manifest, and what a batch writes (so a report folder can be its own input).
 COMPANION_SUFFIXES = (".truth.h5", ".recognition.json", ".confidence.csv", ".tracking.png",
-                      ".status.csv", *(f".{name}.{fmt}" for name in ("confidence", "paths",
-                                                                     "kinematics")
-                                       for fmt in ("png", "svg", "pdf")))
+                      ".status.csv", ".trials.csv",
+                      *(f".{name}.{fmt}" for name in ("confidence", "paths", "kinematics")
+                        for fmt in ("png", "svg", "pdf")))
 #: Which file stands for a clip found more than once: a pose file beside its
 #: video is what the lab tracked it with; a tracks file beside a video stands
 #: for it only when it is current (checked when the video is loaded), so the
-#: video is the clip.
-_PREFERENCE = {"mocap": 4, "pose": 3, "video": 2, "tracks": 1, "unknown": 0}
+#: video is the clip. A motion-capture recording stands for no other file.
+_PREFERENCE = {"pose": 3, "video": 2, "tracks": 1, "unknown": 0}
 #: Tracebacks of the clips that failed through a bug (not their input).
 ERRORS_LOG = "errors.log"
 #: The batch's figures, by stem; each in one of the figure formats (png, svg, pdf).
@@ -72,10 +74,17 @@ class BatchItem:
     condition : str or None
         Stimulus condition, when a manifest gives it.
     reach : int or None
-        Which reach of a motion-capture recording (:func:`expand_recordings`).
+        Which reach of a motion-capture recording (:func:`expand_recordings`):
+        its index among the recording's reaches.
     factors : tuple of (str, str)
         The manifest's other columns for this clip (participant, session, any
         factor), in its order.
+    trial : str or None
+        The recording's trial it belongs to (:func:`expand_recordings`).
+    unscored : (str, str) or None
+        A trial or movement of a recording that gives no reach to score: its
+        status and reason (:class:`~perception.reaches.Unscored`); its row
+        says so, nothing is scored.
     """
 
     clip: str
@@ -84,6 +93,8 @@ class BatchItem:
     condition: str | None = None
     reach: int | None = None
     factors: tuple[tuple[str, str], ...] = ()
+    trial: str | None = None
+    unscored: tuple[str, str] | None = None
 
 
 def check_clip_name(name: str, where: str) -> str:
@@ -206,7 +217,12 @@ def find_clips(source: str | os.PathLike) -> Discovery:
     by_stem: dict[str, list[BatchItem]] = {}
     skipped = []
     rank: dict[Path, int] = {}  # of the pose files DeepLabCut or SLEAP wrote for one video
+    # a report folder may be its own input: its batch's files are not the user's
+    report_folder = (source / "batch.json").is_file()
     for path in sorted(source.iterdir()):
+        if path.name in REPORT_SET and not report_folder and not path.is_dir():
+            skipped.append((path.name, "a name the batch report writes: not read as a clip"))
+            continue
         if path.name.startswith(".") or path.name in COMPANION_NAMES:
             continue
         if path.name.endswith(COMPANION_SUFFIXES) or path.is_dir():
@@ -215,6 +231,8 @@ def find_clips(source: str | os.PathLike) -> Discovery:
         output = pose_output(path.name)
         if output is not None and isinstance(output[1], str):  # a labelled video, metadata
             skipped.append((path.name, output[1]))
+        elif is_regular_file(path) and (why := unknown_layout(path)) is not None:
+            skipped.append((path.name, why))
         elif kind == "unknown":
             skipped.append((path.name, "not a video, tracks or pose file"))
         elif not is_regular_file(path):
@@ -228,13 +246,24 @@ def find_clips(source: str | os.PathLike) -> Discovery:
                 factors=row.factors if row else ()))
     items = []
     for found in by_stem.values():
+        # a recording is never another file's clip (a pose file is its video's): a table
+        # and a video of one stem (P01.tsv, P01.mp4) are two clips, named by file name
+        recordings = [i for i in found if i.kind == "mocap"]
+        found = [i for i in found if i.kind != "mocap"]
+        if recordings and (found or len(recordings) > 1):
+            items += [dataclasses.replace(i, clip=i.path.name) for i in recordings]
+            if found:
+                found = [dataclasses.replace(i, clip=i.path.name) for i in found]
+        elif recordings:
+            items += recordings
+        if not found:
+            continue
         best = max((_PREFERENCE[i.kind], rank[i.path]) for i in found)
         chosen = [i for i in found if (_PREFERENCE[i.kind], rank[i.path]) == best]
         skipped += [(i.path.name, f"clip {i.clip!r} is read from {chosen[0].path.name}")
                     for i in found if i.kind == "pose" and i not in chosen]
         if len(chosen) > 1:  # the stem alone would not tell them apart
-            chosen = [BatchItem(i.path.name, i.path, i.kind, i.condition, factors=i.factors)
-                      for i in chosen]
+            chosen = [dataclasses.replace(i, clip=i.path.name) for i in chosen]
         items += chosen
     skipped.sort()
     for name, why in skipped:
@@ -244,10 +273,16 @@ def find_clips(source: str | os.PathLike) -> Discovery:
 
 def expand_recordings(items: Iterable[BatchItem], settings: RecognitionSettings
                       ) -> list[BatchItem]:
-    """Each motion-capture recording as one item per reach in it (other items as they are).
+    """Each motion-capture recording as one item per reach in it, and one per trial or
+    movement that gives none (other items as they are).
 
     A recording that cannot be read stays one item, which fails with its
-    error when processed.
+    error when processed. A trial or movement that gives no reach is an
+    item with its status and reason (:attr:`BatchItem.unscored`): the batch's
+    row for it says why. A reach's name comes from its trial's: when that
+    cannot name files (``x/../y``) it is made safe (:func:`safe_clip_name`);
+    a recording named by its file name (two files of one stem) names its
+    reaches so too (``P01.tsv-trial3``); a name taken twice gets ``~2``, ...
 
     Parameters
     ----------
@@ -256,18 +291,78 @@ def expand_recordings(items: Iterable[BatchItem], settings: RecognitionSettings
     settings : RecognitionSettings
         Their ``mocap`` settings say how recordings are read.
     """
-    from perception.recordings import cached_reaches
+    from perception.reaches import Reach
+    from perception.recordings import cached_recording
 
     out = []
     for item in items:
-        if item.kind != "mocap" or item.reach is not None:
+        if item.kind != "mocap" or item.reach is not None or item.unscored is not None:
             out.append(item)
             continue
         try:
-            reaches = cached_reaches(item.path, settings.mocap)
+            recording = cached_recording(item.path, settings.mocap)
         except (HammerMVError, OSError):
             out.append(item)
             continue
-        out += [BatchItem(check_clip_name(r.name, str(item.path)), item.path, "mocap",
-                          item.condition, k, item.factors) for k, r in enumerate(reaches)]
+        stem, k = item.path.stem, 0
+        for entry in recording.entries:
+            name = entry.name
+            if item.clip != stem and name.startswith(stem):  # named by its file's name
+                name = item.clip + name[len(stem):]
+            trial = next((t for t in sorted(recording.trials, key=len, reverse=True)
+                          if entry.name == t or entry.name.startswith(f"{t}-")), entry.name)
+            common = dict(clip=safe_clip_name(name, str(item.path)), path=item.path,
+                          kind="mocap", condition=item.condition, factors=item.factors,
+                          trial=trial)
+            if isinstance(entry, Reach):
+                out.append(BatchItem(**common, reach=k))
+                k += 1
+            else:
+                out.append(BatchItem(**common, unscored=(entry.status, entry.reason)))
+    return _unique_clips(out)
+
+
+def safe_clip_name(name: str, where: str) -> str:
+    """``name`` if it can name a clip's report files, else a safe name made from it.
+
+    A trial's name comes from inside a file (a table's trial column): one
+    that cannot name files (``x/../y``, a leading dot) is given separators,
+    control characters and a leading dot as ``_`` and a short hash of the
+    original (:func:`~perception.io.names.output_stem`), so that one unsafe
+    trial never ends a batch. The change is logged.
+
+    Parameters
+    ----------
+    name : str
+        The name.
+    where : str
+        Where it comes from, for the log.
+    """
+    import hashlib
+
+    from perception.io.names import output_stem
+
+    try:
+        return check_clip_name(name, where)
+    except InputError:
+        safe = output_stem(name)
+        if safe == name or safe.startswith("."):  # unchanged there: a dot first, or empty
+            tag = "~" + hashlib.sha1(name.encode("utf-8", "surrogatepass")).hexdigest()[:10]
+            safe = "_" + output_stem(name).lstrip(".")[:180].split("~")[0] + tag
+        log.warning("%s: trial %r named %r in the report", where, name, safe)
+        return safe
+
+
+def _unique_clips(items: list[BatchItem]) -> list[BatchItem]:
+    """``items`` with a clip name taken twice made unique (``~2``, ``~3``, ...): no two
+    clips' reports overwrite each other."""
+    seen: set[str] = set()
+    out = []
+    for item in items:
+        name, k = item.clip, 1
+        while name in seen:
+            k += 1
+            name = f"{item.clip}~{k}"
+        seen.add(name)
+        out.append(item if name == item.clip else dataclasses.replace(item, clip=name))
     return out

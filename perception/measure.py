@@ -13,19 +13,26 @@ on whatever a lab has:
   still gives what it can (the rest NaN, with ``status`` saying why).
 
 One row per movement, SI units in the column names' suffixes
-(``hammer-mv landmarks`` writes the same table as CSV).
+(``hammer-mv landmarks`` writes the same table as CSV), and one per trial or
+movement of a recording that gives no reach, with its ``status`` and
+``reason`` and NaN landmarks (:func:`measure` also counts the trials).
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from perception.errors import InputError
 from perception.landmarks import LandmarkParams, Landmarks, movement_landmarks
 
-__all__ = ["UNITS", "landmarks", "landmarks_row"]
+if TYPE_CHECKING:
+    import pandas as pd
+
+__all__ = ["UNITS", "Measured", "landmarks", "landmarks_row", "measure", "unscored_row"]
 
 #: The table's columns and their units, in order.
 UNITS = {
@@ -61,7 +68,48 @@ def landmarks_row(name: str, lm: Landmarks, **extra) -> dict:
     row = {"trial": name, "status": _status(lm)}
     row.update({k: (math.nan if d[k] is None else d[k]) for k in UNITS})
     row.update(extra)
+    row.setdefault("reason", "")
     return row
+
+
+def unscored_row(entry, **extra) -> dict:
+    """The table row of a trial or movement that gives no reach: its status and reason,
+    its onset and end where known, NaN landmarks.
+
+    Parameters
+    ----------
+    entry : Unscored
+        From :func:`perception.recordings.read_recording`.
+    **extra
+        More columns.
+    """
+    row = {"trial": entry.name, "status": entry.status, **{k: math.nan for k in UNITS}}
+    row.update(onset_time=entry.onset_time, end_time=entry.end_time)
+    row.update(extra)
+    row["reason"] = entry.reason
+    return row
+
+
+@dataclass(frozen=True)
+class Measured:
+    """The landmarks of a file's movements, and how many trials it holds.
+
+    Attributes
+    ----------
+    table : pandas.DataFrame
+        A row per movement, and per trial or movement that gives none
+        (:func:`landmarks`).
+    trials : int
+        The trials read (a video, tracks or pose file is one).
+    """
+
+    table: pd.DataFrame
+    trials: int
+
+    @property
+    def measured(self) -> int:
+        """Rows measured (those without a ``reason``)."""
+        return int((self.table["reason"].fillna("") == "").sum()) if len(self.table) else 0
 
 
 def _tracks_movement(tracks, px_per_m: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -80,8 +128,34 @@ def _tracks_movement(tracks, px_per_m: float) -> tuple[np.ndarray, np.ndarray, n
 
 def landmarks(source, *, params: LandmarkParams | None = None, mocap=None,
               px_per_m: float | None = None, object_diameter: float | None = None, pose=None,
-              tracks_out=None):
-    """The landmarks of every movement in ``source``, as a table.
+              tracks_out=None) -> pd.DataFrame:
+    """The landmarks of every movement in ``source``, as a table (:func:`measure`'s).
+
+    Parameters
+    ----------
+    source : str, os.PathLike or Tracks
+        A motion-capture file, a video, a tracks or pose file, or tracks in memory.
+    params : LandmarkParams, optional
+        The onset and end rule and the low-pass filter.
+    mocap : MocapImport, optional
+        How a motion-capture file is read (markers, rate, units).
+    px_per_m : float, optional
+        Scale of tracks in pixels.
+    object_diameter : float, optional
+        The object's real diameter, m, with its apparent one in the tracks.
+    pose : PoseImport, optional
+        How a pose file becomes tracks.
+    tracks_out : str or os.PathLike, optional
+        Where a video's tracks are written (default: beside the video).
+    """
+    return measure(source, params=params, mocap=mocap, px_per_m=px_per_m,
+                   object_diameter=object_diameter, pose=pose, tracks_out=tracks_out).table
+
+
+def measure(source, *, params: LandmarkParams | None = None, mocap=None,
+            px_per_m: float | None = None, object_diameter: float | None = None, pose=None,
+            tracks_out=None) -> Measured:
+    """The landmarks of every movement in ``source``, as a table, and its trials' count.
 
     Parameters
     ----------
@@ -103,32 +177,43 @@ def landmarks(source, *, params: LandmarkParams | None = None, mocap=None,
 
     Returns
     -------
-    pandas.DataFrame
-        One row per movement: ``trial``, ``status`` and the landmarks of
-        :data:`UNITS` (NaN where the recording does not show them).
+    Measured
+        Its table: one row per movement: ``trial``, ``status``, the landmarks
+        of :data:`UNITS` (NaN where the recording does not show them),
+        ``source`` and ``reason``; a recording's trial or movement that gives
+        no reach is a row with its ``status`` (``no reach``, ``starts in
+        motion``, ...) and ``reason``, NaN landmarks. One trial's failure
+        never stops the trials after it.
 
     Raises
     ------
     InputError
-        The file cannot be read, or the scale of pixel tracks is unknown.
+        The file cannot be read (or is a table of no known layout), or the
+        scale of pixel tracks is unknown.
     """
-    import pandas as pd
-
     from perception.io.tracks import Tracks
 
     params = LandmarkParams() if params is None else params
     rows = []
     if not isinstance(source, Tracks):
         from perception.io.mocap import is_mocap_file
+        from perception.recordings import unknown_layout
 
         if is_mocap_file(source):
-            from perception.recordings import MocapImport, read_reaches
+            from perception.reaches import Reach
+            from perception.recordings import MocapImport, read_recording
 
             mocap = MocapImport() if mocap is None else mocap
-            for reach in read_reaches(source, mocap):
-                lm = movement_landmarks(reach.time, reach.transport, reach.aperture, params)
-                rows.append(landmarks_row(reach.name, lm, source=str(source)))
-            return pd.DataFrame(rows)
+            recording = read_recording(source, mocap)
+            for entry in recording.entries:
+                if not isinstance(entry, Reach):
+                    rows.append(unscored_row(entry, source=str(source)))
+                    continue
+                lm = movement_landmarks(entry.time, entry.transport, entry.aperture, params)
+                rows.append(landmarks_row(entry.name, lm, source=str(source)))
+            return Measured(_table(rows), len(recording.trials))
+        if (why := unknown_layout(source)) is not None:
+            raise InputError(why, source)
         from perception.pipeline import clip_name, load_clip
 
         name = clip_name(source)[0]
@@ -148,4 +233,11 @@ def landmarks(source, *, params: LandmarkParams | None = None, mocap=None,
     time, transport, aperture = _tracks_movement(tracks, scale)
     lm = movement_landmarks(time, transport, aperture, params)
     rows.append(landmarks_row(name, lm, source=str(getattr(tracks, "path", None) or name)))
-    return pd.DataFrame(rows)
+    return Measured(_table(rows), 1)
+
+
+def _table(rows: list[dict]) -> pd.DataFrame:
+    """The rows as the table's columns, in order (an empty table keeps them)."""
+    import pandas as pd
+
+    return pd.DataFrame(rows, columns=["trial", "status", *UNITS, "source", "reason"])

@@ -1,12 +1,17 @@
-"""3D motion-capture recordings in, one recognition per reach out.
+"""3D motion-capture recordings in, one recognition per reach out, every trial accounted for.
 
-:func:`read_reaches` reads a recording (:func:`perception.io.mocap.read_mocap`:
+:func:`read_recording` reads a recording (:func:`perception.io.mocap.read_mocap`:
 C3D, Qualisys TSV, lab tables with X/Y/Z per marker, long tables with a
-trial column), finds every reach to grasp in each of its trials
-(:func:`perception.reaches.recording_reaches`) and :func:`recognize_reach`
-scores one, in the movement's own plane, with the settings the reach's own
+trial column, headerless tables with ``columns``), finds every reach to grasp
+in each of its trials (:func:`perception.reaches.trial_reaches`) and says why
+of every trial or movement that gives none (:class:`~perception.reaches.Unscored`):
+a :class:`Recording`. One trial's failure never stops the trials after it.
+:func:`read_reaches` is its reaches alone. :func:`recognize_reach` scores one
+reach, in the movement's own plane, with the settings the reach's own
 geometry asks for (its scale is a millimetre per "pixel", its object's size
-is the grip's or the one given, and the digits need not touch at rest).
+is the grip's or the one given, and the digits need not touch at rest), and
+measures its landmarks by the verdict rules' ``[verdict.landmarks]``, as a
+video's are.
 
 docs/mocap.md describes the formats, the mapping and what is reported.
 """
@@ -15,19 +20,116 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import logging
 import math
+import re
 from dataclasses import dataclass, field
+from typing import Annotated, Literal
 
 import numpy as np
+from pydantic import AfterValidator, Field
 
 from perception.errors import InputError
 from perception.landmarks import movement_landmarks
-from perception.reaches import PX_PER_M, MarkerMap, Reach, ReachParams, reach_tracks
+from perception.limits import MAX_FPS
+from perception.reaches import (
+    PX_PER_M,
+    MarkerMap,
+    Reach,
+    ReachParams,
+    Unscored,
+    reach_tracks,
+    trial_reaches,
+)
+from perception.validation import Tuple, declared
 
-__all__ = ["MocapImport", "cached_reaches", "read_reaches", "recognize_reach"]
+__all__ = ["TABLE_LAYOUTS", "MocapImport", "Recording", "cached_reaches", "cached_recording",
+           "read_reaches", "read_recording", "recognize_reach", "trial_summary", "unknown_layout"]
+
+log = logging.getLogger(__name__)
 
 
-@dataclass(frozen=True)
+_POSE_LAYOUT = ("a pose file (DeepLabCut or Lightning Pose CSV: scorer, bodyparts and coords "
+                "header rows)")
+#: What a delimited text file must be to be read, said when it is neither.
+TABLE_LAYOUTS = ("a motion-capture table (X, Y and Z columns of each marker; a Qualisys, Vicon "
+                 f"or Motive export; or a headerless table with --columns) or {_POSE_LAYOUT}")
+_TABLE_SUFFIXES = (".csv", ".tsv", ".txt")
+
+
+def unknown_layout(path) -> str | None:
+    """Why a ``.csv``, ``.tsv`` or ``.txt`` file is neither a motion-capture table nor a pose file.
+
+    Only the first lines are read. A file a motion-capture reader or a pose
+    reader takes (whatever it then finds wrong inside) gives None, as does
+    any other kind of file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+
+    Returns
+    -------
+    str or None
+        The one-line problem (``not a motion-capture table or pose file of a
+        known layout (expected ...)``), or None.
+    """
+    from pathlib import Path
+
+    from perception.io.mocap import is_mocap_file
+    from perception.io.pose import pose_output
+
+    p = Path(path)
+    suffix = p.suffix.lower()
+    if suffix not in _TABLE_SUFFIXES or is_mocap_file(p):
+        return None
+    try:
+        with open(p, encoding="utf-8", errors="replace") as fh:
+            lines = [fh.readline() for _ in range(12)]
+    except OSError:
+        return None  # the reader says what is wrong with it
+    if not any(line.strip() for line in lines):
+        return None  # empty: the reader says so
+    if suffix == ".csv" and (pose_output(p.name) is not None or {"bodyparts", "coords"} <= {
+            line.split(",", 1)[0].strip().strip('"').lower() for line in lines[:4]}):
+        return None  # DeepLabCut's header rows (Lightning Pose writes them too)
+    # a .txt of prose (notes) is no table at all: the plain "not a clip" fits it
+    if suffix == ".txt" and not any(_tabular(line) for line in lines):
+        return None
+    try:  # the motion-capture reader's own words for what it found and reads, where it has them
+        from perception.io.mocap import unknown_layout as _told
+    except ImportError:
+        _told = None
+    said = getattr(_told(p), "problem", None) if _told is not None else None
+    if isinstance(said, str) and said:
+        return f"{said}; or {_POSE_LAYOUT}"
+    return f"not a motion-capture table or pose file of a known layout (expected {TABLE_LAYOUTS})"
+
+
+_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+
+
+def _tabular(line: str) -> bool:
+    """Whether a line looks like a table's: cells between tabs, commas or semicolons, or
+    three numbers or more between spaces (a headerless table)."""
+    if max(line.count("\t"), line.count(","), line.count(";")) >= 2:
+        return True
+    cells = line.split()
+    return len(cells) >= 3 and all(_NUMBER.fullmatch(c) for c in cells)
+
+
+def _column_name(name: str) -> str:
+    if not name.strip():
+        raise ValueError("a marker name, not an empty one")
+    return name.strip()
+
+
+#: A marker's name in ``columns``: not empty.
+ColumnName = Annotated[str, AfterValidator(_column_name)]
+
+
+@declared
 class MocapImport:
     """How a motion-capture file becomes reaches.
 
@@ -37,28 +139,156 @@ class MocapImport:
         Which markers are thumb, finger, wrist and object (default: guessed
         from the names, :meth:`MarkerMap.guess`).
     rate : float, optional
-        Samples per second, for tables without a time column.
-    units : str, optional
-        The file's length unit (``mm``, ``cm``, ``m``), if it does not say.
+        Samples per second (above 0, up to 1000), for tables without a time
+        column.
+    units : {"mm", "cm", "m"}, optional
+        The file's length unit, if it does not say.
     trial_column : str, optional
         The column that numbers the trials of a long table.
+    time_column : str, optional
+        The column that holds the time; ``"none"``: the file's time column,
+        if any, is ignored and ``rate`` gives the clock.
+    columns : tuple of str, optional
+        The markers' names in column order, for a table without a header
+        (X, Y and Z of each, as RTMocap writes them).
     reaches : ReachParams
         How reaches are found, cleaned and brought into their plane.
     """
 
     markers: MarkerMap | None = None
-    rate: float | None = None
-    units: str | None = None
+    rate: Annotated[float, Field(gt=0, le=MAX_FPS)] | None = None
+    units: Literal["mm", "cm", "m"] | None = None
     trial_column: str | None = None
+    time_column: str | None = None
+    columns: Annotated[tuple[ColumnName, ...], Tuple, Field(min_length=1)] | None = None
     reaches: ReachParams = field(default_factory=ReachParams)
 
     def to_dict(self) -> dict:
         """JSON-able settings (for a report's fingerprint)."""
         return dataclasses.asdict(self)
 
+    def read_options(self) -> dict:
+        """The keyword arguments of :func:`~perception.io.mocap.read_mocap` these ask for.
+
+        ``columns`` and ``time_column`` are passed only when set, so that a
+        reader without them still reads every other file.
+        """
+        out = {"rate": self.rate, "units": self.units, "trial_column": self.trial_column}
+        if self.time_column is not None:
+            out["time_column"] = self.time_column
+        if self.columns is not None:
+            out["columns"] = self.columns
+        return out
+
+
+def _start(entry: Reach | Unscored) -> float:
+    """Where a reach or an unscored movement starts on its trial's clock (inf if unknown)."""
+    if isinstance(entry, Reach):
+        return float(entry.time[entry.onset])
+    for t in (entry.onset_time, entry.end_time):
+        if math.isfinite(t):
+            return t
+    return math.inf
+
+
+@dataclass(frozen=True, eq=False)
+class Recording:
+    """Every trial of a recording: its reaches to score, and what gives none, and why.
+
+    Attributes
+    ----------
+    source : str
+        The file.
+    trials : tuple of str
+        The trials' names, in file order.
+    entries : tuple of Reach or Unscored
+        Trial by trial in file order, and within a trial by start time: each
+        reach found, and each trial or movement that gives none
+        (:class:`~perception.reaches.Unscored`, with its status and reason).
+        Every trial has at least one.
+    """
+
+    source: str
+    trials: tuple[str, ...]
+    entries: tuple[Reach | Unscored, ...]
+
+    @property
+    def reaches(self) -> list[Reach]:
+        """The reaches to score, in order."""
+        return [e for e in self.entries if isinstance(e, Reach)]
+
+    @property
+    def unscored(self) -> list[Unscored]:
+        """The trials and movements that give no reach, with why."""
+        return [e for e in self.entries if isinstance(e, Unscored)]
+
+
+def trial_summary(trials: int, scored: int, not_scored: int) -> str:
+    """The accounting line every command prints: ``"N trials, M reaches scored, K not scored"``.
+
+    Parameters
+    ----------
+    trials : int
+        Trials read (a video, tracks or pose file is one).
+    scored : int
+        Reaches that got a result.
+    not_scored : int
+        Trials, movements or reaches that did not, each listed with its reason.
+    """
+    return (f"{trials} trial{'s' if trials != 1 else ''}, {scored} "
+            f"reach{'es' if scored != 1 else ''} scored, {not_scored} not scored")
+
+
+def read_recording(path, options: MocapImport | None = None) -> Recording:
+    """Every trial of a motion-capture file: its reaches, and what gives none, and why.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The recording.
+    options : MocapImport, optional
+
+    Returns
+    -------
+    Recording
+        Each trial leaves reaches or an :class:`~perception.reaches.Unscored`
+        entry; a trial on which the reach finder fails (a bug) leaves one with
+        status ``failed``, and the trials after it are read as usual.
+
+    Raises
+    ------
+    InputError
+        The file cannot be read, or the marker mapping names a marker it lacks
+        (mistakes that hold for every trial).
+    """
+    from perception.io.mocap import read_mocap
+
+    options = MocapImport() if options is None else options
+    trials = read_mocap(path, **options.read_options())
+    entries: list[Reach | Unscored] = []
+    for trial in trials:
+        source = str(trial.source)
+        try:
+            reaches, unscored = trial_reaches(trial, options.markers, options.reaches)
+        except InputError:
+            raise  # a mapping naming a marker the file lacks: every trial's mistake
+        except Exception as exc:  # noqa: BLE001 - one trial must not take the others
+            log.exception("%s: the reach finder failed (a bug in hammer-mv)", trial.name)
+            said = str(exc).strip().splitlines()
+            reaches, unscored = [], [Unscored(
+                trial.name, source, "failed", f"failed: unexpected {type(exc).__name__} "
+                f"(a bug in hammer-mv){': ' + said[0] if said else ''}")]
+        if not reaches and not unscored:  # every trial leaves a word
+            unscored = [Unscored(trial.name, source, "no reach", "no reach found")]
+        entries += sorted([*reaches, *unscored], key=_start)
+    return Recording(str(path), tuple(t.name for t in trials), tuple(entries))
+
 
 def read_reaches(path, options: MocapImport | None = None) -> list[Reach]:
     """Every reach to grasp in a motion-capture file, trial by trial.
+
+    The trials and movements that give none are :func:`read_recording`'s
+    :attr:`Recording.unscored`; here they are logged (INFO) and left out.
 
     Parameters
     ----------
@@ -71,36 +301,26 @@ def read_reaches(path, options: MocapImport | None = None) -> list[Reach]:
     InputError
         The file cannot be read, a mapped marker is missing, or no trial holds a reach.
     """
-    from perception.io.mocap import read_mocap
-    from perception.reaches import recording_reaches
-
-    options = MocapImport() if options is None else options
-    trials = read_mocap(path, rate=options.rate, units=options.units,
-                        trial_column=options.trial_column)
-    out: list[Reach] = []
-    errors = []
-    for trial in trials:
-        try:
-            out += recording_reaches(trial, options.markers, options.reaches)
-        except InputError as exc:
-            if len(trials) == 1:
-                raise
-            errors.append(f"{trial.name}: {exc.problem}")
-    if not out:
-        raise InputError(f"no reach to grasp in any of its {len(trials)} trials "
-                         f"({errors[0] if errors else ''})", path)
-    return out
+    recording = read_recording(path, options)
+    for u in recording.unscored:
+        log.info("%s: not scored: %s", u.name, u.reason)
+    if not recording.reaches:
+        n = len(recording.trials)
+        first = recording.unscored[0].reason if recording.unscored else ""
+        where = "its trial" if n == 1 else f"any of its {n} trials"
+        raise InputError(f"no reach to grasp in {where} ({first})", path)
+    return recording.reaches
 
 
 @functools.lru_cache(maxsize=4)
-def _cached(key: tuple, options: MocapImport) -> tuple[Reach, ...]:
-    """The reaches of ``key[0]``; its size and time of change, the rest of ``key``, keep a
+def _cached(key: tuple, options: MocapImport) -> Recording:
+    """The recording ``key[0]``; its size and time of change, the rest of ``key``, keep a
     changed file from being answered from the cache."""
-    return tuple(read_reaches(key[0], options))
+    return read_recording(key[0], options)
 
 
-def cached_reaches(path, options: MocapImport | None = None) -> tuple[Reach, ...]:
-    """:func:`read_reaches`, read once per process while the file is unchanged.
+def cached_recording(path, options: MocapImport | None = None) -> Recording:
+    """:func:`read_recording`, read once per process while the file is unchanged.
 
     A batch scores a recording's reaches one by one, perhaps in several
     processes: each reads the file once, not once per reach.
@@ -117,6 +337,18 @@ def cached_reaches(path, options: MocapImport | None = None) -> tuple[Reach, ...
     return _cached((str(path), st.st_size, st.st_mtime_ns), options or MocapImport())
 
 
+def cached_reaches(path, options: MocapImport | None = None) -> tuple[Reach, ...]:
+    """:func:`cached_recording`'s reaches.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The recording.
+    options : MocapImport, optional
+    """
+    return tuple(cached_recording(path, options).reaches)
+
+
 def recognize_reach(reach: Reach, repertoire, settings=None,
                     options: MocapImport | None = None, plan_cache=None):
     """Score one reach: its tracks in the movement's plane, recognised as a clip's.
@@ -127,7 +359,8 @@ def recognize_reach(reach: Reach, repertoire, settings=None,
         From :func:`read_reaches`.
     repertoire : Repertoire
     settings : RecognitionSettings, optional
-        Its ``observe`` scale, object size and rest aperture are set from the reach.
+        Its ``observe`` scale, object size and rest aperture are set from the reach;
+        the landmarks are measured by its ``rules.landmarks`` (``[verdict.landmarks]``).
     options : MocapImport, optional
     plan_cache : PlanCache, optional
 
@@ -154,8 +387,10 @@ def recognize_reach(reach: Reach, repertoire, settings=None,
     # the landmarks from the 3D speed and aperture, on the observation's clock (its
     # last row is the tracks' last: settling only ever trims or holds the first)
     clock = tracks.time - (tracks.time[-1] - rec.observation.clip_time[-1])
+    # by the verdict rules' [verdict.landmarks], as a video's are (the reach finder's
+    # own bounds, options.reaches.landmarks, only choose the reach's window)
     rec = dataclasses.replace(rec, measured=movement_landmarks(clock, transport, aperture,
-                                                               options.reaches.landmarks))
+                                                               settings.rules.landmarks))
     info = {**info, "trial": reach.name, "source": reach.source,
             "rate": round(1 / float(_median_step(reach.time)), 3)}
     return rec, info

@@ -26,7 +26,9 @@ def register(sub) -> None:
                        "videos / .tracks.h5 files, or a manifest.csv from hammer-mv synth) in "
                        "parallel; write REPORT_DIR/report.html, summary.csv, statistics and "
                        "per-clip reports. Rerunning skips clips whose report is current. "
-                       "Exits 1 if any clip failed (each failure is in the report).")
+                       "A motion-capture recording gives a row per reach and per trial not "
+                       "scored, with its status and reason. Exits 1 if any clip failed or a "
+                       "trial could not be scored (each is in the report, with why).")
     p.add_argument("input", type=Path, metavar="INPUT",
                    help="folder of videos, .tracks.h5 or pose files, or a manifest.csv")
     p.add_argument("-o", "--output", type=Path, required=True, metavar="REPORT_DIR",
@@ -50,36 +52,67 @@ def run(args: argparse.Namespace) -> int:
         Parsed arguments.
     """
     from perception.errors import InputError
+    from perception.recordings import trial_summary
 
     # local processes only: a scheduler's workers are its own
     jobs = (args.jobs if args.scheduler and args.jobs >= 1
             else cap_jobs(args.jobs, "batch", quiet=args.quiet))
     output_folder(args.output)
+    _not_over_inputs(args.input, args.output)
     found = find_clips(args.input)
     items = found.items
     if found.skipped and not args.quiet:
         names = ", ".join(f"{name} ({why})" for name, why in found.skipped[:3])
-        more = f" and {len(found.skipped) - 3} more" if len(found.skipped) > 3 else ""
+        more = (f" and {len(found.skipped) - 3} more (batch.json lists them)"
+                if len(found.skipped) > 3 else "")
         print(f"hammer-mv batch: skipped {len(found.skipped)} file(s) that are not clips: "
               f"{names}{more}", file=sys.stderr)
     if not items:
-        raise InputError("no clips found", args.input)
+        first = (f" ({len(found.skipped)} file(s) skipped; {found.skipped[0][0]}: "
+                 f"{found.skipped[0][1]})" if found.skipped else "")
+        raise InputError(f"no clips found{first}", args.input)
     rep, rep_id = load_repertoire(args)
     summary = run_batch(items, args.output, rep, recognition_settings(args), jobs=jobs,
                         scheduler=args.scheduler, repertoire_id=rep_id, quiet=args.quiet,
                         skipped=found.skipped, figure_format=args.figure_format,
                         dpi=args.dpi)
-    failed = int((summary["status"] != "ok").sum())
+    failed = int((summary["status"] == "failed").sum())
+    unscored = summary[(summary["status"] != "ok") & (summary["status"] != "failed")]
     reused = int(summary["reused"].sum())
+    scored = int((summary["status"] == "ok").sum())
     if not args.quiet:
-        print(f"{len(summary)} clips: {len(summary) - failed - reused} recognised, "
-              f"{reused} reused (their reports were current), {failed} failed -> "
-              f"{args.output / 'report.html'}")
+        print(f"{len(summary)} clips: {scored - reused} recognised, "
+              f"{reused} reused (their reports were current), {failed} failed, "
+              f"{len(unscored)} not scored -> {args.output / 'report.html'}")
+        print(trial_summary(summary.attrs.get("trials", len(summary)), scored,
+                            len(summary) - scored))
+    why = unscored["reason"] if "reason" in unscored else unscored["error"]
+    for clip, reason in zip(unscored["clip"], why):  # always: nothing dropped without a word
+        print(f"{clip}: not scored: {reason}", file=sys.stderr)
     if failed:
         print(f"hammer-mv batch: {failed} clip(s) failed ({failure_reasons(summary, items)}); "
               f"see {args.output / 'summary.csv'}", file=sys.stderr)
-        return 1
-    return 0
+    return 1 if failed or len(unscored) else 0
+
+
+def _not_over_inputs(source: Path, out: Path) -> None:
+    """Refuse a report folder that is the input folder when the batch report would
+    write over a file of the user's there (a recording named ``summary.csv``)."""
+    import os
+
+    from perception.discovery import REPORT_SET
+    from perception.errors import InputError
+
+    try:
+        same = source.is_dir() and out.is_dir() and os.path.samefile(source, out)
+    except OSError:
+        return
+    if not same or (out / "batch.json").is_file():  # a report folder, its own input
+        return
+    clash = next((name for name in REPORT_SET if (out / name).is_file()), None)
+    if clash is not None:
+        raise InputError(f"the batch report would write over {clash}, a file of the input "
+                         "folder: choose another output folder", out, field="--output")
 
 
 def failure_reasons(summary, items) -> str:
@@ -98,7 +131,7 @@ def failure_reasons(summary, items) -> str:
     paths = {item.clip: str(item.path.absolute()) for item in items}  # as run_batch has them
     reasons = Counter()
     for clip, status, error in zip(summary["clip"], summary["status"], summary["error"]):
-        if status == "ok":
+        if status != "failed":
             continue
         reason = str(error or "").strip() or "unknown error"
         if clip in paths:

@@ -24,8 +24,10 @@ def register(sub) -> None:
                        "(motion-capture recordings: every reach; tracks, pose files or "
                        "videos: the movement) by the field's definitions: onset and end where "
                        "the transport speed crosses a share of its peak (or an absolute speed), "
-                       "after a zero-lag low-pass filter. Writes one CSV row per movement "
-                       "(docs/mocap.md lists the columns and their units).")
+                       "after a zero-lag low-pass filter. Writes one CSV row per movement, "
+                       "and one per trial of a recording that gives none, with its status and "
+                       "reason (docs/mocap.md lists the columns and their units). Exit status "
+                       "1 when a trial could not be measured.")
     p.add_argument("inputs", type=Path, nargs="+", metavar="INPUT",
                    help="motion-capture recordings, tracks or pose files, or videos")
     p.add_argument("-o", "--output", type=Path, required=True, metavar="TABLE.csv",
@@ -63,9 +65,10 @@ def run(args: argparse.Namespace) -> int:
     from hammer_mv.cli.checks import options
     from hammer_mv.cli.options import mocap_import
     from perception.errors import InputError
-    from perception.io.atomic import write_text
+    from perception.io.atomic import check_output, write_text
     from perception.landmarks import LandmarkParams
-    from perception.measure import landmarks
+    from perception.measure import measure
+    from perception.recordings import trial_summary
 
     with options({"threshold": "--threshold", "speed": "--speed", "hold": "--hold",
                   "cutoff": "--cutoff"}):
@@ -81,7 +84,8 @@ def run(args: argparse.Namespace) -> int:
     from perception.io.names import output_folder, output_stem
     from perception.pipeline import TRACKS_SUFFIX, clip_name
 
-    tables = []
+    check_output(args.output, args.inputs)  # never over a recording it reads
+    tables, trials = [], 0
     for path in args.inputs:
         if not path.is_file():
             raise InputError("input not found (or not a file)", path)
@@ -90,12 +94,17 @@ def run(args: argparse.Namespace) -> int:
         if clip_name(path)[1] == "video":
             tracks_out = (output_folder(args.output.parent, "tracks")
                           / f"{output_stem(clip_name(path)[0])}{TRACKS_SUFFIX}")
-        tables.append(landmarks(path, params=params, mocap=mocap, px_per_m=args.px_per_m,
-                                object_diameter=args.object_diameter, pose=pose,
-                                tracks_out=tracks_out))
+        found = measure(path, params=params, mocap=mocap, px_per_m=args.px_per_m,
+                        object_diameter=args.object_diameter, pose=pose, tracks_out=tracks_out)
+        tables.append(found.table)
+        trials += found.trials
     table = pd.concat(tables, ignore_index=True)
     write_text(args.output, table.to_csv(index=False))
+    missed = table[table["reason"].fillna("") != ""]
     if not args.quiet:
         done = int((table["status"] == "complete").sum())
         print(f"{len(table)} movement(s), {done} complete -> {args.output}", file=sys.stdout)
-    return 0
+        print(trial_summary(trials, len(table) - len(missed), len(missed)), file=sys.stdout)
+    for name, reason in zip(missed["trial"], missed["reason"]):  # always: none dropped
+        print(f"{name}: not scored: {reason}", file=sys.stderr)
+    return 1 if len(missed) else 0

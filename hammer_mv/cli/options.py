@@ -29,6 +29,12 @@ _HAMMER = HammerParams()
 #: The pose options, by the PoseImport fields they set.
 POSE_FIELDS = {"keypoints": "--keypoints", "pcutoff": "--pcutoff", "fps": "--fps",
                "object_diameter_px": "--object-diameter-px", "individual": "--individual"}
+#: The motion-capture options, by the MocapImport fields they set.
+MOCAP_FIELDS = {"rate": "--rate", "units": "--units", "trial_column": "--trial-column",
+                "time_column": "--time-column", "columns": "--columns", "markers": "--markers"}
+#: The flags that ask for motion-capture settings (none: the defaults).
+MOCAP_FLAGS = ("markers", "rate", "units", "trial_column", "time_column", "columns",
+               "object_size")
 
 
 def add_recognition_options(p: argparse.ArgumentParser) -> None:
@@ -121,7 +127,16 @@ def add_mocap_options(p: argparse.ArgumentParser) -> None:
                         "wrist=NAME[+NAME...] object=NAME[+NAME...] (default: guessed from "
                         "the names: thumb*, index*, hand*/wrist*, object/pillow/target*)")
     g.add_argument("--rate", type=float, default=None, metavar="HZ",
-                   help="samples per second of a table without a time column")
+                   help="samples per second of a table without a time column (or with "
+                        "--time-column none)")
+    g.add_argument("--columns", type=_names, default=None, metavar="NAME,NAME,...",
+                   help="the markers' names in column order, for a table without a header "
+                        "(X, Y and Z of each, as RTMocap writes them): e.g. "
+                        "object,thumb,index,hand,wrist1,wrist2")
+    g.add_argument("--time-column", metavar="NAME|none", default=None,
+                   help="the column that holds the time, in s or ms (default: time, t, "
+                        "Time (s), ...); none: ignore any time column and take the clock "
+                        "from --rate")
     g.add_argument("--units", choices=("mm", "cm", "m"), default=None,
                    help="the file's length unit, if it does not say (default: inferred)")
     g.add_argument("--trial-column", metavar="NAME", default=None,
@@ -162,10 +177,18 @@ def mocap_import(args: argparse.Namespace):
     if size is not None and not (math.isfinite(size) and 0 < size < 1):
         raise InputError(f"expected a size in metres between 0 and 1, got {size}",
                          field="--object-size")
-    return MocapImport(markers=markers, rate=getattr(args, "rate", None),
-                       units=getattr(args, "units", None),
-                       trial_column=getattr(args, "trial_column", None),
-                       reaches=ReachParams(object_size=size))
+    with options(MOCAP_FIELDS):
+        return MocapImport(markers=markers, rate=getattr(args, "rate", None),
+                           units=getattr(args, "units", None),
+                           trial_column=getattr(args, "trial_column", None),
+                           time_column=getattr(args, "time_column", None),
+                           columns=getattr(args, "columns", None),
+                           reaches=ReachParams(object_size=size))
+
+
+def _names(text: str) -> tuple[str, ...]:
+    """``--columns``' comma-separated names (each checked by MocapImport)."""
+    return tuple(name.strip() for name in text.split(","))
 
 
 def _mapping(pairs: list[str]) -> dict[str, str]:
@@ -225,8 +248,7 @@ def recognition_settings(args: argparse.Namespace) -> RecognitionSettings:
 
         tracking = load_setup(args.setup)
     mocap = None
-    if any(getattr(args, k, None) is not None for k in ("markers", "rate", "units",
-                                                        "trial_column", "object_size")):
+    if any(getattr(args, k, None) is not None for k in MOCAP_FLAGS):
         mocap = mocap_import(args)
     rules = VerdictRules()
     if getattr(args, "verdict_rules", None) is not None:

@@ -23,7 +23,10 @@ def register(sub) -> None:
                        "motion-capture recording: every reach in it), score it "
                        "against every model with HAMMER-MV and write DIR/<clip>.recognition.json, "
                        "a per-step CSV and figures. A current tracks file of the video (in "
-                       "DIR/tracks/ or beside the video) is reused instead of tracking again.")
+                       "DIR/tracks/ or beside the video) is reused instead of tracking again. "
+                       "A recording also gets DIR/<recording>.trials.csv, a row per reach and "
+                       "per trial not scored, with its status and reason; exit status 1 when "
+                       "a trial or reach could not be scored (docs/mocap.md).")
     p.add_argument("input", type=Path, metavar="INPUT",
                    help="video, .tracks.h5, pose file (.h5, .csv, .slp, .nc, .nwb) or "
                         "motion-capture file (.c3d, Qualisys .tsv, X/Y/Z table)")
@@ -100,9 +103,14 @@ def run(args: argparse.Namespace) -> int:
 
     if is_mocap_file(path):
         return _run_mocap(args, path)
+    from perception.recordings import unknown_layout
+
+    if (why := unknown_layout(path)) is not None:
+        raise InputError(why, path)
     clip, kind = clip_name(path)
     if kind == "unknown":
         raise InputError("not a video, .tracks.h5 or pose file", path)
+    clip = _own_clip(args.output, clip, path)
     settings = recognition_settings(args)
     rep, rep_id = load_repertoire(args)
     # a few frames for the contact sheet, kept while tracking
@@ -129,30 +137,139 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+#: Columns of ``<recording>.trials.csv``, the accounting of a recording's trials.
+TRIALS_COLUMNS = ("trial", "status", "reason", "verdict", "verdict_detail", "winner",
+                  "onset_time", "end_time", "report", "source")
+
+
 def _run_mocap(args: argparse.Namespace, path: Path) -> int:
-    """``recognize`` of a motion-capture file: every reach in it, one report each."""
+    """``recognize`` of a motion-capture file: every reach in it, one report each, and
+    ``<recording>.trials.csv`` accounting for every trial (exit 1 when one is not scored)."""
+    import dataclasses
+    import traceback
+
     from hammer_mv.cli.options import load_repertoire, mocap_import, recognition_settings
+    from perception.batch import remove_stale_reports
+    from perception.errors import HammerMVError
+    from perception.io.atomic import check_output, write_csv
     from perception.pipeline import clip_fingerprint
-    from perception.recordings import read_reaches, recognize_reach
+    from perception.reaches import Unscored
+    from perception.recordings import read_recording, recognize_reach, trial_summary
     from perception.report.clip import write_clip_report
 
     settings = recognition_settings(args)
     options = settings.mocap or mocap_import(args)
-    reaches = read_reaches(path, options)
+    recording = read_recording(path, options)
     rep, rep_id = load_repertoire(args)
-    for k, reach in enumerate(reaches):
+    args.output.mkdir(parents=True, exist_ok=True)
+    table = check_output(_trials_table(args.output, path), [path])
+    rows, missed, kept, k = [], [], [], 0
+    for entry in recording.entries:
+        if isinstance(entry, Unscored):
+            rows.append(_row(entry.name, entry.status, entry.reason, entry.onset_time,
+                             entry.end_time, path))
+            missed.append((entry.name, entry.reason))
+            continue
+        reach = dataclasses.replace(entry, name=_own_clip(args.output, entry.name, path))
+        onset, end = float(reach.time[reach.onset]), float(reach.time[reach.end])
         fingerprint = clip_fingerprint(path, settings, f"{rep_id}#reach{k}")
-        rec, info = recognize_reach(reach, rep, settings, options)
-        extra = {"fingerprint": fingerprint, "condition": None, "input": str(path),
-                 "mocap": info}
-        paths = write_clip_report(rec, args.output, extra=extra, figures=not args.no_figures,
-                                  figure_format=args.figure_format, dpi=args.dpi)
-        for warning in rec.warnings:
-            print(f"{reach.name}: warning: {warning}", file=sys.stderr)
-        if not args.quiet:
-            why = rec.verdict_detail or (rec.verdict_reason if rec.verdict == "unfamiliar"
-                                         else None)
-            detail = f" ({why})" if why else ""
-            print(f"{reach.name}: {rec.verdict or 'no verdict'}{detail}, winner {rec.winner} "
-                  f"-> {paths['json']}")
-    return 0
+        k += 1
+        try:
+            rec, info = recognize_reach(reach, rep, settings, options)
+            extra = {"fingerprint": fingerprint, "condition": None, "input": str(path),
+                     "mocap": info}
+            paths = write_clip_report(rec, args.output, extra=extra,
+                                      figures=not args.no_figures,
+                                      figure_format=args.figure_format, dpi=args.dpi)
+        except OSError:
+            raise  # the output folder's (full, read-only): the user's to fix, for every reach
+        except HammerMVError as exc:  # this reach's (a scene that cannot be planned, ...)
+            why = f"failed: {exc.problem}"
+        except Exception as exc:  # noqa: BLE001 - a bug on one reach must not take the rest
+            traceback.print_exc()
+            why = (f"failed: unexpected {type(exc).__name__} (a bug in hammer-mv; its "
+                   "traceback is above)")
+        else:
+            kept.append(reach.name)
+            rows.append(_row(reach.name, "ok", "", onset, end, path, rec=rec,
+                             report=paths["json"].name))
+            for warning in rec.warnings:
+                print(f"{reach.name}: warning: {warning}", file=sys.stderr)
+            if not args.quiet:
+                why = rec.verdict_detail or (rec.verdict_reason if rec.verdict == "unfamiliar"
+                                             else None)
+                detail = f" ({why})" if why else ""
+                print(f"{reach.name}: {rec.verdict or 'no verdict'}{detail}, winner "
+                      f"{rec.winner} -> {paths['json']}")
+            continue
+        rows.append(_row(reach.name, "failed", why, onset, end, path))
+        missed.append((reach.name, why))
+    # reports of this recording's trials that are not scored now (or no longer in it)
+    remove_stale_reports(args.output, path, kept)
+    import pandas as pd
+
+    write_csv(table, pd.DataFrame(rows, columns=list(TRIALS_COLUMNS)))
+    if not args.quiet:
+        print(f"{trial_summary(len(recording.trials), len(kept), len(missed))} -> {table}")
+    for name, why in missed:  # always: nothing is dropped without a word
+        print(f"{name}: not scored: {why}", file=sys.stderr)
+    return 1 if missed else 0
+
+
+def _row(name: str, status: str, reason: str, onset: float, end: float, path: Path, *,
+         rec=None, report: str = "") -> dict:
+    """One row of ``<recording>.trials.csv``."""
+    return {"trial": name, "status": status, "reason": reason,
+            "verdict": rec.verdict if rec is not None else None,
+            "verdict_detail": rec.verdict_detail if rec is not None else None,
+            "winner": rec.winner if rec is not None else None,
+            "onset_time": onset, "end_time": end, "report": report, "source": str(path)}
+
+
+def _same_file(a, b: Path) -> bool:
+    """Whether ``a`` (a path as a report recorded it) names the file ``b``."""
+    import os
+
+    try:
+        return os.path.samefile(a, b)
+    except (OSError, TypeError, ValueError):
+        return False
+
+
+def _trials_table(out: Path, path: Path) -> Path:
+    """``out/<stem>.trials.csv``, or ``out/<file name>.trials.csv`` when the first is
+    another recording's (``P01.tsv`` and ``P01.csv`` into one folder)."""
+    from perception.io.names import output_stem
+
+    first = out / f"{output_stem(path.stem)}.trials.csv"
+    if first.is_file():
+        import pandas as pd
+
+        try:
+            sources = pd.read_csv(first, usecols=["source"])["source"].dropna().unique()
+        except (OSError, ValueError):
+            sources = []
+        if len(sources) and not any(_same_file(s, path) for s in sources):
+            return out / f"{output_stem(path.name)}.trials.csv"
+    return first
+
+
+def _own_clip(out: Path, name: str, path: Path) -> str:
+    """``name``, or the input's full file name in its place (``P01.tsv-trial3``,
+    ``P01.mp4``) when ``out`` holds a report of that name made from another input: two
+    recordings' reports never overwrite each other (a video and a table of one stem)."""
+    import json
+
+    from perception.report.clip import clip_outputs
+
+    report = clip_outputs(out, name)["json"]
+    if not report.is_file():
+        return name
+    try:
+        source = json.loads(report.read_text()).get("input")
+    except (OSError, ValueError, AttributeError):
+        return name
+    if source is None or _same_file(source, path):
+        return name
+    tail = name[len(path.stem):] if name.startswith(path.stem) else f"-{name}"
+    return f"{path.name}{tail}"

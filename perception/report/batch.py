@@ -163,8 +163,8 @@ def _num(value, fmt: str) -> str:
 
 
 def _verdict_cell(verdict, status: str, detail=None) -> str:
-    if status != "ok":
-        return '<span class="v-failed">failed</span>'
+    if status != "ok":  # failed, or a trial that gives no reach (its status)
+        return f'<span class="v-failed">{_e(status) or "failed"}</span>'
     v = _e(verdict) or "—"
     # the kind of an abnormal verdict (a float NaN where summary.csv has none)
     # on a line of its own: the main table must fit a 1280 px window
@@ -209,7 +209,7 @@ def _models_table(summary: pd.DataFrame) -> str:
 #: summary.csv columns the main table or the per-model table shows.
 _SHOWN = {"clip", "condition", "winner", "rule", "verdict", "verdict_detail", "familiarity",
           "margin", "winner_log_likelihood", "reference_model", "reference_confidence", "status",
-          "reused", "error"}
+          "reused", "error", "reason"}
 
 
 def _other_columns_table(summary: pd.DataFrame) -> str:
@@ -379,9 +379,12 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
                             + _statistics_html(stats_df))
     anchors = {rec.clip: f"clip-{i}" for i, rec in enumerate(recs)}
     failed = summary[summary["status"] != "ok"]
-    if len(failed):
-        sections.append(f"<h2>Failed clips ({len(failed)})</h2>" + _table(
-            ["clip", "error"], [[_e(r.clip), _e(r.error)] for r in failed.itertuples()]))
+    if len(failed):  # failures and trials that give no reach, each with why
+        why = failed["reason"] if "reason" in failed else failed["error"]
+        why = why.where(why.notna() & (why.astype(str) != ""), failed["error"])
+        sections.append(f"<h2>Not scored ({len(failed)})</h2>" + _table(
+            ["clip", "status", "reason"],
+            [[_e(c), _e(st), _e(w)] for c, st, w in zip(failed["clip"], failed["status"], why)]))
     names = sorted(os.listdir(out))  # once, not once per clip
     clips = [_clip_section(rec, out, anchors[rec.clip], condition_of.get(rec.clip), names)
              for rec in recs]
@@ -389,7 +392,7 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
                                                       else []), *TABLES)]
     body = "\n".join([
         f"<h1>{_e(title)}</h1>",
-        f"<p>{len(summary)} clips: {len(ok)} scored, {len(failed)} failed. Tables: "
+        f"<p>{len(summary)} clips: {len(ok)} scored, {len(failed)} not scored. Tables: "
         + ", ".join(tables) + '. <span class="note">' + _HOW_TO_READ + "</span></p>",
         _verdict_counts(ok),
         "<h2>Summary</h2>", _main_table(summary, anchors, profile_model), _models_table(summary),
