@@ -276,8 +276,8 @@ def expand_recordings(items: Iterable[BatchItem], settings: RecognitionSettings
     """Each motion-capture recording as one item per reach in it, and one per trial or
     movement that gives none (other items as they are).
 
-    A recording that cannot be read stays one item, which fails with its
-    error when processed. A trial or movement that gives no reach is an
+    A recording that cannot be read (or whose reading meets a bug) stays one
+    item, which fails with its error when processed. A trial or movement that gives no reach is an
     item with its status and reason (:attr:`BatchItem.unscored`): the batch's
     row for it says why. A reach's name comes from its trial's: when that
     cannot name files (``x/../y``) it is made safe (:func:`safe_clip_name`);
@@ -303,6 +303,11 @@ def expand_recordings(items: Iterable[BatchItem], settings: RecognitionSettings
             recording = cached_recording(item.path, settings.mocap)
         except (HammerMVError, OSError):
             out.append(item)
+            continue
+        except Exception:  # noqa: BLE001 - a bug reading one file must not end the batch
+            log.debug("%s: unreadable (a bug); it fails when processed", item.path,
+                      exc_info=True)
+            out.append(item)  # processed, it fails with its traceback in errors.log
             continue
         stem, k = item.path.stem, 0
         for entry in recording.entries:

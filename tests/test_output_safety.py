@@ -188,3 +188,29 @@ def test_a_batch_lists_a_table_of_no_known_layout_with_why(tmp_path):
         assert skipped[name].startswith("not a") and "expected" in skipped[name]
         assert "pose file" in skipped[name]
     assert skipped["notes.txt"] == "not a video, tracks or pose file"
+
+
+def test_a_bug_reading_one_recording_does_not_end_the_batch(tmp_path, monkeypatch):
+    from _demos import default_repertoire
+
+    import perception.recordings as recordings
+    from perception.batch import run_batch
+
+    folder = tmp_path / "in"
+    folder.mkdir()
+    write_trials(folder / "good.tsv", trial_column=False)
+    write_trials(folder / "bad.tsv", trial_column=False)
+    real = recordings.read_recording
+
+    def buggy(path, options=None):
+        if Path(path).name == "bad.tsv":
+            raise ValueError("Duplicate names are not allowed.")   # pandas, on a doubled column
+        return real(path, options)
+
+    monkeypatch.setattr(recordings, "read_recording", buggy)
+    recordings._cached.cache_clear()
+    summary = run_batch(find_clips(folder).items, tmp_path / "report", default_repertoire(),
+                        RecognitionSettings(mocap=MocapImport(rate=RATE)), quiet=True)
+    status = dict(zip(summary["clip"], summary["status"]))
+    assert status == {"bad": "failed", "good": "ok"}
+    assert "Duplicate names" in summary.set_index("clip").loc["bad", "reason"]
