@@ -398,7 +398,7 @@ def recognize_tracks(tracks: Tracks, repertoire: Repertoire,
     shape, transport = _shape_pass(shape_obs, repertoire, settings, plan_cache)
     return dataclasses.replace(rec, shape=shape, normalisation=norm,
                                transport_familiarity=transport, mirrored=mirrored,
-                               notes=(settled,) if settled else ())
+                               notes=(*obs.notes, *((settled,) if settled else ())))
 
 
 def _canonical(obs, repertoire: Repertoire, source, rules: VerdictRules):
