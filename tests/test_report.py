@@ -79,7 +79,7 @@ def test_summary_columns_and_a_column_added_by_another_step(scored, monkeypatch)
     assert list(table.columns[:10]) == ["clip", "condition", "winner", "rule", "verdict",
                                         "familiarity", "margin", "winner_log_likelihood",
                                         "lost_frames", "reference_model"]
-    assert list(table.columns[-3:]) == ["status", "reused", "error"]
+    assert list(table.columns[-4:]) == ["status", "reused", "error", "reason"]
     ok = table[table["status"] == "ok"].set_index("clip")
     assert (ok["reference_model"] == "grasp-1.0s").all()  # the model of the normal clips
     for name, (rec, _) in recs.items():
