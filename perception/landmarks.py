@@ -470,12 +470,13 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
         Grip aperture (tip to tip), m; NaN where lost.
     params : LandmarkParams, optional
     bounds : (int or None, int or None), optional
-        Rows of the movement's onset and end where the caller has found them
-        (:func:`perception.reaches.trial_reaches`: a reach that flows out of
-        the movement before it, or into the object's transport; None where
-        the samples start or end in it); the peak is then the fastest row
-        between them. Default: the movement around the fastest row, bounded
-        here by ``params``.
+        Rows the movement does not pass, where the caller has parted it from
+        its neighbours (:func:`perception.reaches.trial_reaches`: a reach
+        that flows out of the movement before it, or into the object's
+        transport; None where the samples start or end in it). The peak is
+        then the fastest row between them, and the onset and end are
+        ``params``' around that peak, but never outside them. Default: the
+        movement around the fastest row.
     """
     params = LandmarkParams() if params is None else params
     time = np.asarray(time, dtype=float)
@@ -489,11 +490,17 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
         peak = int(np.nanargmax(speed))
         onset, end = movement_bounds(time, speed, peak, params)
     else:
-        onset, end = bounds
-        a, b = (0 if onset is None else onset), (len(time) - 1 if end is None else end)
+        lo, hi = bounds
+        a, b = (0 if lo is None else lo), (len(time) - 1 if hi is None else hi)
         if not np.isfinite(speed[a:b + 1]).any():
             return Landmarks()
         peak = a + int(np.nanargmax(speed[a:b + 1]))
+        onset, end = movement_bounds(time, speed, peak, params)
+        # the user's rule, within the rows the movement was parted at
+        if lo is not None and (onset is None or onset < lo):
+            onset = lo
+        if hi is not None and (end is None or end > hi):
+            end = hi
     bound = speed_bound(speed, peak, params)
     t_on = _cross_time(time, speed, onset, bound, True) if onset is not None else math.nan
     t_end = _cross_time(time, speed, end, bound, False) if end is not None else math.nan

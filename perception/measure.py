@@ -209,8 +209,10 @@ def measure(source, *, params: LandmarkParams | None = None, mocap=None,
                 if not isinstance(entry, Reach):
                     rows.append(unscored_row(entry, source=str(source)))
                     continue
-                lm = movement_landmarks(entry.time, entry.transport, entry.aperture, params)
-                rows.append(landmarks_row(entry.name, lm, source=str(source)))
+                lm = movement_landmarks(entry.time, entry.transport, entry.aperture, params,
+                                        bounds=(entry.onset, entry.end))
+                rows.append(landmarks_row(entry.name, lm, source=str(source),
+                                          bound=entry.bound))
             return Measured(_table(rows), len(recording.trials))
         if (why := unknown_layout(source)) is not None:
             raise InputError(why, source)

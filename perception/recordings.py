@@ -168,17 +168,23 @@ class MocapImport:
         return dataclasses.asdict(self)
 
     def read_options(self) -> dict:
-        """The keyword arguments of :func:`~perception.io.mocap.read_mocap` these ask for.
+        """The keyword arguments of :func:`~perception.io.mocap.read_mocap` these ask for."""
+        return {"rate": self.rate, "units": self.units, "trial_column": self.trial_column,
+                "time_column": self.time_column, "columns": self.columns}
 
-        ``columns`` and ``time_column`` are passed only when set, so that a
-        reader without them still reads every other file.
+    def with_landmarks(self, params) -> MocapImport:
+        """These settings with reaches bounded by ``params`` (a :class:`LandmarkParams`).
+
+        The user's landmark definitions (``[verdict.landmarks]``, ``landmarks
+        --threshold``) bound each reach as they bound its measured landmarks,
+        so that a row's window and its landmarks follow one rule.
+
+        Parameters
+        ----------
+        params : LandmarkParams
         """
-        out = {"rate": self.rate, "units": self.units, "trial_column": self.trial_column}
-        if self.time_column is not None:
-            out["time_column"] = self.time_column
-        if self.columns is not None:
-            out["columns"] = self.columns
-        return out
+        return dataclasses.replace(self, reaches=dataclasses.replace(self.reaches,
+                                                                     landmarks=params))
 
 
 def _start(entry: Reach | Unscored) -> float:
@@ -389,8 +395,9 @@ def recognize_reach(reach: Reach, repertoire, settings=None,
     clock = tracks.time - (tracks.time[-1] - rec.observation.clip_time[-1])
     # by the verdict rules' [verdict.landmarks], as a video's are (the reach finder's
     # own bounds, options.reaches.landmarks, only choose the reach's window)
-    rec = dataclasses.replace(rec, measured=movement_landmarks(clock, transport, aperture,
-                                                               settings.rules.landmarks))
+    bounds = (info["bounds"]["onset"], info["bounds"]["end"])
+    rec = dataclasses.replace(rec, measured=movement_landmarks(
+        clock, transport, aperture, settings.rules.landmarks, bounds=bounds))
     info = {**info, "trial": reach.name, "source": reach.source,
             "rate": round(1 / float(_median_step(reach.time)), 3)}
     return rec, info

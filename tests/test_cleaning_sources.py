@@ -224,3 +224,19 @@ def test_the_optotrak_trials_as_deeplabcut_files_score_as_the_clean_files(tmp_pa
     assert abs(res["peak_speed_mean_excess_over_clean"]) < 0.05
     assert res["normal"] >= 26
     assert res["movement_time_median_abs_error_s"] < 0.1
+
+
+def test_the_cli_cleans_pose_files_at_the_scale_it_is_given():
+    # --px-per-m and --object-diameter reach the cleaning (its thresholds are in metres):
+    # before, a pose file was cleaned at the assumed 1000 px/m whatever the user said
+    from hammer_mv.cli import build_parser
+    from hammer_mv.cli.options import recognition_settings
+
+    parser = build_parser()
+    args = parser.parse_args(["recognize", "x.csv", "-o", "out", "--px-per-m", "500"])
+    assert recognition_settings(args).pose.cleaning.px_per_m == 500.0
+    args = parser.parse_args(["recognize", "x.csv", "-o", "out", "--object-diameter", "0.06"])
+    assert recognition_settings(args).pose.cleaning.object_diameter == 0.06
+    # the defaults ask for nothing: no pose settings recorded for a video's report
+    args = parser.parse_args(["recognize", "x.mp4", "-o", "out"])
+    assert recognition_settings(args).pose is None

@@ -74,7 +74,7 @@ def run(args: argparse.Namespace) -> int:
                   "cutoff": "--cutoff"}):
         params = LandmarkParams(threshold=args.threshold, speed=args.speed, hold=args.hold,
                                 cutoff=args.cutoff or None)
-    mocap = mocap_import(args)
+    mocap = mocap_import(args).with_landmarks(params)  # one rule bounds and measures
     pose = None
     if args.fps is not None:
         from perception.io.pose import PoseImport

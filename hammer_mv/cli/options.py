@@ -16,7 +16,9 @@ from pathlib import Path
 from hammer_mv.cli.checks import options
 from hammer_mv.cli.flags import FPS_HELP, add_video_options
 from perception.errors import InputError
+from perception.geometry import DEFAULT_OBJECT_DIAMETER
 from perception.io.config import check_keys, read_toml
+from perception.landmarks import LandmarkParams
 from perception.observation import ObserveParams
 from perception.pipeline import RecognitionSettings
 from perception.recognition.engine import RULES, HammerParams
@@ -215,15 +217,24 @@ def pose_import(args: argparse.Namespace):
     given = {k: v for k, v in given.items() if v is not None}
     if getattr(args, "keypoints", None):
         given["keypoints"] = _mapping(args.keypoints)
+    # the cleaning's distances are metres: it reads pixels at the scale the user gave
+    scale = {"px_per_m": getattr(args, "px_per_m", None),
+             "object_diameter": getattr(args, "object_diameter", None)}
+    # (the default object, the cleaning's own default: no settings to record)
+    scale = {k: v for k, v in scale.items()
+             if v is not None and not (k == "object_diameter" and v == DEFAULT_OBJECT_DIAMETER)}
     config = getattr(args, "pose_config", None)
-    if config is None and not given:
+    if config is None and not given and not scale:
         return None
     from perception.io.pose import PoseImport, load_pose_config
 
     base = load_pose_config(config) if config is not None else PoseImport()
     if "keypoints" in given:
         given["keypoints"] = {**base.keypoints, **given["keypoints"]}
-    with options(POSE_FIELDS):
+    with options({**POSE_FIELDS, "px_per_m": "--px-per-m",
+                  "object_diameter": "--object-diameter"}):
+        if scale and base.cleaning is not None:
+            given["cleaning"] = dataclasses.replace(base.cleaning, **scale)
         return dataclasses.replace(base, **given)
 
 
@@ -255,6 +266,8 @@ def recognition_settings(args: argparse.Namespace) -> RecognitionSettings:
         data = read_toml(args.verdict_rules, "verdict rules")
         check_keys(data, ["verdict"], "the top level", args.verdict_rules)
         rules = VerdictRules.from_dict(data.get("verdict", {}), args.verdict_rules)
+    if rules.landmarks != LandmarkParams():  # the user's definitions bound reaches too
+        mocap = (mocap or mocap_import(args)).with_landmarks(rules.landmarks)
     return RecognitionSettings(observe=observe, hammer=hammer, rules=rules, tracking=tracking,
                                pose=pose_import(args), keep_truncated=args.keep_truncated,
                                fps=args.fps, mocap=mocap)
