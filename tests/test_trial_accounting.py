@@ -299,3 +299,25 @@ def test_a_bad_mocap_flag_is_one_line_naming_it(flags, named, table, tmp_path):
     res = hammer("landmarks", table, "-o", tmp_path / "lm.csv", *flags, timeout=120)
     assert res.returncode == 2 and "Traceback" not in res.stderr
     assert len(res.stderr.strip().splitlines()) == 1 and named in res.stderr
+
+
+def test_recognize_and_landmarks_find_the_same_reaches_in_a_session(tmp_path):
+    # four real trials one after another, no trial column: a session. landmarks found its
+    # movements while recognize refused it whole ("the wrist never leaves its rest
+    # position"); both now take the same reaches, named and timed alike
+    real = pd.read_csv(DATA / "optotrak-trials.tsv", sep="\t")
+    cols = [f"{m}{a}raw" for m in ("index", "thumb") for a in "XYZ"]
+    session = tmp_path / "session.tsv"
+    real[cols].to_csv(session, sep="\t", index=False, float_format="%.3f")
+    res = hammer("landmarks", session, "--rate", RATE, "-o", tmp_path / "lm.csv")
+    assert res.returncode == 0, res.stderr
+    rows = pd.read_csv(tmp_path / "lm.csv")
+    assert len(rows) >= 4 and (rows["status"] == "complete").all()
+    out = tmp_path / "rec"
+    res = hammer("recognize", session, "--rate", RATE, "-o", out, "--no-figures")
+    assert res.returncode == 0, res.stderr
+    trials = pd.read_csv(out / "session.trials.csv")
+    assert list(trials["trial"]) == list(rows["trial"])
+    np.testing.assert_allclose(trials["onset_time"], rows["onset_time"], atol=1.5 / RATE)
+    assert sorted(p.name for p in out.glob("*.recognition.json")) == sorted(
+        f"{name}.recognition.json" for name in rows["trial"])
