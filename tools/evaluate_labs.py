@@ -20,8 +20,11 @@ against an independent segmentation:
   grasps): every approach to the object found or listed;
 * ``independent`` — grasps built from published kinematics without the
   minimum variance model (:mod:`perception.synthetic.independent`), never
-  tuned on, as 3D recordings: single reaches at 100 Hz, a pick-and-place with
-  an object marker, and a session of 12 grasps with returns at 120 Hz;
+  tuned on, as 3D recordings: single reaches at 100 Hz, pick-and-place trials
+  with an object marker at 200 Hz, drinking trials (normal and whole-hand
+  grasps) and a session of 12 grasps with returns at 120 Hz, each written as
+  a lab writes it (Vicon Nexus CSV; pick-and-place as RTMocap's headerless
+  tables) and read back through the readers;
 * ``minvar`` — the same tasks with the model's own grasps
   (:mod:`perception.synthetic.stimuli`).
 
@@ -240,7 +243,17 @@ def qualisys(rep) -> dict:
 
 def generated(rep, generator: str, seed: int = 7000) -> dict:
     """Single reaches of each condition, pick-and-place trials and a 12-grasp session."""
-    from mocap_tasks import VERDICT, drinking, pick_and_place, session, single_reach
+    import tempfile
+
+    from mocap_tasks import (
+        VERDICT,
+        drinking,
+        pick_and_place,
+        session,
+        single_reach,
+        write_headerless,
+        write_vicon,
+    )
 
     made = [single_reach(generator, c, seed + 10 * k + i)
             for k, c in enumerate(VERDICT) for i in range(8)]
@@ -249,30 +262,45 @@ def generated(rep, generator: str, seed: int = 7000) -> dict:
              for i, c in enumerate(["normal"] * 3 + ["whole-hand"] * 3)]
     made.append(session(generator, ["normal"] * 12, seed + 200))
     out = {"trials": len(made), "reaches": [], "unscored": [], "conditions": {}}
-    for g in made:
-        names = g.trial.markers
-        options = MocapImport(markers=MarkerMap(
-            thumb="thumb", finger="index", wrist=("hand",),
-            object=("object",) if "object" in names else ()))
-        res = score_trials([g.trial], options, rep, variants=False)
-        out["unscored"] += res["unscored"]
-        for truth in g.truth:
-            mine = [r for r in res["reaches"]
-                    if "onset" in r and abs(r["onset"] - truth["onset"]) < 0.3]
-            if not mine:
-                out["reaches"].append({"name": f"{g.trial.name}@{truth['onset']:.1f}s",
-                                       "condition": truth["condition"], "verdict": "dropped",
-                                       "detail": None, "reason": "no reach found here"})
-                continue
-            row = dict(mine[0], condition=truth["condition"], ref_mt=truth["mt"],
-                       ref_mga=truth["mga"])
-            out["reaches"].append(row)
-        extra = len(res["reaches"]) - sum(1 for t in g.truth for r in res["reaches"]
-                                          if "onset" in r and abs(r["onset"] - t["onset"]) < 0.3)
-        if extra > 0:
-            out["unscored"].append({"name": g.trial.name, "status": "extra",
-                                    "reason": f"{extra} reach(es) found where none was made"})
+    with tempfile.TemporaryDirectory() as tmp:  # read as written: through the files' readers
+        for g in made:
+            path = Path(tmp) / f"{g.trial.name}.csv"
+            if "-pnp-" in g.trial.name:  # as RTMocap writes them
+                path = path.with_suffix(".txt")
+                columns = write_headerless(g.trial, path)
+                (trial,) = read_mocap(path, rate=g.trial.rate, columns=columns)
+            else:
+                write_vicon(g.trial, path)
+                (trial,) = read_mocap(path)
+            g.trial = trial
+            _score_generated(g, rep, out)
     return out
+
+
+def _score_generated(g, rep, out: dict) -> None:
+    """One generated recording's reaches, matched to the truth by their onsets."""
+    names = g.trial.markers
+    options = MocapImport(markers=MarkerMap(
+        thumb="thumb", finger="index", wrist=("hand",),
+        object=("object",) if "object" in names else ()))
+    res = score_trials([g.trial], options, rep, variants=False)
+    out["unscored"] += res["unscored"]
+    for truth in g.truth:
+        mine = [r for r in res["reaches"]
+                if "onset" in r and abs(r["onset"] - truth["onset"]) < 0.3]
+        if not mine:
+            out["reaches"].append({"name": f"{g.trial.name}@{truth['onset']:.1f}s",
+                                   "condition": truth["condition"], "verdict": "dropped",
+                                   "detail": None, "reason": "no reach found here"})
+            continue
+        row = dict(mine[0], condition=truth["condition"], ref_mt=truth["mt"],
+                   ref_mga=truth["mga"])
+        out["reaches"].append(row)
+    extra = len(res["reaches"]) - sum(1 for t in g.truth for r in res["reaches"]
+                                      if "onset" in r and abs(r["onset"] - t["onset"]) < 0.3)
+    if extra > 0:
+        out["unscored"].append({"name": g.trial.name, "status": "extra",
+                                "reason": f"{extra} reach(es) found where none was made"})
 
 
 def main(argv=None) -> int:

@@ -231,3 +231,27 @@ def _trial(name, time, markers_mm, rate) -> MocapTrial:
     names = {"wrist": "hand", "finger": "index", "thumb": "thumb", "object": "object"}
     return MocapTrial(name, name, time, {names[k]: v / 1000 for k, v in markers_mm.items()},
                       rate, "mm")
+
+
+def write_vicon(trial: MocapTrial, path) -> None:
+    """The trial as Vicon Nexus writes a Trajectories export (mm, empty cells where lost)."""
+    names = list(trial.markers)
+    rate = round(trial.rate)
+    lines = ["Trajectories", str(rate),
+             ",," + ",".join(f"Subject01:{n},," for n in names).rstrip(","),
+             "Frame,Sub Frame," + ",".join("X,Y,Z" for _ in names),
+             ",," + ",".join("mm,mm,mm" for _ in names)]
+    xyz = np.concatenate([trial.markers[n] * 1000 for n in names], axis=1)
+    for i, row in enumerate(xyz):
+        cells = ["" if not np.isfinite(v) else f"{v:.5f}" for v in row]
+        lines.append(f"{i + 1},0," + ",".join(cells))
+    with open(path, "w", newline="") as fh:
+        fh.write("\r\n".join(lines) + "\r\n")
+
+
+def write_headerless(trial: MocapTrial, path) -> tuple[str, ...]:
+    """The trial as RTMocap writes one (whitespace, mm, no header); its markers' names."""
+    names = tuple(trial.markers)
+    np.savetxt(path, np.concatenate([trial.markers[n] * 1000 for n in names], axis=1),
+               fmt="%.4f")
+    return names
