@@ -242,4 +242,4 @@ def _table(rows: list[dict]) -> pd.DataFrame:
     """The rows as the table's columns, in order (an empty table keeps them)."""
     import pandas as pd
 
-    return pd.DataFrame(rows, columns=["trial", "status", *UNITS, "source", "reason"])
+    return pd.DataFrame(rows, columns=["trial", "status", *UNITS, "source", "reason", "bound"])

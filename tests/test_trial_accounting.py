@@ -173,6 +173,8 @@ def test_landmarks_writes_the_still_trial_with_its_status_reason_and_nan(table, 
     assert math.isnan(still["movement_time"]) and math.isnan(still["mga"])
     assert rows.loc[[0, 2], "movement_time"].between(1.0, 2.5).all()
     assert rows.loc[[0, 2], "reason"].isna().all()
+    # each scored row says which rule bounded it (the table dropped the column before)
+    assert list(rows.loc[[0, 2], "bound"]) == ["5 % of peak speed"] * 2
 
 
 def test_batch_has_a_row_for_every_trial_and_exits_1(table, tmp_path):
