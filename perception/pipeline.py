@@ -200,7 +200,7 @@ def file_sha256(path: str | os.PathLike) -> str:
 @functools.lru_cache(maxsize=256)
 def _sha256(key: tuple[Path, int, int]) -> str:
     """SHA-256 of ``key[0]``; its size and time in the key make a changed file a new entry."""
-    from perception.io.video import sha256_file
+    from perception.io.files import sha256_file
 
     return sha256_file(key[0])
 

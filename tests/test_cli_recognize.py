@@ -69,3 +69,29 @@ def test_bad_options(tmp_path, repfile, extra, message):
     path = _save(demo_tracks("normal", 0)[0], tmp_path / "n.tracks.h5")
     proc = _recognize(path, tmp_path / "out", repfile, *extra)
     assert proc.returncode == 2 and proc.stderr.count("\n") == 1 and message in proc.stderr
+
+
+@pytest.mark.parametrize("kind", ["tracks", "mocap"])
+def test_recognize_of_a_file_that_is_not_video_never_loads_opencv(tmp_path, kind):
+    # OpenCV (0.2 s of start-up) was imported by every recognize, to turn its thread pool
+    # off, also for inputs that are never tracked. (A pose file still loads it: movement's
+    # readers import sleap_io, which imports cv2.)
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from perception.synthetic.demos import demo_tracks
+
+    extra = []
+    if kind == "tracks":
+        path = demo_tracks("normal")[0].save(tmp_path / "clip.tracks.h5")
+    else:
+        path = Path(__file__).parent / "data" / "mocap" / "optotrak-trials.tsv"
+        extra = ["--rate", "85", "--markers", "thumb=thumb", "finger=index"]
+    res = subprocess.run([sys.executable, "-X", "importtime", "-m", "hammer_mv", "recognize",
+                          str(path), "-o", str(tmp_path / "out"), "--no-figures", "--quiet",
+                          *extra], capture_output=True, text=True, timeout=300)
+    assert res.returncode in (0, 1), res.stderr[-2000:]
+    imported = [line.rsplit("|", 1)[-1].strip() for line in res.stderr.splitlines()
+                if line.startswith("import time:")]
+    assert imported and "cv2" not in imported

@@ -23,6 +23,7 @@ import os
 import sys
 import traceback
 import warnings
+from pathlib import Path
 
 from minvar import __version__
 from perception.errors import HammerMVError
@@ -71,6 +72,16 @@ def serial_opencv() -> None:
     import cv2
 
     cv2.setNumThreads(1)
+
+
+def _may_track(args: argparse.Namespace) -> bool:
+    """Whether the command may track video: ``recognize`` of a tracks, pose or
+    motion-capture file does not, and need not load OpenCV (0.2 s) to set its pool."""
+    if args.command != "recognize":
+        return True
+    from perception.pipeline import VIDEO_SUFFIXES
+
+    return Path(args.input).suffix.lower() in VIDEO_SUFFIXES
 
 
 def one_blas_thread() -> None:
@@ -210,7 +221,7 @@ def _run(args: argparse.Namespace) -> int:
     with OpenCV's thread pool off (:func:`serial_opencv`), every command with
     one BLAS thread (:func:`one_blas_thread`).
     """
-    if args.command in TRACKING_COMMANDS:
+    if args.command in TRACKING_COMMANDS and _may_track(args):
         serial_opencv()
     one_blas_thread()
     if args.verbose:

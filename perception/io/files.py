@@ -9,13 +9,14 @@ repertoires, manifests) goes through :func:`input_file` first, which only
 
 from __future__ import annotations
 
+import hashlib
 import os
 import stat
 from pathlib import Path
 
 from perception.errors import InputError
 
-__all__ = ["input_file", "is_regular_file"]
+__all__ = ["input_file", "is_regular_file", "sha256_file"]
 
 
 def is_regular_file(path: str | os.PathLike) -> bool:
@@ -56,3 +57,18 @@ def input_file(path: str | os.PathLike, what: str = "file") -> Path:
         raise InputError(f"is not a regular file (a FIFO, device or socket); expected a {what}",
                          p)
     return p
+
+
+def sha256_file(path: str | os.PathLike) -> str:
+    """Hex SHA-256 of the file at ``path``, read in pieces (memory stays flat).
+
+    Here, not with the video readers, so that fingerprinting a table or a
+    pose file never loads OpenCV.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+    """
+    with open(path, "rb") as fh:
+        return hashlib.file_digest(fh, "sha256").hexdigest()

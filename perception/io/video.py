@@ -20,7 +20,6 @@ opens a file, a camera or a stream; :mod:`perception.io.capture` reads the latte
 from __future__ import annotations
 
 import contextlib
-import hashlib
 import logging
 import math
 import os
@@ -37,7 +36,7 @@ from perception.errors import InputError
 from perception.io import capture
 from perception.io.atomic import atomic_path
 from perception.io.capture import LiveSource, TimeResolver
-from perception.io.files import input_file
+from perception.io.files import input_file, sha256_file
 from perception.io.video_files import (
     avi_header_rate,
     fourcc_str,
@@ -57,15 +56,6 @@ TIME_SOURCES = ("container", "index/fps", "mixed")
 #: A stream counts as truncated when it ends this fraction (and at least 2
 #: frames) short of the count its header claims.
 TRUNCATION_TOLERANCE = 0.02
-
-def sha256_file(path: str | os.PathLike, chunk: int = 1 << 20) -> str:
-    """Hex SHA-256 of the file at ``path``, read in ``chunk``-byte pieces (memory stays flat)."""
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        while block := fh.read(chunk):
-            h.update(block)
-    return h.hexdigest()
-
 
 @dataclass(frozen=True)
 class VideoInfo:

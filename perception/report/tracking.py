@@ -17,7 +17,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-import cv2
 import numpy as np
 
 from perception.io.atomic import write_bytes
@@ -187,6 +186,8 @@ def contact_sheet(tracks: Tracks, video: str | os.PathLike | None, out: str | os
     Path or None
         None when the video cannot be read (the sheet needs its frames).
     """
+    import cv2  # only for a sheet: recognising tracks, pose or mocap files never loads it
+
     from perception.tracking.overlay import Labeller, _colours
 
     wanted = _pick_frames(tracks, n)

@@ -30,8 +30,9 @@ import cv2
 import numpy as np
 
 from perception.io.atomic import jsonable
+from perception.io.files import sha256_file
 from perception.io.tracks import TracksWriter
-from perception.io.video import VideoWriter, codec_for, sha256_file
+from perception.io.video import VideoWriter, codec_for
 from perception.synthetic.footage import (
     H264_CODECS,
     H264Writer,

@@ -18,9 +18,9 @@ import cv2
 import numpy as np
 
 from perception.errors import InputError
-from perception.io.files import input_file
+from perception.io.files import input_file, sha256_file
 from perception.io.tracks import Status, Tracks
-from perception.io.video import FrameSource, VideoWriter, sha256_file
+from perception.io.video import FrameSource, VideoWriter
 
 __all__ = ["Labeller", "render_labelled", "tracked_video"]
 
