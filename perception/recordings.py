@@ -43,7 +43,7 @@ from perception.reaches import (
 )
 from perception.validation import Tuple, declared
 
-__all__ = ["TABLE_LAYOUTS", "MocapImport", "Recording", "cached_reaches", "cached_recording",
+__all__ = ["MocapImport", "Recording", "cached_reaches", "cached_recording",
            "read_reaches", "read_recording", "recognize_reach", "trial_summary", "unknown_layout"]
 
 log = logging.getLogger(__name__)
@@ -51,9 +51,6 @@ log = logging.getLogger(__name__)
 
 _POSE_LAYOUT = ("a pose file (DeepLabCut or Lightning Pose CSV: scorer, bodyparts and coords "
                 "header rows)")
-#: What a delimited text file must be to be read, said when it is neither.
-TABLE_LAYOUTS = ("a motion-capture table (X, Y and Z columns of each marker; a Qualisys, Vicon "
-                 f"or Motive export; or a headerless table with --columns) or {_POSE_LAYOUT}")
 _TABLE_SUFFIXES = (".csv", ".tsv", ".txt")
 
 
@@ -97,14 +94,10 @@ def unknown_layout(path) -> str | None:
     # a .txt of prose (notes) is no table at all: the plain "not a clip" fits it
     if suffix == ".txt" and not any(_tabular(line) for line in lines):
         return None
-    try:  # the motion-capture reader's own words for what it found and reads, where it has them
-        from perception.io.mocap import unknown_layout as _told
-    except ImportError:
-        _told = None
-    said = getattr(_told(p), "problem", None) if _told is not None else None
-    if isinstance(said, str) and said:
-        return f"{said}; or {_POSE_LAYOUT}"
-    return f"not a motion-capture table or pose file of a known layout (expected {TABLE_LAYOUTS})"
+    # the motion-capture reader's own words for what it found and the layouts it reads
+    from perception.io.mocap import unknown_layout as told
+
+    return f"{told(p).problem}; or {_POSE_LAYOUT}"
 
 
 _NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
