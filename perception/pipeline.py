@@ -54,7 +54,6 @@ __all__ = [
     "clip_fingerprint",
     "clip_name",
     "current_tracks",
-    "current_tracks",
     "load_clip",
     "recognize_clip",
     "recognize_tracks",

@@ -319,8 +319,9 @@ class Recognition:
         """The landmarks of a model's own noise-free movement (:func:`nominal`'s).
 
         Its movement from its planned start, run until half its planned
-        duration past its end, ends when no hand point moves faster than
-        0.02 m/s (the observation's end rule, without tracking noise).
+        duration past its end, bounded by the verdict rules' landmark
+        definitions (``rules.landmarks``: onset and end at 5 % of the peak
+        speed by default), as a clip's are.
 
         Parameters
         ----------
