@@ -1,8 +1,10 @@
 """The recognition pipeline of one clip: video -> tracks -> observation -> models -> recognition.
 
-:func:`recognize_clip` is the one place the chain is assembled; the
-``recognize`` and ``batch`` commands and :func:`perception.batch.run_batch`
-all go through it:
+:func:`load_clip` (step 1) and :func:`recognize_tracks` (steps 2-4) are the
+chain; :func:`recognize_clip` is the two in one call. The ``recognize`` and
+``batch`` commands and :func:`perception.batch.run_batch` call the two
+apart, since they report the tracking too (a motion-capture reach enters at
+step 2 through :func:`perception.recordings.recognize_reach`):
 
 1. **tracks** — a video is tracked (:func:`perception.tracking.track_video`)
    into a tracks file, unless a current one is at hand (:func:`current_tracks`);
@@ -14,8 +16,6 @@ all go through it:
 4. **recognition** — :func:`perception.recognition.engine.recognize` scores
    every model's one-step predictions.
 
-Steps 2-4 are :func:`recognize_tracks`, for callers that hold the tracks
-(the reports show the tracking's quality too).
 """
 
 from __future__ import annotations
