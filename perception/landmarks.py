@@ -100,7 +100,7 @@ class LandmarkParams:
     order: Annotated[Int, Field(ge=1, le=8)] = 2
     opening_level: Share = 0.10
     peak_prominence: Share = 0.25
-    peak_min_prominence: Share = 0.005
+    peak_min_prominence: NonNegative = 0.005  # a length, m: not capped at 1 as a share is
     max_gap: NonNegative = 0.1
     max_gap_share: Share = 0.2
     second_movement: Share = 0.5

@@ -18,7 +18,13 @@ from _demos import default_repertoire, demo_tracks
 from scipy.special import beta as beta_fn
 
 from perception.batch import ClipResult, summary_table
-from perception.landmarks import Landmarks, count_peaks, movement_landmarks, observed_landmarks
+from perception.landmarks import (
+    LandmarkParams,
+    Landmarks,
+    count_peaks,
+    movement_landmarks,
+    observed_landmarks,
+)
 from perception.observation import ObserveParams, observe
 from perception.pipeline import recognize_clip
 from perception.recognition.rules import VerdictRules, verdict_detail
@@ -258,3 +264,12 @@ def test_the_bounds_survive_deeplabcut_level_noise(noise_px):
         assert got.movement_time == pytest.approx(want.movement_time, abs=0.25)
         assert got.opening_time == pytest.approx(want.opening_time, abs=0.12)
         assert got.mga == pytest.approx(want.mga, abs=0.005)
+
+
+def test_the_least_peak_prominence_is_a_length_not_a_share():
+    # a length in metres, once typed as a share and so refused above 1 m (issue 42)
+    from perception.errors import InputError
+
+    assert LandmarkParams(peak_min_prominence=2.0).peak_min_prominence == 2.0
+    with pytest.raises(InputError, match="peak_min_prominence"):
+        LandmarkParams(peak_min_prominence=-0.001)
