@@ -17,7 +17,7 @@ from hammer_mv.cli.checks import options
 from hammer_mv.cli.flags import FPS_HELP, add_video_options
 from perception.errors import InputError
 from perception.geometry import DEFAULT_OBJECT_DIAMETER
-from perception.io.config import check_keys, read_toml
+from perception.io.config import check_keys, read_toml, sub_table
 from perception.landmarks import LandmarkParams
 from perception.observation import ObserveParams
 from perception.pipeline import RecognitionSettings
@@ -265,7 +265,8 @@ def recognition_settings(args: argparse.Namespace) -> RecognitionSettings:
     if getattr(args, "verdict_rules", None) is not None:
         data = read_toml(args.verdict_rules, "verdict rules")
         check_keys(data, ["verdict"], "the top level", args.verdict_rules)
-        rules = VerdictRules.from_dict(data.get("verdict", {}), args.verdict_rules)
+        rules = VerdictRules.from_dict(sub_table(data, "verdict", "[verdict]", args.verdict_rules),
+                                       args.verdict_rules)
     if rules.landmarks != LandmarkParams():  # the user's definitions bound reaches too
         mocap = (mocap or mocap_import(args)).with_landmarks(rules.landmarks)
     return RecognitionSettings(observe=observe, hammer=hammer, rules=rules, tracking=tracking,

@@ -120,9 +120,10 @@ class VerdictRules:
         path : str or os.PathLike, optional
             The file, named in errors.
         """
-        from perception.io.config import from_table
+        from perception.io.config import from_table, sub_table
 
-        d = dict(d)
+        # a list (``[[verdict]]``) or a number is refused as a table, not read as pairs
+        d = dict(sub_table(d, None, "[verdict]", path))
         landmarks = from_table(LandmarkParams, d.pop("landmarks", {}), "[verdict.landmarks]",
                                path)
         return from_table(cls, d, "[verdict]", path, landmarks=landmarks)

@@ -1,0 +1,50 @@
+"""Issue 46's remaining faults: the rules file, the online stream, the batch and the types.
+
+Each case ends in one named error (an InputError: one line, exit 2 on the command
+line; a TypeError for an object of the wrong type given in Python), never a
+traceback from deep inside.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from _demos import default_repertoire, demo_tracks
+from _faults import one_line, refused
+
+from hammer_mv.cli import main
+from perception.errors import InputError
+from perception.online import OnlineRecognizer
+from perception.recognition.rules import VerdictRules, judge
+
+
+@pytest.fixture(scope="module")
+def rep():
+    return default_repertoire()
+
+
+@pytest.fixture(scope="module")
+def tracks():
+    return demo_tracks("normal", 0)[0]
+
+
+# -- 1. the rules file: a table where a table is meant ----------------------------------
+@pytest.mark.parametrize("text, field", [
+    ("[[verdict]]\nlate_opening = 0.5\n", "[verdict]"),
+    ("verdict = 3\n", "[verdict]"),
+    ("[verdict]\nlate_opening = 0.5\n[[verdict.landmarks]]\nopening_level = 0.2\n",
+     "[verdict.landmarks]"),
+    ("[verdict]\nlandmarks = [1, 2]\n", "[verdict.landmarks]"),
+])
+def test_a_rules_table_of_the_wrong_kind_is_one_line(tmp_path, tracks, capsys, text, field):
+    path = tracks.save(tmp_path / "n.tracks.h5")
+    rules = tmp_path / "rules.toml"
+    rules.write_text(text)
+    assert main(["recognize", str(path), "-o", str(tmp_path / "o"), "--no-figures",
+                 "--verdict-rules", str(rules)]) == 2
+    line = one_line(capsys.readouterr().err, "rules.toml", field, "expected a table")
+    assert "bug" not in line
+    refused(VerdictRules.from_dict, [{"late_opening": 0.5}], rules, path=rules,
+            field="[verdict]")
