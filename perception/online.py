@@ -174,6 +174,7 @@ class OnlineRecognizer:
         self._rows: dict[str, list] = {k: [] for k in ("frame", "time", "position",
                                                        "likelihood", "status")}
         self._received = 0  # frames or rows given to update
+        self._last_time: float | None = None  # the last one's time, s
         self._scene = None  # SimpleNamespace once fixed
         self._onset: float | None = None
         self._moving: list[tuple] = []  # (since onset, wrist, finger tip, thumb tip) from the onset
@@ -200,20 +201,40 @@ class OnlineRecognizer:
             A row's own likelihood and status (a pose file's; default: 1 and
             tracked where seen, 0 and lost where not).
         """
+        t = self._next_time(t)
         data = np.asarray(frame_or_points)
-        index = self._received if index is None else int(index)
-        self._received += 1
-        if data.ndim == 3:
-            return self._frame(data, float(t), index)
-        if data.shape != (len(self.markers), 2):
+        if data.ndim != 3 and data.shape != (len(self.markers), 2):
             raise InputError(f"expected a frame (H, W, 3) or positions ({len(self.markers)}, 2),"
                              f" got shape {data.shape}", field="frame_or_points")
+        index = self._received if index is None else int(index)
+        self._received += 1
+        self._last_time = t
+        if data.ndim == 3:
+            return self._frame(data, t, index)
         pos = data.astype(float)
         seen = np.isfinite(pos).all(axis=1)
-        return self._row(index, float(t), pos,
+        return self._row(index, t, pos,
                          seen.astype(np.float32) if likelihood is None else likelihood,
                          np.where(seen, Status.TRACKED, Status.LOST).astype(np.int8)
                          if status is None else status)
+
+    def _next_time(self, t) -> float:
+        """``t`` as a float, refused unless finite and after the last frame's.
+
+        A NaN would reach the onset's frame search as an index, and a repeated
+        or backward time a step of zero or negative length: both are refused
+        here, where the caller can still tell which frame it was.
+        """
+        try:
+            t = float(t)
+        except (TypeError, ValueError):
+            raise InputError(f"expected a time in s, got {t!r}"[:120], field="t") from None
+        if not math.isfinite(t):
+            raise InputError(f"the time {t} s is not finite", field="t")
+        if self._last_time is not None and t <= self._last_time:
+            raise InputError(f"the time {t:g} s comes after {self._last_time:g} s: "
+                             "times must increase", field="t")
+        return t
 
     def _frame(self, image: np.ndarray, t: float, index: int) -> OnlineState:
         """Track a frame (the tracker's look-ahead spread over the next frames)."""

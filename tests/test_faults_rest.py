@@ -48,3 +48,32 @@ def test_a_rules_table_of_the_wrong_kind_is_one_line(tmp_path, tracks, capsys, t
     assert "bug" not in line
     refused(VerdictRules.from_dict, [{"late_opening": 0.5}], rules, path=rules,
             field="[verdict]")
+
+
+# -- 2. the online stream's times ---------------------------------------------------------
+def _stream(rep, tracks, n):
+    rec = OnlineRecognizer(rep, markers=tracks.markers, tracker_attrs=dict(tracks.tracker))
+    for i in range(n):
+        rec.update(tracks.position[i], tracks.time[i])
+    return rec
+
+
+@pytest.mark.parametrize("frames", [0, 5, "mid"])
+@pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf])
+def test_a_time_that_is_not_finite_is_refused_at_update(rep, tracks, frames, bad):
+    n = tracks.n_frames // 2 if frames == "mid" else frames
+    rec = _stream(rep, tracks, n)
+    err = refused(rec.update, tracks.position[n], bad, field="t", match="not finite")
+    assert str(bad) in str(err)
+    rec.update(tracks.position[n], tracks.time[n])  # the stream goes on from the refused frame
+
+
+@pytest.mark.parametrize("frames", [1, 5, "mid"])
+@pytest.mark.parametrize("step", [0.0, -0.01])
+def test_a_repeated_or_backward_time_is_refused_at_update(rep, tracks, frames, step):
+    n = tracks.n_frames // 2 if frames == "mid" else frames
+    rec = _stream(rep, tracks, n)
+    last = float(tracks.time[n - 1])
+    err = refused(rec.update, tracks.position[n], last + step, field="t")
+    assert f"{last + step:g} s comes after {last:g} s" in str(err)
+    refused(rec.update, tracks.position[n], "soon", field="t", match="expected a time")
