@@ -196,7 +196,12 @@ def measure(source, *, params: LandmarkParams | None = None, mocap=None,
     params = LandmarkParams() if params is None else params
     rows = []
     if not isinstance(source, Tracks):
+        from pathlib import Path
+
         from perception.io.mocap import is_mocap_file
+
+        if not Path(source).exists():  # before its name's ending is read as a layout
+            raise InputError("not found", source)
         from perception.recordings import unknown_layout
 
         if is_mocap_file(source):

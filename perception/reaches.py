@@ -137,6 +137,24 @@ class MarkerMap:
     wrist: MarkerNames = ()
     object: MarkerNames = ()
 
+    def __post_init__(self) -> None:
+        # one marker in two roles measures nothing: a grip of a marker and itself never
+        # opens, a wrist or object that is a digit moves with the grip
+        if self.thumb == self.finger:
+            raise InputError(f"the thumb and the finger are the same marker {self.thumb!r}: "
+                             "each digit needs a marker of its own", None, field="finger")
+        digits = {self.thumb: "thumb", self.finger: "finger"}
+        for role, names in (("wrist", self.wrist), ("object", self.object)):
+            for m in names:
+                if m in digits:
+                    raise InputError(f"the {role} marker {m!r} is also the {digits[m]}: name "
+                                     f"another marker for the {role}", None, field=role)
+        both = set(self.wrist) & set(self.object)
+        if both:
+            raise InputError(f"marker{'s' if len(both) > 1 else ''} "
+                             f"{', '.join(map(repr, sorted(both)))} both wrist and object",
+                             None, field="object")
+
     @classmethod
     def guess(cls, names) -> MarkerMap:
         """The mapping a recording's marker names suggest (``thumb*``, ``index*``, ...).
@@ -172,6 +190,12 @@ class MarkerMap:
         for role, wanted in (("thumb", (self.thumb,)), ("finger", (self.finger,)),
                              ("wrist", self.wrist), ("object", self.object)):
             for m in wanted:
+                alike = sorted(n for n in names if n.casefold() == m.casefold())
+                if m not in names and len(alike) > 1:
+                    # which of them was meant is not ours to choose
+                    raise InputError(f"{m!r} for the {role} matches {len(alike)} markers but "
+                                     f"for case ({', '.join(map(repr, alike))}): name one "
+                                     "exactly", source, field="--markers")
                 if m not in names:
                     raise InputError(f"no marker {m!r} for the {role} (the recording has "
                                      f"{', '.join(sorted(names))})", source, field="--markers")
@@ -1039,8 +1063,12 @@ def reach_tracks(reach: Reach, params: ReachParams | None = None) -> ReachTracks
         at_end = g[max(0, reach.end - 2):reach.end + 1]
         at_end = at_end[np.isfinite(at_end)]
         size = (float(np.median(at_end)) if len(at_end) else math.nan) - rest_g
-        notes.append(f"object size: the grip's opening at the reach's end, "
-                     f"{size * 1000:.0f} mm")
+        if size > 0.005:
+            notes.append(f"object size: the grip's opening at the reach's end, "
+                         f"{size * 1000:.0f} mm")
+        else:  # the note gives the size used, and why it is not the opening
+            notes.append(f"object size: 5 mm, the least used (the grip's opening at the "
+                         f"reach's end, {size * 1000:.0f} mm, is no size)")
     if not size > 0.005:
         size = 0.005
     # the models' hand: a wrist behind the grip, whatever markers the lab put on it

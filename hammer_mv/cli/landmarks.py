@@ -85,8 +85,19 @@ def run(args: argparse.Namespace) -> int:
     from perception.pipeline import TRACKS_SUFFIX, clip_name
 
     check_output(args.output, args.inputs)  # never over a recording it reads
-    tables, trials = [], 0
+    if args.output.suffix.lower() != ".csv":
+        raise InputError("the table written is CSV: name an output ending in .csv", args.output,
+                         field="--output")
+    inputs = []  # a file given twice is measured once: its rows twice would count double
     for path in args.inputs:
+        same = next((p for p in inputs if p.exists() and path.exists() and p.samefile(path)),
+                    None)
+        if same is not None:
+            print(f"{path}: given more than once (as {same}): measured once", file=sys.stderr)
+            continue
+        inputs.append(path)
+    tables, trials = [], 0
+    for path in inputs:
         if not path.is_file():
             raise InputError("input not found (or not a file)", path)
         # a video's tracks go beside the table, never beside the user's video

@@ -47,6 +47,10 @@ _SEPS = " _.:-|/"
 _STEP_LIKE = 0.9
 
 
+#: Two numbers in one field, parted by spaces.
+_SPACED = re.compile(r"\d\s+[-+.\d]")
+
+
 def marker_columns(columns) -> dict[str, tuple]:
     """Marker name -> its (X, Y, Z) columns, found by the axis letter each name carries.
 
@@ -314,11 +318,12 @@ def read_xyz_table(path: Path, source: str, text: TableText, rate, units, trial_
                          f"one has a header ({text.first[:60]!r}): leave --columns out",
                          path, field="--columns")
     sep = delimiter(text.first)
+    sep, mixed = _mixed_spaces(text, sep, path)
     check_header(split(text.first, sep), path)
     decimal = decimal_mark(text.lines[text.skip + 1:], sep)
     df = load(path, text.raw, sep, text.skip, 0, decimal)
     names = list(df.columns)
-    notes = list(text.notes) + (["decimal commas read"] if decimal == "," else [])
+    notes = list(text.notes) + (["decimal commas read"] if decimal == "," else []) + mixed
     time_col = time_column_of(names, time_column, path, notes)
     trial_col = _find_column(names, trial_column, _TRIAL, path, "--trial-column")
     groups = marker_columns([c for c in names if c not in (time_col, trial_col)])
@@ -326,6 +331,33 @@ def read_xyz_table(path: Path, source: str, text: TableText, rate, units, trial_
         raise InputError("no marker columns: expected X, Y and Z columns for each marker "
                          "(such as thumb_x, thumb_y, thumb_z)", path, field="header")
     return table_trials(path, source, df, groups, time_col, trial_col, rate, units, None, notes)
+
+
+def _mixed_spaces(text: TableText, sep: str, path: Path) -> tuple[str, list[str]]:
+    """The separator of a tab-separated table some of whose fields are parted by spaces.
+
+    A tab field holding numbers parted by spaces is two fields written with a
+    space: read as parted by white space where that gives every line as many
+    fields as the header, else refused naming the line (read by tabs alone,
+    a column would swallow its neighbour).
+    """
+    if sep != "\t":
+        return sep, []
+    first = text.skip + 1
+    lines = text.lines[first:first + 1000]
+    mixed = next((k for k, line in enumerate(lines)
+                  if any(_SPACED.search(f) for f in line.split("\t"))), None)
+    if mixed is None:
+        return sep, []
+    width = len(text.first.split())
+    uneven = next((k for k, line in enumerate(lines) if line.strip()
+                   and len(line.split()) != width), None)
+    if uneven is not None:
+        raise InputError(f"line {first + mixed + 1} parts its fields by tabs and spaces, and "
+                         f"line {first + uneven + 1} then has {len(lines[uneven].split())} fields "
+                         f"where the header has {width}: write one separator", path)
+    return r"\s+", [f"tabs and spaces both part the fields (line {first + mixed + 1}): read as "
+                    "parted by white space"]
 
 
 def marker_list(columns, path: Path) -> list[str]:
