@@ -129,3 +129,62 @@ def test_a_table_whose_mixed_separators_leave_rows_uneven_is_refused_naming_the_
                   lambda i: f"{i / 100}\t{i} {2 * i}\t{3 * i + 100}\t{i + 300}\t2\t{i * 5}\n")
     with pytest.raises(InputError, match="line 2 parts its fields by tabs and spaces"):
         read_mocap(path)
+
+
+# -- duplicated and unlisted marker names are said ----------------------------------------------
+def _qtm(tmp_path, names, columns, *, markers=None):
+    """A Qualisys export of 30 frames whose MARKER_NAMES line lists ``names``."""
+    text = (f"NO_OF_FRAMES\t30\nNO_OF_CAMERAS\t7\nNO_OF_MARKERS\t{markers or len(names)}\n"
+            "FREQUENCY\t100\nDATA_INCLUDED\t3D\nMARKER_NAMES\t" + "\t".join(names) + "\n"
+            "Frame\tTime\t" + "\t".join(f"{c} {a}" for c in columns for a in "XYZ") + "\n")
+    for i in range(30):
+        text += f"{i + 1}\t{i / 100:.5f}\t" + "\t".join(
+            f"{100 + i + 10 * k + j:.3f}" for k in range(len(columns)) for j in range(3)) + "\n"
+    path = tmp_path / "qtm.tsv"
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize("names, columns, markers, said", [
+    (["thumb", "", "index"], ["thumb", "index"], None, "MARKER_NAMES leaves name 2 empty"),
+    (["thumb", "index"], ["thumb", "index"], 3, "NO_OF_MARKERS says 3; MARKER_NAMES lists 2"),
+    (["thumb", "Thumb", "index"], ["thumb", "Thumb", "index"], None,
+     "marker names apart only in case ('thumb', 'Thumb')"),
+])
+def test_a_qualisys_marker_list_that_disagrees_is_noted(tmp_path, names, columns, markers, said):
+    from perception.io.mocap import read_mocap
+
+    (trial,) = read_mocap(_qtm(tmp_path, names, columns, markers=markers))
+    assert any(said in n for n in trial.notes), trial.notes
+
+
+def test_a_qualisys_name_listed_twice_is_refused_naming_it(tmp_path):
+    from perception.io.mocap import read_mocap
+
+    with pytest.raises(InputError, match="'thumb' named more than once"):
+        read_mocap(_qtm(tmp_path, ["thumb", "thumb", "index"], ["thumb", "thumb", "index"]))
+
+
+def test_c3d_labels_written_thrice_say_what_each_is_read_as(tmp_path):
+    ezc3d = pytest.importorskip("ezc3d")
+    from perception.io.mocap import read_mocap
+
+    c3d = ezc3d.c3d()
+    c3d["parameters"]["POINT"]["RATE"]["value"] = [100]
+    c3d["parameters"]["POINT"]["LABELS"]["value"] = ("index", "index", "index")
+    points = np.ones((4, 3, 50))
+    points[:3] = np.random.default_rng(2).uniform(100, 400, (3, 3, 50))
+    c3d["data"]["points"] = points
+    path = tmp_path / "thrice.c3d"
+    c3d.write(str(path))
+    (trial,) = read_mocap(path)
+    assert trial.marker_names() == ("index", "index_2", "index_3")
+    assert any("'index' as 'index', 'index_2', 'index_3'" in n for n in trial.notes), trial.notes
+
+
+def test_repeated_subject_marker_names_say_what_each_is_read_as():
+    from perception.io.mocap_trial import strip_subject
+
+    names, notes = strip_subject(["thumb", "thumb", "index"])
+    assert names == ["thumb", "thumb_2", "index"]
+    assert any("'thumb' as 'thumb', 'thumb_2'" in n for n in notes), notes

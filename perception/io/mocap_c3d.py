@@ -104,7 +104,7 @@ def read_c3d(path: Path, source: str, rate, units) -> list[MocapTrial]:
     rate, more = header_rate(rate, float(own[0]), path, "POINT:RATE")
     notes += more
     markers = {}
-    renamed = set()
+    renamed: dict[str, list[str]] = {}  # label -> the names its points are read as
     for i, label in enumerate(labels):
         if label in modelled:
             continue
@@ -112,12 +112,13 @@ def read_c3d(path: Path, source: str, rate, units) -> list[MocapTrial]:
         lost = ~np.isfinite(residuals[0, i]) | (residuals[0, i] < 0) if residuals.size else False
         xyz[lost] = np.nan
         name = unique_name(label, markers)
-        if name != label:
-            renamed.add(label)
+        renamed.setdefault(label, []).append(name)
         markers[name] = xyz
+    renamed = {k: v for k, v in renamed.items() if len(v) > 1 or v != [k]}
     if renamed:
+        said = "; ".join(f"{k!r} as {', '.join(map(repr, v))}" for k, v in sorted(renamed.items()))
         notes.append(f"labels written more than once ({', '.join(map(repr, sorted(renamed)))}): "
-                     "read as NAME, NAME_2, ...")
+                     f"read {said}, in the order of POINT:LABELS")
     modelled_read = sum(1 for label in labels if label in modelled)
     if modelled_read:
         notes.append(f"{modelled_read} modelled points (angles, forces, ...) not read")

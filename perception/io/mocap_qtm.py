@@ -33,6 +33,30 @@ def is_qtm(first_line: str) -> bool:
     return key == "FILE_VERSION" or key.startswith("NO_OF_")
 
 
+def _name_notes(names: list[str], named: list[str], header: dict) -> list[str]:
+    """What a reader of MARKER_NAMES should know: names left empty, a count that disagrees,
+    names apart only in case."""
+    notes = []
+    while named and not named[-1]:  # a line ending in a tab names nothing more
+        named = named[:-1]
+    empty = [i + 1 for i, n in enumerate(named) if not n]
+    if empty:
+        notes.append(f"MARKER_NAMES leaves name{'s' if len(empty) > 1 else ''} "
+                     f"{', '.join(map(str, empty))} empty: not read")
+    stated = (header.get("NO_OF_MARKERS") or [""])[0]
+    if stated and stated != str(len(names)):
+        notes.append(f"NO_OF_MARKERS says {stated}; MARKER_NAMES lists {len(names)} "
+                     f"({', '.join(names)}): only those are read")
+    folded: dict[str, list[str]] = {}
+    for n in names:
+        folded.setdefault(n.casefold(), []).append(n)
+    alike = [", ".join(map(repr, v)) for v in folded.values() if len(v) > 1]
+    if alike:
+        notes.append(f"marker names apart only in case ({'; '.join(alike)}): read as "
+                     "written, each its own marker (--markers names them exactly)")
+    return notes
+
+
 def read_qtm(path: Path, source: str, text: TableText, rate, units, trial_column,
              time_column) -> list[MocapTrial]:
     """A QTM 3D TSV export.
@@ -54,20 +78,27 @@ def read_qtm(path: Path, source: str, text: TableText, rate, units, trial_column
     lines = text.lines
     header: dict[str, list[str]] = {}
     skip = text.skip
+    named: list[str] = []
     for line in lines[text.skip:]:
         fields = [f.strip() for f in line.split("\t")]
         if not _QTM_KEY.fullmatch(fields[0]):
             break
         header.setdefault(fields[0], [f for f in fields[1:] if f])
+        if fields[0] == "MARKER_NAMES":
+            named = fields[1:]
         skip += 1
     names = header.get("MARKER_NAMES")
-    if not names or len(set(names)) < len(names):
+    if not names:
         raise InputError("expected the markers' names, each once", path, field="MARKER_NAMES")
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:  # which column is which cannot be told
+        raise InputError(f"expected the markers' names, each once: {', '.join(map(repr, twice))} "
+                         "named more than once", path, field="MARKER_NAMES")
     included = " ".join(header.get("DATA_INCLUDED", ["3D"]))
     if included.upper() != "3D":
         raise InputError(f"expected 3D marker data, got {included!r}", path,
                          field="DATA_INCLUDED")
-    notes = list(text.notes)
+    notes = list(text.notes) + _name_notes(names, named, header)
     own_rate = None
     if header.get("FREQUENCY"):
         own_rate = (check_rate(header["FREQUENCY"][0], path, "FREQUENCY"), "FREQUENCY")

@@ -235,8 +235,10 @@ def strip_subject(names: list[str]) -> tuple[list[str], list[str]]:
         unique.append(unique_name(name, unique))
     repeated = sorted({a for a, b in zip(out, unique) if a != b})
     if repeated:
+        said = "; ".join(f"{a!r} as {', '.join(repr(b) for o, b in zip(out, unique) if o == a)}"
+                         for a in repeated)
         notes.append(f"marker names written more than once ({', '.join(map(repr, repeated))}): "
-                     "read as NAME, NAME_2, ...")
+                     f"read {said}, in the file's order")
     return unique, notes
 
 
