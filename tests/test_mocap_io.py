@@ -357,6 +357,18 @@ def test_ragged_rows(tmp_path):
     assert "ragged" in err.problem
 
 
+@pytest.mark.parametrize("chunk", [16, 23, 1 << 23])
+def test_a_short_row_is_found_by_its_line_whatever_the_chunks(tmp_path, monkeypatch, chunk):
+    # the fields are counted a chunk of whole lines at a time (a whole-file count took
+    # 8 bytes per byte of a 96 MB table): a chunk's edges must not move the line
+    import perception.io.mocap_text as text
+
+    monkeypatch.setattr(text, "_FIELDS_CHUNK", chunk)
+    rows = "".join(f"0.{i:02d},1,2,3\n" for i in range(40))
+    err = _bad(tmp_path, "time,a_x,a_y,a_z\n" + rows + "0.5,1,2\n" + rows)
+    assert "line 42 has 3 fields" in err.problem and err.field == "a_z"
+
+
 @pytest.mark.parametrize("rate", [2000, 0, -5, float("nan"), float("inf")])
 def test_bad_rate(tmp_path, rate):
     err = _bad(tmp_path, "a_x,a_y,a_z\n1,2,3\n", rate=rate)

@@ -118,11 +118,17 @@ def trial_rows(df, trial_col: str, path: Path) -> list[tuple[str, np.ndarray]]:
     if df[trial_col].isna().any():
         raise InputError(f"empty trial (data row {int(np.argmax(df[trial_col].isna())) + 1})",
                          path, field=trial_col)
-    ids = (df[trial_col].astype(str).str.strip().str.replace(r"\.0+$", "", regex=True)
-           .to_numpy())
-    starts = np.flatnonzero(np.r_[True, ids[1:] != ids[:-1]])
-    ends = np.r_[starts[1:], len(ids)]
-    runs = ids[starts]
+    import pandas as pd
+
+    # the ids as text only where the column changes (a million str() calls took 7 s):
+    # runs whose texts then agree ("1" then "1.0") are one
+    raw = df[trial_col].to_numpy()
+    first_rows = np.flatnonzero(np.r_[True, raw[1:] != raw[:-1]])
+    texts = (pd.Series(raw[first_rows]).astype(str).str.strip()
+             .str.replace(r"\.0+$", "", regex=True).to_numpy())
+    new_run = np.r_[True, texts[1:] != texts[:-1]]
+    starts, runs = first_rows[new_run], texts[new_run]
+    ends = np.r_[starts[1:], len(raw)]
     values, counts = np.unique(runs, return_counts=True)
     if (counts > 1).any():
         recurring = set(values[counts > 1])

@@ -264,19 +264,38 @@ def load(path: Path, raw: bytes, sep: str, skip: int, header: int | None, decima
     return df
 
 
+#: Bytes of a table counted at once for its fields per line: a whole-file cumulative
+#: count took 8 bytes per byte of the file (770 MB and 20 s for a 96 MB table).
+_FIELDS_CHUNK = 1 << 23
+
+
 def _check_fields(path: Path, raw: bytes, sep: str, first: int, width: int, df) -> None:
+    """Refuse the first line below ``first`` with fewer than ``width`` fields (pandas pads it)."""
     data = np.frombuffer(raw, np.uint8)
-    ends = np.flatnonzero(data == 10)
-    if not len(ends) or ends[-1] != len(data) - 1:
-        ends = np.append(ends, len(data))
-    starts = np.concatenate([[0], ends[:-1] + 1])
-    cum = np.concatenate([[0], np.cumsum(data == ord(sep))])
-    fields = cum[ends] - cum[starts] + 1
-    length = ends - starts - ((ends > starts) & (data[np.maximum(ends - 1, 0)] == 13))
-    bad = np.flatnonzero((fields < width) & (length > 0) & (np.arange(len(ends)) >= first))
-    if len(bad):
-        raise InputError(f"line {bad[0] + 1} has {fields[bad[0]]} fields; the rows above "
-                         f"have {width}", path, field=str(df.columns[fields[bad[0]]]))
+    sep_byte, line, start = ord(sep), 0, 0
+    while start < len(data):
+        # a chunk of whole lines (the last one may run to the file's end)
+        stop = min(start + _FIELDS_CHUNK, len(data))
+        if stop < len(data):
+            newline = raw.rfind(b"\n", start, stop)
+            stop = newline + 1 if newline >= start else raw.find(b"\n", stop) + 1 or len(data)
+        chunk = data[start:stop]
+        ends = np.flatnonzero(chunk == 10)
+        if not len(ends) or ends[-1] != len(chunk) - 1:
+            ends = np.append(ends, len(chunk))
+        starts = np.concatenate([[0], ends[:-1] + 1])
+        cum = np.concatenate([[0], np.cumsum(chunk == sep_byte, dtype=np.int32)])
+        fields = cum[ends] - cum[starts] + 1
+        last = np.maximum(ends - 1, 0)
+        length = ends - starts - ((ends > starts) & (chunk[last] == 13))
+        rows = line + np.arange(len(ends))
+        bad = np.flatnonzero((fields < width) & (length > 0) & (rows >= first))
+        if len(bad):
+            b = bad[0]
+            raise InputError(f"line {rows[b] + 1} has {fields[b]} fields; the rows above "
+                             f"have {width}", path, field=str(df.columns[fields[b]]))
+        line += len(ends)
+        start = stop
 
 
 def numeric(column, path: Path, name: str) -> np.ndarray:
