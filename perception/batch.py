@@ -490,7 +490,15 @@ def run_batch(
 
     from perception.report.batch import write_batch_report
 
+    if not isinstance(repertoire, Repertoire):  # not an AttributeError from a worker
+        raise TypeError(f"expected a Repertoire (Repertoire.load or Repertoire.build), "
+                        f"got {type(repertoire).__name__}")
+    if settings is not None and not isinstance(settings, RecognitionSettings):
+        raise TypeError(f"expected RecognitionSettings, got {type(settings).__name__}")
     settings = RecognitionSettings() if settings is None else settings
+    items = list(items)
+    if not items:  # as the command line says it, not a KeyError from an empty summary
+        raise InputError("no clips found: the batch was given none", field="items")
     if jobs < 1:
         raise InputError(f"expected at least 1, got {jobs}", field="--jobs")
     if figure_format not in FIGURE_FORMATS:

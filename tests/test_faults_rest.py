@@ -77,3 +77,12 @@ def test_a_repeated_or_backward_time_is_refused_at_update(rep, tracks, frames, s
     err = refused(rec.update, tracks.position[n], last + step, field="t")
     assert f"{last + step:g} s comes after {last:g} s" in str(err)
     refused(rec.update, tracks.position[n], "soon", field="t", match="expected a time")
+
+
+# -- 3. a batch of nothing ----------------------------------------------------------------
+@pytest.mark.parametrize("items", [[], (), iter([])])
+def test_a_batch_of_no_clips_says_so(rep, tmp_path, items):
+    from perception.batch import run_batch
+
+    refused(run_batch, items, tmp_path / "out", rep, field="items", match="no clips found")
+    assert not (tmp_path / "out").exists()  # refused before anything is written
