@@ -158,6 +158,13 @@ class OnlineRecognizer:
     def __init__(self, repertoire: Repertoire, settings: RecognitionSettings | None = None, *,
                  clip: str = "stream", markers=None, tracker_attrs: dict | None = None,
                  settle: SettleRule | None = None, plan_cache: PlanCache | None = None):
+        if not isinstance(repertoire, Repertoire):  # not an AttributeError frames later
+            raise TypeError(f"expected a Repertoire (Repertoire.load or Repertoire.build), "
+                            f"got {type(repertoire).__name__}")
+        if settings is not None and not isinstance(settings, RecognitionSettings):
+            raise TypeError(f"expected RecognitionSettings, got {type(settings).__name__}")
+        if settle is not None and not isinstance(settle, SettleRule):
+            raise TypeError(f"expected a SettleRule, got {type(settle).__name__}")
         self.repertoire = repertoire
         self.settings = RecognitionSettings() if settings is None else settings
         self.clip = clip

@@ -86,3 +86,35 @@ def test_a_batch_of_no_clips_says_so(rep, tmp_path, items):
 
     refused(run_batch, items, tmp_path / "out", rep, field="items", match="no clips found")
     assert not (tmp_path / "out").exists()  # refused before anything is written
+
+
+# -- 5. objects of the wrong type, said at the boundary -----------------------------------
+def _batch_of(rep, tmp_path, **kw):
+    from perception.batch import run_batch
+
+    return lambda: run_batch([object()], tmp_path / "out", **{"repertoire": rep, **kw})
+
+
+@pytest.mark.parametrize("call, expected", [
+    (lambda rep, tmp: judge(None), "expected Evidence, got NoneType"),
+    (lambda rep, tmp: judge({"kinds": []}), "expected Evidence, got dict"),
+    (lambda rep, tmp: judge(_evidence(), {"late_opening": 0.5}),
+     "expected VerdictRules, got dict"),
+    (lambda rep, tmp: OnlineRecognizer(None), "expected a Repertoire"),
+    (lambda rep, tmp: OnlineRecognizer("default.repertoire.h5"), "got str"),
+    (lambda rep, tmp: OnlineRecognizer(rep, settings={}), "expected RecognitionSettings"),
+    (lambda rep, tmp: OnlineRecognizer(rep, settle=0.5), "expected a SettleRule"),
+    (lambda rep, tmp: _batch_of(None, tmp)(), "expected a Repertoire"),
+    (lambda rep, tmp: _batch_of(rep, tmp, settings="fast")(), "expected RecognitionSettings"),
+])
+def test_an_object_of_the_wrong_type_is_a_type_error_that_says_what_was_expected(
+        rep, tmp_path, call, expected):
+    with pytest.raises(TypeError, match=expected):
+        call(rep, tmp_path)
+    assert not (tmp_path / "out").exists()
+
+
+def _evidence():
+    from perception.recognition.rules import Evidence
+
+    return Evidence(["grasp"], np.zeros(1), np.full(1, 0.5))

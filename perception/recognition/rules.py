@@ -333,6 +333,10 @@ def judge(evidence: Evidence, rules: VerdictRules | None = None) -> Verdict:
     evidence : Evidence
     rules : VerdictRules, optional
     """
+    if not isinstance(evidence, Evidence):  # not an AttributeError at its first use
+        raise TypeError(f"expected Evidence, got {type(evidence).__name__}")
+    if rules is not None and not isinstance(rules, VerdictRules):
+        raise TypeError(f"expected VerdictRules, got {type(rules).__name__}")
     rules = VerdictRules() if rules is None else rules
     ll = np.asarray(evidence.log_likelihood, dtype=float)
     best = int(np.argmax(ll))
