@@ -8,6 +8,7 @@ traceback from deep inside.
 from __future__ import annotations
 
 import math
+import typing
 
 import numpy as np
 import pytest
@@ -15,7 +16,6 @@ from _demos import default_repertoire, demo_tracks
 from _faults import one_line, refused
 
 from hammer_mv.cli import main
-from perception.errors import InputError
 from perception.online import OnlineRecognizer
 from perception.recognition.rules import VerdictRules, judge
 
@@ -118,3 +118,38 @@ def _evidence():
     from perception.recognition.rules import Evidence
 
     return Evidence(["grasp"], np.zeros(1), np.full(1, 0.5))
+
+
+# -- 4. every rule within what it can mean ------------------------------------------------
+@pytest.mark.parametrize("field, value", [
+    ("familiarity_threshold", 1.0), ("familiarity_threshold", 0.0),
+    ("unfamiliar_threshold", 1.0), ("late_opening", 0.0), ("late_mga", 1.5),
+    ("grasp_opening", 10.0), ("grasp_rest_frames", 10**9), ("grasp_rest_frames", 0),
+    ("mirror_opening", 1.0), ("mirror_majority", 0.2), ("mirror_majority", 1.0),
+    ("min_transport", 1e308), ("min_transport", 5.0), ("precision_grip_aperture", 0.0),
+    ("precision_grip_aperture", 2.0), ("no_opening", 1.5), ("arrival", -0.1),
+    ("min_scored", 2.0),
+])
+def test_a_rule_out_of_its_range_is_refused_naming_it(tmp_path, field, value):
+    err = refused(lambda: VerdictRules(**{field: value}))
+    assert field in str(err)
+    rules = tmp_path / "rules.toml"
+    rules.write_text(f"[verdict]\n{field} = {value!r}\n")
+    refused(lambda: VerdictRules.from_dict({field: value}, rules), path=rules,
+            field=f"[verdict] {field}")
+
+
+def test_every_rule_has_a_declared_range_that_holds_its_default():
+    import dataclasses
+
+    from pydantic import TypeAdapter
+
+    hints = typing.get_type_hints(VerdictRules, include_extras=True)
+    for f in dataclasses.fields(VerdictRules):
+        if f.name == "landmarks":
+            continue
+        meta = [m for a in getattr(hints[f.name], "__metadata__", ())
+                for m in getattr(a, "metadata", [a])]
+        bounds = {type(m).__name__ for m in meta}
+        assert bounds & {"Gt", "Ge"} and bounds & {"Lt", "Le"}, f.name
+        TypeAdapter(hints[f.name]).validate_python(getattr(VerdictRules(), f.name))

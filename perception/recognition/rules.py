@@ -25,13 +25,17 @@ from pydantic import Field
 
 from perception.landmarks import LandmarkParams, Landmarks
 from perception.observation import ObserveParams
-from perception.validation import Int, NonNegative, Share, declared
+from perception.validation import Int, Share, declared
 
-__all__ = ["DETAILS", "REASONS", "RULE_TABLE", "VERDICT_RULES", "Evidence", "Verdict",
+__all__ = ["DETAILS", "HAND_SPAN", "REASONS", "RULE_TABLE", "VERDICT_RULES", "Evidence", "Verdict",
            "VerdictRules", "grip_departs", "judge", "slowed", "verdict_detail"]
 
 #: Kinds of an abnormal verdict (:func:`verdict_detail`).
 DETAILS = ("delayed-opening", "re-opening", "no-opening", "other")
+
+
+#: Widest a hand opens, m (thumb to index tip, a large adult hand): no grip is read beyond it.
+HAND_SPAN = 0.3
 
 
 @declared
@@ -43,37 +47,47 @@ class VerdictRules:
     familiarity_threshold : float
         Lowest familiarity (0..1) of the best model for ``normal`` (or
         ``reach``); below it ``abnormal``: a one-sided test at this level
-        that the movement is one of the model's own.
+        that the movement is one of the model's own. Strictly between 0
+        and 1: at 0 no grasp is abnormal, at 1 every one is.
     unfamiliar_threshold : float
         Lowest familiarity of the movement's transport alone (digits held
         closed) to the best reach model; below it the verdict is
-        ``unfamiliar`` (no human reach).
+        ``unfamiliar`` (no human reach). Strictly between 0 and 1, as
+        ``familiarity_threshold``.
     late_opening : float
         ``delayed-opening``: the grip starts to open (exceeds
         ``landmarks.opening_level`` of its opening) after this share of the
         movement. Real healthy grips start at 3-68 % by the field's
         definitions (a lab's Optotrak grasps: up to 50 % on all but 2 of 30
         dev trials), the chapter 5 delayed stimuli at 52-70 %: chosen
-        between, on dev sets only (docs/mocap.md).
+        between, on dev sets only (docs/mocap.md). Above 0 (at 0 every grip
+        opens late); 1 turns the rule off.
     late_mga : float
         ... or the MGA comes after this share while the reference model's
-        comes earlier.
+        comes earlier. Above 0, at most 1 (off), as ``late_opening``.
     no_opening : float
         ``no-opening``: the opening is below this share of the reference model's.
     grasp_opening : float
         The grip opens as a grasp must when it exceeds its rest aperture by
         this share of the object's diameter (healthy adults open 1.5-3.5 cm
         beyond the object, Jeannerod 1984): judged against the grasp
-        models, otherwise against the reach models.
+        models, otherwise against the reach models. At most 2: twice the
+        diameter beyond rest is past what a hand opens for any object it
+        grasps with two digits.
     grasp_rest_frames : int
-        The rest aperture is the mean of this many first seen frames.
+        The rest aperture is the mean of this many first seen frames: 1 to
+        1000 (a second of rest even at a motion-capture 1000 Hz; more would
+        take the movement itself for the rest).
     mirror_opening : float
         Least grip opening, m, at which the side the finger is on is read.
+        At most :data:`HAND_SPAN` (wider, no side is ever read).
     mirror_majority : float
         The scene is mirrored when more than this share of those frames
-        have the finger on the model's -x side.
+        have the finger on the model's -x side. At least 0.5 (a majority)
+        and below 1 (at 1 no scene is mirrored).
     min_transport : float
         Least wrist travel, m, of a movement that can be judged as a reach.
+        At most 1 m: no seated reach to an object travels further.
     arrival : float
         The hand has arrived when the transport, after its peak speed, has
         slowed by this share of it; a clip that ends before is ``incomplete``.
@@ -84,25 +98,28 @@ class VerdictRules:
         Digits further apart at rest than this, m, make a whole-hand grasp
         (``unfamiliar``: the verdict knows precision grips). By default the
         observation's own rest rule for clips (``ObserveParams.max_rest_aperture``).
+        Above 0, at most :data:`HAND_SPAN`.
     landmarks : LandmarkParams
         How the landmarks the rules read are measured: the movement's
         bounds, the aperture's peaks and opening, the gaps that may hide a
         second opening.
     """
 
-    familiarity_threshold: Share = 0.05
-    unfamiliar_threshold: Share = 0.01
-    late_opening: Share = 0.55
-    late_mga: Share = 0.95
+    # the bounds: what each rule can mean; past them a rule fires for every movement or none
+    familiarity_threshold: Annotated[float, Field(gt=0, lt=1)] = 0.05
+    unfamiliar_threshold: Annotated[float, Field(gt=0, lt=1)] = 0.01
+    late_opening: Annotated[float, Field(gt=0, le=1)] = 0.55
+    late_mga: Annotated[float, Field(gt=0, le=1)] = 0.95
     no_opening: Share = 0.30
-    grasp_opening: NonNegative = 0.5
-    grasp_rest_frames: Annotated[Int, Field(ge=1)] = 5
-    mirror_opening: NonNegative = 0.02
-    mirror_majority: Share = 0.5
-    min_transport: NonNegative = 0.02
+    grasp_opening: Annotated[float, Field(ge=0, le=2)] = 0.5
+    grasp_rest_frames: Annotated[Int, Field(ge=1, le=1000)] = 5
+    mirror_opening: Annotated[float, Field(ge=0, le=HAND_SPAN)] = 0.02
+    mirror_majority: Annotated[float, Field(ge=0.5, lt=1)] = 0.5
+    min_transport: Annotated[float, Field(ge=0, le=1)] = 0.02
     arrival: Share = 0.6
     min_scored: Share = 0.5
-    precision_grip_aperture: NonNegative = ObserveParams.max_rest_aperture
+    precision_grip_aperture: Annotated[float, Field(gt=0, le=HAND_SPAN)] = \
+        ObserveParams.max_rest_aperture
     landmarks: LandmarkParams = field(default_factory=LandmarkParams)
 
     def to_dict(self) -> dict:
