@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING, Annotated
 import numpy as np
 from pydantic import Field
 
-from perception.validation import Int, NonNegative, Positive, Share, declared
+from perception.validation import Int, Share, declared
 
 if TYPE_CHECKING:
     from perception.observation import Observation
@@ -93,15 +93,18 @@ class LandmarkParams:
     """
 
     threshold: Annotated[float, Field(gt=0, lt=1)] = 0.05
-    speed: Positive | None = None
-    hold: NonNegative = 0.0
-    noise_factor: NonNegative = 2.0
-    cutoff: Positive | None = 10.0
+    # the bounds say what each number can mean (issue 46: unbounded values were
+    # accepted and made every verdict or landmark meaningless): a hand moves slower
+    # than 10 m/s, rests well within a second, opens no wider than a hand's span
+    speed: Annotated[float, Field(gt=0, le=10)] | None = None
+    hold: Annotated[float, Field(ge=0, le=1)] = 0.0
+    noise_factor: Annotated[float, Field(ge=0, le=20)] = 2.0
+    cutoff: Annotated[float, Field(gt=0, le=100)] | None = 10.0
     order: Annotated[Int, Field(ge=1, le=8)] = 2
     opening_level: Share = 0.10
     peak_prominence: Share = 0.25
-    peak_min_prominence: NonNegative = 0.005  # a length, m: not capped at 1 as a share is
-    max_gap: NonNegative = 0.1
+    peak_min_prominence: Annotated[float, Field(ge=0, le=0.3)] = 0.005  # m, not a share
+    max_gap: Annotated[float, Field(ge=0, le=5)] = 0.1
     max_gap_share: Share = 0.2
     second_movement: Share = 0.5
 

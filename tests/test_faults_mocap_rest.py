@@ -7,14 +7,16 @@ object size a reach's note gives. The tables are written here.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pandas as pd
 import pytest
+from test_reach_finding import _simple_reach
 
 from hammer_mv.cli import main
 from perception.errors import InputError
-from perception.reaches import MarkerMap, recording_reaches, reach_tracks
-from test_reach_finding import _simple_reach
+from perception.reaches import MarkerMap, reach_tracks, recording_reaches
 
 
 def _table(trial, **lost) -> pd.DataFrame:
@@ -105,7 +107,7 @@ def test_the_object_size_note_gives_the_size_used():
 
 
 # -- tabs and spaces mixed in a table -----------------------------------------------------------
-def _mixed(tmp_path, header: str, row) -> "Path":
+def _mixed(tmp_path, header: str, row) -> Path:
     path = tmp_path / "mixed.tsv"
     path.write_text(header + "".join(row(i) for i in range(50)))
     return path

@@ -270,6 +270,17 @@ def test_the_least_peak_prominence_is_a_length_not_a_share():
     # a length in metres, once typed as a share and so refused above 1 m (issue 42)
     from perception.errors import InputError
 
-    assert LandmarkParams(peak_min_prominence=2.0).peak_min_prominence == 2.0
-    with pytest.raises(InputError, match="peak_min_prominence"):
-        LandmarkParams(peak_min_prominence=-0.001)
+    assert LandmarkParams(peak_min_prominence=0.2).peak_min_prominence == 0.2
+    for bad in (-0.001, 2.0):  # a hand opens no wider than 0.3 m
+        with pytest.raises(InputError, match="peak_min_prominence"):
+            LandmarkParams(peak_min_prominence=bad)
+
+
+@pytest.mark.parametrize("field, bad", [("speed", 1e9), ("hold", 1e6), ("noise_factor", 1e9),
+                                        ("cutoff", 1e9), ("max_gap", 1e9)])
+def test_every_landmark_setting_is_bounded(field, bad):
+    # unbounded values were accepted (issue 46); each has a range from what it means
+    from perception.errors import InputError
+
+    with pytest.raises(InputError, match=field):
+        LandmarkParams(**{field: bad})
