@@ -1,0 +1,324 @@
+"""What a reach is, and the settings that find it: the data :mod:`perception.reaches` works on.
+
+:class:`MarkerMap` (which markers are the thumb, finger, wrist and object),
+:class:`ReachParams` (how reaches are found and brought into their plane),
+:class:`Movement` (one movement of the transport point and the rules that
+bounded it), :class:`Reach` (a reach to grasp, in the recording's frame) and
+:class:`Unscored` (a trial or movement that gives no reach, and why), with
+the constants the finder and the tracks share. docs/reaches.md describes
+the rules.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Annotated
+
+import numpy as np
+from pydantic import AfterValidator, BeforeValidator, Field
+
+from perception.cleaning import CleaningParams
+from perception.errors import InputError
+from perception.landmarks import LandmarkParams
+from perception.validation import NonNegative, Positive, Tuple, declared
+
+__all__ = ["APPROACH", "MIN_REST", "MIN_SAMPLES", "PX_PER_M", "RETURNED", "WRIST_BEHIND",
+           "MarkerMap", "Movement", "Reach", "ReachParams", "Unscored"]
+
+#: The scale of the tracks a reach becomes: one "pixel" per millimetre.
+PX_PER_M = 1000.0
+#: Where a reach without a wrist marker gets one: this far behind the grip midpoint, m.
+WRIST_BEHIND = 0.06
+#: Least stillness before a reach's onset the recognition needs, s.
+MIN_REST = 0.3
+#: With object markers, a movement is a reach when the hand ends at least this share
+#: of its starting distance nearer the object (a marker set on the back of the hand
+#: stops well short of the object's centre).
+APPROACH = 0.4
+#: Without object markers, the hand is back from a reach (the next outward movement may
+#: be a reach again) when a movement ends within this share of the reach's length of
+#: where the reach began.
+RETURNED = 0.5
+#: Fewest samples a trial needs to be searched for reaches (the low-pass filter's own
+#: need is 3 x its order + 1 per seen stretch), and a reach to be scored.
+MIN_SAMPLES = 10
+#: A hand is still while its low-passed position stays within this, m, over
+#: :data:`_STILL_WINDOW`: its speed then is the recording's noise floor.
+_STILL_RANGE = 0.002
+_STILL_WINDOW = 0.2
+_ORIGIN_PX = np.array([2000.0, 2000.0])
+
+
+
+
+def _marker_name(name: str) -> str:
+    if not name.strip():
+        raise ValueError("a marker's name, not an empty one")
+    return name
+
+
+def _names(value):
+    # one name is a tuple of one, not of its letters ("eyeL" -> ("eyeL",))
+    return (value,) if isinstance(value, str) else value
+
+
+#: A marker's name (not empty).
+MarkerName = Annotated[str, AfterValidator(_marker_name)]
+#: Markers whose mean is taken: a tuple of names (a list, or one name, is taken as one).
+MarkerNames = Annotated[tuple[MarkerName, ...], BeforeValidator(_names), Tuple]
+
+
+@declared
+class MarkerMap:
+    """Which markers of a recording are the thumb, the finger, the wrist and the object.
+
+    Parameters
+    ----------
+    thumb, finger : str
+        The thumb and index tips' markers.
+    wrist : tuple of str
+        Markers whose mean is the wrist (none: the grip midpoint carries the
+        transport). One name is taken as a tuple of one.
+    object : tuple of str
+        Markers whose mean is the object's centre (none: where the grip closes).
+    """
+
+    thumb: MarkerName = "thumb"
+    finger: MarkerName = "index"
+    wrist: MarkerNames = ()
+    object: MarkerNames = ()
+
+    def __post_init__(self) -> None:
+        # one marker in two roles measures nothing: a grip of a marker and itself never
+        # opens, a wrist or object that is a digit moves with the grip
+        if self.thumb == self.finger:
+            raise InputError(f"the thumb and the finger are the same marker {self.thumb!r}: "
+                             "each digit needs a marker of its own", None, field="finger")
+        digits = {self.thumb: "thumb", self.finger: "finger"}
+        for role, names in (("wrist", self.wrist), ("object", self.object)):
+            for m in names:
+                if m in digits:
+                    raise InputError(f"the {role} marker {m!r} is also the {digits[m]}: name "
+                                     f"another marker for the {role}", None, field=role)
+        both = set(self.wrist) & set(self.object)
+        if both:
+            raise InputError(f"marker{'s' if len(both) > 1 else ''} "
+                             f"{', '.join(map(repr, sorted(both)))} both wrist and object",
+                             None, field="object")
+
+    @classmethod
+    def guess(cls, names) -> MarkerMap:
+        """The mapping a recording's marker names suggest (``thumb*``, ``index*``, ...).
+
+        Tips are preferred (``thumb_tip`` over ``thumb_middle``); markers
+        whose name says hand or wrist are the wrist; ``object``, ``pillow``,
+        ``target`` or ``cube`` the object.
+
+        Parameters
+        ----------
+        names : sequence of str
+            The recording's marker names.
+        """
+        names = list(names)
+        low = {n: n.lower() for n in names}
+
+        def pick(*words):
+            hits = [n for n in names if any(w in low[n] for w in words)]
+            tips = [n for n in hits if "tip" in low[n]]
+            return (tips or hits or [None])[0]
+
+        thumb = pick("thumb")
+        finger = pick("index", "finger")
+        wrist = tuple(n for n in names if "wrist" in low[n]) or tuple(
+            n for n in names if low[n].startswith("hand"))
+        obj = tuple(n for n in names if any(w in low[n] for w in
+                                            ("object", "pillow", "target", "cube", "block")))
+        return cls(thumb or "thumb", finger or "index", wrist, obj)
+
+    def check(self, names, source) -> None:
+        """Refuse a mapping that names a marker the recording lacks."""
+        names = set(names)
+        for role, wanted in (("thumb", (self.thumb,)), ("finger", (self.finger,)),
+                             ("wrist", self.wrist), ("object", self.object)):
+            for m in wanted:
+                alike = sorted(n for n in names if n.casefold() == m.casefold())
+                if m not in names and len(alike) > 1:
+                    # which of them was meant is not ours to choose
+                    raise InputError(f"{m!r} for the {role} matches {len(alike)} markers but "
+                                     f"for case ({', '.join(map(repr, alike))}): name one "
+                                     "exactly", source, field="--markers")
+                if m not in names:
+                    raise InputError(f"no marker {m!r} for the {role} (the recording has "
+                                     f"{', '.join(sorted(names))})", source, field="--markers")
+
+
+@declared
+class ReachParams:
+    """How reaches are found and brought into their plane.
+
+    Parameters
+    ----------
+    landmarks : LandmarkParams
+        The onset and end rule (and the low-pass filter) that bound a movement.
+    cleaning : CleaningParams
+        How spikes, held and missing samples are found and which gaps are bridged.
+    min_travel : float
+        Least distance the transport point goes from a movement's onset to its
+        end, m (less is an adjustment, not a movement); also the least on
+        each side of a turn that parts two movements.
+    min_opening : float
+        A grip that opens less than this above its aperture at a movement's
+        onset, m, says nothing of a grasp (a whole-hand grasp from a flat
+        hand); one that opens more tells a reach from a transport or a lift
+        where the transport alone cannot (docs/reaches.md).
+    min_speed : float
+        Least peak speed of a movement, m/s (a drift of the resting hand is none).
+    turn : float
+        A movement whose path turns by this much or more, degrees, at a
+        minimum of its speed where the grip is closing from its widest (or it
+        barely changes) is two movements: a reach and the object's transport
+        or a lift. A turn of 135 degrees or more (a withdrawal
+        and the next reach) parts them whatever the grip.
+    object_moved : float
+        The object has moved when its markers' mean is this far from where it
+        was at the reach's onset, m (the reach ends where that motion began).
+    object_position : (3,) tuple, optional
+        The object's centre in the recording's frame, m (instead of markers
+        or where the grip closes).
+    object_size : float, optional
+        The object's size across the grip, m.
+    """
+
+    landmarks: LandmarkParams = field(default_factory=LandmarkParams)
+    cleaning: CleaningParams = field(default_factory=CleaningParams)
+    min_travel: Positive = 0.05
+    min_opening: NonNegative = 0.015
+    min_speed: Positive = 0.05
+    turn: Annotated[float, Field(gt=0, lt=180)] = 45.0
+    object_moved: Positive = 0.01
+    object_position: Annotated[tuple[float, float, float], Tuple] | None = None
+    object_size: Annotated[float, Field(gt=0, lt=1)] | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class Reach:
+    """One reach of a recording, in the recording's frame.
+
+    Attributes
+    ----------
+    name : str
+        ``<trial>`` or ``<trial>-reach<k>`` when a trial holds several.
+    source : str
+        The file.
+    time : (N,) array
+        Sample times, s, from the sample before the reach's rest to its end's
+        padding; never earlier than the end of the movement before it.
+    transport : (N, 3) array
+        The transport point (grip midpoint, or wrist), m, NaN where lost.
+    finger, thumb : (N, 3) arrays
+        The digit tips, m.
+    wrist : (N, 3) array or None
+        The mapped wrist, m.
+    object : (3,) array or None
+        The object's centre from markers (where it stands before the hand
+        moves it) or as given, m.
+    onset, end : int
+        Rows of the movement's onset and end.
+    notes : tuple of str
+        What was repaired or inferred.
+    onset_bound, end_bound : str
+        The rule that placed the onset and the end: the field's (``"5 % of
+        peak speed"``), ``"the speed minimum between two movements (N % of
+        peak)"`` or ``"the object's first motion"``.
+    """
+
+    name: str
+    source: str
+    time: np.ndarray
+    transport: np.ndarray
+    finger: np.ndarray
+    thumb: np.ndarray
+    wrist: np.ndarray | None
+    object: np.ndarray | None
+    onset: int
+    end: int
+    notes: tuple[str, ...] = ()
+    onset_bound: str = "5 % of peak speed"
+    end_bound: str = "5 % of peak speed"
+
+    @property
+    def aperture(self) -> np.ndarray:
+        """(N,) 3D thumb-index distance, m."""
+        return np.linalg.norm(self.finger - self.thumb, axis=1)
+
+    @property
+    def bound(self) -> str:
+        """Which rules bound the reach, in words (``"5 % of peak speed"``, or onset and end
+        apart when they differ)."""
+        if self.onset_bound == self.end_bound:
+            return self.onset_bound
+        return f"onset: {self.onset_bound}; end: {self.end_bound}"
+
+
+@dataclass(frozen=True)
+class Unscored:
+    """A trial, or a movement in it, that gives no scored reach, and why.
+
+    Every trial of a recording leaves either reaches or at least one of
+    these, so that nothing is dropped without a word.
+
+    Attributes
+    ----------
+    name : str
+        The trial's name, or ``<trial>-reach<k>`` for one movement of it.
+    source : str
+        The file.
+    status : str
+        A short word for what happened, the outputs' ``status`` column:
+        ``no reach``, ``starts in motion``, ``ends in motion``, ``too short``,
+        ``marker lost`` (docs/reaches.md).
+    reason : str
+        The same in a sentence ("no reach: the hand never moved",
+        "too short: 3 samples", "marker lost throughout: index").
+    onset_time, end_time : float
+        Where the movement starts and ends, s, on the trial's clock (NaN if unknown).
+    """
+
+    name: str
+    source: str
+    status: str
+    reason: str
+    onset_time: float = math.nan
+    end_time: float = math.nan
+
+
+@dataclass(frozen=True)
+class Movement:
+    """One movement of the transport point (:func:`find_movements`).
+
+    Attributes
+    ----------
+    onset, end : int or None
+        Rows of its onset and end; None where the recording starts or ends in it.
+    peak : int
+        Row of its peak speed.
+    onset_bound, end_bound : str
+        The rule that placed each (see :attr:`Reach.onset_bound`).
+    kind : str
+        ``"reach"``, ``"after"`` (what follows a reach: transport, lift,
+        release, return) or ``"other"``, once classified
+        (:func:`classify_movements`); ``""`` before.
+    reason : str
+        Why a movement is not a reach, in words.
+    """
+
+    onset: int | None
+    peak: int
+    end: int | None
+    onset_bound: str
+    end_bound: str
+    kind: str = ""
+    reason: str = ""
+
+
