@@ -295,7 +295,8 @@ def test_every_table_command_takes_columns_and_time_column(command):
 
 @pytest.mark.parametrize("flags, named", [
     (["--columns", "thumb,,index"], "--columns"), (["--rate", "-5"], "--rate"),
-    (["--rate", "5000"], "--rate"),
+    (["--rate", "5000"], "--rate"), (["--object-size", "2"], "--object-size"),
+    (["--object-size", "nan"], "--object-size"),
 ])
 def test_a_bad_mocap_flag_is_one_line_naming_it(flags, named, table, tmp_path):
     res = hammer("landmarks", table, "-o", tmp_path / "lm.csv", *flags, timeout=120)

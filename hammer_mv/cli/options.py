@@ -10,7 +10,6 @@ import argparse
 import dataclasses
 import hashlib
 import json
-import math
 from pathlib import Path
 
 from hammer_mv.cli.checks import options
@@ -33,7 +32,8 @@ POSE_FIELDS = {"keypoints": "--keypoints", "pcutoff": "--pcutoff", "fps": "--fps
                "object_diameter_px": "--object-diameter-px", "individual": "--individual"}
 #: The motion-capture options, by the MocapImport fields they set.
 MOCAP_FIELDS = {"rate": "--rate", "units": "--units", "trial_column": "--trial-column",
-                "time_column": "--time-column", "columns": "--columns", "markers": "--markers"}
+                "time_column": "--time-column", "columns": "--columns", "markers": "--markers",
+                "object_size": "--object-size"}
 #: The flags that ask for motion-capture settings (none: the defaults).
 MOCAP_FLAGS = ("markers", "rate", "units", "trial_column", "time_column", "columns",
                "object_size")
@@ -175,10 +175,7 @@ def mocap_import(args: argparse.Namespace):
                             tuple(roles.get("wrist", "").split("+")) if "wrist" in roles else (),
                             tuple(roles.get("object", "").split("+")) if "object" in roles
                             else ())
-    size = getattr(args, "object_size", None)
-    if size is not None and not (math.isfinite(size) and 0 < size < 1):
-        raise InputError(f"expected a size in metres between 0 and 1, got {size}",
-                         field="--object-size")
+    size = getattr(args, "object_size", None)  # ReachParams declares its range
     with options(MOCAP_FIELDS):
         return MocapImport(markers=markers, rate=getattr(args, "rate", None),
                            units=getattr(args, "units", None),
