@@ -21,7 +21,8 @@ the verdict's shape pass scales a clip by (:mod:`perception.recognition.shape`).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from collections.abc import Mapping
+from dataclasses import dataclass, field, fields
 from typing import TYPE_CHECKING, Annotated
 
 import numpy as np
@@ -32,7 +33,7 @@ from perception.validation import Int, Share, declared
 if TYPE_CHECKING:
     from perception.observation import Observation
 
-__all__ = ["MODEL_SPAN_FRACTION", "LandmarkParams", "Landmarks", "count_peaks", "longest_gap",
+__all__ = ["MODEL_SPAN_FRACTION", "OK", "LandmarkParams", "Landmarks", "count_peaks", "longest_gap",
            "model_landmarks", "movement_bounds", "movement_landmarks", "movement_time",
            "observed_landmarks", "speed_bound", "wrist_movement_time"]
 
@@ -43,6 +44,12 @@ __all__ = ["MODEL_SPAN_FRACTION", "LandmarkParams", "Landmarks", "count_peaks", 
 #: on test clips. The span between two fractions does not depend on where
 #: the onset is placed, which the start of a movement leaves uncertain.
 MODEL_SPAN_FRACTION = 0.467
+#: A landmark's flag when nothing casts doubt on it (:meth:`Landmarks.flag`).
+OK = "ok"
+#: Landmarks derived from others: their flag is the first doubtful one of these.
+_DERIVED = {"opening": ("mga", "rest_aperture"),
+            "peak_speed_seconds": ("peak_speed_time", "movement_time"),
+            "mga_seconds": ("mga_time", "movement_time")}
 
 
 @declared
@@ -270,6 +277,11 @@ class Landmarks:
         Movements in the recording: 1, plus each stretch outside this one in
         which the transport goes faster than ``second_movement`` of its peak
         (None without a speed).
+    flags : mapping of str to str
+        Why a landmark is doubtful or missing, by name (one not named is
+        ``ok`` where it has a value): ``inside a gap: ...`` (taken where the
+        transport point or a digit was lost), ``not seen: ...`` (with why),
+        ``bound raised to N % of peak`` (:meth:`flag`).
     """
 
     movement_time: float = math.nan
@@ -287,6 +299,44 @@ class Landmarks:
     peak_opening_speed: float = math.nan
     closing_time: float = math.nan
     movements: int | None = None
+    # not compared: two movements with the same numbers are the same landmarks
+    flags: Mapping[str, str] = field(default_factory=dict, compare=False)
+
+    def flag(self, name: str) -> str:
+        """Whether landmark ``name`` can be trusted: ``ok``, or why not.
+
+        ``inside a gap: ...``, ``not seen: ...`` or ``bound raised to N % of
+        peak`` as :func:`movement_landmarks` found it; a derived landmark
+        (``opening``, ``peak_speed_seconds``, ``mga_seconds``) takes the
+        first doubtful flag of those it comes from; a missing value never
+        reads ``ok`` (``not seen`` where nothing said why).
+
+        Parameters
+        ----------
+        name : str
+            A field, or ``opening``, ``peak_speed_seconds``, ``mga_seconds``.
+        """
+        if name in self.flags:
+            return self.flags[name]
+        for source in _DERIVED.get(name, ()):
+            if (said := self.flag(source)) != OK:
+                return said
+        value = getattr(self, name)
+        if value is None or not math.isfinite(float(value)):
+            return "not seen"
+        return OK
+
+    @property
+    def status(self) -> str:
+        """Whether the recording holds the whole movement: ``complete``, ``starts in
+        motion``, ``ends in motion`` or ``in motion throughout``."""
+        if math.isnan(self.onset_time) and math.isnan(self.end_time):
+            return "in motion throughout"
+        if math.isnan(self.onset_time):
+            return "starts in motion"
+        if math.isnan(self.end_time):
+            return "ends in motion"
+        return "complete"
 
     @property
     def opening(self) -> float:
@@ -308,10 +358,14 @@ class Landmarks:
         values (NaN becomes None)."""
         out = {}
         for f in fields(self):
+            if f.name == "flags":
+                continue
             v = getattr(self, f.name)
             out[f.name] = v if v is None or isinstance(v, int) else _num(v)
         for name in ("opening", "peak_speed_seconds", "mga_seconds"):
             out[name] = _num(getattr(self, name))
+        if self.flags:  # only where a landmark is doubtful: older readers see the same keys
+            out["flags"] = dict(self.flags)
         return out
 
     @classmethod
@@ -324,9 +378,11 @@ class Landmarks:
             A ``kinematics`` entry of ``<clip>.recognition.json``.
         """
         d = d or {}
-        kw = {}
+        kw = {"flags": {str(k): str(v) for k, v in (d.get("flags") or {}).items()}}
         for f in fields(cls):
             v = d.get(f.name)
+            if f.name == "flags":
+                continue
             if f.name in ("aperture_peaks", "movements"):
                 kw[f.name] = None if v is None else int(v)
             else:
@@ -485,10 +541,12 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
     time = np.asarray(time, dtype=float)
     g_raw = np.asarray(aperture, dtype=float)
     if len(time) < 3:
-        return Landmarks()
-    speed = params.speed_of(time, np.asarray(transport, dtype=float))
+        return Landmarks(flags=_all_flags(f"not seen: {len(time)} samples"))
+    path = np.asarray(transport, dtype=float)
+    speed = params.speed_of(time, path)
     if not np.isfinite(speed).any():
-        return Landmarks()
+        return Landmarks(flags=_all_flags("not seen: the transport point is lost throughout"))
+    raised = []  # (side, share of peak) where a bound was raised above the asked one
     if bounds is None:
         peak = int(np.nanargmax(speed))
         onset, end = movement_bounds(time, speed, peak, params)
@@ -496,15 +554,22 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
         lo, hi = bounds
         a, b = (0 if lo is None else lo), (len(time) - 1 if hi is None else hi)
         if not np.isfinite(speed[a:b + 1]).any():
-            return Landmarks()
+            return Landmarks(flags=_all_flags("not seen: the transport point is lost "
+                                              "throughout the movement"))
         peak = a + int(np.nanargmax(speed[a:b + 1]))
         onset, end = movement_bounds(time, speed, peak, params)
         # the user's rule, within the rows the movement was parted at
         if lo is not None and (onset is None or onset < lo):
             onset = lo
+            raised.append(("onset", float(speed[lo] / speed[peak])))
         if hi is not None and (end is None or end > hi):
             end = hi
+            raised.append(("end", float(speed[hi] / speed[peak])))
     bound = speed_bound(speed, peak, params)
+    if params.speed is None and bound > params.threshold * float(speed[peak]) * (1 + 1e-9):
+        # the noise floor raised the share-of-peak bound: both sides are placed by it
+        raised += [(side, bound / float(speed[peak])) for side in ("onset", "end")
+                   if side not in {s for s, _ in raised}]
     t_on = _cross_time(time, speed, onset, bound, True) if onset is not None else math.nan
     t_end = _cross_time(time, speed, end, bound, False) if end is not None else math.nan
     T = t_end - t_on
@@ -518,11 +583,24 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
     base = {"onset_time": t_on, "end_time": t_end, "movement_time": T, "movements": 1 + others,
             "peak_speed": float(speed[peak]), "peak_speed_time": share(time[peak]),
             "deceleration_time": t_end - float(time[peak])}
+    flags = _bound_flags(onset, end, raised, params.threshold)
+    # the filter and the derivative reach this far either side of a sample: a value taken
+    # this near a lost stretch was shaped by what the tracker did not see
+    reach = max(0.5 / params.cutoff if params.cutoff else 0.0,
+                1.5 * float(np.median(np.diff(time))))
+    lost_transport = ~np.isfinite(path.reshape(len(time), -1)).all(axis=1)
+    if (gap := _gap_near(time, lost_transport, float(time[peak]), reach)) is not None:
+        said = f"inside a gap: the transport point was lost for {gap * 1000:.0f} ms at the peak"
+        for name in ("peak_speed", "peak_speed_time", "deceleration_time"):
+            flags.setdefault(name, said)
     g = params.lowpass(time, g_raw)
     rows = np.arange(lo, hi + 1)
     seen = rows[np.isfinite(g[rows])]
     if len(seen) < 3:
-        return Landmarks(**base)
+        said = f"not seen: the digits are seen together in {len(seen)} samples of the movement"
+        for name in _APERTURE_LANDMARKS:
+            flags.setdefault(name, said)
+        return Landmarks(**base, flags=flags)
     j = int(seen[np.argmax(g[seen])])
     mga, rest = float(g[j]), float(g[seen[0]])
     opening = mga - rest
@@ -532,15 +610,96 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
     if not params.hides_a_reopening(float(gaps.max()), T):
         peaks = count_peaks(g[seen], max(params.peak_prominence * opening,
                                          params.peak_min_prominence))
+    else:
+        flags["aperture_peaks"] = (f"not seen: a digit was lost for {gaps.max() * 1000:.0f} ms, "
+                                   "long enough to hide a closing and re-opening")
+    lost_grip = ~np.isfinite(g_raw)
+    if (gap := _gap_near(time, lost_grip, float(time[j]), reach)) is not None:
+        said = f"inside a gap: a digit was lost for {gap * 1000:.0f} ms at the MGA"
+        for name in ("mga", "mga_time", "closing_time"):
+            flags.setdefault(name, said)
+    if seen[0] > lo and time[seen[0]] - time[lo] > reach:
+        flags["rest_aperture"] = (f"inside a gap: the digits were first seen "
+                                  f"{(time[seen[0]] - time[lo]) * 1000:.0f} ms after the onset")
+    if seen[-1] < hi and time[hi] - time[seen[-1]] > reach:
+        flags["contact_aperture"] = (f"inside a gap: the digits were last seen "
+                                     f"{(time[hi] - time[seen[-1]]) * 1000:.0f} ms before "
+                                     "the end")
+    level = rest + params.opening_level * opening
+    t_open = _crossing(time[lo:hi + 1], g[lo:hi + 1], level, params.max_gap)
+    if math.isnan(t_open):
+        flags["opening_time"] = _why_not_open(time[lo:hi + 1], g[lo:hi + 1], level)
+    elif (gap := _gap_near(time, lost_grip, t_open, reach)) is not None:
+        flags["opening_time"] = (f"inside a gap: a digit was lost for {gap * 1000:.0f} ms "
+                                 "where the grip opened")
     rate = np.gradient(g, time)
     widening = rate[lo:j + 1][np.isfinite(rate[lo:j + 1])]
+    if not len(widening):
+        flags["peak_opening_speed"] = "not seen: the aperture is lost before the MGA"
     return Landmarks(
         **base, mga=mga, mga_time=share(time[j]), contact_aperture=float(g[seen[-1]]),
-        aperture_peaks=peaks, rest_aperture=rest,
-        opening_time=share(_crossing(time[lo:hi + 1], g[lo:hi + 1],
-                                     rest + params.opening_level * opening, params.max_gap)),
+        aperture_peaks=peaks, rest_aperture=rest, opening_time=share(t_open),
         peak_opening_speed=float(widening.max()) if len(widening) else math.nan,
-        closing_time=t_end - float(time[j]))
+        closing_time=t_end - float(time[j]), flags=flags)
+
+
+#: The landmarks measured on the aperture.
+_APERTURE_LANDMARKS = ("mga", "mga_time", "contact_aperture", "aperture_peaks", "rest_aperture",
+                       "opening_time", "peak_opening_speed", "closing_time")
+#: The landmarks measured against the onset, the end or both.
+_NEEDS = {"onset": ("onset_time", "movement_time", "peak_speed_time", "mga_time",
+                    "opening_time", "rest_aperture"),
+          "end": ("end_time", "movement_time", "peak_speed_time", "mga_time", "opening_time",
+                  "deceleration_time", "closing_time", "contact_aperture")}
+
+
+def _all_flags(said: str) -> dict[str, str]:
+    """Every landmark flagged ``said`` (a movement with none measurable)."""
+    return {f.name: said for f in fields(Landmarks) if f.name != "flags"}
+
+
+def _bound_flags(onset: int | None, end: int | None, raised: list[tuple[str, float]],
+                 threshold: float) -> dict[str, str]:
+    """The flags of a movement's bounds: missing (the recording starts or ends in it), or
+    raised above the asked share of the peak speed."""
+    flags: dict[str, str] = {}
+    for side, row, where in (("onset", onset, "starts"), ("end", end, "ends")):
+        if row is None:
+            for name in _NEEDS[side]:
+                flags.setdefault(name, f"not seen: the recording {where} in the movement")
+    for side, share in raised:
+        if round(share * 100) <= round(threshold * 100):  # the asked share, as printed
+            continue
+        said = f"bound raised to {share * 100:.0f} % of peak"
+        for name in (f"{side}_time", "movement_time"):
+            flags.setdefault(name, said)
+    return flags
+
+
+def _gap_near(time: np.ndarray, lost: np.ndarray, at: float, reach: float) -> float | None:
+    """The longest lost stretch within ``reach`` s of time ``at``, s (None if none)."""
+    near = np.flatnonzero(lost & (np.abs(time - at) <= reach + 1e-9))
+    if not len(near):
+        return None
+    edges = np.diff(np.r_[0, lost.astype(np.int8), 0])
+    longest = 0.0
+    for a, b in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)):
+        if a <= near[-1] and b > near[0]:  # this stretch reaches within ``reach``
+            lo, hi = max(a - 1, 0), min(b, len(time) - 1)
+            longest = max(longest, float(time[hi] - time[lo]))
+    return longest
+
+
+def _why_not_open(time: np.ndarray, g: np.ndarray, level: float) -> str:
+    """Why the grip's opening time is missing, in words (see :func:`_crossing`)."""
+    ok = np.isfinite(g)
+    above = np.flatnonzero(g[ok] > level)
+    if not len(above):
+        return "not seen: the grip never crossed the opening level"
+    i = int(above[0])
+    t = time[ok]
+    return (f"not seen: the grip opened while a digit was lost "
+            f"({(t[i] - t[i - 1]) * 1000:.0f} ms unseen)")
 
 
 def observed_landmarks(obs: Observation, params: LandmarkParams | None = None) -> Landmarks:

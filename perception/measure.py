@@ -12,27 +12,37 @@ on whatever a lab has:
   rest are needed, and a recording that starts or ends in the movement
   still gives what it can (the rest NaN, with ``status`` saying why).
 
-One row per movement, SI units in the column names' suffixes
-(``hammer-mv landmarks`` writes the same table as CSV), and one per trial or
-movement of a recording that gives no reach, with its ``status`` and
-``reason`` and NaN landmarks (:func:`measure` also counts the trials).
+:func:`landmarks` gives Python one row per movement in SI units
+(:data:`UNITS`), and one per trial or movement of a recording that gives no
+reach, with its ``status`` and ``reason`` and NaN landmarks (:func:`measure`
+also counts the trials, and gives each movement as a
+:class:`~perception.report.tables.MovementLandmarks`). The files
+``hammer-mv landmarks`` writes are :func:`~perception.report.tables.tidy_landmarks`'
+lab units, the same table as ``batch``'s ``landmarks.csv``:
+:func:`measure_inputs` measures files, folders and manifests, found as
+``batch`` finds them (:mod:`perception.discovery`).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from perception.errors import InputError
 from perception.landmarks import LandmarkParams, Landmarks, movement_landmarks
+from perception.report.tables import MovementLandmarks
 
 if TYPE_CHECKING:
     import pandas as pd
 
-__all__ = ["UNITS", "Measured", "landmarks", "landmarks_row", "measure", "unscored_row"]
+    from perception.discovery import BatchItem
+
+__all__ = ["UNITS", "Measured", "landmarks", "landmarks_row", "measure", "measure_inputs",
+           "unscored_row"]
 
 #: The table's columns and their units, in order.
 UNITS = {
@@ -40,16 +50,6 @@ UNITS = {
     "peak_speed_time": "share", "deceleration_time": "s", "mga": "m", "mga_time": "share",
     "opening": "m", "rest_aperture": "m", "contact_aperture": "m", "opening_time": "share",
     "peak_opening_speed": "m/s", "closing_time": "s", "aperture_peaks": "count"}
-
-
-def _status(lm: Landmarks) -> str:
-    if math.isnan(lm.onset_time) and math.isnan(lm.end_time):
-        return "in motion throughout"
-    if math.isnan(lm.onset_time):
-        return "starts in motion"
-    if math.isnan(lm.end_time):
-        return "ends in motion"
-    return "complete"
 
 
 def landmarks_row(name: str, lm: Landmarks, **extra) -> dict:
@@ -65,7 +65,7 @@ def landmarks_row(name: str, lm: Landmarks, **extra) -> dict:
         More columns.
     """
     d = lm.to_dict()
-    row = {"trial": name, "status": _status(lm)}
+    row = {"trial": name, "status": lm.status}
     row.update({k: (math.nan if d[k] is None else d[k]) for k in UNITS})
     row.update(extra)
     row.setdefault("reason", "")
@@ -101,10 +101,14 @@ class Measured:
         (:func:`landmarks`).
     trials : int
         The trials read (a video, tracks or pose file is one).
+    movements : list of MovementLandmarks
+        The same movements for :func:`~perception.report.tables.tidy_landmarks`
+        (clip, factors, flags), in order.
     """
 
     table: pd.DataFrame
     trials: int
+    movements: list[MovementLandmarks] = field(default_factory=list)
 
     @property
     def measured(self) -> int:
@@ -154,7 +158,7 @@ def landmarks(source, *, params: LandmarkParams | None = None, mocap=None,
 
 def measure(source, *, params: LandmarkParams | None = None, mocap=None,
             px_per_m: float | None = None, object_diameter: float | None = None, pose=None,
-            tracks_out=None) -> Measured:
+            tracks_out=None, object_diameter_px: float | None = None) -> Measured:
     """The landmarks of every movement in ``source``, as a table, and its trials' count.
 
     Parameters
@@ -174,6 +178,9 @@ def measure(source, *, params: LandmarkParams | None = None, mocap=None,
         How a pose file becomes tracks.
     tracks_out : str or os.PathLike, optional
         Where a video's tracks are written (default: beside the video).
+    object_diameter_px : float, optional
+        The object's apparent diameter, px, where the tracks do not give it
+        (with ``object_diameter``).
 
     Returns
     -------
@@ -194,10 +201,7 @@ def measure(source, *, params: LandmarkParams | None = None, mocap=None,
     from perception.io.tracks import Tracks
 
     params = LandmarkParams() if params is None else params
-    rows = []
     if not isinstance(source, Tracks):
-        from pathlib import Path
-
         from perception.io.mocap import is_mocap_file
 
         if not Path(source).exists():  # before its name's ending is read as a layout
@@ -205,20 +209,16 @@ def measure(source, *, params: LandmarkParams | None = None, mocap=None,
         from perception.recordings import unknown_layout
 
         if is_mocap_file(source):
-            from perception.reaches import Reach
             from perception.recordings import MocapImport, read_recording
 
             mocap = MocapImport() if mocap is None else mocap
             recording = read_recording(source, mocap)
+            rows, movements = [], []
             for entry in recording.entries:
-                if not isinstance(entry, Reach):
-                    rows.append(unscored_row(entry, source=str(source)))
-                    continue
-                lm = movement_landmarks(entry.time, entry.transport, entry.aperture, params,
-                                        bounds=(entry.onset, entry.end))
-                rows.append(landmarks_row(entry.name, lm, source=str(source),
-                                          bound=entry.bound))
-            return Measured(_table(rows), len(recording.trials))
+                row, movement = _entry_landmarks(entry, params)
+                rows.append(row)
+                movements.append(movement)
+            return Measured(_table(rows), len(recording.trials), movements)
         if (why := unknown_layout(source)) is not None:
             raise InputError(why, source)
         from perception.pipeline import clip_name, load_clip
@@ -230,17 +230,164 @@ def measure(source, *, params: LandmarkParams | None = None, mocap=None,
         name = str(tracks.attrs.get("clip", "tracks"))
     scale = px_per_m
     if scale is None:
-        dpx = tracks.object_diameter_px()
+        dpx = tracks.object_diameter_px() if object_diameter_px is None else object_diameter_px
         if dpx is None or object_diameter is None:
             where = tracks.path or (source if not isinstance(source, Tracks) else "tracks")
             raise InputError("the scale is unknown: give px_per_m (--px-per-m), or the object's "
-                             "diameter (--object-diameter) with its apparent size in the tracks",
+                             "diameter (--object-diameter) with its apparent size in the "
+                             "tracks (a tracker's, or --object-diameter-px)",
                              where, field="--px-per-m")
         scale = dpx / object_diameter
     time, transport, aperture = _tracks_movement(tracks, scale)
     lm = movement_landmarks(time, transport, aperture, params)
-    rows.append(landmarks_row(name, lm, source=str(getattr(tracks, "path", None) or name)))
-    return Measured(_table(rows), 1)
+    row = landmarks_row(name, lm, source=str(getattr(tracks, "path", None) or name))
+    bound = (f"{params.speed:g} m/s" if params.speed is not None
+             else f"{params.threshold * 100:g} % of peak speed")
+    return Measured(_table([row]), 1, [MovementLandmarks(name, name, lm, lm.status,
+                                                         bound=bound)])
+
+
+def _entry_landmarks(entry, params: LandmarkParams) -> tuple[dict, MovementLandmarks]:
+    """The SI row and the movement of one recording's entry (a Reach or an Unscored)."""
+    from perception.reaches import Reach
+
+    number = getattr(entry, "reach_number", None)
+    common = dict(factors=dict(getattr(entry, "factors", None) or {}),
+                  trial_number=str(getattr(entry, "trial_number", "") or ""),
+                  reach_number="" if number is None else str(number))
+    if not isinstance(entry, Reach):
+        return (unscored_row(entry, source=str(entry.source)),
+                MovementLandmarks(entry.name, entry.name, None, entry.status, entry.reason,
+                                  **common))
+    lm = movement_landmarks(entry.time, entry.transport, entry.aperture, params,
+                            bounds=(entry.onset, entry.end))
+    return (landmarks_row(entry.name, lm, source=str(entry.source), bound=entry.bound),
+            MovementLandmarks(entry.name, entry.name, lm, lm.status, bound=entry.bound,
+                              **common))
+
+
+def measure_inputs(inputs, *, params: LandmarkParams | None = None, mocap=None,
+                   px_per_m: float | None = None, object_diameter: float | None = None,
+                   object_diameter_px: float | None = None, pose=None,
+                   tracks_out=None) -> Measured:
+    """The landmarks of every movement in some files, folders and manifests, as ``batch``
+    finds them.
+
+    A folder or a manifest (a CSV with ``clip`` and ``video`` columns) is
+    listed by :func:`perception.discovery.find_clips` and its recordings
+    split by :func:`perception.discovery.expand_recordings`, so that each
+    movement has the clip name, condition and factors ``batch`` gives it; a
+    clip that cannot be measured there is a ``failed`` row with why, as in a
+    batch. A file named on its own is measured as the one clip of a folder
+    holding it, and its failure is an error.
+
+    Parameters
+    ----------
+    inputs : iterable of str or os.PathLike
+        Files, folders and manifests, each once.
+    params, mocap, px_per_m, object_diameter, pose : optional
+        As :func:`measure`'s.
+    object_diameter_px : float, optional
+        The object's apparent diameter, px, where the tracks do not give it.
+    tracks_out : callable, optional
+        ``tracks_out(path)``: where a video's tracks are written.
+
+    Returns
+    -------
+    Measured
+        Its ``movements`` in order (its ``table`` the same, in SI units).
+    """
+    import pandas as pd
+
+    from perception.discovery import BatchItem, expand_recordings, find_clips
+    from perception.pipeline import clip_name
+    from perception.recordings import MocapImport
+
+    params = LandmarkParams() if params is None else params
+    mocap = MocapImport() if mocap is None else mocap
+    settings = _MocapSettings(mocap)
+    tables, movements, trials = [], [], 0
+    for path in map(Path, inputs):
+        listed = path.is_dir() or _is_manifest(path)
+        if listed:
+            items = find_clips(path).items
+        else:
+            name, kind = clip_name(path)
+            items = [BatchItem(name, path, kind)]
+        items = expand_recordings(items, settings)
+        trials += _trials(items)
+        unscored: dict[Path, list] = {}
+        for item in items:
+            try:
+                found = _item_landmarks(item, params, mocap, unscored, dict(
+                    px_per_m=px_per_m, object_diameter=object_diameter,
+                    object_diameter_px=object_diameter_px, pose=pose,
+                    tracks_out=None if tracks_out is None else tracks_out(item.path)))
+            except InputError as exc:
+                if not listed:
+                    raise
+                found = _failed(item, str(exc))
+            tables.append(found.table)
+            movements += [_tagged(m, item) for m in found.movements]
+    table = pd.concat(tables, ignore_index=True) if tables else _table([])
+    return Measured(table, trials, movements)
+
+
+@dataclass(frozen=True)
+class _MocapSettings:
+    """What :func:`perception.discovery.expand_recordings` reads of a batch's settings."""
+
+    mocap: object
+
+
+def _is_manifest(path: Path) -> bool:
+    """Whether ``path`` is a batch manifest: a CSV whose header names ``clip`` and ``video``."""
+    if path.suffix.lower() != ".csv" or not path.is_file():
+        return False
+    with open(path, encoding="utf-8", errors="replace") as f:
+        header = f.readline().strip().lstrip("\ufeff")
+    names = {c.strip().strip('"') for c in header.split(",")}
+    return {"clip", "video"} <= names
+
+
+def _trials(items: list[BatchItem]) -> int:
+    """The trials of ``items``: a recording's trials, one per other clip."""
+    trials = {(i.path, i.trial) for i in items if i.kind == "mocap" and i.trial is not None}
+    return len(trials) + sum(1 for i in items if i.kind != "mocap" or i.trial is None)
+
+
+def _item_landmarks(item: BatchItem, params: LandmarkParams, mocap, unscored: dict,
+                    kwargs: dict) -> Measured:
+    """The landmarks of one batch item: a recording's reach or unscored entry, or a clip."""
+    from perception.recordings import cached_recording
+
+    if item.kind != "mocap" or (item.reach is None and item.unscored is None):
+        return measure(item.path, params=params, mocap=mocap, **kwargs)
+    recording = cached_recording(item.path, mocap)
+    if item.reach is not None:
+        entry = recording.reaches[item.reach]
+    else:  # expand_recordings lists a recording's unscored entries in its order
+        left = unscored.setdefault(item.path, list(recording.unscored))
+        entry = left.pop(0)
+    row, movement = _entry_landmarks(entry, params)
+    return Measured(_table([row]), 0, [movement])
+
+
+def _failed(item: BatchItem, why: str) -> Measured:
+    """A clip that could not be measured: its row says why, as a batch's does."""
+    row = {"trial": item.clip, "status": "failed", **{k: math.nan for k in UNITS},
+           "source": str(item.path), "reason": why}
+    return Measured(_table([row]), 0, [MovementLandmarks(item.clip, item.clip, None, "failed",
+                                                         why)])
+
+
+def _tagged(m: MovementLandmarks, item: BatchItem) -> MovementLandmarks:
+    """``m`` with the batch item's clip name, condition and (manifest) factors."""
+    import dataclasses
+
+    factors = {**dict(item.factors), **dict(m.factors)}
+    return dataclasses.replace(m, clip=item.clip, condition=item.condition or m.condition,
+                               factors=factors)
 
 
 def _table(rows: list[dict]) -> pd.DataFrame:

@@ -221,18 +221,21 @@ def _reach_arrays(reach):
 def test_landmarks_command_writes_one_row_per_trial(tmp_path):
     out = tmp_path / "lm.csv"
     res = subprocess.run([sys.executable, "-m", "hammer_mv", "landmarks", str(OPTOTRAK),
-                          "--rate", str(RATE), "-o", str(out)], capture_output=True, text=True,
-                         timeout=120)
+                          "--rate", str(RATE), "-o", str(out), "--wide"], capture_output=True,
+                         text=True, timeout=120)
     assert res.returncode == 0, res.stderr
     import pandas as pd
 
     table = pd.read_csv(out)
     assert list(table["trial"]) == [f"optotrak-trials-trial{k}" for k in range(4)]
     assert (table["status"] == "complete").all()
-    assert table["movement_time"].between(1.0, 2.5).all()
+    assert table["movement_time"].between(1000, 2500).all()  # ms
     shares = table[["peak_speed_time", "mga_time", "opening_time"]]
-    # within 0-1, or missing: trial 2's digits are unseen when its grip starts to open
-    assert (shares.isna() | shares.ge(0) & shares.le(1)).all().all()
+    # within 0-100 %, or missing: trial 2's digits are unseen when its grip starts to open
+    assert (shares.isna() | shares.ge(0) & shares.le(100)).all().all()
+    said = table.set_index("trial")["flags"].fillna("")
+    assert all("opening_time: not seen: " in said[t] for t in table["trial"][
+        table["opening_time"].isna()])
     assert shares[["peak_speed_time", "mga_time"]].notna().all().all()
     # the raw MGA is the rest-subtracted opening plus the aperture at rest
     assert np.allclose(table["mga"], table["opening"] + table["rest_aperture"])
@@ -310,5 +313,7 @@ def test_landmarks_of_a_video_write_nothing_beside_it(tmp_path):
     assert (tmp_path / "out" / "tracks" / "clip.tracks.h5").is_file()
     import pandas as pd
 
-    row = pd.read_csv(out).iloc[0]
-    assert row["status"] == "complete" and 0.5 < row["movement_time"] < 1.5
+    table = pd.read_csv(out)
+    assert (table["status"] == "complete").all()
+    time = table.set_index("landmark").loc["movement_time"]
+    assert time["unit"] == "ms" and 500 < time["value"] < 1500

@@ -161,7 +161,7 @@ def test_a_reach_that_cannot_be_planned_does_not_take_the_following_ones(table, 
 
 def test_landmarks_writes_the_still_trial_with_its_status_reason_and_nan(table, tmp_path):
     out = tmp_path / "lm.csv"
-    res = hammer("landmarks", table, "--rate", RATE, "-o", out)
+    res = hammer("landmarks", table, "--rate", RATE, "-o", out, "--wide")
     assert res.returncode == 1, res.stderr
     assert "3 trials, 2 reaches scored, 1 not scored" in res.stdout
     assert f"{STILL}: not scored: " in res.stderr
@@ -171,10 +171,16 @@ def test_landmarks_writes_the_still_trial_with_its_status_reason_and_nan(table, 
     assert isinstance(still["reason"], str) and still["reason"]
     assert still["status"] != "complete"
     assert math.isnan(still["movement_time"]) and math.isnan(still["mga"])
-    assert rows.loc[[0, 2], "movement_time"].between(1.0, 2.5).all()
+    assert rows.loc[[0, 2], "movement_time"].between(1000, 2500).all()  # ms
     assert rows.loc[[0, 2], "reason"].isna().all()
     # each scored row says which rule bounded it (the table dropped the column before)
     assert list(rows.loc[[0, 2], "bound"]) == ["5 % of peak speed"] * 2
+    # the long table (the default): the still trial keeps its rows, flagged not scored
+    res = hammer("landmarks", table, "--rate", RATE, "-o", out)
+    long = pd.read_csv(out, keep_default_na=False, na_values={"value": [""]})
+    still = long[long["trial"] == STILL]
+    assert len(still) and still["value"].isna().all()
+    assert (still["flag"] == "not scored").all() and (still["reason"] != "").all()
 
 
 def test_batch_has_a_row_for_every_trial_and_exits_1(table, tmp_path):
@@ -312,7 +318,7 @@ def test_recognize_and_landmarks_find_the_same_reaches_in_a_session(tmp_path):
     cols = [f"{m}{a}raw" for m in ("index", "thumb") for a in "XYZ"]
     session = tmp_path / "session.tsv"
     real[cols].to_csv(session, sep="\t", index=False, float_format="%.3f")
-    res = hammer("landmarks", session, "--rate", RATE, "-o", tmp_path / "lm.csv")
+    res = hammer("landmarks", session, "--rate", RATE, "-o", tmp_path / "lm.csv", "--wide")
     assert res.returncode == 0, res.stderr
     rows = pd.read_csv(tmp_path / "lm.csv")
     assert len(rows) >= 4 and (rows["status"] == "complete").all()
@@ -321,6 +327,7 @@ def test_recognize_and_landmarks_find_the_same_reaches_in_a_session(tmp_path):
     assert res.returncode == 0, res.stderr
     trials = pd.read_csv(out / "session.trials.csv")
     assert list(trials["trial"]) == list(rows["trial"])
-    np.testing.assert_allclose(trials["onset_time"], rows["onset_time"], atol=1.5 / RATE)
+    # trials.csv in s, the landmark table in ms: both on the recording's clock
+    np.testing.assert_allclose(trials["onset_time"], rows["onset_time"] / 1e3, atol=1.5 / RATE)
     assert sorted(p.name for p in out.glob("*.recognition.json")) == sorted(
         f"{name}.recognition.json" for name in rows["trial"])

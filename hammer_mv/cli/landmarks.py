@@ -22,16 +22,22 @@ def register(sub) -> None:
     p = sub.add_parser("landmarks", help="measure reach-to-grasp landmarks, no models (CSV)",
                        description="Measure the landmarks of every movement in each INPUT "
                        "(motion-capture recordings: every reach; tracks, pose files or "
-                       "videos: the movement) by the field's definitions: onset and end where "
+                       "videos: the movement; a folder or manifest.csv: its clips, as batch "
+                       "finds them) by the field's definitions: onset and end where "
                        "the transport speed crosses a share of its peak (or an absolute speed), "
-                       "after a zero-lag low-pass filter. Writes one CSV row per movement, "
-                       "and one per trial of a recording that gives none, with its status and "
-                       "reason (docs/mocap.md lists the columns and their units). Exit status "
-                       "1 when a trial could not be measured.")
+                       "after a zero-lag low-pass filter. Writes batch's landmarks.csv: one "
+                       "row per landmark per movement in ms, mm, mm/s, %% of the movement, with "
+                       "its unit, clock and flag (ok, or why it is doubtful), and rows for a "
+                       "trial that gives none, with its status and reason (docs/glossary.md "
+                       "lists the columns). Exit status 1 when a trial could not be measured.")
     p.add_argument("inputs", type=Path, nargs="+", metavar="INPUT",
-                   help="motion-capture recordings, tracks or pose files, or videos")
+                   help="motion-capture recordings, tracks or pose files, videos, folders "
+                        "of them, or a batch manifest.csv")
     p.add_argument("-o", "--output", type=Path, required=True, metavar="TABLE.csv",
                    help="the table to write")
+    p.add_argument("--wide", action="store_true",
+                   help="one row per movement, a column per landmark, in the same units "
+                        "(their units and clocks in TABLE.units.json beside it)")
     g = p.add_argument_group("definitions")
     g.add_argument("--threshold", type=float, default=0.05, metavar="SHARE",
                    help="onset and end where the speed crosses this share of its peak "
@@ -47,6 +53,10 @@ def register(sub) -> None:
                    help="image scale of tracks, pose files and videos, px/m")
     g.add_argument("--object-diameter", type=float, default=None, metavar="M",
                    help="the object's real diameter, m, to scale tracks by its apparent one")
+    # the flag recognize's pose options declare (hammer_mv/cli/options.py), here for tracks too
+    g.add_argument("--object-diameter-px", type=float, default=None, metavar="D",
+                   help="the object's apparent diameter in pixels, where the tracks or pose "
+                        "file do not give it (with --object-diameter)")
     g.add_argument("--fps", type=float, default=None, metavar="F", help=FPS_HELP)
     add_mocap_options(p)
     p.set_defaults(func=run)
@@ -60,20 +70,23 @@ def run(args: argparse.Namespace) -> int:
     args : argparse.Namespace
         Parsed arguments.
     """
-    import pandas as pd
-
     from hammer_mv.cli.checks import options
     from hammer_mv.cli.options import mocap_import
     from perception.errors import InputError
     from perception.io.atomic import check_output, write_text
     from perception.landmarks import LandmarkParams
-    from perception.measure import measure
+    from perception.measure import measure_inputs
     from perception.recordings import trial_summary
+    from perception.report.tables import tidy_landmarks, wide_landmarks, write_units
 
     with options({"threshold": "--threshold", "speed": "--speed", "hold": "--hold",
                   "cutoff": "--cutoff"}):
         params = LandmarkParams(threshold=args.threshold, speed=args.speed, hold=args.hold,
                                 cutoff=args.cutoff or None)
+    for flag, value in (("--object-diameter", args.object_diameter),
+                        ("--object-diameter-px", args.object_diameter_px)):
+        if value is not None and not 0 < value < float("inf"):
+            raise InputError(f"{value:g}: expected a size above 0", field=flag)
     mocap = mocap_import(args).with_landmarks(params)  # one rule bounds and measures
     pose = None
     if args.fps is not None:
@@ -95,27 +108,39 @@ def run(args: argparse.Namespace) -> int:
         if same is not None:
             print(f"{path}: given more than once (as {same}): measured once", file=sys.stderr)
             continue
+        if not path.exists():
+            raise InputError("input not found", path)
         inputs.append(path)
-    tables, trials = [], 0
-    for path in inputs:
-        if not path.is_file():
-            raise InputError("input not found (or not a file)", path)
+
+    def tracks_out(path: Path) -> Path | None:
         # a video's tracks go beside the table, never beside the user's video
-        tracks_out = None
-        if clip_name(path)[1] == "video":
-            tracks_out = (output_folder(args.output.parent, "tracks")
-                          / f"{output_stem(clip_name(path)[0])}{TRACKS_SUFFIX}")
-        found = measure(path, params=params, mocap=mocap, px_per_m=args.px_per_m,
-                        object_diameter=args.object_diameter, pose=pose, tracks_out=tracks_out)
-        tables.append(found.table)
-        trials += found.trials
-    table = pd.concat(tables, ignore_index=True)
-    write_text(args.output, table.to_csv(index=False))
-    missed = table[table["reason"].fillna("") != ""]
+        if clip_name(path)[1] != "video":
+            return None
+        return (output_folder(args.output.parent, "tracks")
+                / f"{output_stem(clip_name(path)[0])}{TRACKS_SUFFIX}")
+
+    found = measure_inputs(inputs, params=params, mocap=mocap, px_per_m=args.px_per_m,
+                           object_diameter=args.object_diameter,
+                           object_diameter_px=args.object_diameter_px, pose=pose,
+                           tracks_out=tracks_out)
+    movements = found.movements
+    if args.wide:
+        table = wide_landmarks(movements)
+        write_text(args.output, table.to_csv(index=False))
+        write_units(args.output, table.columns)
+    else:
+        write_text(args.output, tidy_landmarks(movements).to_csv(index=False))
+    missed = [m for m in movements if m.landmarks is None]
+    flagged = [m for m in movements if m.landmarks is not None and m.flagged]
     if not args.quiet:
-        done = int((table["status"] == "complete").sum())
-        print(f"{len(table)} movement(s), {done} complete -> {args.output}", file=sys.stdout)
-        print(trial_summary(trials, len(table) - len(missed), len(missed)), file=sys.stdout)
-    for name, reason in zip(missed["trial"], missed["reason"]):  # always: none dropped
-        print(f"{name}: not scored: {reason}", file=sys.stderr)
-    return 1 if len(missed) else 0
+        done = sum(1 for m in movements
+                   if m.landmarks is not None and m.status == "complete" and not m.flagged)
+        line = f"{len(movements)} movement(s), {done} complete"
+        if flagged:
+            line += f", {len(flagged)} with a flagged landmark"
+        print(f"{line} -> {args.output}", file=sys.stdout)
+        print(trial_summary(found.trials, len(movements) - len(missed), len(missed)),
+              file=sys.stdout)
+    for m in missed:  # always: none dropped
+        print(f"{m.trial}: not scored: {m.reason}", file=sys.stderr)
+    return 1 if missed else 0

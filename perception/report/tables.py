@@ -1,40 +1,69 @@
-"""Tidy batch tables: R-safe column names, the manifest's factors, the long ``landmarks.csv``.
+"""Tidy landmark tables: R-safe column names, the design's factors, one unit convention.
 
 Every table a batch writes carries the manifest's own columns (participant,
-session, any factor) after ``clip`` and ``condition``; ``landmarks.csv``
-holds one row per landmark per trial in lab units (mm, mm/s, ms, % of the
-movement), named so that pandas and R's ``read.csv`` take them as they are.
+session, any factor) after ``clip`` and ``condition``. :func:`tidy_landmarks`
+is the one builder of the long landmark table, one row per landmark per
+movement in lab units (mm, mm/s, ms, % of the movement, count: :data:`LANDMARK_COLUMNS`),
+that ``batch`` writes as ``landmarks.csv`` (:func:`landmark_table`) and
+``hammer-mv landmarks`` writes by default (:func:`wide_landmarks` is its
+``--wide`` form); every value has its ``unit``, ``clock`` and ``flag``
+(``ok``, or why it is doubtful or missing), and a movement that gives no
+reach keeps its rows. A table without a ``unit`` column gets a sidecar
+``<table>.units.json`` (:func:`write_units`). Names are such that pandas and
+R's ``read.csv`` take them as they are.
 """
 
 from __future__ import annotations
 
+import math
 import re
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
 from typing import TYPE_CHECKING
 
-if TYPE_CHECKING:  # pandas only where a batch report is written
+if TYPE_CHECKING:  # pandas only where a table is written
     import pandas as pd
 
+    from perception.landmarks import Landmarks
     from perception.report.clip import ClipSummary
 
-__all__ = ["LANDMARK_UNITS", "TABLES", "factor_columns", "landmark_table", "r_name",
-           "with_r_aliases"]
+__all__ = ["LANDMARK_CLOCKS", "LANDMARK_COLUMNS", "LANDMARK_UNITS", "NOT_SCORED", "TABLES",
+           "MovementLandmarks", "factor_columns", "landmark_table", "r_name", "tidy_landmarks",
+           "units_of", "units_path", "wide_landmarks", "with_r_aliases", "write_units"]
 
 #: The batch tables of this module and :mod:`perception.report.statistics`.
 TABLES = ("landmarks.csv", "participant_means.csv", "landmark_statistics.csv")
 
-#: ``landmarks.csv``'s landmarks and their units: the
-#: :class:`~perception.landmarks.Landmarks` fields, ``opening``, and the
-#: times of the peak speed and the MGA from the onset.
-LANDMARK_UNITS = {
-    "movement_time": "ms", "peak_speed": "mm/s", "peak_speed_time": "%", "mga": "mm",
-    "mga_time": "%", "contact_aperture": "mm", "aperture_peaks": "count",
-    "rest_aperture": "mm", "opening_time": "%", "onset_time": "ms", "end_time": "ms",
-    "deceleration_time": "ms", "peak_opening_speed": "mm/s", "closing_time": "ms",
-    "movements": "count", "opening": "mm", "time_to_peak_speed": "ms", "time_to_mga": "ms"}
+#: Every landmark column of every landmark table: its unit and its clock, in the
+#: long table's order. The :class:`~perception.landmarks.Landmarks` fields,
+#: ``opening``, and the times of the peak speed and the MGA from the onset. Units:
+#: ms, mm, mm/s, % (of the movement time, from its onset), count. Clocks:
+#: ``recording`` (s since the recording's first sample, or its time column's
+#: zero, given in ms), ``onset`` (from the movement's onset), empty for
+#: durations, sizes, speeds, shares and counts.
+LANDMARK_COLUMNS = {
+    "movement_time": ("ms", ""), "peak_speed": ("mm/s", ""), "peak_speed_time": ("%", ""),
+    "mga": ("mm", ""), "mga_time": ("%", ""), "contact_aperture": ("mm", ""),
+    "aperture_peaks": ("count", ""), "rest_aperture": ("mm", ""), "opening_time": ("%", ""),
+    "onset_time": ("ms", "recording"), "end_time": ("ms", "recording"),
+    "deceleration_time": ("ms", ""), "peak_opening_speed": ("mm/s", ""),
+    "closing_time": ("ms", ""), "movements": ("count", ""), "opening": ("mm", ""),
+    "time_to_peak_speed": ("ms", "onset"), "time_to_mga": ("ms", "onset")}
+#: ``landmarks.csv``'s landmarks and their units (:data:`LANDMARK_COLUMNS`).
+LANDMARK_UNITS = {name: unit for name, (unit, _) in LANDMARK_COLUMNS.items()}
+#: The landmarks' clocks (:data:`LANDMARK_COLUMNS`).
+LANDMARK_CLOCKS = {name: clock for name, (_, clock) in LANDMARK_COLUMNS.items()}
+#: The flag of every landmark of a movement that gives no reach (its ``reason`` says why).
+NOT_SCORED = "not scored"
 #: The report's SI value (s, m, m/s, a share) times this is the value in the unit.
 _SCALE = {"ms": 1e3, "mm": 1e3, "mm/s": 1e3, "%": 100.0, "count": 1.0}
-#: ``kinematics.observed`` keys of the landmarks named otherwise there.
+#: :class:`~perception.landmarks.Landmarks` names of the landmarks named otherwise here.
 _KEYS = {"time_to_peak_speed": "peak_speed_seconds", "time_to_mga": "mga_seconds"}
+#: The long table's columns about the movement, before the factors, and after them.
+_HEAD = ("clip", "trial", "condition")
+_NUMBERS = ("trial_number", "reach_number")
+_LONG = ("landmark", "value", "unit", "clock", "flag", "status", "reason")
 _SAFE = re.compile(r"[a-z][a-z0-9_]*")
 
 
@@ -92,9 +121,234 @@ def factor_columns(summary: pd.DataFrame) -> list[str]:
     return [c for c in between if _SAFE.fullmatch(str(c))]
 
 
+@dataclass(frozen=True)
+class MovementLandmarks:
+    """One movement of a landmark table, or a trial or movement that gives no reach.
+
+    Attributes
+    ----------
+    clip : str
+        Its name in a batch (the report's clip).
+    trial : str
+        The movement's name (``<trial>`` or ``<trial>-reach<k>``).
+    landmarks : Landmarks or None
+        Its landmarks in SI units (s, m, m/s, shares); None where it gives no reach.
+    status : str
+        ``complete``, ``starts in motion``, ... (:attr:`Landmarks.status`), or
+        the status of a movement that gives no reach (``no reach``, ``failed``, ...).
+    reason : str
+        Why it gives no reach (empty for a measured movement).
+    condition : str or None
+        Its condition.
+    factors : mapping of str to str
+        The design's other factors (participant, session, ...), as written.
+    trial_number, reach_number : str
+        Its trial's number and which reach of the trial it is (empty if unknown).
+    bound : str
+        Which rules bound the movement, in words (``5 % of peak speed``, or a
+        reach finder's own: the wide table's ``bound``).
+    clock_offset : float or None
+        Seconds added to the landmarks' ``onset_time`` and ``end_time`` to put
+        them on the recording's clock; None where unknown (a report written
+        before it was recorded: the times stay on the report's own clock,
+        ``clock`` saying ``observation``).
+    """
+
+    clip: str
+    trial: str
+    landmarks: Landmarks | None
+    status: str
+    reason: str = ""
+    condition: str | None = None
+    factors: Mapping[str, str] = field(default_factory=dict, compare=False)
+    trial_number: str = ""
+    reach_number: str = ""
+    bound: str = ""
+    clock_offset: float | None = 0.0
+
+    def values(self) -> Iterable[tuple[str, float, str, str, str]]:
+        """Each landmark of :data:`LANDMARK_COLUMNS` as ``(name, value, unit, clock,
+        flag)``, the value in its unit (NaN where missing; every value of a movement
+        that gives no reach, flagged :data:`NOT_SCORED`)."""
+        lm = self.landmarks
+        d = lm.to_dict() if lm is not None else {}
+        for name, (unit, clock) in LANDMARK_COLUMNS.items():
+            if clock == "recording" and self.clock_offset is None:
+                clock = "observation"
+            if lm is None:
+                yield name, math.nan, unit, clock, NOT_SCORED
+                continue
+            key = _KEYS.get(name, name)
+            v = d.get(key)
+            value = math.nan if v is None else float(v)
+            if clock == "recording" and self.clock_offset:
+                value += self.clock_offset
+            yield name, value * _SCALE[unit], unit, clock, lm.flag(key)
+
+    @property
+    def flagged(self) -> list[str]:
+        """The landmarks of a measured movement whose flag is not ``ok``."""
+        if self.landmarks is None:
+            return []
+        return [name for name, *_, flag in self.values() if flag != "ok"]
+
+
+def _factor_names(movements: list[MovementLandmarks]) -> list[str]:
+    """The factors of ``movements`` as R-safe columns (:func:`r_name`), in first-seen order;
+    one named like a column of the table gets ``manifest_`` before it."""
+    own = {*_HEAD, *_NUMBERS, *_LONG, "flags", "bound"}
+    names = dict.fromkeys(r_name(f) for m in movements for f in _own_factors(m))
+    return [f"manifest_{f}" if f in own else f for f in names]
+
+
+def _own_factors(m: MovementLandmarks) -> dict[str, str]:
+    """``m``'s factors by R-safe name, without its condition (a column of its own)."""
+    return {r_name(k): v for k, v in m.factors.items()
+            if not (r_name(k) == "condition" and m.condition is not None)}
+
+
+def _cells(m: MovementLandmarks, factors: list[str]) -> dict:
+    """The columns that name ``m``: clip, trial, condition, factors, numbers."""
+    given = _own_factors(m)
+    condition = m.condition if m.condition is not None else given.pop("condition", None)
+    own = {f.removeprefix("manifest_") if f.startswith("manifest_")
+           and f.removeprefix("manifest_") in given else f: f for f in factors}
+    cells = {"clip": m.clip, "trial": m.trial, "condition": condition}
+    cells.update({column: given.get(name) for name, column in own.items()})
+    cells.update(trial_number=m.trial_number, reach_number=m.reach_number)
+    return cells
+
+
+def tidy_landmarks(movements: Iterable[MovementLandmarks],
+                   factors: list[str] | None = None) -> pd.DataFrame:
+    """The long landmark table: one row per landmark (:data:`LANDMARK_COLUMNS`) per movement.
+
+    The one builder of ``batch``'s ``landmarks.csv`` and of ``hammer-mv
+    landmarks``' table, so that the two cannot drift apart.
+
+    Parameters
+    ----------
+    movements : iterable of MovementLandmarks
+        The movements, and the trials or movements that give no reach, in order.
+    factors : list of str, optional
+        The factor columns, in order (default: those of the movements, R-safe,
+        in first-seen order).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``clip``, ``trial``, ``condition``, the factors,
+        ``trial_number``, ``reach_number``, ``landmark``, ``value`` (in
+        ``unit``; empty where missing, ``flag`` saying why), ``unit``, ``clock``
+        (``recording``, ``onset`` or empty), ``flag`` (``ok``, ``inside a gap:
+        ...``, ``not seen: ...``, ``bound raised to N % of peak``, ``not
+        scored``), ``status`` and ``reason``.
+    """
+    import pandas as pd
+
+    movements = list(movements)
+    factors = _factor_names(movements) if factors is None else list(factors)
+    rows = []
+    for m in movements:
+        cells = _cells(m, factors)
+        for name, value, unit, clock, flag in m.values():
+            rows.append({**cells, "landmark": name, "value": value, "unit": unit,
+                         "clock": clock, "flag": flag, "status": m.status,
+                         "reason": m.reason})
+    table = pd.DataFrame(rows, columns=[*_HEAD, *factors, *_NUMBERS, *_LONG])
+    return table.astype({"trial_number": str, "reach_number": str})
+
+
+def wide_landmarks(movements: Iterable[MovementLandmarks],
+                   factors: list[str] | None = None) -> pd.DataFrame:
+    """:func:`tidy_landmarks`' values as one row per movement, a column per landmark.
+
+    The same values in the same units (:func:`units_of` gives each column's unit
+    and clock, for the sidecar :func:`write_units` writes); ``flags`` lists the
+    landmarks whose flag is not ``ok`` (``peak_speed: inside a gap: ...; ...``).
+
+    Parameters
+    ----------
+    movements : iterable of MovementLandmarks
+    factors : list of str, optional
+        As :func:`tidy_landmarks`'.
+    """
+    import pandas as pd
+
+    movements = list(movements)
+    factors = _factor_names(movements) if factors is None else list(factors)
+    rows = []
+    for m in movements:
+        row = {**_cells(m, factors), "status": m.status, "bound": m.bound}
+        said = []
+        for name, value, _unit, _clock, flag in m.values():
+            row[name] = value
+            if flag not in ("ok", NOT_SCORED):
+                said.append(f"{name}: {flag}")
+        row["flags"] = "; ".join(said)
+        row["reason"] = m.reason
+        rows.append(row)
+    table = pd.DataFrame(rows, columns=[*_HEAD, *factors, *_NUMBERS, "status", "bound",
+                                        *LANDMARK_COLUMNS, "flags", "reason"])
+    counts = [name for name, (unit, _) in LANDMARK_COLUMNS.items() if unit == "count"]
+    # a count: 1, not 1.0 (empty where unknown), as summary.csv writes it
+    return table.astype({**{c: "Int64" for c in counts}, "trial_number": str,
+                         "reach_number": str})
+
+
+def units_of(columns: Iterable[str]) -> dict[str, dict[str, str]]:
+    """The unit and clock of each landmark column of ``columns`` (:data:`LANDMARK_COLUMNS`):
+    a units sidecar's content, ``{column: {"unit": ..., "clock": ...}}``.
+
+    Parameters
+    ----------
+    columns : iterable of str
+        A table's columns; those that are no landmark are left out.
+    """
+    return {c: {"unit": LANDMARK_COLUMNS[c][0], "clock": LANDMARK_COLUMNS[c][1]}
+            for c in columns if c in LANDMARK_COLUMNS}
+
+
+def units_path(table: str | Path) -> Path:
+    """Where the units sidecar of ``table`` goes: ``<table>.units.json`` beside it
+    (``landmarks.csv``: ``landmarks.units.json``).
+
+    Parameters
+    ----------
+    table : str or Path
+        The table's path.
+    """
+    table = Path(table)
+    return table.with_name(f"{table.stem}.units.json")
+
+
+def write_units(table: str | Path, columns: Iterable[str],
+                units: Mapping[str, Mapping[str, str]] | None = None) -> Path:
+    """Write the units sidecar of ``table`` atomically (:func:`units_path`); return its path.
+
+    Parameters
+    ----------
+    table : str or Path
+        The table's path.
+    columns : iterable of str
+        Its columns (the landmark columns among them are described).
+    units : mapping, optional
+        Units and clocks to write instead of :func:`units_of`'s (a table whose
+        landmark columns are in other units says so).
+    """
+    from perception.io.atomic import write_json
+
+    return write_json(units_path(table), dict(units) if units is not None
+                      else units_of(columns))
+
+
 def landmark_table(summary: pd.DataFrame, recognitions: dict[str, ClipSummary]
                    ) -> pd.DataFrame:
-    """``landmarks.csv``: one row per landmark (:data:`LANDMARK_UNITS`) per scored clip.
+    """``landmarks.csv``: :func:`tidy_landmarks` of a batch's clips.
+
+    A scored clip's landmarks are its report's ``kinematics.observed``; a clip
+    that failed or a trial that gives no reach keeps its rows (empty values
+    flagged ``not scored``, its ``status`` and ``reason``).
 
     Parameters
     ----------
@@ -106,25 +360,39 @@ def landmark_table(summary: pd.DataFrame, recognitions: dict[str, ClipSummary]
     Returns
     -------
     pandas.DataFrame
-        Columns ``clip``, ``condition``, the manifest's columns (one named
-        like a column here gets ``manifest_`` before it), ``landmark``,
-        ``value`` (empty where not measurable) and ``unit``.
+        :func:`tidy_landmarks`' columns, the factors those of
+        :func:`factor_columns` (one named like a column here gets
+        ``manifest_`` before it).
     """
-    import pandas as pd
+    from perception.landmarks import Landmarks
 
-    factors = factor_columns(summary)
-    own = ("clip", "condition", "landmark", "value", "unit")
-    rename = {f: f"manifest_{f}" if f in own else f for f in factors}
-    rows = []
-    for r in summary[summary["status"] == "ok"].to_dict("records"):
-        s = recognitions.get(r["clip"])
+    factors = [f for f in factor_columns(summary) if f not in _NUMBERS]
+    movements = []
+    for r in summary.to_dict("records"):
+        s = recognitions.get(r["clip"]) if r["status"] == "ok" else None
+        common = dict(clip=r["clip"], condition=_text(r.get("condition")),
+                      factors={f: _text(r.get(f)) for f in factors},
+                      trial_number=_text(r.get("trial_number")) or "",
+                      reach_number=_text(r.get("reach_number")) or "")
         if s is None:
+            why = _text(r.get("reason")) or _text(r.get("error")) or "not scored"
+            status = r["status"] if r["status"] != "ok" else "failed"
+            movements.append(MovementLandmarks(trial=r["clip"], landmarks=None, status=status,
+                                               reason=why, **common))
             continue
-        cells = {"clip": r["clip"], "condition": r["condition"],
-                 **{rename[f]: r[f] for f in factors}}
-        for name, unit in LANDMARK_UNITS.items():
-            v = s.landmark(_KEYS.get(name, name))
-            rows.append({**cells, "landmark": name, "unit": unit,
-                         "value": float("nan") if v is None else v * _SCALE[unit]})
-    columns = ["clip", "condition", *rename.values(), "landmark", "value", "unit"]
-    return pd.DataFrame(rows, columns=columns)
+        lm = Landmarks.from_dict((s.kinematics or {}).get("observed"))
+        mocap = s.extras.get("mocap") or {}
+        offset = mocap.get("clock_offset", s.extras.get("clock_offset"))
+        movements.append(MovementLandmarks(
+            trial=str(mocap.get("trial") or r["clip"]), landmarks=lm, status=lm.status,
+            clock_offset=None if offset is None else float(offset), **common))
+    own = {*_HEAD, *_NUMBERS, *_LONG}
+    return tidy_landmarks(movements, [f"manifest_{f}" if f in own else f for f in factors])
+
+
+def _text(value) -> str | None:
+    """A table cell as text (None for an empty one)."""
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return None
+    text = str(value)
+    return text if text else None
