@@ -1,5 +1,5 @@
 """Tidy batch tables (issue 34): the manifest's columns everywhere, R-safe names, the long
-landmarks.csv, per-participant means and mixed models, checked against statsmodels itself."""
+landmarks.csv, per-participant means, and the statistics a design supports (issue 44)."""
 
 import json
 import re
@@ -15,7 +15,7 @@ from _reports import disk_full_at
 from scipy import stats
 
 from perception.batch import discover, run_batch
-from perception.report.statistics import landmark_statistics
+from perception.report.statistics import MIN_PARTICIPANTS, landmark_statistics
 from perception.report.tables import LANDMARK_UNITS, TABLES, r_name
 
 SAFE = re.compile(r"^[a-z][a-z0-9_]*$")
@@ -51,8 +51,10 @@ def test_the_manifest_columns_reach_the_summary_and_every_table(batch):
     s = s.set_index("clip")
     assert (s["participant"] == manifest.loc[s.index, "participant"]).all()
     landmarks = pd.read_csv(out / "landmarks.csv")
-    assert list(landmarks.columns) == ["clip", "condition", "participant", "session",
-                                       "age_group", "landmark", "value", "unit"]
+    assert list(landmarks.columns) == ["clip", "trial", "condition", "participant", "session",
+                                       "age_group", "trial_number", "reach_number",
+                                       "landmark", "value", "unit", "clock", "flag", "status",
+                                       "reason"]
     by_clip = landmarks.drop_duplicates("clip").set_index("clip")
     assert (by_clip["age_group"] == manifest["Age group"].loc[by_clip.index]).all()
     means = pd.read_csv(out / "participant_means.csv")
@@ -137,37 +139,30 @@ def _measure(out: Path, measure: str) -> pd.DataFrame:
     return d.dropna(subset=["value"]).reset_index(drop=True)
 
 
-@pytest.mark.filterwarnings("ignore::statsmodels.tools.sm_exceptions.ConvergenceWarning")
-def test_mixed_models_are_statsmodels_own_numbers(batch):
-    import statsmodels.formula.api as smf
-
+def test_three_participants_get_cell_means_not_a_mixed_model(batch):
+    # a random intercept needs MIN_PARTICIPANTS (the mixed model matching statsmodels run
+    # by hand, and each fallback, are in test_statistics_failures.py)
     _, out, _ = batch
     table = pd.read_csv(out / "landmark_statistics.csv", keep_default_na=False,
                         na_values=[""])
-    mixed = table[table["method"] == "mixedlm"]
-    assert {"movement_time", "mga", "mga_time", "reference_confidence"} <= set(mixed["measure"])
+    means = pd.read_csv(out / "participant_means.csv")
+    assert {"movement_time", "mga", "mga_time", "reference_confidence"} <= set(table["measure"])
+    assert set(table["method"]) == {"cell_means"}
+    few = f"3 participants: a random effect needs at least {MIN_PARTICIPANTS}"
+    assert set(table["note"]) <= {f"{few}; cell means only, no test",
+                                  "the same value in every trial; cell means only, no test"}
+    assert table["p_value"].isna().all()
     for measure in ("movement_time", "mga", "opening_time", "reference_confidence"):
         d = _measure(out, measure)
-        fit = smf.mixedlm("value ~ C(condition, Treatment('normal'))", d,
-                          groups=d["participant"]).fit(reml=True)
-        rows = mixed[mixed["measure"] == measure].set_index("term")
-        assert list(rows.index) == ["Intercept", "condition[T.delayed]",
-                                    "participant_variance", "residual_variance"]
-        fixed = rows.iloc[:2]
-        for column, expected in (("estimate", fit.fe_params), ("se", fit.bse.iloc[:2]),
-                                 ("statistic", fit.tvalues.iloc[:2]),
-                                 ("p_value", fit.pvalues.iloc[:2])):
-            np.testing.assert_allclose(fixed[column], expected, rtol=1e-9, atol=1e-300,
-                                       err_msg=f"{measure} {column}")
-        np.testing.assert_allclose(rows.loc["participant_variance", "estimate"],
-                                   fit.cov_re.iloc[0, 0], rtol=1e-9, atol=1e-12)
-        np.testing.assert_allclose(rows.loc["residual_variance", "estimate"], fit.scale,
-                                   rtol=1e-9)
-        assert (rows["n"] == 12).all() and (rows["n_participants"] == 3).all()
-        assert (fixed["statistic_type"] == "z").all()
-    # the participants' own speeds are in the movement time's participant variance
-    mt = mixed[(mixed["measure"] == "movement_time")].set_index("term")
-    assert mt.loc["participant_variance", "estimate"] > mt.loc["residual_variance", "estimate"]
+        rows = table[table["measure"] == measure].set_index("term")
+        assert list(rows.index) == ["mean[normal]", "mean[delayed]"]
+        assert rows["note"].str.startswith(few).all()
+        # each participant counts once: the mean of participant_means.csv's means
+        cells = means[means["measure"] == measure].groupby("condition")["mean"].mean()
+        np.testing.assert_allclose(rows["estimate"], cells[["normal", "delayed"]], rtol=1e-9,
+                                   err_msg=measure)
+        assert list(rows["n"]) == [(d["condition"] == c).sum() for c in ("normal", "delayed")]
+        assert (rows["n_participants"] == 3).all()
 
 
 def test_participant_means_give_n_per_cell(batch):
@@ -214,18 +209,21 @@ def test_without_participants_the_plain_tests_say_why():
     assert t["estimate"] / t["se"] == pytest.approx(welch.statistic, rel=1e-12)
     anova = plain.iloc[0]
     assert (anova["df1"], anova["df2"]) == (1, 10)
-    # one participant with 2 trials or more: not enough for a mixed model
-    one = landmark_statistics(_trials([("a", "normal"), ("a", "delayed"), ("b", "normal")]))
-    assert set(one["method"]) == {"welch_t_test", "one_way_anova"} or one.empty
-    lone = landmark_statistics(_trials([("a", "normal"), ("a", "normal"), ("a", "delayed"),
-                                        ("a", "delayed"), ("b", "normal")]))
-    assert (lone["note"].str.startswith("fewer than 2 participants with 2 trials")).all()
-    assert len(lone) == 2
-    # two participants with two trials: the mixed model
-    assert set(landmark_statistics(data)["method"]) == {"mixedlm"}
-    flat = landmark_statistics(data.assign(value=1.0))
+    # named participants, fewer than MIN_PARTICIPANTS: cell means, no test, and why
+    for few_design in ([("a", "normal"), ("a", "delayed"), ("b", "normal")], design):
+        few = landmark_statistics(_trials(few_design))
+        assert set(few["method"]) == {"cell_means"}
+        assert (few["note"] == f"2 participants: a random effect needs at least "
+                               f"{MIN_PARTICIPANTS}; cell means only, no test").all()
+    # enough participants, each at their own level: the mixed model
+    many = _trials([(w, c) for w in "abcdef" for c in ("normal", "delayed") for _ in range(3)])
+    levels = dict(zip("abcdef", (0, 3, -2, 5, -4, 1)))
+    many["value"] += many["participant"].map(levels)
+    assert set(landmark_statistics(many)["method"]) == {"mixedlm"}
+    flat = landmark_statistics(many.assign(value=1.0))
     assert (flat["method"] != "mixedlm").all()
-    assert (flat["note"] == "the same value in every trial").all()
+    assert (flat["method"] == "cell_means").all()
+    assert (flat["note"] == "the same value in every trial; cell means only, no test").all()
 
 
 @pytest.mark.parametrize("fails", ["landmarks.csv", "landmark_statistics.csv"])
@@ -246,7 +244,8 @@ def test_every_column_landmark_and_method_is_documented(batch):
     section = doc[doc.index("## 9. Batch outputs"):doc.index("## 10.")]
     spans = set(re.findall(r"`([^`]+)`", section))
     names = {*TABLES, *LANDMARK_UNITS, "reference_confidence", "mixedlm", "one_way_anova",
-             "welch_t_test", "participant_variance", "residual_variance"}
+             "welch_t_test", "participant_variance", "residual_variance",
+             "ols_cluster_robust", "cell_means", "MIN_PARTICIPANTS"}
     for name in TABLES:
         names |= {c for c in pd.read_csv(out / name).columns
                   if c not in ("participant", "session", "age_group")} | {"participant"}
