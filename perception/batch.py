@@ -133,6 +133,10 @@ class ClipResult:
     reason : str
         Why it has no result, in a sentence (a failure's error, or a trial's
         reason: ``no reach: the hand never moved``); empty for a scored clip.
+    trial_number : str or None
+        A recording's trial's own id (:attr:`BatchItem.trial_number`).
+    reach_number : int or None
+        Which reach of its trial, from 1 (:attr:`BatchItem.reach_number`).
     """
 
     clip: str
@@ -144,6 +148,8 @@ class ClipResult:
     traceback: str = ""
     factors: tuple[tuple[str, str], ...] = ()
     reason: str = ""
+    trial_number: str | None = None
+    reach_number: int | None = None
 
     @property
     def scored(self) -> bool:
@@ -192,7 +198,7 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
         a bad clip (its stale outputs removed).
     """
     base = dict(clip=item.clip, condition=item.condition, rule=settings.hammer.rule,
-                factors=item.factors)
+                factors=item.factors, **_numbers(item))
     if item.unscored is not None:  # a trial that gives no reach: its row says why
         _remove_outputs(item, out)  # an earlier run's report of it is not current
         status, reason = item.unscored
@@ -214,6 +220,12 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
         log.info("%s failed: %s", item.clip, msg)
         _remove_outputs(item, out)
         return ClipResult(**base, status="failed", error=msg, reason=msg)
+
+
+def _numbers(item: BatchItem) -> dict:
+    """A recording's item's trial and reach numbers, for its :class:`ClipResult`."""
+    return {"trial_number": getattr(item, "trial_number", None),
+            "reach_number": getattr(item, "reach_number", None)}
 
 
 def _first_line(exc: BaseException) -> str:
@@ -256,7 +268,7 @@ def _guarded(item: BatchItem, out: Path, **kwargs) -> ClipResult:
                f"see errors.log): {_first_line(exc)}")
         return ClipResult(item.clip, item.condition, "failed", msg,
                           kwargs["settings"].hammer.rule, traceback=traceback.format_exc(),
-                          factors=item.factors, reason=msg)
+                          factors=item.factors, reason=msg, **_numbers(item))
 
 
 @dataclass(frozen=True)
@@ -285,7 +297,7 @@ class _Job:
         _remove_outputs(item, self.out)
         return ClipResult(item.clip, item.condition, "failed", f"{item.path}: {message}",
                           self.settings.hammer.rule, factors=item.factors,
-                          reason=f"{item.path}: {message}")
+                          reason=f"{item.path}: {message}", **_numbers(item))
 
 
 #: Folder of the plan cache inside a report folder.
@@ -359,8 +371,11 @@ CLIP_COLUMNS: list[tuple[str, Callable[[ClipSummary], object]]] = [
 def summary_table(results: list[ClipResult], reference: str | None = None) -> pd.DataFrame:
     """The batch summary, one row per clip (``summary.csv``).
 
-    Columns: ``clip, condition``, the manifest's other columns (:attr:`ClipResult.factors`;
-    one named like a column here gets ``manifest_`` before it), ``winner, rule``, the
+    Columns: ``clip, condition``, the design's other factors (:attr:`ClipResult.factors`:
+    the manifest's columns, a long table's factor columns, a file name's; one named
+    like a column here gets ``manifest_`` before it), ``trial_number`` and
+    ``reach_number`` where a recording was read (its trial's own id, the reach's
+    number within it, from 1), ``winner, rule``, the
     :data:`CLIP_COLUMNS`
     (``verdict, familiarity, margin, winner_log_likelihood``),
     ``reference_model`` and ``reference_confidence`` (its final thesis-rule
@@ -399,6 +414,8 @@ def summary_table(results: list[ClipResult], reference: str | None = None) -> pd
     if reference is None:
         reference = reference_model([r.summary for r in scored], [r.condition for r in scored])
     factors = list(dict.fromkeys(f for r in results for f, _ in r.factors))
+    numbered = any(getattr(r, "trial_number", None) is not None for r in results)
+    own = ("clip", "condition", *(("trial_number", "reach_number") if numbered else ()))
     table = []
     for r in results:
         entry = {"winner": r.winner, "rule": r.rule}
@@ -421,12 +438,15 @@ def summary_table(results: list[ClipResult], reference: str | None = None) -> pd
         entry["error"] = r.error
         entry["reason"] = r.reason
         given = dict(r.factors)
+        numbers = ({"trial_number": r.trial_number, "reach_number": r.reach_number}
+                   if numbered else {})
         table.append({"clip": r.clip, "condition": r.condition, **{
-            f"manifest_{f}" if f in entry or f in ("clip", "condition") else f: given.get(f)
-            for f in factors}, **entry})
+            f"manifest_{f}" if f in entry or f in own else f: given.get(f)
+            for f in factors}, **numbers, **entry})
     table = pd.DataFrame(table)
-    if "aperture_peaks" in table:  # a count: 1, not 1.0 (empty where unknown)
-        table["aperture_peaks"] = table["aperture_peaks"].astype("Int64")
+    for count in ("aperture_peaks", "reach_number"):  # 1, not 1.0 (empty where unknown)
+        if count in table:
+            table[count] = table[count].astype("Int64")
     return with_r_aliases(table)
 
 

@@ -85,6 +85,11 @@ class BatchItem:
         A trial or movement of a recording that gives no reach to score: its
         status and reason (:class:`~perception.reaches.Unscored`); its row
         says so, nothing is scored.
+    trial_number : str or None
+        A recording's trial's own id, as its trial column writes it (its
+        1-based index in a file without one): :attr:`Reach.trial_number`.
+    reach_number : int or None
+        Which reach of its trial, from 1 (None for a trial that gives none).
     """
 
     clip: str
@@ -95,6 +100,8 @@ class BatchItem:
     factors: tuple[tuple[str, str], ...] = ()
     trial: str | None = None
     unscored: tuple[str, str] | None = None
+    trial_number: str | None = None
+    reach_number: int | None = None
 
 
 def check_clip_name(name: str, where: str) -> str:
@@ -274,7 +281,7 @@ def find_clips(source: str | os.PathLike) -> Discovery:
 def expand_recordings(items: Iterable[BatchItem], settings: RecognitionSettings
                       ) -> list[BatchItem]:
     """Each motion-capture recording as one item per reach in it, and one per trial or
-    movement that gives none (other items as they are).
+    movement that gives none (other items as they are), each with its design's factors.
 
     A recording that cannot be read (or whose reading meets a bug) stays one
     item, which fails with its error when processed. A trial or movement that gives no reach is an
@@ -284,30 +291,46 @@ def expand_recordings(items: Iterable[BatchItem], settings: RecognitionSettings
     a recording named by its file name (two files of one stem) names its
     reaches so too (``P01.tsv-trial3``); a name taken twice gets ``~2``, ...
 
+    Each item's factors are the manifest's, its trial's columns' and its
+    file name's (``settings.mocap.factors_from_name``;
+    :mod:`perception.factors`); a ``condition`` among them is the item's
+    :attr:`BatchItem.condition`. A recording's reach carries its trial's
+    number and its own (:attr:`BatchItem.trial_number`,
+    :attr:`BatchItem.reach_number`).
+
     Parameters
     ----------
     items : iterable of BatchItem
         Clips (see :func:`discover`).
     settings : RecognitionSettings
         Their ``mocap`` settings say how recordings are read.
+
+    Raises
+    ------
+    InputError
+        A factor with one value in the manifest and another in a trial's
+        columns or a file's name (or a bad ``factors_from_name``).
     """
     from perception.reaches import Reach
-    from perception.recordings import cached_recording
+    from perception.recordings import MocapImport, cached_recording
 
+    mocap = getattr(settings, "mocap", None) or MocapImport()
     out = []
     for item in items:
         if item.kind != "mocap" or item.reach is not None or item.unscored is not None:
-            out.append(item)
+            out.append(_with_factors(item, mocap.name_factors(item.path) if item.reach is None
+                                     and item.unscored is None else {}))
             continue
         try:
             recording = cached_recording(item.path, settings.mocap)
         except (HammerMVError, OSError):
-            out.append(item)
+            out.append(_with_factors(item, mocap.name_factors(item.path)))
             continue
         except Exception:  # noqa: BLE001 - a bug reading one file must not end the batch
             log.debug("%s: unreadable (a bug); it fails when processed", item.path,
                       exc_info=True)
-            out.append(item)  # processed, it fails with its traceback in errors.log
+            # processed, it fails with its traceback in errors.log
+            out.append(_with_factors(item, mocap.name_factors(item.path)))
             continue
         stem, k = item.path.stem, 0
         for entry in recording.entries:
@@ -318,13 +341,33 @@ def expand_recordings(items: Iterable[BatchItem], settings: RecognitionSettings
                           if entry.name == t or entry.name.startswith(f"{t}-")), entry.name)
             common = dict(clip=safe_clip_name(name, str(item.path)), path=item.path,
                           kind="mocap", condition=item.condition, factors=item.factors,
-                          trial=trial)
+                          trial=trial, trial_number=entry.trial_number or None,
+                          reach_number=entry.reach_number)
             if isinstance(entry, Reach):
-                out.append(BatchItem(**common, reach=k))
+                new = BatchItem(**common, reach=k)
                 k += 1
             else:
-                out.append(BatchItem(**common, unscored=(entry.status, entry.reason)))
+                new = BatchItem(**common, unscored=(entry.status, entry.reason))
+            out.append(_with_factors(new, entry.factors,
+                                     f"{item.path.name}'s trial columns or file name"))
     return _unique_clips(out)
+
+
+def _with_factors(item: BatchItem, found, source: str | None = None) -> BatchItem:
+    """``item`` with the factors ``found`` for it besides the manifest's: a ``condition``
+    among them is its condition, the others follow the manifest's columns."""
+    if not found:
+        return item
+    from perception.factors import NAME_FLAG, merge_factors
+
+    given = dict(item.factors)
+    if item.condition is not None:
+        given["condition"] = item.condition
+    merged = merge_factors([("the manifest", given),
+                            (source or f"its file name ({NAME_FLAG})", found)], item.path)
+    condition = merged.pop("condition", None)
+    return dataclasses.replace(item, condition=condition or None,
+                               factors=tuple(merged.items()))
 
 
 def safe_clip_name(name: str, where: str) -> str:

@@ -12,6 +12,7 @@ the rules.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Annotated
 
@@ -231,6 +232,14 @@ class Reach:
         The rule that placed the onset and the end: the field's (``"5 % of
         peak speed"``), ``"the speed minimum between two movements (N % of
         peak)"`` or ``"the object's first motion"``.
+    factors : mapping of str to str
+        Its trial's design factors (participant, condition, ...: the trial's
+        columns and the file's name, :mod:`perception.factors`), as written.
+    trial_number : str
+        Its trial's id as the trial column writes it (``"38"``), or the
+        trial's 1-based index in a file without one.
+    reach_number : int or None
+        Which reach of its trial, from 1 (the ``-reach<k>`` of its name).
     """
 
     name: str
@@ -246,6 +255,9 @@ class Reach:
     notes: tuple[str, ...] = ()
     onset_bound: str = "5 % of peak speed"
     end_bound: str = "5 % of peak speed"
+    factors: Mapping[str, str] = field(default_factory=dict)
+    trial_number: str = ""
+    reach_number: int | None = None
 
     @property
     def aperture(self) -> np.ndarray:
@@ -283,6 +295,13 @@ class Unscored:
         "too short: 3 samples", "marker lost throughout: index").
     onset_time, end_time : float
         Where the movement starts and ends, s, on the trial's clock (NaN if unknown).
+    factors : mapping of str to str
+        Its trial's design factors, as :attr:`Reach.factors`.
+    trial_number : str
+        Its trial's id, as :attr:`Reach.trial_number`.
+    reach_number : int or None
+        Which reach candidate of its trial it is, from 1, for a movement
+        (``-reach<k>``); None for a whole trial that gives none.
     """
 
     name: str
@@ -291,6 +310,9 @@ class Unscored:
     reason: str
     onset_time: float = math.nan
     end_time: float = math.nan
+    factors: Mapping[str, str] = field(default_factory=dict, hash=False)
+    trial_number: str = ""
+    reach_number: int | None = None
 
 
 @dataclass(frozen=True)

@@ -154,10 +154,15 @@ def trial_reaches(trial, markers: MarkerMap | None = None,
     source = str(trial.source)
     time = np.asarray(trial.time, dtype=float)
 
-    def unscored(status, reason, name=trial.name, onset=None, end=None):
+    # the trial's design and number go with each of its entries (perception.factors)
+    labels = {"factors": dict(getattr(trial, "factors", {}) or {}),
+              "trial_number": str(getattr(trial, "trial_number", "") or "")}
+
+    def unscored(status, reason, name=trial.name, onset=None, end=None, number=None):
         return Unscored(name, source, status, reason,
                         math.nan if onset is None else float(time[onset]),
-                        math.nan if end is None else float(time[end]))
+                        math.nan if end is None else float(time[end]),
+                        reach_number=number, **labels)
 
     if len(time) < MIN_SAMPLES:
         return [], [unscored("too short", f"too short: {len(time)} samples")]
@@ -196,21 +201,21 @@ def trial_reaches(trial, markers: MarkerMap | None = None,
         name = trial.name if len(candidates) == 1 else f"{trial.name}-reach{k + 1}"
         if m.onset is None:
             skipped.append(unscored("starts in motion", "starts in motion: the recording "
-                                    "begins during the reach", name, None, m.end))
+                                    "begins during the reach", name, None, m.end, k + 1))
             continue
         if m.end is None:
             skipped.append(unscored("ends in motion", "ends in motion: the recording stops "
-                                    "before the hand does", name, m.onset, None))
+                                    "before the hand does", name, m.onset, None, k + 1))
             continue
         if m.end - m.onset + 1 < MIN_SAMPLES:
             skipped.append(unscored("too short", f"too short: {m.end - m.onset + 1} samples",
-                                    name, m.onset, m.end))
+                                    name, m.onset, m.end, k + 1))
             continue
         gone = [n for n, p in ((markers.finger, finger), (markers.thumb, thumb))
                 if not np.isfinite(p[m.onset:m.end + 1]).all(axis=1).any()]
         if gone:
             skipped.append(unscored("marker lost", f"marker lost during the reach: "
-                                    f"{', '.join(gone)}", name, m.onset, m.end))
+                                    f"{', '.join(gone)}", name, m.onset, m.end, k + 1))
             continue
         i = moves.index(m)
         prev_end = moves[i - 1].end if i and moves[i - 1].end is not None else 0
@@ -237,7 +242,7 @@ def trial_reaches(trial, markers: MarkerMap | None = None,
             finger=finger[rows], thumb=thumb[rows],
             wrist=None if wrist is None else wrist[rows], object=obj_at,
             onset=m.onset - lo, end=m.end - lo, notes=tuple(notes + extra),
-            onset_bound=m.onset_bound, end_bound=m.end_bound))
+            onset_bound=m.onset_bound, end_bound=m.end_bound, reach_number=k + 1, **labels))
     return reaches, skipped
 
 

@@ -27,9 +27,11 @@ from dataclasses import dataclass, field
 from typing import Annotated, Literal
 
 import numpy as np
-from pydantic import AfterValidator, Field
+from pydantic import AfterValidator, BeforeValidator, Field
 
 from perception.errors import InputError
+from perception.factors import NAME_FLAG as FACTORS_FROM_NAME
+from perception.factors import merge_factors, name_factors
 from perception.landmarks import movement_landmarks
 from perception.limits import MAX_FPS
 from perception.reaches import (
@@ -122,6 +124,35 @@ def _column_name(name: str) -> str:
 ColumnName = Annotated[str, AfterValidator(_column_name)]
 
 
+def _factor_names(value):
+    if isinstance(value, str):  # "participant,block", as the flag writes it
+        value = value.split(",")
+    if isinstance(value, (list, tuple)):
+        value = tuple(str(v).strip() if isinstance(v, str) else v for v in value)
+        repeated = sorted({v for v in value if value.count(v) > 1})
+        if repeated:
+            raise ValueError(f"each column named once ({repeated[0]!r} is twice)")
+    return value
+
+
+def _name_pattern(value: str) -> str:
+    try:
+        re.compile(value)
+    except re.error as exc:  # said as "expected ..., got ..." by the declared class
+        raise ValueError(f"a regular expression ({exc})") from None
+    if not re.compile(value).groupindex:
+        raise ValueError("a regular expression with a named group per factor, "
+                         "such as (?P<participant>P\\d+)")
+    return value
+
+
+#: The columns read as factors: names, each once (``"a,b"`` is two).
+FactorNames = Annotated[tuple[ColumnName, ...], BeforeValidator(_factor_names), Tuple,
+                        Field(min_length=1)]
+#: A regular expression with named groups (:func:`perception.factors.name_pattern`).
+NamePattern = Annotated[str, AfterValidator(_name_pattern)]
+
+
 @declared
 class MocapImport:
     """How a motion-capture file becomes reaches.
@@ -146,6 +177,14 @@ class MocapImport:
         (X, Y and Z of each, as RTMocap writes them).
     reaches : ReachParams
         How reaches are found, cleaned and brought into their plane.
+    factors : tuple of str, optional
+        Columns of a long table read as the design's factors, each constant
+        within a trial (participant, subject, condition, session, block and
+        group are by default: :func:`perception.factors.table_factors`).
+    factors_from_name : str, optional
+        A regular expression whose named groups, searched in each file's
+        name, are factors of its every row
+        (``(?P<participant>P\\d+)_(?P<condition>[a-z]+)``).
     """
 
     markers: MarkerMap | None = None
@@ -155,6 +194,8 @@ class MocapImport:
     time_column: str | None = None
     columns: Annotated[tuple[ColumnName, ...], Tuple, Field(min_length=1)] | None = None
     reaches: ReachParams = field(default_factory=ReachParams)
+    factors: FactorNames | None = None
+    factors_from_name: NamePattern | None = None
 
     def to_dict(self) -> dict:
         """JSON-able settings (for a report's fingerprint)."""
@@ -163,7 +204,19 @@ class MocapImport:
     def read_options(self) -> dict:
         """The keyword arguments of :func:`~perception.io.mocap.read_mocap` these ask for."""
         return {"rate": self.rate, "units": self.units, "trial_column": self.trial_column,
-                "time_column": self.time_column, "columns": self.columns}
+                "time_column": self.time_column, "columns": self.columns,
+                "factors": self.factors}
+
+    def name_factors(self, path) -> dict[str, str]:
+        """The factors :attr:`factors_from_name` finds in ``path``'s name (``{}`` if none,
+        or if it does not match: a note is logged).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            An input file.
+        """
+        return name_factors(self.factors_from_name, path) or {}
 
     def with_landmarks(self, params) -> MocapImport:
         """These settings with reaches bounded by ``params`` (a :class:`LandmarkParams`).
@@ -264,9 +317,15 @@ def read_recording(path, options: MocapImport | None = None) -> Recording:
 
     options = MocapImport() if options is None else options
     trials = read_mocap(path, **options.read_options())
+    from_name = options.name_factors(path)
     entries: list[Reach | Unscored] = []
     for trial in trials:
         source = str(trial.source)
+        factors = merge_factors([("the table's columns", trial.factors),
+                                 (f"the file name ({FACTORS_FROM_NAME})", from_name)], path)
+        if factors != trial.factors:
+            trial = dataclasses.replace(trial, factors=factors)
+        labels = {"factors": factors, "trial_number": trial.trial_number}
         try:
             reaches, unscored = trial_reaches(trial, options.markers, options.reaches)
         except InputError:
@@ -276,9 +335,9 @@ def read_recording(path, options: MocapImport | None = None) -> Recording:
             said = str(exc).strip().splitlines()
             reaches, unscored = [], [Unscored(
                 trial.name, source, "failed", f"failed: unexpected {type(exc).__name__} "
-                f"(a bug in hammer-mv){': ' + said[0] if said else ''}")]
+                f"(a bug in hammer-mv){': ' + said[0] if said else ''}", **labels)]
         if not reaches and not unscored:  # every trial leaves a word
-            unscored = [Unscored(trial.name, source, "no reach", "no reach found")]
+            unscored = [Unscored(trial.name, source, "no reach", "no reach found", **labels)]
         entries += sorted([*reaches, *unscored], key=_start)
     return Recording(str(path), tuple(t.name for t in trials), tuple(entries))
 

@@ -15,6 +15,7 @@ from pathlib import Path
 from hammer_mv.cli.checks import options
 from hammer_mv.cli.flags import FPS_HELP, add_video_options
 from perception.errors import InputError
+from perception.factors import DEFAULT_FACTORS
 from perception.geometry import DEFAULT_OBJECT_DIAMETER
 from perception.io.config import check_keys, read_toml, sub_table
 from perception.landmarks import LandmarkParams
@@ -33,10 +34,11 @@ POSE_FIELDS = {"keypoints": "--keypoints", "pcutoff": "--pcutoff", "fps": "--fps
 #: The motion-capture options, by the MocapImport fields they set.
 MOCAP_FIELDS = {"rate": "--rate", "units": "--units", "trial_column": "--trial-column",
                 "time_column": "--time-column", "columns": "--columns", "markers": "--markers",
-                "object_size": "--object-size"}
+                "object_size": "--object-size", "factors": "--factors",
+                "factors_from_name": "--factors-from-name"}
 #: The flags that ask for motion-capture settings (none: the defaults).
 MOCAP_FLAGS = ("markers", "rate", "units", "trial_column", "time_column", "columns",
-               "object_size")
+               "object_size", "factors", "factors_from_name")
 
 
 def add_recognition_options(p: argparse.ArgumentParser) -> None:
@@ -147,6 +149,17 @@ def add_mocap_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--object-size", type=float, default=None, metavar="M",
                    help="the object's size across the grip, m (default: the grip's opening "
                         "at the reach's end)")
+    f = p.add_argument_group("factors (the design's participant, condition, ...; "
+                             "docs/mocap.md)")
+    f.add_argument("--factors", type=_names, default=None, metavar="COL[,COL...]",
+                   help="columns of a long table that are the design's factors, text or "
+                        "numbers, one value per trial, carried into every output row "
+                        f"(default: any column called {', '.join(DEFAULT_FACTORS)}, any case, "
+                        "that holds one value per trial)")
+    f.add_argument("--factors-from-name", metavar="REGEX", default=None,
+                   help="a regular expression whose named groups, searched in each input's "
+                        "file name, are factors of its every row: e.g. "
+                        "'(?P<participant>P\\d+)_(?P<condition>[a-z]+)'")
 
 
 def mocap_import(args: argparse.Namespace):
@@ -182,7 +195,9 @@ def mocap_import(args: argparse.Namespace):
                            trial_column=getattr(args, "trial_column", None),
                            time_column=getattr(args, "time_column", None),
                            columns=getattr(args, "columns", None),
-                           reaches=ReachParams(object_size=size))
+                           reaches=ReachParams(object_size=size),
+                           factors=getattr(args, "factors", None),
+                           factors_from_name=getattr(args, "factors_from_name", None))
 
 
 def _names(text: str) -> tuple[str, ...]:

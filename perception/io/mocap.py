@@ -19,6 +19,7 @@ import os
 from pathlib import Path
 
 from perception.errors import InputError
+from perception.factors import FACTOR_FLAG, factor_names
 from perception.io.files import input_file, is_regular_file
 from perception.io.mocap_c3d import read_c3d
 from perception.io.mocap_qtm import is_qtm, read_qtm
@@ -144,7 +145,7 @@ def unknown_layout(path: str | os.PathLike) -> InputError:
 
 def read_mocap(path: str | os.PathLike, *, rate: float | None = None, units: str | None = None,
                trial_column: str | None = None, time_column: str | None = None,
-               columns=None) -> list[MocapTrial]:
+               columns=None, factors=None) -> list[MocapTrial]:
     """Read a motion-capture file of any layout in :data:`LAYOUTS`.
 
     Parameters
@@ -170,6 +171,13 @@ def read_mocap(path: str | os.PathLike, *, rate: float | None = None, units: str
         The markers of a table without a header, in column order, three
         columns (X, Y, Z) each: ``("object", "thumb", "index")`` or
         ``"object,thumb,index"``.
+    factors : sequence of str, or str, optional
+        Columns of a table with a header row to read as the design's factors
+        (``"participant,block"``), text or numbers, each constant within a
+        trial; a column called participant, subject, condition, session,
+        block or group (any case) is one by default where it is constant
+        within every trial (:func:`perception.factors.table_factors`). Each
+        trial's :attr:`MocapTrial.factors`.
 
     Returns
     -------
@@ -182,7 +190,8 @@ def read_mocap(path: str | os.PathLike, *, rate: float | None = None, units: str
         A missing or unreadable file, a layout not read, no marker columns,
         ragged rows, a non-numeric value, a bad rate or unit, a time that does
         not increase or counts frames, a rate that disagrees with the time
-        column, a trial id met in two places, or (for C3D) the ``mocap``
+        column, a trial id met in two places, a factor column the table
+        lacks or that varies within a trial, or (for C3D) the ``mocap``
         extra not installed.
     """
     p = input_file(path, "motion-capture file")
@@ -193,6 +202,11 @@ def read_mocap(path: str | os.PathLike, *, rate: float | None = None, units: str
     if rate is not None:
         rate = check_rate(rate, p, "--rate")
     source = os.fspath(path)
+    factors = factor_names(factors)
+    if factors and p.suffix.lower() == ".c3d":
+        raise InputError("a C3D file has no columns to read factors from: --factors names a "
+                         "table's columns (--factors-from-name reads them from file names)",
+                         p, field=FACTOR_FLAG)
     if p.suffix.lower() == ".c3d":
         if trial_column is not None or columns is not None:
             raise InputError("a C3D file holds named points of one trial: --trial-column and "
@@ -207,13 +221,19 @@ def read_mocap(path: str | os.PathLike, *, rate: float | None = None, units: str
     if layout in ("qtm", "vicon-nexus", "motive") and columns is not None:
         raise InputError(f"--columns names the markers of a table without a header; this is "
                          f"{LAYOUTS[layout]}, which names its own", p, field="--columns")
+    cells = split(text.first, delimiter(text.first))
+    headerless = bool(cells) and all(is_number(c) for c in cells if c)
+    if factors and (layout in ("qtm", "vicon-nexus", "motive") or headerless):
+        raise InputError(f"this is {LAYOUTS['headerless' if headerless else layout]}, with no "
+                         "columns to read factors from: --factors names the columns of a "
+                         "table whose header names X, Y and Z per marker (--factors-from-name "
+                         "reads them from file names)", p, field=FACTOR_FLAG)
     if layout == "qtm":
         return read_qtm(*args)
     if layout == "vicon-nexus":
         return read_vicon(*args)
     if layout == "motive":
         return read_motive(*args)
-    cells = split(text.first, delimiter(text.first))
-    if cells and all(is_number(c) for c in cells if c):
+    if headerless:
         return read_headerless(*args, columns)
-    return read_xyz_table(*args, columns)
+    return read_xyz_table(*args, columns, factors)

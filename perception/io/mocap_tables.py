@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from perception.errors import InputError
+from perception.factors import table_factors
 from perception.io.mocap_text import (
     TableText,
     check_header,
@@ -220,7 +221,8 @@ def _clock(df, time_col: str, rows, rate, own: tuple[float, str] | None, skip: s
 
 def table_trials(path: Path, source: str, df, groups, time_col, trial_col, rate, units,
                  own_units, notes: list[str], *, extra: bool = True,
-                 own_rate: tuple[float, str] | None = None) -> list[MocapTrial]:
+                 own_rate: tuple[float, str] | None = None,
+                 factors=None) -> list[MocapTrial]:
     """Split a table into trials; read its markers, time and (``extra``) other numbers.
 
     Parameters
@@ -249,21 +251,30 @@ def table_trials(path: Path, source: str, df, groups, time_col, trial_col, rate,
         Keep the other numeric columns.
     own_rate : tuple of (float, str), optional
         A header's rate and its field (Qualisys ``FREQUENCY``, Motive's export rate).
+    factors : sequence of str, optional
+        Columns to read as the design's factors (``--factors``); by default
+        those named as :data:`perception.factors.DEFAULT_FACTORS` are, where
+        each holds one value per trial (:func:`perception.factors.table_factors`).
     """
     markers = {m: np.column_stack([numeric(df[c], path, c) for c in cols])
                for m, cols in groups.items()}
     used = {c for cols in groups.values() for c in cols} | {time_col, trial_col}
+    rows = [("", np.arange(len(df)))]
+    if trial_col is not None:
+        rows = trial_rows(df, trial_col, path)
+    per_trial, taken = table_factors(df, [r for _, r in rows], factors, path, notes,
+                                     skip=used)
+    numbers = [suffix[len("-trial"):] if suffix else str(k + 1)
+               for k, (suffix, _) in enumerate(rows)]
     others = {}
     for c in df.columns if extra else ():
         if c in used or df[c].isna().all():
             continue
         if df[c].dtype.kind in "biuf":
             others[c] = df[c].to_numpy(dtype=float)
-        else:
-            notes.append(f"column {c!r} is not numeric: not read")
-    rows = [("", np.arange(len(df)))]
-    if trial_col is not None:
-        rows = trial_rows(df, trial_col, path)
+        elif c not in taken:
+            notes.append(f"column {c!r} is not numeric: not read (--factors {c} reads it as "
+                         "a factor)")
     if time_col is None:
         if own_rate is not None:
             rate, more = header_rate(rate, own_rate[0], path, own_rate[1])
@@ -278,7 +289,8 @@ def table_trials(path: Path, source: str, df, groups, time_col, trial_col, rate,
         times, rate = _clock(df, time_col, rows, rate, own_rate, skip, path, notes)
     pieces = [(suffix, t, {m: xyz[r] for m, xyz in markers.items()},
                {c: v[r] for c, v in others.items()}) for (suffix, r), t in zip(rows, times)]
-    return assemble(path, source, pieces, rate, units, own_units, notes)
+    return assemble(path, source, pieces, rate, units, own_units, notes,
+                    list(zip(numbers, per_trial)))
 
 
 def time_column_of(columns, time_column, path: Path, notes: list[str]):
@@ -305,7 +317,7 @@ def time_column_of(columns, time_column, path: Path, notes: list[str]):
 
 
 def read_xyz_table(path: Path, source: str, text: TableText, rate, units, trial_column,
-                   time_column, columns) -> list[MocapTrial]:
+                   time_column, columns, factors=None) -> list[MocapTrial]:
     """A table whose header row names X, Y and Z columns per marker.
 
     Parameters
@@ -316,7 +328,7 @@ def read_xyz_table(path: Path, source: str, text: TableText, rate, units, trial_
         The file as the caller named it.
     text : TableText
         Its text.
-    rate, units, trial_column, time_column, columns
+    rate, units, trial_column, time_column, columns, factors
         As :func:`perception.io.mocap.read_mocap` takes them.
     """
     if columns is not None:
@@ -332,11 +344,13 @@ def read_xyz_table(path: Path, source: str, text: TableText, rate, units, trial_
     notes = list(text.notes) + (["decimal commas read"] if decimal == "," else []) + mixed
     time_col = time_column_of(names, time_column, path, notes)
     trial_col = _find_column(names, trial_column, _TRIAL, path, "--trial-column")
-    groups = marker_columns([c for c in names if c not in (time_col, trial_col)])
+    groups = marker_columns([c for c in names if c not in (time_col, trial_col)
+                             and c not in (factors or ())])
     if not groups:
         raise InputError("no marker columns: expected X, Y and Z columns for each marker "
                          "(such as thumb_x, thumb_y, thumb_z)", path, field="header")
-    return table_trials(path, source, df, groups, time_col, trial_col, rate, units, None, notes)
+    return table_trials(path, source, df, groups, time_col, trial_col, rate, units, None, notes,
+                        factors=factors)
 
 
 def _mixed_spaces(text: TableText, sep: str, path: Path) -> tuple[str, list[str]]:

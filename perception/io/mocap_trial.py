@@ -59,6 +59,12 @@ class MocapTrial:
         What the reader inferred or repaired, in words.
     extra : mapping of str to (N,) ndarray
         Other numeric per-sample columns of a table (``graspPhase``, ...).
+    factors : mapping of str to str
+        The design's factors the trial's own columns give (participant,
+        condition, ...: :func:`perception.factors.table_factors`), as written.
+    trial_number : str
+        The trial's id as its trial column writes it (``"38"``); for a file
+        without one, the trial's 1-based index in the file.
     """
 
     name: str
@@ -69,16 +75,20 @@ class MocapTrial:
     units: str
     notes: tuple[str, ...] = ()
     extra: Mapping[str, np.ndarray] = field(default_factory=dict)
+    factors: Mapping[str, str] = field(default_factory=dict)
+    trial_number: str = "1"
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "markers", MappingProxyType(dict(self.markers)))
         object.__setattr__(self, "extra", MappingProxyType(dict(self.extra)))
+        object.__setattr__(self, "factors", MappingProxyType(dict(self.factors)))
         object.__setattr__(self, "notes", tuple(self.notes))
 
     def __reduce__(self):
         # MappingProxyType does not pickle: batch workers get the trial sent
         return MocapTrial, (self.name, self.source, self.time, dict(self.markers), self.rate,
-                            self.units, self.notes, dict(self.extra))
+                            self.units, self.notes, dict(self.extra), dict(self.factors),
+                            self.trial_number)
 
     def marker_names(self) -> tuple[str, ...]:
         """The markers' names, in the file's order."""
@@ -267,7 +277,8 @@ def _infer_units(pieces) -> tuple[str, str]:
 
 
 def assemble(path: Path, source: str, pieces, rate: float, units: str | None,
-             own: tuple[str, str] | None, notes: list[str]) -> list[MocapTrial]:
+             own: tuple[str, str] | None, notes: list[str],
+             labels: list[tuple[str, dict]] | None = None) -> list[MocapTrial]:
     """Trials from ``(name suffix, time, {marker: (N, 3) in file units}, extra)`` pieces.
 
     Marks lost samples (all three coordinates 0, NDI's missing value), settles
@@ -290,7 +301,11 @@ def assemble(path: Path, source: str, pieces, rate: float, units: str | None,
         The file's own unit and the field that states it.
     notes : list of str
         Notes for every trial.
+    labels : list of (str, dict), optional
+        Each piece's trial number and factors (default: its 1-based index, none).
     """
+    if labels is None:
+        labels = [(str(k + 1), {}) for k in range(len(pieces))]
     if sum(len(p[1]) for p in pieces) > MAX_FRAMES or len(pieces[0][2]) > MAX_KEYPOINTS:
         raise InputError(f"more than {MAX_FRAMES} samples or {MAX_KEYPOINTS} markers", path)
     zeros = []
@@ -308,7 +323,7 @@ def assemble(path: Path, source: str, pieces, rate: float, units: str | None,
         units, note = _infer_units(pieces)
         notes = [*notes, note]
     trials = []
-    for (suffix, time, markers, extra), count in zip(pieces, zeros):
+    for (suffix, time, markers, extra), count, (number, factors) in zip(pieces, zeros, labels):
         own_notes = notes + ([f"{count} samples at exactly (0, 0, 0) read as lost"] if count
                              else [])
         lost = [m for m, xyz in markers.items() if not np.isfinite(xyz).all(axis=1).any()]
@@ -323,5 +338,6 @@ def assemble(path: Path, source: str, pieces, rate: float, units: str | None,
         trials.append(MocapTrial(
             name=path.stem + suffix, source=source, time=np.asarray(time, dtype=float),
             markers={m: xyz * UNITS[units] for m, xyz in markers.items()},
-            rate=rate, units=units, notes=tuple(own_notes), extra=extra))
+            rate=rate, units=units, notes=tuple(own_notes), extra=extra, factors=factors,
+            trial_number=number))
     return trials
