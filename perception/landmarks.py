@@ -430,10 +430,12 @@ def _crossing(time: np.ndarray, values: np.ndarray, level: float,
     if not len(above):
         return math.nan
     i = int(above[0])
+    # unseen before it for longer than max_gap (since the last seen sample, or the start)
+    before = t[i - 1] if i else time[0]
+    if t[i] - before > max_gap + 1e-9:
+        return math.nan
     if i == 0:
         return float(t[0])
-    if t[i] - t[i - 1] > max_gap + 1e-9:
-        return math.nan
     return float(t[i - 1] + (level - v[i - 1]) / (v[i] - v[i - 1]) * (t[i] - t[i - 1]))
 
 
@@ -698,8 +700,9 @@ def _why_not_open(time: np.ndarray, g: np.ndarray, level: float) -> str:
         return "not seen: the grip never crossed the opening level"
     i = int(above[0])
     t = time[ok]
+    before = t[i - 1] if i else time[0]
     return (f"not seen: the grip opened while a digit was lost "
-            f"({(t[i] - t[i - 1]) * 1000:.0f} ms unseen)")
+            f"({(t[i] - before) * 1000:.0f} ms unseen)")
 
 
 def observed_landmarks(obs: Observation, params: LandmarkParams | None = None) -> Landmarks:

@@ -278,7 +278,7 @@ def measure_inputs(inputs, *, params: LandmarkParams | None = None, mocap=None,
     split by :func:`perception.discovery.expand_recordings`, so that each
     movement has the clip name, condition and factors ``batch`` gives it; a
     clip that cannot be measured there is a ``failed`` row with why, as in a
-    batch. A file named on its own is measured as the one clip of a folder
+    batch, and the movements come in clip order, as a batch's. A file named on its own is measured as the one clip of a folder
     holding it, and its failure is an error.
 
     Parameters
@@ -295,7 +295,7 @@ def measure_inputs(inputs, *, params: LandmarkParams | None = None, mocap=None,
     Returns
     -------
     Measured
-        Its ``movements`` in order (its ``table`` the same, in SI units).
+        Its ``movements`` (its ``table`` the same, in SI units, in the files' order).
     """
     import pandas as pd
 
@@ -317,6 +317,7 @@ def measure_inputs(inputs, *, params: LandmarkParams | None = None, mocap=None,
         items = expand_recordings(items, settings)
         trials += _trials(items)
         unscored: dict[Path, list] = {}
+        found_here: list[MovementLandmarks] = []
         for item in items:
             try:
                 found = _item_landmarks(item, params, mocap, unscored, dict(
@@ -328,7 +329,10 @@ def measure_inputs(inputs, *, params: LandmarkParams | None = None, mocap=None,
                     raise
                 found = _failed(item, str(exc))
             tables.append(found.table)
-            movements += [_tagged(m, item) for m in found.movements]
+            found_here += [_tagged(m, item) for m in found.movements]
+        if listed:  # in clip order, as batch's tables are
+            found_here.sort(key=lambda m: m.clip)
+        movements += found_here
     table = pd.concat(tables, ignore_index=True) if tables else _table([])
     return Measured(table, trials, movements)
 
