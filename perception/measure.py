@@ -278,8 +278,9 @@ def measure_inputs(inputs, *, params: LandmarkParams | None = None, mocap=None,
     split by :func:`perception.discovery.expand_recordings`, so that each
     movement has the clip name, condition and factors ``batch`` gives it; a
     clip that cannot be measured there is a ``failed`` row with why, as in a
-    batch, and the movements come in clip order, as a batch's. A file named on its own is measured as the one clip of a folder
-    holding it, and its failure is an error.
+    batch, and the movements come in clip order, as a batch's. A file named
+    on its own is measured as the one clip of a folder holding it (its
+    movements in the file's order), and its failure is an error.
 
     Parameters
     ----------

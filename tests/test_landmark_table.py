@@ -14,7 +14,6 @@ import json
 import math
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -47,8 +46,9 @@ def _trial(gap=None, closing=False, noise=5e-5, seed=0):
     """One trial: rest, a reach of DISTANCE in DURATION s, rest, the return, rest.
 
     ``gap``: (start, end) s in which the thumb is lost; ``closing``: the grip
-    starts wide open and only closes; ``noise``: SD of the positions' noise, m (a tracker's jitter: a
-    marker that repeats its sample exactly is taken as held, and lost).
+    starts wide open and only closes; ``noise``: SD of the positions' noise, m
+    (a tracker's jitter: a marker that repeats its sample exactly is taken as
+    held, and lost).
     """
     t = np.arange(0, 4.5, 1 / RATE)
     # the return slower than the reach: the reach is the recording's fastest movement
