@@ -64,7 +64,10 @@ def test_the_report_names_the_rule_that_gave_the_verdict(normal):
     rep = default_repertoire()
     rec = recognize_tracks(normal[0], rep)
     d = rec.to_dict()
-    assert d["verdict_rule"] == "familiarity" and rec.verdict_reason is None
+    # every verdict has a reason with its numbers, a normal one too (issue 44)
+    assert d["verdict_rule"] == "familiarity"
+    assert d["verdict_reason"] == rec.verdict_reason
+    assert ">= 0.05 threshold (familiarity_threshold)" in rec.verdict_reason
     assert d["verdict_rules"]["late_opening"] == 0.55
     late = recognize_tracks(demo_tracks("delayed", 0)[0], rep)
     assert (late.verdict, late.verdict_rule) == ("abnormal", "grip-departs")

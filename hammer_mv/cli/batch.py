@@ -52,6 +52,7 @@ def run(args: argparse.Namespace) -> int:
         Parsed arguments.
     """
     from perception.errors import InputError
+    from perception.recognition.result import warnings_summary
     from perception.recordings import trial_summary
 
     # local processes only: a scheduler's workers are its own
@@ -86,6 +87,8 @@ def run(args: argparse.Namespace) -> int:
               f"{len(unscored)} not scored -> {args.output / 'report.html'}")
         print(trial_summary(summary.attrs.get("trials", len(summary)), scored,
                             len(summary) - scored))
+        for line in warnings_summary(_warnings(summary, args.output), "clips"):
+            print(f"hammer-mv batch: warning: {line}", file=sys.stderr)
     why = unscored["reason"] if "reason" in unscored else unscored["error"]
     for clip, reason in zip(unscored["clip"], why):  # always: nothing dropped without a word
         print(f"{clip}: not scored: {reason}", file=sys.stderr)
@@ -93,6 +96,26 @@ def run(args: argparse.Namespace) -> int:
         print(f"hammer-mv batch: {failed} clip(s) failed ({failure_reasons(summary, items)}); "
               f"see {args.output / 'summary.csv'}", file=sys.stderr)
     return 1 if failed or len(unscored) else 0
+
+
+def _warnings(summary, out: Path) -> list[tuple[str, list[dict]]]:
+    """Each scored clip's warnings (its report's ``warning_values``), for one summary of
+    the batch's: a report written before they were recorded counts as without."""
+    import json
+
+    from perception.report.clip import clip_outputs
+
+    found = []
+    for clip, status in zip(summary["clip"], summary["status"]):
+        if status != "ok":
+            continue
+        try:
+            report = json.loads(clip_outputs(out, clip)["json"].read_text())
+        except (OSError, ValueError):
+            report = {}
+        values = report.get("warning_values") if isinstance(report, dict) else None
+        found.append((clip, values if isinstance(values, list) else []))
+    return found
 
 
 def _not_over_inputs(source: Path, out: Path) -> None:

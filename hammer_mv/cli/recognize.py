@@ -127,19 +127,44 @@ def run(args: argparse.Namespace) -> int:
     paths = write_clip_report(rec, args.output, extra=extra, figures=not args.no_figures,
                               figure_format=args.figure_format, dpi=args.dpi)
     if not args.quiet:
-        detail = f" ({rec.verdict_detail})" if rec.verdict_detail else ""
         mirror = ""
         if rec.mirrored:  # the scene was found the other way round from what was asked
             mirror = ("; the scene is not mirrored: scored without --mirror" if args.mirror
                       else "; the scene is mirrored: scored as with --mirror")
-        print(f"{clip}: {rec.verdict or 'no verdict'}{detail}, winner {rec.winner} "
-              f"({rec.rule} rule){mirror} -> {paths['json']}")
+        print(f"{verdict_line(rec, rule=True)}{mirror} -> {paths['json']}")
+        for warning in rec.warnings:
+            print(f"{clip}: warning: {warning}", file=sys.stderr)
     return 0
 
 
+def verdict_line(rec, rule: bool = False) -> str:
+    """``clip: verdict (kind), winner W: reason``: a scored clip's console line.
+
+    A winner whose kind contradicts the verdict (a reach model on a
+    ``normal`` grasp) is named for what it is: ``closest model W (a reach
+    model; the verdict's model: M)`` (:attr:`Recognition.winner_note`).
+
+    Parameters
+    ----------
+    rec : Recognition
+        A scored clip.
+    rule : bool
+        Name the rule that picked the winner (``likelihood rule``).
+    """
+    detail = f" ({rec.verdict_detail})" if rec.verdict_detail else ""
+    how = f" ({rec.rule} rule)" if rule else ""
+    if rec.winner_note is not None:
+        kind = rec.kinds[rec.names.index(rec.winner)]
+        winner = (f"closest model {rec.winner} (a {kind} model{how}; the verdict's model: "
+                  f"{rec.verdict_model})")
+    else:
+        winner = f"winner {rec.winner}{how}"
+    return f"{rec.clip}: {rec.verdict or 'no verdict'}{detail}, {winner}: {rec.verdict_reason}"
+
+
 #: Columns of ``<recording>.trials.csv``, the accounting of a recording's trials.
-TRIALS_COLUMNS = ("trial", "status", "reason", "verdict", "verdict_detail", "winner",
-                  "onset_time", "end_time", "report", "source")
+TRIALS_COLUMNS = ("trial", "status", "reason", "verdict", "verdict_detail", "verdict_reason",
+                  "winner", "winner_note", "onset_time", "end_time", "report", "source")
 
 
 def _run_mocap(args: argparse.Namespace, path: Path) -> int:
@@ -154,6 +179,7 @@ def _run_mocap(args: argparse.Namespace, path: Path) -> int:
     from perception.io.atomic import check_output, write_csv
     from perception.pipeline import clip_fingerprint
     from perception.reaches import Unscored
+    from perception.recognition.result import warnings_summary
     from perception.recordings import read_recording, recognize_reach, trial_summary
     from perception.report.clip import write_clip_report
 
@@ -163,7 +189,7 @@ def _run_mocap(args: argparse.Namespace, path: Path) -> int:
     rep, rep_id = load_repertoire(args)
     args.output.mkdir(parents=True, exist_ok=True)
     table = check_output(_trials_table(args.output, path), [path])
-    rows, missed, kept, k = [], [], [], 0
+    rows, missed, kept, warned, k = [], [], [], [], 0
     for entry in recording.entries:
         if isinstance(entry, Unscored):
             rows.append(_row(entry.name, entry.status, entry.reason, entry.onset_time,
@@ -193,14 +219,9 @@ def _run_mocap(args: argparse.Namespace, path: Path) -> int:
             kept.append(reach.name)
             rows.append(_row(reach.name, "ok", "", onset, end, path, rec=rec,
                              report=paths["json"].name))
-            for warning in rec.warnings:
-                print(f"{reach.name}: warning: {warning}", file=sys.stderr)
+            warned.append((reach.name, [w.to_dict() for w in rec.validation_warnings]))
             if not args.quiet:
-                why = rec.verdict_detail or (rec.verdict_reason if rec.verdict == "unfamiliar"
-                                             else None)
-                detail = f" ({why})" if why else ""
-                print(f"{reach.name}: {rec.verdict or 'no verdict'}{detail}, winner "
-                      f"{rec.winner} -> {paths['json']}")
+                print(f"{verdict_line(rec)} -> {paths['json']}")
             continue
         rows.append(_row(reach.name, "failed", why, onset, end, path))
         missed.append((reach.name, why))
@@ -211,6 +232,9 @@ def _run_mocap(args: argparse.Namespace, path: Path) -> int:
     write_csv(table, pd.DataFrame(rows, columns=list(TRIALS_COLUMNS)))
     if not args.quiet:
         print(f"{trial_summary(len(recording.trials), len(kept), len(missed))} -> {table}")
+        # one line per kind of warning for the recording; each reach's are in its report
+        for line in warnings_summary(warned, "reaches"):
+            print(f"{path.name}: warning: {line}", file=sys.stderr)
     for name, why in missed:  # always: nothing is dropped without a word
         print(f"{name}: not scored: {why}", file=sys.stderr)
     return 1 if missed else 0
@@ -222,7 +246,9 @@ def _row(name: str, status: str, reason: str, onset: float, end: float, path: Pa
     return {"trial": name, "status": status, "reason": reason,
             "verdict": rec.verdict if rec is not None else None,
             "verdict_detail": rec.verdict_detail if rec is not None else None,
+            "verdict_reason": rec.verdict_reason if rec is not None else None,
             "winner": rec.winner if rec is not None else None,
+            "winner_note": rec.winner_note if rec is not None else None,
             "onset_time": onset, "end_time": end, "report": report, "source": str(path)}
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING
@@ -16,6 +17,7 @@ from perception.recognition.rules import (
     Verdict,
     VerdictRules,
     judge,
+    reason,
     slowed,
 )
 from perception.recognition.verdict import misfit
@@ -28,15 +30,100 @@ if TYPE_CHECKING:
     from perception.recognition.models import MotorModel
     from perception.recognition.shape import Normalisation
 
-__all__ = ["VERDICT_RULES", "Recognition"]
+__all__ = ["VALIDATED_DISTANCE", "VALIDATED_MOVEMENT_TIME", "VERDICT_RULES", "Recognition",
+           "ValidationWarning", "warnings_summary"]
 
 
 #: The movement times (onset to end by the field's rule, s) the verdict was
 #: validated on: the synthetic populations' 0.45-1.2 s grasps and a lab's real
 #: Optotrak grasps (1.05-2.06 s).
 VALIDATED_MOVEMENT_TIME = (0.4, 2.1)
-#: The reach distances (wrist at rest to the object's centre, m) it was validated on.
-VALIDATED_DISTANCE = (0.1, 0.7)
+#: A wrist that keeps its offset from the grip midpoint within this, m, in every sample
+#: was placed there, not tracked (:attr:`Recognition.wrist_synthesised`).
+SYNTHESISED_TOLERANCE = 1e-6
+#: The reach distances (wrist at rest to the object's centre, m, as the observation
+#: measures it: a motion-capture reach's wrist is placed 6 cm behind the grip) it was
+#: validated on: the synthetic populations' 0.22-0.40 m and the shared Optotrak table's
+#: 60 grasps (the rules chosen on its even trials, checked on its odd ones: docs/mocap.md),
+#: 0.55-0.715 m.
+VALIDATED_DISTANCE = (0.1, 0.72)
+
+
+@dataclass(frozen=True)
+class ValidationWarning:
+    """Where a movement lies outside what the verdict was validated on.
+
+    Attributes
+    ----------
+    kind : str
+        ``movement_time`` (s), ``distance`` (the reach's, m) or
+        ``time_scale`` (the shape pass's speed rescaling, a factor).
+    value : float
+        The movement's, in that unit.
+    text : str
+        The same in a sentence (the report's ``warnings``).
+    """
+
+    kind: str
+    value: float
+    text: str
+
+    def to_dict(self) -> dict:
+        """``{"kind": ..., "value": ...}``: the report's ``warning_values``."""
+        return {"kind": self.kind, "value": _num(self.value)}
+
+
+def warnings_summary(trials: Sequence[tuple[str, Sequence[dict]]], what: str = "trials"
+                     ) -> list[str]:
+    """One line per kind of warning for many trials, in place of a line per trial.
+
+    ``"58 of 60 trials judged at the repertoire's speed (times scaled by
+    0.65-0.87)"``; a kind that few trials have names them. Each trial's own
+    warnings stay in its report.
+
+    Parameters
+    ----------
+    trials : sequence of (str, sequence of dict)
+        Each trial's name and its warnings' ``{"kind", "value"}``
+        (:meth:`ValidationWarning.to_dict`: the report's ``warning_values``).
+    what : str
+        What a trial is called in the lines (``trials``, ``clips``).
+    """
+    by_kind: dict[str, list[tuple[str, float]]] = {}
+    for name, warnings in trials:
+        for w in warnings:
+            value = w.get("value")
+            by_kind.setdefault(w.get("kind", "other"), []).append(
+                (name, math.nan if value is None else float(value)))
+    total, out = len(trials), []
+    for kind, hits in by_kind.items():
+        values = np.array([v for _, v in hits], dtype=float)
+        values = values[np.isfinite(values)]
+        span = ""
+        if values.size:
+            unit, digits = _WARNING_UNITS.get(kind, ("", 2))
+            lo, hi = (f"{x:.{digits}f}" for x in (values.min(), values.max()))
+            span = f"{lo}{unit}" if lo == hi else f"{lo}-{hi}{unit}"
+        count = f"{len(hits)} of {total} {what}"
+        if kind == "time_scale":
+            line = f"{count} judged at the repertoire's speed (times scaled by {span})"
+        elif kind in _WARNING_RANGES:
+            label, (lo, hi), unit = _WARNING_RANGES[kind]
+            line = (f"{count}: {label} {span}, outside the {lo}-{hi}{unit} the verdict was "
+                    "validated on")
+        else:
+            line = f"{count}: {kind} {span}"
+        if len(hits) <= 3:
+            line += f" ({', '.join(name for name, _ in hits)})"
+        out.append(line)
+    return out
+
+
+#: The unit and decimals of each kind of warning's value in :func:`warnings_summary`.
+_WARNING_UNITS = {"movement_time": (" s", 2), "distance": (" m", 2), "time_scale": ("", 2)}
+#: Each range-checked kind: its words, its validated range and unit.
+_WARNING_RANGES = {"movement_time": ("movement time", VALIDATED_MOVEMENT_TIME, " s"),
+                   "distance": ("reach distance", VALIDATED_DISTANCE, " m")}
 
 @dataclass(frozen=True, eq=False)
 class Recognition:
@@ -94,6 +181,13 @@ class Recognition:
     notes : tuple of str
         What was done to the clip before it was scored (a start without
         rest: :func:`perception.settling.settle_start`).
+    time_origin : float
+        The recording's own clock at the observation clock's zero, s: a time
+        of :attr:`time`, of ``observation.clip_time`` or of the landmarks plus
+        it is on the recording's clock (a motion-capture file's time column or
+        first sample, a video's first frame); NaN where the caller did not
+        say (the figures then stay on the observation's clock, from the
+        scored movement's start, and say so).
     """
 
     clip: str
@@ -119,6 +213,7 @@ class Recognition:
     mirrored: bool = False
     measured: Landmarks | None = field(default=None, repr=False)
     notes: tuple[str, ...] = ()
+    time_origin: float = math.nan
 
     def score(self, rule: str | None = None) -> np.ndarray:
         """(M, N) cumulative score under ``rule`` (default: the winner's rule)."""
@@ -191,42 +286,76 @@ class Recognition:
         return self.decision.verdict
 
     @property
-    def verdict_reason(self) -> str | None:
-        """Why an ``unfamiliar`` or ``abnormal`` verdict was given, in words (None otherwise).
+    def wrist_synthesised(self) -> bool:
+        """Whether the observation's wrist was placed from the grip rather than recorded.
 
-        ``unfamiliar`` is "not a human reach" (even the transport is like
-        none of the reach models' own), "insufficient data" naming the digit
-        lost longest and where (or the movements seen), or "incomplete";
-        ``abnormal`` names the rule.
+        A motion-capture reach's tracks carry the models' wrist
+        (:data:`perception.reach_data.WRIST_BEHIND` behind the grip midpoint,
+        :func:`perception.reach_plane.reach_tracks`): it keeps one offset from
+        the grip midpoint, to the micrometre, in every sample, as no tracked
+        wrist does. Its paths and speed are the grip midpoint's, moved.
         """
-        rule = self.verdict_rule
-        if rule == "not-a-precision-grip":
-            return (f"not a precision grip: the digits start "
-                    f"{self.observation.marker_separation * 100:.0f} cm apart (the "
-                    "verdict knows grasps whose digits start closed)")
-        if rule == "not-a-human-reach":
-            return (f"not a human reach: its transport fits the reach models worse than "
-                    f"{1 - self.unfamiliar_threshold:.0%} of their own reaches")
-        if rule == "insufficient-data" and self.verdict_detail == "several-movements":
-            return (f"insufficient data: {self.landmarks[0].movements} movements in the clip "
-                    "(the verdict judges one)")
-        if rule == "insufficient-data" and self.evidence.scored_share < self.rules.min_scored:
-            return (f"insufficient data: the digits are seen in two frames running on "
-                    f"{self.evidence.scored_share:.0%} of the movement's steps (a verdict "
-                    f"needs {self.rules.min_scored:.0%})")
-        if rule == "insufficient-data":
-            return "insufficient data: " + self._longest_loss()
-        if rule == "incomplete":
-            return (f"incomplete: the clip ends before the hand arrives (its transport slowed "
-                    f"by {self.evidence.slowed:.0%} of its peak speed, not "
-                    f"{self.rules.arrival:.0%})")
-        if rule == "grip-departs":
-            return "the grip opens late or twice (the field's landmarks)"
-        if self.verdict == "abnormal":
-            return (f"no model explains the movement as well as "
-                    f"{1 - self.familiarity_threshold:.0%} of its own movements")
-        return None
+        obs = self.observation
+        if obs.clip_raw is not None:
+            wrist, finger, thumb = (obs.clip_raw[:, k] for k in range(3))
+        elif obs.raw and all(k in obs.raw for k in ("wrist", "finger", "thumb")):
+            wrist, finger, thumb = obs.raw["wrist"], obs.raw["finger"], obs.raw["thumb"]
+        else:
+            return False
+        offset = np.asarray(wrist, dtype=float) - 0.5 * (np.asarray(finger, dtype=float)
+                                                         + np.asarray(thumb, dtype=float))
+        offset = offset[np.isfinite(offset).all(axis=1)]
+        return len(offset) > 2 and float(np.ptp(offset, axis=0).max()) < SYNTHESISED_TOLERANCE
 
+    @property
+    def transport_point(self) -> str:
+        """What the figures' and traces' transport speed is the speed of: ``wrist``, or
+        ``grip midpoint`` where the wrist was synthesised from it (:attr:`wrist_synthesised`)."""
+        return "grip midpoint" if self.wrist_synthesised else "wrist"
+
+    @property
+    def verdict_model(self) -> str | None:
+        """The model the verdict was judged on: the best by log-likelihood of the pass
+        that gives the verdict (the reference pass with a :attr:`shape`)."""
+        names = self.shape.names if self.shape is not None else self.names
+        return names[self.decision.best] if len(names) else None
+
+    @property
+    def verdict_reason(self) -> str:
+        """Why the verdict was given, in words, with each measured value against its
+        rule's threshold (:func:`perception.recognition.rules.reason`).
+
+        Every verdict has one: the rule that fired ("delayed-opening: the grip
+        starts to open at 62 % of the movement, after the 55 % threshold
+        (late_opening); best model grasp-1.0s familiarity 0.40 >= 0.05 ...");
+        a movement whose digits were lost too long names the digit lost
+        longest and where.
+        """
+        names = self.shape.names if self.shape is not None else self.names
+        lost = self._longest_loss() if self.observation.raw else None
+        return reason(self.decision, self.evidence, self.rules, names, lost=lost)
+
+    @property
+    def winner_note(self) -> str | None:
+        """Where the winner's kind contradicts the verdict ("normal", a reach model
+        winning), what the winner is, in words; None where they agree.
+
+        The winner is the best of every model at the clip's own scale (the
+        scene pass); the verdict judges the movement at the repertoire's
+        scale (:attr:`shape`), where :attr:`verdict_model` fits best. A
+        report names the winner "closest model" then, not "winner".
+        """
+        winner, verdict = self.winner, self.verdict
+        if winner is None or verdict not in ("normal", "abnormal", "reach"):
+            return None
+        kind = self.kinds[self.names.index(winner)]
+        if (kind == "reach") == (verdict == "reach"):
+            return None
+        scale = "the repertoire's" if self.shape is not None else "the clip's own"
+        judged = "a reach" if verdict == "reach" else "a grasp"
+        return (f"closest model {winner}: a {kind} model fits the clip best at its own "
+                f"scale; the verdict judges it as {judged} at {scale} scale, where "
+                f"{self.verdict_model} fits best")
 
     def _longest_loss(self) -> str:
         """The digit lost longest during the movement, for how long and where."""
@@ -259,25 +388,36 @@ class Recognition:
                 f"{lp.max_gap_share:.0%} of the movement may hide a second opening)")
 
     @property
-    def warnings(self) -> list[str]:
-        """Where the movement lies outside what the verdict was validated on (docs/mocap.md)."""
+    def validation_warnings(self) -> list[ValidationWarning]:
+        """Where the movement lies outside what the verdict was validated on
+        (docs/mocap.md), each with its kind and measured value."""
         out = []
         lm = self.landmarks[0]
         lo, hi = VALIDATED_MOVEMENT_TIME
         if math.isfinite(lm.movement_time) and not lo <= lm.movement_time <= hi:
-            out.append(f"movement time {lm.movement_time:.2f} s is outside the "
-                       f"{lo}-{hi} s the verdict was validated on")
+            out.append(ValidationWarning(
+                "movement_time", lm.movement_time,
+                f"movement time {lm.movement_time:.2f} s is outside the {lo}-{hi} s the "
+                "verdict was validated on"))
         lo, hi = VALIDATED_DISTANCE
         d = self.observation.start_distance
         if not lo <= d <= hi:
-            out.append(f"reach distance {d:.2f} m is outside the {lo}-{hi} m the verdict "
-                       "was validated on")
+            out.append(ValidationWarning(
+                "distance", d, f"reach distance {d:.2f} m is outside the {lo}-{hi} m the "
+                "verdict was validated on"))
         if math.isfinite(lm.movement_time) and lm.movement_time > 0 and self.shape is not None:
             n = self.normalisation
             if n is not None and abs(n.time_scale - 1) > 1e-9:
-                out.append(f"judged at the repertoire's speed: times scaled by "
-                           f"{n.time_scale:.2f}")
+                out.append(ValidationWarning(
+                    "time_scale", n.time_scale,
+                    f"judged at the repertoire's speed: times scaled by {n.time_scale:.2f}"))
         return out
+
+    @property
+    def warnings(self) -> list[str]:
+        """Where the movement lies outside what the verdict was validated on, in words
+        (:attr:`validation_warnings`)."""
+        return [w.text for w in self.validation_warnings]
 
     @property
     def reference_model(self) -> str | None:
@@ -439,6 +579,11 @@ class Recognition:
             "verdict_rules": self.rules.to_dict(),
             "verdict_reason": self.verdict_reason,
             "warnings": self.warnings,
+            "warning_values": [w.to_dict() for w in self.validation_warnings],
+            "winner_note": self.winner_note,
+            "verdict_model": self.verdict_model,
+            "transport_point": self.transport_point,
+            "time_origin": _num(self.time_origin),
             "notes": list(self.notes),
             "familiarity": _num(d.familiarity),
             "margin": _num(d.margin),

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Annotated
 
@@ -28,7 +28,7 @@ from perception.observation import ObserveParams
 from perception.validation import Int, Share, declared
 
 __all__ = ["DETAILS", "HAND_SPAN", "REASONS", "RULE_TABLE", "VERDICT_RULES", "Evidence", "Verdict",
-           "VerdictRules", "grip_departs", "judge", "slowed", "verdict_detail"]
+           "VerdictRules", "grip_departs", "judge", "reason", "slowed", "verdict_detail"]
 
 #: Kinds of an abnormal verdict (:func:`verdict_detail`).
 DETAILS = ("delayed-opening", "re-opening", "no-opening", "other")
@@ -371,3 +371,159 @@ def judge(evidence: Evidence, rules: VerdictRules | None = None) -> Verdict:
                 detail = verdict_detail(evidence.observed, evidence.reference, rules)
             return Verdict(verdict, best, fam, margin, name, detail)
     return Verdict(None, best, fam, margin)
+
+
+def _pc(share: float) -> str:
+    """A share of the movement as the reasons print it: ``62 %``."""
+    return f"{share * 100:.0f} %"
+
+
+def _fam(x: float) -> str:
+    """A familiarity with the digits that tell it from its threshold (0.02, 0.004, 3e-05)."""
+    return f"{x:.2f}" if x >= 0.01 else f"{x:.1g}"
+
+
+def _opening(o: Landmarks, rules: VerdictRules) -> str:
+    """When the grip starts to open, against ``late_opening``."""
+    if not math.isfinite(o.opening_time):
+        return "the grip's start to open was not seen"
+    side = "after" if o.opening_time > rules.late_opening else "before"
+    return (f"the grip starts to open at {_pc(o.opening_time)} of the movement, {side} the "
+            f"{_pc(rules.late_opening)} threshold (late_opening)")
+
+
+def _peaks(o: Landmarks) -> str:
+    """The aperture's peaks: a grasp opens once."""
+    if o.aperture_peaks is None:
+        return "the aperture's peaks not counted (the digits were unseen too long)"
+    if o.aperture_peaks >= 2:
+        return f"{o.aperture_peaks} aperture peaks (a grasp opens once)"
+    return f"{o.aperture_peaks} aperture peak"
+
+
+def _mga(o: Landmarks, ref: Landmarks | None, rules: VerdictRules) -> str:
+    """When the MGA comes, against ``late_mga`` (and the reference model's own)."""
+    if not math.isfinite(o.mga_time):
+        return "the MGA was not seen"
+    side = "after" if o.mga_time > rules.late_mga else "before"
+    text = (f"the MGA comes at {_pc(o.mga_time)} of the movement, {side} the "
+            f"{_pc(rules.late_mga)} threshold (late_mga)")
+    if ref is not None and math.isfinite(ref.mga_time):
+        text += f", the reference model's at {_pc(ref.mga_time)}"
+    return text
+
+
+def _no_opening(o: Landmarks, ref: Landmarks, rules: VerdictRules) -> str:
+    """How far the grip opens against ``no_opening`` of the reference model's opening."""
+    return (f"the grip opens {o.opening * 1000:.0f} mm beyond its rest, under "
+            f"{_pc(rules.no_opening)} of the reference model's {ref.opening * 1000:.0f} mm "
+            "(no_opening)")
+
+
+def _departure(detail: str | None, e: Evidence, rules: VerdictRules) -> str:
+    """The kind of an abnormal grasp with the landmark that made it, against its threshold."""
+    o, ref = e.observed, e.reference
+    if o is None or detail is None:
+        return ""
+    if detail == "no-opening" and ref is not None:
+        return f"no-opening: {_no_opening(o, ref, rules)}"
+    if detail == "re-opening":
+        return f"re-opening: {_peaks(o)}"
+    if detail == "delayed-opening":
+        late = math.isfinite(o.opening_time) and o.opening_time > rules.late_opening
+        return f"delayed-opening: {_opening(o, rules) if late else _mga(o, ref, rules)}"
+    # nothing in the landmarks departs: say what they are, so that a reader sees it
+    return (f"no landmark departs: {_opening(o, rules)}, {_peaks(o)}, "
+            f"{_mga(o, ref, rules)}")
+
+
+def _familiarity(e: Evidence, rules: VerdictRules, best: int, names: Sequence[str]) -> str:
+    """The best model's familiarity against the threshold, and the model nearest to passing."""
+    fam, t = float(e.familiarity[best]), rules.familiarity_threshold
+    sign = "<" if fam < t else ">="
+    text = (f"best model {names[best]} familiarity {_fam(fam)} {sign} {_fam(t)} threshold "
+            "(familiarity_threshold)")
+    others = [(float(f), i) for i, f in enumerate(e.familiarity)
+              if i != best and math.isfinite(f)]
+    if fam < t and others:
+        near, i = max(others)
+        ll = np.asarray(e.log_likelihood, dtype=float)
+        if near >= t:  # familiar, but a worse fit than the best: it does not decide
+            text += (f"; {names[i]} would pass at {_fam(near)} but fits worse "
+                     f"(log-likelihood {ll[best] - ll[i]:.1f} lower)")
+        else:
+            text += f"; the nearest to passing: {names[i]} at {_fam(near)}"
+    return text
+
+
+def reason(verdict: Verdict, evidence: Evidence, rules: VerdictRules | None = None,
+           names: Sequence[str] | None = None, lost: str | None = None) -> str:
+    """Why ``verdict`` was given, in words, with each measured value against its threshold.
+
+    The rule that fired (:attr:`Verdict.rule`) with what it read in
+    ``evidence``: the landmark that made an abnormal grasp's kind (``"delayed-opening:
+    the grip starts to open at 62 % of the movement, after the 55 % threshold
+    (late_opening)"``), the best model's familiarity against
+    ``familiarity_threshold`` and the model nearest to passing, the digits'
+    gap, the transport's slowing or familiarity, the rest aperture. Every
+    verdict gets one, ``normal`` and ``reach`` too; each threshold is named
+    by its :class:`VerdictRules` field.
+
+    Parameters
+    ----------
+    verdict : Verdict
+        :func:`judge`'s, of ``evidence`` under ``rules``.
+    evidence : Evidence
+    rules : VerdictRules, optional
+    names : sequence of str, optional
+        The models' names, in the order of ``evidence.kinds`` (default:
+        ``model 1``, ``model 2``, ...).
+    lost : str, optional
+        What was lost and where, in words (the observation's: "the thumb was
+        lost 0.48 s at 2-34 % of the movement"), for a movement whose gap
+        leaves too little to judge; default: the evidence's longest gap.
+    """
+    rules = VerdictRules() if rules is None else rules
+    e, v = evidence, verdict
+    names = list(names) if names is not None else [f"model {i + 1}"
+                                                   for i in range(len(e.kinds))]
+    o, rule = e.observed, v.rule
+    if rule == "not-a-precision-grip":
+        return (f"not a precision grip: the digits start {e.rest_aperture * 100:.0f} cm "
+                f"apart, over the {rules.precision_grip_aperture * 100:.0f} cm limit "
+                "(precision_grip_aperture; the verdict knows grasps whose digits start closed)")
+    if rule == "insufficient-data" and v.detail == "several-movements" and o is not None:
+        return f"insufficient data: {o.movements} movements in the clip (the verdict judges one)"
+    if rule == "insufficient-data" and e.scored_share < rules.min_scored:
+        return (f"insufficient data: the digits are seen in two frames running on "
+                f"{_pc(e.scored_share)} of the movement's steps, under the "
+                f"{_pc(rules.min_scored)} a verdict needs (min_scored)")
+    if rule == "insufficient-data":
+        lp = rules.landmarks
+        lost = lost or f"the aperture was lost {e.aperture_gap:.2f} s during the movement"
+        return (f"insufficient data: {lost} (a gap over {lp.max_gap:.2f} s and "
+                f"{_pc(lp.max_gap_share)} of the movement may hide a second opening: "
+                "max_gap, max_gap_share)")
+    if rule == "incomplete":
+        return (f"incomplete: the clip ends before the hand arrives: its transport slowed "
+                f"by {_pc(e.slowed)} of its peak speed, under the {_pc(rules.arrival)} "
+                "of an arrival (arrival)")
+    if rule == "not-a-human-reach":
+        return (f"not a human reach: its transport's familiarity to the best reach model "
+                f"{_fam(e.transport_familiarity)} < {_fam(rules.unfamiliar_threshold)} "
+                "threshold (unfamiliar_threshold)")
+    if rule is None:
+        return (f"no verdict: the best model {names[v.best]} has no calibration (no "
+                "familiarity to judge by)")
+    fam = _familiarity(e, rules, v.best, names)
+    departs = _departure(v.detail, e, rules)
+    if rule == "grip-departs":
+        if v.detail == "no-opening" and o is not None:  # the kind, then why the rule fired
+            departs += "; " + (_peaks(o) if (o.aperture_peaks or 0) >= 2
+                               else _opening(o, rules))
+        return f"{departs}; {fam}"
+    if v.verdict == "abnormal":
+        return "; ".join(x for x in (fam, departs) if x)
+    if v.verdict == "normal" and o is not None:  # the grip's landmarks, each within its rule
+        return f"{fam}; {_opening(o, rules)}, {_peaks(o)}"
+    return fam

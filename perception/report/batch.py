@@ -46,6 +46,7 @@ from perception.report.paper import (
     condition_kinematics_figure,
     kinematic_profiles,
     landmark_strip_figure,
+    transport_name,
 )
 from perception.report.statistics import (
     landmark_statistics,
@@ -162,6 +163,36 @@ def _num(value, fmt: str) -> str:
     return format(v, fmt) if np.isfinite(v) else ""
 
 
+def with_verdict_reasons(summary: pd.DataFrame, recognitions: dict[str, ClipSummary]
+                         ) -> pd.DataFrame:
+    """``summary`` with ``verdict_reason`` and ``winner_note`` after ``verdict_rule``.
+
+    Each scored clip's :attr:`ClipSummary.verdict_reason` (the rule that
+    fired, with the measured value against its threshold) and
+    :attr:`ClipSummary.winner_note` (what the winner is where its kind
+    contradicts the verdict); empty for clips without a result. Columns the
+    summary already has are kept as they are.
+
+    Parameters
+    ----------
+    summary : pandas.DataFrame
+        One row per clip (:func:`perception.batch.summary_table`).
+    recognitions : dict of ClipSummary
+        Scored clips by name.
+    """
+    summary = summary.copy()
+    where = (list(summary.columns).index("verdict_rule") + 1 if "verdict_rule" in summary
+             else len(summary.columns))
+    for column in ("verdict_reason", "winner_note"):
+        if column in summary:
+            continue
+        values = [getattr(recognitions[c], column) if c in recognitions and ok == "ok"
+                  else None for c, ok in zip(summary["clip"], summary["status"])]
+        summary.insert(where, column, values)
+        where += 1
+    return summary
+
+
 def _verdict_cell(verdict, status: str, detail=None) -> str:
     if status != "ok":  # failed, or a trial that gives no reach (its status)
         return f'<span class="v-failed">{_e(status) or "failed"}</span>'
@@ -209,7 +240,7 @@ def _models_table(summary: pd.DataFrame) -> str:
 #: summary.csv columns the main table or the per-model table shows.
 _SHOWN = {"clip", "condition", "winner", "rule", "verdict", "verdict_detail", "familiarity",
           "margin", "winner_log_likelihood", "reference_model", "reference_confidence", "status",
-          "reused", "error", "reason"}
+          "reused", "error", "reason", "verdict_reason", "winner_note"}
 
 
 def _other_columns_table(summary: pd.DataFrame) -> str:
@@ -242,10 +273,18 @@ def _clip_section(rec: ClipSummary, out: Path, anchor: str, condition,
     files = clip_outputs(out, rec.clip)
     links = " · ".join(_link(files[k].name, label) for k, label in
                        (("json", "recognition.json"), ("csv", "confidence.csv")))
+    # a winner whose kind contradicts the verdict is named for what it is
+    winner = ("closest model" if rec.winner_note else "winner")
     line = (f"verdict {_verdict_cell(rec.verdict, 'ok', rec.verdict_detail)}"
             f" (familiarity {_num(rec.familiarity, '.2f')}, margin {_num(rec.margin, '.1f')})"
-            f"; winner {_e(rec.winner)} ({_e(rec.rule)} rule); condition "
+            f"; {winner} {_e(rec.winner)} ({_e(rec.rule)} rule); condition "
             f"{_e(condition) or 'unlabelled'}; files: {links}")
+    if rec.verdict_reason:
+        line += f"<br>why: {_e(rec.verdict_reason)}"
+    if rec.winner_note:
+        line += f"<br>{_e(rec.winner_note)}"
+    if rec.warnings:
+        line += "<br>warnings: " + "; ".join(_e(w) for w in rec.warnings)
     # each figure links to itself at full size; the kinematics one shows as a thumbnail
     thumb = files["kinematics_png"].with_suffix("").name
     figs = "".join(_image(p.name, p.name, "thumb" if p.with_suffix("").name == thumb else "",
@@ -295,8 +334,9 @@ def _kinematics(recs: list[ClipSummary], conds: list[str], landmarks: pd.DataFra
     write_figure(condition_kinematics_figure(recs, conds), out / "kinematic_profiles", fmt, dpi)
     write_figure(landmark_strip_figure(landmarks), out / "landmark_strips", fmt, dpi)
     return "<h2>Kinematics per condition</h2>" + _grid([
-        ("kinematic_profiles", "wrist speed (mm/s) and grip aperture (mm) per condition, "
-         "mean ± SD, from each trial's onset to its end (kinematic_profiles.csv)"),
+        ("kinematic_profiles", f"{transport_name(recs)} speed (mm/s) and grip aperture (mm) "
+         "per condition, mean ± SD, from each trial's onset to its end "
+         "(kinematic_profiles.csv)"),
         ("landmark_strips", "each landmark of every trial, per condition (coloured by "
          "participant where the manifest names them), with the condition's mean ± SD")], fmt)
 
@@ -351,6 +391,7 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
     """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
+    summary = with_verdict_reasons(summary, recognitions)
     write_csv(out / "summary.csv", _printable_table(summary))
     landmarks = landmark_table(summary, recognitions)
     measures = measure_table(landmarks, summary)

@@ -32,7 +32,8 @@ RECOGNITION_KEYS = frozenset({
     "clip", "models", "winner", "rule", "verdict", "familiarity", "margin",
     "familiarity_threshold", "reference_model", "time", "confidence", "transport_confidence",
     "aperture", "verdict_detail", "verdict_rule", "verdict_rules", "verdict_reason", "warnings",
-    "notes", "kinematics", "shape", "passes", "mirrored", "traces"})
+    "notes", "kinematics", "shape", "passes", "mirrored", "traces", "warning_values",
+    "winner_note", "verdict_model", "transport_point", "time_origin"})
 
 #: The observed landmarks a batch's ``summary.csv`` shows, one column each
 #: (:attr:`ClipSummary.kinematics`; units in docs/recognition.md §9).
@@ -120,6 +121,25 @@ class ClipSummary:
     extras : dict
         The JSON's other keys (``fingerprint``, ``condition``, ``input``,
         ``tracking``, …).
+    verdict_reason : str or None
+        Why the verdict was given, with each measured value against its
+        rule's threshold (:attr:`Recognition.verdict_reason`; None in reports
+        written before every verdict had one and it was not given).
+    winner_note : str or None
+        What the winner is where its kind contradicts the verdict
+        (:attr:`Recognition.winner_note`); None where they agree.
+    warnings : list of str
+        Where the clip lies outside what the verdict was validated on, in words.
+    warning_values : list of dict
+        The same as ``{"kind", "value"}``
+        (:meth:`~perception.recognition.result.ValidationWarning.to_dict`).
+    transport_point : str
+        Whose speed ``traces["wrist_speed"]`` is: ``wrist``, or ``grip
+        midpoint`` where no wrist was recorded
+        (:attr:`Recognition.transport_point`).
+    time_origin : float
+        The recording's clock at the observation clock's zero, s (NaN: not
+        known; :attr:`Recognition.time_origin`).
     """
 
     clip: str
@@ -142,6 +162,12 @@ class ClipSummary:
     kinematics: dict | None = None
     verdict_rule: str | None = None
     traces: dict | None = None
+    verdict_reason: str | None = None
+    winner_note: str | None = None
+    warnings: list = field(default_factory=list)
+    warning_values: list = field(default_factory=list)
+    transport_point: str = "wrist"
+    time_origin: float = float("nan")
 
     @property
     def tracking(self) -> dict | None:
@@ -203,6 +229,12 @@ class ClipSummary:
             kinematics=d.get("kinematics"),
             verdict_rule=d.get("verdict_rule"),
             traces=d.get("traces"),
+            verdict_reason=d.get("verdict_reason"),
+            winner_note=d.get("winner_note"),
+            warnings=list(d.get("warnings") or []),
+            warning_values=list(d.get("warning_values") or []),
+            transport_point=d.get("transport_point") or "wrist",
+            time_origin=float(_floats([d.get("time_origin")])[0]),
         )
 
     @classmethod
@@ -225,7 +257,10 @@ class ClipSummary:
                    transport=np.cumsum(rec.dC_r, axis=1), aperture=rec.observation.g,
                    extras=dict(extras or {}), verdict_detail=rec.verdict_detail,
                    kinematics=rec.kinematics, verdict_rule=rec.verdict_rule,
-                   traces=clip_traces(rec))
+                   traces=clip_traces(rec), verdict_reason=rec.verdict_reason,
+                   winner_note=rec.winner_note, warnings=rec.warnings,
+                   warning_values=[w.to_dict() for w in rec.validation_warnings],
+                   transport_point=rec.transport_point, time_origin=rec.time_origin)
 
     def index(self, model: str) -> int:
         """Row of ``model`` in the per-model arrays.

@@ -143,10 +143,13 @@ def _title(fig: Figure, title: str) -> None:
 
 def _verdict_line(rec: Recognition) -> str:
     d = rec.decision
+    # a winner whose kind contradicts the verdict (a reach model on a normal grasp) is
+    # the closest model at the clip's own scale, not what the verdict is about
+    winner = "closest model" if getattr(rec, "winner_note", None) else "winner"
     if d.verdict is None:
-        return f"winner {rec.winner} ({rec.rule} rule)"
+        return f"{winner} {rec.winner} ({rec.rule} rule)"
     return (f"verdict {d.verdict} (familiarity {d.familiarity:.2f}, margin {d.margin:.1f}); "
-            f"winner {rec.winner} ({rec.rule} rule)")
+            f"{winner} {rec.winner} ({rec.rule} rule)")
 
 
 # -- one clip ---------------------------------------------------------------------
@@ -188,6 +191,11 @@ def paths_figure(rec: Recognition, model: str | None = None) -> Figure:
     Left, the observed wrist, finger and thumb paths and the model's own
     noise-free movement from the same start; right, the grip aperture over
     time: observed, the model's own, and the model's one-step predictions.
+    A wrist that was not recorded but placed behind the grip (a
+    motion-capture reach without a wrist marker:
+    :attr:`~perception.recognition.result.Recognition.wrist_synthesised`) is
+    not drawn as observed: it would be the grip midpoint's path, moved; the
+    panel's title says so.
 
     Parameters
     ----------
@@ -201,9 +209,12 @@ def paths_figure(rec: Recognition, model: str | None = None) -> Figure:
     i = rec.names.index(model)
     obs, own = rec.observation, rec.nominal(model)
     fig, (paths, grip) = _figure((12, 5.5), 2, titled=True)
+    placed = bool(getattr(rec, "wrist_synthesised", False))
     for key, colour in (("finger", "g"), ("thumb", "r"), ("wrist", "b")):
         seen, plan = getattr(obs, key), own[key]
-        paths.plot(seen[:, 0], seen[:, 1], "-", color=colour, lw=1.8, label=f"{key} observed")
+        if not (key == "wrist" and placed):
+            paths.plot(seen[:, 0], seen[:, 1], "-", color=colour, lw=1.8,
+                       label=f"{key} observed")
         paths.plot(plan[:, 0], plan[:, 1], "--", color=colour, lw=1.5, label=f"{key}, {model}")
     circle = np.linspace(0, 2 * np.pi, 100)
     rad = obs.object_diameter / 2
@@ -212,6 +223,10 @@ def paths_figure(rec: Recognition, model: str | None = None) -> Figure:
     paths.set_aspect("equal", adjustable="datalim")
     _panel(paths, f"paths: observed (solid) and {model}'s own movement (dashed)", "x (m)",
            "y (m), toward the object")
+    if placed:  # under the title, in its own words (a title is printed, newlines escaped)
+        paths.annotate("wrist not recorded (placed behind the grip): not drawn", (0.5, 1.0),
+                       xycoords="axes fraction", xytext=(0, -12), textcoords="offset points",
+                       ha="center", va="top", fontsize=LEGEND_PT, color="0.3", gid="no-wrist")
     _legend(paths, paths.get_lines(), ncols=2)
     own_g = np.linalg.norm(own["finger"] - own["thumb"], axis=1)
     grip.plot(rec.time, obs.g * CM, "-", color="k", lw=2.0, label="observed")

@@ -1,7 +1,9 @@
 """One trial's kinematics at a glance: transport speed and grip aperture with their landmarks.
 
-:func:`kinematics_figure` draws, over the whole clip, the wrist's speed
-(mm/s) above the grip aperture (mm), sharing the time axis, with the
+:func:`kinematics_figure` draws, over the whole clip, the transport's speed
+(mm/s: the wrist's, or the grip midpoint's where no wrist was recorded)
+above the grip aperture (mm), sharing the time axis (the recording's clock
+where it is known), with the
 landmarks of :func:`perception.landmarks.observed_landmarks` marked on them:
 the movement's onset and end (lines across both panels, the movement
 shaded between them), the peak speed, the maximum grip aperture (MGA, with
@@ -18,6 +20,7 @@ an Agg canvas, never through pyplot, matplotlib imported with the first figure.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import TYPE_CHECKING
 
@@ -33,7 +36,8 @@ if TYPE_CHECKING:
     from perception.observation import Observation
     from perception.recognition.result import Recognition
 
-__all__ = ["kinematic_traces", "kinematics_figure", "kinematics_title"]
+__all__ = ["kinematic_traces", "kinematics_figure", "kinematics_title", "time_axis",
+           "transport_label"]
 
 MM = 1000.0
 #: The figure's size, inches; margins around the two panels (left, right, the
@@ -109,6 +113,39 @@ def kinematics_title(rec: Recognition) -> str:
     return f"{rec.clip}: {verdict}, familiarity {fam}"
 
 
+def time_axis(rec: Recognition) -> tuple[float, str]:
+    """The figure's clock: what to add to the observation's times, and the axis label.
+
+    The recording's own clock where the recognition knows it
+    (:attr:`~perception.recognition.result.Recognition.time_origin`: a
+    motion-capture file's time column or first sample, as ``landmarks``'
+    ``onset_time`` and ``end_time``); else the observation's, from the scored
+    movement's start, named as such.
+
+    Parameters
+    ----------
+    rec : Recognition
+        A scored clip.
+    """
+    origin = getattr(rec, "time_origin", math.nan)
+    if _finite(origin):
+        return float(origin), "time on the recording's clock (s)"
+    return 0.0, "time from the scored movement's start (s)"
+
+
+def transport_label(rec: Recognition) -> str:
+    """What the speed curve is the speed of: ``wrist``, or ``grip midpoint`` where the
+    wrist was not recorded but placed behind the grip
+    (:attr:`~perception.recognition.result.Recognition.transport_point`).
+
+    Parameters
+    ----------
+    rec : Recognition
+        A scored clip.
+    """
+    return getattr(rec, "transport_point", "wrist")
+
+
 def _at(lm: Landmarks, share: float) -> float:
     """The clock time of a share of the movement (NaN where any part is)."""
     return lm.onset_time + share * lm.movement_time
@@ -127,8 +164,12 @@ def _note(ax: Axes, x: float, y: float, text: str, colour: str, dy: float = 8.0)
 def kinematics_figure(rec: Recognition) -> Figure:
     """The trial's transport speed and grip aperture with their landmarks.
 
-    Above, the wrist's speed (mm/s); below, the grip aperture (mm); over the
-    whole clip, on the observation's clock (s). The movement, onset to end,
+    Above, the transport's speed (mm/s; labelled for what it is: the
+    wrist's, or the grip midpoint's where the wrist was synthesised from the
+    grip, :func:`transport_label`); below, the grip aperture (mm); over the
+    whole clip, on the recording's clock where it is known, else from the
+    scored movement's start, the axis label saying which
+    (:func:`time_axis`). The movement, onset to end,
     is shaded and bounded by dashed lines across both panels (the bound's
     speed, 5 % of the peak, dotted); the peak speed and the MGA are dots on
     their curves, labelled with their values, the grip's start to open a
@@ -149,6 +190,11 @@ def kinematics_figure(rec: Recognition) -> Figure:
     lm = rec.landmarks[0]
     params = LandmarkParams()
     time, speed, aperture = kinematic_traces(rec.observation, params)
+    origin, xlabel = time_axis(rec)
+    time = time + origin
+    lm = dataclasses.replace(lm, onset_time=lm.onset_time + origin,
+                             end_time=lm.end_time + origin)
+    point = transport_label(rec)
 
     width, height = SIZE
     fig = Figure(figsize=SIZE)
@@ -157,7 +203,7 @@ def kinematics_figure(rec: Recognition) -> Figure:
         left=LEFT / width, right=1 - RIGHT / width, bottom=BOTTOM / height,
         top=1 - TOP / height, hspace=GAP / ((height - BOTTOM - TOP - GAP) / 2)))
     handles = [top.plot(time, speed * MM, color=SPEED_COLOUR, lw=1.8,
-                        label="wrist speed")[0],
+                        label=f"{point} speed")[0],
                grip.plot(time, aperture * MM, color=GRIP_COLOUR, lw=1.8,
                          label="grip aperture")[0]]
 
@@ -204,7 +250,7 @@ def kinematics_figure(rec: Recognition) -> Figure:
                              zorder=3, gid="mga", label="MGA (maximum grip aperture)")
         _note(grip, t_mga, y, f"MGA {y:.0f} mm", GRIP_COLOUR)
 
-    for ax, label, curve, least in ((top, "wrist speed (mm/s)", speed, MIN_TOP[0]),
+    for ax, label, curve, least in ((top, f"{point} speed (mm/s)", speed, MIN_TOP[0]),
                                     (grip, "grip aperture (mm)", aperture, MIN_TOP[1])):
         ax.set_ylabel(label)
         ax.grid(True, color="0.92", lw=0.6, zorder=0)
@@ -213,7 +259,7 @@ def kinematics_figure(rec: Recognition) -> Figure:
         ax.set_ylim(0.0, max(1.2 * peak, least))
     if len(time):
         grip.set_xlim(float(np.nanmin(time)), float(np.nanmax(time)))
-    grip.set_xlabel("time (s)")
+    grip.set_xlabel(xlabel)
     _legend(fig, handles, "lower center", ncols=4, frameon=False)
     _title(fig, kinematics_title(rec))
     return fig

@@ -1,7 +1,9 @@
 """Figures for a paper: each condition's kinematics, mean ± SD, and every trial's landmarks.
 
-:func:`condition_kinematics_figure` draws the wrist's speed (mm/s) and the
-grip aperture (mm) of each condition, mean ± SD over its trials, against
+:func:`condition_kinematics_figure` draws the transport's speed (mm/s: the
+wrist's, or the grip midpoint's where no wrist was recorded,
+:func:`transport_name`) and the grip aperture (mm) of each condition, mean
+± SD over its trials, against
 the share of the movement (0-100 %, from each trial's onset to its end by
 the field's definitions: the landmarks' ``onset_time`` and ``end_time``,
 :class:`~perception.landmarks.LandmarkParams`); :func:`kinematic_profiles`
@@ -51,7 +53,7 @@ if TYPE_CHECKING:
     from perception.recognition.result import Recognition
 
 __all__ = ["LANDMARKS", "PARTICIPANT_COLUMNS", "condition_kinematics_figure",
-           "kinematic_profiles", "landmark_strip_figure"]
+           "kinematic_profiles", "landmark_strip_figure", "transport_name"]
 
 #: Samples of the movement (0-100 %) of the profiles.
 POINTS = 101
@@ -80,6 +82,24 @@ def _trial(rec: Recognition | ClipSummary) -> tuple[np.ndarray, np.ndarray, np.n
     else:
         curves = [rec.time, np.full(len(rec.time), np.nan), rec.aperture]
     return (*curves, rec.landmark("onset_time"), rec.landmark("end_time"))
+
+
+def transport_name(recognitions: Sequence[Recognition | ClipSummary]) -> str:
+    """What the trials' speed curves are the speed of, in words.
+
+    ``wrist``, ``grip midpoint`` (no wrist recorded: the one the reports
+    name, :attr:`~perception.recognition.result.Recognition.transport_point`),
+    or ``transport (wrist or grip midpoint)`` where the trials differ.
+
+    Parameters
+    ----------
+    recognitions : sequence of Recognition or ClipSummary
+        The trials.
+    """
+    points = {getattr(rec, "transport_point", "wrist") for rec in recognitions}
+    if len(points) == 1:
+        return points.pop()
+    return "transport (wrist or grip midpoint)" if points else "wrist"
 
 
 def _resampled(time: np.ndarray, values: np.ndarray, onset: float, end: float,
@@ -144,11 +164,12 @@ def kinematic_profiles(recognitions: Sequence[Recognition | ClipSummary],
 
 def condition_kinematics_figure(recognitions: Sequence[Recognition | ClipSummary],
                                 conditions: Sequence[str | None]) -> Figure:
-    """Wrist speed (mm/s) and grip aperture (mm) per condition, mean ± SD, onset to end.
+    """Transport speed (mm/s) and grip aperture (mm) per condition, mean ± SD, onset to end.
 
-    Left the speed, right the aperture, against the share of the movement
-    (0-100 %); one line per condition over a band of ± 1 SD, each panel's
-    legend giving the trials behind its lines (:func:`kinematic_profiles`).
+    Left the speed (named for its point, :func:`transport_name`), right the
+    aperture, against the share of the movement (0-100 %); one line per
+    condition over a band of ± 1 SD, each panel's legend giving the trials
+    behind its lines (:func:`kinematic_profiles`).
 
     Parameters
     ----------
@@ -160,7 +181,8 @@ def condition_kinematics_figure(recognitions: Sequence[Recognition | ClipSummary
     profiles = kinematic_profiles(recognitions, conditions)
     conds = list(dict.fromkeys(profiles["condition"]))
     fig, axes = _figure((11.0, 4.8), 2, titled=True)
-    for ax, key, title, unit in zip(axes, ("speed", "aperture"), ("wrist speed", "grip aperture"),
+    speed = f"{transport_name(recognitions)} speed"
+    for ax, key, title, unit in zip(axes, ("speed", "aperture"), (speed, "grip aperture"),
                                     ("mm/s", "mm")):
         lines = []
         for cond, g in profiles.groupby("condition", sort=False):
