@@ -341,3 +341,43 @@ def test_landmarks_takes_object_diameter_px_and_suggests_only_its_own_flags():
     found = measure(tracks, object_diameter=0.06, object_diameter_px=60.0).movements[0]
     direct = measure(tracks, px_per_m=px).movements[0]
     assert found.landmarks.movement_time == pytest.approx(direct.landmarks.movement_time)
+
+
+def test_landmarks_on_a_deeplabcut_file_takes_the_flag_it_suggests(tmp_path):
+    from perception.io.pose import write_dlc
+    from perception.synthetic.demos import demo_tracks
+
+    tracks, _ = demo_tracks("normal", 0, fps=25.0)
+    pose = tmp_path / "t1DLC_resnet50_xShuffle1_1000.csv"
+    write_dlc(tracks, pose, scorer="DLC_resnet50_xShuffle1_1000")
+    out = tmp_path / "lm.csv"
+    res = hammer("landmarks", pose, "--fps", 25, "-o", out)
+    assert res.returncode == 2 and "--object-diameter-px" in res.stderr, res.stderr
+    help_text = hammer("landmarks", "--help").stdout
+    for flag in {f for f in res.stderr.split() if f.startswith("--")}:
+        assert flag.strip("(),.:") in help_text, flag  # every flag it names, it has
+    res = hammer("landmarks", pose, "--fps", 25, "-o", out, "--object-diameter-px", 80,
+                 "--object-diameter", 0.06)
+    assert res.returncode == 0, res.stderr
+    by_px = _read(out).set_index("landmark")["value"]
+    res = hammer("landmarks", pose, "--fps", 25, "-o", out, "--px-per-m", 80 / 0.06)
+    assert res.returncode == 0, res.stderr
+    pd.testing.assert_series_equal(_read(out).set_index("landmark")["value"], by_px)
+    assert 500 < by_px["movement_time"] < 1500
+
+
+def test_a_table_in_si_units_is_put_in_lab_units_with_its_sidecar(tmp_path):
+    from perception.report.tables import in_lab_units, write_units
+
+    si = pd.DataFrame({"clip": ["a"], "movement_time": [1.25], "peak_speed_time": [0.4],
+                       "mga": [0.081], "aperture_peaks": pd.array([1], dtype="Int64"),
+                       "verdict": ["normal"]})
+    lab = in_lab_units(si)
+    assert lab.loc[0, "movement_time"] == 1250.0 and lab.loc[0, "peak_speed_time"] == 40.0
+    assert lab.loc[0, "mga"] == pytest.approx(81.0) and lab.loc[0, "aperture_peaks"] == 1
+    assert lab.loc[0, "verdict"] == "normal" and si.loc[0, "movement_time"] == 1.25
+    path = write_units(tmp_path / "summary.csv", lab.columns)
+    assert path == tmp_path / "summary.units.json"
+    assert json.loads(path.read_text()) == {
+        "movement_time": {"unit": "ms", "clock": ""}, "peak_speed_time": {"unit": "%", "clock": ""},
+        "mga": {"unit": "mm", "clock": ""}, "aperture_peaks": {"unit": "count", "clock": ""}}

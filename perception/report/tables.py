@@ -29,7 +29,8 @@ if TYPE_CHECKING:  # pandas only where a table is written
     from perception.report.clip import ClipSummary
 
 __all__ = ["LANDMARK_CLOCKS", "LANDMARK_COLUMNS", "LANDMARK_UNITS", "NOT_SCORED", "TABLES",
-           "MovementLandmarks", "factor_columns", "landmark_table", "r_name", "tidy_landmarks",
+           "MovementLandmarks", "factor_columns", "in_lab_units", "landmark_table", "r_name",
+           "tidy_landmarks",
            "units_of", "units_path", "wide_landmarks", "with_r_aliases", "write_units"]
 
 #: The batch tables of this module and :mod:`perception.report.statistics`.
@@ -307,6 +308,24 @@ def units_of(columns: Iterable[str]) -> dict[str, dict[str, str]]:
     """
     return {c: {"unit": LANDMARK_COLUMNS[c][0], "clock": LANDMARK_COLUMNS[c][1]}
             for c in columns if c in LANDMARK_COLUMNS}
+
+
+def in_lab_units(table: pd.DataFrame) -> pd.DataFrame:
+    """``table`` with each landmark column (:data:`LANDMARK_COLUMNS`) from SI units (s, m,
+    m/s, shares 0-1) to the landmark tables' (ms, mm, mm/s, %), other columns as they are.
+
+    For ``summary.csv``'s landmark columns, with :func:`write_units` beside it.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        A table whose landmark columns are in SI units.
+    """
+    out = table.copy()
+    for column in table.columns:
+        if column in LANDMARK_COLUMNS and _SCALE[LANDMARK_COLUMNS[column][0]] != 1.0:
+            out[column] = table[column].astype(float) * _SCALE[LANDMARK_COLUMNS[column][0]]
+    return out
 
 
 def units_path(table: str | Path) -> Path:
