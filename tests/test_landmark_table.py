@@ -267,15 +267,12 @@ def _same(ours: pd.DataFrame, batch: pd.DataFrame) -> None:
     assert list(ours["clip"]) == list(batch["clip"])
     assert list(ours["landmark"]) == list(batch["landmark"])
     for column in ("trial", "condition", "participant", "trial_number", "reach_number", "unit",
-                   "flag", "status", "reason"):
+                   "clock", "flag", "status", "reason"):
         assert list(ours[column]) == list(batch[column]), column
-    # a report written before the clock's offset was recorded keeps its own clock (and says
-    # so); every other value, and every clock, agrees
-    own = batch["clock"] == "observation"
-    assert (ours.loc[own, "clock"] == "recording").all()
-    assert list(ours.loc[~own, "clock"]) == list(batch.loc[~own, "clock"])
-    np.testing.assert_allclose(ours.loc[~own, "value"], batch.loc[~own, "value"], rtol=1e-9,
-                               atol=1e-9)
+    # every value, onset_time and end_time on the recording's clock included (the report's
+    # observation clock put on it by the report's time_origin)
+    assert "observation" not in set(batch["clock"])
+    np.testing.assert_allclose(ours["value"], batch["value"], rtol=1e-9, atol=1e-9)
 
 
 def test_landmarks_on_a_folder_and_a_manifest_give_batchs_table(design, batch_table, tmp_path):
@@ -381,3 +378,18 @@ def test_a_table_in_si_units_is_put_in_lab_units_with_its_sidecar(tmp_path):
     assert json.loads(path.read_text()) == {
         "movement_time": {"unit": "ms", "clock": ""}, "peak_speed_time": {"unit": "%", "clock": ""},
         "mga": {"unit": "mm", "clock": ""}, "aperture_peaks": {"unit": "count", "clock": ""}}
+
+
+def test_times_go_on_the_recordings_clock_or_say_whose_they_are():
+    from perception.landmarks import Landmarks
+    from perception.report.tables import MovementLandmarks
+
+    lm = Landmarks(onset_time=0.1, end_time=1.3, movement_time=1.2)
+    known = tidy_landmarks([MovementLandmarks("a", "a", lm, "complete", clock_offset=2.0)])
+    unknown = tidy_landmarks([MovementLandmarks("a", "a", lm, "complete", clock_offset=None)])
+    k, u = known.set_index("landmark"), unknown.set_index("landmark")
+    assert k.loc["onset_time", "value"] == pytest.approx(2100.0)
+    assert k.loc["onset_time", "clock"] == "recording"
+    assert u.loc["onset_time", "value"] == pytest.approx(100.0)
+    assert u.loc["onset_time", "clock"] == "observation"  # a report without its time origin
+    assert k.loc["movement_time", "value"] == u.loc["movement_time", "value"] == 1200.0

@@ -401,10 +401,12 @@ def landmark_table(summary: pd.DataFrame, recognitions: dict[str, ClipSummary]
             continue
         lm = Landmarks.from_dict((s.kinematics or {}).get("observed"))
         mocap = s.extras.get("mocap") or {}
-        offset = mocap.get("clock_offset", s.extras.get("clock_offset"))
+        # the report's times are on the observation's clock; its origin puts them on the
+        # recording's (unknown in reports written before it was recorded)
+        origin = float(getattr(s, "time_origin", math.nan))
         movements.append(MovementLandmarks(
             trial=str(mocap.get("trial") or r["clip"]), landmarks=lm, status=lm.status,
-            clock_offset=None if offset is None else float(offset), **common))
+            clock_offset=origin if math.isfinite(origin) else None, **common))
     own = {*_HEAD, *_NUMBERS, *_LONG}
     return tidy_landmarks(movements, [f"manifest_{f}" if f in own else f for f in factors])
 
