@@ -7,6 +7,7 @@ import socket
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import pytest
 from _demos import default_repertoire
@@ -59,25 +60,57 @@ def _free_port() -> int:
         return s.getsockname()[1]
 
 
+def _udp_bound(port: int) -> bool:
+    """Whether a socket of this machine is bound to UDP ``port`` (Linux's /proc/net/udp)."""
+    table = Path("/proc/net/udp")
+    return any(line.split()[1].endswith(f":{port:04X}")
+               for line in table.read_text().splitlines()[1:] if line.strip())
+
+
+def _wait_until_listening(port: int, watch: subprocess.Popen, limit: float = 600) -> None:
+    """Wait until ``watch`` has bound ``port``: however long the machine takes to start it,
+    not a guessed number of seconds (``limit``: a hang, not a slow machine)."""
+    if not Path("/proc/net/udp").exists():  # no table to read: a generous pause instead
+        time.sleep(10)
+        return
+    deadline = time.monotonic() + limit
+    while not _udp_bound(port):
+        assert watch.poll() is None, watch.communicate()[1]
+        assert time.monotonic() < deadline, f"watch never listened on UDP {port}"
+        time.sleep(0.05)
+
+
+#: `hammer-mv watch` with a read-ahead that holds the whole clip: a stream's reader drops
+#: the oldest frame when the consumer falls behind, which a busy machine's does; here every
+#: frame sent waits for it, so what it judges does not depend on the machine's speed (the
+#: dropping itself is tested in test_live_source.py, deterministically)
+_WATCH_HOLDING_EVERY_FRAME = ("import sys; from perception.io import capture; "
+                              "capture.READ_AHEAD = 100_000; from hammer_mv.cli import main; "
+                              "sys.exit(main(sys.argv[1:]))")
+
+
 def test_watch_a_udp_stream_fed_by_ffmpeg(clip, tmp_path):
     imageio_ffmpeg = pytest.importorskip("imageio_ffmpeg")
     video, rep, offline, _ = clip
     port = _free_port()
-    watch = subprocess.Popen([sys.executable, "-m", "hammer_mv", "watch",
+    watch = subprocess.Popen([sys.executable, "-c", _WATCH_HOLDING_EVERY_FRAME, "watch",
                               f"udp://127.0.0.1:{port}", "-o", str(tmp_path), "--clip", "clip",
-                              "--no-figures", "--repertoire", str(rep), "--stall-timeout", "2"],
+                              "--no-figures", "--repertoire", str(rep), "--stall-timeout", "5"],
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    time.sleep(3)  # the receiver listens before the first packet is sent
+    _wait_until_listening(port, watch)  # the receiver listens before the first packet is sent
     # the file's own frames, re-muxed (not re-encoded); its decoder header with every keyframe
     subprocess.run([imageio_ffmpeg.get_ffmpeg_exe(), "-loglevel", "error", "-re", "-i",
                     str(video), "-c", "copy", "-bsf:v", "dump_extra", "-f", "mpegts",
-                    f"udp://127.0.0.1:{port}?pkt_size=1316"], check=True, timeout=60)
-    out, err = watch.communicate(timeout=60)
+                    f"udp://127.0.0.1:{port}?pkt_size=1316"], check=True, timeout=600)
+    out, err = watch.communicate(timeout=600)
     assert watch.returncode == 0, err
     online = json.loads((tmp_path / "clip.recognition.json").read_text())
+    info = online.pop("online")
+    # every frame sent is accounted for: judged, or counted as dropped
+    assert info["frames"] + info["dropped_frames"] == 75, info
+    assert info["read_ahead_dropped"] == 0  # the reader held every frame, however slow
     final = out.splitlines()[-1]  # the report's line: the clip, its verdict, every frame
     assert final.startswith(f"clip: {online['verdict']}") and "(75 frames, 0 dropped)" in final
-    info = online.pop("online")
     assert info["source"] == "stream" and info["frames"] == 75 and info["dropped_frames"] == 0
     assert online.pop("input") == f"udp://127.0.0.1:{port}"
     expected = {k: v for k, v in offline.items() if k not in ("input", "fingerprint")}
