@@ -397,7 +397,10 @@ def recognize_tracks(tracks: Tracks, repertoire: Repertoire,
     shape, transport = _shape_pass(shape_obs, repertoire, settings, plan_cache)
     return dataclasses.replace(rec, shape=shape, normalisation=norm,
                                transport_familiarity=transport, mirrored=mirrored,
-                               notes=(*obs.notes, *((settled,) if settled else ())))
+                               notes=(*obs.notes, *((settled,) if settled else ())),
+                               # the tracks' clock at the observation's zero (both end
+                               # on the last row: settling only trims the first)
+                               time_origin=float(tracks.time[-1] - obs.clip_time[-1]))
 
 
 def _canonical(obs, repertoire: Repertoire, source, rules: VerdictRules):

@@ -449,7 +449,9 @@ def recognize_reach(reach: Reach, repertoire, settings=None,
     # own bounds, options.reaches.landmarks, only choose the reach's window)
     bounds = (info["bounds"]["onset"], info["bounds"]["end"])
     rec = dataclasses.replace(rec, measured=movement_landmarks(
-        clock, transport, aperture, settings.rules.landmarks, bounds=bounds))
+        clock, transport, aperture, settings.rules.landmarks, bounds=bounds),
+        # the recording's clock at the observation's zero: the onset row's time in the file
+        time_origin=float(reach.time[reach.onset] - clock[bounds[0]]))
     info = {**info, "trial": reach.name, "source": reach.source,
             "rate": round(1 / float(_median_step(reach.time)), 3)}
     return rec, info

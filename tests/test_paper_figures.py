@@ -44,19 +44,23 @@ def test_the_trial_figure_marks_its_landmarks_where_they_are(trials):
     lm = rec.landmarks[0]
     fig = kinematics_figure(rec)
     speed, grip = fig.axes
+    # drawn on the recording's clock: the observation's times from the tracks' first row
+    t0 = rec.time_origin
+    assert np.isfinite(t0) and "recording" in speed.get_xlabel() + grip.get_xlabel()
+    onset, end = lm.onset_time + t0, lm.end_time + t0
     for ax in (speed, grip):  # onset and end: vertical lines across both panels
-        for gid, t in (("onset", lm.onset_time), ("end", lm.end_time)):
+        for gid, t in (("onset", onset), ("end", end)):
             (line,) = _gid(ax, gid)
             np.testing.assert_allclose(line.get_xdata(), [t, t])
     (peak,) = _gid(speed, "peak_speed")
-    assert peak.get_xdata()[0] == pytest.approx(lm.onset_time + lm.peak_speed_seconds)
+    assert peak.get_xdata()[0] == pytest.approx(onset + lm.peak_speed_seconds)
     assert peak.get_ydata()[0] == pytest.approx(lm.peak_speed * 1000)  # mm/s
     (mga,) = _gid(grip, "mga")
-    assert mga.get_xdata()[0] == pytest.approx(lm.onset_time + lm.mga_seconds)
+    assert mga.get_xdata()[0] == pytest.approx(onset + lm.mga_seconds)
     assert mga.get_ydata()[0] == pytest.approx(lm.mga * 1000)  # mm
     labels = {t.get_text() for ax in fig.axes for t in ax.texts}
     assert {f"peak {lm.peak_speed * 1000:.0f} mm/s", f"MGA {lm.mga * 1000:.0f} mm",
-            f"onset {lm.onset_time:.2f} s", f"end {lm.end_time:.2f} s"} <= labels
+            f"onset {onset:.2f} s", f"end {end:.2f} s"} <= labels
     assert "Fig." not in fig.get_suptitle()
 
 

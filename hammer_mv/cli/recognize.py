@@ -176,6 +176,7 @@ def _run_mocap(args: argparse.Namespace, path: Path) -> int:
     from hammer_mv.cli.options import load_repertoire, mocap_import, recognition_settings
     from perception.batch import remove_stale_reports
     from perception.errors import HammerMVError
+    from perception.factors import entry_columns
     from perception.io.atomic import check_output, write_csv
     from perception.pipeline import clip_fingerprint
     from perception.reaches import Unscored
@@ -192,8 +193,8 @@ def _run_mocap(args: argparse.Namespace, path: Path) -> int:
     rows, missed, kept, warned, k = [], [], [], [], 0
     for entry in recording.entries:
         if isinstance(entry, Unscored):
-            rows.append(_row(entry.name, entry.status, entry.reason, entry.onset_time,
-                             entry.end_time, path))
+            rows.append({**_row(entry.name, entry.status, entry.reason, entry.onset_time,
+                                entry.end_time, path), **entry_columns(entry)})
             missed.append((entry.name, entry.reason))
             continue
         reach = dataclasses.replace(entry, name=_own_clip(args.output, entry.name, path))
@@ -217,19 +218,26 @@ def _run_mocap(args: argparse.Namespace, path: Path) -> int:
                    "traceback is above)")
         else:
             kept.append(reach.name)
-            rows.append(_row(reach.name, "ok", "", onset, end, path, rec=rec,
-                             report=paths["json"].name))
+            rows.append({**_row(reach.name, "ok", "", onset, end, path, rec=rec,
+                                report=paths["json"].name), **entry_columns(entry)})
             warned.append((reach.name, [w.to_dict() for w in rec.validation_warnings]))
             if not args.quiet:
                 print(f"{verdict_line(rec)} -> {paths['json']}")
             continue
-        rows.append(_row(reach.name, "failed", why, onset, end, path))
+        rows.append({**_row(reach.name, "failed", why, onset, end, path),
+                     **entry_columns(entry)})
         missed.append((reach.name, why))
     # reports of this recording's trials that are not scored now (or no longer in it)
     remove_stale_reports(args.output, path, kept)
     import pandas as pd
 
-    write_csv(table, pd.DataFrame(rows, columns=list(TRIALS_COLUMNS)))
+    # the trial's factors and numbers after its name, as summary.csv has them
+    more = list(dict.fromkeys(c for r in rows for c in r if c not in TRIALS_COLUMNS))
+    columns = [TRIALS_COLUMNS[0], *more, *TRIALS_COLUMNS[1:]]
+    trials = pd.DataFrame(rows, columns=columns)
+    if "reach_number" in trials:  # a whole trial without a reach has none: not 1.0
+        trials = trials.astype({"reach_number": "Int64"})
+    write_csv(table, trials)
     if not args.quiet:
         print(f"{trial_summary(len(recording.trials), len(kept), len(missed))} -> {table}")
         # one line per kind of warning for the recording; each reach's are in its report
