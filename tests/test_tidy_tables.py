@@ -251,3 +251,19 @@ def test_every_column_landmark_and_method_is_documented(batch):
                   if c not in ("participant", "session", "age_group")} | {"participant"}
     assert sorted(names - spans) == []
     assert set(LANDMARK_UNITS.values()) <= spans
+
+
+def test_summary_csv_is_in_the_landmark_tables_units_and_says_so(batch):
+    # one unit convention for every landmark file (issue 44): summary.csv was SI (shares 0-1)
+    _, out, summary = batch
+    written = pd.read_csv(out / "summary.csv").set_index("clip")
+    ok = summary[summary["status"] == "ok"].set_index("clip")
+    for column, scale in (("movement_time", 1e3), ("peak_speed", 1e3), ("peak_speed_time", 100),
+                          ("mga", 1e3), ("mga_time", 100)):
+        np.testing.assert_allclose(written.loc[ok.index, column], ok[column] * scale, rtol=1e-9)
+    units = json.loads((out / "summary.units.json").read_text())
+    assert {units[c]["unit"] for c in ("movement_time", "peak_speed_time", "mga")} == \
+        {"ms", "%", "mm"}
+    long = pd.read_csv(out / "landmarks.csv")
+    mt = long[long["landmark"] == "movement_time"].set_index("clip")["value"]
+    np.testing.assert_allclose(mt.loc[ok.index], written.loc[ok.index, "movement_time"])

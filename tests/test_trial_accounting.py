@@ -328,6 +328,6 @@ def test_recognize_and_landmarks_find_the_same_reaches_in_a_session(tmp_path):
     trials = pd.read_csv(out / "session.trials.csv")
     assert list(trials["trial"]) == list(rows["trial"])
     # trials.csv in s, the landmark table in ms: both on the recording's clock
-    np.testing.assert_allclose(trials["onset_time"], rows["onset_time"] / 1e3, atol=1.5 / RATE)
+    np.testing.assert_allclose(trials["onset_time"], rows["onset_time"], atol=1.5e3 / RATE)  # ms
     assert sorted(p.name for p in out.glob("*.recognition.json")) == sorted(
         f"{name}.recognition.json" for name in rows["trial"])

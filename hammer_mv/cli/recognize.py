@@ -183,6 +183,7 @@ def _run_mocap(args: argparse.Namespace, path: Path) -> int:
     from perception.recognition.result import warnings_summary
     from perception.recordings import read_recording, recognize_reach, trial_summary
     from perception.report.clip import write_clip_report
+    from perception.report.tables import write_units
 
     settings = recognition_settings(args)
     options = settings.mocap or mocap_import(args)
@@ -238,6 +239,7 @@ def _run_mocap(args: argparse.Namespace, path: Path) -> int:
     if "reach_number" in trials:  # a whole trial without a reach has none: not 1.0
         trials = trials.astype({"reach_number": "Int64"})
     write_csv(table, trials)
+    write_units(table, trials.columns)
     if not args.quiet:
         print(f"{trial_summary(len(recording.trials), len(kept), len(missed))} -> {table}")
         # one line per kind of warning for the recording; each reach's are in its report
@@ -257,7 +259,9 @@ def _row(name: str, status: str, reason: str, onset: float, end: float, path: Pa
             "verdict_reason": rec.verdict_reason if rec is not None else None,
             "winner": rec.winner if rec is not None else None,
             "winner_note": rec.winner_note if rec is not None else None,
-            "onset_time": onset, "end_time": end, "report": report, "source": str(path)}
+            # ms on the recording's clock, as every landmark file (docs/glossary.md)
+            "onset_time": onset * 1e3, "end_time": end * 1e3, "report": report,
+            "source": str(path)}
 
 
 def _same_file(a, b: Path) -> bool:

@@ -53,7 +53,13 @@ from perception.report.statistics import (
     measure_table,
     participant_means,
 )
-from perception.report.tables import TABLES, landmark_table, r_aliases
+from perception.report.tables import (
+    TABLES,
+    in_lab_units,
+    landmark_table,
+    r_aliases,
+    write_units,
+)
 
 __all__ = ["BatchReport", "write_batch_report"]
 
@@ -392,7 +398,9 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     summary = with_verdict_reasons(summary, recognitions)
-    write_csv(out / "summary.csv", _printable_table(summary))
+    # the landmark columns in the landmark tables' units (ms, mm, mm/s, %), said beside it
+    write_csv(out / "summary.csv", _printable_table(in_lab_units(summary)))
+    write_units(out / "summary.csv", summary.columns)
     landmarks = landmark_table(summary, recognitions)
     measures = measure_table(landmarks, summary)
     for name, table in zip(TABLES, (landmarks, participant_means(measures),
