@@ -30,8 +30,13 @@ def refused(call, *args, path=None, field=..., match=None) -> InputError:
     return err.value
 
 
-def error_within(call, path, seconds=1.0):
-    """``call(path)``'s exception (None if it returned); fails if it reads past ``seconds``."""
+def error_within(call, path, seconds=60.0):
+    """``call(path)``'s exception (None if it returned); fails if it reads past ``seconds``.
+
+    A reader that opens a FIFO with no writer blocks for ever, one that refuses it
+    returns: ``seconds`` only bounds that wait (a hang, not a speed: a busy machine takes
+    longer to refuse, never for ever).
+    """
     box = {}
 
     def run():

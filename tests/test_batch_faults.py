@@ -50,14 +50,15 @@ def _batch(src, out, *extra):
 
 
 def _alive(procs: list[psutil.Process]) -> list[psutil.Process]:
-    """Those of ``procs`` still running after 5 s (a zombie has ended)."""
+    """Those of ``procs`` still running after 120 s (a zombie has ended)."""
     def running(p):
         try:
             return p.status() != psutil.STATUS_ZOMBIE
         except psutil.NoSuchProcess:
             return False
 
-    return [p for p in psutil.wait_procs(procs, timeout=5)[1] if running(p)]
+    # a bound for a bug (workers that never end), not a speed: returns once all have ended
+    return [p for p in psutil.wait_procs(procs, timeout=120)[1] if running(p)]
 
 
 def test_killing_the_main_process_ends_its_workers(clips, repfile, tmp_path):
@@ -94,7 +95,7 @@ def test_a_relative_output_on_a_cluster_is_the_clients_folder(clips, repfile, tm
                       host="127.0.0.1", dashboard_address=None) as cluster:
         proc = subprocess.run(_batch("src", "out", "--repertoire", str(repfile),
                                      "--scheduler", cluster.scheduler_address),
-                              cwd=client, capture_output=True, text=True, timeout=120)
+                              cwd=client, capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr
     assert (pd.read_csv(client / "out" / "summary.csv")["status"] == "ok").all()
     assert len(list((client / "out").glob("*.recognition.json"))) == 4

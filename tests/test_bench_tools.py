@@ -3,6 +3,7 @@ clips it makes, and its measure of what the machine itself allows."""
 
 import dataclasses
 import sys
+import time
 from pathlib import Path
 
 import pandas as pd
@@ -39,8 +40,10 @@ def test_side_by_side_batches_share_every_clip_once(tmp_path):
                                  counts={"normal": 2, "delayed": 1})
     synthesize(recipe, tmp_path / "clips", seed=0)
     items = discover(tmp_path / "clips")
+    start = time.perf_counter()
     wall = bench_recognition._side_by_side(items, tmp_path / "out", default_repertoire(), 2)
-    assert 0 < wall < 120
+    # the run's own wall time: within the call's, however long a busy machine takes
+    assert 0 < wall <= time.perf_counter() - start
     done = [list(pd.read_csv(f)["clip"])
             for f in sorted((tmp_path / "out").glob("alone*/summary.csv"))]
     ranked = [i.clip for i in sorted(items, key=lambda i: i.path.stat().st_size, reverse=True)]

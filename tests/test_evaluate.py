@@ -6,7 +6,6 @@ run."""
 import json
 import math
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -213,11 +212,10 @@ def test_every_drawn_population_clip_fits_its_frame():
 
 @pytest.mark.slow
 def test_quick_evaluation_end_to_end(tmp_path):
-    start = time.perf_counter()
     assert ev.main(["--set", "dev", "--quick", "-o", str(tmp_path), "--jobs", "2",
                     "--quiet"]) == 0
-    assert time.perf_counter() - start < 90
     result = json.loads((tmp_path / "evaluation.json").read_text())
+    # quick by its size, whatever the machine's speed (no wall-time bound): 2 seeds, 4 clips
     assert result["seeds"] == [1000, 1003] and result["groups"]["all"]["n"] == 4
     assert len(result["clips"]) == 4
     assert {c["condition"] for c in result["clips"]} == set(CONDITIONS)

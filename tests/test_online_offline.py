@@ -348,10 +348,13 @@ def test_real_reaches_fed_row_by_row_end_as_recognize(rep, optotrak, k, row):
     offline = recognize_tracks(tracks, rep, settings, clip=reach.name)
     assert json.dumps(final.to_dict()) == json.dumps(offline.to_dict())
     # recognize_reach measures the landmarks on the 3D marker paths (`measured`), which
-    # rows of 2D positions do not carry: that, and only that, differs by construction
+    # rows of 2D positions do not carry, and knows the recording's clock (`time_origin`, the
+    # reach's onset row in the file), which the rows do not: those, and only those, differ
+    # by construction
     measured, _ = recognize_reach(reach, rep, base, options)
     assert measured.measured is not None and final.measured is None
-    assert json.dumps(dataclasses.replace(final, measured=measured.measured).to_dict()) == \
+    assert json.dumps(dataclasses.replace(final, measured=measured.measured,
+                                          time_origin=measured.time_origin).to_dict()) == \
         json.dumps(measured.to_dict())
     if rec.decision is not None:
         assert rec.decision.verdict == final.verdict

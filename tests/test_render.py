@@ -143,9 +143,11 @@ def test_rendering_is_fast(tmp_path):
     style = RenderStyle(width=320, height=240, hand=True, noise_sd=5, lighting=0.4, blur_sigma=0.7)
     cam = Camera.for_frame(320, 240)
     render_clip(scene, cam, style, tmp_path / "warm.mp4")  # first-call costs aside
-    t0 = time.perf_counter()
+    # this process's CPU time, not the wall clock: other processes on a busy machine do
+    # not count (a performance test still depends on the CPU: 10 times the usual ~0.1 s)
+    t0 = time.process_time()
     render_clip(scene, cam, style, tmp_path / "fast.mp4")
-    assert time.perf_counter() - t0 < 1.0  # typically ~0.1 s
+    assert time.process_time() - t0 < 1.0
 
 
 def test_failed_render_leaves_no_files(tmp_path, monkeypatch):

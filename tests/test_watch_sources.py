@@ -183,8 +183,11 @@ def test_a_camera_is_recognised_on_its_own_clock_until_it_stalls(clip, camera, t
     assert len(times) == N and np.all(np.diff(times) > 0)
     assert times == pytest.approx(WARMUP + np.arange(N) / FPS, abs=1e-3)  # printed to 1 ms
     assert f"camera3: {offline['verdict']}" in out
-    # and the report is `recognize`'s, to the rounding of times 0.3 s later
-    expected = {k: v for k, v in offline.items() if k not in ("clip", "input", "fingerprint")}
+    # and the report is `recognize`'s, to the rounding of times 0.3 s later; its clock's
+    # origin the camera's, the warm-up later than the file's
+    assert online.pop("time_origin") == pytest.approx(offline["time_origin"] + WARMUP)
+    expected = {k: v for k, v in offline.items()
+                if k not in ("clip", "input", "fingerprint", "time_origin")}
     _close({k: v for k, v in online.items() if k not in ("clip", "input", "online")}, expected)
     cam.unblock.set()  # the driver returns at last: the reader stops and lets the camera go
     assert cam.released.wait(HANG)
