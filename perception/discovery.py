@@ -48,9 +48,9 @@ ERRORS_LOG = "errors.log"
 BATCH_FIGURES = ("aperture_profiles", "confidence_single", "confidence_all", "condition_profiles",
                  "kinematic_profiles", "landmark_strips")
 #: What a batch writes beside its clips' reports: one run's set, never a mix (:func:`run_batch`).
-REPORT_SET = ("summary.csv", "summary.units.json", "statistics.csv", "condition_profiles.csv", "report.html",
-              "batch.json", "aperture_profiles.csv", "kinematic_profiles.csv", ERRORS_LOG,
-              "landmarks.csv", "participant_means.csv", "landmark_statistics.csv",
+REPORT_SET = ("summary.csv", "summary.units.json", "statistics.csv", "condition_profiles.csv",
+              "report.html", "batch.json", "aperture_profiles.csv", "kinematic_profiles.csv",
+              ERRORS_LOG, "landmarks.csv", "participant_means.csv", "landmark_statistics.csv",
               *(f"{stem}.{fmt}" for stem in BATCH_FIGURES for fmt in ("png", "svg", "pdf")))
 COMPANION_NAMES = ("manifest.csv", "README.md", "recipe.toml", "repertoire.h5", *REPORT_SET)
 #: A clip name becomes file names in the report folder: no separators, no

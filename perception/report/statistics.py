@@ -98,12 +98,15 @@ def measure_table(landmarks: pd.DataFrame, summary: pd.DataFrame) -> pd.DataFram
     summary : pandas.DataFrame
         :func:`perception.batch.summary_table`.
     """
-    keys = [c for c in landmarks.columns if c not in ("landmark", "value", "unit")]
+    # a landmark's own clock and flag are not the clip's: the confidence gets its own
+    keys = [c for c in landmarks.columns
+            if c not in ("landmark", "value", "unit", "clock", "flag")]
     ok = summary[summary["status"] == "ok"].set_index("clip")
     conf = (landmarks.drop_duplicates("clip")[keys]
             .assign(measure="reference_confidence", unit="mm",
                     value=lambda d: ok["reference_confidence"].reindex(d["clip"]).to_numpy(
-                        float) * 1e3))
+                        float) * 1e3, clock="",
+                    flag=lambda d: np.where(d["value"].isna(), "not scored", "ok")))
     return pd.concat([landmarks.rename(columns={"landmark": "measure"}), conf],
                      ignore_index=True)
 
