@@ -57,28 +57,30 @@ def test_the_marks_sit_at_the_landmarks(recs):
     lm = rec.landmarks[0]
     fig = kinematics_figure(rec)
     top, grip = fig.axes
+    t0 = rec.time_origin  # drawn on the recording's (the tracks') clock
     for ax in (top, grip):  # the movement's bounds cross both panels
-        for gid, t in (("onset", lm.onset_time), ("end", lm.end_time)):
+        for gid, t in (("onset", lm.onset_time + t0), ("end", lm.end_time + t0)):
             (line,) = _gid(ax, gid)
             np.testing.assert_allclose(line.get_xdata(), [t, t])
     (mga,) = _gid(grip, "mga")
-    assert mga.get_xdata()[0] == pytest.approx(lm.onset_time + lm.mga_time * lm.movement_time)
+    assert mga.get_xdata()[0] == pytest.approx(
+        lm.onset_time + t0 + lm.mga_time * lm.movement_time)
     assert abs(mga.get_ydata()[0] - lm.mga * 1000) < 1e-6
     assert any(t.get_text() == f"MGA {lm.mga * 1000:.0f} mm" for t in grip.texts)
     (peak,) = _gid(top, "peak_speed")
     assert peak.get_xdata()[0] == pytest.approx(
-        lm.onset_time + lm.peak_speed_time * lm.movement_time)
+        lm.onset_time + t0 + lm.peak_speed_time * lm.movement_time)
     assert peak.get_ydata()[0] == pytest.approx(lm.peak_speed * 1000)
     (opening,) = _gid(grip, "opening")
     assert opening.get_xdata()[0] == pytest.approx(
-        lm.onset_time + lm.opening_time * lm.movement_time)
+        lm.onset_time + t0 + lm.opening_time * lm.movement_time)
     # the marks lie on the curves the landmarks are measured on
     time, speed, aperture = kinematic_traces(rec.observation)
     assert np.nanmax(speed) == pytest.approx(lm.peak_speed)
-    assert np.interp(mga.get_xdata()[0], time, aperture) * 1000 == pytest.approx(
+    assert np.interp(mga.get_xdata()[0], time + t0, aperture) * 1000 == pytest.approx(
         lm.mga * 1000, rel=1e-3)
     # the shaded movement
-    spans = [p for p in top.patches if p.get_x() == pytest.approx(lm.onset_time)]
+    spans = [p for p in top.patches if p.get_x() == pytest.approx(lm.onset_time + t0)]
     assert spans and spans[0].get_width() == pytest.approx(lm.end_time - lm.onset_time)
 
 
