@@ -25,7 +25,7 @@ from perception.landmarks import LandmarkParams
 from perception.validation import NonNegative, Positive, Tuple, declared
 
 __all__ = ["APPROACH", "MIN_REST", "MIN_SAMPLES", "PX_PER_M", "RETURNED", "WRIST_BEHIND",
-           "MarkerMap", "Movement", "Reach", "ReachParams", "Unscored"]
+           "MarkerMap", "Movement", "Reach", "ReachParams", "Unscored", "ever_seen"]
 
 #: The scale of the tracks a reach becomes: one "pixel" per millimetre.
 PX_PER_M = 1000.0
@@ -49,6 +49,15 @@ MIN_SAMPLES = 10
 _STILL_RANGE = 0.002
 _STILL_WINDOW = 0.2
 _ORIGIN_PX = np.array([2000.0, 2000.0])
+
+
+def ever_seen(path) -> bool:
+    """Whether a marker's (N, 3) path has one sample seen (all three coordinates finite).
+
+    The readers turn a C3D sample's negative residual and a table's all-zero
+    sample into NaN, so a marker lost throughout is all NaN here.
+    """
+    return bool(np.isfinite(np.asarray(path, dtype=float)).all(axis=1).any())
 
 
 
@@ -114,28 +123,39 @@ class MarkerMap:
 
         Tips are preferred (``thumb_tip`` over ``thumb_middle``); markers
         whose name says hand or wrist are the wrist; ``object``, ``pillow``,
-        ``target`` or ``cube`` the object.
+        ``target`` or ``cube`` the object. Given the markers' paths, a marker
+        never seen (every sample missing) is no wrist or object, and a digit
+        only where no other marker's name says that digit.
 
         Parameters
         ----------
-        names : sequence of str
-            The recording's marker names.
+        names : sequence of str, or mapping of str to (N, 3) arrays
+            The recording's marker names, or its markers by name.
         """
+        paths = names if isinstance(names, Mapping) else None
         names = list(names)
         low = {n: n.lower() for n in names}
+        seen = {n: paths is None or ever_seen(paths[n]) for n in names}
 
         def pick(*words):
             hits = [n for n in names if any(w in low[n] for w in words)]
-            tips = [n for n in hits if "tip" in low[n]]
-            return (tips or hits or [None])[0]
+            # a marker seen before one never seen, then a tip before another point
+            hits.sort(key=lambda n: (not seen[n], "tip" not in low[n]))
+            return (hits or [None])[0]
 
         thumb = pick("thumb")
         finger = pick("index", "finger")
-        wrist = tuple(n for n in names if "wrist" in low[n]) or tuple(
-            n for n in names if low[n].startswith("hand"))
-        obj = tuple(n for n in names if any(w in low[n] for w in
-                                            ("object", "pillow", "target", "cube", "block")))
+        wrist = tuple(n for n in names if "wrist" in low[n] and seen[n]) or tuple(
+            n for n in names if low[n].startswith("hand") and seen[n])
+        obj = tuple(n for n in names if seen[n] and any(w in low[n] for w in
+                                                        ("object", "pillow", "target", "cube",
+                                                         "block")))
         return cls(thumb or "thumb", finger or "index", wrist, obj)
+
+    def roles(self) -> list[tuple[str, str]]:
+        """Each mapped marker with its role: ``[("thumb", "thumb"), ("index", "finger"), ...]``."""
+        return [(self.thumb, "thumb"), (self.finger, "finger"),
+                *((m, "wrist") for m in self.wrist), *((m, "object") for m in self.object)]
 
     def check(self, names, source) -> None:
         """Refuse a mapping that names a marker the recording lacks."""

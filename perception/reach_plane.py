@@ -16,6 +16,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from perception.boundary import expect
 from perception.errors import InputError
 from perception.io.tracks import Status, Tracks
 from perception.reach_data import _ORIGIN_PX, MIN_REST, PX_PER_M, WRIST_BEHIND, Reach, ReachParams
@@ -110,6 +111,8 @@ def reach_tracks(reach: Reach, params: ReachParams | None = None) -> ReachTracks
     params : ReachParams, optional
         Its ``object_size``, if given, is the object's.
     """
+    expect(reach, Reach, "reach_tracks(reach=)", hint="read_reaches or read_recording")
+    expect(params, ReachParams, "reach_tracks(params=)", optional=True)
     params = ReachParams() if params is None else params
     notes = list(reach.notes)
     if not 0 <= reach.onset < reach.end < len(reach.time):

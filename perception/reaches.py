@@ -64,6 +64,7 @@ import math
 
 import numpy as np
 
+from perception.boundary import expect
 from perception.cleaning import clean_path
 from perception.errors import InputError
 from perception.movements import classify_movements, find_movements, find_reaches
@@ -79,6 +80,7 @@ from perception.reach_data import (
     Reach,
     ReachParams,
     Unscored,
+    ever_seen,
 )
 from perception.reach_plane import PlaneFit, ReachTracks, fit_plane, reach_tracks
 
@@ -109,11 +111,8 @@ def _mean_marker(markers, names, time, params, notes) -> np.ndarray | None:
 
 def _lost_throughout(trial, markers: MarkerMap) -> str | None:
     """The role's markers none of whose samples is seen, named (None if each role is seen)."""
-    def seen(name):
-        return bool(np.isfinite(np.asarray(trial.markers[name], dtype=float)).all(axis=1).any())
-
     for names in ((markers.finger,), (markers.thumb,), markers.wrist):
-        if names and not any(seen(m) for m in names):
+        if names and not any(ever_seen(trial.markers[m]) for m in names):
             return ", ".join(names)
     return None
 
@@ -148,8 +147,16 @@ def trial_reaches(trial, markers: MarkerMap | None = None,
         Only for a mapping that names a marker the recording lacks (a mistake
         that holds for every trial of the file).
     """
+    expect(markers, MarkerMap, "trial_reaches(markers=)", optional=True)
+    expect(params, ReachParams, "trial_reaches(params=)", optional=True)
     params = ReachParams() if params is None else params
-    markers = MarkerMap.guess(trial.markers) if markers is None else markers
+    notes = list(getattr(trial, "notes", ()))
+    if markers is None:
+        markers = MarkerMap.guess(trial.markers)
+        # a marker the names suggest but never seen is passed over, said
+        used = {m for m, _ in markers.roles()}
+        notes += [f"marker {m!r} is never seen: not taken as the {role}"
+                  for m, role in MarkerMap.guess(list(trial.markers)).roles() if m not in used]
     markers.check(trial.markers, trial.source)
     source = str(trial.source)
     time = np.asarray(trial.time, dtype=float)
@@ -168,7 +175,6 @@ def trial_reaches(trial, markers: MarkerMap | None = None,
         return [], [unscored("too short", f"too short: {len(time)} samples")]
     if (lost := _lost_throughout(trial, markers)) is not None:
         return [], [unscored("marker lost", f"marker lost throughout: {lost}")]
-    notes = list(getattr(trial, "notes", ()))
     finger = _mean_marker(trial.markers, (markers.finger,), time, params, notes)
     thumb = _mean_marker(trial.markers, (markers.thumb,), time, params, notes)
     wrist = _mean_marker(trial.markers, markers.wrist, time, params, notes)

@@ -24,11 +24,12 @@ import logging
 import math
 import re
 from dataclasses import dataclass, field
-from typing import Annotated, Literal
+from typing import Annotated, Literal, NamedTuple
 
 import numpy as np
 from pydantic import AfterValidator, BeforeValidator, Field
 
+from perception.boundary import expect
 from perception.errors import InputError
 from perception.factors import NAME_FLAG as FACTORS_FROM_NAME
 from perception.factors import merge_factors, name_factors
@@ -40,13 +41,15 @@ from perception.reaches import (
     Reach,
     ReachParams,
     Unscored,
+    ever_seen,
     reach_tracks,
     trial_reaches,
 )
 from perception.validation import Tuple, declared
 
-__all__ = ["MocapImport", "Recording", "cached_reaches", "cached_recording",
-           "read_reaches", "read_recording", "recognize_reach", "trial_summary", "unknown_layout"]
+__all__ = ["MocapImport", "PreparedReach", "Recording", "cached_reaches", "cached_recording",
+           "measure_reach", "prepare_reach", "read_reaches", "read_recording", "recognize_reach",
+           "trial_summary", "unknown_layout"]
 
 log = logging.getLogger(__name__)
 
@@ -310,13 +313,17 @@ def read_recording(path, options: MocapImport | None = None) -> Recording:
     Raises
     ------
     InputError
-        The file cannot be read, or the marker mapping names a marker it lacks
+        The file cannot be read, the marker mapping names a marker it lacks,
+        or a digit's (or a mapped wrist's) marker is never seen in any trial
         (mistakes that hold for every trial).
     """
     from perception.io.mocap import read_mocap
 
+    expect(options, MocapImport, "read_recording(options=)", optional=True)
     options = MocapImport() if options is None else options
     trials = read_mocap(path, **options.read_options())
+    if (lost := _never_seen(trials, options.markers)) is not None:
+        raise InputError(lost, path)
     from_name = options.name_factors(path)
     entries: list[Reach | Unscored] = []
     for trial in trials:
@@ -342,6 +349,32 @@ def read_recording(path, options: MocapImport | None = None) -> Recording:
     return Recording(str(path), tuple(t.name for t in trials), tuple(entries))
 
 
+def _never_seen(trials, markers: MarkerMap | None) -> str | None:
+    """Why the recording gives no reach anywhere: a digit's or a mapped wrist's marker that
+    no trial ever sees (None if each is seen somewhere).
+
+    The marker is named, not the "no reach" it leads to: a lost marker or a
+    wrong mapping, the user's to fix for every trial at once. A trial that
+    loses one another trial sees is that trial's (``marker lost``). The
+    object's markers may be lost (the object is then where the grip closes).
+    """
+    seen: dict[tuple[str, str], bool] = {}
+    for trial in trials:
+        mapped = MarkerMap.guess(trial.markers) if markers is None else markers
+        for name, role in mapped.roles():
+            if role != "object" and name in trial.markers:  # a missing one: check() says
+                seen[name, role] = seen.get((name, role), False) or ever_seen(
+                    trial.markers[name])
+    lost = [(name, role) for (name, role), ok in seen.items() if not ok]
+    if not lost:
+        return None
+    name, role = lost[0]
+    what = f"marker {name!r}" + ("" if name == role else f" (the {role})")
+    where = f"any of its {len(trials)} trials" if len(trials) > 1 else "the recording"
+    return (f"{what} is never seen in {where}: every sample of it is "
+            "missing (empty, NaN, all zeros or flagged); check --markers or the recording")
+
+
 def read_reaches(path, options: MocapImport | None = None) -> list[Reach]:
     """Every reach to grasp in a motion-capture file, trial by trial.
 
@@ -359,6 +392,7 @@ def read_reaches(path, options: MocapImport | None = None) -> list[Reach]:
     InputError
         The file cannot be read, a mapped marker is missing, or no trial holds a reach.
     """
+    expect(options, MocapImport, "read_reaches(options=)", optional=True)
     recording = read_recording(path, options)
     for u in recording.unscored:
         log.info("%s: not scored: %s", u.name, u.reason)
@@ -391,6 +425,7 @@ def cached_recording(path, options: MocapImport | None = None) -> Recording:
     """
     import os
 
+    expect(options, MocapImport, "cached_recording(options=)", optional=True)
     st = os.stat(path)
     return _cached((str(path), st.st_size, st.st_mtime_ns), options or MocapImport())
 
@@ -404,6 +439,7 @@ def cached_reaches(path, options: MocapImport | None = None) -> tuple[Reach, ...
         The recording.
     options : MocapImport, optional
     """
+    expect(options, MocapImport, "cached_reaches(options=)", optional=True)
     return tuple(cached_recording(path, options).reaches)
 
 
@@ -429,7 +465,61 @@ def recognize_reach(reach: Reach, repertoire, settings=None,
         object size, notes).
     """
     from perception.pipeline import RecognitionSettings, recognize_tracks
+    from perception.recognition import Repertoire
 
+    # each refused here, not as an AttributeError at its first use
+    expect(reach, Reach, "recognize_reach(reach=)", hint="read_reaches or read_recording")
+    expect(repertoire, Repertoire, "recognize_reach(repertoire=)",
+           hint="Repertoire.load or Repertoire.build")
+    expect(settings, RecognitionSettings, "recognize_reach(settings=)", optional=True)
+    expect(options, MocapImport, "recognize_reach(options=)", optional=True)
+    prepared = prepare_reach(reach, settings, options)
+    rec = recognize_tracks(prepared.tracks, repertoire, prepared.settings, clip=reach.name,
+                           source=reach.source, plan_cache=plan_cache)
+    return measure_reach(rec, reach, prepared), prepared.info
+
+
+class PreparedReach(NamedTuple):
+    """A reach ready to be scored, offline or row by row (:func:`prepare_reach`).
+
+    Attributes
+    ----------
+    tracks, info, transport, aperture
+        :func:`~perception.reaches.reach_tracks`' (``info`` with the reach's
+        ``trial``, ``source`` and ``rate``: the report's ``mocap`` entry).
+    settings : RecognitionSettings
+        The settings its geometry asks for: a millimetre per "pixel", the
+        grip's object size, a whole hand's rest aperture.
+    """
+
+    tracks: object
+    info: dict
+    transport: np.ndarray
+    aperture: np.ndarray
+    settings: object
+
+
+def prepare_reach(reach: Reach, settings=None, options: MocapImport | None = None
+                  ) -> PreparedReach:
+    """A reach's tracks in its plane and the settings they are scored with.
+
+    :func:`recognize_reach` scores them offline; ``hammer-mv watch`` of a
+    recording feeds their rows to an :class:`~perception.online.OnlineRecognizer`,
+    and each ends in :func:`measure_reach`.
+
+    Parameters
+    ----------
+    reach : Reach
+    settings : RecognitionSettings, optional
+        The user's; its ``observe`` scale, object size and rest aperture are
+        set from the reach.
+    options : MocapImport, optional
+    """
+    from perception.pipeline import RecognitionSettings
+
+    expect(reach, Reach, "prepare_reach(reach=)", hint="read_reaches or read_recording")
+    expect(settings, RecognitionSettings, "prepare_reach(settings=)", optional=True)
+    expect(options, MocapImport, "prepare_reach(options=)", optional=True)
     options = MocapImport() if options is None else options
     settings = RecognitionSettings() if settings is None else settings
     tracks, info, transport, aperture = reach_tracks(reach, options.reaches)
@@ -440,21 +530,35 @@ def recognize_reach(reach: Reach, repertoire, settings=None,
         # a whole-hand grasp may rest with the digits apart: the rest
         # aperture is taken off like the markers' separation at rest
         max_rest_aperture=max(settings.observe.max_rest_aperture, widest + 0.01))
-    rec = recognize_tracks(tracks, repertoire, dataclasses.replace(settings, observe=observe),
-                           clip=reach.name, source=reach.source, plan_cache=plan_cache)
+    info = {**info, "trial": reach.name, "source": reach.source,
+            "rate": round(1 / float(_median_step(reach.time)), 3)}
+    return PreparedReach(tracks, info, transport, aperture,
+                         dataclasses.replace(settings, observe=observe))
+
+
+def measure_reach(rec, reach: Reach, prepared: PreparedReach):
+    """``rec`` (the recognition of ``prepared.tracks``) with the reach's landmarks, measured
+    on its 3D marker paths, and the recording's clock (``time_origin``).
+
+    Parameters
+    ----------
+    rec : Recognition
+    reach : Reach
+    prepared : PreparedReach
+        :func:`prepare_reach`'s for ``reach``.
+    """
+    tracks, info = prepared.tracks, prepared.info
     # the landmarks from the 3D speed and aperture, on the observation's clock (its
     # last row is the tracks' last: settling only ever trims or holds the first)
     clock = tracks.time - (tracks.time[-1] - rec.observation.clip_time[-1])
     # by the verdict rules' [verdict.landmarks], as a video's are (the reach finder's
     # own bounds, options.reaches.landmarks, only choose the reach's window)
     bounds = (info["bounds"]["onset"], info["bounds"]["end"])
-    rec = dataclasses.replace(rec, measured=movement_landmarks(
-        clock, transport, aperture, settings.rules.landmarks, bounds=bounds),
+    return dataclasses.replace(rec, measured=movement_landmarks(
+        clock, prepared.transport, prepared.aperture, prepared.settings.rules.landmarks,
+        bounds=bounds),
         # the recording's clock at the observation's zero: the onset row's time in the file
         time_origin=float(reach.time[reach.onset] - clock[bounds[0]]))
-    info = {**info, "trial": reach.name, "source": reach.source,
-            "rate": round(1 / float(_median_step(reach.time)), 3)}
-    return rec, info
 
 
 def _median_step(time) -> float:

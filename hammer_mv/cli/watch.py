@@ -34,8 +34,9 @@ def register(sub) -> None:
                        "with an `online` entry: when the verdict settled, dropped frames.")
     p.add_argument("source", metavar="SOURCE",
                    help="camera index (0), video file, stream URL FFmpeg opens "
-                        "(udp://127.0.0.1:5000, tcp://HOST:PORT, rtsp://...), or a pose "
-                        "file (DeepLabCut, SLEAP, ...) fed row by row")
+                        "(udp://127.0.0.1:5000, tcp://HOST:PORT, rtsp://...), a pose "
+                        "file (DeepLabCut, SLEAP, ...) fed row by row, or a motion-capture "
+                        "recording (C3D, Qualisys TSV, a lab table) replayed reach by reach")
     p.add_argument("-o", "--output", type=Path, required=True, metavar="DIR",
                    help="folder for the clip's report")
     p.add_argument("--clip", metavar="NAME",
@@ -95,6 +96,8 @@ def _watch(args: argparse.Namespace, signals: _Signals) -> int:
     from perception.report.tracking import write_tracking_report
 
     kind = source_kind(args.source)
+    if kind == "file" and _is_recording(args.source):
+        return _watch_recording(args, signals)
     if kind == "file" and clip_name(args.source)[1] == "pose":
         kind = "pose"  # a pose file's keypoints, row by row
     clip = args.clip or {"camera": f"camera{args.source}", "stream": "stream"}.get(kind) \
@@ -179,6 +182,129 @@ def _watch(args: argparse.Namespace, signals: _Signals) -> int:
         print(f"hammer-mv watch: error: labelled video not written: {draw.error}",
               file=sys.stderr)
     return 128 + signals.received if signals.received else 2 if draw.error else 0
+
+
+def _is_recording(source: str) -> bool:
+    """Whether ``source`` names a motion-capture recording (C3D, Qualisys TSV, a lab table)."""
+    from perception.io.mocap import is_mocap_file
+
+    path = Path(source)
+    return path.is_file() and is_mocap_file(path)
+
+
+def _watch_recording(args: argparse.Namespace, signals: _Signals) -> int:
+    """``watch`` of a motion-capture recording: each reach replayed row by row through the
+    online recogniser, as ``recognize`` would score it offline (docs/online.md).
+
+    Each reach prints what a watched file prints (with ``--live`` a line per
+    row, the settled verdict, the final line) and leaves the report watch
+    writes; the trials that give none are listed, as ``recognize`` lists them,
+    with the accounting line. Exit status 1 when a trial or reach is not
+    scored; a signal ends the replay after the reach under way is reported.
+    """
+    import dataclasses
+
+    import numpy as np
+
+    from hammer_mv.cli.checks import writable_folder
+    from hammer_mv.cli.options import load_repertoire, mocap_import, recognition_settings
+    from perception.batch import remove_stale_reports
+    from perception.errors import InputError
+    from perception.io.atomic import check_output
+    from perception.online import OnlineRecognizer, decision_summary
+    from perception.pipeline import clip_fingerprint
+    from perception.reaches import Unscored
+    from perception.recordings import measure_reach, prepare_reach, read_recording, trial_summary
+    from perception.report import clip as report
+
+    path = Path(args.source)
+    if args.labelled_video is not None:
+        raise InputError("a motion-capture recording has no frames to label (leave out "
+                         "--labelled-video)", args.labelled_video, field="--labelled-video")
+    settings = recognition_settings(args)
+    options = settings.mocap or mocap_import(args)
+    out = writable_folder(args.output)
+    recording = read_recording(path, options)
+    stem = path.stem
+
+    def named(entry):  # --clip names the recording: its trials and reaches keep their tails
+        if args.clip is None:
+            return entry.name
+        return args.clip + (entry.name[len(stem):] if entry.name.startswith(stem) else
+                            f"-{entry.name}")
+
+    reaches = [dataclasses.replace(e, name=named(e)) for e in recording.reaches]
+    inputs = [f for f in (args.repertoire, path) if f is not None]
+    for reach in reaches:  # every output refused before the first reach is replayed
+        for target in report.clip_outputs(out, reach.name).values():
+            check_output(target, inputs)
+    rep, rep_id = load_repertoire(args)
+    say = (lambda line: None) if args.quiet else (lambda line: print(line, flush=True))
+    missed = [(named(u), u.reason) for u in recording.entries if isinstance(u, Unscored)]
+    kept, interrupted = [], False
+    signals.holding = True  # a signal ends the replay at the next row, never mid-output
+    for k, reach in enumerate(reaches):
+        if interrupted or signals.received:
+            interrupted = True
+            missed.append((reach.name, f"not replayed: watch interrupted ({signals.name})"))
+            continue
+        prepared = prepare_reach(reach, settings, options)
+        tracks = prepared.tracks
+        rec = OnlineRecognizer(rep, prepared.settings, clip=reach.name, markers=tracks.markers,
+                               tracker_attrs=dict(tracks.tracker))
+        latency, decided = [], None
+        start = time.monotonic()
+        try:
+            for i in range(tracks.n_frames):
+                t = float(tracks.time[i])
+                if not args.as_fast_as_possible:  # played at its own rate
+                    signals.holding = False
+                    time.sleep(max(0.0, t - (time.monotonic() - start)))
+                    signals.holding = True
+                if signals.received:
+                    raise KeyboardInterrupt
+                t0 = time.perf_counter()
+                state = rec.update(tracks.position[i], t, i)
+                latency.append(time.perf_counter() - t0)
+                if args.live:
+                    say(f"{t:8.3f} s  {state.phase:<6}  {state.leading or '-':<12} "
+                        f"{_shown(state):<22}")
+                if state.decision is not None and decided is None:
+                    decided = state.decision
+                    detail = f" ({decided.detail})" if decided.detail else ""
+                    say(f"{reach.name}: settled {decided.verdict}{detail} at "
+                        f"{decided.time:.3f} s ({decided.since_onset:.3f} s after the onset)")
+        except KeyboardInterrupt:  # this reach's outputs of what was seen, then no more
+            signals.holding, interrupted = True, True
+        try:
+            result = measure_reach(rec.finish(dict(tracks.video), source=reach.source), reach,
+                                   prepared)
+        except HammerMVError as exc:  # this reach's (too few rows when interrupted, ...)
+            missed.append((reach.name, f"failed: {exc.problem}"))
+            continue
+        online = {**decision_summary(result, rec.decision), "source": "recording",
+                  "frames": len(latency), "dropped_frames": 0, "read_ahead_dropped": 0,
+                  "interrupted": interrupted,
+                  "signal": signals.name if interrupted else None,
+                  "labelled_video_error": None,
+                  "latency_ms": {"median": float(np.median(latency) * 1e3),
+                                 "p99": float(np.percentile(latency, 99) * 1e3)}}
+        extra = {"fingerprint": clip_fingerprint(path, settings, f"{rep_id}#reach{k}"),
+                 "condition": None, "input": str(path), "mocap": prepared.info,
+                 "online": online}
+        paths = report.write_clip_report(result, out, extra=extra, figures=not args.no_figures)
+        kept.append(reach.name)
+        detail = f" ({result.verdict_detail})" if result.verdict_detail else ""
+        say(f"{reach.name}: {result.verdict or 'no verdict'}{detail}, winner {result.winner} "
+            f"({len(latency)} rows) -> {paths['json']}")
+    if not interrupted:  # reports of trials no longer scored (a rerun after one was lost)
+        remove_stale_reports(out, path, kept)
+    say(trial_summary(len(recording.trials), len(kept), len(missed)))
+    for name, why in missed:  # always: nothing is dropped without a word
+        print(f"{name}: not scored: {why}", file=sys.stderr)
+    if interrupted:
+        return 128 + (signals.received or signal.SIGINT)
+    return 1 if missed else 0
 
 
 def _shown(state) -> str:

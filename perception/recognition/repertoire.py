@@ -19,9 +19,10 @@ import json
 import logging
 import os
 import time
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from pathlib import Path
 
+from perception.boundary import expect
 from perception.errors import InputError, PlanningError
 from perception.io.atomic import owner_gone, owner_tag
 from perception.io.repertoire import (
@@ -129,7 +130,19 @@ class Repertoire:
         ------
         PlanningError
             A model cannot be planned in ``scene`` (out of reach, too short).
+        TypeError
+            An argument of another type (``task='x'``), said on entry.
         """
+        # each refused here, not as a TypeError from deep in the planner
+        expect(scene, SceneSpec, "Repertoire.build(scene=)", optional=True)
+        expect(task, Mapping, "Repertoire.build(task=)", optional=True,
+               hint="GraspTask fields by name")
+        if specs is not None:
+            if isinstance(specs, (str, bytes, Mapping)) or not isinstance(specs, Iterable):
+                raise TypeError(f"Repertoire.build(specs=): expected ModelSpec objects, got "
+                                f"{type(specs).__name__} {specs!r:.40}")
+            for spec in (specs := list(specs)):
+                expect(spec, ModelSpec, "Repertoire.build(specs=[...])")
         specs = default_specs() if specs is None else list(specs)
         if task:
             specs = [ModelSpec(s.name, s.kind, {**task, **s.task}) for s in specs]
