@@ -83,3 +83,37 @@ def test_watch_of_a_recording_refuses_a_labelled_video(recording, tmp_path, caps
     err = capsys.readouterr().err
     assert code == 2 and "no frames to label" in err and len(err.strip().splitlines()) == 1
     assert not list(tmp_path.glob("*.recognition.json"))
+
+
+def test_a_signal_ends_the_replay_after_the_reach_under_way_is_reported(tmp_path, monkeypatch,
+                                                                         capsys):
+    import _thread
+    import signal
+
+    from perception import online
+
+    first = _table(_simple_reach([(0.75, 1.05, 1.4, 0.05, 0.035)]))
+    second = _table(_simple_reach([(0.75, 1.05, 1.4, 0.05, 0.035)], seed=1))
+    path = tmp_path / "two.tsv"
+    pd.concat([first.assign(trial=1), second.assign(trial=2)])[
+        ["trial", *first.columns]].to_csv(path, sep="\t", index=False)
+    update, calls = online.OnlineRecognizer.update, []
+
+    def updating(self, *args, **kwargs):
+        calls.append(1)
+        if len(calls) == 120:  # Ctrl-C during the first reach
+            _thread.interrupt_main(signal.SIGINT)
+        return update(self, *args, **kwargs)
+
+    monkeypatch.setattr(online.OnlineRecognizer, "update", updating)
+    before = signal.getsignal(signal.SIGINT)
+    code = _watch(path, tmp_path / "out")
+    said = capsys.readouterr()
+    assert code == 130, said
+    report = json.loads((tmp_path / "out" / "two-trial1.recognition.json").read_text())
+    assert report["online"]["interrupted"] and report["online"]["signal"] == "SIGINT"
+    assert report["online"]["frames"] == 120
+    assert not (tmp_path / "out" / "two-trial2.recognition.json").exists()
+    assert "2 trials, 1 reach scored, 1 not scored" in said.out
+    assert "two-trial2: not scored: not replayed: watch interrupted (SIGINT)" in said.err
+    assert signal.getsignal(signal.SIGINT) == before
