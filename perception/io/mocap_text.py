@@ -20,7 +20,7 @@ import numpy as np
 from perception.errors import InputError
 from perception.limits import MAX_FRAMES
 
-__all__ = ["TableText", "table_text"]
+__all__ = ["TableText", "check_fields", "header_width", "load_chunks", "table_text"]
 
 #: Data lines looked at to tell the decimal mark (not only the first: a table
 #: may start at integer positions, 0;100;20, and write 0,01 further down).
@@ -240,9 +240,8 @@ def load(path: Path, raw: bytes, sep: str, skip: int, header: int | None, decima
     import pandas as pd
 
     try:
-        df = pd.read_csv(io.BytesIO(raw), sep=sep, skiprows=skip, header=header, decimal=decimal,
-                         index_col=False, nrows=MAX_FRAMES + 1, encoding="utf-8-sig",
-                         encoding_errors="replace", skipinitialspace=True, low_memory=False)
+        df = pd.read_csv(io.BytesIO(raw), **_read_options(sep, skip, header, decimal),
+                         nrows=MAX_FRAMES + 1, low_memory=False)
     except pd.errors.EmptyDataError:
         raise InputError("no data rows", path) from None
     except pd.errors.ParserError as exc:
@@ -255,10 +254,7 @@ def load(path: Path, raw: bytes, sep: str, skip: int, header: int | None, decima
             df = df.iloc[:, :-1]
         width = df.shape[1]
     else:
-        df.columns = [str(c).strip() for c in df.columns]
-        width = len(df.columns)  # a header ending in a separator names a last empty column
-        while width > 1 and df.columns[width - 1].startswith("Unnamed: "):
-            width -= 1
+        width = header_width(df)
     if sep != r"\s+":  # pandas fills a short row with NaN: count its fields
         _check_fields(path, raw, sep, skip + (header is not None), width, df)
     return df
@@ -269,23 +265,47 @@ def load(path: Path, raw: bytes, sep: str, skip: int, header: int | None, decima
 _FIELDS_CHUNK = 1 << 23
 
 
-def _check_fields(path: Path, raw: bytes, sep: str, first: int, width: int, df) -> None:
-    """Refuse the first line below ``first`` with fewer than ``width`` fields (pandas pads it)."""
-    data = np.frombuffer(raw, np.uint8)
-    sep_byte, line, start = ord(sep), 0, 0
-    while start < len(data):
-        # a chunk of whole lines (the last one may run to the file's end)
-        stop = min(start + _FIELDS_CHUNK, len(data))
-        if stop < len(data):
-            newline = raw.rfind(b"\n", start, stop)
-            stop = newline + 1 if newline >= start else raw.find(b"\n", stop) + 1 or len(data)
-        chunk = data[start:stop]
+def _line_blocks(source):
+    """Blocks of whole lines of ``source`` (bytes, or a path read a block at a time)."""
+    if isinstance(source, (bytes, bytearray)):
+        start = 0
+        while start < len(source):
+            stop = min(start + _FIELDS_CHUNK, len(source))
+            if stop < len(source):
+                newline = source.rfind(b"\n", start, stop)
+                stop = (newline + 1 if newline >= start
+                        else source.find(b"\n", stop) + 1 or len(source))
+            yield source[start:stop]
+            start = stop
+        return
+    with open(source, "rb") as fh:
+        rest = b""
+        # smaller blocks from a file: its reader holds one chunk, not the whole text
+        while block := fh.read(_FIELDS_CHUNK // 8):
+            block = rest + block
+            cut = block.rfind(b"\n") + 1
+            if not cut:  # one long line so far
+                rest = block
+                continue
+            rest = block[cut:]
+            yield block[:cut]
+        if rest:
+            yield rest
+
+
+def _check_fields(path: Path, source, sep: str, first: int, width: int, df) -> int:
+    """Refuse the first line below ``first`` with fewer than ``width`` fields (pandas pads it);
+    return the lines counted. ``source`` is the table's bytes, or its path."""
+    sep_byte, line = ord(sep), 0
+    for block in _line_blocks(source):
+        chunk = np.frombuffer(block, np.uint8)
         ends = np.flatnonzero(chunk == 10)
         if not len(ends) or ends[-1] != len(chunk) - 1:
             ends = np.append(ends, len(chunk))
         starts = np.concatenate([[0], ends[:-1] + 1])
-        cum = np.concatenate([[0], np.cumsum(chunk == sep_byte, dtype=np.int32)])
-        fields = cum[ends] - cum[starts] + 1
+        # separators per line summed line by line: a cumulative count over every byte
+        # took 8 bytes per byte of the block
+        fields = np.add.reduceat(chunk == sep_byte, starts, dtype=np.int64) + 1
         last = np.maximum(ends - 1, 0)
         length = ends - starts - ((ends > starts) & (chunk[last] == 13))
         rows = line + np.arange(len(ends))
@@ -295,7 +315,77 @@ def _check_fields(path: Path, raw: bytes, sep: str, first: int, width: int, df) 
             raise InputError(f"line {rows[b] + 1} has {fields[b]} fields; the rows above "
                              f"have {width}", path, field=str(df.columns[fields[b]]))
         line += len(ends)
-        start = stop
+    return line
+
+
+def _read_options(sep: str, skip: int, header: int | None, decimal: str) -> dict:
+    """pandas' options for a table, read whole or in chunks alike."""
+    return dict(sep=sep, skiprows=skip, header=header, decimal=decimal, index_col=False,
+                encoding="utf-8-sig", encoding_errors="replace", skipinitialspace=True)
+
+
+def header_width(df) -> int:
+    """Columns of a table read with its header: a header ending in a separator names a last
+    empty column, not counted."""
+    df.columns = [str(c).strip() for c in df.columns]
+    width = len(df.columns)
+    while width > 1 and df.columns[width - 1].startswith("Unnamed: "):
+        width -= 1
+    return width
+
+
+def load_chunks(path: Path, sep: str, skip: int, decimal: str, rows: int, usecols=None):
+    """The table below ``skip`` lines (a header row first) from the file, ``rows`` at a time.
+
+    Read so, a table takes the memory of one chunk rather than of its every
+    row: for a long table read trial by trial
+    (:func:`perception.io.mocap_tables.read_xyz_table`'s large files). The
+    chunks' columns are stripped of spaces; nothing is checked here (the
+    caller compares the chunks' kinds, and counts fields with
+    :func:`check_fields`).
+
+    Parameters
+    ----------
+    path : Path
+        The file (UTF-8).
+    sep : str
+        A one-character separator.
+    skip : int
+        Lines above the header.
+    decimal : str
+        The decimal mark.
+    rows : int
+        Rows per chunk.
+    usecols : list of int, optional
+        The columns read, by position.
+    """
+    import pandas as pd
+
+    with pd.read_csv(path, **_read_options(sep, skip, 0, decimal), chunksize=rows,
+                     usecols=usecols) as reader:
+        for chunk in reader:
+            chunk.columns = [str(c).strip() for c in chunk.columns]
+            yield chunk
+
+
+def check_fields(path: Path, sep: str, skip: int, width: int, df) -> int:
+    """Refuse a line of the file below its header with fewer than ``width`` fields, read a
+    block at a time; return the file's lines.
+
+    Parameters
+    ----------
+    path : Path
+        The file.
+    sep : str
+        Its one-character separator.
+    skip : int
+        Lines above the header.
+    width : int
+        The header's columns.
+    df : pandas.DataFrame
+        A frame with the table's columns (to name the first missing one).
+    """
+    return _check_fields(path, path, sep, skip + 1, width, df)
 
 
 def numeric(column, path: Path, name: str) -> np.ndarray:

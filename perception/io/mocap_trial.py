@@ -10,9 +10,12 @@ format applies them alike.
 
 from __future__ import annotations
 
+import itertools
 import logging
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
+from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
@@ -22,7 +25,7 @@ import numpy as np
 from perception.errors import InputError
 from perception.limits import MAX_FPS, MAX_FRAMES, MAX_KEYPOINTS
 
-__all__ = ["UNITS", "MocapTrial"]
+__all__ = ["UNITS", "MocapTrial", "Spread", "TrialStream", "reading_progress"]
 
 _log = logging.getLogger(__name__)
 
@@ -32,6 +35,8 @@ UNITS = {"mm": 1e-3, "cm": 1e-2, "m": 1.0}
 _MM_ABOVE = 5.0
 #: Coordinates this large are NDI's missing-marker value (-3.697314e28), not positions.
 _NDI_MISSING = 1e25
+#: Where a table read trial by trial says how far it is (:func:`reading_progress`).
+_PROGRESS: ContextVar = ContextVar("mocap_progress", default=None)
 #: A rate given and a file's own clock may differ by this share before they disagree.
 RATE_TOLERANCE = 0.01
 
@@ -252,14 +257,61 @@ def strip_subject(names: list[str]) -> tuple[list[str], list[str]]:
     return unique, notes
 
 
-def _infer_units(pieces) -> tuple[str, str]:
-    """The unit a table's positions are in, from their spread, and the note saying so.
+class Spread:
+    """Each marker's range over a recording, without its most extreme 1 % of values, gathered
+    a piece at a time (:func:`_infer_units`' rule, for a table read in chunks).
 
-    Each marker's coordinates range over the capture volume: tens of cm or more
-    for the markers of a reach (more than 5 in mm, less in m). The range is
-    taken per marker without its most extreme 1 % of values, and the median
-    over markers decides: one glitch, or one marker off on its own, does not.
+    Only the smallest and the largest ``bound`` values of each marker are
+    kept, ``bound`` being 1 % of the most values there can be, plus one: the
+    1 % cut of the values there are is among them, so the range is the one
+    the whole table gives, and the memory is that of 2 % of it.
+
+    Parameters
+    ----------
+    names : list of str
+        The markers.
+    most : int
+        The most values (rows x 3) any marker can have.
     """
+
+    def __init__(self, names, most: int):
+        self.bound = int(0.01 * most) + 1
+        self.count = dict.fromkeys(names, 0)
+        self.low = {n: np.empty(0) for n in names}
+        self.high = {n: np.empty(0) for n in names}
+
+    def add(self, markers: Mapping[str, np.ndarray]) -> None:
+        """Take in a piece: marker -> positions (lost samples NaN).
+
+        Parameters
+        ----------
+        markers : mapping of str to ndarray
+        """
+        for name, xyz in markers.items():
+            values = xyz.ravel()
+            values = values[np.isfinite(values)]
+            self.count[name] += len(values)
+            self.low[name] = _extreme(np.concatenate([self.low[name], values]), self.bound)
+            self.high[name] = -_extreme(np.concatenate([-self.high[name], -values]), self.bound)
+
+    def spans(self) -> list[float]:
+        """Each seen marker's range without its extreme 1 %, in order."""
+        out = []
+        for name, n in self.count.items():
+            if n:
+                cut = int(0.01 * n)
+                low, high = np.sort(self.low[name]), np.sort(self.high[name])
+                out.append(float(high[len(high) - 1 - cut] - low[cut]))
+        return out
+
+
+def _extreme(values: np.ndarray, k: int) -> np.ndarray:
+    """The ``k`` smallest of ``values`` (all of them if fewer)."""
+    return values if len(values) <= k else np.partition(values, k - 1)[:k]
+
+
+def _spans(pieces) -> list[float]:
+    """Each marker's range over ``pieces`` without its extreme 1 %."""
     spans = []
     names = list(pieces[0][2])
     for name in names:
@@ -268,12 +320,62 @@ def _infer_units(pieces) -> tuple[str, str]:
         if len(values):
             cut = int(0.01 * len(values))
             spans.append(float(values[len(values) - 1 - cut] - values[cut]))
+    return spans
+
+
+def infer_units(spans: list[float]) -> tuple[str, str]:
+    """The unit a table's positions are in, from their spread, and the note saying so.
+
+    Each marker's coordinates range over the capture volume: tens of cm or more
+    for the markers of a reach (more than 5 in mm, less in m). The range is
+    taken per marker without its most extreme 1 % of values, and the median
+    over markers decides: one glitch, or one marker off on its own, does not.
+
+    Parameters
+    ----------
+    spans : list of float
+        Each marker's range (:class:`Spread`).
+    """
     span = float(np.median(spans)) if spans else 0.0
     units = "mm" if span > _MM_ABOVE else "m"
     markers = f"{len(spans)} marker{'s' if len(spans) != 1 else ''}"
     return units, (f"units inferred: {units} (the positions span {span:.4g}: the median over "
                    f"{markers} of each one's range, without its extreme 1 %; give --units to "
                    "say)")
+
+
+def mark_lost(markers: Mapping[str, np.ndarray]) -> int:
+    """Mark lost samples NaN in place (all three coordinates 0, NDI's missing value); return
+    how many were at the origin.
+
+    Parameters
+    ----------
+    markers : mapping of str to (N, 3) ndarray
+        Positions in the file's unit.
+    """
+    count = 0
+    for xyz in markers.values():
+        at_origin = (xyz == 0).all(axis=1)
+        # NDI systems write -3.697314e28 for a marker they lost
+        xyz[at_origin | ~(np.abs(xyz) < _NDI_MISSING).all(axis=1)] = np.nan
+        count += int(at_origin.sum())
+    return count
+
+
+def check_size(samples: int, markers: int, path: Path) -> None:
+    """Refuse a recording of more samples or markers than are read.
+
+    Parameters
+    ----------
+    samples : int
+        Its samples, all trials together.
+    markers : int
+        Its markers.
+    path : Path
+        The file.
+    """
+    if samples > MAX_FRAMES or markers > MAX_KEYPOINTS:
+        raise InputError(f"more than {MAX_FRAMES} samples or {MAX_KEYPOINTS} markers", path)
 
 
 def assemble(path: Path, source: str, pieces, rate: float, units: str | None,
@@ -306,38 +408,119 @@ def assemble(path: Path, source: str, pieces, rate: float, units: str | None,
     """
     if labels is None:
         labels = [(str(k + 1), {}) for k in range(len(pieces))]
-    if sum(len(p[1]) for p in pieces) > MAX_FRAMES or len(pieces[0][2]) > MAX_KEYPOINTS:
-        raise InputError(f"more than {MAX_FRAMES} samples or {MAX_KEYPOINTS} markers", path)
-    zeros = []
-    for _, _, markers, _ in pieces:
-        count = 0
-        for xyz in markers.values():
-            at_origin = (xyz == 0).all(axis=1)
-            # NDI systems write -3.697314e28 for a marker they lost
-            xyz[at_origin | ~(np.abs(xyz) < _NDI_MISSING).all(axis=1)] = np.nan
-            count += int(at_origin.sum())
-        zeros.append(count)
+    check_size(sum(len(p[1]) for p in pieces), len(pieces[0][2]), path)
+    zeros = [mark_lost(markers) for _, _, markers, _ in pieces]
     if units is None and own is not None:
         units = check_unit(own[0], path, own[1])
     if units is None:
-        units, note = _infer_units(pieces)
+        units, note = infer_units(_spans(pieces))
         notes = [*notes, note]
-    trials = []
-    for (suffix, time, markers, extra), count, (number, factors) in zip(pieces, zeros, labels):
-        own_notes = notes + ([f"{count} samples at exactly (0, 0, 0) read as lost"] if count
-                             else [])
-        lost = [m for m, xyz in markers.items() if not np.isfinite(xyz).all(axis=1).any()]
-        if lost and len(lost) < len(markers):
-            own_notes.append(f"marker{'s' if len(lost) > 1 else ''} "
-                             f"{', '.join(map(repr, lost))} never seen (every sample empty, "
-                             "NaN or at (0, 0, 0))")
-        elif lost:
-            own_notes.append("no marker is ever seen (every sample empty, NaN or at (0, 0, 0))")
-        for note in own_notes:
-            _log.debug("%s%s: %s", source, suffix, note)
-        trials.append(MocapTrial(
-            name=path.stem + suffix, source=source, time=np.asarray(time, dtype=float),
-            markers={m: xyz * UNITS[units] for m, xyz in markers.items()},
-            rate=rate, units=units, notes=tuple(own_notes), extra=extra, factors=factors,
-            trial_number=number))
-    return trials
+    return [make_trial(path, source, piece, count, rate, units, notes, label)
+            for piece, count, label in zip(pieces, zeros, labels)]
+
+
+def make_trial(path: Path, source: str, piece, zeros: int, rate: float, units: str,
+               notes: list[str], label: tuple[str, dict]) -> MocapTrial:
+    """One trial in metres from its piece (lost samples marked: :func:`mark_lost`).
+
+    Parameters
+    ----------
+    path : Path
+        The file.
+    source : str
+        The file as the caller named it.
+    piece : tuple
+        ``(name suffix, time, {marker: (N, 3) in file units}, extra)``.
+    zeros : int
+        Its samples found at the origin.
+    rate : float
+        Samples/s.
+    units : str
+        The file's unit.
+    notes : list of str
+        Notes for every trial.
+    label : tuple of (str, dict)
+        Its trial number and factors.
+    """
+    suffix, time, markers, extra = piece
+    number, factors = label
+    own_notes = notes + ([f"{zeros} samples at exactly (0, 0, 0) read as lost"] if zeros
+                         else [])
+    lost = [m for m, xyz in markers.items() if not np.isfinite(xyz).all(axis=1).any()]
+    if lost and len(lost) < len(markers):
+        own_notes.append(f"marker{'s' if len(lost) > 1 else ''} "
+                         f"{', '.join(map(repr, lost))} never seen (every sample empty, "
+                         "NaN or at (0, 0, 0))")
+    elif lost:
+        own_notes.append("no marker is ever seen (every sample empty, NaN or at (0, 0, 0))")
+    for note in own_notes:
+        _log.debug("%s%s: %s", source, suffix, note)
+    return MocapTrial(
+        name=path.stem + suffix, source=source, time=np.asarray(time, dtype=float),
+        markers={m: xyz * UNITS[units] for m, xyz in markers.items()},
+        rate=rate, units=units, notes=tuple(own_notes), extra=extra, factors=factors,
+        trial_number=number)
+
+
+class TrialStream(Sequence):
+    """A long table's trials, read one by one as they are reached.
+
+    What :func:`perception.io.mocap.read_mocap` returns for a large table
+    (:data:`perception.io.mocap_tables.STREAM_BYTES`): a sequence of
+    :class:`MocapTrial` like the list it returns otherwise, whose every pass
+    reads the file once more, a chunk at a time, and holds one trial (and one
+    chunk) at a time. The file was checked whole when it was opened: a
+    mistake in it is raised then, not halfway.
+
+    Parameters
+    ----------
+    names : sequence of str
+        The trials' names, in file order.
+    read : callable
+        ``read()`` -> an iterator over the trials, from the first.
+    """
+
+    def __init__(self, names, read):
+        self.names = tuple(names)
+        self._read = read
+
+    def __len__(self) -> int:
+        return len(self.names)
+
+    def __iter__(self):
+        return self._read()
+
+    def __getitem__(self, index):
+        if isinstance(index, slice):
+            return [self[k] for k in range(len(self))[index]]
+        k = range(len(self))[index]  # an IndexError as a list's
+        return next(itertools.islice(self._read(), k, None))
+
+    def __repr__(self) -> str:
+        return f"TrialStream({len(self)} trials)"
+
+
+@contextmanager
+def reading_progress(callback):
+    """Within it, a table read trial by trial says how far it is: ``callback(done, total,
+    what)`` (rows checked, then trials read; ``what`` says which, and of which file).
+
+    The library never prints: a command passes a callback that draws a
+    progress bar (``hammer-mv landmarks`` on a terminal), through the layers
+    between it and the reader.
+
+    Parameters
+    ----------
+    callback : callable or None
+        ``callback(done: int, total: int, what: str)``; None: nothing is said.
+    """
+    token = _PROGRESS.set(callback)
+    try:
+        yield
+    finally:
+        _PROGRESS.reset(token)
+
+
+def progress_callback():
+    """The callback :func:`reading_progress` set here, or None."""
+    return _PROGRESS.get()
