@@ -11,7 +11,8 @@ reach, in the movement's own plane, with the settings the reach's own
 geometry asks for (its scale is a millimetre per "pixel", its object's size
 is the grip's or the one given, and the digits need not touch at rest), and
 measures its landmarks by the verdict rules' ``[verdict.landmarks]``, as a
-video's are.
+video's are: :func:`prepare_reach`, the recognition, then :func:`measure_reach`
+(``hammer-mv watch`` puts an online recogniser fed row by row between the two).
 
 docs/mocap.md describes the formats, the mapping and what is reported.
 """
