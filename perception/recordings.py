@@ -323,11 +323,13 @@ def read_recording(path, options: MocapImport | None = None) -> Recording:
     expect(options, MocapImport, "read_recording(options=)", optional=True)
     options = MocapImport() if options is None else options
     trials = read_mocap(path, **options.read_options())
-    if (lost := _never_seen(trials, options.markers)) is not None:
-        raise InputError(lost, path)
     from_name = options.name_factors(path)
     entries: list[Reach | Unscored] = []
+    # one pass: a large table's trials are read from the file on each (TrialStream)
+    names, seen = [], {}
     for trial in trials:
+        names.append(trial.name)
+        _note_seen(seen, trial, options.markers)
         source = str(trial.source)
         factors = merge_factors([("the table's columns", trial.factors),
                                  (f"the file name ({FACTORS_FROM_NAME})", from_name)], path)
@@ -347,31 +349,36 @@ def read_recording(path, options: MocapImport | None = None) -> Recording:
         if not reaches and not unscored:  # every trial leaves a word
             unscored = [Unscored(trial.name, source, "no reach", "no reach found", **labels)]
         entries += sorted([*reaches, *unscored], key=_start)
-    return Recording(str(path), tuple(t.name for t in trials), tuple(entries))
+    if (lost := _never_seen(seen, len(names))) is not None:
+        raise InputError(lost, path)
+    return Recording(str(path), tuple(names), tuple(entries))
 
 
-def _never_seen(trials, markers: MarkerMap | None) -> str | None:
+def _note_seen(seen: dict, trial, markers: MarkerMap | None) -> None:
+    """Mark in ``seen`` (``(name, role) -> bool``) whether ``trial`` sees each marker its
+    mapping (``markers``, or the guess) gives a digit or the wrist."""
+    mapped = MarkerMap.guess(trial.markers) if markers is None else markers
+    for name, role in mapped.roles():
+        if role != "object" and name in trial.markers:  # a missing one: check() says
+            seen[name, role] = seen.get((name, role), False) or ever_seen(trial.markers[name])
+
+
+def _never_seen(seen: dict, trials: int) -> str | None:
     """Why the recording gives no reach anywhere: a digit's or a mapped wrist's marker that
-    no trial ever sees (None if each is seen somewhere).
+    none of its ``trials`` ever sees (``seen`` by :func:`_note_seen`; None if each is seen
+    somewhere).
 
     The marker is named, not the "no reach" it leads to: a lost marker or a
     wrong mapping, the user's to fix for every trial at once. A trial that
     loses one another trial sees is that trial's (``marker lost``). The
     object's markers may be lost (the object is then where the grip closes).
     """
-    seen: dict[tuple[str, str], bool] = {}
-    for trial in trials:
-        mapped = MarkerMap.guess(trial.markers) if markers is None else markers
-        for name, role in mapped.roles():
-            if role != "object" and name in trial.markers:  # a missing one: check() says
-                seen[name, role] = seen.get((name, role), False) or ever_seen(
-                    trial.markers[name])
     lost = [(name, role) for (name, role), ok in seen.items() if not ok]
     if not lost:
         return None
     name, role = lost[0]
     what = f"marker {name!r}" + ("" if name == role else f" (the {role})")
-    where = f"any of its {len(trials)} trials" if len(trials) > 1 else "the recording"
+    where = f"any of its {trials} trials" if trials > 1 else "the recording"
     return (f"{what} is never seen in {where}: every sample of it is "
             "missing (empty, NaN, all zeros or flagged); check --markers or the recording")
 
