@@ -269,7 +269,7 @@ def _entry_landmarks(entry, params: LandmarkParams) -> tuple[dict, MovementLandm
 def measure_inputs(inputs, *, params: LandmarkParams | None = None, mocap=None,
                    px_per_m: float | None = None, object_diameter: float | None = None,
                    object_diameter_px: float | None = None, pose=None,
-                   tracks_out=None) -> Measured:
+                   tracks_out=None, progress=None) -> Measured:
     """The landmarks of every movement in some files, folders and manifests, as ``batch``
     finds them.
 
@@ -292,12 +292,28 @@ def measure_inputs(inputs, *, params: LandmarkParams | None = None, mocap=None,
         The object's apparent diameter, px, where the tracks do not give it.
     tracks_out : callable, optional
         ``tracks_out(path)``: where a video's tracks are written.
+    progress : callable, optional
+        ``progress(done, total, what)``, told how far the work is: a large
+        table's rows checked and trials read
+        (:func:`perception.io.mocap_trial.reading_progress`), then each
+        input's movements measured. Nothing is said without it.
 
     Returns
     -------
     Measured
         Its ``movements`` (its ``table`` the same, in SI units, in the files' order).
     """
+    from perception.io.mocap_trial import reading_progress
+
+    with reading_progress(progress):
+        return _measure_inputs(list(map(Path, inputs)), params, mocap, progress, dict(
+            px_per_m=px_per_m, object_diameter=object_diameter,
+            object_diameter_px=object_diameter_px, pose=pose), tracks_out)
+
+
+def _measure_inputs(inputs: list[Path], params, mocap, progress, kwargs: dict,
+                    tracks_out) -> Measured:
+    """:func:`measure_inputs`' work."""
     import pandas as pd
 
     from perception.discovery import BatchItem, expand_recordings, find_clips
@@ -308,7 +324,7 @@ def measure_inputs(inputs, *, params: LandmarkParams | None = None, mocap=None,
     mocap = MocapImport() if mocap is None else mocap
     settings = _MocapSettings(mocap)
     tables, movements, trials = [], [], 0
-    for path in map(Path, inputs):
+    for path in inputs:
         listed = path.is_dir() or _is_manifest(path)
         if listed:
             items = find_clips(path).items
@@ -319,18 +335,18 @@ def measure_inputs(inputs, *, params: LandmarkParams | None = None, mocap=None,
         trials += _trials(items)
         unscored: dict[Path, list] = {}
         found_here: list[MovementLandmarks] = []
-        for item in items:
+        for k, item in enumerate(items):
             try:
                 found = _item_landmarks(item, params, mocap, unscored, dict(
-                    px_per_m=px_per_m, object_diameter=object_diameter,
-                    object_diameter_px=object_diameter_px, pose=pose,
-                    tracks_out=None if tracks_out is None else tracks_out(item.path)))
+                    kwargs, tracks_out=None if tracks_out is None else tracks_out(item.path)))
             except InputError as exc:
                 if not listed:
                     raise
                 found = _failed(item, str(exc))
             tables.append(found.table)
             found_here += [_tagged(m, item) for m in found.movements]
+            if progress is not None:
+                progress(k + 1, len(items), f"measuring {path.name}")
         if listed:  # in clip order, as batch's tables are
             found_here.sort(key=lambda m: m.clip)
         movements += found_here

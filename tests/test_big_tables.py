@@ -7,12 +7,15 @@ forced small, so that tables of a few kB take that path and a trial spans
 several chunks.
 """
 
+import io
+import sys
 import tracemalloc
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from hammer_mv.cli import main
 from perception.errors import InputError
 from perception.io import mocap_tables, mocap_text
 from perception.io.mocap import read_mocap
@@ -174,3 +177,26 @@ def test_progress_is_said_through_a_callback(tmp_path):
     said.clear()
     list(trials)  # outside: nothing said
     assert said == []
+
+
+class _Terminal(io.StringIO):
+    def isatty(self) -> bool:
+        return True
+
+
+@pytest.mark.usefixtures("streamed")
+def test_landmarks_draws_a_progress_bar_on_a_terminal_only(tmp_path, monkeypatch):
+    path = write_table(tmp_path / "t.tsv", trials=4)
+    monkeypatch.delenv("CI", raising=False)
+    for env, quiet, terminal, drawn in [(None, False, True, True), ("true", False, True, False),
+                                        (None, True, True, False), (None, False, False, False)]:
+        if env:
+            monkeypatch.setenv("CI", env)
+        err = _Terminal() if terminal else io.StringIO()
+        monkeypatch.setattr(sys, "stderr", err)
+        main(["landmarks", str(path), "--rate", "100", "-o", str(tmp_path / "out.csv"),
+              *(["--quiet"] if quiet else [])])
+        monkeypatch.delenv("CI", raising=False)
+        said = err.getvalue()
+        assert ("reading t.tsv" in said and "measuring t.tsv" in said) is drawn, said
+        assert ("checking t.tsv" in said) is drawn

@@ -119,10 +119,15 @@ def run(args: argparse.Namespace) -> int:
         return (output_folder(args.output.parent, "tracks")
                 / f"{output_stem(clip_name(path)[0])}{TRACKS_SUFFIX}")
 
-    found = measure_inputs(inputs, params=params, mocap=mocap, px_per_m=args.px_per_m,
-                           object_diameter=args.object_diameter,
-                           object_diameter_px=args.object_diameter_px, pose=pose,
-                           tracks_out=tracks_out)
+    bar = progress_bar(args.quiet)
+    try:
+        found = measure_inputs(inputs, params=params, mocap=mocap, px_per_m=args.px_per_m,
+                               object_diameter=args.object_diameter,
+                               object_diameter_px=args.object_diameter_px, pose=pose,
+                               tracks_out=tracks_out, progress=bar)
+    finally:
+        if bar is not None:
+            bar.close()
     movements = found.movements
     if args.wide:
         table = wide_landmarks(movements)
@@ -144,3 +149,47 @@ def run(args: argparse.Namespace) -> int:
     for m in missed:  # always: none dropped
         print(f"{m.trial}: not scored: {m.reason}", file=sys.stderr)
     return 1 if missed else 0
+
+
+class _Bar:
+    """tqdm bars on stderr that follow ``(done, total, what)`` reports: a bar per stage (a
+    large table's rows checked, its trials read on each pass, the movements measured)."""
+
+    #: The unit counted, by the report's first word.
+    UNITS = {"checking": "row", "reading": "trial", "measuring": "movement"}
+
+    def __init__(self):
+        self.bar = None
+        self.what = None
+
+    def __call__(self, done: int, total: int, what: str) -> None:
+        if self.bar is None or what != self.what or done < self.bar.n:  # a new stage or pass
+            from tqdm import tqdm
+
+            self.close()  # a bar of its own: tqdm's pace (miniters) is the last stage's
+            self.bar = tqdm(total=total, desc=what, file=sys.stderr, leave=False,
+                            dynamic_ncols=True, unit=self.UNITS.get(what.split()[0], "it"))
+            self.what = what
+        self.bar.total = total
+        self.bar.update(done - self.bar.n)
+
+    def close(self) -> None:
+        """Clear the bar drawn last."""
+        if self.bar is not None:
+            self.bar.close()
+
+
+def progress_bar(quiet: bool) -> _Bar | None:
+    """A progress bar for ``measure_inputs``' ``progress``, or None: with ``--quiet``,
+    when stderr is not a terminal, or on CI (``CI=true``).
+
+    Parameters
+    ----------
+    quiet : bool
+        ``--quiet``.
+    """
+    import os
+
+    if quiet or not sys.stderr.isatty() or os.environ.get("CI", "").lower() in ("true", "1"):
+        return None
+    return _Bar()
