@@ -642,6 +642,11 @@ def observe(tracks, params: ObserveParams | None = None, *, clip: str | None = N
         does not start with a still, visible hand that looks like a hand, no
         movement is found, or the movement is too short to score.
     """
+    from perception.boundary import expect
+    from perception.io.tracks import Tracks
+
+    expect(tracks, Tracks, "observe(tracks=)", hint="perception.load_tracks or track_video")
+    expect(params, ObserveParams, "observe(params=)", optional=True)
     params = ObserveParams() if params is None else params
     p = _prepare(tracks, params, _clip_name(tracks, clip))
     sc = p.scene

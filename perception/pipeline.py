@@ -495,6 +495,11 @@ def recognize_clip(source: str | os.PathLike | Tracks, repertoire: Repertoire,
     InputError
         Bad input at any stage, in one message naming the input file.
     """
+    from perception.boundary import expect
+
+    expect(repertoire, Repertoire, "recognize_clip(repertoire=)",
+           hint="Repertoire.load or Repertoire.build")
+    expect(settings, RecognitionSettings, "recognize_clip(settings=)", optional=True)
     settings = RecognitionSettings() if settings is None else settings
     is_file = not isinstance(source, Tracks)
     name = clip or (clip_name(source)[0] if is_file else None)

@@ -17,8 +17,10 @@ from test_reach_finding import _simple_reach
 
 import perception as pc
 from perception.errors import InputError
+from perception.observation import observe
 from perception.reaches import MarkerMap, reach_tracks, trial_reaches
 from perception.recordings import cached_reaches, cached_recording, prepare_reach, read_recording
+from perception.report.clip import write_clip_report
 
 
 def _trial():
@@ -64,6 +66,16 @@ TYPE_CASES = [  # (call, what the message names)
      "ModelSpec objects, got str"),
     (lambda p, r: pc.Repertoire.build(specs=[{"name": "g"}]), "Repertoire.build(specs=[...]): "
      "expected ModelSpec, got dict"),
+    (lambda p, r: pc.recognize_clip(p, "rep.h5"), "recognize_clip(repertoire=): expected "
+     "Repertoire"),
+    (lambda p, r: pc.recognize_clip(p, pc.Repertoire.default(), settings="fast"),
+     "recognize_clip(settings=): expected RecognitionSettings or None, got str"),
+    (lambda p, r: observe("tracks.h5"), "observe(tracks=): expected Tracks"),
+    (lambda p, r: observe(reach_tracks(r)[0], "x"), "observe(params=): expected ObserveParams"),
+    (lambda p, r: write_clip_report("x", p.parent), "write_clip_report(rec=): expected "
+     "Recognition"),
+    (lambda p, r: pc.track_video("clip.mp4", params="x"), "track_video(params=): expected "
+     "TrackerParams"),
 ]
 
 

@@ -381,6 +381,9 @@ def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,
     dict of Path
         The files written (see :func:`clip_outputs`).
     """
+    from perception.boundary import expect
+
+    expect(rec, Recognition, "write_clip_report(rec=)", hint="recognize_clip's result")
     paths = clip_outputs(Path(out), rec.clip, figure_format)
     if figures:
         from perception.report.figures import confidence_figure, paths_figure, write_figure

@@ -596,6 +596,9 @@ def track_video(
     says why); a Python caller tracking many clips may do the same with
     ``cv2.setNumThreads(1)``.
     """
+    from perception.boundary import expect
+
+    expect(params, TrackerParams, "track_video(params=)", optional=True)
     markers = default_markers() if markers is None else markers
     out_path = tracks_path_for(video) if out is None else Path(out)
     tracker = Tracker(markers, params, rois)
