@@ -13,21 +13,36 @@ so it needs nothing outside the repository.
   every figure and the batch report;
 * baseline: one trial of the same table, ``recognize --no-figures``, whole
   process (60 times it is what scoring trial by trial would cost).
+
+The ``size`` part (issue 46; ``python tools/bench_mocap.py --only size``)
+builds a 1,000,000-row table of the same trials (1,984 trials, 95 MB) and
+runs ``hammer-mv landmarks`` of it in a subprocess: wall time and peak
+resident memory (Linux ``wait4``), against the targets of 60 s and 4 times
+the file's size, beside the floor measured in the same run (a process that
+imports ``perception``, pandas and scipy.signal, and does nothing).
 """
 
 from __future__ import annotations
 
+import argparse
+import os
 import shutil
+import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 from bench import table  # also puts the project root on sys.path
-from bench_speed import HAMMER, _timed
+from bench_speed import HAMMER, _on_two_cores, _timed
 
 ROOT = Path(__file__).resolve().parents[1]
 SOURCE = ROOT / "tests" / "data" / "mocap" / "optotrak-trials.tsv"
 RATE = "85"
+#: Copies of the shipped trials in the size benchmark: 496 x 4 trials, 1,000,432 rows.
+BIG_COPIES = 496
+#: The memory target: this many times the table's size.
+MEMORY_TARGET = 4
 
 
 def make_table(path: Path, copies: int = 15) -> int:
@@ -42,7 +57,8 @@ def make_table(path: Path, copies: int = 15) -> int:
     return copies * len(trials)
 
 
-def main() -> None:
+def scoring() -> None:
+    """The 60-trial table scored by ``recognize`` and ``batch``, against one trial."""
     work = Path(tempfile.mkdtemp(prefix="bench-mocap-"))
     try:
         folder = work / "session"
@@ -71,6 +87,53 @@ def main() -> None:
         ])
     finally:
         shutil.rmtree(work, ignore_errors=True)
+
+
+def _peak(cmd: list[str]) -> tuple[float, float]:
+    """Wall time, s, and peak resident memory, bytes, of ``cmd`` in a fresh process (Linux)."""
+    t0 = time.perf_counter()
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, cwd=ROOT,
+                            preexec_fn=_on_two_cores)
+    _, status, usage = os.wait4(proc.pid, 0)
+    wall = time.perf_counter() - t0
+    proc.returncode = os.waitstatus_to_exitcode(status)
+    if proc.returncode not in (0, 1):  # 1: a trial not measured, still a run to the end
+        raise subprocess.CalledProcessError(proc.returncode, cmd)
+    return wall, usage.ru_maxrss * 1024.0  # kB on Linux
+
+
+def size() -> None:
+    """``landmarks`` of a 1,000,000-row table: wall time and peak memory against the targets."""
+    work = Path(tempfile.mkdtemp(prefix="bench-mocap-size-"))
+    try:
+        big = work / "big.tsv"
+        n = make_table(big, BIG_COPIES)
+        rows = sum(1 for _ in big.open()) - 1
+        mb = big.stat().st_size / 1e6
+        _, floor = _peak([sys.executable, "-c", "import perception, pandas, scipy.signal"])
+        wall, peak = _peak([*HAMMER, "landmarks", str(big), "--rate", RATE, "-o",
+                            str(work / "out.csv"), "--quiet"])
+        target = MEMORY_TARGET * big.stat().st_size
+        table(f"motion capture: landmarks of a {rows:,}-row table ({n:,} trials, {mb:.0f} MB)", [
+            ("landmarks, wall time", f"{wall:.1f} s", "target <= 60 s",
+             "ok" if wall <= 60 else "MISSED"),
+            ("landmarks, peak memory", f"{peak / 1e6:.0f} MB ({peak / big.stat().st_size:.1f}x "
+             "the file)", f"target <= {MEMORY_TARGET}x the file, {target / 1e6:.0f} MB; floor "
+             f"(imports alone) {floor / 1e6:.0f} MB", "ok" if peak <= target else "MISSED"),
+        ])
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+
+PARTS = {"scoring": scoring, "size": size}
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Run the parts named (default: all)."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--only", nargs="+", choices=sorted(PARTS), help="parts to run")
+    for name in parser.parse_args(argv).only or list(PARTS):
+        PARTS[name]()
 
 
 if __name__ == "__main__":
