@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import itertools
 import logging
 import math
 import re
@@ -319,6 +320,7 @@ def read_recording(path, options: MocapImport | None = None) -> Recording:
         (mistakes that hold for every trial).
     """
     from perception.io.mocap import read_mocap
+    from perception.plausibility import SCALE_TRIALS, check_scale
 
     expect(options, MocapImport, "read_recording(options=)", optional=True)
     options = MocapImport() if options is None else options
@@ -327,7 +329,11 @@ def read_recording(path, options: MocapImport | None = None) -> Recording:
     entries: list[Reach | Unscored] = []
     # one pass: a large table's trials are read from the file on each (TrialStream)
     names, seen = [], {}
-    for trial in trials:
+    # a unit or a rate no human hand fits is every trial's: said before any reach is sought
+    read = iter(trials)
+    first = list(itertools.islice(read, SCALE_TRIALS))
+    check_scale(first, path, options)
+    for trial in itertools.chain(first, read):
         names.append(trial.name)
         _note_seen(seen, trial, options.markers)
         source = str(trial.source)
