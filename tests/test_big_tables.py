@@ -200,3 +200,12 @@ def test_landmarks_draws_a_progress_bar_on_a_terminal_only(tmp_path, monkeypatch
         said = err.getvalue()
         assert ("reading t.tsv" in said and "measuring t.tsv" in said) is drawn, said
         assert ("checking t.tsv" in said) is drawn
+
+
+@pytest.mark.usefixtures("streamed")
+def test_a_table_cut_short_after_it_was_opened_is_refused_not_read_short(tmp_path):
+    path = write_table(tmp_path / "t.tsv", trials=4)
+    trials = read_mocap(path, rate=100)
+    path.write_text("\n".join(path.read_text().splitlines()[:301]) + "\n")  # 2 trials left
+    with pytest.raises(InputError, match="changed while it was read .2 of its 4 trials gone"):
+        list(trials)

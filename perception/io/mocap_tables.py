@@ -587,12 +587,12 @@ def _checked_stream(path: Path, source: str, text: TableText, sep: str, rate, un
     if first is None or first.empty:
         return None
     names = list(first.columns)
-    lines = check_fields(path, sep, text.skip, header_width(first), first)
     time_col = time_column_of(names, time_column, path, notes)
     trial_col = _find_column(names, trial_column, _TRIAL, path, "--trial-column")
     asked = list(factors or ())
     if trial_col is None or any(a not in names for a in asked):
         return None
+    lines = check_fields(path, sep, text.skip, header_width(first), first)
     groups = marker_columns([c for c in names if c not in (time_col, trial_col)
                              and c not in asked])
     if not groups:
@@ -727,3 +727,6 @@ class _Plan:
                 if progress is not None:
                     progress(k, len(self.spans), f"reading {self.path.name}")
             offset += n
+        if k < len(self.spans):  # rows checked on opening are gone
+            raise InputError(f"the file changed while it was read ({len(self.spans) - k} of "
+                             f"its {len(self.spans)} trials gone): read it again", self.path)
