@@ -108,3 +108,26 @@ def test_recognize_and_landmarks_refuse_in_one_line(tmp_path, flags, named):
         lines = run.stderr.strip().splitlines()
         assert len(lines) == 1 and named in lines[0] and "Traceback" not in run.stderr
         assert "--px-per-m" not in lines[0]
+
+
+def test_centimetres_read_as_millimetres_get_a_peak_speed_warning(tmp_path):
+    # not refusable (a slow, small hand may be a still one), but never judged without a word
+    import pandas as pd
+
+    from perception.recognition.repertoire import Repertoire
+    from perception.recordings import read_recording, recognize_reach
+
+    table = pd.read_csv(DATA / "optotrak-trials.tsv", sep="\t")
+    table = table[table["trialN"] == table["trialN"].iloc[0]]
+    mm, cm = tmp_path / "mm.tsv", tmp_path / "cm.tsv"
+    table.to_csv(mm, sep="\t", index=False)
+    raw = [c for c in table.columns if c.endswith("raw")]
+    table.assign(**{c: table[c] / 10 for c in raw}).to_csv(cm, sep="\t", index=False)
+    speeds = {}
+    for path in (mm, cm):
+        options = MocapImport(rate=85.0, units="mm")
+        reach = read_recording(path, options).reaches[0]
+        rec, _ = recognize_reach(reach, Repertoire.default(), options=options)
+        speeds[path.stem] = {w.kind: w.value for w in rec.validation_warnings}
+    assert "peak_speed" not in speeds["mm"]
+    assert 0.05 < speeds["cm"]["peak_speed"] < 0.15  # the real 0.75-1.3 m/s, tenfold too slow

@@ -30,7 +30,7 @@ if TYPE_CHECKING:
     from perception.recognition.models import MotorModel
     from perception.recognition.shape import Normalisation
 
-__all__ = ["VALIDATED_DISTANCE", "VALIDATED_MOVEMENT_TIME", "VERDICT_RULES", "Recognition",
+__all__ = ["VALIDATED_DISTANCE", "VALIDATED_MOVEMENT_TIME", "VALIDATED_PEAK_SPEED", "VERDICT_RULES", "Recognition",
            "ValidationWarning", "warnings_summary"]
 
 
@@ -47,6 +47,11 @@ SYNTHESISED_TOLERANCE = 1e-6
 #: 60 grasps (the rules chosen on its even trials, checked on its odd ones: docs/mocap.md),
 #: 0.55-0.715 m.
 VALIDATED_DISTANCE = (0.1, 0.72)
+#: The peak speeds (the transport's, m/s) it was validated on: the synthetic
+#: populations' 0.22-0.40 m in 0.45-1.4 s (about 0.3-2 m/s) and the shared Optotrak
+#: grasps' 0.74-1.32 m/s. A hand far slower is often a unit too small for the numbers
+#: (centimetres read as millimetres), which perception.plausibility cannot refuse.
+VALIDATED_PEAK_SPEED = (0.25, 2.5)
 
 
 @dataclass(frozen=True)
@@ -56,8 +61,9 @@ class ValidationWarning:
     Attributes
     ----------
     kind : str
-        ``movement_time`` (s), ``distance`` (the reach's, m) or
-        ``time_scale`` (the shape pass's speed rescaling, a factor).
+        ``movement_time`` (s), ``distance`` (the reach's, m), ``peak_speed``
+        (the transport's, m/s) or ``time_scale`` (the shape pass's speed
+        rescaling, a factor).
     value : float
         The movement's, in that unit.
     text : str
@@ -120,10 +126,12 @@ def warnings_summary(trials: Sequence[tuple[str, Sequence[dict]]], what: str = "
 
 
 #: The unit and decimals of each kind of warning's value in :func:`warnings_summary`.
-_WARNING_UNITS = {"movement_time": (" s", 2), "distance": (" m", 2), "time_scale": ("", 2)}
+_WARNING_UNITS = {"movement_time": (" s", 2), "distance": (" m", 2), "time_scale": ("", 2),
+                  "peak_speed": (" m/s", 2)}
 #: Each range-checked kind: its words, its validated range and unit.
 _WARNING_RANGES = {"movement_time": ("movement time", VALIDATED_MOVEMENT_TIME, " s"),
-                   "distance": ("reach distance", VALIDATED_DISTANCE, " m")}
+                   "distance": ("reach distance", VALIDATED_DISTANCE, " m"),
+                   "peak_speed": ("peak speed", VALIDATED_PEAK_SPEED, " m/s")}
 
 @dataclass(frozen=True, eq=False)
 class Recognition:
@@ -399,6 +407,12 @@ class Recognition:
                 "movement_time", lm.movement_time,
                 f"movement time {lm.movement_time:.2f} s is outside the {lo}-{hi} s the "
                 "verdict was validated on"))
+        lo, hi = VALIDATED_PEAK_SPEED
+        if math.isfinite(lm.peak_speed) and not lo <= lm.peak_speed <= hi:
+            out.append(ValidationWarning(
+                "peak_speed", lm.peak_speed,
+                f"peak speed {lm.peak_speed:.2f} m/s is outside the {lo}-{hi} m/s the verdict "
+                "was validated on (a motion-capture file's --units?)"))
         lo, hi = VALIDATED_DISTANCE
         d = self.observation.start_distance
         if not lo <= d <= hi:
