@@ -30,8 +30,8 @@ if TYPE_CHECKING:
     from perception.recognition.models import MotorModel
     from perception.recognition.shape import Normalisation
 
-__all__ = ["VALIDATED_DISTANCE", "VALIDATED_MOVEMENT_TIME", "VALIDATED_PEAK_SPEED", "VERDICT_RULES", "Recognition",
-           "ValidationWarning", "warnings_summary"]
+__all__ = ["VALIDATED_DISTANCE", "VALIDATED_MOVEMENT_TIME", "VALIDATED_PEAK_SPEED", "VERDICT_RULES",
+           "Recognition", "ValidationWarning", "warnings_summary"]
 
 
 #: The movement times (onset to end by the field's rule, s) the verdict was
