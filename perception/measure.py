@@ -198,8 +198,12 @@ def measure(source, *, params: LandmarkParams | None = None, mocap=None,
         The file cannot be read (or is a table of no known layout), or the
         scale of pixel tracks is unknown.
     """
+    from perception.boundary import expect
     from perception.io.tracks import Tracks
+    from perception.recordings import MocapImport
 
+    expect(params, LandmarkParams, "landmarks(params=)", optional=True)
+    expect(mocap, MocapImport, "landmarks(mocap=)", optional=True)
     params = LandmarkParams() if params is None else params
     if not isinstance(source, Tracks):
         from perception.io.mocap import is_mocap_file
@@ -209,7 +213,7 @@ def measure(source, *, params: LandmarkParams | None = None, mocap=None,
         from perception.recordings import unknown_layout
 
         if is_mocap_file(source):
-            from perception.recordings import MocapImport, read_recording
+            from perception.recordings import read_recording
 
             mocap = MocapImport() if mocap is None else mocap
             recording = read_recording(source, mocap)

@@ -76,6 +76,8 @@ TYPE_CASES = [  # (call, what the message names)
      "Recognition"),
     (lambda p, r: pc.track_video("clip.mp4", params="x"), "track_video(params=): expected "
      "TrackerParams"),
+    (lambda p, r: pc.landmarks(p, params="x"), "landmarks(params=): expected LandmarkParams"),
+    (lambda p, r: pc.landmarks(p, mocap="fast"), "landmarks(mocap=): expected MocapImport"),
 ]
 
 
