@@ -326,7 +326,13 @@ def _read_options(sep: str, skip: int, header: int | None, decimal: str) -> dict
 
 def header_width(df) -> int:
     """Columns of a table read with its header: a header ending in a separator names a last
-    empty column, not counted."""
+    empty column, not counted.
+
+    Parameters
+    ----------
+    df : pandas.DataFrame
+        The table (or its first chunk); its column names are stripped of spaces in place.
+    """
     df.columns = [str(c).strip() for c in df.columns]
     width = len(df.columns)
     while width > 1 and df.columns[width - 1].startswith("Unnamed: "):
