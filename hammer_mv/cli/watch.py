@@ -146,14 +146,7 @@ def _watch(args: argparse.Namespace, signals: _Signals) -> int:
                 signals.holding = False
                 if signals.received:  # one came meanwhile
                     raise KeyboardInterrupt
-                if args.live:  # a settled verdict in capitals, a provisional one with a ?
-                    say(f"{t:8.3f} s  {state.phase:<6}  {state.leading or '-':<12} "
-                        f"{_shown(state):<22}")
-                if state.decision is not None and decided is None:
-                    decided = state.decision
-                    detail = f" ({decided.detail})" if decided.detail else ""
-                    say(f"{clip}: settled {decided.verdict}{detail} at {decided.time:.3f} s "
-                        f"({decided.since_onset:.3f} s after the onset)")
+                decided = _say_state(say, clip, t, state, decided, args.live)
         except KeyboardInterrupt:  # the outputs of what was seen
             interrupted = True
         signals.holding = True  # from here on a signal waits for the outputs
@@ -266,14 +259,7 @@ def _watch_recording(args: argparse.Namespace, signals: _Signals) -> int:
                 t0 = time.perf_counter()
                 state = rec.update(tracks.position[i], t, i)
                 latency.append(time.perf_counter() - t0)
-                if args.live:
-                    say(f"{t:8.3f} s  {state.phase:<6}  {state.leading or '-':<12} "
-                        f"{_shown(state):<22}")
-                if state.decision is not None and decided is None:
-                    decided = state.decision
-                    detail = f" ({decided.detail})" if decided.detail else ""
-                    say(f"{reach.name}: settled {decided.verdict}{detail} at "
-                        f"{decided.time:.3f} s ({decided.since_onset:.3f} s after the onset)")
+                decided = _say_state(say, reach.name, t, state, decided, args.live)
         except KeyboardInterrupt:  # this reach's outputs of what was seen, then no more
             signals.holding, interrupted = True, True
         try:
@@ -306,6 +292,19 @@ def _watch_recording(args: argparse.Namespace, signals: _Signals) -> int:
         return 128 + (signals.received or signal.SIGINT)
     return 1 if missed else 0
 
+
+
+def _say_state(say, clip: str, t: float, state, decided, live: bool):
+    """Print a frame's state (``--live``: a settled verdict in capitals, a provisional one
+    with a ?) and the verdict the first time it settles; return the settled one so far."""
+    if live:
+        say(f"{t:8.3f} s  {state.phase:<6}  {state.leading or '-':<12} {_shown(state):<22}")
+    if state.decision is not None and decided is None:
+        decided = state.decision
+        detail = f" ({decided.detail})" if decided.detail else ""
+        say(f"{clip}: settled {decided.verdict}{detail} at {decided.time:.3f} s "
+            f"({decided.since_onset:.3f} s after the onset)")
+    return decided
 
 def _shown(state) -> str:
     """A state's verdict as the live lines and the labelled video show it: the settled one in
