@@ -293,7 +293,6 @@ def _watch_recording(args: argparse.Namespace, signals: _Signals) -> int:
     return 1 if missed else 0
 
 
-
 def _say_state(say, clip: str, t: float, state, decided, live: bool):
     """Print a frame's state (``--live``: a settled verdict in capitals, a provisional one
     with a ?) and the verdict the first time it settles; return the settled one so far."""
@@ -305,6 +304,7 @@ def _say_state(say, clip: str, t: float, state, decided, live: bool):
         say(f"{clip}: settled {decided.verdict}{detail} at {decided.time:.3f} s "
             f"({decided.since_onset:.3f} s after the onset)")
     return decided
+
 
 def _shown(state) -> str:
     """A state's verdict as the live lines and the labelled video show it: the settled one in
