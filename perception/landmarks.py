@@ -22,13 +22,19 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Mapping
-from dataclasses import dataclass, field, fields
 from typing import TYPE_CHECKING, Annotated
 
 import numpy as np
 from pydantic import Field
 
+from perception.landmark_flags import (
+    APERTURE_LANDMARKS,
+    all_flags,
+    bound_flags,
+    gap_near,
+    why_not_open,
+)
+from perception.landmark_values import _NAMES, OK, Landmarks
 from perception.validation import Int, Share, declared
 
 if TYPE_CHECKING:
@@ -45,13 +51,6 @@ __all__ = ["MODEL_SPAN_FRACTION", "OK", "LandmarkParams", "Landmarks", "count_pe
 #: on test clips. The span between two fractions does not depend on where
 #: the onset is placed, which the start of a movement leaves uncertain.
 MODEL_SPAN_FRACTION = 0.467
-#: A landmark's flag when nothing casts doubt on it (:meth:`Landmarks.flag`).
-OK = "ok"
-#: Landmarks derived from others: their flag is the first doubtful one of these.
-_DERIVED = {"opening": ("mga", "rest_aperture"),
-            "peak_speed_seconds": ("peak_speed_time", "movement_time"),
-            "mga_seconds": ("mga_time", "movement_time")}
-
 
 @functools.lru_cache(maxsize=64)
 def _butter(order: int, wn: float) -> tuple[np.ndarray, np.ndarray]:
@@ -238,172 +237,6 @@ def _cross_time(time, speed, row, bound, rising) -> float:
     return float(time[other] + f * (time[row] - time[other]))
 
 
-@dataclass(frozen=True)
-class Landmarks:
-    """The standard landmarks of one reach-to-grasp movement (NaN where not computable).
-
-    Times called shares are fractions of the movement time from its onset
-    (0-1); the movement runs from onset to end by :class:`LandmarkParams`.
-
-    Attributes
-    ----------
-    onset_time, end_time : float
-        The movement's onset and end on the recording's clock, s (NaN where
-        the recording starts or ends in the movement).
-    movement_time : float
-        End minus onset, s.
-    peak_speed : float
-        Peak transport speed, m/s.
-    peak_speed_time : float
-        When it comes, share.
-    deceleration_time : float
-        From the peak speed to the end, s.
-    mga : float
-        Maximum grip aperture, m: the largest tip-to-tip (marker-to-marker)
-        distance between onset and end.
-    mga_time : float
-        When it comes, share.
-    contact_aperture : float
-        Grip aperture at the movement's end, m.
-    aperture_peaks : int or None
-        Maxima of the aperture with a prominence of at least
-        :attr:`LandmarkParams.peak_prominence` of the opening and
-        ``peak_min_prominence`` (see :func:`count_peaks`); None where the
-        aperture is missing for long enough to hide a second opening
-        (:meth:`LandmarkParams.hides_a_reopening`) or
-        has fewer than 3 samples.
-    rest_aperture : float
-        Grip aperture at the movement's onset, m.
-    opening_time : float
-        When the aperture first exceeds ``rest_aperture`` + ``opening_level``
-        of the opening: the grip starts to open, share (NaN where the digits
-        were unseen for more than ``max_gap`` then).
-    peak_opening_speed : float
-        The aperture's fastest widening before the MGA, m/s.
-    closing_time : float
-        From the MGA to the movement's end, s.
-    movements : int or None
-        Movements in the recording: 1, plus each stretch outside this one in
-        which the transport goes faster than ``second_movement`` of its peak
-        (None without a speed).
-    flags : mapping of str to str
-        Why a landmark is doubtful or missing, by name (one not named is
-        ``ok`` where it has a value): ``inside a gap: ...`` (taken where the
-        transport point or a digit was lost), ``not seen: ...`` (with why),
-        ``bound raised to N % of peak`` (:meth:`flag`).
-    """
-
-    movement_time: float = math.nan
-    peak_speed: float = math.nan
-    peak_speed_time: float = math.nan
-    mga: float = math.nan
-    mga_time: float = math.nan
-    contact_aperture: float = math.nan
-    aperture_peaks: int | None = None
-    rest_aperture: float = math.nan
-    opening_time: float = math.nan
-    onset_time: float = math.nan
-    end_time: float = math.nan
-    deceleration_time: float = math.nan
-    peak_opening_speed: float = math.nan
-    closing_time: float = math.nan
-    movements: int | None = None
-    # not compared: two movements with the same numbers are the same landmarks
-    flags: Mapping[str, str] = field(default_factory=dict, compare=False)
-
-    def flag(self, name: str) -> str:
-        """Whether landmark ``name`` can be trusted: ``ok``, or why not.
-
-        ``inside a gap: ...``, ``not seen: ...`` or ``bound raised to N % of
-        peak`` as :func:`movement_landmarks` found it; a derived landmark
-        (``opening``, ``peak_speed_seconds``, ``mga_seconds``) takes the
-        first doubtful flag of those it comes from; a missing value never
-        reads ``ok`` (``not seen`` where nothing said why).
-
-        Parameters
-        ----------
-        name : str
-            A field, or ``opening``, ``peak_speed_seconds``, ``mga_seconds``.
-        """
-        if name in self.flags:
-            return self.flags[name]
-        for source in _DERIVED.get(name, ()):
-            if (said := self.flag(source)) != OK:
-                return said
-        value = getattr(self, name)
-        if value is None or not math.isfinite(float(value)):
-            return "not seen"
-        return OK
-
-    @property
-    def status(self) -> str:
-        """Whether the recording holds the whole movement: ``complete``, ``starts in
-        motion``, ``ends in motion`` or ``in motion throughout``."""
-        if math.isnan(self.onset_time) and math.isnan(self.end_time):
-            return "in motion throughout"
-        if math.isnan(self.onset_time):
-            return "starts in motion"
-        if math.isnan(self.end_time):
-            return "ends in motion"
-        return "complete"
-
-    @property
-    def opening(self) -> float:
-        """How far the hand opened: ``mga - rest_aperture``, m."""
-        return self.mga - self.rest_aperture
-
-    @property
-    def peak_speed_seconds(self) -> float:
-        """When the peak speed comes, s from the onset."""
-        return self.peak_speed_time * self.movement_time
-
-    @property
-    def mga_seconds(self) -> float:
-        """When the MGA comes, s from the onset."""
-        return self.mga_time * self.movement_time
-
-    def to_dict(self) -> dict:
-        """The landmarks, ``opening``, ``peak_speed_seconds`` and ``mga_seconds`` as JSON
-        values (NaN becomes None)."""
-        out = {}
-        for f in fields(self):
-            if f.name == "flags":
-                continue
-            v = getattr(self, f.name)
-            out[f.name] = v if v is None or isinstance(v, int) else _num(v)
-        for name in ("opening", "peak_speed_seconds", "mga_seconds"):
-            out[name] = _num(getattr(self, name))
-        if self.flags:  # only where a landmark is doubtful: older readers see the same keys
-            out["flags"] = dict(self.flags)
-        return out
-
-    @classmethod
-    def from_dict(cls, d: dict | None) -> Landmarks:
-        """From :meth:`to_dict`'s output (None and missing keys read as NaN).
-
-        Parameters
-        ----------
-        d : dict or None
-            A ``kinematics`` entry of ``<clip>.recognition.json``.
-        """
-        d = d or {}
-        kw = {"flags": {str(k): str(v) for k, v in (d.get("flags") or {}).items()}}
-        for f in fields(cls):
-            v = d.get(f.name)
-            if f.name == "flags":
-                continue
-            if f.name in ("aperture_peaks", "movements"):
-                kw[f.name] = None if v is None else int(v)
-            else:
-                kw[f.name] = math.nan if v is None else float(v)
-        return cls(**kw)
-
-
-def _num(x) -> float | None:
-    x = float(x)
-    return x if math.isfinite(x) else None
-
-
 def count_peaks(values: np.ndarray, min_prominence: float) -> int:
     """Maxima of a sequence whose topographic prominence is at least ``min_prominence``.
 
@@ -552,11 +385,12 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
     time = np.asarray(time, dtype=float)
     g_raw = np.asarray(aperture, dtype=float)
     if len(time) < 3:
-        return Landmarks(flags=_all_flags(f"not seen: {len(time)} samples"))
+        return Landmarks(flags=all_flags(_NAMES, f"not seen: {len(time)} samples"))
     path = np.asarray(transport, dtype=float)
     speed = params.speed_of(time, path)
     if not np.isfinite(speed).any():
-        return Landmarks(flags=_all_flags("not seen: the transport point is lost throughout"))
+        return Landmarks(flags=all_flags(_NAMES, "not seen: the transport point is lost "
+                                                 "throughout"))
     raised = []  # (side, share of peak) where a bound was raised above the asked one
     if bounds is None:
         peak = int(np.nanargmax(speed))
@@ -565,7 +399,7 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
         lo, hi = bounds
         a, b = (0 if lo is None else lo), (len(time) - 1 if hi is None else hi)
         if not np.isfinite(speed[a:b + 1]).any():
-            return Landmarks(flags=_all_flags("not seen: the transport point is lost "
+            return Landmarks(flags=all_flags(_NAMES, "not seen: the transport point is lost "
                                               "throughout the movement"))
         peak = a + int(np.nanargmax(speed[a:b + 1]))
         onset, end = movement_bounds(time, speed, peak, params)
@@ -594,13 +428,13 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
     base = {"onset_time": t_on, "end_time": t_end, "movement_time": T, "movements": 1 + others,
             "peak_speed": float(speed[peak]), "peak_speed_time": share(time[peak]),
             "deceleration_time": t_end - float(time[peak])}
-    flags = _bound_flags(onset, end, raised, params.threshold)
+    flags = bound_flags(onset, end, raised, params.threshold)
     # the filter and the derivative reach this far either side of a sample: a value taken
     # this near a lost stretch was shaped by what the tracker did not see
     reach = max(0.5 / params.cutoff if params.cutoff else 0.0,
                 1.5 * float(np.median(np.diff(time))))
     lost_transport = ~np.isfinite(path.reshape(len(time), -1)).all(axis=1)
-    if (gap := _gap_near(time, lost_transport, float(time[peak]), reach)) is not None:
+    if (gap := gap_near(time, lost_transport, float(time[peak]), reach)) is not None:
         said = f"inside a gap: the transport point was lost for {gap * 1000:.0f} ms at the peak"
         for name in ("peak_speed", "peak_speed_time", "deceleration_time"):
             flags.setdefault(name, said)
@@ -609,7 +443,7 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
     seen = rows[np.isfinite(g[rows])]
     if len(seen) < 3:
         said = f"not seen: the digits are seen together in {len(seen)} samples of the movement"
-        for name in _APERTURE_LANDMARKS:
+        for name in APERTURE_LANDMARKS:
             flags.setdefault(name, said)
         return Landmarks(**base, flags=flags)
     j = int(seen[np.argmax(g[seen])])
@@ -625,7 +459,7 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
         flags["aperture_peaks"] = (f"not seen: a digit was lost for {gaps.max() * 1000:.0f} ms, "
                                    "long enough to hide a closing and re-opening")
     lost_grip = ~np.isfinite(g_raw)
-    if (gap := _gap_near(time, lost_grip, float(time[j]), reach)) is not None:
+    if (gap := gap_near(time, lost_grip, float(time[j]), reach)) is not None:
         said = f"inside a gap: a digit was lost for {gap * 1000:.0f} ms at the MGA"
         for name in ("mga", "mga_time", "closing_time"):
             flags.setdefault(name, said)
@@ -639,8 +473,8 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
     level = rest + params.opening_level * opening
     t_open = _crossing(time[lo:hi + 1], g[lo:hi + 1], level, params.max_gap)
     if math.isnan(t_open):
-        flags["opening_time"] = _why_not_open(time[lo:hi + 1], g[lo:hi + 1], level)
-    elif (gap := _gap_near(time, lost_grip, t_open, reach)) is not None:
+        flags["opening_time"] = why_not_open(time[lo:hi + 1], g[lo:hi + 1], level)
+    elif (gap := gap_near(time, lost_grip, t_open, reach)) is not None:
         flags["opening_time"] = (f"inside a gap: a digit was lost for {gap * 1000:.0f} ms "
                                  "where the grip opened")
     rate = np.gradient(g, time)
@@ -652,66 +486,6 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
         aperture_peaks=peaks, rest_aperture=rest, opening_time=share(t_open),
         peak_opening_speed=float(widening.max()) if len(widening) else math.nan,
         closing_time=t_end - float(time[j]), flags=flags)
-
-
-#: The landmarks measured on the aperture.
-_APERTURE_LANDMARKS = ("mga", "mga_time", "contact_aperture", "aperture_peaks", "rest_aperture",
-                       "opening_time", "peak_opening_speed", "closing_time")
-#: The landmarks measured against the onset, the end or both.
-_NEEDS = {"onset": ("onset_time", "movement_time", "peak_speed_time", "mga_time",
-                    "opening_time", "rest_aperture"),
-          "end": ("end_time", "movement_time", "peak_speed_time", "mga_time", "opening_time",
-                  "deceleration_time", "closing_time", "contact_aperture")}
-
-
-def _all_flags(said: str) -> dict[str, str]:
-    """Every landmark flagged ``said`` (a movement with none measurable)."""
-    return {f.name: said for f in fields(Landmarks) if f.name != "flags"}
-
-
-def _bound_flags(onset: int | None, end: int | None, raised: list[tuple[str, float]],
-                 threshold: float) -> dict[str, str]:
-    """The flags of a movement's bounds: missing (the recording starts or ends in it), or
-    raised above the asked share of the peak speed."""
-    flags: dict[str, str] = {}
-    for side, row, where in (("onset", onset, "starts"), ("end", end, "ends")):
-        if row is None:
-            for name in _NEEDS[side]:
-                flags.setdefault(name, f"not seen: the recording {where} in the movement")
-    for side, share in raised:
-        if round(share * 100) <= round(threshold * 100):  # the asked share, as printed
-            continue
-        said = f"bound raised to {share * 100:.0f} % of peak"
-        for name in (f"{side}_time", "movement_time"):
-            flags.setdefault(name, said)
-    return flags
-
-
-def _gap_near(time: np.ndarray, lost: np.ndarray, at: float, reach: float) -> float | None:
-    """The longest lost stretch within ``reach`` s of time ``at``, s (None if none)."""
-    near = np.flatnonzero(lost & (np.abs(time - at) <= reach + 1e-9))
-    if not len(near):
-        return None
-    edges = np.diff(np.r_[0, lost.astype(np.int8), 0])
-    longest = 0.0
-    for a, b in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)):
-        if a <= near[-1] and b > near[0]:  # this stretch reaches within ``reach``
-            lo, hi = max(a - 1, 0), min(b, len(time) - 1)
-            longest = max(longest, float(time[hi] - time[lo]))
-    return longest
-
-
-def _why_not_open(time: np.ndarray, g: np.ndarray, level: float) -> str:
-    """Why the grip's opening time is missing, in words (see :func:`_crossing`)."""
-    ok = np.isfinite(g)
-    above = np.flatnonzero(g[ok] > level)
-    if not len(above):
-        return "not seen: the grip never crossed the opening level"
-    i = int(above[0])
-    t = time[ok]
-    before = t[i - 1] if i else time[0]
-    return (f"not seen: the grip opened while a digit was lost "
-            f"({(t[i] - before) * 1000:.0f} ms unseen)")
 
 
 def observed_landmarks(obs: Observation, params: LandmarkParams | None = None) -> Landmarks:

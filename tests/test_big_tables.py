@@ -1,8 +1,8 @@
 """Large long tables read trial by trial (issue 46, "Size"): the same trials and landmarks as
 read whole, in memory that does not grow with the number of trials, with progress said.
 
-A table above :data:`perception.io.mocap_tables.STREAM_BYTES` is read in
-chunks of :data:`~perception.io.mocap_tables.CHUNK_ROWS` rows; here both are
+A table above :data:`perception.io.mocap_stream.STREAM_BYTES` is read in
+chunks of :data:`~perception.io.mocap_stream.CHUNK_ROWS` rows; here both are
 forced small, so that tables of a few kB take that path and a trial spans
 several chunks.
 """
@@ -17,7 +17,7 @@ import pytest
 
 from hammer_mv.cli import main
 from perception.errors import InputError
-from perception.io import mocap_tables, mocap_text
+from perception.io import mocap_stream, mocap_text
 from perception.io.mocap import read_mocap
 from perception.io.mocap_trial import TrialStream, reading_progress
 from perception.measure import measure
@@ -29,17 +29,17 @@ REAL = Path(__file__).parent / "data" / "mocap" / "optotrak-trials.tsv"
 @pytest.fixture
 def streamed(monkeypatch):
     """Every table with a trial column read trial by trial, 100 rows a chunk."""
-    monkeypatch.setattr(mocap_tables, "STREAM_BYTES", 0)
-    monkeypatch.setattr(mocap_tables, "CHUNK_ROWS", 100)
+    monkeypatch.setattr(mocap_stream, "STREAM_BYTES", 0)
+    monkeypatch.setattr(mocap_stream, "CHUNK_ROWS", 100)
 
 
 def _whole(path, **kw):
-    old = mocap_tables.STREAM_BYTES
-    mocap_tables.STREAM_BYTES = 1 << 62
+    old = mocap_stream.STREAM_BYTES
+    mocap_stream.STREAM_BYTES = 1 << 62
     try:
         return read_mocap(path, **kw)
     finally:
-        mocap_tables.STREAM_BYTES = old
+        mocap_stream.STREAM_BYTES = old
 
 
 def write_table(path: Path, trials: int = 6, rows: int = 150, *, sep: str = "\t",
@@ -108,7 +108,7 @@ def test_the_real_trials_give_the_same_landmarks_read_in_chunks(tmp_path):
     options = MocapImport(rate=85)
     assert isinstance(read_mocap(path, rate=85), TrialStream)
     chunked = measure(path, mocap=options)
-    mocap_tables.STREAM_BYTES = 1 << 62
+    mocap_stream.STREAM_BYTES = 1 << 62
     whole = measure(path, mocap=options)
     assert chunked.trials == whole.trials == 8
     assert chunked.measured == whole.measured >= 6
@@ -150,13 +150,13 @@ def test_memory_does_not_grow_with_the_number_of_trials(tmp_path, monkeypatch):
 
     # the buffers of a fixed size (the head decoded, the blocks whose fields are counted,
     # the rows of a chunk) made small, so that 2 MB is a large table
-    monkeypatch.setattr(mocap_tables, "HEAD_BYTES", 1 << 16)
+    monkeypatch.setattr(mocap_stream, "HEAD_BYTES", 1 << 16)
     monkeypatch.setattr(mocap_text, "_FIELDS_CHUNK", 1 << 19)
-    monkeypatch.setattr(mocap_tables, "CHUNK_ROWS", 500)
+    monkeypatch.setattr(mocap_stream, "CHUNK_ROWS", 500)
     few = write_table(tmp_path / "few.tsv", trials=20, rows=100)
     many = write_table(tmp_path / "many.tsv", trials=200, rows=100)
     streamed_few, streamed_many = _peak(few), _peak(many)
-    monkeypatch.setattr(mocap_tables, "STREAM_BYTES", 1 << 62)
+    monkeypatch.setattr(mocap_stream, "STREAM_BYTES", 1 << 62)
     whole_few, whole_many = _peak(few), _peak(many)
     assert whole_many > 3 * whole_few  # read whole, ten times the rows take several times more
     assert streamed_many < 2 * streamed_few  # trial by trial, the rows are never all held

@@ -20,15 +20,15 @@ from pathlib import Path
 
 from perception.errors import InputError
 from perception.factors import FACTOR_FLAG, factor_names
-from perception.io import mocap_tables
+from perception.io import mocap_stream
 from perception.io.files import input_file, is_regular_file
 from perception.io.mocap_c3d import read_c3d
 from perception.io.mocap_qtm import is_qtm, read_qtm
+from perception.io.mocap_stream import stream_xyz_table
 from perception.io.mocap_tables import (
     marker_columns,
     read_headerless,
     read_xyz_table,
-    stream_xyz_table,
 )
 from perception.io.mocap_text import TableText, delimiter, is_number, split, table_text
 from perception.io.mocap_trial import UNITS, MocapTrial, TrialStream, check_rate, check_unit
@@ -190,7 +190,7 @@ def read_mocap(path: str | os.PathLike, *, rate: float | None = None, units: str
     list of MocapTrial, or TrialStream
         One per trial of a long table, in file order; otherwise one. A long
         table whose header names X, Y, Z per marker, larger than
-        :data:`~perception.io.mocap_tables.STREAM_BYTES`, comes as a
+        :data:`~perception.io.mocap_stream.STREAM_BYTES`, comes as a
         :class:`~perception.io.mocap_trial.TrialStream`: a sequence of the
         same trials, checked whole now and read one by one on each pass, in
         the memory of one trial (docs/mocap.md, "Large tables").
@@ -224,7 +224,7 @@ def read_mocap(path: str | os.PathLike, *, rate: float | None = None, units: str
                              "--columns are for tables", p, field="--columns"
                              if columns is not None else "--trial-column")
         return read_c3d(p, source, rate, units)
-    if p.stat().st_size > mocap_tables.STREAM_BYTES:
+    if p.stat().st_size > mocap_stream.STREAM_BYTES:
         trials = _streamed(p, source, rate, units, trial_column, time_column, columns, factors)
         if trials is not None:
             return trials
@@ -257,8 +257,8 @@ def read_mocap(path: str | os.PathLike, *, rate: float | None = None, units: str
 def _streamed(p: Path, source: str, rate, units, trial_column, time_column, columns,
               factors) -> TrialStream | None:
     """A large long table whose header names X, Y, Z per marker, read trial by trial
-    (:func:`~perception.io.mocap_tables.stream_xyz_table`); None for any other file."""
-    text = table_text(p, head=mocap_tables.HEAD_BYTES)
+    (:func:`~perception.io.mocap_stream.stream_xyz_table`); None for any other file."""
+    text = table_text(p, head=mocap_stream.HEAD_BYTES)
     cells = split(text.first, delimiter(text.first))
     if (columns is not None or _sniff(text) != "xyz-table"
             or all(is_number(c) for c in cells if c)):

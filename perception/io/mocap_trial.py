@@ -466,7 +466,7 @@ class TrialStream(Sequence):
     """A long table's trials, read one by one as they are reached.
 
     What :func:`perception.io.mocap.read_mocap` returns for a large table
-    (:data:`perception.io.mocap_tables.STREAM_BYTES`): a sequence of
+    (:data:`perception.io.mocap_stream.STREAM_BYTES`): a sequence of
     :class:`MocapTrial` like the list it returns otherwise, whose every pass
     reads the file once more, a chunk at a time, and holds one trial (and one
     chunk) at a time. The file was checked whole when it was opened: a
