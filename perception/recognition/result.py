@@ -130,8 +130,10 @@ _WARNING_UNITS = {"movement_time": (" s", 2), "distance": (" m", 2), "time_scale
                   "peak_speed": (" m/s", 2)}
 #: Each range-checked kind: its words, its validated range and unit.
 _WARNING_RANGES = {"movement_time": ("movement time", VALIDATED_MOVEMENT_TIME, " s"),
-                   "distance": ("reach distance", VALIDATED_DISTANCE, " m"),
-                   "peak_speed": ("peak speed", VALIDATED_PEAK_SPEED, " m/s")}
+                   "peak_speed": ("peak speed", VALIDATED_PEAK_SPEED, " m/s"),
+                   "distance": ("reach distance", VALIDATED_DISTANCE, " m")}
+#: What a warning's likely cause may be, where one is known.
+_WARNING_HINTS = {"peak_speed": " (a motion-capture file's --units?)"}
 
 @dataclass(frozen=True, eq=False)
 class Recognition:
@@ -401,24 +403,14 @@ class Recognition:
         (docs/mocap.md), each with its kind and measured value."""
         out = []
         lm = self.landmarks[0]
-        lo, hi = VALIDATED_MOVEMENT_TIME
-        if math.isfinite(lm.movement_time) and not lo <= lm.movement_time <= hi:
-            out.append(ValidationWarning(
-                "movement_time", lm.movement_time,
-                f"movement time {lm.movement_time:.2f} s is outside the {lo}-{hi} s the "
-                "verdict was validated on"))
-        lo, hi = VALIDATED_PEAK_SPEED
-        if math.isfinite(lm.peak_speed) and not lo <= lm.peak_speed <= hi:
-            out.append(ValidationWarning(
-                "peak_speed", lm.peak_speed,
-                f"peak speed {lm.peak_speed:.2f} m/s is outside the {lo}-{hi} m/s the verdict "
-                "was validated on (a motion-capture file's --units?)"))
-        lo, hi = VALIDATED_DISTANCE
-        d = self.observation.start_distance
-        if not lo <= d <= hi:
-            out.append(ValidationWarning(
-                "distance", d, f"reach distance {d:.2f} m is outside the {lo}-{hi} m the "
-                "verdict was validated on"))
+        measured = {"movement_time": lm.movement_time, "peak_speed": lm.peak_speed,
+                    "distance": self.observation.start_distance}
+        for kind, (label, (lo, hi), unit) in _WARNING_RANGES.items():  # one table of ranges
+            v = measured[kind]
+            if math.isfinite(v) and not lo <= v <= hi:
+                out.append(ValidationWarning(
+                    kind, v, f"{label} {v:.2f}{unit} is outside the {lo}-{hi}{unit} the "
+                    f"verdict was validated on{_WARNING_HINTS.get(kind, '')}"))
         if math.isfinite(lm.movement_time) and lm.movement_time > 0 and self.shape is not None:
             n = self.normalisation
             if n is not None and abs(n.time_scale - 1) > 1e-9:
