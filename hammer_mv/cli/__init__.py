@@ -8,8 +8,10 @@ parser shows its defaults, and every command takes ``-v/--verbose`` and
 
 A user's mistake (a :class:`~perception.errors.HammerMVError`, or an
 ``OSError`` from the user's files) is printed as one line on stderr and exits
-with status 2; anything else (a bare ``ValueError`` included) is a bug: it shows
-its traceback, a line saying so, and exits with status 1. Library warnings
+with status 2 (:func:`error_line`: where the library names a field, the line
+names the flag that sets it, :mod:`hammer_mv.cli.flags`); anything else (a
+bare ``ValueError`` included) is a bug: it shows its traceback, a line saying
+so, and exits with status 1. Library warnings
 (numpy's RuntimeWarnings and the like) are shown with ``-v``; otherwise they
 are counted and summarised in one line at the end (nothing with ``--quiet``).
 """
@@ -204,6 +206,22 @@ def _user_error(exc: BaseException) -> str:
     return _first_line(str(exc)) or type(exc).__name__
 
 
+def error_line(command: str, exc: HammerMVError | OSError) -> str:
+    """The one line ``main`` prints for a user's mistake, the fields it names given as the
+    command's flags (``--px-per-m``, where the library says ``px_per_m``).
+
+    Parameters
+    ----------
+    command : str
+        The command that ran (its flags are those its parser registered).
+    exc : HammerMVError or OSError
+        The error.
+    """
+    from hammer_mv.cli.flags import as_flags
+
+    return f"hammer-mv {command}: error: {_user_error(as_flags(exc))}"
+
+
 def _warnings_line(command: str, caught: list[warnings.WarningMessage]) -> str:
     first = caught[0]
     return (f"hammer-mv {command}: {len(caught)} library warning(s) hidden (first: "
@@ -255,7 +273,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return _run(args)
     except (HammerMVError, OSError) as exc:  # the user's to fix: one line
-        print(f"hammer-mv {args.command}: error: {_user_error(exc)}", file=sys.stderr)
+        print(error_line(args.command, exc), file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("hammer-mv: interrupted", file=sys.stderr)

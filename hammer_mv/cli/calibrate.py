@@ -35,6 +35,7 @@ def run(args: argparse.Namespace) -> int:
     """Calibrate from ``args.video`` and write ``args.output``; print a summary."""
     import dataclasses
 
+    from hammer_mv.cli.checks import options
     from perception.errors import InputError
     from perception.io.atomic import check_output
     from perception.io.video import FrameSource
@@ -43,10 +44,9 @@ def run(args: argparse.Namespace) -> int:
     check_output(args.output, [p for p in (args.video, args.setup) if p is not None])
     base = load_setup(args.setup) if args.setup else TrackingSetup()
     params = base.params
-    if args.object_diameter is not None:
-        if not args.object_diameter > 0:
-            raise InputError(f"--object-diameter: expected > 0 m, got {args.object_diameter}")
-        params = dataclasses.replace(params, object_diameter=args.object_diameter)
+    if args.object_diameter is not None:  # TrackerParams declares its range
+        with options({"object_diameter": "--object-diameter"}):
+            params = dataclasses.replace(params, object_diameter=args.object_diameter)
     rois = parse_rois(args.roi, base.markers.names)
     with FrameSource(args.video, hash=False) as src:
         frames = [f for _, _, f in itertools.islice(src, max(params.init_frames, 1))]

@@ -6,7 +6,34 @@ import argparse
 import sys
 from pathlib import Path
 
-from hammer_mv.cli.flags import FPS_HELP
+from hammer_mv.cli.flags import FPS_HELP, Setting, add_settings
+from hammer_mv.cli.options import add_mocap_options, mocap_import
+from perception.io.pose import PoseImport
+from perception.landmarks import LandmarkParams
+from perception.observation import ObserveParams
+
+#: The field's definitions of a movement, fields of LandmarkParams.
+DEFINITIONS = (
+    Setting(LandmarkParams, "threshold", "onset and end where the speed crosses this share of "
+            "its peak (default {default})", metavar="SHARE"),
+    Setting(LandmarkParams, "speed", "an absolute speed bound instead of the share",
+            metavar="M/S"),
+    Setting(LandmarkParams, "hold", "the speed must stay beyond the bound this long (default "
+            "{default})", metavar="S"),
+    Setting(LandmarkParams, "cutoff", "zero-lag Butterworth low-pass cutoff (default {default} "
+            "Hz; 0: none)", metavar="HZ"),
+)
+#: The scale of pixel tracks: none by default (the file's own, or refused as unknown).
+SCALE = (
+    Setting(ObserveParams, "px_per_m", "image scale of tracks, pose files and videos, px/m",
+            metavar="X"),
+    Setting(ObserveParams, "object_diameter", "the object's real diameter, m, to scale tracks "
+            "by its apparent one", default=None, metavar="M"),
+    # the flag recognize's pose options declare (hammer_mv/cli/options.py), here for tracks too
+    Setting(PoseImport, "object_diameter_px", "the object's apparent diameter in pixels, where "
+            "the tracks or pose file do not give it (with --object-diameter)", metavar="D"),
+    Setting(PoseImport, "fps", FPS_HELP, metavar="F"),
+)
 
 
 def register(sub) -> None:
@@ -17,8 +44,6 @@ def register(sub) -> None:
     sub : argparse._SubParsersAction
         The top-level parser's subparsers.
     """
-    from hammer_mv.cli.options import add_mocap_options
-
     p = sub.add_parser("landmarks", help="measure reach-to-grasp landmarks, no models (CSV)",
                        description="Measure the landmarks of every movement in each INPUT "
                        "(motion-capture recordings: every reach; tracks, pose files or "
@@ -38,28 +63,37 @@ def register(sub) -> None:
     p.add_argument("--wide", action="store_true",
                    help="one row per movement, a column per landmark, in the same units "
                         "(their units and clocks in TABLE.units.json beside it)")
-    g = p.add_argument_group("definitions")
-    g.add_argument("--threshold", type=float, default=0.05, metavar="SHARE",
-                   help="onset and end where the speed crosses this share of its peak "
-                        "(default 0.05)")
-    g.add_argument("--speed", type=float, default=None, metavar="M/S",
-                   help="an absolute speed bound instead of the share")
-    g.add_argument("--hold", type=float, default=0.0, metavar="S",
-                   help="the speed must stay beyond the bound this long (default 0)")
-    g.add_argument("--cutoff", type=float, default=10.0, metavar="HZ",
-                   help="zero-lag Butterworth low-pass cutoff (default 10 Hz; 0: none)")
-    g = p.add_argument_group("scale of pixel tracks")
-    g.add_argument("--px-per-m", type=float, default=None, metavar="X",
-                   help="image scale of tracks, pose files and videos, px/m")
-    g.add_argument("--object-diameter", type=float, default=None, metavar="M",
-                   help="the object's real diameter, m, to scale tracks by its apparent one")
-    # the flag recognize's pose options declare (hammer_mv/cli/options.py), here for tracks too
-    g.add_argument("--object-diameter-px", type=float, default=None, metavar="D",
-                   help="the object's apparent diameter in pixels, where the tracks or pose "
-                        "file do not give it (with --object-diameter)")
-    g.add_argument("--fps", type=float, default=None, metavar="F", help=FPS_HELP)
+    add_settings(p.add_argument_group("definitions"), DEFINITIONS)
+    add_settings(p.add_argument_group("scale of pixel tracks"), SCALE)
     add_mocap_options(p)
     p.set_defaults(func=run)
+
+
+def landmark_settings(args: argparse.Namespace):
+    """The definitions, motion-capture and pose settings of parsed ``args``, each checked by
+    the class that declares it (an error names the field; the command line its flag).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments of ``landmarks``.
+
+    Returns
+    -------
+    params : LandmarkParams
+    mocap : MocapImport
+        Bounded by ``params`` too: one rule bounds and measures.
+    pose : PoseImport or None
+        None without ``--fps``.
+    """
+    params = LandmarkParams(threshold=args.threshold, speed=args.speed, hold=args.hold,
+                            cutoff=args.cutoff or None)
+    # the scale is measure_inputs' arguments: checked by the classes that declare it
+    ObserveParams(**{k: v for k, v in (("object_diameter", args.object_diameter),
+                                       ("px_per_m", args.px_per_m)) if v is not None})
+    pose = PoseImport(fps=args.fps, object_diameter_px=args.object_diameter_px)
+    mocap = mocap_import(args).with_landmarks(params)
+    return params, mocap, pose if args.fps is not None else None
 
 
 def run(args: argparse.Namespace) -> int:
@@ -70,30 +104,13 @@ def run(args: argparse.Namespace) -> int:
     args : argparse.Namespace
         Parsed arguments.
     """
-    from hammer_mv.cli.checks import options
-    from hammer_mv.cli.options import mocap_import
     from perception.errors import InputError
     from perception.io.atomic import check_output, write_text
-    from perception.landmarks import LandmarkParams
     from perception.measure import measure_inputs
     from perception.recordings import trial_summary
     from perception.report.tables import tidy_landmarks, wide_landmarks, write_units
 
-    with options({"threshold": "--threshold", "speed": "--speed", "hold": "--hold",
-                  "cutoff": "--cutoff"}):
-        params = LandmarkParams(threshold=args.threshold, speed=args.speed, hold=args.hold,
-                                cutoff=args.cutoff or None)
-    for flag, value in (("--object-diameter", args.object_diameter),
-                        ("--object-diameter-px", args.object_diameter_px)):
-        if value is not None and not 0 < value < float("inf"):
-            raise InputError(f"{value:g}: expected a size above 0", field=flag)
-    mocap = mocap_import(args).with_landmarks(params)  # one rule bounds and measures
-    pose = None
-    if args.fps is not None:
-        from perception.io.pose import PoseImport
-
-        with options({"fps": "--fps"}):
-            pose = PoseImport(fps=args.fps)
+    params, mocap, pose = landmark_settings(args)
     from perception.io.names import output_folder, output_stem
     from perception.pipeline import TRACKS_SUFFIX, clip_name
 

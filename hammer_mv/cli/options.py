@@ -1,7 +1,11 @@
-"""Options shared by the recognition commands (``recognize``, ``batch``).
+"""Options shared by the recognition commands (``recognize``, ``batch``, ``watch``,
+``landmarks``), generated from the declared fields they set.
 
-Defaults are read from the parameter dataclasses, so the help text and the
-library agree by construction.
+Each flag that sets a field is a :class:`~hammer_mv.cli.flags.Setting` of the
+tables below (:data:`RECOGNITION`, :data:`POSE`, :data:`MOCAP`,
+:data:`FACTORS`): its name, type, choices and default come from the field, so
+the help text and the library agree by construction, and an error about the
+field names the flag (:func:`hammer_mv.cli.flags.as_flags`).
 """
 
 from __future__ import annotations
@@ -12,33 +16,103 @@ import hashlib
 import json
 from pathlib import Path
 
-from hammer_mv.cli.checks import options
-from hammer_mv.cli.flags import FPS_HELP, add_video_options
+from hammer_mv.cli.flags import FPS_HELP, Setting, add_settings, add_video_options
 from perception.errors import InputError
 from perception.factors import DEFAULT_FACTORS
 from perception.geometry import DEFAULT_OBJECT_DIAMETER
 from perception.io.config import check_keys, read_toml, sub_table
+from perception.io.pose import PoseImport
 from perception.landmarks import LandmarkParams
 from perception.observation import ObserveParams
 from perception.pipeline import RecognitionSettings
-from perception.recognition.engine import RULES, HammerParams
+from perception.reach_data import MarkerMap, ReachParams
+from perception.recognition.engine import HammerParams
 from perception.recognition.repertoire import Repertoire
 from perception.recognition.rules import VerdictRules
-from perception.recognition.scoring import THESIS_SIGNS
+from perception.recordings import MocapImport
 
 _OBSERVE = ObserveParams()
-_HAMMER = HammerParams()
-#: The pose options, by the PoseImport fields they set.
-POSE_FIELDS = {"keypoints": "--keypoints", "pcutoff": "--pcutoff", "fps": "--fps",
-               "object_diameter_px": "--object-diameter-px", "individual": "--individual"}
-#: The motion-capture options, by the MocapImport fields they set.
-MOCAP_FIELDS = {"rate": "--rate", "units": "--units", "trial_column": "--trial-column",
-                "time_column": "--time-column", "columns": "--columns", "markers": "--markers",
-                "object_size": "--object-size", "factors": "--factors",
-                "factors_from_name": "--factors-from-name"}
-#: The flags that ask for motion-capture settings (none: the defaults).
-MOCAP_FLAGS = ("markers", "rate", "units", "trial_column", "time_column", "columns",
-               "object_size", "factors", "factors_from_name")
+
+#: The recognition flags of recognize, batch and watch, each a declared field.
+RECOGNITION = (
+    Setting(HammerParams, "rule", "rule that picks the winner (default: {default}); the "
+            "thesis rule's confidence is reported either way"),
+    Setting(HammerParams, "w_r", "transport weight of the thesis rule (default: {default})"),
+    Setting(HammerParams, "w_g", "grip weight of the thesis rule (default: {default})"),
+    Setting(HammerParams, "thesis_sign", "reading of the sign in the thesis rule, eqs. "
+            "5.1/5.7/5.8 (default: {default}: +1 when observed and predicted changes agree; "
+            "printed: the equations as printed, the observed change's sign alone); see "
+            "docs/recognition.md"),
+    Setting(HammerParams, "filter_gain", "how strongly observed positions correct each "
+            "model's estimate of velocity and force (0: the plan alone; 1: the plan's Kalman "
+            "gains; default {default})", metavar="G"),
+    Setting(ObserveParams, "object_diameter", "real diameter of the object, m (default: "
+            "{default}, the thesis's ball)", metavar="M"),
+    Setting(ObserveParams, "px_per_m", "image scale (default: from the object's apparent "
+            "size)", metavar="X"),
+    Setting(ObserveParams, "mirror", "mirror the image so the finger lies on the model's +x "
+            "side"),
+)
+
+
+def _pose_settings(fps_help: str) -> tuple[Setting, ...]:
+    # the flags that leave a field unset (None) so that a --pose-config's value applies
+    return (
+        Setting(PoseImport, "keypoints", "which keypoint is which marker: thumb=NAME "
+                "finger=NAME wrist=NAME object=NAME (markers left out take the keypoint of "
+                "their own name)", default=None, nargs="+", metavar="MARKER=NAME"),
+        Setting(PoseImport, "pcutoff", "points below this likelihood count as lost (default: "
+                "{default}, DeepLabCut's)", default=None, metavar="P"),
+        Setting(PoseImport, "individual", "the individual to score in a multi-individual file",
+                metavar="NAME"),
+        Setting(PoseImport, "fps", fps_help, metavar="F"),
+        Setting(PoseImport, "object_diameter_px", "the object's apparent diameter in pixels: "
+                "sets the metric scale of a pose file (or give --px-per-m)", metavar="D"),
+    )
+
+
+#: The pose options; ``--pose-config`` (a file, no field) goes between the first two.
+POSE = _pose_settings(FPS_HELP + "; a pose file that carries none (DeepLabCut, SLEAP "
+                      "analysis, Lightning Pose) takes the rate of the video of its name "
+                      "beside it, else needs this")
+
+
+def _names(text: str) -> tuple[str, ...]:
+    """``--columns``' comma-separated names (each checked by MocapImport)."""
+    return tuple(name.strip() for name in text.split(","))
+
+
+#: The motion-capture options, each a field of MocapImport (or of its ReachParams).
+MOCAP = (
+    Setting(MocapImport, "markers", "which markers are which: thumb=NAME finger=NAME, and "
+            "optionally wrist=NAME[+NAME...] object=NAME[+NAME...] (default: guessed from the "
+            "names: thumb*, index*, hand*/wrist*, object/pillow/target*)", nargs="+",
+            metavar="ROLE=NAME"),
+    Setting(MocapImport, "rate", "samples per second of a table without a time column (or "
+            "with --time-column none)", metavar="HZ"),
+    Setting(MocapImport, "columns", "the markers' names in column order, for a table without "
+            "a header (X, Y and Z of each, as RTMocap writes them): e.g. "
+            "object,thumb,index,hand,wrist1,wrist2", type=_names, metavar="NAME,NAME,..."),
+    Setting(MocapImport, "time_column", "the column that holds the time, in s or ms "
+            "(default: time, t, Time (s), ...); none: ignore any time column and take the "
+            "clock from --rate", metavar="NAME|none"),
+    Setting(MocapImport, "units", "the file's length unit, if it does not say (default: "
+            "inferred)"),
+    Setting(MocapImport, "trial_column", "the column that numbers a long table's trials "
+            "(default: trial, trialN, ...)", metavar="NAME"),
+    Setting(ReachParams, "object_size", "the object's size across the grip, m (default: the "
+            "grip's opening at the reach's end)", metavar="M"),
+)
+#: The design's factors, fields of MocapImport.
+FACTORS = (
+    Setting(MocapImport, "factors", "columns of a long table that are the design's factors, "
+            "text or numbers, one value per trial, carried into every output row (default: "
+            f"any column called {', '.join(DEFAULT_FACTORS)}, any case, that holds one value "
+            "per trial)", type=_names, metavar="COL[,COL...]"),
+    Setting(MocapImport, "factors_from_name", "a regular expression whose named groups, "
+            "searched in each input's file name, are factors of its every row: e.g. "
+            "'(?P<participant>P\\d+)_(?P<condition>[a-z]+)'", metavar="REGEX"),
+)
 
 
 def add_recognition_options(p: argparse.ArgumentParser) -> None:
@@ -52,29 +126,7 @@ def add_recognition_options(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("recognition")
     g.add_argument("--repertoire", type=Path, metavar="REP.h5",
                    help="models to score against (default: build the default repertoire)")
-    g.add_argument("--rule", choices=RULES, default=_HAMMER.rule,
-                   help=f"rule that picks the winner (default: {_HAMMER.rule}); the thesis "
-                        "rule's confidence is reported either way")
-    g.add_argument("--w-r", type=float, default=_HAMMER.w_r,
-                   help=f"transport weight of the thesis rule (default: {_HAMMER.w_r:g})")
-    g.add_argument("--w-g", type=float, default=_HAMMER.w_g,
-                   help=f"grip weight of the thesis rule (default: {_HAMMER.w_g:g})")
-    g.add_argument("--thesis-sign", choices=THESIS_SIGNS, default=_HAMMER.thesis_sign,
-                   help="reading of the sign in the thesis rule, eqs. 5.1/5.7/5.8 (default: "
-                        f"{_HAMMER.thesis_sign}: +1 when observed and predicted changes agree; "
-                        "printed: the equations as printed, the observed change's sign "
-                        "alone); see docs/recognition.md")
-    g.add_argument("--filter-gain", type=float, default=_HAMMER.filter_gain, metavar="G",
-                   help="how strongly observed positions correct each model's estimate of "
-                        "velocity and force (0: the plan alone; 1: the plan's Kalman gains; "
-                        f"default {_HAMMER.filter_gain:g})")
-    g.add_argument("--object-diameter", type=float, default=_OBSERVE.object_diameter,
-                   metavar="M", help="real diameter of the object, m (default: "
-                   f"{_OBSERVE.object_diameter:g}, the thesis's ball)")
-    g.add_argument("--px-per-m", type=float, default=None, metavar="X",
-                   help="image scale (default: from the object's apparent size)")
-    g.add_argument("--mirror", action="store_true",
-                   help="mirror the image so the finger lies on the model's +x side")
+    add_settings(g, RECOGNITION)
     g.add_argument("--verdict-rules", type=Path, metavar="RULES.toml",
                    help="the verdict's thresholds: a TOML file with a [verdict] table of "
                         "VerdictRules fields (and [verdict.landmarks]); the report's "
@@ -97,24 +149,11 @@ def add_pose_options(p: argparse.ArgumentParser) -> None:
     """
     g = p.add_argument_group("pose files (DeepLabCut, SLEAP, Lightning Pose, NWB, movement; "
                              "docs/pose-files.md)")
-    g.add_argument("--keypoints", nargs="+", metavar="MARKER=NAME", default=None,
-                   help="which keypoint is which marker: thumb=NAME finger=NAME wrist=NAME "
-                        "object=NAME (markers left out take the keypoint of their own name)")
+    add_settings(g, POSE[:1])
     g.add_argument("--pose-config", type=Path, metavar="FILE",
                    help="TOML with a [keypoints] table and any of pcutoff, fps, "
                         "object_diameter_px, individual (for a batch)")
-    g.add_argument("--pcutoff", type=float, default=None, metavar="P",
-                   help="points below this likelihood count as lost (default: 0.6, "
-                        "DeepLabCut's)")
-    g.add_argument("--individual", metavar="NAME",
-                   help="the individual to score in a multi-individual file")
-    g.add_argument("--fps", type=float, default=None, metavar="F",
-                   help=FPS_HELP + "; a pose file that carries none (DeepLabCut, SLEAP "
-                        "analysis, Lightning Pose) takes the rate of the video of its name "
-                        "beside it, else needs this")
-    g.add_argument("--object-diameter-px", type=float, default=None, metavar="D",
-                   help="the object's apparent diameter in pixels: sets the metric scale of "
-                        "a pose file (or give --px-per-m)")
+    add_settings(g, POSE[1:])
 
 
 def add_mocap_options(p: argparse.ArgumentParser) -> None:
@@ -125,54 +164,25 @@ def add_mocap_options(p: argparse.ArgumentParser) -> None:
     p : argparse.ArgumentParser
         The subcommand's parser.
     """
-    g = p.add_argument_group("motion capture (C3D, Qualisys TSV, X/Y/Z tables; docs/mocap.md)")
-    g.add_argument("--markers", nargs="+", metavar="ROLE=NAME", default=None,
-                   help="which markers are which: thumb=NAME finger=NAME, and optionally "
-                        "wrist=NAME[+NAME...] object=NAME[+NAME...] (default: guessed from "
-                        "the names: thumb*, index*, hand*/wrist*, object/pillow/target*)")
-    g.add_argument("--rate", type=float, default=None, metavar="HZ",
-                   help="samples per second of a table without a time column (or with "
-                        "--time-column none)")
-    g.add_argument("--columns", type=_names, default=None, metavar="NAME,NAME,...",
-                   help="the markers' names in column order, for a table without a header "
-                        "(X, Y and Z of each, as RTMocap writes them): e.g. "
-                        "object,thumb,index,hand,wrist1,wrist2")
-    g.add_argument("--time-column", metavar="NAME|none", default=None,
-                   help="the column that holds the time, in s or ms (default: time, t, "
-                        "Time (s), ...); none: ignore any time column and take the clock "
-                        "from --rate")
-    g.add_argument("--units", choices=("mm", "cm", "m"), default=None,
-                   help="the file's length unit, if it does not say (default: inferred)")
-    g.add_argument("--trial-column", metavar="NAME", default=None,
-                   help="the column that numbers a long table's trials (default: trial, "
-                        "trialN, ...)")
-    g.add_argument("--object-size", type=float, default=None, metavar="M",
-                   help="the object's size across the grip, m (default: the grip's opening "
-                        "at the reach's end)")
-    f = p.add_argument_group("factors (the design's participant, condition, ...; "
-                             "docs/mocap.md)")
-    f.add_argument("--factors", type=_names, default=None, metavar="COL[,COL...]",
-                   help="columns of a long table that are the design's factors, text or "
-                        "numbers, one value per trial, carried into every output row "
-                        f"(default: any column called {', '.join(DEFAULT_FACTORS)}, any case, "
-                        "that holds one value per trial)")
-    f.add_argument("--factors-from-name", metavar="REGEX", default=None,
-                   help="a regular expression whose named groups, searched in each input's "
-                        "file name, are factors of its every row: e.g. "
-                        "'(?P<participant>P\\d+)_(?P<condition>[a-z]+)'")
+    add_settings(p.add_argument_group("motion capture (C3D, Qualisys TSV, X/Y/Z tables; "
+                                      "docs/mocap.md)"), MOCAP)
+    add_settings(p.add_argument_group("factors (the design's participant, condition, ...; "
+                                      "docs/mocap.md)"), FACTORS)
 
 
-def mocap_import(args: argparse.Namespace):
+def mocap_import(args: argparse.Namespace) -> MocapImport:
     """The :class:`~perception.recordings.MocapImport` the motion-capture options ask for.
 
     Parameters
     ----------
     args : argparse.Namespace
         Parsed arguments of :func:`add_mocap_options`.
-    """
-    from perception.reaches import MarkerMap, ReachParams
-    from perception.recordings import MocapImport
 
+    Raises
+    ------
+    InputError
+        A bad value, naming its field (the command line names its flag).
+    """
     markers = None
     if getattr(args, "markers", None):
         roles = {}
@@ -180,29 +190,26 @@ def mocap_import(args: argparse.Namespace):
             role, sep, name = pair.partition("=")
             if not sep or role not in ("thumb", "finger", "wrist", "object") or not name:
                 raise InputError(f"{pair}: expected ROLE=NAME with ROLE thumb, finger, wrist "
-                                 "or object", field="--markers")
+                                 "or object", field="markers")
             roles[role] = name
         if "thumb" not in roles or "finger" not in roles:
-            raise InputError("give both thumb=NAME and finger=NAME", field="--markers")
-        markers = MarkerMap(roles["thumb"], roles["finger"],
-                            tuple(roles.get("wrist", "").split("+")) if "wrist" in roles else (),
-                            tuple(roles.get("object", "").split("+")) if "object" in roles
-                            else ())
-    size = getattr(args, "object_size", None)  # ReachParams declares its range
-    with options(MOCAP_FIELDS):
-        return MocapImport(markers=markers, rate=getattr(args, "rate", None),
-                           units=getattr(args, "units", None),
-                           trial_column=getattr(args, "trial_column", None),
-                           time_column=getattr(args, "time_column", None),
-                           columns=getattr(args, "columns", None),
-                           reaches=ReachParams(object_size=size),
-                           factors=getattr(args, "factors", None),
-                           factors_from_name=getattr(args, "factors_from_name", None))
+            raise InputError("give both thumb=NAME and finger=NAME", field="markers")
+        try:
+            markers = MarkerMap(roles["thumb"], roles["finger"],
+                                tuple(roles["wrist"].split("+")) if "wrist" in roles else (),
+                                tuple(roles["object"].split("+")) if "object" in roles else ())
+        except InputError as exc:  # the role it is about, after the flag that gave it
+            raise InputError(f"{exc.field}: {exc.problem}" if exc.field else exc.problem,
+                             field="markers") from None
+    given = {s.field: getattr(args, s.field, None) for s in (*MOCAP, *FACTORS)
+             if s.owner is MocapImport and s.field != "markers"}
+    return MocapImport(markers=markers, reaches=ReachParams(
+        object_size=getattr(args, "object_size", None)), **given)
 
 
-def _names(text: str) -> tuple[str, ...]:
-    """``--columns``' comma-separated names (each checked by MocapImport)."""
-    return tuple(name.strip() for name in text.split(","))
+def mocap_asked(args: argparse.Namespace) -> bool:
+    """Whether any motion-capture flag was given (none: the defaults, no settings recorded)."""
+    return any(getattr(args, s.field, None) is not None for s in (*MOCAP, *FACTORS))
 
 
 def _mapping(pairs: list[str]) -> dict[str, str]:
@@ -211,12 +218,12 @@ def _mapping(pairs: list[str]) -> dict[str, str]:
         marker, sep, name = pair.partition("=")
         if not sep or not marker or not name:
             raise InputError(f"{pair}: expected MARKER=NAME, e.g. thumb=Thumb_tip",
-                             field="--keypoints")
+                             field="keypoints")
         out[marker] = name
     return out
 
 
-def pose_import(args: argparse.Namespace):
+def pose_import(args: argparse.Namespace) -> PoseImport | None:
     """The :class:`~perception.io.pose.PoseImport` the pose options ask for, or None if none.
 
     Parameters
@@ -224,8 +231,7 @@ def pose_import(args: argparse.Namespace):
     args : argparse.Namespace
         Parsed arguments of :func:`add_pose_options`.
     """
-    given = {k: getattr(args, k, None) for k in ("pcutoff", "individual", "fps",
-                                                 "object_diameter_px")}
+    given = {s.field: getattr(args, s.field, None) for s in POSE if s.field != "keypoints"}
     given = {k: v for k, v in given.items() if v is not None}
     if getattr(args, "keypoints", None):
         given["keypoints"] = _mapping(args.keypoints)
@@ -238,41 +244,37 @@ def pose_import(args: argparse.Namespace):
     config = getattr(args, "pose_config", None)
     if config is None and not given and not scale:
         return None
-    from perception.io.pose import PoseImport, load_pose_config
+    from perception.io.pose import load_pose_config
 
     base = load_pose_config(config) if config is not None else PoseImport()
     if "keypoints" in given:
         given["keypoints"] = {**base.keypoints, **given["keypoints"]}
-    with options({**POSE_FIELDS, "px_per_m": "--px-per-m",
-                  "object_diameter": "--object-diameter"}):
-        if scale and base.cleaning is not None:
-            given["cleaning"] = dataclasses.replace(base.cleaning, **scale)
-        return dataclasses.replace(base, **given)
+    if scale and base.cleaning is not None:
+        given["cleaning"] = dataclasses.replace(base.cleaning, **scale)
+    return dataclasses.replace(base, **given)
 
 
 def recognition_settings(args: argparse.Namespace) -> RecognitionSettings:
     """:class:`~perception.pipeline.RecognitionSettings` from parsed ``args``.
+
+    A bad value raises its class's error, which names the field
+    (``ObserveParams.px_per_m``); the command line names its flag.
 
     Parameters
     ----------
     args : argparse.Namespace
         Parsed arguments of :func:`add_recognition_options`.
     """
-    with options({"object_diameter": "--object-diameter", "px_per_m": "--px-per-m"}):
-        observe = ObserveParams(object_diameter=args.object_diameter, px_per_m=args.px_per_m,
-                                mirror=args.mirror)
-    with options({"rule": "--rule", "filter_gain": "--filter-gain", "w_r": "--w-r",
-                  "w_g": "--w-g"}):
-        hammer = HammerParams(rule=args.rule, w_r=args.w_r, w_g=args.w_g,
-                              filter_gain=args.filter_gain, thesis_sign=args.thesis_sign)
+    observe = ObserveParams(object_diameter=args.object_diameter, px_per_m=args.px_per_m,
+                            mirror=args.mirror)
+    hammer = HammerParams(rule=args.rule, w_r=args.w_r, w_g=args.w_g,
+                          filter_gain=args.filter_gain, thesis_sign=args.thesis_sign)
     tracking = None
     if getattr(args, "setup", None) is not None:
         from perception.tracking.setup import load_setup
 
         tracking = load_setup(args.setup)
-    mocap = None
-    if any(getattr(args, k, None) is not None for k in MOCAP_FLAGS):
-        mocap = mocap_import(args)
+    mocap = mocap_import(args) if mocap_asked(args) else None
     rules = VerdictRules()
     if getattr(args, "verdict_rules", None) is not None:
         data = read_toml(args.verdict_rules, "verdict rules")

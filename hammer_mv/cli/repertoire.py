@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import math
 from pathlib import Path
 
 from hammer_mv.cli.checks import options
@@ -55,16 +54,15 @@ def run_build(args: argparse.Namespace) -> int:
     if args.config is not None:
         rep = Repertoire.from_config(args.config)
     else:
-        if not 0 < args.fps <= MAX_FPS:
+        if not 0 < args.fps <= MAX_FPS:  # a rate: SceneSpec declares the period's range only
             raise InputError(f"expected a frame rate in (0, {MAX_FPS:g}] frames/s, "
                              f"got {args.fps}", field="--fps")
+        with options(_SCENE_FLAGS):  # SceneSpec declares what a distance and a size may be
+            scene = SceneSpec(distance=args.distance, object_size=args.object_size,
+                              frame_period=1.0 / args.fps)
         for flag, value in (("--distance", args.distance), ("--object-size", args.object_size)):
-            if not (math.isfinite(value) and value > 0):  # what SceneSpec asks
-                raise InputError(f"expected a positive length in m, got {value}", field=flag)
-            with options(flag):
+            with options(flag):  # and the table's metres, which no field declares
                 check_position(value, flag)
-        scene = SceneSpec(distance=args.distance, object_size=args.object_size,
-                          frame_period=1.0 / args.fps)
         dt = scene.frame_period / model_substeps(scene.frame_period)
         for duration in args.durations:  # named by the flag, before any planning
             with options("--durations"):

@@ -97,11 +97,16 @@ def from_table(cls: type, table: Any, where: str, path: str | os.PathLike | None
     Raises
     ------
     InputError
-        Not a table, an unknown key (with the nearest valid one), or a bad
-        value, naming the file and ``[where] key``.
+        Not a table, an unknown key (with the nearest valid one: the class
+        refuses it), or a bad value, naming the file and ``[where] key``.
     """
     table = sub_table(table, None, where, path)
-    check_keys(table, [k for k in cls.__dataclass_fields__ if k not in given], where, path)
+    # an unknown key is the class's to refuse (extra="forbid"), one the reader sets is ours
+    valid = [k for k in cls.__dataclass_fields__ if k not in given]
+    for key in table:
+        if key in given:
+            raise InputError(f"unknown key {key!r}; expected one of {', '.join(valid)}", path,
+                             field=f"{where} {key}")
     try:
         return cls(**table, **given)
     except HammerMVError as exc:
