@@ -1,12 +1,14 @@
 """minvar: the minimum variance model of reaching and grasping.
 
-Todorov's (2005) LQG with signal-dependent noise (:mod:`minvar.lqg`), the
-point-mass/muscle plant of Todorov & Jordan 2002 (:mod:`minvar.plant`),
-reaching tasks with via-points (:mod:`minvar.task`), vectorised Monte Carlo
-execution (:mod:`minvar.execution`, :mod:`minvar.reach`), two-link kinematics
+Todorov's (2005) LQG with signal-dependent noise (the problem,
+:mod:`minvar.problem`; its solver, :mod:`minvar.lqg`; the exact moments of any
+gains, :mod:`minvar.moments`), the point-mass/muscle plant of Todorov & Jordan
+2002 (:mod:`minvar.plant`), reaching tasks with via-points
+(:mod:`minvar.task`), vectorised Monte Carlo execution
+(:mod:`minvar.execution`, :mod:`minvar.reach`), two-link kinematics
 (:mod:`minvar.kinematics`), the limits on sizes and positions checked before
-anything is allocated (:mod:`minvar.limits`), the analyses of the thesis's chapter 3
-(:mod:`minvar.analysis`), chapter 2's comparison models
+anything is allocated (:mod:`minvar.limits`), the analyses of the thesis's
+chapter 3 (:mod:`minvar.analysis`), chapter 2's comparison models
 (:mod:`minvar.baselines`), appendix A's via-point representation
 (:mod:`minvar.viapoints`, :mod:`minvar.similarity`), and reach-to-grasp
 (chapter 4): the arm-and-gripper model (:mod:`minvar.grasp`), its statistics

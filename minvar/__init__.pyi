@@ -13,6 +13,7 @@ from . import lqg as lqg
 from . import moments as moments
 from . import plant as plant
 from . import plotting as plotting
+from . import problem as problem
 from . import reach as reach
 from . import similarity as similarity
 from . import task as task
@@ -35,13 +36,13 @@ from .grasp_stats import summarize_grasp as summarize_grasp
 from .grasp_task import GraspTask as GraspTask
 from .grasp_task import GripVia as GripVia
 from .grasp_task import shoulder_for as shoulder_for
-from .lqg import LQGProblem as LQGProblem
 from .lqg import LQGSolution as LQGSolution
 from .lqg import kernel_engine as kernel_engine
 from .lqg import solve as solve
 from .moments import expected_cost as expected_cost
 from .moments import state_moments as state_moments
 from .plant import PointMassPlant as PointMassPlant
+from .problem import LQGProblem as LQGProblem
 from .reach import ReachResult as ReachResult
 from .reach import simulate_reach as simulate_reach
 from .task import ReachTask as ReachTask

@@ -159,7 +159,7 @@ def expected_distance(offset, cov) -> float:
     """Mean distance from a target of normally distributed end-points, without sampling.
 
     The exact counterpart of :attr:`EndpointStats.distance_mean` for end-points
-    ``N(target + offset, cov)`` (e.g. from :func:`minvar.lqg.state_moments`),
+    ``N(target + offset, cov)`` (e.g. from :func:`minvar.moments.state_moments`),
     by Gauss-Hermite quadrature along the principal axes (48 nodes each). The
     error is below 0.3 % even with the mean on the target, where ``|x|`` has a
     kink, and far smaller once the systematic error is a few SDs: well under

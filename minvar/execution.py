@@ -12,7 +12,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .limits import check_simulation
-from .lqg import LQGProblem, LQGSolution
+from .lqg import LQGSolution
+from .problem import LQGProblem
 
 __all__ = ["Trajectories", "simulate", "as_generator"]
 

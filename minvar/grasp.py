@@ -35,8 +35,9 @@ from .limits import (
     check_memory,
     simulation_bytes,
 )
-from .lqg import LQGProblem, LQGSolution, kernel_engine, solve
+from .lqg import LQGSolution, kernel_engine, solve
 from .plant import POSITION, VELOCITY
+from .problem import LQGProblem
 from .task import ReachTask, ViaPoint, reach_problem
 
 if TYPE_CHECKING:  # pragma: no cover

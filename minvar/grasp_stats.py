@@ -1,15 +1,22 @@
 """Statistics of grasps (thesis chapter 4): grip aperture, variability, end-points.
 
-Functions take arrays, so they serve simulated and observed grasps alike;
-:func:`summarize_grasp` collects them for one :class:`~minvar.grasp.GraspResult`,
-whose own ``aperture``, ``mga``, ``wrist_sd``, ... properties call them too.
-This module needs nothing of :mod:`minvar.grasp` at run time (its classes
-are imported for type checking only), so :mod:`minvar.grasp` can build on it.
-:func:`grasp_moments` gives the same variabilities without sampling error,
-from the exact joint-space moments of each chain's plan
-(:func:`minvar.lqg.state_moments`) mapped through the kinematics to first
-order — exact up to terms of order (noise SD / link length)^2, i.e. to a
-part in 10^4 at the thesis's 1 % execution noise.
+Two kinds of function. The measures (:func:`grip_aperture`,
+:func:`max_grip_aperture`, :func:`path_sd`, :func:`peak`,
+:func:`peak_deviation`, :func:`bootstrap_peak`) take arrays (anything
+``numpy.asarray`` reads), so they serve simulated and observed grasps alike;
+a :class:`~minvar.grasp.GraspResult`'s own ``aperture``, ``mga``,
+``wrist_sd``, ... properties call them too. The summaries take grasp objects:
+:func:`grasp_moments` a :class:`~minvar.grasp.GraspPlan`,
+:func:`summarize_grasp` a :class:`~minvar.grasp.GraspResult` (and,
+optionally, its :class:`GraspMoments`), :func:`end_distance` a
+:class:`GraspMoments`. This module needs nothing of :mod:`minvar.grasp` at
+run time (its classes are imported for type checking only, and read by
+attribute), so :mod:`minvar.grasp` can build on it. :func:`grasp_moments`
+gives the variabilities without sampling error, from the exact joint-space
+moments of each chain's plan (:func:`minvar.moments.state_moments`) mapped
+through the kinematics to first order — exact up to terms of order (noise
+SD / link length)^2, i.e. to a part in 10^4 at the thesis's 1 % execution
+noise.
 """
 
 from __future__ import annotations
@@ -20,10 +27,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .analysis import endpoint_stats, expected_distance
-from .lqg import state_moments
+from .moments import state_moments
 from .plant import POSITION
 
 if TYPE_CHECKING:  # pragma: no cover - minvar.grasp imports this module
+    from numpy.typing import ArrayLike
+
     from .grasp import GraspPlan, GraspResult
 
 __all__ = [
@@ -41,12 +50,12 @@ __all__ = [
 ]
 
 
-def grip_aperture(finger: np.ndarray, thumb: np.ndarray) -> np.ndarray:
+def grip_aperture(finger: ArrayLike, thumb: ArrayLike) -> np.ndarray:
     """Grip aperture: the distance between the finger and thumb tips.
 
     Parameters
     ----------
-    finger, thumb : (..., 2) arrays
+    finger, thumb : (..., 2) array_like
         Tip positions (any frame, the same for both), m.
 
     Returns
@@ -58,14 +67,15 @@ def grip_aperture(finger: np.ndarray, thumb: np.ndarray) -> np.ndarray:
     return np.hypot(d[..., 0], d[..., 1])
 
 
-def max_grip_aperture(aperture: np.ndarray, relative_time: np.ndarray):
+def max_grip_aperture(aperture: ArrayLike,
+                      relative_time: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """Maximum grip aperture (MGA) of each repetition and when it occurs.
 
     Parameters
     ----------
-    aperture : (trials, S+1) array
-        Grip aperture over time, m.
-    relative_time : (S+1,) array
+    aperture : (trials, S+1) or (S+1,) array_like
+        Grip aperture over time, m (one repetition may be given as 1-D).
+    relative_time : (S+1,) array_like
         Time of each sample as a fraction of the movement.
 
     Returns
@@ -80,12 +90,12 @@ def max_grip_aperture(aperture: np.ndarray, relative_time: np.ndarray):
     return aperture[np.arange(len(i)), i], np.asarray(relative_time, dtype=float)[i]
 
 
-def path_sd(paths: np.ndarray) -> np.ndarray:
+def path_sd(paths: ArrayLike) -> np.ndarray:
     """Standard deviation across repetitions at each time step.
 
     Parameters
     ----------
-    paths : (trials, S+1) or (trials, S+1, 2) array
+    paths : (trials, S+1) or (trials, S+1, 2) array_like
         A scalar (e.g. aperture, m) or a 2-D position (m) over time. For
         positions the SD is ``sqrt(var x + var y)``.
 
@@ -99,21 +109,28 @@ def path_sd(paths: np.ndarray) -> np.ndarray:
     return np.sqrt(var.sum(axis=-1)) if paths.ndim == 3 else np.sqrt(var)
 
 
-def peak(curve: np.ndarray, relative_time: np.ndarray) -> tuple[float, float]:
+def peak(curve: ArrayLike, relative_time: ArrayLike) -> tuple[float, float]:
     """Largest value of a curve and its time.
 
     Parameters
     ----------
-    curve : (S+1,) array
+    curve : (S+1,) array_like
         E.g. an SD over time.
-    relative_time : (S+1,) array
+    relative_time : (S+1,) array_like
         Time of each sample (any unit; fractions of the movement here).
+
+    Returns
+    -------
+    value, time : float
+        The largest value and the time of its first occurrence.
     """
+    curve = np.asarray(curve, dtype=float)
     i = int(np.argmax(curve))
-    return float(curve[i]), float(np.asarray(relative_time)[i])
+    return float(curve[i]), float(np.asarray(relative_time, dtype=float)[i])
 
 
-def peak_deviation(paths: np.ndarray, relative_time: np.ndarray):
+def peak_deviation(paths: ArrayLike,
+                   relative_time: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """Each repetition's largest deviation from the mean path, and its time.
 
     The per-repetition measure of variability that one-way ANOVA compares
@@ -123,9 +140,9 @@ def peak_deviation(paths: np.ndarray, relative_time: np.ndarray):
 
     Parameters
     ----------
-    paths : (trials, S+1) or (trials, S+1, 2) array
+    paths : (trials, S+1) or (trials, S+1, 2) array_like
         Scalar or 2-D positions over time, m.
-    relative_time : (S+1,) array
+    relative_time : (S+1,) array_like
         Time of each sample as a fraction of the movement.
 
     Returns
@@ -143,7 +160,7 @@ def peak_deviation(paths: np.ndarray, relative_time: np.ndarray):
 
 
 def bootstrap_peak(
-    paths: np.ndarray, relative_time: np.ndarray, draws: int, rng: np.random.Generator
+    paths: ArrayLike, relative_time: ArrayLike, draws: int, rng: np.random.Generator
 ) -> np.ndarray:
     """Bootstrap draws of the peak of the SD over time, and of its time.
 
@@ -154,9 +171,9 @@ def bootstrap_peak(
 
     Parameters
     ----------
-    paths : (trials, S+1) or (trials, S+1, 2) array
+    paths : (trials, S+1) or (trials, S+1, 2) array_like
         Scalar (e.g. aperture, m) or 2-D positions (m) over time.
-    relative_time : (S+1,) array
+    relative_time : (S+1,) array_like
         Time of each sample, fraction of the movement.
     draws : int
         Number of resamples (>= 1).
@@ -389,7 +406,7 @@ class GraspSummary:
         return asdict(self)
 
 
-def end_distance(moments: GraspMoments, digit: str, target) -> float:
+def end_distance(moments: GraspMoments, digit: str, target: ArrayLike) -> float:
     """Exact mean distance of a digit's final position from its target, m.
 
     Parameters

@@ -15,14 +15,11 @@ their compiled twin and must match them to rounding (tests/test_speed_solver.py)
 from __future__ import annotations
 
 import functools
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from . import _kernel
-
-if TYPE_CHECKING:
-    from .lqg import LQGProblem
+from .problem import LQGProblem
 
 __all__ = ["Moments", "estimation_error_covariance", "expected_cost", "mean_states",
            "state_moments"]

@@ -26,8 +26,8 @@ import numpy as np
 
 from .errors import ParameterError
 from .limits import check_problem, check_steps
-from .lqg import LQGProblem
 from .plant import FORCE, FORMS, N_BASE, POSITION, VELOCITY, PointMassPlant
+from .problem import LQGProblem
 from .validation import NonNegative, Point, Positive, Tuple, declared
 
 __all__ = ["ViaPoint", "ReachTask", "reach_problem"]
@@ -146,7 +146,7 @@ class ReachTask:
 
 
 def reach_problem(task: ReachTask, plant: PointMassPlant | None = None) -> LQGProblem:
-    """Build the :class:`~minvar.lqg.LQGProblem` of a reaching task.
+    """Build the :class:`~minvar.problem.LQGProblem` of a reaching task.
 
     Parameters
     ----------

@@ -16,7 +16,7 @@ from minvar.grasp_stats import (
     peak_deviation,
     summarize_grasp,
 )
-from minvar.lqg import state_moments
+from minvar.moments import state_moments
 
 pytestmark = pytest.mark.usefixtures("engine")  # plans and simulations once per solver engine
 

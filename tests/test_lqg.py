@@ -175,7 +175,7 @@ def test_bad_solver_options(reference_problem):
 
 
 def test_estimation_error_covariance_matches_monte_carlo(reference_problem, noisy_mc, engine):
-    from minvar.lqg import estimation_error_covariance
+    from minvar.moments import estimation_error_covariance
 
     p, s = _all_noise(reference_problem), noisy_mc.solution
     P = estimation_error_covariance(p, s.K, s.L, engine=engine)  # of the gains sampled
@@ -267,7 +267,7 @@ def test_grasp_plans_are_the_same_with_each_engine(engine, monkeypatch):
 
 
 def test_engine_argument_is_checked(reference_problem):
-    from minvar.lqg import estimation_error_covariance
+    from minvar.moments import estimation_error_covariance
 
     for bad in ("bogus", "C", None):
         with pytest.raises(ValueError, match=r"solve: engine must be one of 'auto', 'c', "):
@@ -317,7 +317,8 @@ def _without_kernel(monkeypatch):
 
 
 def test_c_engine_without_the_kernel_raises(reference_problem, monkeypatch):
-    from minvar.lqg import KernelUnavailableError, estimation_error_covariance
+    from minvar.lqg import KernelUnavailableError
+    from minvar.moments import estimation_error_covariance
 
     _without_kernel(monkeypatch)
     with pytest.raises(KernelUnavailableError, match=r"engine='c' needs the compiled.*no C "):
