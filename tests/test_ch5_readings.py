@@ -1,4 +1,4 @@
-"""tools/reproduce_ch5_readings.py: eqs. 5.1/5.7 under every reading the thesis allows."""
+"""tools/thesis/ch5_readings.py: eqs. 5.1/5.7 under every reading the thesis allows."""
 
 import sys
 from pathlib import Path
@@ -7,9 +7,11 @@ import numpy as np
 import pytest
 from _demos import default_repertoire, demo_tracks
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from reproduce_ch5_readings import (  # noqa: E402
+from perception.pipeline import RecognitionSettings, recognize_clip  # noqa: E402
+from perception.recognition import HammerParams  # noqa: E402
+from tools.thesis.ch5_readings import (  # noqa: E402
     ALLOWED,
     READINGS,
     balanced_ratio,
@@ -18,9 +20,6 @@ from reproduce_ch5_readings import (  # noqa: E402
     reading_terms,
     survived,
 )
-
-from perception.pipeline import RecognitionSettings, recognize_clip  # noqa: E402
-from perception.recognition import HammerParams  # noqa: E402
 
 
 @pytest.fixture(scope="module")

@@ -1,59 +1,61 @@
-"""tools/reproduce_thesis.py: figures, numbers.md, and the guarded chapter 4 hook."""
+"""tools/thesis (``python -m tools.thesis``, tools/reproduce_thesis.py): figures,
+numbers.md, the claims as data and the one evaluator."""
 
+import dataclasses
+import importlib
 import re
+import subprocess
 import sys
-import textwrap
 from pathlib import Path
 
 import pandas as pd
 import pytest
 
-TOOLS = Path(__file__).resolve().parents[1] / "tools"
-sys.path.insert(0, str(TOOLS))
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
 
-import reproduce_thesis  # noqa: E402
-from reproduce_common import (  # noqa: E402
+from tools.thesis import cli as reproduce_thesis  # noqa: E402
+from tools.thesis.claims import Claim, Measured, below, evaluate, holds  # noqa: E402
+from tools.thesis.markdown import at_thesis_verdict, numbers_markdown  # noqa: E402
+from tools.thesis.records import (  # noqa: E402
     CLAIM_KEYS,
+    TABLE_HEADINGS,
+    VERDICTS,
     claim,
-    quote_is_on_line,
     sensitivity,
-    thesis_text,
 )
+from tools.thesis.text import quote_is_on_line, thesis_text  # noqa: E402
 
 
 def _row(cells) -> str:
     return "| " + " | ".join(cells) + " |"
 
 
-#: The chapter modules whose citation tables are checked against the thesis text.
-CITING = ("reproduce_ch2", "reproduce_ch3", "reproduce_appendix_a", "reproduce_ch4",
-          "reproduce_ch5")
+#: Every chapter's table of claims.
+TABLES = ("ch2_claims", "ch3_claims", "appendix_a_claims", "ch4_claims", "ch5_claims")
+
+
+def _tables():
+    return {name: importlib.import_module(f"tools.thesis.{name}").CLAIMS for name in TABLES}
 
 
 def test_every_cited_line_holds_the_quoted_words():
-    # the tools find the thesis text as reproduce_common.thesis_text does: users may not
+    # the tools find the thesis text as tools.thesis.text.thesis_text does: users may not
     # have it, so the check is skipped, saying why
     lines = thesis_text()
     if lines is None:
         pytest.skip("thesis text not found ($HAMMER_MV_THESIS or shared/seed/"
                     "minimum-variance-thesis.txt in or beside the checkout)")
-    import importlib
-
     checked = 0
-    for name in CITING:
-        for prefix, entry in importlib.import_module(name).CITES.items():
-            line, quote = entry[:2]
-            if line is None:  # our own check, not a thesis claim
+    for name, table in _tables().items():
+        for c in table:
+            if c.line is None:  # our own check, not a thesis claim
                 continue
-            assert quote_is_on_line(lines, line, quote), (name, prefix, line, quote)
+            assert quote_is_on_line(lines, c.line, c.quote), (name, c.id, c.line, c.quote)
             checked += 1
-    import reproduce_ch4
-    import reproduce_ch5_cites
-
-    for line, quote, _ in reproduce_ch5_cites.INCONSISTENT.values():
-        assert quote_is_on_line(lines, line, quote), (line, quote)
-    for c in reproduce_ch4._inconsistencies():
-        assert quote_is_on_line(lines, c["line"], c["quote"]), c["claim"]
+            if c.against:  # the other place where the thesis says the opposite
+                assert quote_is_on_line(lines, *c.against[:2]), (name, c.id, c.against)
     assert checked >= 60
     # and a wrong line is caught: the Fig. 4.8 claims are on 875/877, 880 is blank
     assert not quote_is_on_line(lines, 880, "grip size increases and occurs *earlier*")
@@ -81,7 +83,7 @@ def test_quick_run_writes_every_figure_and_the_claims_table(tmp_path, capsys):
     assert len(sweep) == 8 and sweep["sd_total"].iloc[0] > sweep["sd_total"].iloc[-1]
 
     md = (tmp_path / "numbers.md").read_text()
-    header = _row(reproduce_thesis.TABLE_HEADINGS)
+    header = _row(TABLE_HEADINGS)
     body, inside = [], False
     for line in md.splitlines():  # the rows of each chapter's thesis-claims table
         inside = line == header or (inside and line.startswith("|"))
@@ -102,7 +104,10 @@ def test_quick_run_writes_every_figure_and_the_claims_table(tmp_path, capsys):
     assert (claims["location"].str.len() > 0).all() and (claims["measure"].str.len() > 0).all()
     assert (thesis["line"].astype(str).str.len() > 0).all()
     assert (thesis["quote"].str.len() > 0).all() and (thesis["at_thesis"].str.len() > 0).all()
-    assert set(claims["verdict"]) <= {*reproduce_thesis.VERDICTS, "conditional"}
+    assert set(claims["verdict"]) <= {*VERDICTS, "conditional"}
+    # every row names its declared claim, and the rule it was judged by
+    assert claims.groupby("chapter")["id"].apply(lambda ids: ids.is_unique).all()
+    assert (claims["id"].str.len() > 0).all() and (claims["expected"].str.len() > 0).all()
     human = claims[claims["claim"].str.contains("closest to minimum jerk")].iloc[0]
     assert "15/8" in human["ours"] and human["verdict"] == "by construction"  # closed form
     assert "human" in human["thesis"]  # 1.875 is the thesis's human value
@@ -124,66 +129,50 @@ def test_quick_run_writes_every_figure_and_the_claims_table(tmp_path, capsys):
         for _, c in thesis.iterrows():
             assert quote_is_on_line(lines, int(c["line"]), c["quote"]), (c["line"], c["quote"])
     assert "15 figures" in capsys.readouterr().out
+    # the thin command and the module are the same program
+    for cmd in ([sys.executable, "tools/reproduce_thesis.py", "--help"],
+                [sys.executable, "-m", "tools.thesis", "--help"]):
+        done = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
+        assert done.returncode == 0 and "--skip-ch4" in done.stdout, cmd
 
 
-def _fake_ch4(folder: Path, body: str) -> None:
-    (folder / "reproduce_ch4.py").write_text(textwrap.dedent(body))
-
-
-def test_chapter4_is_called_with_its_interface(tmp_path, monkeypatch):
-    mods = tmp_path / "mods"
-    mods.mkdir()
-    _fake_ch4(mods, """
-        def reproduce(out, *, trials=500, seed=0):
-            (out / "fig4_9_fake.png").write_bytes(b"png")
-            return [dict(section="4.1", claim="c", thesis="0.92", ours=f"{trials} {seed}",
-                         agrees=True, note="")]
-    """)
-    monkeypatch.syspath_prepend(str(mods))
-    monkeypatch.delitem(sys.modules, "reproduce_ch4", raising=False)
-    out = tmp_path / "out"
-    out.mkdir()
-    ch4 = [("Chapter 4", "reproduce_ch4")]
-    try:
-        claims, notes, _, ok = reproduce_thesis.run(out, trials=None, seed=3, quick=False,
-                                                    chapters=ch4)
-        assert ok and not notes and claims[0]["ours"] == "500 3"
-        claims, *_ = reproduce_thesis.run(out, trials=None, seed=3, quick=True, chapters=ch4)
-        assert claims[0]["ours"] == f"{reproduce_thesis.QUICK_TRIALS} 3"
-    finally:
-        # the fake must not shadow tools/reproduce_ch4.py for later tests in this process
-        sys.modules.pop("reproduce_ch4", None)
-
-
-def test_missing_chapter4_is_noted_and_a_failing_one_reported(tmp_path, monkeypatch):
-    monkeypatch.setattr(reproduce_thesis, "load_chapter", lambda module: None)
-    ch4 = [("Chapter 4", "reproduce_ch4")]
-    claims, notes, _, ok = reproduce_thesis.run(tmp_path, trials=5, seed=0, quick=True,
-                                                chapters=ch4)
-    assert ok and claims == [] and "missing" in notes[0]
-
-    def broken(out, *, trials, seed):
+def test_a_failing_chapter_is_reported_and_the_others_go_on(tmp_path, monkeypatch):
+    def broken(out, **kw):
         raise RuntimeError("boom")
 
     monkeypatch.setattr(reproduce_thesis, "load_chapter", lambda module: broken)
-    claims, notes, _, ok = reproduce_thesis.run(tmp_path, trials=5, seed=0, quick=True,
-                                                chapters=ch4)
-    assert not ok and "FAILED" in notes[0] and "boom" in notes[0]
-    # a chapter of ours that is missing is an error, not a note
-    monkeypatch.setattr(reproduce_thesis, "load_chapter", lambda module: None)
-    _, notes, _, ok = reproduce_thesis.run(tmp_path, trials=5, seed=0, quick=True,
-                                           chapters=[("Chapter 2", "reproduce_ch2")])
-    assert not ok and "FAILED" in notes[0]
+    claims, notes, timings, ok = reproduce_thesis.run(
+        tmp_path, trials=5, seed=0, quick=True, chapters=[("Chapter 4", "tools.thesis.ch4")])
+    assert not ok and claims == [] and "FAILED" in notes[0] and "boom" in notes[0]
+    assert timings[0].startswith("Chapter 4: ")
+
+
+def test_every_chapter_takes_the_same_interface(tmp_path, monkeypatch):
+    # one call for every chapter: the trials, seed and smoke flag it was given
+    seen = []
+
+    def fake(out, *, trials, seed, quick, progress):
+        seen.append((trials, seed, quick))
+        return [claim("4.1", "c", "t", f"{trials} {seed}", True)]
+
+    monkeypatch.setattr(reproduce_thesis, "load_chapter", lambda module: fake)
+    ch = list(reproduce_thesis.CHAPTERS)
+    claims, notes, _, ok = reproduce_thesis.run(tmp_path, trials=None, seed=3, quick=False,
+                                                chapters=ch)
+    assert ok and not notes and seen == [(None, 3, False)] * len(ch)
+    assert [c["chapter"] for c in claims] == [t for t, _ in ch]
+    claims, *_ = reproduce_thesis.run(tmp_path, trials=None, seed=3, quick=True, chapters=ch[:1])
+    assert claims[0]["ours"] == f"{reproduce_thesis.QUICK_TRIALS} 3"
 
 
 def test_numbers_markdown_escapes_cells_and_checks_keys():
     # a record of the original six keys still renders, as a row of the new table
     row = dict(section="A.1", claim="a | b", thesis="1", ours="2", agrees=False, note="n")
-    md = reproduce_thesis.numbers_markdown([row], ["note line"], ["header"])
+    md = numbers_markdown([row], ["note line"], ["header"])
     assert "| a \\| b | A.1 |  | not stated | 1 | 2 | **differs** |  | n |" in md
     assert "- note line" in md and "1 claims: 0 agree, 1 differ" in md
     with pytest.raises(ValueError, match="lacks"):
-        reproduce_thesis.numbers_markdown([{"section": "x"}], [], [])
+        numbers_markdown([{"section": "x"}], [], [])
 
 
 def test_claims_and_tables_are_grouped_by_chapter():
@@ -195,7 +184,7 @@ def test_claims_and_tables_are_grouped_by_chapter():
         dict(sensitivity("tip_start", "not given", "we use 2 cm", ["tip_start", "verdict"],
                          [["1 cm", "yes"], ["6 cm", "**no**"]]), chapter="Chapter 4"),
     ]
-    md = reproduce_thesis.numbers_markdown(rows, [], ["header"])
+    md = numbers_markdown(rows, [], ["header"])
     assert md.index("## Chapter 2") < md.index("| c1 |") < md.index("## Chapter 4")
     assert "| c1 | Fig. 2.6(c); line 276 |  | m1 | t | o | agree |  |  |" in md
     assert "| **thesis inconsistent** |  | both |" in md
@@ -204,7 +193,7 @@ def test_claims_and_tables_are_grouped_by_chapter():
             "inconsistent") in md
     # our own checks are counted apart from the thesis's claims
     own = dict(claim("5.3", "o1", "—", "o", True, kind="own", measure="m"), chapter="Chapter 4")
-    md = reproduce_thesis.numbers_markdown([*rows, own], [], ["header"])
+    md = numbers_markdown([*rows, own], [], ["header"])
     assert "- 2 thesis claims, each counted once" in md and "- 1 checks of our own" in md
     assert "  - at our settings: 1 agree, 0 differ, 0 conditional, 0 by construction, 1 " \
         "thesis inconsistent;" in md
@@ -232,7 +221,7 @@ def test_claim_record():
 
 
 def test_chapters_in_two_processes_give_the_same_records(tmp_path):
-    ch = [("Chapter 2", "reproduce_ch2"), ("Appendix A", "reproduce_appendix_a")]
+    ch = [("Chapter 2", "tools.thesis.ch2"), ("Appendix A", "tools.thesis.appendix_a")]
     one, _, _, ok1 = reproduce_thesis.run(tmp_path / "a", trials=3, seed=2, quick=True,
                                           chapters=ch)
     two, _, timings, ok2 = reproduce_thesis.run(tmp_path / "b", trials=3, seed=2, quick=True,
@@ -258,8 +247,8 @@ def test_by_construction_never_enters_an_agree_tally_in_either_column():
             dict(claim("5.4", "holds", "t", "o", True,
                        at_thesis="agree (survives text, printed, consecutive): o"),
                  chapter="Chapter 5")]
-    assert reproduce_thesis.at_thesis_verdict("agree: o", "by construction") == "by construction"
-    md = reproduce_thesis.numbers_markdown(rows, [], ["header"])
+    assert at_thesis_verdict("agree: o", "by construction") == "by construction"
+    md = numbers_markdown(rows, [], ["header"])
     assert ("  - at the thesis's settings: 1 agree, 0 differ, 1 conditional, 1 by "
             "construction, 0 thesis inconsistent.") in md
     assert "| Chapter 3 | built |  | by construction | by construction |" in md
@@ -275,7 +264,63 @@ def test_a_claim_measured_two_ways_is_counted_once():
                        at_thesis="differs: o"), chapter="Chapter 4"),
             dict(claim("4.3", "Another", "t", "o", True, at_thesis="agree: o"),
                  chapter="Chapter 4")]
-    md = reproduce_thesis.numbers_markdown(rows, [], ["header"])
+    md = numbers_markdown(rows, [], ["header"])
     assert "- 2 thesis claims (3 rows: a hand-frame row beside" in md
     assert "  - at our settings: 1 agree, 0 differ, 1 conditional," in md
     assert "  - at the thesis's settings: 1 agree, 1 differ, 0 conditional," in md
+
+
+def test_claims_are_data_and_one_evaluator_checks_every_one():
+    # every chapter's claims are declared in one table: an id, where the thesis says it
+    # (a cited line and its words, or our own check), how it is measured and the rule
+    for name, table in _tables().items():
+        ids = [c.id for c in table]
+        assert len(set(ids)) == len(ids) >= 5, name
+        for c in table:
+            assert isinstance(c, Claim) and c.location and c.measure and c.expected, c.id
+            assert (c.line is not None and c.quote) or c.kind == "own", c.id
+            assert c.rule or c.verdict in ("by construction", "thesis inconsistent"), c.id
+    # the evaluator yields one row per claim, in the table's order, each with the
+    # measured value, the rule, the verdict and the note
+    table = _tables()["ch2_claims"]
+    measured = {c.id: Measured("ours", dict.fromkeys(
+        {check.value for check in c.rule}, 0.5)) for c in table}
+    rows = evaluate(table, measured)
+    assert [r["id"] for r in rows] == [c.id for c in table]
+    assert all(set(r) == set(CLAIM_KEYS) for r in rows)
+    assert all(r["expected"] == c.expected for r, c in zip(rows, table))
+    with pytest.raises(KeyError, match="not measured"):
+        evaluate(table, dict(list(measured.items())[1:]))
+
+
+def test_a_broken_claim_is_reported_as_not_ok():
+    straight = Claim("straight", "2.2.2", "Paths are straight", "straight", "line 260",
+                     "largest deviation; agree below 1 mm", rule=(below("deviation_m", 1e-3),),
+                     line=260, quote="straight")
+    ok = evaluate([straight], {"straight": Measured("0.1 mm", {"deviation_m": 1e-4})})[0]
+    assert ok["verdict"] == "agree" and ok["agrees"] and ok["expected"] == "deviation_m < 0.001"
+    # the same claim with its tolerance broken (a hundred times tighter) fails, and says why
+    broken = dataclasses.replace(straight, rule=(below("deviation_m", 1e-5),))
+    row = evaluate([broken], {"straight": Measured("0.1 mm", {"deviation_m": 1e-4})},
+                   unexplained="the numbers fail the rule")[0]
+    assert row["verdict"] == "differs" and not row["agrees"]
+    assert row["why"] == "the numbers fail the rule"
+    # a rule read against another measured value, and a truth value the chapter computes
+    check = below("rise", "se", 2)
+    assert check.words() == "rise < 2 × se"
+    rise = Claim("rise", "4.2", "Rises", "rises", "line 834", "m", line=834, quote="q",
+                 rule=(check, holds("monotone")))
+    got = evaluate([rise], {"rise": Measured("o", {"rise": 1.0, "se": 1.0, "monotone": False})})
+    assert got[0]["verdict"] == "differs"
+    # a fixed verdict is kept whatever the numbers; a chapter's conditional overrides the rule
+    built = dataclasses.replace(broken, verdict="by construction")
+    assert evaluate([built], {"straight": Measured("o", {"deviation_m": 1.0})})[0][
+        "verdict"] == "by construction"
+    assert evaluate([broken], {"straight": Measured("o", {"deviation_m": 1.0},
+                                                    verdict="conditional")})[0][
+        "verdict"] == "conditional"
+    # a claim that is not data cannot be declared
+    with pytest.raises(ValueError, match="rule or a fixed verdict"):
+        Claim("x", "1", "c", "t", "l", "m", line=1, quote="q")
+    with pytest.raises(ValueError, match="cites a line"):
+        Claim("x", "1", "c", "t", "l", "m", rule=(holds("y"),))

@@ -42,28 +42,34 @@ def test_initial_gains_are_checked():
         solve(problem, initial_L=bad)
 
 
-TOOLS = Path(__file__).resolve().parents[1] / "tools"
+ROOT = Path(__file__).resolve().parents[1]
 THESIS_WEIGHTS = {"r": 0.002, "w_v": 0.1, "w_f": 0.01}  # lines 537, 552
 THESIS_SETTINGS = {**THESIS_WEIGHTS, "form": "thesis"}  # and the printed model
 
 
+def _measured(step, *args) -> dict:
+    """The chapter 3 claims one measuring step of tools.thesis makes, evaluated by id."""
+    from tools.thesis.ch3_claims import CLAIMS
+    from tools.thesis.claims import evaluate
+
+    got = {}
+    step(None, got, *args)
+    return {c["id"]: c for c in evaluate(CLAIMS, got, strict=False)}
+
+
 @pytest.fixture(scope="module")
 def ch3():
-    sys.path.insert(0, str(TOOLS))
-    try:
-        import reproduce_ch3
-    finally:
-        sys.path.remove(str(TOOLS))
-    return reproduce_ch3
+    if str(ROOT) not in sys.path:
+        sys.path.insert(0, str(ROOT))
+    from tools.thesis import ch3_letters, ch3_reach
+
+    return ch3_reach, ch3_letters
 
 
 def test_a_100_ms_shift_alters_the_path_beyond_the_noise(ch3):
     # thesis line 591: "up to about 100ms do not significantly alter the trajectory";
     # judged against the repetition noise ours differs (pinned)
-    claims = []
-    ch3._fig3_2(None, claims, 0, {})
-    flat = next(c for c in claims if c["claim"].startswith("Via-point time differences"))
-    assert flat["verdict"] == "differs"
+    assert _measured(ch3[0].fig3_2, 0, {})["viapoint-shift-100ms"]["verdict"] == "differs"
 
 
 def test_at_the_thesis_settings_the_printed_plant_passes_the_s_and_stops_short():
@@ -91,30 +97,25 @@ def test_at_the_thesis_settings_the_printed_plant_passes_the_s_and_stops_short()
 
 @pytest.fixture(scope="module")
 def point_to_point(ch3):
-    claims = []
-    ch3._fig3_4_3_5(None, claims, 50, 0, {})
-    return {c["claim"]: c for c in claims}
+    return _measured(ch3[0].fig3_4_3_5, 50, 0, {})
 
 
 def test_the_straight_mean_path_is_by_construction(point_to_point):
     # line 636: straight 'as expected' with zero-mean noise on a linear plant
-    row = next(c for k, c in point_to_point.items() if k.startswith("The mean path"))
-    assert row["verdict"] == "by construction"
+    assert point_to_point["mean-straight"]["verdict"] == "by construction"
 
 
 def test_single_movements_bow_either_way_not_as_people_curve(point_to_point):
     # line 622: 'slightly curved in the same way as human arm movements'; ours scatter
     # to both sides of the straight mean about equally (numbers.md: differs)
-    row = next(c for k, c in point_to_point.items() if k.startswith("Single movements"))
+    row = point_to_point["single-curved"]
     assert row["verdict"] == "differs" and "bow to one side" in row["ours"]
 
 
 def test_the_letter_keeps_its_shape_only_above_a_movement_time(ch3):
     # lines 676, 684: the thesis gives neither the times nor the via-points; the verdict
     # turns on the times chosen, so it is conditional, with the time where it crosses
-    claims = []
-    ch3._fig3_8_3_9(None, claims, 20, 0, {})
-    row = next(c for c in claims if c["claim"].startswith("The 'a' keeps its shape"))
+    row = _measured(ch3[1].fig3_8_3_9, 20, 0, {})["a-keeps-shape"]
     assert row["verdict"] == "conditional" and "down to 1500 ms" in row["ours"]
 
 
@@ -123,21 +124,19 @@ def test_the_s_end_point_sd_falls_beyond_the_noise_at_the_thesis_settings(ch3):
     # relationship'. No threshold in the thesis, so the noise's: the fall beyond 2 standard
     # errors of an SD from 200 repetitions and a rank trend beyond chance (numbers.md:
     # agree; rho is -0.76, which our former, untied -0.8 called 'differs')
-    claims = []
-    ch3._fig3_6_3_7(None, claims, 200, 0, ch3.THESIS_SETTINGS)
-    row = next(c for c in claims if c["claim"].endswith("(the 's')"))
+    row = _measured(ch3[1].fig3_6_3_7, 200, 0, THESIS_SETTINGS)["sd-falls-s"]
     assert row["verdict"] == "agree" and "standard errors" in row["ours"]
 
 
 def test_the_re_timed_letter_is_conditional_on_how_much_faster(ch3):
     # Fig. A.3(a), line 1358: 'a much shorter movement time', not given; the shape keeps
     # within twice the noise for mild re-timings and not for the 2 s -> 1 s we drew
-    sys.path.insert(0, str(TOOLS))
-    try:
-        import reproduce_appendix_a
-    finally:
-        sys.path.remove(str(TOOLS))
-    claims = []
-    reproduce_appendix_a._fig_a3(None, claims, 20, 0, {})
-    row = next(c for c in claims if c["claim"].startswith("Re-timed"))
+    from tools.thesis.appendix_a import fig_a3
+    from tools.thesis.appendix_a_claims import CLAIMS
+    from tools.thesis.claims import evaluate
+
+    got = {}
+    fig_a3(None, got, 20, 0, {})
+    row = evaluate(CLAIMS, got, strict=False)[0]
+    assert row["id"] == "retimed-shape"
     assert row["verdict"] == "conditional" and "within twice the noise from" in row["ours"]

@@ -1,6 +1,6 @@
 """From video, both generators: the verdict, the chapter 5 figures and claims, reruns.
 
-One small run of ``tools/reproduce_ch5.py`` (2 clips per condition and
+One small run of ``tools/thesis/ch5.py`` (2 clips per condition and
 generator, rendered, tracked, recognised with ``run_batch --jobs 2``) feeds
 every test here; ``make reproduce`` runs it with 10.
 """
@@ -13,10 +13,14 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-TOOLS = Path(__file__).resolve().parents[1] / "tools"
-sys.path.insert(0, str(TOOLS))
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
 
-import reproduce_ch5  # noqa: E402
+from tools.thesis import ch5 as reproduce_ch5  # noqa: E402
+from tools.thesis.ch5_batch import EXPECTED, GENERATORS  # noqa: E402
+from tools.thesis.ch5_claims import CLAIMS  # noqa: E402
+from tools.thesis.markdown import numbers_markdown  # noqa: E402
 
 pytestmark = pytest.mark.slow
 
@@ -30,9 +34,9 @@ def run(tmp_path_factory):
 
 def test_the_verdict_is_right_from_video_for_both_generators(run):
     folder, claims = run
-    for generator in reproduce_ch5.GENERATORS:
+    for generator in GENERATORS:
         table = pd.read_csv(folder / f"verdict_{generator}.csv").set_index("condition")
-        for condition, want in reproduce_ch5.EXPECTED.items():
+        for condition, want in EXPECTED.items():
             row = table.loc[condition]
             assert row.get(want, 0) / row.sum() >= 0.95, (generator, condition, dict(row))
         verdict = claims[claims["claim"].str.startswith(f"{generator} clips from video")]
@@ -43,7 +47,7 @@ def test_the_verdict_is_right_from_video_for_both_generators(run):
 
 def test_chapter5_figures_and_claims(run):
     folder, claims = run
-    for generator in reproduce_ch5.GENERATORS:
+    for generator in GENERATORS:
         report = folder / generator / "report"
         for name in ("aperture_profiles.png", "confidence_single.png", "confidence_all.png",
                      "condition_profiles.png", "report.html", "statistics.csv"):
@@ -54,7 +58,9 @@ def test_chapter5_figures_and_claims(run):
         assert claims["section"].str.contains(section, regex=False).any(), section
     assert claims["location"].str.contains("line").all()  # where the thesis says it
     assert (claims["measure"] != "").all()
-    assert len(claims) == 2 * 20
+    assert len(claims) == 2 * 20 == 2 * len(CLAIMS)
+    # one row per declared claim and generator, in the table's order
+    assert list(claims["id"]) == [c.id for c in CLAIMS] * 2
     # on the model's own clips nothing can be a plain agreement; independent ones can be
     mine = claims[claims["claim"].str.startswith("thesis")]
     assert len(mine) == 20 and (mine["verdict"] != "agree").all()
@@ -72,9 +78,7 @@ def test_chapter5_figures_and_claims(run):
     assert first["location"].str.contains("vs line 1125").all()
     assert first["at_thesis"].str.startswith("thesis inconsistent").all()
     # numbers.md: chapter 5's rows with the thesis location, measure and verdict columns
-    import reproduce_thesis
-
-    md = reproduce_thesis.numbers_markdown(
+    md = numbers_markdown(
         [dict(c, chapter="Chapter 5") for c in claims.to_dict("records")], [], [])
     assert "## Chapter 5" in md and "| claim | thesis location (line) |" in md
     assert "### Thesis claims (Chapter 5)" in md and "### Our own checks (Chapter 5" in md

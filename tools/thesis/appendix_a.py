@@ -1,7 +1,7 @@
 """Thesis appendix A: via-point selection and generalisation, Figs. A.1-A.3.
 
-``reproduce(out, *, trials, seed)`` writes the figures and returns the claims
-and a sensitivity table (see ``reproduce_common``).
+``reproduce(out, *, trials, seed)`` writes the figures and returns the claims of
+:data:`tools.thesis.appendix_a_claims.CLAIMS`, evaluated, and a sensitivity table.
 
 The thesis compares its three via-point criteria on "several repeated
 trials" (line 1339) of the trajectory of Fig. A.2, a curved movement whose
@@ -11,7 +11,7 @@ via-point, each followed by ``POST_MOVEMENT`` s of the hand at rest. Eq. A.1
 mixes a length unit with seconds; line 1324 gives its terms in m^2 s^-3, so
 metres are used, and the other units are tabulated. Both figures are computed
 at our settings and at the thesis's (its printed model,
-``reproduce_common.THESIS_SETTINGS``).
+:data:`tools.thesis.common.THESIS_SETTINGS`).
 """
 
 from __future__ import annotations
@@ -21,20 +21,6 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from reproduce_common import (
-    CONDITIONAL,
-    THESIS_SETTINGS,
-    Progress,
-    at_settings,
-    borderline,
-    ci95,
-    cite,
-    claim,
-    no_progress,
-    rng_for,
-    save,
-    sensitivity,
-)
 from scipy.stats import binomtest
 
 from minvar.plotting.viapoints import criteria_figure, curvature_figure, generalisation_figure
@@ -42,6 +28,18 @@ from minvar.reach import simulate_reach
 from minvar.similarity import path_distance
 from minvar.task import ReachTask, ViaPoint
 from minvar.viapoints import CRITERIA, compare_criteria, extract_via_points, letter_a, replay
+from tools.thesis.appendix_a_claims import CLAIMS
+from tools.thesis.claims import Measured, at_settings, evaluate
+from tools.thesis.common import (
+    THESIS_SETTINGS,
+    Progress,
+    borderline,
+    ci95,
+    no_progress,
+    rng_for,
+    save,
+)
+from tools.thesis.records import CONDITIONAL, sensitivity
 
 #: The movement of Figs. A.1-A.2 (m, s): a curved reach within a 0.30 + 0.30 m arm's reach.
 A2_TASK = ReachTask((-0.15, 0.30), (0.15, 0.30), 1.0, (ViaPoint((0.0, 0.42), fraction=0.4),))
@@ -95,7 +93,8 @@ def _paired(scores: pd.DataFrame, a: str, b: str, seed: int) -> tuple[float, tup
     return float(d.mean()), ci95(draws)
 
 
-def _fig_a1(out: Path | None, claims: list, seed: int, repeats: int, w: dict):
+def fig_a1(out: Path | None, got: dict, seed: int, repeats: int, w: dict):
+    """Fig. A.1: the three via-point criteria compared on repetitions of one movement."""
     trajs = observed(seed, repeats, w)
     comparison = compare_criteria(trajs, weights=w)
     if out is not None:
@@ -108,17 +107,14 @@ def _fig_a1(out: Path | None, claims: list, seed: int, repeats: int, w: dict):
            f"{POST_MOVEMENT * 1000:.0f} ms at rest, as Fig. A.2's trajectory; replayed by the "
            "model's expected path; eq. A.2 in the joint space of a 0.30 + 0.30 m arm, per "
            "sample; extrema below 5 % of a signal's range ignored")
-    claims.append(claim(
-        "A.1", "Acceleration extrema capture the original movement well", "captures well",
+    got["acceleration-captures"] = Measured(
         f"MSD per sample (1e-4 rad²): {msds}; points stored: {points}",
-        s.loc["acceleration", "msd_per_sample"] <= s.loc["speed", "msd_per_sample"],
-        location="Fig. A.1(a); line 1339",
-        measure="mean MSD per sample of the replay; agree if acceleration's is no worse "
-        "than speed's",
+        {"acceleration_msd": s.loc["acceleration", "msd_per_sample"],
+         "speed_msd": s.loc["speed", "msd_per_sample"]},
         note="the criteria follow the text (extrema of speed, acceleration, curvature); Fig. "
         "A.1's caption says 'zero-crossings of the derivatives of position, velocity and "
-        f"curvature'. {how}"))
-    claims.append(_best_claim(comparison, seed, how))
+        f"curvature'. {how}")
+    got["curvature-best"] = _best(comparison, seed, how)
     return trajs, comparison
 
 
@@ -142,7 +138,7 @@ def _wins(scores: pd.DataFrame, a: str, b: str) -> tuple[int, int, float]:
     return k, m, float(binomtest(k, m).pvalue) if m else 1.0
 
 
-def _best_claim(comparison, seed: int, how: str) -> dict:
+def _best(comparison, seed: int, how: str) -> Measured:
     scores = _scores(comparison.table)
     other = min((c for c in CRITERIA if c != "curvature"), key=lambda c: scores[c].mean())
     diff, ci = _paired(scores, "curvature", other, seed)
@@ -150,20 +146,14 @@ def _best_claim(comparison, seed: int, how: str) -> dict:
     near, total = _coincident(comparison.table, "curvature", "acceleration", steps=3)
     beats = {c: _wins(scores, "curvature", c) for c in CRITERIA if c != "curvature"}
     best = all(k > m / 2 and p < 0.05 for k, m, p in beats.values())
-    return claim(
-        "A.1", "Curvature extrema give the best MSD × number of via-points", "curvature best",
+    return Measured(
         "curvature's score lower than " + "; ".join(
             f"{c}'s on {k} of {m} repetitions (sign test p = {p:.2g})"
             for c, (k, m, p) in beats.items())
         + "; mean MSD/sample × points (1e-4 rad², Fig. A.1(b)'s bars): " + ", ".join(
             f"{c} {summary.loc[c, 'score'] * 1e4:.2f}" for c in CRITERIA)
         + f"; curvature minus {other}: {diff * 1e4:+.2f} (95 % CI {ci[0] * 1e4:+.2f} to "
-        f"{ci[1] * 1e4:+.2f})", best, location="Fig. A.1(b); lines 1337, 1339",
-        measure="score (MSD per sample × points stored, Fig. A.1(b)) of each criterion on "
-        f"each of {len(scores)} repetitions; 'generally ... the best' (line 1339) read per "
-        "repetition: agree if curvature scores lowest on most repetitions against each other "
-        "criterion, resolved by a two-sided sign test (p < 0.05); eq. A.1 in metres and "
-        "seconds (the unit table)",
+        f"{ci[1] * 1e4:+.2f})", {"curvature_wins_each": best, "repetitions": len(scores)},
         note=f"the bars' means rest on a few repetitions whose replay fails (one criterion "
         f"misses a turn), so the paired mean's CI is wide; the per-repetition count does not. "
         f"In metres hand speeds are under 1, so eq. A.1 is close to |acceleration| and the "
@@ -216,7 +206,8 @@ def _event_hits(t: np.ndarray, p: np.ndarray, unit: float = 1.0) -> int:
     return len(events(t, p)) - len(_event_misses(t, p, unit))
 
 
-def _fig_a2(out: Path | None, claims: list, trajs: list, comparison) -> None:
+def fig_a2(out: Path | None, got: dict, trajs: list, comparison) -> None:
+    """Fig. A.2: where the curvature via-points fall against the movement's landmarks."""
     t, p = trajs[0]
     rows = comparison.table
     idx = rows.loc[(rows["trajectory"] == 0) & (rows["criterion"] == "curvature"), "indices"]
@@ -231,29 +222,22 @@ def _fig_a2(out: Path | None, claims: list, trajs: list, comparison) -> None:
     missed = pd.Series([n for m in misses for n in m], dtype=object).value_counts()
     k = sum(h == len(marks) for h in every)
     p_k = float(binomtest(k, len(trajs)).pvalue)
-    claims.append(claim(
-        "A.1", "Curvature via-points fall at the movement's start, where its speed rises, at "
-        "its peak speed, at the start of the post-movement period and at its end",
-        "those five places",
+    got["curvature-landmarks"] = Measured(
         f"{len(idx)} points between the ends, at " + ", ".join(
             f"{t[i] * 1000:.0f}" for i in idx) + " ms on the drawn repetition (nearest point to "
         "each landmark: " + ", ".join(
             f"{n} at {marks[n] * 1000:.0f} ms, {near[n] * 1000:.0f} ms away" for n in marks)
         + f"); all three landmarks hit on {k} of {len(trajs)} repetitions (sign test against "
         f"one half p = {p_k:.2g})",
-        k > len(trajs) / 2 and p_k < 0.05, location="Fig. A.2; line 1351",
-        measure=f"every repetition of Fig. A.1's set, eq. A.1 in metres: each landmark (speed "
-        f"first / last above 5 % of its peak, the peak) needs a curvature point within "
-        f"{EVENT_TOLERANCE * 1000:.0f} ms; start and end are always stored; agree if all "
-        "three are hit on most repetitions, resolved by a two-sided sign test (p < 0.05; "
-        "the figure draws one)",
+        {"all_hit": k, "repetitions": len(trajs), "sign_test_p": p_k},
         note="landmarks missed, over the repetitions: " + (", ".join(
             f"{n} {k}" for n, k in missed.items()) or "none")
         + f". The drawn repetition stores {len(idx)} points between the ends; the thesis "
-        "names three. The unit table gives the landmarks hit with eq. A.1 in cm and mm."))
+        "names three. The unit table gives the landmarks hit with eq. A.1 in cm and mm.")
 
 
-def _fig_a3(out: Path | None, claims: list, n: int, seed: int, w: dict) -> None:
+def fig_a3(out: Path | None, got: dict, n: int, seed: int, w: dict) -> None:
+    """Fig. A.3: the 'a' re-timed and scaled."""
     rng = rng_for(seed, "figA_3")
     movement = letter_a(duration=A3_SLOW)
     faster = movement.retime(A3_FAST)
@@ -283,34 +267,22 @@ def _fig_a3(out: Path | None, claims: list, n: int, seed: int, w: dict) -> None:
          "path_distance_to_original_shape_m": [0.0, shape, scaled_err]}
     )
     save(out, "figA_3_generalisation", table=table)
-    claims += [
-        claim("A.2", "Re-timed (eq. A.3) the 'a' keeps its basic shape",
-              "shape retained, cruder when faster",
+    got["retimed-shape"] = Measured(
               f"{A3_SLOW * 1000:.0f} ms -> {A3_FAST * 1000:.0f} ms: expected paths at most "
-              f"{shape * 1000:.1f} mm apart (letter 10 cm high){sweep}", shape < 2 * scatter,
+              f"{shape * 1000:.1f} mm apart (letter 10 cm high){sweep}",
+              {"shape_m": shape, "scatter_m": scatter, "scatter_mm": scatter * 1000},
               verdict=CONDITIONAL if flips else None,
-              location="Fig. A.3(a); lines 1358, 1364",
-              measure="Hausdorff distance between the expected paths, against the repetition "
-              "noise: agree if below twice the median Hausdorff distance of a single "
-              f"repetition of the original from its mean path ({scatter * 1000:.1f} mm; the "
-              "thesis allows 'cruder', so twice what noise alone does); the re-timing is "
-              "swept, and the verdict holds only where it does not turn on it",
               note="the faster movement cuts the bowl's corners. The thesis gives neither "
               "the two movement times ('a much shorter movement time', line 1358) nor the "
               "'a's via-points, and the verdict turns on how much faster"
               + (f": it holds re-timed to {min(holds) * 1000:.0f} ms or slower, not faster"
                  if flips else "") + ". Our former 20 mm rule was our own number."
-              + borderline(shape, 2 * scatter)),
-        claim("A.2",
-              "Scaled by 1/2 (eqs. A.4-A.5) the 'a' is the same letter, half size",
-              "same shape, half size",
+              + borderline(shape, 2 * scatter))
+    got["scaled-half"] = Measured(
               f"expected path within {scaled_err * 1000:.2f} mm of the original scaled by 1/2",
-              scaled_err < 0.05 * A3_SCALE * 0.10, location="Fig. A.3(b); lines 1364-1366",
-              measure="largest distance between the scaled replay and the original's path "
-              "scaled by 1/2; agree within 5 % of the scaled letter's height",
+              {"scaled_error_m": scaled_err},
               note="not exact: signal-dependent noise scales with the movement but the "
-              "sensory noise does not"),
-    ]
+              "sensory noise does not")
 
 
 def reproduce(
@@ -318,6 +290,7 @@ def reproduce(
     *,
     trials: int | None = None,
     seed: int = 0,
+    quick: bool = False,
     repeats: int = REPEATS,
     progress: Progress = no_progress,
 ) -> list[dict]:
@@ -331,6 +304,8 @@ def reproduce(
         Repetitions drawn for Fig. A.3 (default 50).
     seed : int
         Base seed; each figure draws from its own stream.
+    quick : bool
+        Smoke run: one observed repetition in Fig. A.1 (``repeats`` is ignored).
     repeats : int
         Observed repetitions of the test movement in Fig. A.1 (at least 2).
     progress : callable
@@ -338,32 +313,17 @@ def reproduce(
     """
     out = Path(out)
     n = 50 if trials is None else int(trials)
-    claims = []
-
-    repeats = max(int(repeats), 2)
-    theirs: list[dict] = []
+    repeats = max(1 if quick else int(repeats), 2)
+    ours: dict[str, Measured] = {}
+    theirs: dict[str, Measured] = {}
     progress("figA_1")
-    trajs, comparison = _fig_a1(out, claims, seed, repeats, {})
-    their_trajs, their_comparison = _fig_a1(None, theirs, seed, repeats, THESIS_SETTINGS)
+    trajs, comparison = fig_a1(out, ours, seed, repeats, {})
+    their_trajs, their_comparison = fig_a1(None, theirs, seed, repeats, THESIS_SETTINGS)
     progress("figA_2")
-    _fig_a2(out, claims, trajs, comparison)
-    _fig_a2(None, theirs, their_trajs, their_comparison)
+    fig_a2(out, ours, trajs, comparison)
+    fig_a2(None, theirs, their_trajs, their_comparison)
     progress("figA_3")
-    _fig_a3(out, claims, n, seed, {})
-    _fig_a3(None, theirs, n, seed, THESIS_SETTINGS)
-    at_settings(claims, theirs)
-    cite(claims, CITES)
+    fig_a3(out, ours, n, seed, {})
+    fig_a3(None, theirs, n, seed, THESIS_SETTINGS)
+    claims = at_settings(evaluate(CLAIMS, ours), evaluate(CLAIMS, theirs))
     return claims + [_units_table(comparison, trajs, seed)]
-
-
-#: Claim prefix -> (thesis line, the thesis's words on it[, changes]).
-CITES = {
-    "Acceleration extrema capture": (1339, "maxima and minima of acceleration captures the "
-                                     "original trajectory well"),
-    "Curvature extrema give the best": (1339, "maxima and minima of curvature results in the "
-                                        "best replicated trajectory for the least number of "
-                                        "points"),
-    "Curvature via-points fall": (1351, "the start of the post-movement period"),
-    "Re-timed (eq. A.3)": (1364, "the basic same is retained"),
-    "Scaled by 1/2": (1364, "scaled by a factor of"),
-}

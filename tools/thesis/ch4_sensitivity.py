@@ -1,11 +1,11 @@
-"""Chapter 4's verdict rules, and how they depend on what the thesis leaves open.
+"""How chapter 4's verdicts depend on what the thesis leaves open.
 
-The rules (:func:`level_is_best`, :func:`u_minimum`) judge both the thesis
-claims of :mod:`reproduce_ch4` and the sensitivity tables here: every
-verdict that rests on geometry the thesis does not give (``tip_start``, the
-reading of its "20 cm"), recomputed from exact moments over the range the
-thesis allows, so a dependent row is reported as conditional with the range
-where it holds rather than at a value chosen after seeing the verdicts.
+The rules of :mod:`tools.thesis.ch4_rules` judge both the claims and the
+sensitivity tables here: every verdict that rests on geometry the thesis does not
+give (``tip_start``, the reading of its "20 cm"), recomputed from exact moments
+over the range the thesis allows, so a dependent row is reported as conditional
+with the range where it holds rather than at a value chosen after seeing the
+verdicts.
 """
 
 from __future__ import annotations
@@ -13,45 +13,12 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
-from reproduce_common import CONDITIONAL, sensitivity
 
 from minvar.grasp import GraspTask, plan_grasp
 from minvar.grasp_experiments import GraspExperiment
 from minvar.grasp_stats import end_distance, grasp_moments
-
-UM = 1e6
-#: Sampling error of an SD from the thesis's 500 repetitions, 1/sqrt(2 (n - 1)): a rise
-#: in the SD counts beyond twice this (the rule of chapter 4's line-834 row).
-SD_ERROR_500 = 1 / np.sqrt(2 * 499)
-
-
-def pct(x: float) -> str:
-    return f"{100 * x:.0f} %"
-
-
-def cm(x: float) -> str:
-    return f"{100 * x:g} cm"
-
-
-
-def level_is_best(heights, values) -> bool:
-    """Lowest at the level setting, falling toward it from below and rising above."""
-    h, v = np.asarray(heights), np.asarray(values)
-    i = int(np.argmin(v))
-    return bool(abs(h[i]) < 1e-9 and np.all(np.diff(v[: i + 1]) < 0)
-                and np.all(np.diff(v[i:]) > 0))
-
-
-def u_minimum(times, sd, upto: float = 0.85) -> tuple[float, bool]:
-    """Where the SD is lowest among via-point times <= ``upto``, and whether that is
-    an interior minimum (the SD rises on both sides). Where, only: an interior minimum
-    is not the thesis's claim (line 834 asks for a rise below 70 %), so no verdict
-    rests on it."""
-    t, y = np.asarray(times), np.asarray(sd)
-    keep = t <= upto + 1e-9
-    i = int(np.argmin(np.where(keep, y, np.inf)))
-    return float(t[i]), bool(0 < i < int(keep.sum()) - 1)
-
+from tools.thesis.ch4_rules import SD_ERROR_500, UM, cm, level_is_best, pct, u_minimum
+from tools.thesis.records import CONDITIONAL, sensitivity
 
 #: tip_start values tabulated: from just ahead of the wrist to on the target line.
 TIP_STARTS = (0.01, 0.02, 0.03, 0.04, 0.06)
@@ -152,11 +119,11 @@ def mark_conditional(claims: list[dict], dependent: dict[str, int], ours: dict,
                      theirs: dict) -> None:
     """Rows that depend on tip_start: say where they hold across the thesis's 0-6 cm, in
     each column from the tip_start table at that column's settings (``ours``, ``theirs``:
-    :func:`tip_start_table`; ``dependent``: claim prefix -> the table's column). A column
+    :func:`tip_start_table`; ``dependent``: claim id -> the table's column). A column
     is ``conditional`` only where the verdict flips within the range; where it holds at
     every tip_start or at none, the range is reported beside the verdict."""
     for c in claims:
-        col = next((k for p, k in dependent.items() if c["claim"].startswith(p)), None)
+        col = dependent.get(c["id"])
         if col is None:
             continue
         for key, table, whose in (("at_thesis", theirs, "the thesis's model and weights"),

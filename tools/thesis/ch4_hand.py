@@ -7,16 +7,16 @@ are planned and executed as independent chains, so the world covariance of a
 tip is the wrist's plus the tip's own about the wrist); the hand frame removes
 the wrist and leaves what the digit's via-point acts on. These rows give the
 same claims (lines 790 and 834) measured there, from the exact moments of the
-experiments :mod:`reproduce_ch4` runs.
+experiments :mod:`tools.thesis.ch4` runs.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from reproduce_ch4_sensitivity import SD_ERROR_500, UM, cm, level_is_best, pct
-from reproduce_common import claim
 
 from minvar.grasp_experiments import GraspExperiment
+from tools.thesis.ch4_rules import SD_ERROR_500, UM, cm, level_is_best, pct
+from tools.thesis.claims import Measured
 
 DIGITS = ("finger", "thumb")
 
@@ -32,7 +32,7 @@ def _sds(e: GraspExperiment, digit: str) -> dict[str, np.ndarray]:
     return {"x": x, "y": y, "total": np.hypot(x, y)}
 
 
-def level_claim(e: GraspExperiment) -> dict:
+def level(e: GraspExperiment) -> tuple[str, Measured]:
     """Line 790 in the hand frame: each digit's SD lowest with the via-points level."""
     h = e.values
     lvl = int(np.argmin(np.abs(h)))
@@ -42,17 +42,12 @@ def level_claim(e: GraspExperiment) -> dict:
     total = sds["finger"]["total"]
     near = total[[max(lvl - 1, 0), min(lvl + 1, len(h) - 1)]] / total[lvl] - 1
     shape = "monotone" if level_is_best(h, total) else "not monotone"
-    return claim(
-        "4.2.1.1", "Hand frame: digit end-point SD is lowest with the via-points level with "
-        "the targets", "lowest at 0 cm (level) for each digit, per axis as Fig. 4.3(c,d) plots it",
+    return "hand-sd-level", Measured(
         "; ".join(f"{d}: lowest x SD at {cm(lowest[(d, 'x')])}, y at {cm(lowest[(d, 'y')])}, "
                   f"total at {cm(lowest[(d, 'total')])}" for d in DIGITS)
         + f"; finger total {total[lvl] * UM:.2f} µm at level, neighbours "
-        f"{100 * near[0]:+.1f} % and {100 * near[1]:+.1f} %", per_axis,
-        location="Fig. 4.3(c,d); line 790 ('in the wrist target frame of reference')",
-        measure="exact end-point SD of each digit about the wrist (hand frame), per axis and "
-        "height; agree if each axis of each digit is lowest at level and monotone on both "
-        "sides (the rule of the world-frame row)",
+        f"{100 * near[0]:+.1f} % and {100 * near[1]:+.1f} %",
+        {"each_axis_level_is_best": per_axis},
         note=f"the total hand-frame SD is lowest at level ({shape} on both sides), its "
         f"nearer neighbour {100 * near.min():.1f} % higher against "
         f"{200 * SD_ERROR_500:.1f} %, two standard errors of an SD from 500 repetitions; per "
@@ -60,7 +55,7 @@ def level_claim(e: GraspExperiment) -> dict:
         "the finger in the hand frame, so its SDs are the finger's.")
 
 
-def timing_claim(e: GraspExperiment) -> dict:
+def timing(e: GraspExperiment) -> tuple[str, Measured]:
     """Line 834 in the hand frame: SD lowest near 70 %, higher for earlier via-points."""
     f = e.values
     sd = _sds(e, "finger")["total"]
@@ -69,15 +64,9 @@ def timing_claim(e: GraspExperiment) -> dict:
     rise = sd[below] / sd[i70] - 1
     upto = f <= 0.85 + 1e-9
     t_min = f[int(np.argmin(np.where(upto, sd, np.inf)))]
-    return claim(
-        "4.2.1.2", "Hand frame: end-point SD is lowest for a via-point near 70 % and rises "
-        "below it", "below approximately 70 %: an increase in SD",
+    return "hand-sd-70", Measured(
         f"SD about the wrist at 50-67.5 % is {100 * rise.min():+.1f} to {100 * rise.max():+.1f} "
         f"% of the SD at 70 % ({sd[i70] * UM:.2f} µm); lowest at {pct(t_min)}",
-        bool(np.all(rise > 0) and rise.max() > 2 * SD_ERROR_500),
-        location="Fig. 4.5(c,d); lines 834, 838",
-        measure="exact total finger end-point SD about the wrist (hand frame) for via-point "
-        "times 50-67.5 % against 70 %; agree if higher at every earlier time and resolvably "
-        f"so somewhere (beyond {200 * SD_ERROR_500:.1f} %, the world-frame row's rule)",
+        {"smallest_rise": rise.min(), "largest_rise": rise.max()},
         note="without the wrist's share the fall below 70 % is larger, not smaller: the "
         "digits' own scatter is lowest for a via-point near 60 %")

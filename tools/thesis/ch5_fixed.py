@@ -2,8 +2,9 @@
 
 The verdict and the likelihood rule (our own checks), the aperture profiles
 (Fig. 5.4(d)) and the reference model's own movement against the clips
-(Figs. 5.5-5.7). Part of :mod:`reproduce_ch5`, which gives each function a
-``Batch`` (one generator's clips, their summary and recognition reports).
+(Figs. 5.5-5.7). Part of :mod:`tools.thesis.ch5`, which gives each function a
+:class:`~tools.thesis.ch5_batch.Batch` (one generator's clips, their summary and
+recognition reports).
 """
 
 from __future__ import annotations
@@ -13,13 +14,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
-from reproduce_ch5_cites import where
-from reproduce_common import claim, save
 
 from perception.io.atomic import write_csv
+from tools.thesis.claims import Measured
+from tools.thesis.common import save
 
 if TYPE_CHECKING:
-    from reproduce_ch5 import Batch
+    from tools.thesis.ch5_batch import Batch
 
 CONDITIONS = ("normal", "delayed", "open-close-open", "reach")
 ABNORMAL = ("delayed", "open-close-open")
@@ -33,7 +34,7 @@ def _auc(pos: np.ndarray, neg: np.ndarray) -> float:
     return float(np.mean(diff > 0) + 0.5 * np.mean(diff == 0))
 
 
-def verdict_claims(b: Batch, out: Path) -> list[dict]:
+def verdicts(b: Batch, out: Path) -> list[tuple[str, Measured]]:
     """Accuracy per class, the confusion table and ROC AUC of familiarity."""
     s = b.summary[b.summary["status"] == "ok"]
     table = pd.crosstab(s["condition"], s["verdict"]).reindex(CONDITIONS).fillna(0).astype(int)
@@ -42,25 +43,23 @@ def verdict_claims(b: Batch, out: Path) -> list[dict]:
     for cls, conds in (("normal", ["normal"]), ("abnormal", list(ABNORMAL)), ("reach", ["reach"])):
         group = s[s["condition"].isin(conds)]
         right = (group["verdict"] == cls).mean() if len(group) else float("nan")
-        rows.append(claim(
-            "5.3 (verdict; issue 10)", f"{b.name} clips from video: {cls} clips get the "
-            f"verdict {cls}", ">= 95 % (issue 10 acceptance)",
-            f"{100 * right:.0f} % of {len(group)}", right >= 0.95,
-            "confusion table (rows: condition, columns: verdict): "
+        rows.append((f"verdict-{cls}", Measured(f"{100 * right:.0f} % of {len(group)}",
+        {"right": right},
+        note="confusion table (rows: condition, columns: verdict): "
             + "; ".join(f"{c}: " + ", ".join(f"{v} {n}" for v, n in table.loc[c].items() if n)
-                        for c in table.index) + ".", kind="own", **where("verdict")))
+                        for c in table.index) + ".")))
     grasp = s[s["condition"].isin(["normal", *ABNORMAL])]
     fam = grasp["familiarity"].to_numpy(float)
     auc = _auc(fam[grasp["condition"].to_numpy() == "normal"],
                fam[grasp["condition"].to_numpy() != "normal"])
-    rows.append(claim("5.3 (verdict; issue 10)", f"{b.name}: familiarity tells normal from "
-                      "abnormal grasps (ROC AUC)", "—", f"AUC {auc:.3f}", auc >= 0.95,
-                      "familiarity of the best model, normal clips against delayed and "
-                      "open-close-open ones; agreement: AUC >= 0.95.", kind="own", **where("auc")))
+    rows.append(("auc", Measured(f"AUC {auc:.3f}",
+        {"auc": auc},
+        note="familiarity of the best model, normal clips against delayed and "
+                      "open-close-open ones; agreement: AUC >= 0.95.")))
     return rows
 
 
-def likelihood_claim(b: Batch) -> dict:
+def likelihood(b: Batch) -> tuple[str, Measured]:
     """How far apart normal and abnormal grasps lie in log-likelihood."""
     def best_grasp_ll(d):
         return max(m["final_log_likelihood"] for m in d["models"] if m["kind"] == "grasp")
@@ -68,14 +67,12 @@ def likelihood_claim(b: Batch) -> dict:
     normal = np.array([best_grasp_ll(d) for d in b.by_condition("normal")])
     other = np.array([best_grasp_ll(d) for c in ABNORMAL for d in b.by_condition(c)])
     gap = float(normal.min() - other.max()) if len(normal) and len(other) else float("nan")
-    return claim("5.3 (likelihood rule)", f"{b.name}: the best grasp model's log-likelihood "
-                 "is higher for every normal clip than for every abnormal one", "—",
-                 f"lowest normal minus highest abnormal: {gap:.0f}", gap > 0,
-                 f"medians: normal {np.median(normal):.0f}, abnormal {np.median(other):.0f}.",
-                 kind="own", **where("likelihood"))
+    return ("likelihood", Measured(f"lowest normal minus highest abnormal: {gap:.0f}",
+        {"gap": gap},
+        note=f"medians: normal {np.median(normal):.0f}, abnormal {np.median(other):.0f}."))
 
 
-def aperture_claims(b: Batch, model: pd.DataFrame | None = None) -> list[dict]:
+def apertures(b: Batch, model: pd.DataFrame | None = None) -> list[tuple[str, Measured]]:
     """Fig. 5.4(d): normal's aperture like the model's; more variable for the other stimuli.
 
     ``model``: the reference model's own aperture profile (phase, mean;
@@ -92,27 +89,23 @@ def aperture_claims(b: Batch, model: pd.DataFrame | None = None) -> list[dict]:
     sd = {c: (float(by[c]["sd"].mean()), float(by[c]["sd"].max())) for c in ("normal", *ABNORMAL)
           if c in by}
     return [
-        claim("5.4.1, Fig. 5.4(d)", f"{b.name}: the normal grasp's aperture is like the model's",
-              "similar profiles", f"maximum {100 * mga_obs:.1f} cm at {100 * t_obs:.0f} % "
+        ("aperture", Measured(f"maximum {100 * mga_obs:.1f} cm at {100 * t_obs:.0f} % "
               f"(model {b.reference}: {100 * mga_model:.1f} cm at {100 * t_model:.0f} %)",
-              abs(mga_obs - mga_model) <= 0.02 and abs(t_obs - t_model) <= 0.1,
-              "agreement: maximum aperture within 2 cm and 10 % of the movement.",
-              **where("aperture")),
-        claim("5.4.1, Fig. 5.4(d)", f"{b.name}: aperture varies more for the abnormal grasps",
-              "variances greater for the non-natural grips",
-              "largest SD " + ", ".join(f"{c} {100 * v[1]:.2f} cm" for c, v in sd.items())
+        {"mga_gap_m": abs(mga_obs - mga_model), "time_gap": abs(t_obs - t_model)},
+        note="agreement: maximum aperture within 2 cm and 10 % of the movement.")),
+        ("aperture-sd", Measured(
+            "largest SD " + ", ".join(f"{c} {100 * v[1]:.2f} cm" for c, v in sd.items())
               + "; mean SD " + ", ".join(f"{c} {100 * v[0]:.2f} cm" for c, v in sd.items()),
-              all(sd[c][1] > sd["normal"][1] for c in ABNORMAL if c in sd),
-              "SD across clips over normalised movement time; agreement judged on the largest "
+        {"abnormal_above_normal": all(sd[c][1] > sd["normal"][1] for c in ABNORMAL if c in sd)},
+        note="SD across clips over normalised movement time; agreement judged on the largest "
               "(the widest band of the figure). A delayed grasp's closed digits vary little for "
               "half the movement, so its mean SD can be below normal's. A check of our stimuli, "
               "not of the model: line 1109 describes the human demonstrator's recordings, and "
-              "here the spread is the stimulus generator's.", kind="own",
-              **where("aperture sd")),
+              "here the spread is the stimulus generator's.")),
     ]
 
 
-def prediction_claim(b: Batch, recs: dict, inside: str) -> dict:
+def prediction(b: Batch, recs: dict, inside: str) -> tuple[str, Measured]:
     """Figs. 5.5-5.7: the normal model's own movement is close to normal grasps only."""
     err = {}
     for cond in ("normal", *ABNORMAL):
@@ -123,18 +116,14 @@ def prediction_claim(b: Batch, recs: dict, inside: str) -> dict:
             g_own = np.linalg.norm(own["finger"] - own["thumb"], axis=1)
             values.append(np.nanmean(np.abs(rec.observation.g - g_own)))
         err[cond] = float(np.median(values))
-    return claim(
-        "5.4.3, Figs. 5.5-5.7", f"{b.name}: the normal grasp model's own movement is close to "
-        "the normal demonstrations and far from the abnormal ones", "similar for normal; "
-        "large differences for the non-natural actions",
+    return ("prediction", Measured(
         "median |observed - model| aperture " + ", ".join(f"{c} {100 * v:.1f} cm"
                                                           for c, v in err.items()),
-        all(err[c] > 1.5 * err["normal"] for c in ABNORMAL),
-        f"model: {b.reference}, the reference normal model, as the thesis draws it (figures "
+        {"abnormal_beyond_1_5_normal": all(err[c] > 1.5 * err["normal"] for c in ABNORMAL)},
+        note=f"model: {b.reference}, the reference normal model, as the thesis draws it (figures "
         f"fig5_5-5_7_*_{b.name}.png): its noise-free movement from the clip's onset; "
         "agreement: abnormal > 1.5 x normal. Clips whose observed digit paths enter the "
-        f"object by more than 1 cm: {inside} (the stimulus generator's, not the figure's).",
-        **where("prediction"))
+        f"object by more than 1 cm: {inside} (the stimulus generator's, not the figure's)."))
 
 
 def prediction_figures(b: Batch, recs: dict, out: Path) -> str:
@@ -171,3 +160,4 @@ def prediction_figures(b: Batch, recs: dict, out: Path) -> str:
             inside.append((cond, d["clip"], depth < radius - 0.01))  # 1 cm through the surface
     n_in = {c: sum(x for cc, _, x in inside if cc == c) for c in ("normal", *ABNORMAL)}
     return ", ".join(f"{c}: {k} of {len(b.by_condition(c))}" for c, k in n_in.items())
+
