@@ -364,7 +364,7 @@ def _with_factors(item: BatchItem, found, source: str | None = None) -> BatchIte
     if item.condition is not None:
         given["condition"] = item.condition
     merged = merge_factors([("the manifest", given),
-                            (source or f"its file name ({NAME_FLAG})", found)], item.path)
+                            (source or f"its file name (`{NAME_FLAG}`)", found)], item.path)
     condition = merged.pop("condition", None)
     return dataclasses.replace(item, condition=condition or None,
                                factors=tuple(merged.items()))

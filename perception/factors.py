@@ -32,9 +32,10 @@ log = logging.getLogger(__name__)
 #: Columns of a long table taken as factors without being named (any case), where
 #: each is constant within every trial.
 DEFAULT_FACTORS = ("participant", "subject", "condition", "session", "block", "group")
-#: The flags that name factors, for messages.
-FACTOR_FLAG = "--factors"
-NAME_FLAG = "--factors-from-name"
+#: The fields that name factors (MocapImport's; the command line's --factors and
+#: --factors-from-name), named by errors.
+FACTOR_FLAG = "factors"
+NAME_FLAG = "factors_from_name"
 
 
 def factor_names(value) -> tuple[str, ...] | None:
@@ -109,8 +110,9 @@ def name_factors(pattern, name: str | os.PathLike) -> dict[str, str] | None:
     stem = Path(name).stem
     found = compiled.search(stem)
     if found is None:
-        log.warning("%s: %s %r does not match the file name %r: no factors from its name",
-                    name, NAME_FLAG, compiled.pattern, stem)
+        # a warning, not an error: no field to name, so in the command line's words
+        log.warning("%s: --factors-from-name %r does not match the file name %r: no factors "
+                    "from its name", name, compiled.pattern, stem)
         return None
     return {k: v for k, v in found.groupdict().items() if v is not None}
 

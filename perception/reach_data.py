@@ -168,10 +168,10 @@ class MarkerMap:
                     # which of them was meant is not ours to choose
                     raise InputError(f"{m!r} for the {role} matches {len(alike)} markers but "
                                      f"for case ({', '.join(map(repr, alike))}): name one "
-                                     "exactly", source, field="--markers")
+                                     "exactly", source, field="markers")
                 if m not in names:
                     raise InputError(f"no marker {m!r} for the {role} (the recording has "
-                                     f"{', '.join(sorted(names))})", source, field="--markers")
+                                     f"{', '.join(sorted(names))})", source, field="markers")
 
 
 @declared

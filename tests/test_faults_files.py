@@ -166,9 +166,9 @@ FILES = [
           ("substeps -3", _attr("models/g", "substeps", -3), "/models/g.substeps")]],
     # -- frame rates in headers
     _case("header of 0 frames/s, not read as 25", _avi_at_0, _read_video, "frame rate",
-          "no frame rate.*--fps"),
+          "no frame rate.*`fps`"),
     _case("header of 1000 frames/s", _mp4_at_1000, _read_video, "frame rate",
-          "claims 1000 frames/s.*--fps"),
+          "claims 1000 frames/s.*`fps`"),
 ]
 
 

@@ -66,7 +66,7 @@ def test_a_mapped_name_matching_two_markers_but_for_case_is_refused():
                          "WRIST": trial.markers["thumb"] + 0.06}, trial.rate, "m")
     with pytest.raises(InputError, match="'WRIST', 'Wrist'") as err:
         recording_reaches(trial, MarkerMap("thumb", "index", wrist="wrist"))
-    assert err.value.field == "--markers"
+    assert err.value.field == "markers"
 
 
 # -- landmarks: its output and its inputs -------------------------------------------------------

@@ -8,6 +8,7 @@ from collections import Counter
 from pathlib import Path
 
 from hammer_mv.cli.checks import cap_jobs, output_folder
+from hammer_mv.cli.flags import flag_text
 from hammer_mv.cli.options import add_recognition_options, load_repertoire, recognition_settings
 from hammer_mv.cli.recognize import add_figure_options
 from perception.batch import find_clips, run_batch
@@ -91,7 +92,7 @@ def run(args: argparse.Namespace) -> int:
             print(f"hammer-mv batch: warning: {line}", file=sys.stderr)
     why = unscored["reason"] if "reason" in unscored else unscored["error"]
     for clip, reason in zip(unscored["clip"], why):  # always: nothing dropped without a word
-        print(f"{clip}: not scored: {reason}", file=sys.stderr)
+        print(f"{clip}: not scored: {flag_text(str(reason))}", file=sys.stderr)
     if failed:
         print(f"hammer-mv batch: {failed} clip(s) failed ({failure_reasons(summary, items)}); "
               f"see {args.output / 'summary.csv'}", file=sys.stderr)
@@ -162,4 +163,4 @@ def failure_reasons(summary, items) -> str:
         reasons[reason.splitlines()[0]] += 1
     reason, count = reasons.most_common(1)[0]
     others = sum(reasons.values()) - count
-    return f"{count}: {reason}" + (f"; {others} other" if others else "")
+    return f"{count}: {flag_text(reason)}" + (f"; {others} other" if others else "")

@@ -27,7 +27,7 @@ from typing import Any
 from minvar.errors import LocatedError
 
 __all__ = ["FIELD_FLAGS", "FPS_HELP", "OWNER_FLAGS", "Setting", "add_settings",
-           "add_video_options", "as_flags", "field_flag"]
+           "add_video_options", "as_flags", "field_flag", "flag_text"]
 
 #: Help of ``--fps``; the recognition commands add what it means for pose files.
 FPS_HELP = ("true frame rate, frames/s (default: the file's own): for videos whose header is "
@@ -180,10 +180,16 @@ def as_flags(exc: BaseException) -> BaseException:
     if (flag is None and exc.path is None and len(exc.location) >= 2
             and exc.field == ".".join(exc.location)):
         flag = OWNER_FLAGS.get(tuple(exc.location[-2:]))
-    problem = _NAMED.sub(lambda m: FIELD_FLAGS.get(m[1], m[0]), exc.problem)
+    problem = flag_text(exc.problem)
     if flag is None and problem == exc.problem:
         return exc
     return type(exc)(problem, exc.path, field=flag or exc.field, location=exc.location)
+
+
+def flag_text(text: str) -> str:
+    """``text`` (a reason kept from a library error: a clip's, a trial's) with each field it
+    names in backquotes given as its flag, as :func:`as_flags` does for an error."""
+    return _NAMED.sub(lambda m: FIELD_FLAGS.get(m[1], m[0]), text)
 
 
 def add_video_options(p: argparse.ArgumentParser, *, fps: bool = True) -> None:

@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from hammer_mv.cli.flags import FPS_HELP, Setting, add_settings
+from hammer_mv.cli.flags import FPS_HELP, Setting, add_settings, flag_text
 from hammer_mv.cli.options import add_mocap_options, mocap_import
 from perception.io.pose import PoseImport
 from perception.landmarks import LandmarkParams
@@ -164,7 +164,7 @@ def run(args: argparse.Namespace) -> int:
         print(trial_summary(found.trials, len(movements) - len(missed), len(missed)),
               file=sys.stdout)
     for m in missed:  # always: none dropped
-        print(f"{m.trial}: not scored: {m.reason}", file=sys.stderr)
+        print(f"{m.trial}: not scored: {flag_text(m.reason)}", file=sys.stderr)
     return 1 if missed else 0
 
 

@@ -173,6 +173,7 @@ def _run_mocap(args: argparse.Namespace, path: Path) -> int:
     import dataclasses
     import traceback
 
+    from hammer_mv.cli.flags import flag_text
     from hammer_mv.cli.options import load_repertoire, mocap_import, recognition_settings
     from perception.batch import remove_stale_reports
     from perception.errors import HammerMVError
@@ -212,7 +213,7 @@ def _run_mocap(args: argparse.Namespace, path: Path) -> int:
         except OSError:
             raise  # the output folder's (full, read-only): the user's to fix, for every reach
         except HammerMVError as exc:  # this reach's (a scene that cannot be planned, ...)
-            why = f"failed: {exc.problem}"
+            why = f"failed: {flag_text(exc.problem)}"
         except Exception as exc:  # noqa: BLE001 - a bug on one reach must not take the rest
             traceback.print_exc()
             why = (f"failed: unexpected {type(exc).__name__} (a bug in hammer-mv; its "

@@ -47,7 +47,7 @@ LAYOUTS = {
     "motive": "an OptiTrack Motive CSV export (Format Version, ...)",
     "xyz-table": "a table whose header names X, Y and Z columns per marker (thumb_x, thumb_y, "
                  "thumb_z, ...)",
-    "headerless": "a table of numbers without a header, X Y Z per marker (named with --columns)",
+    "headerless": "a table of numbers without a header, X Y Z per marker (named with `columns`)",
     "c3d": "a C3D file",
 }
 #: The layouts read, in one line (for a message that a file is none of them).
@@ -209,20 +209,20 @@ def read_mocap(path: str | os.PathLike, *, rate: float | None = None, units: str
     if p.suffix.lower() not in MOCAP_SUFFIXES:
         raise InputError("expected a .c3d, .tsv, .txt or .csv motion-capture file", p)
     if units is not None:
-        units = check_unit(units, p, "--units")
+        units = check_unit(units, p, "units")
     if rate is not None:
-        rate = check_rate(rate, p, "--rate")
+        rate = check_rate(rate, p, "rate")
     source = os.fspath(path)
     factors = factor_names(factors)
     if factors and p.suffix.lower() == ".c3d":
-        raise InputError("a C3D file has no columns to read factors from: --factors names a "
-                         "table's columns (--factors-from-name reads them from file names)",
+        raise InputError("a C3D file has no columns to read factors from: `factors` names a "
+                         "table's columns (`factors_from_name` reads them from file names)",
                          p, field=FACTOR_FLAG)
     if p.suffix.lower() == ".c3d":
         if trial_column is not None or columns is not None:
-            raise InputError("a C3D file holds named points of one trial: --trial-column and "
-                             "--columns are for tables", p, field="--columns"
-                             if columns is not None else "--trial-column")
+            raise InputError("a C3D file holds named points of one trial: `trial_column` and "
+                             "`columns` are for tables", p, field="columns"
+                             if columns is not None else "trial_column")
         return read_c3d(p, source, rate, units)
     if p.stat().st_size > mocap_stream.STREAM_BYTES:
         trials = _streamed(p, source, rate, units, trial_column, time_column, columns, factors)
@@ -234,14 +234,14 @@ def read_mocap(path: str | os.PathLike, *, rate: float | None = None, units: str
     layout = _sniff(text)
     args = (p, source, text, rate, units, trial_column, time_column)
     if layout in ("qtm", "vicon-nexus", "motive") and columns is not None:
-        raise InputError(f"--columns names the markers of a table without a header; this is "
-                         f"{LAYOUTS[layout]}, which names its own", p, field="--columns")
+        raise InputError(f"`columns` names the markers of a table without a header; this is "
+                         f"{LAYOUTS[layout]}, which names its own", p, field="columns")
     cells = split(text.first, delimiter(text.first))
     headerless = bool(cells) and all(is_number(c) for c in cells if c)
     if factors and (layout in ("qtm", "vicon-nexus", "motive") or headerless):
         raise InputError(f"this is {LAYOUTS['headerless' if headerless else layout]}, with no "
-                         "columns to read factors from: --factors names the columns of a "
-                         "table whose header names X, Y and Z per marker (--factors-from-name "
+                         "columns to read factors from: `factors` names the columns of a "
+                         "table whose header names X, Y and Z per marker (`factors_from_name` "
                          "reads them from file names)", p, field=FACTOR_FLAG)
     if layout == "qtm":
         return read_qtm(*args)

@@ -74,7 +74,7 @@ def read_qtm(path: Path, source: str, text: TableText, rate, units, trial_column
     """
     if trial_column is not None:
         raise InputError("a Qualisys export holds one recording: it has no trial column",
-                         path, field="--trial-column")
+                         path, field="trial_column")
     lines = text.lines
     header: dict[str, list[str]] = {}
     skip = text.skip
@@ -103,7 +103,7 @@ def read_qtm(path: Path, source: str, text: TableText, rate, units, trial_column
     if header.get("FREQUENCY"):
         own_rate = (check_rate(header["FREQUENCY"][0], path, "FREQUENCY"), "FREQUENCY")
     elif rate is None:
-        raise InputError("no sampling rate: give it with --rate", path, field="FREQUENCY")
+        raise InputError("no sampling rate: give it with `rate`", path, field="FREQUENCY")
     groups = {m: tuple(f"{m} {a}" for a in "XYZ") for m in names}
     first = lines[skip].split("\t")[0].strip() if skip < len(lines) else ""
     titled = bool(first) and not re.fullmatch(r"[-+0-9.eE]+", first)

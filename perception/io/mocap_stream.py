@@ -120,7 +120,7 @@ def _checked_stream(path: Path, source: str, text: TableText, sep: str, rate, un
         return None
     names = list(first.columns)
     time_col = time_column_of(names, time_column, path, notes)
-    trial_col = _find_column(names, trial_column, _TRIAL, path, "--trial-column")
+    trial_col = _find_column(names, trial_column, _TRIAL, path, "trial_column")
     asked = list(factors or ())
     if trial_col is None or any(a not in names for a in asked):
         return None

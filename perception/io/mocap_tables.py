@@ -164,7 +164,7 @@ def trial_spans(ids, first_rows: np.ndarray, rows: int, trial_col: str,
             raise InputError(f"column {trial_col!r} does not number the trials: its "
                              f"{len(values)} values recur in {len(runs)} blocks ({first!r} at "
                              f"data rows {where}); name the column that numbers the trials "
-                             "with --trial-column", path, field=trial_col)
+                             "with `trial_column`", path, field=trial_col)
         raise InputError(f"trial {first} appears in {len(blocks)} separate blocks (data rows "
                          f"{where}): each trial needs an id of its own", path, field=trial_col)
     return [(f"-trial{v}", int(s), int(e)) for s, e, v in zip(starts, ends, runs)]
@@ -195,9 +195,9 @@ def _not_a_clock(df, time_col: str, t: np.ndarray, rows, skip: set, path: Path) 
     if others:
         which = "columns that increase" if len(others) > 1 else "a column that increases"
         what += (f"; {which}: {', '.join(map(repr, others[:5]))}: name the clock with "
-                 "--time-column NAME, or give --time-column none and --rate")
+                 "`time_column` NAME, or give `time_column` none and `rate`")
     else:
-        what += "; name the clock with --time-column NAME, or give --time-column none and --rate"
+        what += "; name the clock with `time_column` NAME, or give `time_column` none and `rate`"
     return InputError(what, path, field=time_col)
 
 
@@ -222,9 +222,9 @@ def _clock(df, time_col: str, rows, rate, own: tuple[float, str] | None, skip: s
     if integral and stated not in ("ms", "msec"):
         if rate is None:
             raise InputError(f"the time column {time_col!r} counts frames (whole numbers in "
-                             "steps of 1), not a clock in s or ms: give the rate with --rate "
+                             "steps of 1), not a clock in s or ms: give the rate with `rate` "
                              "(the frames are then timed frame / rate), or name the clock with "
-                             "--time-column NAME", path, field="--rate")
+                             "`time_column` NAME", path, field="rate")
         notes.append(f"time column {time_col!r} counts frames: the time is frame / {rate:g}")
         return [t / rate for t in times], rate
     step = float(np.median(steps)) if len(steps) else math.nan
@@ -235,7 +235,7 @@ def _clock(df, time_col: str, rows, rate, own: tuple[float, str] | None, skip: s
     if not math.isfinite(step):
         if rate is None:
             raise InputError("one sample per trial: give the sampling rate", path,
-                             field="--rate")
+                             field="rate")
         return times, rate
     own_rate = check_rate(round(1 / step, 6), path, time_col)
     if rate is None:
@@ -305,8 +305,8 @@ def table_trials(path: Path, source: str, df, groups, time_col, trial_col, rate,
             notes += more
         elif rate is None:
             raise InputError("the table has no time column: give the sampling rate "
-                             "(samples/s) with --rate, or name the time column with "
-                             "--time-column NAME", path, field="--rate")
+                             "(samples/s) with `rate`, or name the time column with "
+                             "`time_column` NAME", path, field="rate")
         times = [np.arange(len(r)) / rate for _, r in rows]
     else:
         skip = {c for cols in groups.values() for c in cols} | {trial_col}
@@ -332,12 +332,12 @@ def time_column_of(columns, time_column, path: Path, notes: list[str]):
         Gets a note when a time column is ignored.
     """
     if _no_clock(time_column):
-        found = _find_column(columns, None, TIME, path, "--time-column")
+        found = _find_column(columns, None, TIME, path, "time_column")
         if found is not None:
             notes.append(f"time column {found!r} ignored (--time-column none): the samples "
                          "are timed by the rate")
         return None
-    return _find_column(columns, time_column, TIME, path, "--time-column")
+    return _find_column(columns, time_column, TIME, path, "time_column")
 
 
 def read_xyz_table(path: Path, source: str, text: TableText, rate, units, trial_column,
@@ -356,9 +356,9 @@ def read_xyz_table(path: Path, source: str, text: TableText, rate, units, trial_
         As :func:`perception.io.mocap.read_mocap` takes them.
     """
     if columns is not None:
-        raise InputError("--columns names the markers of a table without a header row; this "
-                         f"one has a header ({text.first[:60]!r}): leave --columns out",
-                         path, field="--columns")
+        raise InputError("`columns` names the markers of a table without a header row; this "
+                         f"one has a header ({text.first[:60]!r}): leave `columns` out",
+                         path, field="columns")
     sep = delimiter(text.first)
     sep, mixed = _mixed_spaces(text, sep, path)
     check_header(split(text.first, sep), path)
@@ -367,7 +367,7 @@ def read_xyz_table(path: Path, source: str, text: TableText, rate, units, trial_
     names = list(df.columns)
     notes = list(text.notes) + (["decimal commas read"] if decimal == "," else []) + mixed
     time_col = time_column_of(names, time_column, path, notes)
-    trial_col = _find_column(names, trial_column, _TRIAL, path, "--trial-column")
+    trial_col = _find_column(names, trial_column, _TRIAL, path, "trial_column")
     groups = marker_columns([c for c in names if c not in (time_col, trial_col)
                              and c not in (factors or ())])
     if not groups:
@@ -420,13 +420,13 @@ def marker_list(columns, path: Path) -> list[str]:
         names = [str(c).strip() for c in columns]
     except TypeError:
         raise InputError(f"expected marker names, got {columns!r}", path,
-                         field="--columns") from None
+                         field="columns") from None
     if not names or not all(names):
         raise InputError(f"expected a marker name for every 3 columns, got {columns!r}", path,
-                         field="--columns")
+                         field="columns")
     repeated = sorted({n for n in names if names.count(n) > 1})
     if repeated:
-        raise InputError(f"marker {repeated[0]!r} named twice", path, field="--columns")
+        raise InputError(f"marker {repeated[0]!r} named twice", path, field="columns")
     return names
 
 
@@ -468,30 +468,30 @@ def read_headerless(path: Path, source: str, text: TableText, rate, units, trial
         per = ("X, Y, Z for each of " f"{width // 3} markers" if width % 3 == 0
                else "not a multiple of 3 (X, Y, Z per marker)")
         raise InputError(f"a table without a header row, {width} columns ({per}): name its "
-                         "markers in column order with --columns NAME,NAME,...", path,
-                         field="--columns")
+                         "markers in column order with `columns` NAME,NAME,...", path,
+                         field="columns")
     names = marker_list(columns, path)
     if 3 * len(names) == full:
         width = full
     if 3 * len(names) != width:
-        raise InputError(f"--columns names {len(names)} markers, {3 * len(names)} columns "
+        raise InputError(f"`columns` names {len(names)} markers, {3 * len(names)} columns "
                          f"(X, Y, Z each); the table has {width} columns", path,
-                         field="--columns")
+                         field="columns")
     if trial_column is not None:
         raise InputError("a table without a header row has no trial column to name", path,
-                         field="--trial-column")
+                         field="trial_column")
     if time_column is not None and not _no_clock(time_column):
         raise InputError(f"a table without a header row has no column {time_column!r}: its "
-                         "samples are timed by --rate", path, field="--time-column")
+                         "samples are timed by `rate`", path, field="time_column")
     if rate is None:
         raise InputError("a table without a header row has no time column: give the sampling "
-                         "rate (samples/s) with --rate", path, field="--rate")
+                         "rate (samples/s) with `rate`", path, field="rate")
     sep = delimiter(text.first)
     decimal = decimal_mark(text.lines[text.skip:], sep)
     df = load(path, text.raw, sep, text.skip, None, decimal)
     if df.shape[1] > width:
         raise InputError(f"a row has {df.shape[1]} fields; the first has {width}", path,
-                         field="--columns")
+                         field="columns")
     for k in range(df.shape[1], width):  # a last marker lost throughout: empty cells
         df[k] = np.nan
     df.columns = [f"{n} {a}" for n in names for a in "XYZ"]

@@ -192,10 +192,10 @@ def clock_rate(rate: float | None, own: float, path: Path, column: str,
     if rate is None:
         return own
     if abs(rate / own - 1) > RATE_TOLERANCE:
-        raise InputError(f"--rate {rate:g} disagrees with the time column {column!r} "
-                         f"({own:.6g} samples/s from {source}): leave --rate out, or give "
-                         "--time-column none to time the samples by --rate instead", path,
-                         field="--rate")
+        raise InputError(f"`rate` {rate:g} disagrees with the time column {column!r} "
+                         f"({own:.6g} samples/s from {source}): leave `rate` out, or give "
+                         "`time_column` none to time the samples by `rate` instead", path,
+                         field="rate")
     return rate
 
 

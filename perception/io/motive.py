@@ -70,7 +70,7 @@ def read_motive(path: Path, source: str, text: TableText, rate, units, trial_col
     """
     if trial_column is not None:
         raise InputError("a Motive export holds one take: it has no trial column", path,
-                         field="--trial-column")
+                         field="trial_column")
     lines = text.lines
     sep = delimiter(text.first)
     cells = split(text.first, sep)
@@ -127,8 +127,8 @@ def read_motive(path: Path, source: str, text: TableText, rate, units, trial_col
     if time_column is not None:
         if str(time_column).strip().lower() != "none":
             raise InputError(f"a Motive export's clock is its {axes[1]!r} column: leave "
-                             "--time-column out to use it, or give --time-column none",
-                             path, field="--time-column")
+                             "`time_column` out to use it, or give `time_column` none",
+                             path, field="time_column")
         if time_col is not None:
             notes.append(f"time column {time_col!r} ignored (--time-column none): the samples "
                          "are timed by the rate")
@@ -139,7 +139,7 @@ def read_motive(path: Path, source: str, text: TableText, rate, units, trial_col
             own_rate = (check_rate(meta[key], path, key.title()), key.title())
             break
     if own_rate is None and rate is None and time_col is None:
-        raise InputError("no frame rate in the export header: give it with --rate", path,
+        raise InputError("no frame rate in the export header: give it with `rate`", path,
                          field="Export Frame Rate")
     own_units = None
     stated = meta.get("length units")

@@ -271,15 +271,15 @@ def _video_rate(path: Path) -> float:
     if video is None:
         raise InputError(f"the pose file has no frame rate, and there is no video "
                          f"{_video_stem(path)}.mp4 (.avi, .mkv, .mov, .m4v) beside it: give it "
-                         "with --fps", path, field="--fps")
+                         "with `fps`", path, field="fps")
     from perception.io.video import FrameSource  # OpenCV only when there is a video
 
     try:
         source = FrameSource(video, prefetch=0, hash=False)
     except InputError as exc:
         raise InputError(f"the pose file has no frame rate, nor has its video {video.name}: "
-                         f"{exc.problem.removesuffix('; give the true rate with --fps')}; "
-                         "give it with --fps", path, field="--fps") from None
+                         f"{exc.problem.removesuffix('; give the true rate with `fps`')}; "
+                         "give it with `fps`", path, field="fps") from None
     source.close()
     return source.header.fps_nominal
 
@@ -455,12 +455,12 @@ def _pick_individual(ds, options: PoseImport, path: Path):
     names = [str(n) for n in ds["individuals"].values] if "individuals" in ds.dims else []
     if options.individual is not None:
         if options.individual not in names:
-            raise InputError(f"--individual {options.individual!r}: not in the file "
+            raise InputError(f"`individual` {options.individual!r}: not in the file "
                              f"(individuals: {', '.join(names) or 'none'})", path)
         return ds.sel(individuals=options.individual)
     if len(names) > 1:
         raise InputError(f"the file holds {len(names)} individuals ({', '.join(names)}): "
-                         "choose one with --individual", path)
+                         "choose one with `individual`", path)
     return ds.isel(individuals=0) if names else ds
 
 
@@ -501,7 +501,7 @@ def _marker_arrays(ds, options: PoseImport, path: Path) -> tuple[np.ndarray, np.
     if missing:
         raise InputError(f"keypoint {options.keypoint(missing[0])!r} (for {missing[0]}) is not "
                          f"in the file (keypoints: {', '.join(names)}); map the markers with "
-                         "--keypoints thumb=NAME finger=NAME wrist=NAME object=NAME", path)
+                         "`keypoints` thumb=NAME finger=NAME wrist=NAME object=NAME", path)
     pos = ds["position"].transpose("time", "keypoints", "space")
     if pos.sizes["space"] != 2:
         raise InputError(f"expected 2-D poses (x, y), got {pos.sizes['space']} coordinates",

@@ -83,10 +83,10 @@ def read_vicon(path: Path, source: str, text: TableText, rate, units, trial_colu
     """
     if trial_column is not None:
         raise InputError("a Vicon Nexus export holds one trial: it has no trial column", path,
-                         field="--trial-column")
+                         field="trial_column")
     if time_column is not None and str(time_column).strip().lower() != "none":
         raise InputError("a Vicon Nexus export has no time column: its frames are timed by "
-                         "the Trajectories block's rate", path, field="--time-column")
+                         "the Trajectories block's rate", path, field="time_column")
     lines = text.all_lines()
     blocks = _blocks(lines, text.skip)
     found = [i for title, i in blocks if title == "Trajectories"]

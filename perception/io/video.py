@@ -140,8 +140,8 @@ class FrameSource(capture.Source):
         self.prefetch = int(prefetch)
         self.keep_truncated = bool(keep_truncated)
         if fps is not None and not (math.isfinite(fps) and 0 < fps <= MAX_FPS):
-            raise InputError(f"--fps: expected a frame rate in (0, {MAX_FPS:g}] frames/s, "
-                             f"got {fps!r}")
+            raise InputError(f"expected a frame rate in (0, {MAX_FPS:g}] frames/s, "
+                             f"got {fps!r}", field="fps")
         self.fps_override = fps
         if not self.path.exists():
             raise InputError("no such file", self.path)
@@ -237,7 +237,7 @@ class FrameSource(capture.Source):
             else:
                 problem = (f"the container claims {fps:g} frames/s, more than this believes "
                            f"of a header (below {MAX_FPS:g})")
-            raise InputError(f"{problem}; give the true rate with --fps", self.path,
+            raise InputError(f"{problem}; give the true rate with `fps`", self.path,
                              field="frame rate")
 
     def _check_count(self) -> None:
@@ -249,7 +249,7 @@ class FrameSource(capture.Source):
             if not self.keep_truncated:
                 raise InputError(
                     f"truncated or corrupt video: decoded {self.n_decoded} of the {claimed} "
-                    "frames its header claims (--keep-truncated uses the decoded frames)",
+                    "frames its header claims (`keep_truncated` uses the decoded frames)",
                     self.path)
             logger.warning("%s: decoded %d of the %d frames the header claims; keeping them "
                            "(--keep-truncated)", self.path, self.n_decoded, claimed)
