@@ -13,6 +13,7 @@ from __future__ import annotations
 import importlib
 import math
 import pkgutil
+import typing
 
 import pytest
 
@@ -89,3 +90,109 @@ def test_a_value_outside_a_declared_range_is_refused_naming_the_field(cls, field
     message = str(caught.value)
     assert isinstance(caught.value, ValueError)
     assert "\n" not in message and f"{cls.__name__}.{field}" in message, message
+
+
+# -- the same on the command line: every flag that sets a declared field ------------------
+
+def _flag_bounds(info) -> list[tuple[str, float]]:
+    """A field's bounds, also those inside an optional's ``Annotated`` (``X | None``)."""
+    found = _bounds(info)
+
+    def walk(kind):
+        for arg in typing.get_args(kind):
+            for meta in getattr(arg, "__metadata__", ()):
+                for m in [meta, *getattr(meta, "metadata", [])]:
+                    found.extend((op, getattr(m, op)) for op in ("gt", "ge", "lt", "le")
+                                 if getattr(m, op, None) is not None)
+            walk(arg)
+
+    walk(info.annotation)
+    return sorted(set(found))
+
+
+#: Values the declarations of fields that are not numbers refuse (an empty name, a
+#: mapping that is no ROLE=NAME pair, a name twice, a pattern that does not compile).
+NOT_NUMBERS = {"keypoints": ["thumb"], "markers": ["thumb", "thumb=a", "thumb=a finger=a"],
+               "columns": [","], "factors": [",", "a,a"], "factors_from_name": ["(", "P1"]}
+#: Values a flag gives a meaning of its own (``--cutoff 0``: no low-pass filter).
+MEANT = {("--cutoff", "0")}
+
+
+def _flag_values(setting) -> list[str]:
+    """What to type after ``setting``'s flag: just past each declared bound, NaN, a word
+    for a number; a word that is no choice; the refused values of :data:`NOT_NUMBERS`."""
+    from hammer_mv.cli.flags import _plain
+
+    info = setting.info()
+    kind = _plain(info.annotation)
+    if typing.get_origin(kind) is typing.Literal:
+        return ["no-such-choice"]
+    if kind not in (int, float):
+        return NOT_NUMBERS.get(setting.field, [])
+    values = []
+    for op, bound in _flag_bounds(info):
+        if op in ("gt", "lt"):
+            values.append(bound)
+        else:
+            step = 1 if kind is int else max(abs(bound), 1.0) * 1e-3
+            values.append(bound - step if op == "ge" else bound + step)
+    words = [f"{v:g}" if isinstance(v, float) else str(v) for v in values]
+    return [w for w in [*words, "nan", "x"] if (setting.name, w) not in MEANT]
+
+
+def _commands():
+    from hammer_mv.cli import landmarks, options
+
+    recognition = (*options.RECOGNITION, *options.POSE, *options.MOCAP, *options.FACTORS)
+    yield "recognize", "x.tracks.h5", "out", recognition, options.recognition_settings
+    yield "batch", "clips", "out", recognition, options.recognition_settings
+    yield ("landmarks", "x.csv", "out.csv",
+           (*landmarks.DEFINITIONS, *landmarks.SCALE, *options.MOCAP, *options.FACTORS),
+           landmarks.landmark_settings)
+
+
+def _flag_cases():
+    for command, source, out, settings, assemble in _commands():
+        for setting in settings:
+            for value in _flag_values(setting):
+                yield pytest.param(command, [source, "-o", out, *setting.name.split(),
+                                             *value.split()], setting.name, assemble,
+                                   id=f"{command} {setting.name} {value}")
+
+
+FLAG_CASES = list(_flag_cases())
+
+
+def test_every_declared_field_a_flag_sets_is_generated():
+    flags = {(case.values[0], case.values[2]) for case in FLAG_CASES}
+    for command in ("recognize", "batch", "landmarks"):
+        named = {flag for c, flag in flags if c == command}
+        assert {"--px-per-m", "--object-diameter", "--object-size", "--rate", "--fps",
+                "--markers", "--factors-from-name"} <= named, command
+    assert {"--w-g", "--filter-gain", "--pcutoff", "--rule", "--units"} <= {
+        flag for c, flag in flags if c == "recognize"}
+    assert {"--threshold", "--hold", "--cutoff", "--speed"} <= {
+        flag for c, flag in flags if c == "landmarks"}
+    assert len(FLAG_CASES) > 100
+
+
+@pytest.mark.parametrize(("command", "argv", "flag", "assemble"), FLAG_CASES)
+def test_an_invalid_flag_value_is_one_line_naming_the_flag_exit_2(command, argv, flag, assemble,
+                                                                   capsys):
+    """What ``main`` does with the value, without running the command: the parser, then the
+    settings the command builds from the arguments, then the line ``main`` prints."""
+    from hammer_mv.cli import build_parser, error_line
+    from perception.errors import HammerMVError
+
+    try:
+        args = build_parser(command).parse_args([command, *argv])
+    except SystemExit as exc:  # refused by the parser (a word for a number, no choice)
+        assert exc.code == 2
+        line = capsys.readouterr().err.strip()
+    else:
+        with pytest.raises(HammerMVError) as caught:  # main's exit 2
+            assemble(args)
+        line = error_line(command, caught.value)
+    assert "\n" not in line and flag in line, line
+    assert line.startswith((f"hammer-mv {command}: error: {flag}: ",
+                            f"hammer-mv {command}: error: argument {flag}: "))

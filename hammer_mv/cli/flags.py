@@ -179,7 +179,9 @@ def as_flags(exc: BaseException) -> BaseException:
     flag = FIELD_FLAGS.get(exc.field) if exc.field else None
     if (flag is None and exc.path is None and len(exc.location) >= 2
             and exc.field == ".".join(exc.location)):
-        flag = OWNER_FLAGS.get(tuple(exc.location[-2:]))
+        # the class's own flag, else the command's flag of a field of that name (one
+        # value set in two classes: --fps sets PoseImport's and RecognitionSettings')
+        flag = OWNER_FLAGS.get(tuple(exc.location[-2:]), FIELD_FLAGS.get(exc.location[-1]))
     problem = flag_text(exc.problem)
     if flag is None and problem == exc.problem:
         return exc
