@@ -31,8 +31,6 @@ from perception.recognition.repertoire import Repertoire
 from perception.recognition.rules import VerdictRules
 from perception.recordings import MocapImport
 
-_OBSERVE = ObserveParams()
-
 #: The recognition flags of recognize, batch and watch, each a declared field.
 RECOGNITION = (
     Setting(HammerParams, "rule", "rule that picks the winner (default: {default}); the "
@@ -55,26 +53,23 @@ RECOGNITION = (
 )
 
 
-def _pose_settings(fps_help: str) -> tuple[Setting, ...]:
-    # the flags that leave a field unset (None) so that a --pose-config's value applies
-    return (
-        Setting(PoseImport, "keypoints", "which keypoint is which marker: thumb=NAME "
-                "finger=NAME wrist=NAME object=NAME (markers left out take the keypoint of "
-                "their own name)", default=None, nargs="+", metavar="MARKER=NAME"),
-        Setting(PoseImport, "pcutoff", "points below this likelihood count as lost (default: "
-                "{default}, DeepLabCut's)", default=None, metavar="P"),
-        Setting(PoseImport, "individual", "the individual to score in a multi-individual file",
-                metavar="NAME"),
-        Setting(PoseImport, "fps", fps_help, metavar="F"),
-        Setting(PoseImport, "object_diameter_px", "the object's apparent diameter in pixels: "
-                "sets the metric scale of a pose file (or give --px-per-m)", metavar="D"),
-    )
-
-
 #: The pose options; ``--pose-config`` (a file, no field) goes between the first two.
-POSE = _pose_settings(FPS_HELP + "; a pose file that carries none (DeepLabCut, SLEAP "
-                      "analysis, Lightning Pose) takes the rate of the video of its name "
-                      "beside it, else needs this")
+#: ``--keypoints`` and ``--pcutoff`` default to None, "not given", so that a
+#: ``--pose-config``'s value applies.
+POSE = (
+    Setting(PoseImport, "keypoints", "which keypoint is which marker: thumb=NAME finger=NAME "
+            "wrist=NAME object=NAME (markers left out take the keypoint of their own name)",
+            default=None, nargs="+", metavar="MARKER=NAME"),
+    Setting(PoseImport, "pcutoff", "points below this likelihood count as lost (default: "
+            "{default}, DeepLabCut's)", default=None, metavar="P"),
+    Setting(PoseImport, "individual", "the individual to score in a multi-individual file",
+            metavar="NAME"),
+    Setting(PoseImport, "fps", FPS_HELP + "; a pose file that carries none (DeepLabCut, SLEAP "
+            "analysis, Lightning Pose) takes the rate of the video of its name beside it, else "
+            "needs this", metavar="F"),
+    Setting(PoseImport, "object_diameter_px", "the object's apparent diameter in pixels: sets "
+            "the metric scale of a pose file (or give --px-per-m)", metavar="D"),
+)
 
 
 def _names(text: str) -> tuple[str, ...]:
