@@ -34,10 +34,7 @@ import numpy as np
 
 from . import _kernel
 from ._kernel import KernelUnavailableError
-from .moments import (
-    Moments,
-    estimation_error_covariance,  # noqa: F401  # only until planning.py moves
-)
+from .moments import Moments
 from .moments import mean_states as _mean_states
 from .problem import LQGProblem
 

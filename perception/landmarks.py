@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import functools
 import math
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, NamedTuple
 
 import numpy as np
 from pydantic import Field
@@ -40,9 +40,10 @@ from perception.validation import Int, Share, declared
 if TYPE_CHECKING:
     from perception.observation import Observation
 
-__all__ = ["MODEL_SPAN_FRACTION", "OK", "LandmarkParams", "Landmarks", "count_peaks", "longest_gap",
-           "model_landmarks", "movement_bounds", "movement_landmarks", "movement_time",
-           "observed_landmarks", "speed_bound", "wrist_movement_time"]
+__all__ = ["MODEL_SPAN_FRACTION", "OK", "LandmarkParams", "Landmarks", "MeasuredPaths",
+           "count_peaks", "longest_gap", "model_landmarks", "movement_bounds",
+           "movement_landmarks", "movement_time", "observed_landmarks", "speed_bound",
+           "wrist_movement_time"]
 
 
 #: The wrist covers the middle 80 % of its path (10 % to 90 %) in this
@@ -348,6 +349,31 @@ def longest_gap(time: np.ndarray, values: np.ndarray) -> float:
     if not len(ts):
         return float(time[-1] - time[0])
     return float(np.diff(np.r_[time[0], ts, time[-1]]).max())
+
+
+class MeasuredPaths(NamedTuple):
+    """A movement's transport and aperture measured on better data than its tracks hold
+    (a 3D recording's own marker paths): its landmarks are measured on them.
+
+    Attributes
+    ----------
+    time : (N,) array
+        Times on the tracks' clock, s.
+    transport : (N, D) array
+        The transport point's path, m.
+    aperture : (N,) array
+        The grip aperture, m.
+    bounds : (int, int)
+        The movement's onset and end rows (:func:`movement_landmarks`).
+    clock_offset : float
+        The recording's clock minus the tracks', s (its ``time_origin``).
+    """
+
+    time: np.ndarray
+    transport: np.ndarray
+    aperture: np.ndarray
+    bounds: tuple[int, int]
+    clock_offset: float = 0.0
 
 
 def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.ndarray,

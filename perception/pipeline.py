@@ -29,17 +29,22 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from perception.errors import InputError, PlanningError
 from perception.io.mocap import is_mocap_file
 from perception.io.pose import pose_output
 from perception.io.tracks import Tracks, tracks_path_for
+from perception.landmarks import MeasuredPaths, movement_landmarks
 from perception.observation import ObserveParams, observe
 from perception.provenance import code_digest
-from perception.recognition.engine import HammerParams, recognize
+from perception.recognition.engine import HammerParams, score_clip
+from perception.recognition.evidence import clip_landmarks, judged_models, movement_evidence
 from perception.recognition.models import SceneSpec
 from perception.recognition.repertoire import PlanCache, Repertoire
 from perception.recognition.result import Recognition
-from perception.recognition.rules import VerdictRules
+from perception.recognition.rules import VerdictRules, judge
+from perception.recognition.verdict import misfit
 
 if TYPE_CHECKING:  # the tracker (OpenCV) and movement are imported only when needed
     from perception.io.frame_sample import FrameSample
@@ -341,8 +346,15 @@ def _tracker_attrs(setup: TrackingSetup | None) -> dict:
 def recognize_tracks(tracks: Tracks, repertoire: Repertoire,
                      settings: RecognitionSettings | None = None, *, clip: str | None = None,
                      source: str | os.PathLike | None = None,
-                     plan_cache: PlanCache | None = None) -> Recognition:
-    """Observe tracks, plan the models for their scene and recognise the movement.
+                     plan_cache: PlanCache | None = None,
+                     paths: MeasuredPaths | None = None) -> Recognition:
+    """Observe tracks, bring them to the repertoire's scale, score every model and judge.
+
+    One planning pass (the repertoire's reference scene, with the clip's
+    object size), one scoring pass of every model (the verdict's and the
+    winner's), one of the transport alone (the digits held closed, against
+    the reach models), and the verdict judged once
+    (:mod:`perception.recognition.evidence`).
 
     Parameters
     ----------
@@ -358,6 +370,10 @@ def recognize_tracks(tracks: Tracks, repertoire: Repertoire,
         The file the user gave, named in errors (default: the clip's name).
     plan_cache : PlanCache, optional
         Models re-planned for a scene, shared with other processes.
+    paths : MeasuredPaths, optional
+        The movement's transport and aperture on better data than the tracks
+        (a motion-capture reach's 3D paths): its landmarks are measured on
+        them, and its clock is the recording's.
 
     Raises
     ------
@@ -366,15 +382,16 @@ def recognize_tracks(tracks: Tracks, repertoire: Repertoire,
     PlanningError
         Their scene cannot be planned (out of the models' reach: often a wrong scale).
     """
-    from perception.recognition.shape import is_mirrored
+    from perception.recognition.shape import is_mirrored, opens
     from perception.settling import settle_start
 
     settings = RecognitionSettings() if settings is None else settings
+    rules = settings.rules
     try:
         # a clip that does not start still is scored from the scene its data give
         tracks, settled = settle_start(tracks, settings.observe, clip=clip)
         obs = observe(tracks, settings.observe, clip=clip)
-        mirrored = is_mirrored(obs, settings.rules)
+        mirrored = is_mirrored(obs, rules)
         if mirrored:  # the other hand, or the camera on the other side: score its mirror image
             obs = observe(tracks, dataclasses.replace(settings.observe,
                                                       mirror=not settings.observe.mirror),
@@ -386,21 +403,39 @@ def recognize_tracks(tracks: Tracks, repertoire: Repertoire,
         raise type(exc)(exc.problem, source, field=exc.field) from None
     # brought to the reference scale first: a clip that cannot be judged is
     # refused before its scene is planned
-    shape_obs, norm = _canonical(obs, repertoire, source, settings.rules)
+    scored_obs, norm = _canonical(obs, repertoire, source, rules)
     try:
-        models = repertoire.for_scene(SceneSpec.of(obs), cache=plan_cache,
+        models = repertoire.for_scene(SceneSpec.of(scored_obs), cache=plan_cache,
                                       threads=settings.planning_threads)
     except PlanningError as exc:  # the scene, not the software: name the clip and the scale
         raise PlanningError(f"{exc.problem} (check the scale: --px-per-m, --object-diameter)",
                             source or obs.clip, field=exc.field) from None
-    rec = _scored(obs, models, repertoire, settings.hammer, settings.rules)
-    shape, transport = _shape_pass(shape_obs, repertoire, settings, plan_cache)
-    return dataclasses.replace(rec, shape=shape, normalisation=norm,
-                               transport_familiarity=transport, mirrored=mirrored,
-                               notes=(*obs.notes, *((settled,) if settled else ())),
-                               # the tracks' clock at the observation's zero (both end
-                               # on the last row: settling only trims the first)
-                               time_origin=float(tracks.time[-1] - obs.clip_time[-1]))
+    # the clip's own tracking noise, where it exceeds what the rule assumes
+    hammer = dataclasses.replace(settings.hammer,
+                                 obs_sd=max(settings.hammer.obs_sd, scored_obs.noise))
+    scores = score_clip(scored_obs, models, hammer)
+    judged = judged_models(scores.kinds, "grasp" if opens(scored_obs, rules) else "reach")
+    models, familiarity = _calibrated(repertoire, models, scores, judged, scored_obs.dt)
+    transport = _transport_familiarity(scored_obs, models, repertoire, hammer)
+    # the tracks' clock at the observation's zero (both end on the last row:
+    # settling only trims the first)
+    shift = float(tracks.time[-1] - obs.clip_time[-1])
+    measured = None if paths is None else movement_landmarks(
+        paths.time - shift, paths.transport, paths.aperture, rules.landmarks,
+        bounds=paths.bounds)
+    landmarks = clip_landmarks(obs, models, scores.log_likelihood[:, -1], rules, measured)
+    share = scores.scored[list(judged)].sum(axis=1).max() / max(scores.scored.shape[1] - 1, 1)
+    evidence = movement_evidence(
+        obs, [scores.kinds[i] for i in judged], scores.log_likelihood[judged, -1],
+        familiarity[list(judged)], landmarks, transport, float(share))
+    return Recognition(
+        clip=obs.clip, time=scored_obs.time / norm.time_scale, frame=scored_obs.frame,
+        **{**scores._asdict(), "familiarity": familiarity}, observation=obs, models=models,
+        rules=rules, scored_observation=scored_obs, normalisation=norm, judged=judged,
+        evidence=evidence, decision=judge(evidence, rules), landmarks=landmarks,
+        transport_familiarity=transport, mirrored=mirrored,
+        notes=(*obs.notes, *((settled,) if settled else ())),
+        time_origin=shift + (0.0 if paths is None else paths.clock_offset))
 
 
 def _canonical(obs, repertoire: Repertoire, source, rules: VerdictRules):
@@ -419,46 +454,32 @@ def _canonical(obs, repertoire: Repertoire, source, rules: VerdictRules):
         raise type(exc)(exc.problem, source or obs.clip, field=exc.field) from None
 
 
-def _shape_pass(shape_obs, repertoire: Repertoire, settings: RecognitionSettings,
-                plan_cache: PlanCache | None) -> tuple[Recognition, float]:
-    """The demonstration at the reference scale, scored there: the verdict.
+def _calibrated(repertoire: Repertoire, models: list, scores, among, frame_period: float):
+    """The models and their familiarities, the best of ``among`` calibrated now if it has
+    no calibration yet (the default repertoire calibrates only the models a verdict rests
+    on): familiarity is read off it."""
+    best = scores.best(among)
+    familiarity = scores.familiarity.copy()
+    if np.isfinite(familiarity[best]):
+        return models, familiarity
+    models = repertoire.calibrated(models, best)
+    fit = misfit(scores.mahalanobis, scores.scored)
+    familiarity[best] = models[best].calibration.familiarity(float(fit[best]), frame_period)
+    return models, familiarity
 
-    See :mod:`perception.recognition.shape`. It is scored against the
-    repertoire's grasp models if its grip opens as a grasp's must
-    (:func:`~perception.recognition.shape.opens`), else against its reach
-    models. Also the familiarity of its transport alone (digits held
-    closed) to the best reach model: NaN without reach models.
-    """
-    from perception.recognition.shape import closed_hand, opens
 
-    scene = SceneSpec.of(shape_obs)
-    every = repertoire.for_scene(scene, cache=plan_cache, threads=settings.planning_threads)
-    kind = "grasp" if opens(shape_obs, settings.rules) else "reach"
-    models = [m for m in every if m.kind == kind] or every
-    # the clip's own tracking noise, where it exceeds what the rule assumes
-    hammer = dataclasses.replace(settings.hammer,
-                                 obs_sd=max(settings.hammer.obs_sd, shape_obs.noise))
-    shape = _scored(shape_obs, models, repertoire, hammer, settings.rules)
-    reach = [m for m in every if m.kind == "reach"]
+def _transport_familiarity(obs, models: list, repertoire: Repertoire, hammer: HammerParams
+                           ) -> float:
+    """The familiarity of the transport alone (the digits held closed at their rest place)
+    to the best reach model: NaN without reach models."""
+    from perception.recognition.shape import closed_hand
+
+    reach = [m for m in models if m.kind == "reach"]
     if not reach:
-        return shape, float("nan")
-    return shape, _scored(closed_hand(shape_obs), reach, repertoire, hammer,
-                          settings.rules).decision.familiarity
-
-
-def _scored(obs, models: list, repertoire: Repertoire, params: HammerParams,
-            rules: VerdictRules) -> Recognition:
-    """:func:`recognize`, with the best model's familiarity read off its calibration made
-    now if it has none yet (the default repertoire calibrates only the models a verdict
-    rests on)."""
-    rec = recognize(obs, models, params, rules)
-    best = rec.decision.best
-    if rec.verdict is not None:
-        return rec
-    models = repertoire.calibrated(rec.models, best)
-    familiarity = rec.familiarity.copy()
-    familiarity[best] = models[best].calibration.familiarity(float(rec.misfit[best]), obs.dt)
-    return dataclasses.replace(rec, models=models, familiarity=familiarity)
+        return float("nan")
+    scores = score_clip(closed_hand(obs), reach, hammer)
+    _, familiarity = _calibrated(repertoire, reach, scores, range(len(reach)), obs.dt)
+    return float(familiarity[scores.best()])
 
 
 def recognize_clip(source: str | os.PathLike | Tracks, repertoire: Repertoire,

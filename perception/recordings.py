@@ -11,8 +11,8 @@ reach, in the movement's own plane, with the settings the reach's own
 geometry asks for (its scale is a millimetre per "pixel", its object's size
 is the grip's or the one given, and the digits need not touch at rest), and
 measures its landmarks by the verdict rules' ``[verdict.landmarks]``, as a
-video's are: :func:`prepare_reach`, the recognition, then :func:`measure_reach`
-(``hammer-mv watch`` puts an online recogniser fed row by row between the two).
+video's are: :func:`prepare_reach`, then the recognition with the reach's 3D
+paths (``hammer-mv watch`` feeds its rows to an online recogniser first).
 
 docs/mocap.md describes the formats, the mapping and what is reported.
 """
@@ -35,7 +35,7 @@ from perception.boundary import expect
 from perception.errors import InputError
 from perception.factors import NAME_FLAG as FACTORS_FROM_NAME
 from perception.factors import merge_factors, name_factors
-from perception.landmarks import movement_landmarks
+from perception.landmarks import MeasuredPaths
 from perception.limits import MAX_FPS
 from perception.reaches import (
     PX_PER_M,
@@ -50,7 +50,7 @@ from perception.reaches import (
 from perception.validation import Tuple, declared
 
 __all__ = ["MocapImport", "PreparedReach", "Recording", "cached_reaches", "cached_recording",
-           "measure_reach", "prepare_reach", "read_reaches", "read_recording", "recognize_reach",
+           "prepare_reach", "read_reaches", "read_recording", "recognize_reach",
            "trial_summary", "unknown_layout"]
 
 log = logging.getLogger(__name__)
@@ -489,8 +489,8 @@ def recognize_reach(reach: Reach, repertoire, settings=None,
     expect(options, MocapImport, "recognize_reach(options=)", optional=True)
     prepared = prepare_reach(reach, settings, options)
     rec = recognize_tracks(prepared.tracks, repertoire, prepared.settings, clip=reach.name,
-                           source=reach.source, plan_cache=plan_cache)
-    return measure_reach(rec, reach, prepared), prepared.info
+                           source=reach.source, plan_cache=plan_cache, paths=prepared.paths)
+    return rec, prepared.info
 
 
 class PreparedReach(NamedTuple):
@@ -498,9 +498,14 @@ class PreparedReach(NamedTuple):
 
     Attributes
     ----------
-    tracks, info, transport, aperture
+    tracks, info
         :func:`~perception.reaches.reach_tracks`' (``info`` with the reach's
         ``trial``, ``source`` and ``rate``: the report's ``mocap`` entry).
+    paths : MeasuredPaths
+        Its 3D transport and aperture, which its landmarks are measured on
+        (by the verdict rules' ``[verdict.landmarks]``, as a video's are; the
+        reach finder's own bounds only choose the reach's window), and the
+        recording's clock.
     settings : RecognitionSettings
         The settings its geometry asks for: a millimetre per "pixel", the
         grip's object size, a whole hand's rest aperture.
@@ -508,8 +513,7 @@ class PreparedReach(NamedTuple):
 
     tracks: object
     info: dict
-    transport: np.ndarray
-    aperture: np.ndarray
+    paths: MeasuredPaths
     settings: object
 
 
@@ -518,8 +522,8 @@ def prepare_reach(reach: Reach, settings=None, options: MocapImport | None = Non
     """A reach's tracks in its plane and the settings they are scored with.
 
     :func:`recognize_reach` scores them offline; ``hammer-mv watch`` of a
-    recording feeds their rows to an :class:`~perception.online.OnlineRecognizer`,
-    and each ends in :func:`measure_reach`.
+    recording feeds their rows to an :class:`~perception.online.OnlineRecognizer`;
+    both end in :func:`perception.pipeline.recognize_tracks` with its ``paths``.
 
     Parameters
     ----------
@@ -546,33 +550,11 @@ def prepare_reach(reach: Reach, settings=None, options: MocapImport | None = Non
         max_rest_aperture=max(settings.observe.max_rest_aperture, widest + 0.01))
     info = {**info, "trial": reach.name, "source": reach.source,
             "rate": round(1 / float(_median_step(reach.time)), 3)}
-    return PreparedReach(tracks, info, transport, aperture,
-                         dataclasses.replace(settings, observe=observe))
-
-
-def measure_reach(rec, reach: Reach, prepared: PreparedReach):
-    """``rec`` (the recognition of ``prepared.tracks``) with the reach's landmarks, measured
-    on its 3D marker paths, and the recording's clock (``time_origin``).
-
-    Parameters
-    ----------
-    rec : Recognition
-    reach : Reach
-    prepared : PreparedReach
-        :func:`prepare_reach`'s for ``reach``.
-    """
-    tracks, info = prepared.tracks, prepared.info
-    # the landmarks from the 3D speed and aperture, on the observation's clock (its
-    # last row is the tracks' last: settling only ever trims or holds the first)
-    clock = tracks.time - (tracks.time[-1] - rec.observation.clip_time[-1])
-    # by the verdict rules' [verdict.landmarks], as a video's are (the reach finder's
-    # own bounds, options.reaches.landmarks, only choose the reach's window)
     bounds = (info["bounds"]["onset"], info["bounds"]["end"])
-    return dataclasses.replace(rec, measured=movement_landmarks(
-        clock, prepared.transport, prepared.aperture, prepared.settings.rules.landmarks,
-        bounds=bounds),
-        # the recording's clock at the observation's zero: the onset row's time in the file
-        time_origin=float(reach.time[reach.onset] - clock[bounds[0]]))
+    # the recording's clock at the tracks' onset row: the onset row's time in the file
+    paths = MeasuredPaths(tracks.time, transport, aperture, bounds,
+                          float(reach.time[reach.onset] - tracks.time[bounds[0]]))
+    return PreparedReach(tracks, info, paths, dataclasses.replace(settings, observe=observe))
 
 
 def _median_step(time) -> float:

@@ -144,10 +144,12 @@ def test_a_report_set_is_never_half_replaced(clips, tmp_path, monkeypatch, fails
 class _KillsEveryWorker(Repertoire):
     """A clip that kills every worker that plans its models."""
 
-    distance: float
+    clip: str
 
     def for_scene(self, scene, cache=None, **kwargs):
-        if abs(scene.distance - self.distance) < 0.02:  # the clip at 0.3 m, as measured
+        # every clip is planned at the one reference scene (issue 42): the clip is told
+        # by the recognition that asks, two frames up
+        if sys._getframe(1).f_locals.get("clip") == self.clip:
             os.kill(os.getpid(), signal.SIGKILL)
         return super().for_scene(scene, cache, **kwargs)
 
@@ -162,7 +164,7 @@ def test_a_clip_that_kills_its_dask_workers_fails_alone(tmp_path):
     for k, distance in enumerate((0.25, 0.25, 0.3)):
         demo_tracks("normal", k, distance=distance)[0].save(src / f"c{k}.tracks.h5")
     rep = _KillsEveryWorker(default_repertoire().models)
-    rep.distance = 0.3
+    rep.clip = "c2"
     with dask.config.set({"distributed.scheduler.allowed-failures": 0}), \
             LocalCluster(n_workers=2, threads_per_worker=1, processes=True, protocol="tcp",
                          host="127.0.0.1", dashboard_address=None) as cluster:

@@ -145,8 +145,11 @@ def test_trim_keeps_exactly_the_frames_recognition_scores(tmp_path):
     trimmed = pd.read_csv(out)["frame"].to_numpy()
     proc = hammer("recognize", tracks_file, "-o", tmp_path / "rec", "--quiet")
     assert proc.returncode == 0, proc.stderr
+    # the per-step table is the movement resampled at the repertoire's frame period (issue
+    # 42): each step's nearest frame, inside the span and reaching its ends
     scored = np.unique(pd.read_csv(tmp_path / "rec" / "reach.confidence.csv")["frame"])
-    np.testing.assert_array_equal(trimmed, scored)
+    assert set(scored) <= set(trimmed)
+    assert scored[0] - trimmed[0] <= 1 and trimmed[-1] - scored[-1] <= 1
     # the movement: from just before the onset (frame 12) to a little after the end
     assert 8 <= trimmed[0] <= 13 and 40 <= trimmed[-1] < 59
     info = hammer("tracks", "info", tracks_file)

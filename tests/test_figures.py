@@ -78,14 +78,15 @@ def test_the_paths_figure_draws_the_demonstration_against_the_models_own(rec):
     assert [ln.get_label() for ln in lines] == [
         "finger observed", f"finger, {model}", "thumb observed", f"thumb, {model}",
         "wrist observed", f"wrist, {model}", "object"]
-    np.testing.assert_allclose(lines[0].get_xydata(), rec.observation.finger)
+    # the movement as it was scored, at the repertoire's scale where the model's own is
+    np.testing.assert_allclose(lines[0].get_xydata(), rec.scored_movement.finger)
     np.testing.assert_allclose(lines[3].get_xydata(), rec.nominal(model)["thumb"])
     x, y = _xy(lines[-1])
-    np.testing.assert_allclose(np.hypot(x, y), rec.observation.object_diameter / 2)
+    np.testing.assert_allclose(np.hypot(x, y), rec.scored_movement.object_diameter / 2)
     assert _legend_texts(left.get_legend()) == [ln.get_label() for ln in lines]
     grip = right.get_lines()
     assert [ln.get_linestyle() for ln in grip] == ["-", "--", ":"]
-    np.testing.assert_allclose(_xy(grip[0])[1], rec.observation.g * 100)
+    np.testing.assert_allclose(_xy(grip[0])[1], rec.scored_movement.g * 100)
     i = rec.names.index(model)
     np.testing.assert_allclose(_xy(grip[2])[1], rec.predicted_g[i] * 100)
     # another model on request

@@ -62,7 +62,7 @@ def test_delayed_opening_rises_clearly_less_over_the_first_half(scored):
 
 def test_open_close_open_falls_after_the_unexpected_closing(scored):
     for rec in scored["open-close-open"]:
-        c, g, t = _conf(rec), rec.observation.g, rec.time
+        c, g, t = _conf(rec), rec.scored_movement.g, rec.time
         closing = np.flatnonzero((np.diff(g) < -0.003) & (t[1:] > 0.2))[0] + 1  # closes fast
         peak = np.argmax(c[: closing + 1])
         after = c[peak: closing + 8]
@@ -89,7 +89,7 @@ def test_movement_time_is_recognised_within_one_variant(rep):
 def test_predictions_follow_a_normal_grasp(scored):
     rec = scored["normal"][0]
     i = rec.names.index(MODEL)
-    err = np.abs(rec.predicted_g[i][1:] - rec.observation.g[1:])
+    err = np.abs(rec.predicted_g[i][1:] - rec.scored_movement.g[1:])
     assert np.nanmedian(err) < 0.003  # mm-level one-step prediction of the aperture
 
 
@@ -116,12 +116,17 @@ def test_other_scene_is_replanned(rep):
     rec = _score(tracks, rep)
     assert rec.kinds[rec.names.index(rec.winner)] == "grasp"
     assert _conf(rec)[-1] > 0.3
-    # the pipeline plans for the clip's first frames; the engine scores what it is given
+    # the engine scores what it is given: models planned for the clip's own scene
     obs = observe(tracks)
     models = rep.for_scene(SceneSpec.of(obs))
     assert all(m.scene.distance == pytest.approx(0.20, abs=0.005) for m in models)
     assert all(m.substeps == 4 for m in models)  # 40 ms frames in ~10 ms steps
-    np.testing.assert_array_equal(recognize(obs, models).log_likelihood, rec.log_likelihood)
+    assert recognize(obs, models).log_likelihood.shape[1] == obs.n_frames
+    # the pipeline plans once, for the repertoire's reference scene with the clip's object,
+    # and scores the clip brought to it (issue 42: one planning pass)
+    reference = rep.reference()[0]
+    assert all(m.scene.distance == pytest.approx(reference.distance) for m in rec.models)
+    assert rec.scored_observation.dt == pytest.approx(reference.frame_period)
 
 
 def test_thesis_rule_can_pick_the_winner(rep):

@@ -95,14 +95,9 @@ def test_the_import_list_tells_a_refused_import_from_a_load():
                                   "import time:    18203 |      18852 |       cv2\n"))
 
 
-# pose: movement.io.load_poses -> sleap_io.io.slp -> sleap_io.io.video_reading, whose
-# top-level `try: import cv2` loads OpenCV; the fix (perception/io/movement_import.py,
-# refusing cv2 while movement imports) is the lead's: see the report of brief 42-C
-POSE_LOADS_CV2 = pytest.mark.xfail(
-    strict=True, reason="sleap_io.io.video_reading imports cv2 when movement.io is imported")
-
-
-@pytest.mark.parametrize("kind", ["tracks", pytest.param("pose", marks=POSE_LOADS_CV2), "mocap"])
+# pose: movement.io.load_poses -> sleap_io.io.video_reading, whose top-level
+# `try: import cv2` loaded OpenCV until perception/io/movement_import.py refused it
+@pytest.mark.parametrize("kind", ["tracks", "pose", "mocap"])
 def test_recognize_of_a_file_that_is_not_video_loads_no_opencv(tmp_path, kind):
     if kind == "tracks":
         res, rows = _recognize(_tracks(tmp_path), tmp_path / "out")
@@ -131,8 +126,6 @@ def test_minvar_lqg_does_not_re_export_the_moments():
     assert not set(lqg.__all__) & set(moments.__all__)
 
 
-@pytest.mark.xfail(strict=True, reason="perception/recognition/planning.py still imports "
-                                       "estimation_error_covariance from minvar.lqg")
 def test_minvar_lqg_keeps_no_moments_name_for_an_old_importer():
     assert not hasattr(lqg, "estimation_error_covariance")
 

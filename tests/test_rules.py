@@ -84,9 +84,14 @@ def test_the_report_carries_the_rules_and_the_passes(tmp_path):
     assert VerdictRules.from_dict(d["verdict_rules"]) == VerdictRules()
     assert d["verdict_rule"] == "grip-departs" and d["verdict_detail"] == "delayed-opening"
     p = d["passes"]
-    assert p["winner_from"] == "scene" and p["verdict_from"] == "reference"
-    assert p["scene"]["winner"] == d["winner"] == rec.winner
-    assert p["reference"]["best"] == d["shape"]["model"]
+    # one scoring pass gives the verdict and the winner (issue 42): every model scored at
+    # the repertoire's scale, the verdict's and the winner's of the kind the grip shows
+    assert p["winner_from"] == p["verdict_from"] == "reference" and "scene" not in p
+    assert p["reference"]["winner"] == d["winner"] == rec.winner
+    assert p["reference"]["best"] == d["shape"]["model"] == d["verdict_model"]
+    assert p["reference"]["models"] == [m["name"] for m in d["models"]]
+    assert set(p["reference"]["judged"]) == {n for n, k in zip(rec.names, rec.kinds)
+                                             if k == "grasp"}
     # settings that move a threshold move the verdict, and the report says so
     lenient = RecognitionSettings(rules=VerdictRules(late_opening=0.9, late_mga=1.0))
     other = recognize_tracks(tracks, default_repertoire(), lenient)

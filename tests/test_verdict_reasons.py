@@ -158,7 +158,7 @@ def test_a_winner_that_contradicts_the_verdict_is_named_for_what_it_is(delayed):
     odd = dataclasses.replace(normal, kinds=kinds)
     assert odd.verdict == "normal"
     assert odd.winner_note.startswith(f"closest model {odd.winner}: a reach model fits the clip "
-                                      "best at its own scale")
+                                      "best at the repertoire's scale")
     assert odd.verdict_model in odd.winner_note
     line = verdict_line(odd)
     assert f"closest model {odd.winner} (a reach model; the verdict's model: " in line

@@ -207,7 +207,7 @@ def _watch_recording(args: argparse.Namespace, signals: _Signals) -> int:
     from perception.online import OnlineRecognizer, decision_summary
     from perception.pipeline import clip_fingerprint
     from perception.reaches import Unscored
-    from perception.recordings import measure_reach, prepare_reach, read_recording, trial_summary
+    from perception.recordings import prepare_reach, read_recording, trial_summary
     from perception.report import clip as report
 
     path = Path(args.source)
@@ -263,8 +263,7 @@ def _watch_recording(args: argparse.Namespace, signals: _Signals) -> int:
         except KeyboardInterrupt:  # this reach's outputs of what was seen, then no more
             signals.holding, interrupted = True, True
         try:
-            result = measure_reach(rec.finish(dict(tracks.video), source=reach.source), reach,
-                                   prepared)
+            result = rec.finish(dict(tracks.video), source=reach.source, paths=prepared.paths)
         except HammerMVError as exc:  # this reach's (too few rows when interrupted, ...)
             missed.append((reach.name, f"failed: {exc.problem}"))
             continue

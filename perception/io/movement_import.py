@@ -69,6 +69,10 @@ def import_movement() -> None:
             super().__init__(*args, **kwargs)
 
     platformdirs.PlatformDirs = _NoCreate
+    # sleap_io (movement's SLEAP reader) imports OpenCV if it can; a pose file needs none
+    hide_cv2 = "cv2" not in sys.modules
+    if hide_cv2:
+        sys.modules["cv2"] = None  # import cv2 raises ImportError, which sleap_io allows
     try:
         importlib.import_module("movement.io")
     except BaseException:
@@ -77,6 +81,8 @@ def import_movement() -> None:
     finally:
         logging.MovementLogger.configure = configure
         platformdirs.PlatformDirs = dirs
+        if hide_cv2:
+            del sys.modules["cv2"]
     importlib.import_module("movement.utils").logging = logging  # as an import would
     from loguru import logger
 

@@ -33,11 +33,11 @@ from perception.observation import Observation
 from perception.recognition.leaves import Leaves, forward_kinematics
 from perception.recognition.models import ChainModel, MotorModel
 from perception.recognition.result import Recognition
-from perception.recognition.rules import VerdictRules
+from perception.recognition.rules import VerdictRules, judge
 from perception.recognition.scoring import RULES, THESIS_SIGNS, likelihood_rule, thesis_rule
 from perception.validation import NonNegative, Positive, Share, declared
 
-__all__ = ["HammerParams", "RULES", "StepScorer", "recognize"]
+__all__ = ["ClipScores", "HammerParams", "RULES", "StepScorer", "recognize", "score_clip"]
 
 #: Model steps a :class:`StepScorer`'s stacked gains are first made for (doubled when
 #: a movement lasts longer; past a plan's horizon its gains stay the last ones).
@@ -261,7 +261,7 @@ class StepScorer:
         if len(dts) != 1:
             raise ValueError(f"models disagree on their time step: {sorted(dts)} s")
         self.dt = self.models[0].dt
-        self.leaves = Leaves(self.models, max(int(steps), 1))
+        self.leaves = Leaves.of(self.models, max(int(steps), 1))
         self.grasp = np.array([m.kind == "grasp" for m in self.models])
         self.restart()
 
@@ -306,7 +306,7 @@ class StepScorer:
         self.frames += 1
         step = self._shift + self.frames - 1
         if step >= len(self.leaves.P):
-            self.leaves = Leaves(self.models, 2 * step)
+            self.leaves = Leaves.of(self.models, 2 * step)
         return step
 
     def predict(self, step: int, angles: np.ndarray, seen: bool) -> np.ndarray | None:
@@ -386,13 +386,71 @@ class _Steps(NamedTuple):
     observable: np.ndarray
 
 
+class ClipScores(NamedTuple):
+    """Every model's scores over one observation (:func:`score_clip`): the arrays of a
+    :class:`~perception.recognition.result.Recognition`, before any verdict."""
+
+    names: list
+    kinds: list
+    confidence: np.ndarray
+    dC_r: np.ndarray
+    dC_g: np.ndarray
+    log_likelihood: np.ndarray
+    mahalanobis: np.ndarray
+    scored: np.ndarray
+    familiarity: np.ndarray
+    predicted: dict
+    rule: str
+
+    def best(self, among: Sequence[int] | None = None) -> int:
+        """Index of the model with the highest final log-likelihood (of ``among``)."""
+        among = range(len(self.names)) if among is None else among
+        among = list(among)
+        return among[int(np.argmax(self.log_likelihood[among, -1]))]
+
+
+def score_clip(observation: Observation, models: Sequence[MotorModel],
+               params: HammerParams | None = None) -> ClipScores:
+    """Score a demonstration against every model: one scoring pass, no verdict.
+
+    Parameters
+    ----------
+    observation : Observation
+        The demonstration in the model frame.
+    models : sequence of MotorModel
+        The models, planned for its scene.
+    params : HammerParams, optional
+        Rule and weights.
+    """
+    obs, models = observation, list(models)
+    # gains stacked once for the whole clip
+    scorer = StepScorer(models, params, steps=int(round(obs.time[-1] / models[0].dt))
+                        + obs.n_frames + 1)
+    terms = scorer.score(obs.time, obs.wrist, obs.finger, obs.thumb)
+    dC_r, dC_g, dll, maha, valid, pred, _ = terms
+    _refuse_broken_models(models, terms.observable, valid)
+    _refuse_non_finite(models, {"confidence": dC_r + dC_g, "log-likelihood": dll})
+    return ClipScores(
+        names=[m.name for m in models], kinds=[m.kind for m in models],
+        confidence=np.cumsum(dC_r + dC_g, axis=1), dC_r=dC_r, dC_g=dC_g,
+        log_likelihood=np.cumsum(dll, axis=1), mahalanobis=maha, scored=valid,
+        familiarity=scorer.familiarity(obs.dt),
+        predicted={"wrist": pred.wrist, "finger": pred.finger, "thumb": pred.thumb},
+        rule=scorer.params.rule)
+
+
 def recognize(
     observation: Observation,
     models: Sequence[MotorModel],
     params: HammerParams | None = None,
     rules: VerdictRules | None = None,
 ) -> Recognition:
-    """Score a demonstration against every model.
+    """Score a demonstration against every model, and judge it on the scores alone.
+
+    One pass at the observation's own scene, with the verdict of
+    :func:`perception.recognition.rules.judge` on the best model's
+    familiarity (no landmarks, no reference scale: a clip's recognition is
+    :func:`perception.pipeline.recognize_tracks`).
 
     Parameters
     ----------
@@ -411,31 +469,15 @@ def recognize(
     -------
     Recognition
     """
-    obs, models = observation, list(models)
-    # gains stacked once for the whole clip
-    scorer = StepScorer(models, params, steps=int(round(obs.time[-1] / models[0].dt))
-                        + obs.n_frames + 1)
-    params = scorer.params
-    terms = scorer.score(obs.time, obs.wrist, obs.finger, obs.thumb)
-    dC_r, dC_g, dll, maha, valid, pred, _ = terms
-    _refuse_broken_models(models, terms.observable, valid)
-    _refuse_non_finite(models, {"confidence": dC_r + dC_g, "log-likelihood": dll})
+    from perception.recognition.evidence import clip_landmarks, movement_evidence
+
+    rules = VerdictRules() if rules is None else rules
+    models = list(models)
+    scores = score_clip(observation, models, params)
+    evidence = movement_evidence(observation, scores.kinds, scores.log_likelihood[:, -1],
+                                 scores.familiarity)
     return Recognition(
-        clip=obs.clip,
-        time=obs.time,
-        frame=obs.frame,
-        names=[m.name for m in models],
-        kinds=[m.kind for m in models],
-        confidence=np.cumsum(dC_r + dC_g, axis=1),
-        dC_r=dC_r,
-        dC_g=dC_g,
-        log_likelihood=np.cumsum(dll, axis=1),
-        mahalanobis=maha,
-        scored=valid,
-        familiarity=scorer.familiarity(obs.dt),
-        predicted={"wrist": pred.wrist, "finger": pred.finger, "thumb": pred.thumb},
-        observation=obs,
-        models=models,
-        rule=params.rule,
-        rules=VerdictRules() if rules is None else rules,
-    )
+        clip=observation.clip, time=observation.time, frame=observation.frame,
+        **scores._asdict(), observation=observation, models=models, rules=rules,
+        evidence=evidence, decision=judge(evidence, rules),
+        landmarks=clip_landmarks(observation, models, scores.log_likelihood[:, -1], rules))

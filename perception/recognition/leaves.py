@@ -9,6 +9,7 @@ padded to one state size, and the forward kinematics of the stacked chains.
 
 from __future__ import annotations
 
+from collections import OrderedDict
 from collections.abc import Sequence
 
 import numpy as np
@@ -17,6 +18,10 @@ from minvar.kinematics import TwoLinkChain
 from perception.recognition.models import MotorModel
 
 __all__ = ["Leaves", "forward_kinematics"]
+
+#: Stacked gains kept for the last few model sets (:meth:`Leaves.of`).
+CACHED_SETS = 8
+_CACHE: OrderedDict[tuple[int, ...], tuple[tuple[MotorModel, ...], Leaves]] = OrderedDict()
 
 
 class Leaves:
@@ -57,6 +62,29 @@ class Leaves:
         self.l2 = np.array([c.l2 for c in chains])
         self.base = np.array([c.base for c in chains])
         self.chains = chains
+
+    @classmethod
+    def of(cls, models: Sequence[MotorModel], steps: int) -> Leaves:
+        """The models' leaves for at least ``steps`` steps, stacked once per set of models.
+
+        A stream judged frame by frame scores the same models again at every
+        frame (:class:`perception.online.OnlineRecognizer`): their gains are
+        stacked once. Keyed on the models themselves (a model is never changed
+        after it is planned; a calibrated or re-planned one is a new object),
+        so more steps than asked for change nothing: past a plan's horizon its
+        gains are the last ones.
+        """
+        key = tuple(id(m) for m in models)
+        hit = _CACHE.get(key)
+        if hit is not None and all(a is b for a, b in zip(hit[0], models)) \
+                and len(hit[1].P) >= steps:
+            _CACHE.move_to_end(key)
+            return hit[1]
+        leaves = cls(models, steps)
+        _CACHE[key] = (tuple(models), leaves)
+        while len(_CACHE) > CACHED_SETS:
+            _CACHE.popitem(last=False)
+        return leaves
 
     def command(self, state: np.ndarray, s: int) -> np.ndarray:
         """The motor command ``-L x`` of every leaf at step ``s`` for (L, ..., n) states."""

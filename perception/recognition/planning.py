@@ -9,7 +9,7 @@ from collections.abc import Iterable
 import numpy as np
 
 from minvar import plan_grasp
-from minvar.lqg import estimation_error_covariance
+from minvar.moments import estimation_error_covariance
 from perception.errors import PlanningError
 from perception.recognition.models import (
     KINDS,

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -17,7 +18,7 @@ from perception.recognition.result import Recognition
 from perception.recognition.rules import Evidence, Verdict, VerdictRules
 from perception.validation import NonNegative, Share, declared
 
-__all__ = ["Decision", "OnlineState", "SettleRule", "decision_summary"]
+__all__ = ["Decision", "OnlineState", "SettleRule", "decision_summary", "grip_course"]
 
 
 @declared
@@ -52,8 +53,9 @@ class SettleRule:
     min_progress, arrived, reach_progress : float
         Share of the wrist's way, 0..1.
     late_margin : float
-        Share of the movement kept from ``late_opening`` (the online estimate
-        of when the grip opened is not the offline landmark).
+        Share of the movement kept from ``late_opening``: on a movement not
+        yet over, when the grip started to open is a share of the movement
+        so far (the landmark of the prefix), which its end moves.
     slowed, reach_slowed, closing : float
         Share of the peak speed, of the opening, 0..1.
     reach_opening : float
@@ -71,7 +73,7 @@ class SettleRule:
     arrived: Share = 0.95
     margin: NonNegative = 1.0
     reach_progress: Share = 0.7
-    reach_slowed: Share = 0.9
+    reach_slowed: Share = 0.7
     reach_opening: NonNegative = 0.01
     hold: NonNegative = 0.0
 
@@ -191,6 +193,12 @@ class OnlineState:
         Whether :attr:`decision` has been reached (at this frame or before).
     decision : Decision or None
         The first settled verdict (it stays; see docs/online.md).
+    judged_on : Evidence or None
+        What the provisional verdict was judged on: the evidence of the rows
+        so far, as ``recognize`` of them builds it (None before the onset).
+    waiting_for : str or None
+        Why the rows so far are not judged yet (``recognize`` of them refuses
+        them: no movement yet, too short, ...); None once they are.
     """
 
     frame: int
@@ -207,11 +215,47 @@ class OnlineState:
     familiarity: float = math.nan
     evidence: float = 0.0
     decision: Decision | None = None
+    judged_on: Evidence | None = field(default=None, repr=False)
+    waiting_for: str | None = None
 
     @property
     def settled(self) -> bool:
         """Whether a verdict has settled."""
         return self.decision is not None
+
+
+def grip_course(rec: Recognition) -> SimpleNamespace:
+    """The movement's course so far, as :meth:`SettleRule.sure` reads it, from its recognition.
+
+    ``opened`` (the grip opened as a grasp's must: the grasp models judged),
+    ``peaks`` (its landmark ``aperture_peaks``), ``opening`` (m beyond its
+    rest: :func:`~perception.recognition.shape.rest_and_opening` of the
+    markers' own aperture), ``closing`` (share of the opening closed since its
+    maximum), ``slowed`` (the evidence's), ``progress`` (the largest share of
+    the wrist's way to the models' goal covered so far, 0..1).
+
+    Parameters
+    ----------
+    rec : Recognition
+        The recognition of the rows so far.
+    """
+    from perception.recognition.shape import WRIST_GOAL_OFFSET, rest_and_opening
+
+    obs, ev = rec.observation, rec.evidence
+    raw = obs.raw or {}
+    g = (np.linalg.norm(raw["finger"] - raw["thumb"], axis=1)
+         if "finger" in raw and "thumb" in raw else obs.g)
+    g = g[np.isfinite(g)]
+    _, opening = rest_and_opening(g, rec.rules)
+    closing = float(g.max() - g[-1]) / opening if opening > 0 and g.size else 0.0
+    # the wrist's displacement from where the movement started, against its way to the goal
+    way = obs.start_distance - WRIST_GOAL_OFFSET
+    moved = np.linalg.norm(obs.wrist - obs.wrist[0], axis=1) / way
+    progress = float(np.clip(np.nanmax(moved, initial=0.0), 0.0, 1.0))
+    opened = rec.judged is not None and rec.kinds[rec.judged[0]] == "grasp"
+    peaks = ev.observed.aperture_peaks if ev.observed is not None else None
+    return SimpleNamespace(opened=opened, peaks=peaks, opening=opening, closing=closing,
+                           slowed=ev.slowed, progress=progress)
 
 
 def decision_summary(rec: Recognition, decision: Decision | None) -> dict:

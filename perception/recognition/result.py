@@ -5,21 +5,13 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from functools import cached_property
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from perception.landmarks import Landmarks, longest_gap, model_landmarks, observed_landmarks
-from perception.recognition.rules import (
-    VERDICT_RULES,
-    Evidence,
-    Verdict,
-    VerdictRules,
-    judge,
-    reason,
-    slowed,
-)
+from perception.landmarks import Landmarks, longest_gap
+from perception.recognition.evidence import model_own_landmarks, reference_model
+from perception.recognition.rules import VERDICT_RULES, Evidence, Verdict, VerdictRules, reason
 from perception.recognition.verdict import misfit
 
 if TYPE_CHECKING:
@@ -172,22 +164,31 @@ class Recognition:
         The rule that picks the winner.
     rules : VerdictRules
         The verdict's rules (:mod:`perception.recognition.rules`).
-    shape : Recognition or None
-        The same demonstration brought to the repertoire's reference scale
-        and scored against its models there (:mod:`perception.recognition.shape`):
-        when present, the verdict, familiarity and margin are its.
+    scored_observation : Observation or None
+        What was scored: the demonstration brought to the repertoire's
+        reference scale (:mod:`perception.recognition.shape`), on the
+        reference clock (``time`` above is the same samples on the clip's);
+        None where the observation itself was scored (a lone engine pass).
     normalisation : Normalisation or None
         How it was brought to that scale.
+    judged : tuple of int or None
+        The models the verdict judged: those of the kind the grip shows
+        (None: every model).
+    evidence : Evidence
+        What the verdict was judged on (:mod:`perception.recognition.evidence`).
+    decision : Verdict
+        The verdict, judged once when the recognition was made
+        (:func:`perception.recognition.rules.judge`).
+    landmarks : (Landmarks, Landmarks or None)
+        The demonstration's landmarks (measured on the observation, or on a
+        3D recording's own speed and aperture) and the reference grasp
+        model's own (None without a grasp model).
     transport_familiarity : float
         Familiarity of the movement's transport alone (digits held closed, at
         the reference scale) to the best reach model; NaN if not measured.
     mirrored : bool
         The scene was found mirrored (the finger opening on the model's -x
         side) and its mirror image was scored: the opposite of ``--mirror``.
-    measured : Landmarks, optional
-        The demonstration's landmarks measured on better data than the
-        observation holds (a 3D recording's own speed and aperture, on the
-        observation's clock); otherwise they are measured on the observation.
     notes : tuple of str
         What was done to the clip before it was scored (a start without
         rest: :func:`perception.settling.settle_start`).
@@ -217,11 +218,14 @@ class Recognition:
     models: list[MotorModel] = field(repr=False)
     rule: str = "likelihood"
     rules: VerdictRules = field(default_factory=VerdictRules, repr=False)
-    shape: Recognition | None = field(default=None, repr=False)
+    scored_observation: Observation | None = field(default=None, repr=False)
     normalisation: Normalisation | None = None
+    judged: tuple[int, ...] | None = None
+    evidence: Evidence | None = field(default=None, repr=False)
+    decision: Verdict | None = field(default=None, repr=False)
+    landmarks: tuple[Landmarks, Landmarks | None] | None = field(default=None, repr=False)
     transport_familiarity: float = float("nan")
     mirrored: bool = False
-    measured: Landmarks | None = field(default=None, repr=False)
     notes: tuple[str, ...] = ()
     time_origin: float = math.nan
 
@@ -236,8 +240,12 @@ class Recognition:
 
     @property
     def winner(self) -> str | None:
-        """Best model at the end of the demonstration, by :attr:`rule` (None: no step scored)."""
-        return self.winner_at(-1) if self.scored.any() else None
+        """Best model at the end of the demonstration by :attr:`rule`, of the models the
+        verdict judged (:attr:`judged`; None: no step scored)."""
+        if not self.scored.any():
+            return None
+        among = list(range(len(self.names)) if self.judged is None else self.judged)
+        return self.names[among[int(np.argmax(self.score()[among, -1]))]]
 
     @property
     def final_confidence(self) -> dict[str, float]:
@@ -265,30 +273,9 @@ class Recognition:
         return self.decision.rule
 
     @property
-    def evidence(self) -> Evidence:
-        """What the verdict is judged on: the reference pass's scores and the movement's
-        own landmarks, rest aperture and gaps (a lone pass, without a :attr:`shape`:
-        its scores alone)."""
-        if self.shape is None:
-            return Evidence(self.kinds, self.log_likelihood[:, -1], self.familiarity)
-        obs, shape = self.observation, self.shape
-        scored = shape.scored.sum(axis=1).max() / max(shape.scored.shape[1] - 1, 1)
-        raw = obs.raw or {}  # the filtered aperture coasts through a gap: the markers' own
-        g = (np.linalg.norm(raw["finger"] - raw["thumb"], axis=1) if "finger" in raw
-             and "thumb" in raw else obs.g)
-        return Evidence(shape.kinds, shape.log_likelihood[:, -1], shape.familiarity,
-                        self.transport_familiarity, obs.marker_separation, *self.landmarks,
-                        longest_gap(obs.time, g), slowed(obs.time, obs.wrist), float(scored))
-
-    @cached_property
-    def decision(self) -> Verdict:
-        """The verdict, judged once (:func:`perception.recognition.rules.judge`).
-
-        With a :attr:`shape` pass, the scores are that pass's: the movement's
-        coordination judged at the repertoire's reference scale, not its
-        speed, size or camera.
-        """
-        return judge(self.evidence, self.rules)
+    def judged_names(self) -> list[str]:
+        """The names of the models the verdict judged (:attr:`judged`)."""
+        return self.names if self.judged is None else [self.names[i] for i in self.judged]
 
     @property
     def verdict(self) -> str | None:
@@ -325,9 +312,9 @@ class Recognition:
 
     @property
     def verdict_model(self) -> str | None:
-        """The model the verdict was judged on: the best by log-likelihood of the pass
-        that gives the verdict (the reference pass with a :attr:`shape`)."""
-        names = self.shape.names if self.shape is not None else self.names
+        """The model the verdict was judged on: the best by log-likelihood of the models
+        it judged (:attr:`judged`)."""
+        names = self.judged_names
         return names[self.decision.best] if len(names) else None
 
     @property
@@ -341,19 +328,18 @@ class Recognition:
         a movement whose digits were lost too long names the digit lost
         longest and where.
         """
-        names = self.shape.names if self.shape is not None else self.names
         lost = self._longest_loss() if self.observation.raw else None
-        return reason(self.decision, self.evidence, self.rules, names, lost=lost)
+        return reason(self.decision, self.evidence, self.rules, self.judged_names, lost=lost)
 
     @property
     def winner_note(self) -> str | None:
         """Where the winner's kind contradicts the verdict ("normal", a reach model
         winning), what the winner is, in words; None where they agree.
 
-        The winner is the best of every model at the clip's own scale (the
-        scene pass); the verdict judges the movement at the repertoire's
-        scale (:attr:`shape`), where :attr:`verdict_model` fits best. A
-        report names the winner "closest model" then, not "winner".
+        The winner is the best of the judged models by :attr:`rule`; where
+        the grip showed no kind (every model judged) it may be of the other
+        kind than the verdict's. A report names the winner "closest model"
+        then, not "winner".
         """
         winner, verdict = self.winner, self.verdict
         if winner is None or verdict not in ("normal", "abnormal", "reach"):
@@ -361,11 +347,11 @@ class Recognition:
         kind = self.kinds[self.names.index(winner)]
         if (kind == "reach") == (verdict == "reach"):
             return None
-        scale = "the repertoire's" if self.shape is not None else "the clip's own"
+        scale = "the repertoire's" if self.normalisation is not None else "the clip's own"
         judged = "a reach" if verdict == "reach" else "a grasp"
-        return (f"closest model {winner}: a {kind} model fits the clip best at its own "
-                f"scale; the verdict judges it as {judged} at {scale} scale, where "
-                f"{self.verdict_model} fits best")
+        return (f"closest model {winner}: a {kind} model fits the clip best at {scale} "
+                f"scale; the verdict judges it as {judged}, where {self.verdict_model} "
+                "fits best")
 
     def _longest_loss(self) -> str:
         """The digit lost longest during the movement, for how long and where."""
@@ -411,7 +397,7 @@ class Recognition:
                 out.append(ValidationWarning(
                     kind, v, f"{label} {v:.2f}{unit} is outside the {lo}-{hi}{unit} the "
                     f"verdict was validated on{_WARNING_HINTS.get(kind, '')}"))
-        if math.isfinite(lm.movement_time) and lm.movement_time > 0 and self.shape is not None:
+        if math.isfinite(lm.movement_time) and lm.movement_time > 0:
             n = self.normalisation
             if n is not None and abs(n.time_scale - 1) > 1e-9:
                 out.append(ValidationWarning(
@@ -428,16 +414,14 @@ class Recognition:
     @property
     def reference_model(self) -> str | None:
         """The grasp model with the highest log-likelihood (None if there is none)."""
-        grasp = [i for i, k in enumerate(self.kinds) if k == "grasp"]
-        if not grasp:
-            return None
-        return self.names[grasp[int(np.argmax(self.log_likelihood[grasp, -1]))]]
+        return reference_model(self.names, self.kinds, self.log_likelihood[:, -1])
 
     def nominal(self, model: str) -> dict[str, np.ndarray]:
         """The model's own noise-free movement at this clip's sample times.
 
         What the model would do from its planned start (thesis Figs. 5.5-5.7
-        draw it against the demonstration), aligned on the clip's movement onset.
+        draw it against the demonstration), aligned on the clip's movement onset,
+        at the scale the demonstration was scored at (:attr:`scored_observation`).
 
         Parameters
         ----------
@@ -452,13 +436,14 @@ class Recognition:
         from perception.recognition.rollout import rollout
 
         m = self.models[self.names.index(model)]
-        steps = int(np.ceil(max(self.time[-1], 0.0) / m.dt)) + 1
+        time = self.scored_movement.time
+        steps = int(np.ceil(max(time[-1], 0.0) / m.dt)) + 1
         run = rollout([m], steps)
         out = {}
         for key in ("wrist", "finger", "thumb"):
             xy = getattr(run, key)[0, 0]
-            out[key] = np.stack([np.interp(self.time, run.time, xy[:, 0]),
-                                 np.interp(self.time, run.time, xy[:, 1])], axis=1)
+            out[key] = np.stack([np.interp(time, run.time, xy[:, 0]),
+                                 np.interp(time, run.time, xy[:, 1])], axis=1)
         return out
 
     def own_landmarks(self, model: str) -> Landmarks:
@@ -474,21 +459,12 @@ class Recognition:
         model : str
             Model name.
         """
-        from perception.recognition.rollout import rollout
+        return model_own_landmarks(self.models[self.names.index(model)], self.rules)
 
-        m = self.models[self.names.index(model)]
-        run = rollout([m], int(np.ceil(1.5 * m.duration / m.dt)) + 1)
-        return model_landmarks(run.time, run.wrist[0, 0], run.finger[0, 0], run.thumb[0, 0],
-                               self.rules.landmarks)
-
-    @cached_property
-    def landmarks(self) -> tuple[Landmarks, Landmarks | None]:
-        """The demonstration's landmarks and the reference grasp model's own (None without one)."""
-        ref = self.reference_model
-        observed = self.measured if self.measured is not None else observed_landmarks(
-            self.observation, self.rules.landmarks)
-        return (observed,
-                self.own_landmarks(ref) if ref is not None else None)
+    @property
+    def scored_movement(self) -> Observation:
+        """What was scored (:attr:`scored_observation`, else the observation)."""
+        return self.scored_observation if self.scored_observation is not None else self.observation
 
     @property
     def kinematics(self) -> dict:
@@ -603,31 +579,30 @@ class Recognition:
                            for n, row in zip(self.names, self.confidence)},
             "transport_confidence": {n: [float(c) for c in row]
                                      for n, row in zip(self.names, transport)},
-            "aperture": [_num(g) for g in self.observation.g],
+            "aperture": [_num(g) for g in self.scored_movement.g],
             "kinematics": self.kinematics,
         }
 
 
 def _shape_summary(rec: Recognition) -> dict | None:
-    if rec.shape is None:
+    if rec.normalisation is None:
         return None
-    d = rec.shape.decision
-    out = {"model": rec.shape.names[d.best], "familiarity": _num(d.familiarity),
-           "margin": _num(d.margin), "transport_familiarity": _num(rec.transport_familiarity)}
-    if rec.normalisation is not None:
-        out.update({k: _num(v) for k, v in rec.normalisation.to_dict().items()})
-    return out
+    d = rec.decision
+    return {"model": rec.verdict_model, "familiarity": _num(d.familiarity),
+            "margin": _num(d.margin), "transport_familiarity": _num(rec.transport_familiarity),
+            **{k: _num(v) for k, v in rec.normalisation.to_dict().items()}}
 
 
 def _passes(rec: Recognition) -> dict:
-    """Which scoring pass gave what: ``winner`` and the profiles come from the clip's own
-    scene, the verdict from the reference pass (the scene's without one)."""
-    out = {"scene": {"models": list(rec.names), "winner": rec.winner},
-           "winner_from": "scene", "verdict_from": "scene" if rec.shape is None else "reference"}
-    if rec.shape is not None:
-        d = rec.decision
-        out["reference"] = {"models": list(rec.shape.names), "best": rec.shape.names[d.best],
-                            "familiarity": _num(d.familiarity)}
+    """The scoring passes: every model at one scale (the repertoire's reference scale,
+    where the clip was brought to it), the verdict and the winner from the models of
+    the kind the grip shows, and the transport's own pass."""
+    scale = "reference" if rec.normalisation is not None else "scene"
+    out = {scale: {"models": list(rec.names), "judged": rec.judged_names,
+                   "best": rec.verdict_model, "winner": rec.winner,
+                   "familiarity": _num(rec.decision.familiarity)},
+           "winner_from": scale, "verdict_from": scale}
+    if rec.normalisation is not None:
         out["transport"] = {"familiarity": _num(rec.transport_familiarity)}
     return out
 

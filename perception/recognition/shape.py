@@ -44,7 +44,7 @@ from perception.recognition.models import SceneSpec
 from perception.recognition.rules import VerdictRules
 
 __all__ = ["WRIST_GOAL_OFFSET", "Normalisation", "canonical", "closed_hand", "is_mirrored",
-           "mirror_votes", "opens", "rest_and_opening"]
+           "opens", "rest_and_opening"]
 
 #: Where the models' wrists stop: this far short of the object centre, m (the
 #: grasp task's own ``wrist_offset``).
@@ -176,23 +176,10 @@ def is_mirrored(obs: Observation, rules: VerdictRules | None = None) -> bool:
         The demonstration.
     rules : VerdictRules, optional
     """
-    return mirror_votes(obs.finger - obs.thumb, rules) is True
-
-
-def mirror_votes(opening: np.ndarray, rules: VerdictRules | None = None) -> bool | None:
-    """:func:`is_mirrored` on grip openings; None where none is wide enough to read.
-
-    Parameters
-    ----------
-    opening : (N, 2) array
-        Finger minus thumb, m, in the model frame.
-    rules : VerdictRules, optional
-    """
     rules = VerdictRules() if rules is None else rules
+    opening = obs.finger - obs.thumb
     wide = np.linalg.norm(opening, axis=1) >= rules.mirror_opening
-    if not wide.any():
-        return None
-    return bool(np.mean(opening[wide, 0] < 0) > rules.mirror_majority)
+    return bool(wide.any() and np.mean(opening[wide, 0] < 0) > rules.mirror_majority)
 
 
 def opens(obs: Observation, rules: VerdictRules | None = None) -> bool:

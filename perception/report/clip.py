@@ -254,7 +254,7 @@ class ClipSummary:
                    winner=rec.winner, rule=rec.rule, verdict=d.verdict,
                    familiarity=d.familiarity, margin=d.margin, familiarities=rec.familiarity,
                    reference_model=rec.reference_model,
-                   transport=np.cumsum(rec.dC_r, axis=1), aperture=rec.observation.g,
+                   transport=np.cumsum(rec.dC_r, axis=1), aperture=rec.scored_movement.g,
                    extras=dict(extras or {}), verdict_detail=rec.verdict_detail,
                    kinematics=rec.kinematics, verdict_rule=rec.verdict_rule,
                    traces=clip_traces(rec), verdict_reason=rec.verdict_reason,

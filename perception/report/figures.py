@@ -207,7 +207,8 @@ def paths_figure(rec: Recognition, model: str | None = None) -> Figure:
     """
     model = model or rec.reference_model or rec.winner
     i = rec.names.index(model)
-    obs, own = rec.observation, rec.nominal(model)
+    # the movement as it was scored (at the repertoire's scale, where the model's own is)
+    obs, own = rec.scored_movement, rec.nominal(model)
     fig, (paths, grip) = _figure((12, 5.5), 2, titled=True)
     placed = bool(getattr(rec, "wrist_synthesised", False))
     for key, colour in (("finger", "g"), ("thumb", "r"), ("wrist", "b")):

@@ -114,7 +114,7 @@ def prediction(b: Batch, recs: dict, inside: str) -> tuple[str, Measured]:
             rec = recs[d["clip"]]
             own = rec.nominal(b.reference)
             g_own = np.linalg.norm(own["finger"] - own["thumb"], axis=1)
-            values.append(np.nanmean(np.abs(rec.observation.g - g_own)))
+            values.append(np.nanmean(np.abs(rec.scored_movement.g - g_own)))
         err[cond] = float(np.median(values))
     return ("prediction", Measured(
         "median |observed - model| aperture " + ", ".join(f"{c} {100 * v:.1f} cm"
@@ -139,7 +139,7 @@ def prediction_figures(b: Batch, recs: dict, out: Path) -> str:
             continue
         rec = recs[names[0]]
         own = rec.nominal(b.reference)
-        obs = rec.observation
+        obs = rec.scored_movement  # the scale the model was scored (and drawn) at
         radius = obs.object_diameter / 2
         fig = Figure(figsize=(5, 5))
         ax = fig.add_subplot()
@@ -154,7 +154,7 @@ def prediction_figures(b: Batch, recs: dict, out: Path) -> str:
         ax.legend(fontsize=7)
         save(out, f"fig5_{number}_{cond.replace('-', '_')}_{b.name}", fig)
         for d in b.by_condition(cond):
-            o = recs[d["clip"]].observation
+            o = recs[d["clip"]].scored_movement
             depth = min(np.nanmin(np.linalg.norm(getattr(o, k), axis=1)) for k in
                         ("finger", "thumb"))
             inside.append((cond, d["clip"], depth < radius - 0.01))  # 1 cm through the surface

@@ -70,7 +70,7 @@ def reading_terms(rec, reading: str, w_r: float, w_g: float) -> tuple[np.ndarray
     """
     if reading not in READINGS:
         raise ValueError(f"reading: expected one of {READINGS}, got {reading!r}")
-    obs = rec.observation
+    obs = rec.scored_movement  # what the predictions are of
     r_obs, g_obs = obs.r, obs.g
     r_pred, g_pred = rec.predicted_r, rec.predicted_g
     grasp = np.array([k == "grasp" for k in rec.kinds])[:, None]
@@ -112,7 +112,7 @@ def reading_clip(rec, reading: str, w_r: float, w_g: float) -> dict:
         "time": [float(t) for t in rec.time],
         "confidence": dict(zip(rec.names, conf.tolist())),
         "transport_confidence": dict(zip(rec.names, transport.tolist())),
-        "aperture": [None if not np.isfinite(g) else float(g) for g in rec.observation.g],
+        "aperture": [None if not np.isfinite(g) else float(g) for g in rec.scored_movement.g],
         "path": dict(zip(rec.names, path.sum(axis=1).tolist())),
         "durations": {m.name: float(m.spec.task.get("duration", np.nan)) for m in rec.models},
     }

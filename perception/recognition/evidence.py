@@ -1,0 +1,151 @@
+"""What a verdict is judged on, built in one place for every path.
+
+A clip's recognition (:func:`perception.pipeline.recognize_tracks`) scores
+the movement once, at the repertoire's reference scale, against every model;
+the verdict then judges the models of the kind the grip shows
+(:func:`judged_models`), the movement's own landmarks against the reference
+grasp model's (:func:`clip_landmarks`), and the gaps and the end of the
+movement (:func:`movement_evidence`). :func:`perception.recognition.rules.judge`
+is called once on the :class:`~perception.recognition.rules.Evidence` built
+here.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from perception.landmarks import Landmarks, longest_gap, model_landmarks, observed_landmarks
+from perception.recognition.rules import Evidence, VerdictRules, slowed
+
+if TYPE_CHECKING:
+    from perception.observation import Observation
+    from perception.recognition.models import MotorModel
+
+__all__ = ["clip_landmarks", "judged_models", "model_own_landmarks", "movement_evidence",
+           "reference_model"]
+
+
+def judged_models(kinds: Sequence[str], kind: str) -> tuple[int, ...]:
+    """Indices of the models of ``kind`` (every model where there is none of it).
+
+    Parameters
+    ----------
+    kinds : sequence of str
+        Each model's kind.
+    kind : str
+        ``grasp`` where the grip opens as a grasp's must, else ``reach``
+        (:func:`perception.recognition.shape.opens`).
+    """
+    every = tuple(range(len(kinds)))
+    return tuple(i for i in every if kinds[i] == kind) or every
+
+
+def reference_model(names: Sequence[str], kinds: Sequence[str],
+                    log_likelihood: np.ndarray) -> str | None:
+    """The grasp model with the highest final log-likelihood (None without a grasp model).
+
+    Parameters
+    ----------
+    names, kinds : sequence of str
+    log_likelihood : (M,) array
+        Each model's final log-likelihood.
+    """
+    grasp = [i for i, k in enumerate(kinds) if k == "grasp"]
+    if not grasp:
+        return None
+    return names[grasp[int(np.argmax(np.asarray(log_likelihood)[grasp]))]]
+
+
+def model_own_landmarks(model: MotorModel, rules: VerdictRules) -> Landmarks:
+    """The landmarks of a model's own noise-free movement.
+
+    Its movement from its planned start, run until half its planned duration
+    past its end, bounded by ``rules.landmarks`` as a clip's are. Measured
+    once per model and landmark definition (a stream judged frame by frame
+    asks at every frame; a model is never changed after it is planned).
+    """
+    from perception.recognition.rollout import rollout
+
+    key = (id(model), rules.landmarks)
+    hit = _OWN.get(key)
+    if hit is not None and hit[0] is model:
+        return hit[1]
+    run = rollout([model], int(np.ceil(1.5 * model.duration / model.dt)) + 1)
+    own = model_landmarks(run.time, run.wrist[0, 0], run.finger[0, 0], run.thumb[0, 0],
+                          rules.landmarks)
+    if len(_OWN) >= 64:  # a repertoire's models a few times over
+        _OWN.pop(next(iter(_OWN)))
+    _OWN[key] = (model, own)
+    return own
+
+
+#: :func:`model_own_landmarks`' measured so far: (model id, landmark params) -> (model, landmarks).
+_OWN: dict[tuple, tuple] = {}
+
+
+def clip_landmarks(observation: Observation, models: Sequence[MotorModel],
+                   log_likelihood: np.ndarray, rules: VerdictRules,
+                   measured: Landmarks | None = None
+                   ) -> tuple[Landmarks, Landmarks | None]:
+    """The movement's landmarks and the reference grasp model's own.
+
+    Parameters
+    ----------
+    observation : Observation
+        The movement at its own scale (the landmarks' units are the clip's).
+    models : sequence of MotorModel
+        The models scored.
+    log_likelihood : (M,) array
+        Their final log-likelihoods (:func:`reference_model`).
+    rules : VerdictRules
+        Its ``landmarks`` bound them.
+    measured : Landmarks, optional
+        The movement's landmarks measured on better data than the observation
+        holds (a 3D recording's speed and aperture); else measured on it.
+    """
+    names = [m.name for m in models]
+    ref = reference_model(names, [m.kind for m in models], log_likelihood)
+    observed = (measured if measured is not None
+                else observed_landmarks(observation, rules.landmarks))
+    own = model_own_landmarks(models[names.index(ref)], rules) if ref is not None else None
+    return observed, own
+
+
+def movement_evidence(observation: Observation, kinds: Sequence[str],
+                      log_likelihood: np.ndarray, familiarity: np.ndarray,
+                      landmarks: tuple[Landmarks, Landmarks | None] | None = None,
+                      transport_familiarity: float = float("nan"),
+                      scored_share: float = 1.0) -> Evidence:
+    """The :class:`~perception.recognition.rules.Evidence` of a movement.
+
+    Parameters
+    ----------
+    observation : Observation
+        The movement at its own scale: its rest aperture, the longest stretch
+        its digits went unseen (the markers' own aperture: the filtered one
+        coasts through a gap) and how far its transport slowed.
+    kinds : sequence of str
+        The judged models' kinds.
+    log_likelihood, familiarity : (M,) arrays
+        The judged models' final log-likelihood and familiarity.
+    landmarks : (Landmarks, Landmarks or None), optional
+        :func:`clip_landmarks`' (None: scores alone, as a lone engine pass).
+    transport_familiarity : float
+        The transport's alone to the best reach model (NaN: not measured).
+    scored_share : float
+        Share of the movement's steps scored.
+    """
+    if landmarks is None:
+        return Evidence(list(kinds), np.asarray(log_likelihood), np.asarray(familiarity))
+    obs = observation
+    raw = obs.raw or {}
+    g = (np.linalg.norm(raw["finger"] - raw["thumb"], axis=1)
+         if "finger" in raw and "thumb" in raw else obs.g)
+    return Evidence(list(kinds), np.asarray(log_likelihood), np.asarray(familiarity),
+                    transport_familiarity=float(transport_familiarity),
+                    rest_aperture=obs.marker_separation, observed=landmarks[0],
+                    reference=landmarks[1], aperture_gap=longest_gap(obs.time, g),
+                    slowed=slowed(obs.time, obs.wrist), scored_share=float(scored_share))
