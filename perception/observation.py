@@ -413,9 +413,9 @@ def _scene_transform(px: dict[str, np.ndarray], tracks, params: ObserveParams,
     if scale is None:
         dpx = tracks.object_diameter_px()
         if dpx is None:
-            pose = "--object-diameter-px (the object in pixels) or " if is_pose_file(name) else ""
+            pose = "`object_diameter_px` (the object in pixels) or " if is_pose_file(name) else ""
             raise InputError(f"image scale unknown: the tracks carry no object size; give "
-                             f"{pose}--px-per-m", name)
+                             f"{pose}`px_per_m`", name)
         scale = dpx / params.object_diameter
     d = np.median(px["wrist"][rest], axis=0) - origin
     approach = np.array([-d[0], d[1]])  # from wrist toward object, in y-up image coordinates
@@ -609,10 +609,10 @@ def check_hand(scene: RestScene, params: ObserveParams | None = None) -> None:
     if apart > params.max_rest_aperture or not lo <= size <= hi:
         raise InputError(f"the hand at rest does not look like a hand: finger and thumb "
                          f"markers {apart * 100:.1f} cm apart, {size * 100:.1f} cm from the "
-                         + ("wrist (keypoints on the wrong markers? check --keypoints, and "
-                            "--object-diameter-px or --px-per-m)" if is_pose_file(scene.source)
+                         + ("wrist (keypoints on the wrong markers? check `keypoints`, and "
+                            "`object_diameter_px` or `px_per_m`)" if is_pose_file(scene.source)
                             else "wrist (a same-coloured object taken for a marker? give --roi "
-                            "when tracking, or check --px-per-m)"), scene.source)
+                            "when tracking, or check `px_per_m`)"), scene.source)
 
 
 def observe(tracks, params: ObserveParams | None = None, *, clip: str | None = None) -> Observation:

@@ -1,20 +1,24 @@
-"""The recognition pipeline of one clip: video -> tracks -> observation -> models -> recognition.
+"""The recognition pipeline of one clip: video -> tracks -> observation -> models -> verdict.
 
-:func:`load_clip` (step 1) and :func:`recognize_tracks` (steps 2-4) are the
-chain; :func:`recognize_clip` is the two in one call. The ``recognize`` and
-``batch`` commands and :func:`perception.batch.run_batch` call the two
-apart, since they report the tracking too (a motion-capture reach enters at
-step 2 through :func:`perception.recordings.recognize_reach`):
+:func:`load_clip` (step 1) and :func:`recognize_tracks` (steps 2-5) are the
+chain; :func:`recognize_clip` is the two in one call (the Python API's).
+The ``recognize`` and ``batch`` commands call the two apart, since they
+report the tracking too; a motion-capture reach enters at step 2 through
+:func:`perception.recordings.recognize_reach`, and the online recogniser
+calls step 2-5 on the rows received so far (docs/architecture.md):
 
 1. **tracks** — a video is tracked (:func:`perception.tracking.track_video`)
    into a tracks file, unless a current one is at hand (:func:`current_tracks`);
    a tracks file is loaded; a :class:`Tracks` object is used as it is;
 2. **observation** — :func:`perception.observation.observe` maps the tracks to
    the model frame and finds the movement;
-3. **planning** — the repertoire's models are taken, or re-planned, for the
-   scene of the clip's first frames (:meth:`Repertoire.for_scene`);
-4. **recognition** — :func:`perception.recognition.engine.recognize` scores
-   every model's one-step predictions.
+3. **reference scale** — the movement is brought to the repertoire's
+   reference scene (:mod:`perception.recognition.shape`), whose models are
+   planned once (:meth:`Repertoire.for_scene`);
+4. **scoring** — :func:`perception.recognition.engine.score_clip` scores
+   every model once, and the transport alone against the reach models;
+5. **verdict** — :mod:`perception.recognition.evidence` builds the evidence
+   and :func:`perception.recognition.rules.judge` decides, once.
 
 """
 
@@ -408,7 +412,7 @@ def recognize_tracks(tracks: Tracks, repertoire: Repertoire,
         models = repertoire.for_scene(SceneSpec.of(scored_obs), cache=plan_cache,
                                       threads=settings.planning_threads)
     except PlanningError as exc:  # the scene, not the software: name the clip and the scale
-        raise PlanningError(f"{exc.problem} (check the scale: --px-per-m, --object-diameter)",
+        raise PlanningError(f"{exc.problem} (check the scale: `px_per_m`, `object_diameter`)",
                             source or obs.clip, field=exc.field) from None
     # the clip's own tracking noise, where it exceeds what the rule assumes
     hammer = dataclasses.replace(settings.hammer,

@@ -338,7 +338,7 @@ def read_recording(path, options: MocapImport | None = None) -> Recording:
         _note_seen(seen, trial, options.markers)
         source = str(trial.source)
         factors = merge_factors([("the table's columns", trial.factors),
-                                 (f"the file name ({FACTORS_FROM_NAME})", from_name)], path)
+                                 (f"the file name (`{FACTORS_FROM_NAME}`)", from_name)], path)
         if factors != trial.factors:
             trial = dataclasses.replace(trial, factors=factors)
         labels = {"factors": factors, "trial_number": trial.trial_number}
@@ -386,7 +386,7 @@ def _never_seen(seen: dict, trials: int) -> str | None:
     what = f"marker {name!r}" + ("" if name == role else f" (the {role})")
     where = f"any of its {trials} trials" if trials > 1 else "the recording"
     return (f"{what} is never seen in {where}: every sample of it is "
-            "missing (empty, NaN, all zeros or flagged); check --markers or the recording")
+            "missing (empty, NaN, all zeros or flagged); check `markers` or the recording")
 
 
 def read_reaches(path, options: MocapImport | None = None) -> list[Reach]:

@@ -131,10 +131,10 @@ def test_fps_overrides_the_video_and_without_either_the_error_names_it(session, 
     shutil.copy(dlc, alone)
     with pytest.raises(InputError) as err:
         read_pose(alone)
-    assert err.value.field == "--fps" and "trial02.mp4" in str(err.value)
+    assert err.value.field == "fps" and "trial02.mp4" in str(err.value)
     assert "\n" not in str(err.value)
     (tmp_path / "trial02.mp4").write_bytes(b"not a video")
-    with pytest.raises(InputError, match="its video trial02.mp4: not a readable video.*--fps"):
+    with pytest.raises(InputError, match="its video trial02.mp4: not a readable video.*`fps`"):
         read_pose(alone)
 
 
@@ -166,18 +166,18 @@ def _error(call) -> str:
 
 def test_a_missing_keypoint_names_keypoints(session):
     path = session / f"trial02{SCORER}.h5"
-    assert "--keypoints" in _error(lambda: read_pose(path, PoseImport(keypoints={"thumb": "x"})))
+    assert "`keypoints`" in _error(lambda: read_pose(path, PoseImport(keypoints={"thumb": "x"})))
 
 
-# The two below need the change to perception/observation.py proposed with issue 34
-# item 1 (the scale and hand messages of a pose file name its options, not --roi);
-# remove these marks with it.
+# the scale and hand messages of a pose file name its options (fields here; the command
+# line gives their flags), not the tracker's --roi
 def test_an_unknown_scale_names_object_diameter_px(session):
     tracks = read_pose(session / f"trial02{SCORER}.h5")
     message = _error(lambda: observe(tracks))
-    assert "--object-diameter-px" in message and "--px-per-m" in message
+    assert "`object_diameter_px`" in message and "`px_per_m`" in message
 
 
 def test_a_pose_file_that_is_no_hand_gets_no_colour_tracking_advice(session):
     tracks = read_pose(session / f"trial02{SCORER}.h5")
-    assert "--keypoints" in _error(lambda: observe(tracks, ObserveParams(px_per_m=8000)))
+    message = _error(lambda: observe(tracks, ObserveParams(px_per_m=8000)))
+    assert "`keypoints`" in message and "roi" not in message

@@ -82,7 +82,7 @@ def test_a_factor_named_that_varies_within_a_trial_is_refused(tmp_path):
     with pytest.raises(InputError, match=r"column 'condition' changes within a trial "
                                          r"\('far' then 'other' at data row 302, trial 2\)") as e:
         read_mocap(path, rate=RATE, factors=["condition"])
-    assert e.value.field == "--factors"
+    assert e.value.field == "factors"
     assert "t.tsv" in str(e.value)
 
 
@@ -111,7 +111,7 @@ def test_factors_of_a_layout_without_columns_are_refused(tmp_path):
     path.write_text("1 2 3 4 5 6\n1 2 3 4 5 6\n")
     with pytest.raises(InputError, match="no columns to read factors from") as e:
         read_mocap(path, rate=RATE, columns="thumb,index", factors="participant")
-    assert e.value.field == "--factors"
+    assert e.value.field == "factors"
 
 
 def test_a_trial_keeps_its_factors_through_pickling(tmp_path):
@@ -155,7 +155,7 @@ def test_name_factors_are_the_named_groups_searched_in_the_stem(caplog):
 def test_a_bad_name_pattern_is_refused_naming_the_flag(bad, said):
     with pytest.raises(InputError, match=said) as e:
         name_pattern(bad)
-    assert e.value.field == "--factors-from-name"
+    assert e.value.field == "factors_from_name"
     with pytest.raises(InputError) as e:
         MocapImport(factors_from_name=bad)
     assert e.value.field.endswith("factors_from_name")

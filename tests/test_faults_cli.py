@@ -338,6 +338,6 @@ def test_recognize_tracks_names_the_clip_of_a_planning_error(monkeypatch, error)
         pipeline.recognize_tracks(None, Scenes(), source="clip.mp4")
     if isinstance(error, PlanningError):
         assert info.value.path == "clip.mp4" and info.value.field == "distance"
-        assert "out of the arm's reach" in str(info.value) and "--px-per-m" in str(info.value)
+        assert "out of the arm's reach" in str(info.value) and "`px_per_m`" in str(info.value)
     else:
         assert not isinstance(info.value, InputError | PlanningError)

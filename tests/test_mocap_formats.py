@@ -69,7 +69,7 @@ def test_unknown_layout_is_one_line_naming_what_was_expected(tmp_path):
     assert table_layout(path) is None
     err = unknown_layout(path)
     assert str(path) in str(err) and "'subject,age,hand'" in err.problem
-    for layout in ("Qualisys", "Vicon Nexus", "Motive", "X, Y and Z", "--columns"):
+    for layout in ("Qualisys", "Vicon Nexus", "Motive", "X, Y and Z", "`columns`"):
         assert layout in err.problem and layout in LAYOUTS_READ
     assert "pose" not in str(err) and "\n" not in str(err)
     wide = _write(tmp_path, "wide.csv", ",".join(["1.5"] * 20) + "\n")
@@ -152,8 +152,8 @@ def test_vicon_refusals(tmp_path):
     assert err.field == "Trajectories" and "without a Trajectories block" in err.problem
     assert "Devices" in err.problem
     err = _refused(VICON, time_column="Frame")
-    assert err.field == "--time-column" and "no time column" in err.problem
-    assert _refused(VICON, trial_column="trial").field == "--trial-column"
+    assert err.field == "time_column" and "no time column" in err.problem
+    assert _refused(VICON, trial_column="trial").field == "trial_column"
     text = VICON.read_text().replace(",,mm,mm,mm,mm", ",,mm,cm,mm,mm")
     mixed = _write(tmp_path, "mixed.csv", text)
     err = _refused(mixed)
@@ -191,15 +191,15 @@ def test_motive_length_units(tmp_path, motive):
 
 def test_motive_rate_given_must_agree_with_its_clock(motive):
     err = _refused(MOTIVE, rate=60)
-    assert err.field == "--rate" and "'Time (Seconds)'" in err.problem
-    assert "120 samples/s" in err.problem and "--time-column none" in err.problem
+    assert err.field == "rate" and "'Time (Seconds)'" in err.problem
+    assert "120 samples/s" in err.problem and "`time_column` none" in err.problem
     (trial,) = read_mocap(MOTIVE, rate=60, time_column="none")
     np.testing.assert_allclose(trial.time, np.arange(36) / 60)
     assert any("'Time (Seconds)' ignored" in n for n in trial.notes)
     (same,) = read_mocap(MOTIVE, rate=120.5)  # within 1 %
     assert same.rate == 120.5
     np.testing.assert_array_equal(same.time, motive.time)
-    assert _refused(MOTIVE, time_column="Frame").field == "--time-column"
+    assert _refused(MOTIVE, time_column="Frame").field == "time_column"
 
 
 # -- headerless tables (RTMocap's layout) ---------------------------------------------
@@ -216,18 +216,18 @@ def test_headerless_table_with_columns():
 
 def test_headerless_refusals(tmp_path):
     err = _refused(HEADERLESS, rate=200)
-    assert err.field == "--columns" and "18 columns" in err.problem and "6 markers" in err.problem
+    assert err.field == "columns" and "18 columns" in err.problem and "6 markers" in err.problem
     err = _refused(HEADERLESS, rate=200, columns=("object", "thumb", "index"))
-    assert err.field == "--columns" and "9 columns" in err.problem and "18 columns" in err.problem
+    assert err.field == "columns" and "9 columns" in err.problem and "18 columns" in err.problem
     err = _refused(HEADERLESS, columns=RTMOCAP)
-    assert err.field == "--rate"
+    assert err.field == "rate"
     err = _refused(HEADERLESS, rate=200, columns=("a", "a", "b", "c", "d", "e"))
-    assert err.field == "--columns" and "'a' named twice" in err.problem
+    assert err.field == "columns" and "'a' named twice" in err.problem
     err = _refused(DATA / "optotrak-trials.tsv", rate=85, columns=RTMOCAP)
-    assert err.field == "--columns" and "header" in err.problem
+    assert err.field == "columns" and "header" in err.problem
     wide = _write(tmp_path, "wide.txt", "\n".join(["\t".join(["1.5"] * 20)] * 3))
     err = _refused(wide, rate=100)
-    assert err.field == "--columns" and "20 columns" in err.problem
+    assert err.field == "columns" and "20 columns" in err.problem
     assert "not a multiple of 3" in err.problem
 
 
@@ -259,7 +259,7 @@ def test_time_column_of_steps_names_the_clock(tmp_path):
     err = _refused(path)
     assert err.field == "time" and "steps between samples" in err.problem
     assert "not a clock" in err.problem and "'globalTime'" in err.problem
-    assert "--time-column" in err.problem
+    assert "`time_column`" in err.problem
     trials = read_mocap(path, time_column="globalTime")
     assert [t.name for t in trials] == ["optotrak-trial1", "optotrak-trial2"]
     assert trials[0].rate == pytest.approx(85, rel=0.02)
@@ -268,15 +268,15 @@ def test_time_column_of_steps_names_the_clock(tmp_path):
     plain = read_mocap(path, time_column="none", rate=85)
     np.testing.assert_allclose(plain[1].time, np.arange(30) / 85)
     assert any("'time' ignored" in n for n in plain[0].notes)
-    assert _refused(path, time_column="none").field == "--rate"
+    assert _refused(path, time_column="none").field == "rate"
 
 
 def test_frame_counter_is_not_ms(tmp_path):
     rows = "\n".join(f"{i},{100 + i},{20},{30}" for i in range(10))
     path = _write(tmp_path, "frames.csv", "time,a_x,a_y,a_z\n" + rows + "\n")
     err = _refused(path)
-    assert err.field == "--rate" and "counts frames" in err.problem
-    assert "--time-column" in err.problem
+    assert err.field == "rate" and "counts frames" in err.problem
+    assert "`time_column`" in err.problem
     (trial,) = read_mocap(path, rate=100)
     np.testing.assert_allclose(trial.time, np.arange(10) / 100)
     assert trial.rate == 100.0 and any("counts frames" in n for n in trial.notes)
@@ -289,7 +289,7 @@ def test_rate_given_and_time_column_are_reconciled(tmp_path):
     rows = "\n".join(f"{i / 100:.2f},{100 + i},{20},{30}" for i in range(10))
     path = _write(tmp_path, "t.csv", "t,a_x,a_y,a_z\n" + rows + "\n")
     err = _refused(path, rate=50)
-    assert err.field == "--rate" and "disagrees with the time column 't'" in err.problem
+    assert err.field == "rate" and "disagrees with the time column 't'" in err.problem
     (trial,) = read_mocap(path, rate=100.5)
     assert trial.rate == 100.5 and trial.time[5] == pytest.approx(0.05)
     (trial,) = read_mocap(path, rate=50, time_column="none")
@@ -299,7 +299,7 @@ def test_rate_given_and_time_column_are_reconciled(tmp_path):
 def test_qtm_rate_given_against_its_time_column(tmp_path):
     qtm = DATA / "qualisys-recording.tsv"
     err = _refused(qtm, rate=50)
-    assert err.field == "--rate" and "'Time'" in err.problem and "FREQUENCY" in err.problem
+    assert err.field == "rate" and "'Time'" in err.problem and "FREQUENCY" in err.problem
     (trial,) = read_mocap(qtm, rate=50, time_column="none")
     assert trial.rate == 50.0 and trial.time[200] == pytest.approx(4.0)
     assert any("FREQUENCY says 100" in n for n in trial.notes)
@@ -354,7 +354,7 @@ def test_repeated_trial_id_is_not_merged(tmp_path):
 def test_a_phase_column_is_not_a_trial_column():
     err = _refused(DATA / "optotrak-trials.tsv", rate=85, trial_column="graspPhase")
     assert err.field == "graspPhase" and "does not number the trials" in err.problem
-    assert "--trial-column" in err.problem
+    assert "`trial_column`" in err.problem
 
 
 def test_truncated_c3d_is_said_to_be_short(tmp_path):

@@ -254,7 +254,7 @@ def test_landmarks_of_pose_like_tracks_need_no_wrist_and_no_object():
     table = landmarks(bare, px_per_m=1000.0)
     assert len(table) == 1 and table.loc[0, "status"] == "complete"
     assert 1.0 < table.loc[0, "movement_time"] < 2.5
-    with pytest.raises(Exception, match="px-per-m"):
+    with pytest.raises(Exception, match="px_per_m"):
         landmarks(bare)
 
 

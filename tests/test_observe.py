@@ -103,7 +103,7 @@ def test_too_short_and_no_scale_and_no_movement():
                            status=tracks.status[:5])
     with pytest.raises(InputError, match="too short"):
         observe(short)
-    with pytest.raises(InputError, match="px-per-m"):
+    with pytest.raises(InputError, match="px_per_m"):
         observe(tracks.replace(tracker={}))
     assert observe(tracks.replace(tracker={}), ObserveParams(px_per_m=800.0)).n_frames > 20
     still = tracks.position.copy()

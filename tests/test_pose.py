@@ -104,7 +104,7 @@ def test_trackpy_links_and_measures_our_export(tracks, tmp_path):
 
 @pytest.mark.parametrize("options, message", [
     (PoseImport(keypoints={"thumb": "nope"}, fps=30), "keypoint 'nope'"),
-    (PoseImport(individual="ghost", fps=30), "--individual 'ghost'"),
+    (PoseImport(individual="ghost", fps=30), "`individual` 'ghost'"),
     (PoseImport(), "no frame rate"),
 ])
 def test_bad_mappings_name_the_problem(tracks, tmp_path, options, message):

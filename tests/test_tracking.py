@@ -202,7 +202,7 @@ def test_truncated_video_is_refused_unless_kept_and_fps_overrides_the_container(
     data = clip.video.read_bytes()
     cut.write_bytes(data[: int(len(data) * 0.6)])  # the AVI index and the last frames gone
     out = tmp_path / "cut.tracks.h5"
-    with pytest.raises(InputError, match="truncated or corrupt video.*--keep-truncated") as err:
+    with pytest.raises(InputError, match="truncated or corrupt video.*`keep_truncated`") as err:
         track_video(cut, out)
     assert str(err.value).startswith(str(cut)) and not out.exists()
     tracks = Tracks.load(track_video(cut, out, keep_truncated=True))

@@ -200,6 +200,7 @@ def _watch_recording(args: argparse.Namespace, signals: _Signals) -> int:
     import numpy as np
 
     from hammer_mv.cli.checks import writable_folder
+    from hammer_mv.cli.flags import flag_text
     from hammer_mv.cli.options import load_repertoire, mocap_import, recognition_settings
     from perception.batch import remove_stale_reports
     from perception.errors import InputError
@@ -265,7 +266,7 @@ def _watch_recording(args: argparse.Namespace, signals: _Signals) -> int:
         try:
             result = rec.finish(dict(tracks.video), source=reach.source, paths=prepared.paths)
         except HammerMVError as exc:  # this reach's (too few rows when interrupted, ...)
-            missed.append((reach.name, f"failed: {exc.problem}"))
+            missed.append((reach.name, f"failed: {flag_text(exc.problem)}"))
             continue
         online = {**decision_summary(result, rec.decision), "source": "recording",
                   "frames": len(latency), "dropped_frames": 0, "read_ahead_dropped": 0,

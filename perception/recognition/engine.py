@@ -226,13 +226,12 @@ def _terms(r_obs: np.ndarray, g_obs: np.ndarray, pred: _Predicted, valid: np.nda
 class StepScorer:
     """Every model's one-step predictions and scores, one frame at a time.
 
-    The engine's only implementation of a step: :func:`recognize` runs it
+    The engine's only implementation of a step: :func:`score_clip` runs it
     over a whole observation (the predictions frame by frame, their scoring
-    vectorised), :class:`perception.online.OnlineRecognizer` frame by frame
-    as they arrive (:meth:`step`); after frame *n* the sums equal
-    :func:`recognize`'s arrays' column *n*. Each step costs the same however
-    long the stream has run: the state is the filters' estimate and the
-    last frame, never the history.
+    vectorised); fed one frame at a time (:meth:`step`), after frame *n* its
+    sums equal :func:`score_clip`'s arrays' column *n*. Each step costs the
+    same however many came before: the state is the filters' estimate and
+    the last frame, never the history.
 
     Parameters
     ----------

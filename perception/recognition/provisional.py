@@ -83,9 +83,7 @@ class SettleRule:
         a grip seen to depart; 0 without a familiarity)."""
         if verdict.rule == "grip-departs":
             return math.inf
-        fam = verdict.familiarity
-        return abs(math.log(max(fam, 1e-300) / rules.familiarity_threshold)) \
-            if math.isfinite(fam) else 0.0
+        return _log_margin(verdict.familiarity, rules.familiarity_threshold)
 
     def sure(self, verdict: Verdict, evidence: Evidence, grip, rules: VerdictRules,
              progress: float) -> bool:
@@ -118,8 +116,7 @@ class SettleRule:
             return False
         tf = evidence.transport_familiarity
         if self.evidence(verdict, evidence, rules) < self.margin or (
-                math.isfinite(tf) and abs(math.log(max(tf, 1e-300) / rules.unfamiliar_threshold))
-                < self.margin):
+                math.isfinite(tf) and _log_margin(tf, rules.unfamiliar_threshold) < self.margin):
             return False
         if grip.opened:  # the maximum is past, and with it the time for a second opening
             return (grip.closing >= self.closing and grip.peaks == 1
@@ -127,6 +124,11 @@ class SettleRule:
                     and lm.opening_time <= rules.late_opening - self.late_margin)
         return (progress >= self.reach_progress and grip.slowed >= self.reach_slowed
                 and grip.opening < self.reach_opening)
+
+
+def _log_margin(value: float, threshold: float) -> float:
+    """``|ln(value / threshold)|``: how far a familiarity is from its threshold (0 for NaN)."""
+    return abs(math.log(max(value, 1e-300) / threshold)) if math.isfinite(value) else 0.0
 
 
 @dataclass(frozen=True)
