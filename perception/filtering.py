@@ -3,19 +3,26 @@
 A constant-velocity tracker with fixed gains: each frame's position is
 predicted from the last estimate and velocity, then corrected by ``alpha``
 (position) and ``beta`` (velocity) times the residual. It lags a frame or
-so but never looks ahead, so the online recogniser
-(:class:`perception.online.OnlineRecognizer`, one frame at a time through
-:class:`AlphaBeta`) and the offline observation (:func:`alpha_beta`, a whole
-clip) filter identically. docs/recognition.md says why the positions are
+so but never looks ahead: :func:`alpha_beta` of a clip is :class:`AlphaBeta`
+run over its frames one at a time, and a series that begins with one
+filtered before resumes from it (the online recogniser observes the rows so
+far after every row). docs/recognition.md says why the positions are
 filtered at all: with raw tracks half a pixel of noise randomises the sign
 of the small per-frame changes the thesis's confidence rule counts.
 """
 
 from __future__ import annotations
 
+import copy
+import threading
+
 import numpy as np
 
 __all__ = ["AlphaBeta", "alpha_beta"]
+
+#: Filtered series kept per thread to resume from (:func:`alpha_beta`).
+RESUMABLE = 4
+_KEPT = threading.local()
 
 
 def alpha_beta(z: np.ndarray, dt: np.ndarray | float, alpha: float, beta: float) -> np.ndarray:
@@ -39,10 +46,44 @@ def alpha_beta(z: np.ndarray, dt: np.ndarray | float, alpha: float, beta: float)
     z = np.asarray(z, dtype=float)
     dt = np.broadcast_to(np.asarray(dt, dtype=float), (z.shape[0],))
     out = np.full_like(z, np.nan)
-    step = AlphaBeta(z.shape[1:], alpha, beta)
-    for i in range(z.shape[0]):
+    start, step = _resume(z, dt, alpha, beta, out)
+    for i in range(start, z.shape[0]):
         out[i] = step(z[i], dt[i])
+    _keep(z, dt, alpha, beta, out, step)
     return out
+
+
+def _resume(z, dt, alpha, beta, out) -> tuple[int, AlphaBeta]:
+    """Where to start filtering ``z``: after the longest series filtered before (in this
+    thread, with these gains) that ``z`` and ``dt`` begin with, its output copied into
+    ``out``; else at 0.
+
+    The online recogniser observes the rows so far after every row: each call
+    is the last one's series and one row more. The filter is causal, so the
+    rows it has filtered are filtered alike (the same operations on the same
+    numbers) and only the new ones cost anything.
+    """
+    best = None
+    for kept in getattr(_KEPT, "series", ()):
+        kz, kdt, ka, kb, kout, kstep = kept
+        n = len(kz)
+        if (ka == alpha and kb == beta and kz.shape[1:] == z.shape[1:] and n <= len(z)
+                and (best is None or n > len(best[0]))
+                and np.array_equal(kz, z[:n], equal_nan=True) and np.array_equal(kdt, dt[:n])):
+            best = kept
+    if best is None:
+        return 0, AlphaBeta(z.shape[1:], alpha, beta)
+    n = len(best[0])
+    out[:n] = best[4]
+    return n, copy.deepcopy(best[5])
+
+
+def _keep(z, dt, alpha, beta, out, step) -> None:
+    """Keep a filtered series and the filter's state after it (:func:`_resume`)."""
+    series = [k for k in getattr(_KEPT, "series", ()) if len(k[0]) != len(z)
+              or not np.array_equal(k[0], z, equal_nan=True)]
+    _KEPT.series = [(z.copy(), dt.copy(), alpha, beta, out.copy(), copy.deepcopy(step)),
+                    *series][:RESUMABLE]
 
 
 class AlphaBeta:

@@ -14,7 +14,7 @@ from perception.filtering import AlphaBeta, alpha_beta
 from perception.observation import movement_span
 from perception.online import OnlineRecognizer, SettleRule
 from perception.pipeline import RecognitionSettings, recognize_tracks
-from perception.recognition.engine import HammerParams, StepScorer, recognize
+from perception.recognition.engine import HammerParams, StepScorer, recognize, score_clip
 from perception.recognition.models import SceneSpec
 from perception.recognition.rules import VerdictRules
 from perception.synthetic.independent import draw_independent, independent_tracks
@@ -45,6 +45,40 @@ def test_alpha_beta_one_frame_at_a_time_is_the_offline_filter():
     f = AlphaBeta((3, 2), 0.5, 0.15)
     online = np.stack([f(z[i], dt[i]) for i in range(40)])
     np.testing.assert_array_equal(online, alpha_beta(z, dt, 0.5, 0.15))
+
+
+def test_a_series_resumed_from_one_filtered_before_is_the_series_filtered_whole():
+    """The online recogniser observes the rows so far after every row: alpha_beta resumes
+    from the longest series it filtered before that the new one begins with (bitwise the
+    same), and starts over where an earlier value differs."""
+    rng = np.random.default_rng(1)
+    z = rng.normal(size=(60, 3, 2))
+    z[10:13, 2] = np.nan
+    dt = rng.uniform(0.03, 0.04, 60)
+    step = AlphaBeta((3, 2), 0.5, 0.15)
+    whole = np.stack([step(z[i], dt[i]) for i in range(60)])
+    for n in (20, 21, 45, 60):
+        np.testing.assert_array_equal(alpha_beta(z[:n], dt[:n], 0.5, 0.15), whole[:n])
+    changed = z.copy()
+    changed[5, 0] += 1.0  # not a continuation of anything filtered before
+    step = AlphaBeta((3, 2), 0.5, 0.15)
+    again = np.stack([step(changed[i], dt[i]) for i in range(60)])
+    np.testing.assert_array_equal(alpha_beta(changed, dt, 0.5, 0.15), again)
+    assert not np.array_equal(again, whole, equal_nan=True)
+
+
+def test_scores_of_the_same_movement_are_reused_and_of_another_are_not(rep):
+    obs = recognize_tracks(_tracks("normal"), rep).scored_observation
+    models = rep.for_scene(SceneSpec.of(obs))
+    first = score_clip(obs, models)
+    assert score_clip(dataclasses.replace(obs, wrist=obs.wrist.copy()), models) is first
+    moved = obs.wrist.copy()
+    moved[len(moved) // 2] += 0.01
+    other = score_clip(dataclasses.replace(obs, wrist=moved), models)
+    assert other is not first
+    assert not np.array_equal(other.log_likelihood, first.log_likelihood)
+    with pytest.raises(ValueError):  # shared by every result made from them: read-only
+        first.log_likelihood[0, 0] = 0.0
 
 
 @pytest.mark.parametrize("params", [
