@@ -206,13 +206,14 @@ def measure(source, *, params: LandmarkParams | None = None, mocap=None,
     expect(mocap, MocapImport, "landmarks(mocap=)", optional=True)
     params = LandmarkParams() if params is None else params
     if not isinstance(source, Tracks):
-        from perception.io.mocap import is_mocap_file
+        from perception.sources import input_kind
 
         if not Path(source).exists():  # before its name's ending is read as a layout
             raise InputError("not found", source)
         from perception.recordings import unknown_layout
 
-        if is_mocap_file(source):
+        kind = input_kind(source)
+        if kind is not None and kind.name == "mocap":
             from perception.recordings import read_recording
 
             mocap = MocapImport() if mocap is None else mocap

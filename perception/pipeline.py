@@ -36,8 +36,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from perception.errors import InputError, PlanningError
-from perception.io.mocap import is_mocap_file
-from perception.io.pose import pose_output
 from perception.io.tracks import Tracks, tracks_path_for
 from perception.landmarks import MeasuredPaths, movement_landmarks
 from perception.observation import ObserveParams, observe
@@ -49,6 +47,7 @@ from perception.recognition.repertoire import PlanCache, Repertoire
 from perception.recognition.result import Recognition
 from perception.recognition.rules import VerdictRules, judge
 from perception.recognition.verdict import misfit
+from perception.sources import TRACKS_SUFFIX, VIDEO_SUFFIXES, clip_name
 
 if TYPE_CHECKING:  # the tracker (OpenCV) and movement are imported only when needed
     from perception.io.frame_sample import FrameSample
@@ -67,14 +66,6 @@ __all__ = [
     "recognize_clip",
     "recognize_tracks",
 ]
-
-#: Video file extensions the pipeline accepts (case-insensitive).
-VIDEO_SUFFIXES = (".mp4", ".avi", ".mkv", ".mov", ".m4v")
-#: Name ending of a tracks file.
-TRACKS_SUFFIX = ".tracks.h5"
-#: Endings of pose files (a ``.h5`` that is not a tracks file is read as one).
-POSE_SUFFIXES = (".h5", ".csv", ".slp", ".nc", ".nwb")
-
 
 @dataclass(frozen=True)
 class RecognitionSettings:
@@ -139,29 +130,6 @@ class RecognitionSettings:
         if self.keep_truncated or self.fps is not None:
             out["video"] = {"keep_truncated": self.keep_truncated, "fps": self.fps}
         return out
-
-
-def clip_name(path: str | os.PathLike) -> tuple[str, str]:
-    """Clip name and input kind (``video``, ``tracks``, ``pose``, ``mocap`` or ``unknown``) of a
-    file (a DeepLabCut or SLEAP output is named after its video: ``trial01DLC_….h5``, ``trial01``).
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-        The file.
-    """
-    path = Path(path)
-    name = path.name
-    if name.endswith(TRACKS_SUFFIX):
-        return name[: -len(TRACKS_SUFFIX)], "tracks"
-    if path.suffix.lower() in VIDEO_SUFFIXES:
-        return path.stem, "video"
-    if is_mocap_file(path):
-        return path.stem, "mocap"
-    if path.suffix.lower() in POSE_SUFFIXES:
-        output = pose_output(name)  # DeepLabCut's and SLEAP's: the clip is their video's
-        return (output[0] if output else path.stem), "pose"
-    return path.stem, "unknown"
 
 
 def clip_fingerprint(path: str | os.PathLike, settings: RecognitionSettings,

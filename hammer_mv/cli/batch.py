@@ -30,7 +30,8 @@ def register(sub) -> None:
                        "A motion-capture recording gives a row per reach and per trial not "
                        "scored, with its status and reason. Exits 1 if any clip failed or a "
                        "trial could not be scored (each is in the report, with why).")
-    p.add_argument("input", type=Path, metavar="INPUT",
+    # kept as typed (a Path would make "udp://host" "udp:/host"): its kind is read first
+    p.add_argument("input", metavar="INPUT",
                    help="folder of videos, .tracks.h5 or pose files, or a manifest.csv")
     p.add_argument("-o", "--output", type=Path, required=True, metavar="REPORT_DIR",
                    help="report folder (report.html, summary.csv, per-clip reports)")
@@ -59,6 +60,10 @@ def run(args: argparse.Namespace) -> int:
     # local processes only: a scheduler's workers are its own
     jobs = (args.jobs if args.scheduler and args.jobs >= 1
             else cap_jobs(args.jobs, "batch", quiet=args.quiet))
+    from perception.sources import check_command
+
+    check_command(args.input, "batch")  # a camera or a stream: watch's
+    args.input = Path(args.input)
     output_folder(args.output)
     _not_over_inputs(args.input, args.output)
     found = find_clips(args.input)

@@ -55,7 +55,8 @@ def register(sub) -> None:
                        "its unit, clock and flag (ok, or why it is doubtful), and rows for a "
                        "trial that gives none, with its status and reason (docs/glossary.md "
                        "lists the columns). Exit status 1 when a trial could not be measured.")
-    p.add_argument("inputs", type=Path, nargs="+", metavar="INPUT",
+    # kept as typed (a Path would make "udp://host" "udp:/host"): their kinds are read first
+    p.add_argument("inputs", nargs="+", metavar="INPUT",
                    help="motion-capture recordings, tracks or pose files, videos, folders "
                         "of them, or a batch manifest.csv")
     p.add_argument("-o", "--output", type=Path, required=True, metavar="TABLE.csv",
@@ -113,7 +114,11 @@ def run(args: argparse.Namespace) -> int:
     params, mocap, pose = landmark_settings(args)
     from perception.io.names import output_folder, output_stem
     from perception.pipeline import TRACKS_SUFFIX, clip_name
+    from perception.sources import check_command
 
+    for spec in args.inputs:  # a camera or a stream: watch's
+        check_command(spec, "landmarks")
+    args.inputs = [Path(spec) for spec in args.inputs]
     check_output(args.output, args.inputs)  # never over a recording it reads
     if args.output.suffix.lower() != ".csv":
         raise InputError("the table written is CSV: name an output ending in .csv", args.output,

@@ -27,7 +27,8 @@ def register(sub) -> None:
                        "A recording also gets DIR/<recording>.trials.csv, a row per reach and "
                        "per trial not scored, with its status and reason; exit status 1 when "
                        "a trial or reach could not be scored (docs/mocap.md).")
-    p.add_argument("input", type=Path, metavar="INPUT",
+    # kept as typed (a Path would make "udp://host" "udp:/host"): its kind is read first
+    p.add_argument("input", metavar="INPUT",
                    help="video, .tracks.h5, pose file (.h5, .csv, .slp, .nc, .nwb) or "
                         "motion-capture file (.c3d, Qualisys .tsv, X/Y/Z table)")
     p.add_argument("-o", "--output", type=Path, required=True, metavar="DIR",
@@ -91,17 +92,17 @@ def run(args: argparse.Namespace) -> int:
     )
     from perception.report.clip import write_clip_report
     from perception.report.tracking import write_tracking_report
+    from perception.sources import check_command
 
-    path: Path = args.input
+    kind = check_command(args.input, "recognize")  # a camera or a stream: watch's
+    path = args.input = Path(args.input)
     output_folder(args.output)  # before any tracking
     if not path.exists():
         raise InputError("input not found", path)
     if path.is_dir():
-        raise InputError("expected a video, tracks or pose file, got a folder "
-                         "(use hammer-mv batch)", path)
-    from perception.io.mocap import is_mocap_file
-
-    if is_mocap_file(path):
+        raise InputError("expected a video, tracks file, pose file or motion-capture "
+                         "recording, got a folder (use hammer-mv batch)", path)
+    if kind is not None and kind.name == "mocap":
         return _run_mocap(args, path)
     from perception.recordings import unknown_layout
 
@@ -109,7 +110,7 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(why, path)
     clip, kind = clip_name(path)
     if kind == "unknown":
-        raise InputError("not a video, .tracks.h5 or pose file", path)
+        raise InputError("not a video, tracks file, pose file or motion-capture recording", path)
     clip = _own_clip(args.output, clip, path)
     settings = recognition_settings(args)
     rep, rep_id = load_repertoire(args)

@@ -94,14 +94,15 @@ def _watch(args: argparse.Namespace, signals: _Signals) -> int:
     from perception.pipeline import clip_fingerprint, clip_name, load_clip
     from perception.report import clip as report
     from perception.report.tracking import write_tracking_report
+    from perception.sources import check_command
 
-    kind = source_kind(args.source)
-    if kind == "file" and _is_recording(args.source):
+    taken = check_command(args.source, "watch")  # a tracks file: recognize's
+    if taken is not None and taken.name == "mocap":
         return _watch_recording(args, signals)
-    if kind == "file" and clip_name(args.source)[1] == "pose":
+    kind = source_kind(args.source)
+    if taken is not None and taken.name == "pose":
         kind = "pose"  # a pose file's keypoints, row by row
-    clip = args.clip or {"camera": f"camera{args.source}", "stream": "stream"}.get(kind) \
-        or clip_name(args.source)[0]
+    clip = args.clip or clip_name(args.source)[0]
     # every output refused before the source opens if it cannot be written or is an input
     # (the source named as a path or as FFmpeg's file: URL)
     source = [] if kind == "camera" else [args.source, args.source.removeprefix("file:")]
@@ -175,14 +176,6 @@ def _watch(args: argparse.Namespace, signals: _Signals) -> int:
         print(f"hammer-mv watch: error: labelled video not written: {draw.error}",
               file=sys.stderr)
     return 128 + signals.received if signals.received else 2 if draw.error else 0
-
-
-def _is_recording(source: str) -> bool:
-    """Whether ``source`` names a motion-capture recording (C3D, Qualisys TSV, a lab table)."""
-    from perception.io.mocap import is_mocap_file
-
-    path = Path(source)
-    return path.is_file() and is_mocap_file(path)
 
 
 def _watch_recording(args: argparse.Namespace, signals: _Signals) -> int:

@@ -23,7 +23,15 @@ from pathlib import Path
 
 from perception.errors import InputError
 
-__all__ = ["NAME_MAX", "STEM_MAX", "output_folder", "output_stem", "printable"]
+#: Video file extensions (case-insensitive).
+VIDEO_SUFFIXES = (".mp4", ".avi", ".mkv", ".mov", ".m4v")
+#: Name ending of a tracks file.
+TRACKS_SUFFIX = ".tracks.h5"
+#: Endings of pose files (a ``.h5`` that is not a tracks file is read as one).
+POSE_SUFFIXES = (".h5", ".csv", ".slp", ".nc", ".nwb")
+
+__all__ = ["NAME_MAX", "POSE_SUFFIXES", "STEM_MAX", "TRACKS_SUFFIX", "VIDEO_SUFFIXES",
+           "output_folder", "output_stem", "printable"]
 
 #: The longest file name (bytes) on the usual file systems (ext4, XFS, APFS, NTFS).
 NAME_MAX = 255

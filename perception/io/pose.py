@@ -42,6 +42,7 @@ from perception.io.atomic import write_bytes, write_text
 from perception.io.files import input_file
 from perception.io.movement_import import POSE_EXTRA as _EXTRA
 from perception.io.movement_import import movement_loaders as _movement
+from perception.io.names import POSE_SUFFIXES, TRACKS_SUFFIX, VIDEO_SUFFIXES
 from perception.io.tracks import Status, Tracks, position_bounds
 from perception.limits import MAX_FPS, MAX_FRAMES, MAX_KEYPOINTS, MAX_MARKERS, MAX_POSE_POINTS
 from perception.track_cleaning import TrackCleaning, clean_tracks
@@ -63,14 +64,10 @@ __all__ = [
 
 #: The markers recognition needs, in the tracks' column order.
 MARKERS = ("thumb", "finger", "wrist", "object")
-#: File endings read as pose files (a ``.h5`` is a pose file unless it is a tracks file).
-POSE_SUFFIXES = (".h5", ".csv", ".slp", ".nc", ".nwb")
 #: The pandas HDF key of a DeepLabCut ``.h5`` table (as DeepLabCut writes it).
 DLC_KEY = "df_with_missing"
 #: ``movement``'s name for each source, by how the file is recognised.
 _SOURCES = {"dlc": "DeepLabCut", "sleap": "SLEAP", "lp": "LightningPose", "nwb": "NWB"}
-#: Endings of the video a pose file was made from (as ``perception.pipeline.VIDEO_SUFFIXES``).
-_VIDEO_SUFFIXES = (".mp4", ".avi", ".mkv", ".mov", ".m4v")
 _VIDEO = r"\.(?:mp4|avi|mkv|mov|m4v)"
 #: ``<video stem>`` and a DeepLabCut scorer (``DLC_…``; ``DeepCut_…`` before DeepLabCut 2.1).
 _DLC = r"(?P<video>.+?)(?-i:DLC|DeepCut)_.+?"
@@ -228,7 +225,7 @@ def is_pose_file(path: str | os.PathLike) -> bool:
         A file name.
     """
     name = Path(path).name.lower()
-    return name.endswith(POSE_SUFFIXES) and not name.endswith(".tracks.h5")
+    return name.endswith(POSE_SUFFIXES) and not name.endswith(TRACKS_SUFFIX)
 
 
 def pose_output(name: str) -> tuple[str, int | str] | None:
@@ -256,7 +253,7 @@ def video_beside(path: str | os.PathLike) -> Path | None:
         its DeepLabCut or SLEAP name (:func:`pose_output`).
     """
     stem = _video_stem(Path(path))
-    videos = (Path(path).with_name(stem + s) for e in _VIDEO_SUFFIXES for s in (e, e.upper()))
+    videos = (Path(path).with_name(stem + s) for e in VIDEO_SUFFIXES for s in (e, e.upper()))
     return next((v for v in videos if v.is_file()), None)
 
 
