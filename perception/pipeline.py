@@ -421,7 +421,7 @@ def _canonical(obs, repertoire: Repertoire, source, rules: VerdictRules):
     scene, durations = repertoire.reference()
     scene = dataclasses.replace(scene, object_size=obs.object_diameter)
     try:
-        return canonical(obs, scene, durations, rules)
+        return canonical(obs, scene, durations, rules, repertoire.wrist_offset())
     except InputError as exc:
         raise type(exc)(exc.problem, source or obs.clip, field=exc.field) from None
 

@@ -168,3 +168,21 @@ def test_fast_movements_are_judged_against_the_fastest_models(condition, verdict
         rec = recognize_tracks(demo_tracks(condition, 1, duration=duration)[0],
                                default_repertoire())
         assert rec.verdict == verdict, (condition, duration, rec.decision)
+
+
+def test_the_transport_is_scaled_about_the_reference_models_own_wrist_goal():
+    """Before, the goal was GraspTask's class default (6 cm) whatever the repertoire's tasks
+    set: a repertoire whose wrists stop 8 cm short scaled transports about the wrong point."""
+    from perception.recognition.planning import default_specs
+    from perception.recognition.repertoire import Repertoire
+
+    specs = default_specs((1.0,))
+    scene = SceneSpec(distance=0.25, object_size=0.10, frame_period=1 / 30)
+    rep = Repertoire.build(specs, scene, task={"wrist_offset": 0.08})
+    assert rep.wrist_offset() == 0.08 and default_repertoire().wrist_offset() == 0.06
+    tracks = demo_tracks("normal", 0, distance=0.30)[0]
+    rec = recognize_tracks(tracks, rep)
+    n = rec.normalisation
+    assert n.wrist_offset == 0.08 and rec.to_dict()["shape"]["wrist_offset"] == 0.08
+    start = rec.observation.start_distance
+    assert n.distance_scale == pytest.approx((0.25 - 0.08) / (start - 0.08))

@@ -241,7 +241,7 @@ def grip_course(rec: Recognition) -> SimpleNamespace:
     rec : Recognition
         The recognition of the rows so far.
     """
-    from perception.recognition.shape import WRIST_GOAL_OFFSET, rest_and_opening
+    from perception.recognition.shape import rest_and_opening
 
     obs, ev = rec.observation, rec.evidence
     raw = obs.raw or {}
@@ -251,7 +251,7 @@ def grip_course(rec: Recognition) -> SimpleNamespace:
     _, opening = rest_and_opening(g, rec.rules)
     closing = float(g.max() - g[-1]) / opening if opening > 0 and g.size else 0.0
     # the wrist's displacement from where the movement started, against its way to the goal
-    way = obs.start_distance - WRIST_GOAL_OFFSET
+    way = obs.start_distance - rec.normalisation.wrist_offset
     moved = np.linalg.norm(obs.wrist - obs.wrist[0], axis=1) / way
     progress = float(np.clip(np.nanmax(moved, initial=0.0), 0.0, 1.0))
     opened = rec.judged is not None and rec.kinds[rec.judged[0]] == "grasp"

@@ -109,6 +109,12 @@ class Repertoire:
         times = times or [m.duration for m in self.models]
         return scene, (float(min(times)), float(max(times)))
 
+    def wrist_offset(self) -> float:
+        """Where the grasp models' wrists stop short of the object centre, m: their tasks'
+        own ``wrist_offset`` (the most common; :class:`minvar.GraspTask`'s by default).
+        The reference scale scales a transport about it (:mod:`perception.recognition.shape`)."""
+        return _wrist_offset(m.spec for m in self.models)
+
     @classmethod
     def build(cls, specs: Iterable[ModelSpec] | None = None,
               scene: SceneSpec | None = None, *, task: dict | None = None) -> Repertoire:
@@ -326,6 +332,16 @@ def _shipped_calibrations() -> dict[str, Calibration]:
         return {}
 
 
+def _wrist_offset(specs: Iterable[ModelSpec]) -> float:
+    """The most common ``wrist_offset`` of the grasp specs' tasks (of all, if none grasps)."""
+    from minvar.grasp_task import GraspTask
+
+    specs = list(specs)
+    grasp = [s for s in specs if s.kind == "grasp"] or specs
+    offsets = [float(s.task.get("wrist_offset", GraspTask.wrist_offset)) for s in grasp]
+    return max(offsets, key=offsets.count) if offsets else float(GraspTask.wrist_offset)
+
+
 class LazyRepertoire(Repertoire):
     """The default repertoire (:meth:`Repertoire.default`), planned on first use.
 
@@ -364,6 +380,9 @@ class LazyRepertoire(Repertoire):
         # without planning the default scene's models
         times = [float(s.task["duration"]) for s in self._specs if s.kind == "grasp"]
         return self._scene, (min(times), max(times))
+
+    def wrist_offset(self) -> float:
+        return _wrist_offset(self._specs)
 
     def __len__(self) -> int:
         return len(self._specs)

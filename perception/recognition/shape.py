@@ -46,8 +46,9 @@ from perception.recognition.rules import VerdictRules
 __all__ = ["WRIST_GOAL_OFFSET", "Normalisation", "canonical", "closed_hand", "is_mirrored",
            "opens", "rest_and_opening"]
 
-#: Where the models' wrists stop: this far short of the object centre, m (the
-#: grasp task's own ``wrist_offset``).
+#: Where the models' wrists stop by default: this far short of the object centre, m
+#: (the grasp task's default ``wrist_offset``; a repertoire's own:
+#: :meth:`~perception.recognition.repertoire.Repertoire.wrist_offset`).
 WRIST_GOAL_OFFSET: float = GraspTask.wrist_offset
 
 
@@ -64,11 +65,15 @@ class Normalisation:
         repertoire's fastest model; 1 within the repertoire's range).
     distance_scale : float
         Reference transport / its transport.
+    wrist_offset : float
+        Where the models' wrists stop short of the object centre, m: the goal
+        the transport was scaled about.
     """
 
     movement_time: float
     time_scale: float
     distance_scale: float
+    wrist_offset: float = WRIST_GOAL_OFFSET
 
     def to_dict(self) -> dict:
         """JSON-able fields."""
@@ -88,7 +93,8 @@ def _resample(t_new: np.ndarray, t: np.ndarray, xy: np.ndarray) -> np.ndarray:
 
 
 def canonical(obs: Observation, scene: SceneSpec, durations: tuple[float, float],
-              rules: VerdictRules | None = None) -> tuple[Observation, Normalisation]:
+              rules: VerdictRules | None = None, wrist_offset: float = WRIST_GOAL_OFFSET
+              ) -> tuple[Observation, Normalisation]:
     """``obs`` brought to ``scene`` and the range of ``durations`` (see the module docstring).
 
     Parameters
@@ -101,6 +107,9 @@ def canonical(obs: Observation, scene: SceneSpec, durations: tuple[float, float]
         The shortest and longest reference movement time, s.
     rules : VerdictRules, optional
         Its ``min_transport``.
+    wrist_offset : float
+        Where the reference models' wrists stop short of the object centre, m
+        (:meth:`~perception.recognition.repertoire.Repertoire.wrist_offset`).
 
     Returns
     -------
@@ -120,12 +129,12 @@ def canonical(obs: Observation, scene: SceneSpec, durations: tuple[float, float]
         raise InputError("the wrist is seen too little to measure the movement time",
                          obs.clip, field="wrist")
     alpha = float(np.clip(mt, *durations)) / mt
-    transport = obs.start_distance - WRIST_GOAL_OFFSET
+    transport = obs.start_distance - wrist_offset
     if transport < (VerdictRules() if rules is None else rules).min_transport:
         raise InputError(f"starts {obs.start_distance * 1000:.0f} mm from the object: too near "
                          "to judge a reach", obs.clip, field="wrist")
-    s = (scene.distance - WRIST_GOAL_OFFSET) / transport
-    goal = np.array([0.0, -WRIST_GOAL_OFFSET])
+    s = (scene.distance - wrist_offset) / transport
+    goal = np.array([0.0, -wrist_offset])
     tip = np.array([0.0, scene.tip_start]) - np.asarray(obs.hand_offset, dtype=float)
     wrist = goal + (obs.wrist - goal) * s
     finger = obs.finger - obs.wrist + wrist + tip
@@ -141,7 +150,7 @@ def canonical(obs: Observation, scene: SceneSpec, durations: tuple[float, float]
         start_distance=scene.distance,
         hand_offset=np.asarray(obs.hand_offset, dtype=float) + tip,
         noise=obs.noise * s)
-    return out, Normalisation(float(mt), float(alpha), float(s))
+    return out, Normalisation(float(mt), float(alpha), float(s), float(wrist_offset))
 
 
 def closed_hand(obs: Observation) -> Observation:
