@@ -2,10 +2,13 @@
 
 Generated, not written case by case (issue 46): the classes are found by walking
 :mod:`minvar` and :mod:`perception` for :func:`minvar.validation.declared` classes;
-each numeric field with a declared bound gets a value just past it, NaN and a string,
-and each must be refused with a :class:`~minvar.errors.LocatedError` (a ``ValueError``)
-that names the class and the field in one line — never accepted, never an error
-from deep inside.
+each numeric field (optional or not) gets a value just past each declared bound, NaN
+and a string; a field of choices a word that is none; a field holding a declared class
+a string and a mapping in place of an instance. Each must be refused with a
+:class:`~minvar.errors.LocatedError` (a ``ValueError``) that names the class and the
+field in one line — never accepted, never an error from deep inside. This replaces the
+per-field fault tables (issue 42 item 6): a fault test feeds a value through a file or
+a command only where what it checks is more than the field's declaration.
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ import pytest
 
 import minvar
 import perception
+from hammer_mv.cli.flags import _plain
 from minvar.errors import LocatedError
 from minvar.validation import CONFIG
 
@@ -42,61 +46,9 @@ CLASSES = _declared_classes()
 
 
 def _bounds(info) -> list[tuple[str, float]]:
-    return [(op, getattr(m, op)) for m in info.metadata for op in ("gt", "ge", "lt", "le")
-            if getattr(m, op, None) is not None]
-
-
-def _outside(info) -> list[object]:
-    """Values the field's declaration refuses: just past each bound, NaN, a string."""
-    values: list[object] = []
-    for op, bound in _bounds(info):
-        if op in ("gt", "lt"):
-            values.append(bound)
-        else:
-            step = 1 if info.annotation is int else max(abs(bound), 1.0) * 1e-3
-            values.append(bound - step if op == "ge" else bound + step)
-    if info.annotation is float:
-        values.append(math.nan)
-    return [*values, "x"]
-
-
-def _cases():
-    for _name, cls in sorted(CLASSES.items()):
-        try:
-            cls()
-        except Exception:  # noqa: BLE001 - a class with required fields: not generated
-            continue
-        for field, info in cls.__pydantic_fields__.items():
-            if info.annotation not in (int, float):
-                continue
-            for value in _outside(info):
-                yield pytest.param(cls, field, value, id=f"{cls.__name__}.{field}={value!r}")
-
-
-CASES = list(_cases())
-
-
-def test_the_walk_finds_the_settings_classes_users_set():
-    names = {cls.__name__ for cls in CLASSES.values()}
-    assert {"VerdictRules", "LandmarkParams", "ObserveParams", "TrackerParams", "ReachParams",
-            "MocapImport", "CalibrationParams", "ReachTask", "GraspTask"} <= names
-    assert len(CASES) > 150  # every bounded numeric field of them, several values each
-
-
-@pytest.mark.parametrize(("cls", "field", "value"), CASES)
-def test_a_value_outside_a_declared_range_is_refused_naming_the_field(cls, field, value):
-    with pytest.raises(LocatedError) as caught:
-        cls(**{field: value})
-    message = str(caught.value)
-    assert isinstance(caught.value, ValueError)
-    assert "\n" not in message and f"{cls.__name__}.{field}" in message, message
-
-
-# -- the same on the command line: every flag that sets a declared field ------------------
-
-def _flag_bounds(info) -> list[tuple[str, float]]:
     """A field's bounds, also those inside an optional's ``Annotated`` (``X | None``)."""
-    found = _bounds(info)
+    found = [(op, getattr(m, op)) for m in info.metadata for op in ("gt", "ge", "lt", "le")
+             if getattr(m, op, None) is not None]
 
     def walk(kind):
         for arg in typing.get_args(kind):
@@ -110,6 +62,75 @@ def _flag_bounds(info) -> list[tuple[str, float]]:
     return sorted(set(found))
 
 
+def _past(bounds, kind) -> list[object]:
+    """Values just past each of ``bounds`` (the bound itself where it is excluded)."""
+    values: list[object] = []
+    for op, bound in bounds:
+        if op in ("gt", "lt"):
+            values.append(bound)
+        else:
+            step = 1 if kind is int else max(abs(bound), 1.0) * 1e-3
+            values.append(bound - step if op == "ge" else bound + step)
+    return values
+
+
+def _declared(kind) -> bool:
+    return isinstance(kind, type) and getattr(kind, "__pydantic_config__", None) == CONFIG
+
+
+def _outside(info) -> list[object]:
+    """Values the field's declaration refuses: for a number (optional or not) just past each
+    bound, NaN, a string; a word that is no choice; for a field holding a declared class, a
+    string and a mapping in place of an instance (``MocapImport(markers={...})``)."""
+    kind = _plain(info.annotation)
+    if kind in (int, float):
+        return [*_past(_bounds(info), kind), *([math.nan] if kind is float else []), "x"]
+    if typing.get_origin(kind) is typing.Literal:
+        return ["no-such-choice"]
+    if _declared(kind):
+        return ["x", {"x": 1}]
+    return []
+
+
+def _cases():
+    for _name, cls in sorted(CLASSES.items()):
+        try:
+            cls()
+        except Exception:  # noqa: BLE001 - a class with required fields: not generated
+            continue
+        for field, info in cls.__pydantic_fields__.items():
+            kind = _plain(info.annotation)
+            said = f"{cls.__name__}.{field}" + (
+                f": expected an instance of {kind.__name__}" if _declared(kind) else "")
+            for value in _outside(info):
+                yield pytest.param(cls, field, value, said,
+                                   id=f"{cls.__name__}.{field}={value!r}")
+
+
+CASES = list(_cases())
+
+
+def test_the_walk_finds_the_settings_classes_users_set():
+    names = {cls.__name__ for cls in CLASSES.values()}
+    assert {"VerdictRules", "LandmarkParams", "ObserveParams", "TrackerParams", "ReachParams",
+            "MocapImport", "CalibrationParams", "ReachTask", "GraspTask"} <= names
+    assert len(CASES) > 150  # every bounded numeric field of them, several values each
+    generated = {case.id for case in CASES}
+    assert {"MocapImport.rate=0", "PoseImport.fps=0", "MocapImport.units='no-such-choice'",
+            "MocapImport.markers={'x': 1}", "MocapImport.reaches='x'"} <= generated
+
+
+@pytest.mark.parametrize(("cls", "field", "value", "said"), CASES)
+def test_a_value_outside_a_declared_range_is_refused_naming_the_field(cls, field, value, said):
+    with pytest.raises(LocatedError) as caught:
+        cls(**{field: value})
+    message = str(caught.value)
+    assert isinstance(caught.value, ValueError)
+    assert "\n" not in message and said in message, message
+
+
+# -- the same on the command line: every flag that sets a declared field ------------------
+
 #: Values the declarations of fields that are not numbers refuse (an empty name, a
 #: mapping that is no ROLE=NAME pair, a name twice, a pattern that does not compile).
 NOT_NUMBERS = {"keypoints": ["thumb"], "markers": ["thumb", "thumb=a", "thumb=a finger=a"],
@@ -121,21 +142,13 @@ MEANT = {("--cutoff", "0")}
 def _flag_values(setting) -> list[str]:
     """What to type after ``setting``'s flag: just past each declared bound, NaN, a word
     for a number; a word that is no choice; the refused values of :data:`NOT_NUMBERS`."""
-    from hammer_mv.cli.flags import _plain
-
     info = setting.info()
     kind = _plain(info.annotation)
     if typing.get_origin(kind) is typing.Literal:
         return ["no-such-choice"]
     if kind not in (int, float):
         return NOT_NUMBERS.get(setting.field, [])
-    values = []
-    for op, bound in _flag_bounds(info):
-        if op in ("gt", "lt"):
-            values.append(bound)
-        else:
-            step = 1 if kind is int else max(abs(bound), 1.0) * 1e-3
-            values.append(bound - step if op == "ge" else bound + step)
+    values = _past(_bounds(info), kind)
     words = [f"{v:g}" if isinstance(v, float) else str(v) for v in values]
     return [w for w in [*words, "nan", "x"] if (setting.name, w) not in MEANT]
 

@@ -66,10 +66,10 @@ CASES = [
         (ONE_CLIP + "[[render.occlusions]]\nmarker = \"nose\"\nstart = 1\nstop = 2\n",
          "[[render.occlusions]] #1 marker")]),
     *_keys(load_recipe, RECIPE, head=ONE_CLIP, tables={
-        "scene": [("distance", "1e300"), ("duration", "nan"), ("object_size", "\"big\"")],
+        "scene": [("distance", "1e300"), ("object_size", "\"big\"")],
         "variation": [("camera_angle_deg", "[1]")],
-        "render": [("width", "\"640\""), ("noise_sd", "-3"), ("motion_samples", "2147483648"),
-                   ("hand", "1"), ("sleeve", "\"scarf\""), ("distractors", "5")],
+        "render": [("width", "\"640\""), ("noise_sd", "-3"), ("hand", "1"),
+                   ("sleeve", "\"scarf\""), ("distractors", "5")],
     }),
     *_texts(load_markers, "c.toml", [("[thumb]\nsat_min = nan\n", "thumb.sat_min"),
                                      ("thumb = 3\n", "thumb")]),
@@ -105,12 +105,9 @@ def test_every_tracker_field_has_a_range_and_the_defaults_are_in_it(tmp_path):
     assert load_setup(path).frames == 5
 
 
-@pytest.mark.parametrize("kwargs", [
-    # (each range: tests/test_declared_fields.py) a bool is no integer, a huge one no int32
-    {"search_tries": True}, {"term_max_iter": 2**63 - 1},
-], ids=str)
-def test_tracker_params_from_python_are_checked_too(kwargs):
-    refused(lambda: TrackerParams(**kwargs), match=f"TrackerParams.{next(iter(kwargs))}")
+def test_tracker_params_from_python_are_checked_too():
+    # (each range: tests/test_declared_fields.py) a bool is no integer
+    refused(lambda: TrackerParams(search_tries=True), match="TrackerParams.search_tries")
     assert TrackerParams(min_area_px=10_000_000).min_area_px == 10_000_000  # its upper bound
 
 

@@ -126,9 +126,7 @@ def _evidence():
 @pytest.mark.parametrize("field, value", [
     ("familiarity_threshold", 1.0), ("grasp_rest_frames", 10**9), ("min_transport", 1e308),
 ])
-def test_a_rule_out_of_its_range_is_refused_naming_it(tmp_path, field, value):
-    err = refused(lambda: VerdictRules(**{field: value}))
-    assert field in str(err)
+def test_a_rule_out_of_its_range_in_a_rules_file_names_file_and_key(tmp_path, field, value):
     rules = tmp_path / "rules.toml"
     rules.write_text(f"[verdict]\n{field} = {value!r}\n")
     refused(lambda: VerdictRules.from_dict({field: value}, rules), path=rules,
