@@ -41,7 +41,12 @@ from perception.landmarks import MeasuredPaths, movement_landmarks
 from perception.observation import ObserveParams, observe
 from perception.provenance import code_digest
 from perception.recognition.engine import HammerParams, score_clip
-from perception.recognition.evidence import clip_landmarks, judged_models, movement_evidence
+from perception.recognition.evidence import (
+    clip_landmarks,
+    judged_models,
+    movement_evidence,
+    opening_progress,
+)
 from perception.recognition.models import SceneSpec
 from perception.recognition.repertoire import PlanCache, Repertoire
 from perception.recognition.result import Recognition
@@ -399,7 +404,8 @@ def recognize_tracks(tracks: Tracks, repertoire: Repertoire,
     share = scores.scored[list(judged)].sum(axis=1).max() / max(scores.scored.shape[1] - 1, 1)
     evidence = movement_evidence(
         obs, [scores.kinds[i] for i in judged], scores.log_likelihood[judged, -1],
-        familiarity[list(judged)], landmarks, transport, float(share))
+        familiarity[list(judged)], landmarks, transport, float(share),
+        opening_progress(obs, rules, norm.wrist_offset))
     return Recognition(
         clip=obs.clip, time=scored_obs.time / norm.time_scale, frame=scored_obs.frame,
         **{**scores._asdict(), "familiarity": familiarity}, observation=obs, models=models,

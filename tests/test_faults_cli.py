@@ -331,6 +331,9 @@ def test_recognize_tracks_names_the_clip_of_a_planning_error(monkeypatch, error)
         def reference(self):
             return SceneSpec(), (0.6, 1.2)
 
+        def wrist_offset(self):
+            return 0.06
+
         def for_scene(self, scene, **kwargs):
             raise error
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 
 import numpy as np
 import pytest
@@ -194,6 +195,25 @@ def test_a_stream_too_near_the_object_is_refused_as_offline(rep):
     with pytest.raises(InputError) as online:
         rec.finish()
     assert "too near" in str(offline.value) and online.value.problem == offline.value.problem
+
+
+def test_a_normal_grasp_settles_on_when_its_grip_started_to_open_before_its_end_is_seen(rep):
+    """The landmark opening_time needs the movement's end; before it, the evidence's
+    opening_progress (how far the wrist had come when the grip started to open) is known as
+    soon as the opening starts, and the settle rule reads it (SettleRule.early_opening)."""
+    tracks = _tracks("normal", seed=11)
+    rec, states = _feed(rep, tracks)
+    d = rec.decision
+    assert d is not None and d.verdict == "normal"
+    at = states[next(i for i, s in enumerate(states) if s.decision is not None)].judged_on
+    assert math.isnan(at.observed.opening_time)  # the movement's end not seen yet
+    assert at.opening_progress <= SettleRule().early_opening
+    # the same rows with a rule that asks for an earlier opening than this one's wait
+    late, _ = _feed(rep, tracks, settle=SettleRule(early_opening=at.opening_progress / 2))
+    assert late.decision is None or late.decision.frame > d.frame
+    # before the grip opens it is not known
+    first = next(s for s in states if s.phase == "moving")
+    assert math.isnan(first.judged_on.opening_progress)
 
 
 def test_a_state_says_why_rows_are_not_judged_yet(rep):

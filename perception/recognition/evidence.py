@@ -25,7 +25,7 @@ if TYPE_CHECKING:
     from perception.recognition.models import MotorModel
 
 __all__ = ["clip_landmarks", "judged_models", "model_own_landmarks", "movement_evidence",
-           "reference_model"]
+           "opening_progress", "reference_model"]
 
 
 def judged_models(kinds: Sequence[str], kind: str) -> tuple[int, ...]:
@@ -114,11 +114,53 @@ def clip_landmarks(observation: Observation, models: Sequence[MotorModel],
     return observed, own
 
 
+def _aperture(obs: Observation) -> np.ndarray:
+    """The markers' own aperture (the filtered one coasts through a gap), m."""
+    raw = obs.raw or {}
+    if "finger" in raw and "thumb" in raw:
+        return np.linalg.norm(raw["finger"] - raw["thumb"], axis=1)
+    return obs.g
+
+
+def opening_progress(observation: Observation, rules: VerdictRules,
+                     wrist_offset: float) -> float:
+    """How far the wrist had come on its way to the models' goal when the grip started to
+    open: its displacement from the onset over ``start distance - wrist_offset``, 0..1.
+
+    The grip starts to open where its aperture first exceeds its rest (the mean of
+    the first ``rules.grasp_rest_frames`` seen samples) by ``opening_level`` of its
+    opening, as the landmark ``opening_time`` reads it; NaN where it has not opened
+    by ``rules.grasp_opening`` × the object's diameter.
+
+    Parameters
+    ----------
+    observation : Observation
+        The movement at its own scale.
+    rules : VerdictRules
+    wrist_offset : float
+        Where the models' wrists stop short of the object centre, m.
+    """
+    obs = observation
+    g = _aperture(obs)
+    rows = np.flatnonzero(np.isfinite(g))
+    if len(rows) < 3:
+        return float("nan")
+    gs = g[rows]
+    rest = float(np.mean(gs[:rules.grasp_rest_frames]))
+    opening = float(gs.max()) - rest
+    if opening < rules.grasp_opening * obs.object_diameter:
+        return float("nan")
+    k = rows[int(np.argmax(gs > rest + rules.landmarks.opening_level * opening))]
+    way = obs.start_distance - wrist_offset
+    return float(np.clip(np.linalg.norm(obs.wrist[k] - obs.wrist[0]) / way, 0.0, 1.0))
+
+
 def movement_evidence(observation: Observation, kinds: Sequence[str],
                       log_likelihood: np.ndarray, familiarity: np.ndarray,
                       landmarks: tuple[Landmarks, Landmarks | None] | None = None,
                       transport_familiarity: float = float("nan"),
-                      scored_share: float = 1.0) -> Evidence:
+                      scored_share: float = 1.0,
+                      opening_progress: float = float("nan")) -> Evidence:
     """The :class:`~perception.recognition.rules.Evidence` of a movement.
 
     Parameters
@@ -137,15 +179,15 @@ def movement_evidence(observation: Observation, kinds: Sequence[str],
         The transport's alone to the best reach model (NaN: not measured).
     scored_share : float
         Share of the movement's steps scored.
+    opening_progress : float
+        :func:`opening_progress`'s (NaN: not measured).
     """
     if landmarks is None:
         return Evidence(list(kinds), np.asarray(log_likelihood), np.asarray(familiarity))
     obs = observation
-    raw = obs.raw or {}
-    g = (np.linalg.norm(raw["finger"] - raw["thumb"], axis=1)
-         if "finger" in raw and "thumb" in raw else obs.g)
     return Evidence(list(kinds), np.asarray(log_likelihood), np.asarray(familiarity),
                     transport_familiarity=float(transport_familiarity),
                     rest_aperture=obs.marker_separation, observed=landmarks[0],
-                    reference=landmarks[1], aperture_gap=longest_gap(obs.time, g),
-                    slowed=slowed(obs.time, obs.wrist), scored_share=float(scored_share))
+                    reference=landmarks[1], aperture_gap=longest_gap(obs.time, _aperture(obs)),
+                    slowed=slowed(obs.time, obs.wrist), scored_share=float(scored_share),
+                    opening_progress=float(opening_progress))

@@ -29,33 +29,39 @@ class SettleRule:
     * a grip seen to depart from the transport (``grip-departs``): the wrist
       has covered ``min_progress`` of its way to the models' goal, and the
       grip has opened twice, or — the hand arrived (below) — started to open
-      after ``late_opening + late_margin`` of the movement (estimated from
-      how far the wrist had come);
+      after ``late_opening + late_margin`` of the movement (the landmark,
+      known once the movement's end is seen);
     * a verdict resting on familiarity: the hand has arrived — the transport
       has slowed by ``slowed`` (at least the rules' ``arrival``) from its peak
       speed: a stream cut after that is no longer ``incomplete`` —, the
       leading model's familiarity and the transport's are each at least
       ``margin`` natural-log units from their thresholds, and either the grip
       has opened — once, starting before ``late_opening - late_margin`` of
-      the movement, and closed ``closing`` of its opening since its maximum
-      while the wrist has covered ``arrived`` of its way: the hand is at the
-      object, and a second opening comes on the way there — or it has not
-      opened by even ``reach_opening`` m while the wrist has covered
-      ``reach_progress`` of its way and slowed by ``reach_slowed`` (a late
-      opener has started by then);
+      the movement (before its end is seen: before the wrist had covered
+      ``early_opening`` of its way), and closed ``closing`` of its opening
+      since its maximum while the wrist has covered ``arrived`` of its way:
+      the hand is at the object, and a second opening comes on the way
+      there — or, the movement's end seen, it has not opened by even
+      ``reach_opening`` m while the wrist has covered ``reach_progress`` of
+      its way and slowed by ``reach_slowed`` (a late opener has opened by
+      then);
     * the other rules (``unfamiliar``) settle at the end.
 
     The defaults were chosen on the dev population (seeds 1000 + k,
-    ``tools/evaluate_online.py --set dev``), never on the held-out one.
+    ``tools/evaluate_online.py --set dev``) and the shared Optotrak table's
+    even trials replayed by ``hammer-mv watch``, never on the held-out ones.
 
     Parameters
     ----------
     min_progress, arrived, reach_progress : float
         Share of the wrist's way, 0..1.
     late_margin : float
-        Share of the movement kept from ``late_opening``: on a movement not
-        yet over, when the grip started to open is a share of the movement
-        so far (the landmark of the prefix), which its end moves.
+        Share of the movement kept from ``late_opening`` (the landmark
+        ``opening_time``, known once the movement's end is seen).
+    early_opening : float
+        Before the movement's end is seen: the grip must have started to open
+        before the wrist covered this share of its way
+        (:attr:`~perception.recognition.rules.Evidence.opening_progress`).
     slowed, reach_slowed, closing : float
         Share of the peak speed, of the opening, 0..1.
     reach_opening : float
@@ -75,6 +81,7 @@ class SettleRule:
     reach_progress: Share = 0.7
     reach_slowed: Share = 0.7
     reach_opening: NonNegative = 0.01
+    early_opening: Share = 0.4
     hold: NonNegative = 0.0
 
     @staticmethod
@@ -119,11 +126,16 @@ class SettleRule:
                 math.isfinite(tf) and _log_margin(tf, rules.unfamiliar_threshold) < self.margin):
             return False
         if grip.opened:  # the maximum is past, and with it the time for a second opening
+            # when the grip started to open: the landmark once the movement's end is seen,
+            # before it how far the wrist had come by then
+            early = (lm.opening_time <= rules.late_opening - self.late_margin
+                     if math.isfinite(lm.opening_time)
+                     else evidence.opening_progress <= self.early_opening)
             return (grip.closing >= self.closing and grip.peaks == 1
-                    and progress >= self.arrived
-                    and lm.opening_time <= rules.late_opening - self.late_margin)
+                    and progress >= self.arrived and early)
+        # a late opener opens by the end of its movement: a reach's end must be seen
         return (progress >= self.reach_progress and grip.slowed >= self.reach_slowed
-                and grip.opening < self.reach_opening)
+                and grip.opening < self.reach_opening and math.isfinite(lm.end_time))
 
 
 def _log_margin(value: float, threshold: float) -> float:

@@ -200,6 +200,12 @@ class Evidence:
         (:func:`slowed`; 1: the hand came to rest).
     scored_share : float
         Share of the movement's steps scored.
+    opening_progress : float
+        How far the wrist had come on its way to the models' goal when the
+        grip started to open, 0..1 (NaN: it has not opened as a grasp's must):
+        known as soon as the opening starts, before the movement's end that
+        the landmark ``opening_time`` needs (what the online settle rule reads
+        while the movement is under way; the verdict does not).
     """
 
     kinds: list[str]
@@ -212,6 +218,7 @@ class Evidence:
     aperture_gap: float = 0.0
     slowed: float = 1.0
     scored_share: float = 1.0
+    opening_progress: float = math.nan
 
 
 def slowed(time: np.ndarray, wrist: np.ndarray) -> float:
