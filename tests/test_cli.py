@@ -56,6 +56,73 @@ FLAGS = {
                   ("--px-per-m", "px_per_m", None), ("--object-diameter", "object_diameter", None),
                   ("--object-diameter-px", "object_diameter_px", None), ("--fps", "fps", None),
                   *_MOCAP],
+    # the simulation commands (issue 42 item 6: written down before they were generated)
+    "reach": [("--start", "start", (0.2, 0.2)), ("--goal", "goal", (0.4, 0.5)),
+              ("--duration", "duration", 0.5), ("--via", "via", []),
+              ("--trials", "trials", None), ("--seed", "seed", 0), ("--sweep", "sweep", False),
+              ("--durations", "durations", [0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2]),
+              ("--r", "r", 2e-4), ("--w-v", "w_v", 0.2), ("--w-f", "w_f", 0.01),
+              ("--sigma-u", "sigma_u", 0.4), ("--sigma-s", "sigma_s", 0.4),
+              ("-o --output", "output", None)],
+    "grasp simulate": [
+        ("--object-size", "object_size", 0.04), ("--distance", "distance", 0.26),
+        ("--duration", "duration", 1.0), ("--viapoint-offset", "viapoint_offset", 0.01),
+        ("--viapoint-height", "viapoint_height", 0.0), ("--viapoint-time", "viapoint_time", 0.7),
+        ("--tip-start", "tip_start", 0.02), ("--reach-only", "reach_only", False),
+        ("--execution-cv", "execution_cv", 0.01), ("--dt", "dt", 0.01),
+        ("--trials", "trials", 500), ("--seed", "seed", 0), ("-o --output", "output", None)],
+    "repertoire build": [
+        ("-o --output", "output", None),
+        ("--durations", "durations", [0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2]),
+        ("--distance", "distance", 0.25), ("--object-size", "object_size", 0.1),
+        ("--fps", "fps", 30.0)],
+}
+#: What ``--help`` shows of the simulation commands' flags: (metavar, nargs, help).
+SHOWN = {
+    "reach": {
+        "--start": (("X", "Y"), 2, "start position, m (default: 0.2 0.2, thesis Fig. 3.4)"),
+        "--goal": (("X", "Y"), 2, "goal position, m (default: 0.4 0.5)"),
+        "--duration": ("S", None, "movement time, s (default: 0.5)"),
+        "--via": (("X", "Y", "FRACTION"), 3,
+                  "via-point at (X, Y) m, at FRACTION (0-1) of the movement; repeatable"),
+        "--trials": ("N", None, "repetitions (default: 100; 200 per duration with --sweep)"),
+        "--seed": ("N", None, "random seed (default: 0)"),
+        "--sweep": (None, 0, "speed-accuracy sweep over --durations instead of one movement"),
+        "--durations": ("S", "+", "movement times for --sweep, s (default: 0.5 ... 1.2)"),
+        "--r": (None, None, "effort weight r (default: 0.0002)"),
+        "--w-v": (None, None, "final velocity weight (default: 0.2)"),
+        "--w-f": (None, None, "final force weight (default: 0.01)"),
+        "--sigma-u": (None, None, "control-dependent noise scale (default: 0.4)"),
+        "--sigma-s": (None, None, "sensory noise scale (default: 0.4)"),
+        "-o --output": ("DIR", None, "folder for the figures and tables")},
+    "grasp simulate": {
+        "--object-size": ("M", None, "object diameter, m (default 0.04)"),
+        "--distance": ("M", None, "wrist start to object centre, m (default 0.26: the wrist "
+                       "travels 0.2, stopping 0.06 short of the centre)"),
+        "--duration": ("S", None, "movement time, s (default 1.0)"),
+        "--viapoint-offset": ("M", None, "digit via-point distance outside the object, m "
+                              "(default 0.01)"),
+        "--viapoint-height": ("M", None, "digit via-point height above the target line, m "
+                              "(default 0)"),
+        "--viapoint-time": ("F", None, "digit via-point time, fraction of the movement "
+                            "(default 0.7)"),
+        "--tip-start": ("M", None, "how far ahead of the wrist the closed digit tips start, m "
+                        "(default 0.02: below the target line, 0.06 ahead of the wrist at the "
+                        "goal)"),
+        "--reach-only": (None, 0, "transport only: the digits stay closed"),
+        "--execution-cv": ("CV", None, "coefficient of variation of the execution noise "
+                           "(default 0.01)"),
+        "--dt": ("S", None, "time step, s (default 0.01)"),
+        "--trials": ("N", None, "repetitions (default 500)"),
+        "--seed": ("N", None, "random seed (default 0)"),
+        "-o --output": ("DIR", None, "folder for the figures and tables")},
+    "repertoire build": {
+        "-o --output": ("REP.h5", None, "repertoire file to write (HDF5)"),
+        # (says 0.8 where the default starts at 0.5: kept as users read it)
+        "--durations": ("S", "+", "movement times without CONFIG (default: 0.8 ... 1.2)"),
+        "--distance": (None, None, "wrist start to object centre, m (without CONFIG)"),
+        "--object-size": (None, None, "object diameter, m (without CONFIG)"),
+        "--fps": (None, None, "video frame rate (without CONFIG)")},
 }
 #: The flags whose values are a choice.
 CHOICES = {"--rule": ("likelihood", "thesis"), "--thesis-sign": ("text", "printed"),
@@ -63,13 +130,17 @@ CHOICES = {"--rule": ("likelihood", "thesis"), "--thesis-sign": ("text", "printe
 
 
 def _parser(command):
+    """The parser of ``command`` (``"grasp simulate"``: a subcommand's)."""
     import argparse
 
     from hammer_mv.cli import build_parser
 
-    top = build_parser(command)
-    (sub,) = [a for a in top._actions if isinstance(a, argparse._SubParsersAction)]
-    return sub.choices[command]
+    names = command.split()
+    parser = build_parser(names[0])
+    for name in names:
+        (sub,) = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
+        parser = sub.choices[name]
+    return parser
 
 
 @pytest.mark.parametrize("command", sorted(FLAGS))
@@ -81,6 +152,17 @@ def test_the_generated_flags_are_todays(command):
     for action in parser._actions:
         if action.option_strings and action.option_strings[-1] in CHOICES:
             assert tuple(action.choices) == CHOICES[action.option_strings[-1]]
+
+
+@pytest.mark.parametrize("command", sorted(SHOWN))
+def test_the_simulation_flags_help_is_todays(command):
+    shown = {" ".join(a.option_strings): (a.metavar, a.nargs, a.help)
+             for a in _parser(command)._actions
+             if a.option_strings and a.dest not in ("help", "verbose", "quiet")}
+    assert shown == SHOWN[command]
+    types = {" ".join(a.option_strings): a.type for a in _parser(command)._actions}
+    assert {types[f] for f in SHOWN[command] if SHOWN[command][f][1] != 0
+            and f not in ("-o --output", "--trials", "--seed")} == {float}
 
 
 def test_a_field_and_its_flag_are_one_map():
@@ -96,6 +178,20 @@ def test_a_field_and_its_flag_are_one_map():
     assert OWNER_FLAGS[("LandmarkParams", "cutoff")] == "--cutoff"
     # the files and tables the user names are no fields
     assert "setup" not in FIELD_FLAGS and "verdict_rules" not in FIELD_FLAGS
+
+
+def test_the_simulation_flags_are_the_fields_flags():
+    from hammer_mv.cli.flags import OWNER_FLAGS
+
+    for command in ("reach", "grasp simulate", "repertoire build"):
+        _parser(command)
+    assert OWNER_FLAGS[("ReachTask", "w_v")] == "--w-v"
+    assert OWNER_FLAGS[("PointMassPlant", "sigma_s")] == "--sigma-s"
+    assert OWNER_FLAGS[("GraspTask", "viapoint_time")] == "--viapoint-time"
+    assert OWNER_FLAGS[("PointMassPlant", "dt")] == "--dt"
+    assert OWNER_FLAGS[("SceneSpec", "object_size")] == "--object-size"
+    # the flags that set no field: a count, a seed, a rate turned into a period, a list
+    assert not {("ReachTask", "via_points"), ("SceneSpec", "frame_period")} & set(OWNER_FLAGS)
 
 
 @pytest.mark.parametrize("error, line", [

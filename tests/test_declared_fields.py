@@ -134,7 +134,9 @@ def test_a_value_outside_a_declared_range_is_refused_naming_the_field(cls, field
 #: Values the declarations of fields that are not numbers refuse (an empty name, a
 #: mapping that is no ROLE=NAME pair, a name twice, a pattern that does not compile).
 NOT_NUMBERS = {"keypoints": ["thumb"], "markers": ["thumb", "thumb=a", "thumb=a finger=a"],
-               "columns": [","], "factors": [",", "a,a"], "factors_from_name": ["(", "P1"]}
+               "columns": [","], "factors": [",", "a,a"], "factors_from_name": ["(", "P1"],
+               # a point off the table (MAX_POSITION_M), a coordinate no number
+               "start": ["nan 0", "20 0", "x 0"], "goal": ["0 nan", "0 20", "0 x"]}
 #: Values a flag gives a meaning of its own (``--cutoff 0``: no low-pass filter).
 MEANT = {("--cutoff", "0")}
 
@@ -154,22 +156,27 @@ def _flag_values(setting) -> list[str]:
 
 
 def _commands():
-    from hammer_mv.cli import landmarks, options
+    """Each command's words, the arguments it needs besides the flag, its generated flags and
+    the function that builds its settings from the parsed arguments."""
+    from hammer_mv.cli import grasp, landmarks, options, reach, repertoire
 
     recognition = (*options.RECOGNITION, *options.POSE, *options.MOCAP, *options.FACTORS)
-    yield "recognize", "x.tracks.h5", "out", recognition, options.recognition_settings
-    yield "batch", "clips", "out", recognition, options.recognition_settings
-    yield ("landmarks", "x.csv", "out.csv",
+    yield "recognize", ["x.tracks.h5", "-o", "out"], recognition, options.recognition_settings
+    yield "batch", ["clips", "-o", "out"], recognition, options.recognition_settings
+    yield ("landmarks", ["x.csv", "-o", "out.csv"],
            (*landmarks.DEFINITIONS, *landmarks.SCALE, *options.MOCAP, *options.FACTORS),
            landmarks.landmark_settings)
+    yield "reach", ["-o", "out"], (*reach.TASK, *reach.PLANT), reach.reach_settings
+    yield "grasp simulate", ["-o", "out"], grasp.SIMULATE, grasp.grasp_task
+    yield "repertoire build", ["-o", "rep.h5"], repertoire.SCENE, repertoire.build_scene
 
 
 def _flag_cases():
-    for command, source, out, settings, assemble in _commands():
+    for command, needed, settings, assemble in _commands():
         for setting in settings:
             for value in _flag_values(setting):
-                yield pytest.param(command, [source, "-o", out, *setting.name.split(),
-                                             *value.split()], setting.name, assemble,
+                yield pytest.param(command, [*needed, *setting.name.split(), *value.split()],
+                                   setting.name, assemble,
                                    id=f"{command} {setting.name} {value}")
 
 
@@ -186,6 +193,14 @@ def test_every_declared_field_a_flag_sets_is_generated():
         flag for c, flag in flags if c == "recognize"}
     assert {"--threshold", "--hold", "--cutoff", "--speed"} <= {
         flag for c, flag in flags if c == "landmarks"}
+    # the simulation commands (issue 42 item 6): every flag that sets a field
+    assert {flag for c, flag in flags if c == "reach"} == {
+        "--start", "--goal", "--duration", "--r", "--w-v", "--w-f", "--sigma-u", "--sigma-s"}
+    assert {flag for c, flag in flags if c == "grasp simulate"} == {
+        "--object-size", "--distance", "--duration", "--viapoint-offset", "--viapoint-height",
+        "--viapoint-time", "--tip-start", "--execution-cv", "--dt"}  # (--reach-only: a switch)
+    assert {flag for c, flag in flags if c == "repertoire build"} == {
+        "--distance", "--object-size"}
     assert len(FLAG_CASES) > 100
 
 
@@ -197,15 +212,16 @@ def test_an_invalid_flag_value_is_one_line_naming_the_flag_exit_2(command, argv,
     from hammer_mv.cli import build_parser, error_line
     from perception.errors import HammerMVError
 
+    words = command.split()  # main names the command, the parser a subcommand too
     try:
-        args = build_parser(command).parse_args([command, *argv])
+        args = build_parser(words[0]).parse_args([*words, *argv])
     except SystemExit as exc:  # refused by the parser (a word for a number, no choice)
         assert exc.code == 2
         line = capsys.readouterr().err.strip()
     else:
         with pytest.raises(HammerMVError) as caught:  # main's exit 2
             assemble(args)
-        line = error_line(command, caught.value)
+        line = error_line(words[0], caught.value)
     assert "\n" not in line and flag in line, line
-    assert line.startswith((f"hammer-mv {command}: error: {flag}: ",
+    assert line.startswith((f"hammer-mv {words[0]}: error: {flag}: ",
                             f"hammer-mv {command}: error: argument {flag}: "))

@@ -273,20 +273,17 @@ def test_synth_quiet_prints_nothing(fake_synthesize, recipe, capsys):
 # -- option values checked at the boundary, named by their flag
 
 @pytest.mark.parametrize("argv, field", [
-    (["reach", "--r", "-1"], "--r"),
-    (["reach", "--sigma-s", "nan"], "--sigma-s"),
+    # (every flag of a declared field of recognize, batch, landmarks, reach, grasp simulate
+    # and repertoire build: tests/test_declared_fields.py, generated; here the checks no
+    # field declares, and one generated flag through main)
     (["reach", "--trials", "1"], "--trials"),
-    (["grasp", "simulate", "--dt", "0"], "--dt"),
-    (["grasp", "simulate", "--execution-cv", "-1"], "--execution-cv"),
-    (["repertoire", "build", "--object-size", "-1"], "--object-size"),
-    (["repertoire", "build", "--distance", "2"], "--distance"),
+    (["repertoire", "build", "--distance", "2"], "--distance"),  # off the table: by hand
     (["repertoire", "build", "--durations", "0"], "--durations"),
     (["repertoire", "build", "--durations", "0.01"], "--durations"),  # under two model steps
+    (["repertoire", "build", "--fps", "0"], "--fps"),  # a rate: SceneSpec holds its period
     (["reach", "--seed", "-1"], "--seed"),  # numpy's own ValueError, checked first
     (["grasp", "experiment", "object-size", "--seed", "-1"], "--seed"),
     (["synth", "r.toml", "--seed", "-1"], "--seed"),
-    # (every flag of a declared field of recognize, batch and landmarks:
-    # tests/test_declared_fields.py, generated; here one, through main)
     (["recognize", "{clip}", "--px-per-m", "0"], "--px-per-m"),
     *[([command, folder, "--jobs", jobs], "--jobs") for jobs in ["0", "-2"]
       for command, folder in [("synth", "{recipe}"), ("batch", "{folder}")]],

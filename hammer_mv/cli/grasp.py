@@ -13,6 +13,7 @@ import time
 from pathlib import Path
 
 from hammer_mv.cli.checks import check_seed, options, output_folder
+from hammer_mv.cli.flags import Setting, add_settings
 from minvar.grasp import GraspTask, check_grasp_simulation
 from minvar.grasp_experiments import EXPERIMENTS, THESIS_TRIALS, check_trials
 from minvar.limits import MAX_TRIALS
@@ -21,7 +22,33 @@ from perception.io.atomic import save_figure, write_csv, write_json
 
 #: Columns of trajectories.csv (:meth:`minvar.grasp.GraspResult.to_pandas`).
 TABLE_COLUMNS = 17
-#: The flags of ``grasp simulate`` that are lengths, m (bounded by MAX_POSITION_M).
+#: The task's defaults, which the help says in its own words.
+_D = GraspTask()
+#: The flags of ``grasp simulate`` that set the task (GraspTask) and its plant's time step
+#: (PointMassPlant), in ``--help``'s order; the help says the defaults as it always has.
+SIMULATE = (
+    Setting(GraspTask, "object_size", f"object diameter, m (default {_D.object_size})",
+            metavar="M"),
+    Setting(GraspTask, "distance", f"wrist start to object centre, m (default {_D.distance}: "
+            f"the wrist travels {_D.transport_distance:g}, stopping {_D.wrist_offset:g} short "
+            "of the centre)", metavar="M"),
+    Setting(GraspTask, "duration", f"movement time, s (default {_D.duration})", metavar="S"),
+    Setting(GraspTask, "viapoint_offset", "digit via-point distance outside the object, m "
+            f"(default {_D.viapoint_offset})", metavar="M"),
+    Setting(GraspTask, "viapoint_height", "digit via-point height above the target line, m "
+            f"(default {_D.viapoint_height:g})", metavar="M"),
+    Setting(GraspTask, "viapoint_time", "digit via-point time, fraction of the movement "
+            f"(default {_D.viapoint_time})", metavar="F"),
+    Setting(GraspTask, "tip_start", "how far ahead of the wrist the closed digit tips start, m "
+            f"(default {_D.tip_start}: below the target line, {_D.wrist_offset:g} ahead of the "
+            "wrist at the goal)", metavar="M"),
+    Setting(GraspTask, "reach_only", "transport only: the digits stay closed"),
+    Setting(GraspTask, "execution_cv", "coefficient of variation of the execution noise "
+            f"(default {_D.execution_cv})", metavar="CV"),
+    Setting(PointMassPlant, "dt", f"time step, s (default {_D.plant.dt})", metavar="S"),
+)
+
+
 def register(sub) -> None:
     """Add the ``grasp`` subcommand to ``sub`` (an argparse subparsers action)."""
     p = sub.add_parser(
@@ -45,35 +72,7 @@ def _add_simulate(gsub) -> None:
         "(one row per repetition and step), summary.json (MGA, variability, end-points), "
         "grasp.png and setup.png.",
     )
-    d = GraspTask()
-    s.add_argument("--object-size", type=float, default=d.object_size, metavar="M",
-                   help=f"object diameter, m (default {d.object_size})")
-    s.add_argument("--distance", type=float, default=d.distance, metavar="M",
-                   help=f"wrist start to object centre, m (default {d.distance}: the wrist "
-                        f"travels {d.transport_distance:g}, stopping {d.wrist_offset:g} short "
-                        "of the centre)")
-    s.add_argument("--duration", type=float, default=d.duration, metavar="S",
-                   help=f"movement time, s (default {d.duration})")
-    s.add_argument("--viapoint-offset", type=float, default=d.viapoint_offset, metavar="M",
-                   help=f"digit via-point distance outside the object, m "
-                        f"(default {d.viapoint_offset})")
-    s.add_argument("--viapoint-height", type=float, default=d.viapoint_height, metavar="M",
-                   help=f"digit via-point height above the target line, m "
-                        f"(default {d.viapoint_height:g})")
-    s.add_argument("--viapoint-time", type=float, default=d.viapoint_time, metavar="F",
-                   help=f"digit via-point time, fraction of the movement "
-                        f"(default {d.viapoint_time})")
-    s.add_argument("--tip-start", type=float, default=d.tip_start, metavar="M",
-                   help=f"how far ahead of the wrist the closed digit tips start, m "
-                        f"(default {d.tip_start}: below the target line, "
-                        f"{d.wrist_offset:g} ahead of the wrist at the goal)")
-    s.add_argument("--reach-only", action="store_true",
-                   help="transport only: the digits stay closed")
-    s.add_argument("--execution-cv", type=float, default=d.execution_cv, metavar="CV",
-                   help=f"coefficient of variation of the execution noise "
-                        f"(default {d.execution_cv})")
-    s.add_argument("--dt", type=float, default=d.plant.dt, metavar="S",
-                   help=f"time step, s (default {d.plant.dt})")
+    add_settings(s, SIMULATE)
     s.add_argument("--trials", type=int, default=THESIS_TRIALS, metavar="N",
                    help=f"repetitions (default {THESIS_TRIALS})")
     s.add_argument("--seed", type=int, default=0, metavar="N", help="random seed (default 0)")
@@ -108,11 +107,27 @@ def _usage(parser: argparse.ArgumentParser) -> int:
     return 2
 
 
-#: GraspTask fields -> the ``grasp simulate`` options that set them.
-TASK_FIELDS = {"object_size": "--object-size", "distance": "--distance",
-               "duration": "--duration", "viapoint_offset": "--viapoint-offset",
-               "viapoint_height": "--viapoint-height", "viapoint_time": "--viapoint-time",
-               "tip_start": "--tip-start", "execution_cv": "--execution-cv", "dt": "--dt"}
+#: GraspTask fields -> the ``grasp simulate`` options that set them (the plant's too).
+TASK_FIELDS = {setting.field: setting.name for setting in SIMULATE}
+
+
+def grasp_task(args: argparse.Namespace) -> GraspTask:
+    """The task that parsed ``args`` say, each value checked and a bad one named by its flag.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments of ``hammer-mv grasp simulate``.
+    """
+    # every size, length and the movement's steps are the task's fields, named by their flags
+    with options(TASK_FIELDS):
+        plant = PointMassPlant(dt=args.dt)
+        return GraspTask(
+            object_size=args.object_size, distance=args.distance, duration=args.duration,
+            viapoint_offset=args.viapoint_offset, viapoint_height=args.viapoint_height,
+            viapoint_time=args.viapoint_time, tip_start=args.tip_start,
+            reach_only=args.reach_only, execution_cv=args.execution_cv, plant=plant,
+        )
 
 
 def run_simulate(args: argparse.Namespace) -> int:
@@ -124,17 +139,8 @@ def run_simulate(args: argparse.Namespace) -> int:
     with options("--trials"):
         check_trials(args.trials, name="--trials")
     check_seed(args.seed)
-    with options({"dt": "--dt"}):
-        plant = PointMassPlant(dt=args.dt)
+    task = grasp_task(args)
     out = output_folder(args.output)
-    # every size, length and the movement's steps are the task's fields, named by their flags
-    with options(TASK_FIELDS):
-        task = GraspTask(
-            object_size=args.object_size, distance=args.distance, duration=args.duration,
-            viapoint_offset=args.viapoint_offset, viapoint_height=args.viapoint_height,
-            viapoint_time=args.viapoint_time, tip_start=args.tip_start,
-            reach_only=args.reach_only, execution_cv=args.execution_cv, plant=plant,
-        )
     # the simulation, and the table of trajectories.csv in the same budget
     with options("--trials"):
         check_grasp_simulation(task, args.trials, "--trials", extra_floats=TABLE_COLUMNS,

@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from hammer_mv.cli.checks import check_seed, options, output_folder
+from hammer_mv.cli.flags import Setting, add_settings
 from minvar.analysis import (
     THESIS_DURATIONS,
     closest_approach,
@@ -34,6 +35,26 @@ from perception.io.atomic import save_figure, write_csv, write_json
 TABLE_COLUMNS = 10
 
 
+#: The flags that set the reach's task (ReachTask): where, how long (first in ``--help``),
+#: and the cost's weights (after ``--durations``).
+TASK = (
+    Setting(ReachTask, "start", "start position, m (default: 0.2 0.2, thesis Fig. 3.4)",
+            default=(0.2, 0.2), type=float, nargs=2, metavar=("X", "Y")),
+    Setting(ReachTask, "goal", "goal position, m (default: 0.4 0.5)", default=(0.4, 0.5),
+            type=float, nargs=2, metavar=("X", "Y")),
+    Setting(ReachTask, "duration", "movement time, s (default: 0.5)", default=0.5,
+            metavar="S"),
+    Setting(ReachTask, "r", "effort weight r (default: {default})"),
+    Setting(ReachTask, "w_v", "final velocity weight (default: {default})"),
+    Setting(ReachTask, "w_f", "final force weight (default: {default})"),
+)
+#: The flags that set the plant's noise (PointMassPlant).
+PLANT = (
+    Setting(PointMassPlant, "sigma_u", "control-dependent noise scale (default: {default})"),
+    Setting(PointMassPlant, "sigma_s", "sensory noise scale (default: {default})"),
+)
+
+
 def register(sub) -> None:
     """Add the ``reach`` subcommand to ``sub`` (an argparse subparsers action)."""
     p = sub.add_parser(
@@ -43,12 +64,7 @@ def register(sub) -> None:
         "and write figures (PNG) and trajectories (CSV). With --sweep, the speed-accuracy "
         "trade-off over several movement times (thesis Figs. 3.5, 3.7).",
     )
-    p.add_argument("--start", nargs=2, type=float, metavar=("X", "Y"), default=(0.2, 0.2),
-                   help="start position, m (default: 0.2 0.2, thesis Fig. 3.4)")
-    p.add_argument("--goal", nargs=2, type=float, metavar=("X", "Y"), default=(0.4, 0.5),
-                   help="goal position, m (default: 0.4 0.5)")
-    p.add_argument("--duration", type=float, default=0.5, metavar="S",
-                   help="movement time, s (default: 0.5)")
+    add_settings(p, TASK[:3])
     p.add_argument("--via", nargs=3, type=float, action="append", default=[],
                    metavar=("X", "Y", "FRACTION"),
                    help="via-point at (X, Y) m, at FRACTION (0-1) of the movement; repeatable")
@@ -60,19 +76,39 @@ def register(sub) -> None:
     p.add_argument("--durations", nargs="+", type=float, default=list(THESIS_DURATIONS),
                    metavar="S", help=f"movement times for --sweep, s (default: "
                                      f"{THESIS_DURATIONS[0]:g} ... {THESIS_DURATIONS[-1]:g})")
-    p.add_argument("--r", type=float, default=ReachTask.r,
-                   help=f"effort weight r (default: {ReachTask.r:g})")
-    p.add_argument("--w-v", type=float, default=ReachTask.w_v,
-                   help=f"final velocity weight (default: {ReachTask.w_v:g})")
-    p.add_argument("--w-f", type=float, default=ReachTask.w_f,
-                   help=f"final force weight (default: {ReachTask.w_f:g})")
-    p.add_argument("--sigma-u", type=float, default=PointMassPlant.sigma_u,
-                   help=f"control-dependent noise scale (default: {PointMassPlant.sigma_u:g})")
-    p.add_argument("--sigma-s", type=float, default=PointMassPlant.sigma_s,
-                   help=f"sensory noise scale (default: {PointMassPlant.sigma_s:g})")
+    add_settings(p, TASK[3:])
+    add_settings(p, PLANT)
     p.add_argument("-o", "--output", required=True, type=Path, metavar="DIR",
                    help="folder for the figures and tables")
     p.set_defaults(func=run)
+
+
+def _flags(settings) -> dict[str, str]:
+    """Field -> flag of ``settings``, for :func:`~hammer_mv.cli.checks.options`."""
+    return {s.field: s.name for s in settings}
+
+
+def reach_settings(args: argparse.Namespace) -> tuple[PointMassPlant, ReachTask]:
+    """The plant and the task that parsed ``args`` say, each value checked and a bad one
+    named by its flag (the via-points' times and the movement's steps too).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments of ``hammer-mv reach``.
+    """
+    with options(_flags(PLANT)):
+        plant = PointMassPlant(sigma_u=args.sigma_u, sigma_s=args.sigma_s)
+    with options("--via"):
+        vias = tuple(ViaPoint((x, y), fraction=f) for x, y, f in args.via)
+    with options(_flags(TASK)):
+        task = ReachTask(tuple(args.start), tuple(args.goal), args.duration, vias,
+                         r=args.r, w_v=args.w_v, w_f=args.w_f)
+        task.steps(plant.dt)
+    with options("--via"):
+        for v in vias:
+            v.step(task.duration, plant.dt)  # reject bad via-point times before any work
+    return plant, task
 
 
 def run(args: argparse.Namespace) -> int:
@@ -80,18 +116,8 @@ def run(args: argparse.Namespace) -> int:
     from minvar.plotting import reach_figure, speed_accuracy_figure
 
     check_seed(args.seed)
-    with options({"sigma_u": "--sigma-u", "sigma_s": "--sigma-s"}):
-        plant = PointMassPlant(sigma_u=args.sigma_u, sigma_s=args.sigma_s)
-    with options("--via"):
-        vias = tuple(ViaPoint((x, y), fraction=f) for x, y, f in args.via)
-    with options({"start": "--start", "goal": "--goal", "duration": "--duration",
-                  "r": "--r", "w_v": "--w-v", "w_f": "--w-f"}):
-        task = ReachTask(tuple(args.start), tuple(args.goal), args.duration, vias,
-                         r=args.r, w_v=args.w_v, w_f=args.w_f)
-        task.steps(plant.dt)
-    with options("--via"):
-        for v in vias:
-            v.step(task.duration, plant.dt)  # reject bad via-point times before any work
+    plant, task = reach_settings(args)
+    vias = task.via_points
     n_states = plant.n_states(len(task.targets))
     out: Path = output_folder(args.output)
     if args.sweep:

@@ -6,12 +6,19 @@ import argparse
 from pathlib import Path
 
 from hammer_mv.cli.checks import options
+from hammer_mv.cli.flags import Setting, add_settings
 from minvar.limits import check_position, check_steps
 from perception.errors import InputError, PlanningError
 from perception.limits import MAX_FPS
 from perception.recognition.models import SceneSpec, model_substeps
 from perception.recognition.planning import DEFAULT_DURATIONS, default_specs
 from perception.recognition.repertoire import Repertoire
+
+#: The flags that set the scene of a repertoire built without CONFIG (SceneSpec).
+SCENE = (
+    Setting(SceneSpec, "distance", "wrist start to object centre, m (without CONFIG)"),
+    Setting(SceneSpec, "object_size", "object diameter, m (without CONFIG)"),
+)
 
 
 def register(sub) -> None:
@@ -30,10 +37,7 @@ def register(sub) -> None:
                    help="repertoire file to write (HDF5)")
     b.add_argument("--durations", nargs="+", type=float, default=list(DEFAULT_DURATIONS),
                    metavar="S", help="movement times without CONFIG (default: 0.8 ... 1.2)")
-    b.add_argument("--distance", type=float, default=SceneSpec.distance,
-                   help="wrist start to object centre, m (without CONFIG)")
-    b.add_argument("--object-size", type=float, default=SceneSpec.object_size,
-                   help="object diameter, m (without CONFIG)")
+    add_settings(b, SCENE)
     b.add_argument("--fps", type=float, default=30.0, help="video frame rate (without CONFIG)")
     b.set_defaults(func=run_build)
     i = verbs.add_parser("info", help="list the models of a repertoire file")
@@ -42,8 +46,28 @@ def register(sub) -> None:
 
 
 #: The GraspTask fields a planning problem can be about, by the flag that sets them.
-_SCENE_FLAGS = {"distance": "--distance", "object_size": "--object-size",
-                "duration": "--durations"}
+_SCENE_FLAGS = {**{s.field: s.name for s in SCENE}, "duration": "--durations"}
+
+
+def build_scene(args: argparse.Namespace) -> SceneSpec:
+    """The scene that parsed ``args`` say (no CONFIG), each value checked and a bad one
+    named by its flag.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments of ``hammer-mv repertoire build``.
+    """
+    if not 0 < args.fps <= MAX_FPS:  # a rate: SceneSpec declares the period's range only
+        raise InputError(f"expected a frame rate in (0, {MAX_FPS:g}] frames/s, "
+                         f"got {args.fps}", field="--fps")
+    with options(_SCENE_FLAGS):  # SceneSpec declares what a distance and a size may be
+        scene = SceneSpec(distance=args.distance, object_size=args.object_size,
+                          frame_period=1.0 / args.fps)
+    for flag, value in (("--distance", args.distance), ("--object-size", args.object_size)):
+        with options(flag):  # and the table's metres, which no field declares
+            check_position(value, flag)
+    return scene
 
 
 def run_build(args: argparse.Namespace) -> int:
@@ -54,15 +78,7 @@ def run_build(args: argparse.Namespace) -> int:
     if args.config is not None:
         rep = Repertoire.from_config(args.config)
     else:
-        if not 0 < args.fps <= MAX_FPS:  # a rate: SceneSpec declares the period's range only
-            raise InputError(f"expected a frame rate in (0, {MAX_FPS:g}] frames/s, "
-                             f"got {args.fps}", field="--fps")
-        with options(_SCENE_FLAGS):  # SceneSpec declares what a distance and a size may be
-            scene = SceneSpec(distance=args.distance, object_size=args.object_size,
-                              frame_period=1.0 / args.fps)
-        for flag, value in (("--distance", args.distance), ("--object-size", args.object_size)):
-            with options(flag):  # and the table's metres, which no field declares
-                check_position(value, flag)
+        scene = build_scene(args)
         dt = scene.frame_period / model_substeps(scene.frame_period)
         for duration in args.durations:  # named by the flag, before any planning
             with options("--durations"):
