@@ -354,7 +354,9 @@ def test_numpy_engine_without_the_kernel_is_silent(reference_problem, monkeypatc
     with caplog.at_level(logging.WARNING, logger="minvar"):
         solve(reference_problem, max_iter=2)
         solve(reference_problem, max_iter=2, engine="numpy")
-    assert not caplog.records
+    # nothing from the kernel's loader (two iterations do not converge: the solver's own
+    # warning, once per problem and process, is another matter and was order-dependent here)
+    assert not [r for r in caplog.records if r.module == "_kernel"]
 
 
 def test_an_install_without_the_kernel_solves_and_says_so_once():
