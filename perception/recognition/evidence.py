@@ -24,8 +24,8 @@ if TYPE_CHECKING:
     from perception.observation import Observation
     from perception.recognition.models import MotorModel
 
-__all__ = ["clip_landmarks", "judged_models", "model_own_landmarks", "movement_evidence",
-           "opening_progress", "reference_model"]
+__all__ = ["clip_landmarks", "judged_models", "marker_aperture", "model_own_landmarks",
+           "movement_evidence", "opening_progress", "reference_model", "wrist_progress"]
 
 
 def judged_models(kinds: Sequence[str], kind: str) -> tuple[int, ...]:
@@ -114,23 +114,45 @@ def clip_landmarks(observation: Observation, models: Sequence[MotorModel],
     return observed, own
 
 
-def _aperture(obs: Observation) -> np.ndarray:
-    """The markers' own aperture (the filtered one coasts through a gap), m."""
+def marker_aperture(obs: Observation) -> np.ndarray:
+    """The digit markers' own aperture, m, NaN where one is lost (the filtered aperture
+    coasts through a gap).
+
+    Parameters
+    ----------
+    obs : Observation
+        The movement (its ``raw`` positions, else its filtered ``g``).
+    """
     raw = obs.raw or {}
     if "finger" in raw and "thumb" in raw:
         return np.linalg.norm(raw["finger"] - raw["thumb"], axis=1)
     return obs.g
 
 
+def wrist_progress(obs: Observation, wrist_offset: float) -> np.ndarray:
+    """(N,) the wrist's displacement from where the movement started, as a share of its way
+    to the models' goal (``start distance - wrist_offset``); not clipped.
+
+    Parameters
+    ----------
+    obs : Observation
+        The movement at its own scale.
+    wrist_offset : float
+        Where the models' wrists stop short of the object centre, m.
+    """
+    return np.linalg.norm(obs.wrist - obs.wrist[0], axis=1) / (obs.start_distance - wrist_offset)
+
+
 def opening_progress(observation: Observation, rules: VerdictRules,
                      wrist_offset: float) -> float:
     """How far the wrist had come on its way to the models' goal when the grip started to
-    open: its displacement from the onset over ``start distance - wrist_offset``, 0..1.
+    open (:func:`wrist_progress` there), 0..1.
 
-    The grip starts to open where its aperture first exceeds its rest (the mean of
-    the first ``rules.grasp_rest_frames`` seen samples) by ``opening_level`` of its
-    opening, as the landmark ``opening_time`` reads it; NaN where it has not opened
-    by ``rules.grasp_opening`` × the object's diameter.
+    The grip starts to open where its aperture first exceeds its rest by
+    ``opening_level`` of its opening
+    (:func:`~perception.recognition.shape.rest_and_opening`), as the landmark
+    ``opening_time`` reads it; NaN where it has not opened by
+    ``rules.grasp_opening`` × the object's diameter.
 
     Parameters
     ----------
@@ -140,19 +162,18 @@ def opening_progress(observation: Observation, rules: VerdictRules,
     wrist_offset : float
         Where the models' wrists stop short of the object centre, m.
     """
+    from perception.recognition.shape import rest_and_opening
+
     obs = observation
-    g = _aperture(obs)
+    g = marker_aperture(obs)
     rows = np.flatnonzero(np.isfinite(g))
     if len(rows) < 3:
         return float("nan")
-    gs = g[rows]
-    rest = float(np.mean(gs[:rules.grasp_rest_frames]))
-    opening = float(gs.max()) - rest
+    rest, opening = rest_and_opening(g[rows], rules)
     if opening < rules.grasp_opening * obs.object_diameter:
         return float("nan")
-    k = rows[int(np.argmax(gs > rest + rules.landmarks.opening_level * opening))]
-    way = obs.start_distance - wrist_offset
-    return float(np.clip(np.linalg.norm(obs.wrist[k] - obs.wrist[0]) / way, 0.0, 1.0))
+    k = rows[int(np.argmax(g[rows] > rest + rules.landmarks.opening_level * opening))]
+    return float(np.clip(wrist_progress(obs, wrist_offset)[k], 0.0, 1.0))
 
 
 def movement_evidence(observation: Observation, kinds: Sequence[str],
@@ -188,6 +209,7 @@ def movement_evidence(observation: Observation, kinds: Sequence[str],
     return Evidence(list(kinds), np.asarray(log_likelihood), np.asarray(familiarity),
                     transport_familiarity=float(transport_familiarity),
                     rest_aperture=obs.marker_separation, observed=landmarks[0],
-                    reference=landmarks[1], aperture_gap=longest_gap(obs.time, _aperture(obs)),
+                    reference=landmarks[1],
+                    aperture_gap=longest_gap(obs.time, marker_aperture(obs)),
                     slowed=slowed(obs.time, obs.wrist), scored_share=float(scored_share),
                     opening_progress=float(opening_progress))

@@ -253,18 +253,15 @@ def grip_course(rec: Recognition) -> SimpleNamespace:
     rec : Recognition
         The recognition of the rows so far.
     """
+    from perception.recognition.evidence import marker_aperture, wrist_progress
     from perception.recognition.shape import rest_and_opening
 
     obs, ev = rec.observation, rec.evidence
-    raw = obs.raw or {}
-    g = (np.linalg.norm(raw["finger"] - raw["thumb"], axis=1)
-         if "finger" in raw and "thumb" in raw else obs.g)
+    g = marker_aperture(obs)
     g = g[np.isfinite(g)]
     _, opening = rest_and_opening(g, rec.rules)
     closing = float(g.max() - g[-1]) / opening if opening > 0 and g.size else 0.0
-    # the wrist's displacement from where the movement started, against its way to the goal
-    way = obs.start_distance - rec.normalisation.wrist_offset
-    moved = np.linalg.norm(obs.wrist - obs.wrist[0], axis=1) / way
+    moved = wrist_progress(obs, rec.normalisation.wrist_offset)
     progress = float(np.clip(np.nanmax(moved, initial=0.0), 0.0, 1.0))
     opened = rec.judged is not None and rec.kinds[rec.judged[0]] == "grasp"
     peaks = ev.observed.aperture_peaks if ev.observed is not None else None
