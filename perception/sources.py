@@ -17,13 +17,12 @@ lines (a ``.csv`` may be either), then a pose file.
 from __future__ import annotations
 
 import os
-import re
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 from perception.errors import InputError
-from perception.io.names import POSE_SUFFIXES, TRACKS_SUFFIX, VIDEO_SUFFIXES
+from perception.io.names import POSE_SUFFIXES, TRACKS_SUFFIX, VIDEO_SUFFIXES, live_kind
 
 __all__ = ["KINDS", "POSE_SUFFIXES", "TRACKS_SUFFIX", "VIDEO_SUFFIXES", "Kind", "check_command",
            "clip_name", "input_kind"]
@@ -74,16 +73,14 @@ def _is_mocap(spec: str) -> bool:
 _FILES = frozenset({"recognize", "landmarks", "watch", "batch"})
 #: Every kind, in the order they are tested (the module docstring).
 KINDS: tuple[Kind, ...] = (
-    Kind("camera", "a camera", None, frozenset({"watch"}),
-         lambda s: re.fullmatch(r"\d+", s) is not None),
-    Kind("stream", "a stream URL", None, frozenset({"watch"}), lambda s: "://" in s),
+    Kind("camera", "a camera", None, frozenset({"watch"}), lambda s: live_kind(s) == "camera"),
+    Kind("stream", "a stream URL", None, frozenset({"watch"}), lambda s: live_kind(s) == "stream"),
     Kind("tracks", "a tracks file", None, frozenset({"recognize", "landmarks", "batch"}),
          lambda s: s.endswith(TRACKS_SUFFIX)),
     Kind("video", "a video", "tracking", _FILES, lambda s: _suffix(s) in VIDEO_SUFFIXES),
     Kind("mocap", "a motion-capture recording", "mocap", _FILES, _is_mocap),
     Kind("pose", "a pose file", "pose", _FILES, lambda s: _suffix(s) in POSE_SUFFIXES),
 )
-_BY_NAME = {k.name: k for k in KINDS}
 
 
 def input_kind(spec: str | os.PathLike) -> Kind | None:
@@ -158,8 +155,3 @@ def check_command(spec: str | os.PathLike, command: str) -> Kind | None:
     instead = _INSTEAD.get(kind.name)
     raise InputError(f"{kind.what}: {command} takes {listed}"
                      + (f"; {instead}" if instead else ""), os.fspath(spec))
-
-
-def kind_named(name: str) -> Kind:
-    """The :class:`Kind` called ``name``."""
-    return _BY_NAME[name]

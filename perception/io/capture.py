@@ -7,7 +7,6 @@ import contextlib
 import itertools
 import math
 import queue
-import re
 import threading
 import time
 from collections.abc import Callable, Iterator
@@ -16,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from perception.errors import InputError
+from perception.io.names import live_kind
 
 #: Frames a source holds ahead of its consumer: a second at 30 frames/s (the
 #: pause of a watch's scene fix, about one, is absorbed, not dropped).
@@ -197,9 +197,9 @@ def read_frames(cap: Any) -> Iterator[tuple[Any, float]]:
 
 
 def source_kind(source: str | Any) -> str:
-    """``"camera"`` (an index such as ``"0"``), ``"stream"`` (a URL) or ``"file"``: ``source``."""
-    return ("camera" if re.fullmatch(r"\d+", str(source))
-            else "stream" if "://" in str(source) else "file")
+    """``"camera"`` (an index such as ``"0"``), ``"stream"`` (a URL) or ``"file"``: ``source``
+    (:func:`perception.io.names.live_kind`)."""
+    return live_kind(str(source)) or "file"
 
 
 class LiveSource(Source):

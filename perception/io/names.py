@@ -30,8 +30,22 @@ TRACKS_SUFFIX = ".tracks.h5"
 #: Endings of pose files (a ``.h5`` that is not a tracks file is read as one).
 POSE_SUFFIXES = (".h5", ".csv", ".slp", ".nc", ".nwb")
 
+
+def live_kind(spec: str) -> str | None:
+    """``camera`` (an index such as ``0``), ``stream`` (a URL) or None (a file): the one test
+    of a live source, for the registry (:mod:`perception.sources`) and the capture that
+    opens it.
+
+    Parameters
+    ----------
+    spec : str
+        The input as the user gave it.
+    """
+    spec = str(spec)
+    return "camera" if re.fullmatch(r"\d+", spec) else "stream" if "://" in spec else None
+
 __all__ = ["NAME_MAX", "POSE_SUFFIXES", "STEM_MAX", "TRACKS_SUFFIX", "VIDEO_SUFFIXES",
-           "output_folder", "output_stem", "printable"]
+           "live_kind", "output_folder", "output_stem", "printable"]
 
 #: The longest file name (bytes) on the usual file systems (ext4, XFS, APFS, NTFS).
 NAME_MAX = 255
