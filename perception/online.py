@@ -39,6 +39,31 @@ __all__ = ["Decision", "OnlineRecognizer", "OnlineState", "SettleRule", "decisio
 _FIELDS = ("frame", "time", "position", "likelihood", "status")
 
 
+class _Rows:
+    """The rows received, in arrays that grow by doubling: a prefix is a copy of their
+    first rows, not a conversion of growing lists at every row."""
+
+    def __init__(self, markers: int):
+        self.n = 0
+        self._a = {"frame": np.empty(64, np.int64), "time": np.empty(64),
+                   "position": np.empty((64, markers, 2)),
+                   "likelihood": np.empty((64, markers)),
+                   "status": np.empty((64, markers), np.int64)}
+
+    def append(self, *row) -> None:
+        if self.n == len(self._a["time"]):
+            self._a = {k: np.concatenate([a, np.empty_like(a)]) for k, a in self._a.items()}
+        for key, value in zip(_FIELDS, row):
+            self._a[key][self.n] = value
+        self.n += 1
+
+    def arrays(self, last: bool = False) -> dict | None:
+        """Every row (copies), or the last row alone (None before one)."""
+        if last:
+            return None if not self.n else {k: a[self.n - 1] for k, a in self._a.items()}
+        return {k: a[:self.n].copy() for k, a in self._a.items()}
+
+
 class OnlineRecognizer:
     """Recognise a movement frame by frame (see the module docstring).
 
@@ -92,7 +117,7 @@ class OnlineRecognizer:
             markers = (MARKER_NAMES if self.settings.tracking is None
                        else self.settings.tracking.markers.names)
         self.markers = tuple(markers)
-        self._rows: dict[str, list] = {k: [] for k in _FIELDS}
+        self._rows = _Rows(len(self.markers))
         self._received = 0  # frames or rows given to update
         self._last_time: float | None = None
         self._verdicts: list[tuple[float, str | None]] = []  # (since onset, verdict) on change
@@ -164,9 +189,8 @@ class OnlineRecognizer:
 
     # -- the stream -------------------------------------------------------------
     def _row(self, index: int, t: float, position, likelihood, status) -> OnlineState:
-        for key, value in zip(_FIELDS, (index, t, position, likelihood, status)):
-            self._rows[key].append(value)
-        if len(self._rows["time"]) < 2 * self.settings.observe.rest_frames:
+        self._rows.append(index, t, position, likelihood, status)
+        if self._rows.n < 2 * self.settings.observe.rest_frames:
             return self._waiting(index, t, "start")
         try:
             self.prefix = recognize_tracks(self.tracks(), self.repertoire, self.settings,
@@ -209,22 +233,15 @@ class OnlineRecognizer:
         video : dict, optional
             ``/video`` attributes to carry.
         """
-        rows, m = self._rows, len(self.markers)
         tracker = self._tracker.attrs() if self._tracker is not None else self._tracker_attrs
-        return Tracks(frame=np.asarray(rows["frame"], dtype=np.int64),
-                      time=np.asarray(rows["time"], dtype=float), markers=self.markers,
-                      position=np.reshape(rows["position"], (-1, m, 2)),
-                      likelihood=np.reshape(rows["likelihood"], (-1, m)),
-                      status=np.reshape(rows["status"], (-1, m)),
-                      video=video or {}, tracker=tracker)
+        return Tracks(markers=self.markers, video=video or {}, tracker=tracker,
+                      **self._rows.arrays())
 
     @property
     def last_row(self) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
         """The last row: positions (M, 2) px, likelihood (M,), status (M,); None before one."""
-        rows = self._rows
-        if not rows["time"]:
-            return None
-        return rows["position"][-1], rows["likelihood"][-1], rows["status"][-1]
+        rows = self._rows.arrays(last=True)
+        return None if rows is None else (rows["position"], rows["likelihood"], rows["status"])
 
     # -- the end ----------------------------------------------------------------
     @property
@@ -254,7 +271,7 @@ class OnlineRecognizer:
         if self._tracker is not None:  # the frames the tracker still holds
             for row in self._tracker.flush():
                 self._row(*row[:5])
-        if not self._rows["time"]:
+        if not self._rows.n:
             raise InputError("no frames received", source or self.clip)
         return recognize_tracks(self.tracks(video), self.repertoire, self.settings,
                                 clip=self.clip, source=source, plan_cache=self.plan_cache,
