@@ -82,15 +82,13 @@ def run(args: argparse.Namespace) -> int:
 
 def _watch(args: argparse.Namespace, signals: _Signals) -> int:
     """:func:`run`'s watch, ``signals`` its handlers."""
-    import numpy as np
-
     from hammer_mv.cli.checks import writable_folder
     from hammer_mv.cli.options import load_repertoire, recognition_settings
     from perception.errors import InputError
     from perception.io.atomic import check_output
     from perception.io.capture import RowsSource, source_kind
     from perception.io.video import codec_for, open_source
-    from perception.online import OnlineRecognizer, decision_summary
+    from perception.online import OnlineRecognizer
     from perception.pipeline import clip_fingerprint, clip_name, load_clip
     from perception.report import clip as report
     from perception.report.tracking import write_tracking_report
@@ -117,61 +115,26 @@ def _watch(args: argparse.Namespace, signals: _Signals) -> int:
         writable_folder(args.labelled_video.parent, "--labelled-video")
     settings = recognition_settings(args)
     rep, rep_id = load_repertoire(args)
-    latency, dropped, last, decided, interrupted = [], 0, None, None, False
     with (_Drawer(args.labelled_video) as draw,  # a watch that fails leaves no video
           (RowsSource(load_clip(args.source, pose=settings.pose, **settings.video_options()),
                       args.source) if kind == "pose" else
            open_source(args.source, stall_timeout=args.stall_timeout, fps=settings.fps,
                        keep_truncated=settings.keep_truncated)) as src):
-        fps = draw.fps = src.fps
         rows = getattr(src, "tracks", None)
         rec = OnlineRecognizer(rep, settings, clip=clip) if rows is None else OnlineRecognizer(
             rep, settings, clip=clip, markers=rows.markers, tracker_attrs=dict(rows.tracker))
-        say = (lambda line: None) if args.quiet else (lambda line: print(line, flush=True))
-        pace = kind in ("file", "pose") and not args.as_fast_as_possible
-        start = time.monotonic()
-        try:
-            for index, t, frame in src:
-                if pace:  # played at its own rate
-                    time.sleep(max(0.0, t - (time.monotonic() - start)))
-                if last is not None:  # frames the read-ahead dropped, or never sent
-                    gap = fps > 0 and t - last[1] > GAP_PERIODS / fps
-                    dropped += max(index - last[0], round((t - last[1]) * fps) if gap else 1) - 1
-                last = index, t
-                signals.holding = True  # a frame is judged and drawn whole, or not at all
-                t0 = time.perf_counter()
-                state = (rec.update(frame, t, index) if rows is None else
-                         rec.update(frame[0], t, index, likelihood=frame[1], status=frame[2]))
-                latency.append(time.perf_counter() - t0)
-                draw(frame, state, rec)
-                signals.holding = False
-                if signals.received:  # one came meanwhile
-                    raise KeyboardInterrupt
-                decided = _say_state(say, clip, t, state, decided, args.live)
-        except KeyboardInterrupt:  # the outputs of what was seen
-            interrupted = True
-        signals.holding = True  # from here on a signal waits for the outputs
-        src.close()
+        online = _stream(src, rec, args, signals, draw, pace=kind in ("file", "pose"))
         video = src.attrs()
         result = rec.finish(video, source=args.source)
-        online = {**decision_summary(result, rec.decision), "source": kind,
-                  "frames": len(latency), "dropped_frames": dropped,
-                  "read_ahead_dropped": src.dropped, "interrupted": interrupted,
-                  "signal": signals.name if interrupted else None,
-                  "labelled_video_error": draw.finish(),
-                  "latency_ms": {"median": float(np.median(latency) * 1e3),
-                                 "p99": float(np.percentile(latency, 99) * 1e3)}}
-        tracks = rec.tracks(video)
         extra = {"fingerprint": clip_fingerprint(args.source, settings, rep_id)} \
             if kind in ("file", "pose") else {}
         extra.update({"condition": None, "input": args.source,
-                      "tracking": write_tracking_report(tracks, args.output, clip, sheet=False),
-                      "online": online})
+                      "tracking": write_tracking_report(rec.tracks(video), args.output, clip,
+                                                        sheet=False),
+                      "online": {**online(result), "source": kind}})
         paths = report.write_clip_report(result, args.output, extra=extra,
                                          figures=not args.no_figures)
-    detail = f" ({result.verdict_detail})" if result.verdict_detail else ""
-    say(f"{clip}: {result.verdict or 'no verdict'}{detail}, winner {result.winner} "
-        f"({len(latency)} frames, {dropped} dropped) -> {paths['json']}")
+    _say_result(args, clip, result, online, paths)
     if draw.error is not None:  # the user's disk or folder: the report is kept, status 2
         print(f"hammer-mv watch: error: labelled video not written: {draw.error}",
               file=sys.stderr)
@@ -179,18 +142,15 @@ def _watch(args: argparse.Namespace, signals: _Signals) -> int:
 
 
 def _watch_recording(args: argparse.Namespace, signals: _Signals) -> int:
-    """``watch`` of a motion-capture recording: each reach replayed row by row through the
-    online recogniser, as ``recognize`` would score it offline (docs/online.md).
+    """``watch`` of a motion-capture recording: each reach's rows streamed as a pose file's,
+    as ``recognize`` would score it offline (docs/online.md).
 
-    Each reach prints what a watched file prints (with ``--live`` a line per
-    row, the settled verdict, the final line) and leaves the report watch
+    Each reach prints what a watched file prints and leaves the report watch
     writes; the trials that give none are listed, as ``recognize`` lists them,
     with the accounting line. Exit status 1 when a trial or reach is not
     scored; a signal ends the replay after the reach under way is reported.
     """
     import dataclasses
-
-    import numpy as np
 
     from hammer_mv.cli.checks import writable_folder
     from hammer_mv.cli.flags import flag_text
@@ -198,7 +158,8 @@ def _watch_recording(args: argparse.Namespace, signals: _Signals) -> int:
     from perception.batch import remove_stale_reports
     from perception.errors import InputError
     from perception.io.atomic import check_output
-    from perception.online import OnlineRecognizer, decision_summary
+    from perception.io.capture import RowsSource
+    from perception.online import OnlineRecognizer
     from perception.pipeline import clip_fingerprint
     from perception.reaches import Unscored
     from perception.recordings import prepare_reach, read_recording, trial_summary
@@ -226,64 +187,104 @@ def _watch_recording(args: argparse.Namespace, signals: _Signals) -> int:
         for target in report.clip_outputs(out, reach.name).values():
             check_output(target, inputs)
     rep, rep_id = load_repertoire(args)
-    say = (lambda line: None) if args.quiet else (lambda line: print(line, flush=True))
     missed = [(named(u), u.reason) for u in recording.entries if isinstance(u, Unscored)]
-    kept, interrupted = [], False
-    signals.holding = True  # a signal ends the replay at the next row, never mid-output
+    kept = []
     for k, reach in enumerate(reaches):
-        if interrupted or signals.received:
-            interrupted = True
+        if signals.received:
             missed.append((reach.name, f"not replayed: watch interrupted ({signals.name})"))
             continue
         prepared = prepare_reach(reach, settings, options)
-        tracks = prepared.tracks
-        rec = OnlineRecognizer(rep, prepared.settings, clip=reach.name, markers=tracks.markers,
-                               tracker_attrs=dict(tracks.tracker))
-        latency, decided = [], None
-        start = time.monotonic()
+        rows = prepared.tracks
+        rec = OnlineRecognizer(rep, prepared.settings, clip=reach.name, markers=rows.markers,
+                               tracker_attrs=dict(rows.tracker))
+        with RowsSource(rows, str(path)) as src:
+            online = _stream(src, rec, args, signals, _Drawer(None), pace=True)
         try:
-            for i in range(tracks.n_frames):
-                t = float(tracks.time[i])
-                if not args.as_fast_as_possible:  # played at its own rate
-                    signals.holding = False
-                    time.sleep(max(0.0, t - (time.monotonic() - start)))
-                    signals.holding = True
-                if signals.received:
-                    raise KeyboardInterrupt
-                t0 = time.perf_counter()
-                state = rec.update(tracks.position[i], t, i)
-                latency.append(time.perf_counter() - t0)
-                decided = _say_state(say, reach.name, t, state, decided, args.live)
-        except KeyboardInterrupt:  # this reach's outputs of what was seen, then no more
-            signals.holding, interrupted = True, True
-        try:
-            result = rec.finish(dict(tracks.video), source=reach.source, paths=prepared.paths)
+            result = rec.finish(dict(rows.video), source=reach.source, paths=prepared.paths)
         except HammerMVError as exc:  # this reach's (too few rows when interrupted, ...)
             missed.append((reach.name, f"failed: {flag_text(exc.problem)}"))
             continue
-        online = {**decision_summary(result, rec.decision), "source": "recording",
-                  "frames": len(latency), "dropped_frames": 0, "read_ahead_dropped": 0,
-                  "interrupted": interrupted,
-                  "signal": signals.name if interrupted else None,
-                  "labelled_video_error": None,
-                  "latency_ms": {"median": float(np.median(latency) * 1e3),
-                                 "p99": float(np.percentile(latency, 99) * 1e3)}}
         extra = {"fingerprint": clip_fingerprint(path, settings, f"{rep_id}#reach{k}"),
                  "condition": None, "input": str(path), "mocap": prepared.info,
-                 "online": online}
+                 "online": {**online(result), "source": "recording"}}
         paths = report.write_clip_report(result, out, extra=extra, figures=not args.no_figures)
         kept.append(reach.name)
-        detail = f" ({result.verdict_detail})" if result.verdict_detail else ""
-        say(f"{reach.name}: {result.verdict or 'no verdict'}{detail}, winner {result.winner} "
-            f"({len(latency)} rows) -> {paths['json']}")
-    if not interrupted:  # reports of trials no longer scored (a rerun after one was lost)
+        _say_result(args, reach.name, result, online, paths, rows=True)
+    if not signals.received:  # reports of trials no longer scored (a rerun after one was lost)
         remove_stale_reports(out, path, kept)
-    say(trial_summary(len(recording.trials), len(kept), len(missed)))
+    if not args.quiet:
+        print(trial_summary(len(recording.trials), len(kept), len(missed)), flush=True)
     for name, why in missed:  # always: nothing is dropped without a word
         print(f"{name}: not scored: {why}", file=sys.stderr)
-    if interrupted:
-        return 128 + (signals.received or signal.SIGINT)
+    if signals.received:
+        return 128 + signals.received
     return 1 if missed else 0
+
+
+def _stream(src, rec, args: argparse.Namespace, signals: _Signals, draw: _Drawer, *,
+            pace: bool):
+    """Feed ``src``'s frames (or rows) to ``rec`` one at a time, printing what
+    :func:`_say_state` prints; a signal ends it. Return ``online(result)``: the report's
+    ``online`` entry once ``rec`` is finished into ``result``.
+
+    A file (or a recording's rows) is played at its own rate unless
+    ``--as-fast-as-possible``. A frame is judged and drawn whole or not at all; from the
+    end of the stream on, a signal waits for the outputs.
+    """
+    import numpy as np
+
+    from perception.online import decision_summary
+
+    say = (lambda line: None) if args.quiet else (lambda line: print(line, flush=True))
+    pace = pace and not args.as_fast_as_possible
+    latency, dropped, last, decided, interrupted = [], 0, None, None, False
+    start = time.monotonic()
+    try:
+        if signals.received:  # came while the outputs of an earlier reach were written
+            raise KeyboardInterrupt
+        signals.holding = False
+        for index, t, frame in src:
+            if pace:
+                time.sleep(max(0.0, t - (time.monotonic() - start)))
+            if last is not None:  # frames the read-ahead dropped, or never sent
+                gap = src.fps > 0 and t - last[1] > GAP_PERIODS / src.fps
+                dropped += max(index - last[0], round((t - last[1]) * src.fps) if gap else 1) - 1
+            last = index, t
+            signals.holding = True
+            t0 = time.perf_counter()
+            state = (rec.update(frame[0], t, index, likelihood=frame[1], status=frame[2])
+                     if isinstance(frame, tuple) else rec.update(frame, t, index))
+            latency.append(time.perf_counter() - t0)
+            draw(frame, state, rec)
+            signals.holding = False
+            if signals.received:  # one came meanwhile
+                raise KeyboardInterrupt
+            decided = _say_state(say, rec.clip, t, state, decided, args.live)
+    except KeyboardInterrupt:  # the outputs of what was seen
+        interrupted = True
+    signals.holding = True
+    src.close()
+    error = draw.finish()
+    ms = np.asarray(latency) * 1e3
+    return lambda result: {
+        **decision_summary(result, rec.decision), "frames": len(latency),
+        "dropped_frames": dropped, "read_ahead_dropped": src.dropped,
+        "interrupted": interrupted, "signal": signals.name if interrupted else None,
+        "labelled_video_error": error,
+        "latency_ms": {"median": float(np.median(ms)), "p99": float(np.percentile(ms, 99))}}
+
+
+def _say_result(args: argparse.Namespace, clip: str, result, online, paths: dict, *,
+                rows: bool = False) -> None:
+    """The final line of a clip or reach (``rows``: a recording's): its verdict, winner,
+    frames (rows) and report."""
+    if not args.quiet:
+        info = online(result)
+        seen = (f"{info['frames']} rows" if rows else
+                f"{info['frames']} frames, {info['dropped_frames']} dropped")
+        detail = f" ({result.verdict_detail})" if result.verdict_detail else ""
+        print(f"{clip}: {result.verdict or 'no verdict'}{detail}, winner {result.winner} "
+              f"({seen}) -> {paths['json']}", flush=True)
 
 
 def _say_state(say, clip: str, t: float, state, decided, live: bool):
