@@ -10,6 +10,16 @@ and reports how often the verdict is right::
     python tools/evaluate_verdict.py --set heldout -o out/eval/heldout
     python tools/evaluate_verdict.py --set dev -o out/eval/dev --jobs 2
 
+``--generator sigma-lognormal`` evaluates on the second generator instead
+(:mod:`perception.synthetic.sigma_lognormal`: lognormal speed strokes, grip
+pulses, marker noise and dropouts; used only to evaluate, never to tune), with
+the same set names and seeds; ``--source tracks`` recognises in-memory tracks
+of the same movements (no video, no tracker: seconds instead of minutes)::
+
+    python tools/evaluate_verdict.py --generator sigma-lognormal --set heldout -o out/eval/sl
+    python tools/evaluate_verdict.py --generator sigma-lognormal --source tracks \
+        --set fast-heldout -o out/eval/sl-fast-tracks
+
 Two populations, disjoint by seed (clip *k* of a set draws everything from
 ``numpy.random.default_rng(first_seed + k)``):
 
@@ -72,6 +82,11 @@ CONDITIONS = tuple(DEFAULT_COUNTS)
 EXPECTED: dict[str, str] = {"normal": "normal", "delayed": "abnormal",
                             "open-close-open": "abnormal", "reach": "reach"}
 FAILED = "failed/refused"
+#: The generators a set can be drawn from (docs/generators.md).
+GENERATORS = ("independent", "sigma-lognormal")
+#: Where the verdict is computed from: rendered video through ``hammer-mv batch``, or
+#: in-memory tracks of the same movements.
+SOURCES = ("video", "tracks")
 #: Columns of the confusion table (any other verdict met is appended).
 VERDICTS = ("normal", "abnormal", "reach", "unfamiliar", FAILED)
 #: Confidently wrong: a familiar-movement clip called abnormal below LOW, an
@@ -208,8 +223,10 @@ def markdown(result: dict, table: pd.DataFrame, *, list_clips: bool) -> str:
     """The evaluation as markdown: confusion, share right by group, familiarity, wrong clips."""
     allm = result["groups"]["all"]
     verdicts = list(next(iter(allm["confusion"].values())).keys()) if allm["confusion"] else []
-    lines = [f"## Verdict on the `{result['set']}` population "
-             f"(seeds {result['seeds'][0]}–{result['seeds'][1]}, {allm['n']} clips, from video)",
+    generator = result.get("generator", "independent")
+    lines = [f"## Verdict on the `{result['set']}` population of the `{generator}` generator "
+             f"(seeds {result['seeds'][0]}–{result['seeds'][1]}, {allm['n']} clips, "
+             f"from {result.get('source', 'video')})",
              "",
              "Confusion, condition × verdict:", "",
              "| condition | " + " | ".join(f"`{v}`" if v != FAILED else v for v in verdicts)
@@ -237,9 +254,12 @@ def markdown(result: dict, table: pd.DataFrame, *, list_clips: bool) -> str:
         if len(f):
             lines.append(f"| {c} | {f.median():.3g} | {f.min():.3g} | {f.max():.3g} |")
     t = result.get("timing", {})
-    if t:
+    if t and result.get("source", "video") == "video":
         lines += ["", f"Rendering {t['render_s']:.0f} s, tracking and recognition "
                   f"{t['batch_s']:.0f} s (`--jobs {result['jobs']}`)."]
+    elif t:
+        lines += ["", f"Recognition of in-memory tracks {t['batch_s']:.0f} s "
+                  f"(`--jobs {result['jobs']}`)."]
     wrong = table[table["verdict"] != table["condition"].map(EXPECTED)]
     if list_clips and len(wrong):
         cols = ["clip", "verdict", "familiarity", "winner", "movement_time", "distance",
@@ -286,36 +306,130 @@ def hammer_mv() -> list[str]:
     return [sys.executable, "-c", "import sys; from hammer_mv.cli import main; sys.exit(main())"]
 
 
-def run(set_name: str, out: str | os.PathLike, counts: dict[str, int], *, jobs: int = 2,
-        quiet: bool = False) -> tuple[pd.DataFrame, dict]:
-    """Render the set, run ``hammer-mv batch`` on it, evaluate, write the tables."""
-    from perception.synthetic.population import POPULATION_RANGES, render_population_set
+def _fast_ranges(set_name: str) -> dict | None:
+    """The independent population's ranges for a set (fast sets: :data:`FAST_DURATION`)."""
+    from perception.synthetic.population import POPULATION_RANGES
 
-    ranges = ({**POPULATION_RANGES, "duration": FAST_DURATION} if set_name.startswith("fast")
-              else None)
+    return ({**POPULATION_RANGES, "duration": FAST_DURATION} if set_name.startswith("fast")
+            else None)
+
+
+def render_set(generator: str, set_name: str, out: Path, counts: dict[str, int], seed: int,
+               *, jobs: int, progress: bool) -> pd.DataFrame:
+    """Render a set of ``generator`` into ``out`` with its ``manifest.csv``."""
+    if generator == "sigma-lognormal":
+        from perception.synthetic.sigma_lognormal import render_sigma_lognormal_set
+
+        return render_sigma_lognormal_set(out, counts, seed=seed,
+                                          fast=set_name.startswith("fast"), jobs=jobs,
+                                          progress=progress)
+    from perception.synthetic.population import render_population_set
+
+    return render_population_set(out, counts, seed=seed, ranges=_fast_ranges(set_name),
+                                 jobs=jobs, progress=progress)
+
+
+def clip_tracks(generator: str, set_name: str, condition: str, clip_seed: int):
+    """The in-memory tracks of a set's clip and its manifest row (no video).
+
+    The same movement and filming the rendered clip of that seed shows; the
+    tracker's part is pixel noise (and, in the second generator, its own
+    marker noise and dropouts).
+    """
+    rng = np.random.default_rng(clip_seed)
+    if generator == "sigma-lognormal":
+        from perception.synthetic import sigma_lognormal as sl
+
+        clip = sl.draw_sigma_lognormal_clip(condition, rng, fast=set_name.startswith("fast"))
+        return sl.clip_tracks(clip, rng)[0], clip.row()
+    from perception.synthetic.independent import independent_paths, tracked_paths
+    from perception.synthetic.population import draw_population, population_camera
+
+    draw = draw_population(condition, rng, ranges=_fast_ranges(set_name))
+    t, paths = independent_paths(draw.params, draw.fps, seed=rng)
+    world = {m: paths[m] for m in ("wrist", "finger", "thumb")}
+    world["object"] = np.zeros_like(paths["wrist"])
+    tracks = tracked_paths(t, world, population_camera(draw), draw.params.object_size,
+                           "independent", seed=clip_seed, noise_px=0.4)
+    return tracks, draw.row()
+
+
+_REPERTOIRE = None
+
+
+def _recognise_one(work: tuple) -> dict:
+    """Recognise one clip's in-memory tracks: its summary row."""
+    global _REPERTOIRE
+    from perception.pipeline import recognize_clip
+    from perception.recognition.repertoire import Repertoire
+
+    generator, set_name, clip, condition, clip_seed = work
+    if _REPERTOIRE is None:  # one per worker process: its plans are reused
+        _REPERTOIRE = Repertoire.default()
+    tracks, row = clip_tracks(generator, set_name, condition, clip_seed)
+    base = {"clip": clip, "condition": condition, "seed": clip_seed, **row}
+    try:
+        rec = recognize_clip(tracks, _REPERTOIRE, clip=clip).to_dict()
+    except Exception as exc:  # noqa: BLE001 - a refused clip is a result, counted as such
+        return {**base, "status": "failed", "error": f"{type(exc).__name__}: {exc}"}
+    return {**base, "status": "ok", "verdict": rec.get("verdict"),
+            "familiarity": rec.get("familiarity"), "winner": rec.get("winner")}
+
+
+def recognise_tracks(generator: str, set_name: str, counts: dict[str, int], seed: int, *,
+                     jobs: int) -> list[dict]:
+    """Recognise every clip of a set from in-memory tracks; one row per clip."""
+    clips = [(cond, i) for cond in CONDITIONS for i in range(counts.get(cond, 0))]
+    work = [(generator, set_name, f"{cond}-{i + 1:02d}", cond, seed + k)
+            for k, (cond, i) in enumerate(clips)]
+    if jobs == 1:
+        return [_recognise_one(w) for w in work]
+    from concurrent.futures import ProcessPoolExecutor
+
+    with ProcessPoolExecutor(jobs) as pool:
+        return list(pool.map(_recognise_one, work))
+
+
+def run(set_name: str, out: str | os.PathLike, counts: dict[str, int], *, jobs: int = 2,
+        quiet: bool = False, generator: str = "independent",
+        source: str = "video") -> tuple[pd.DataFrame, dict]:
+    """Render the set, run ``hammer-mv batch`` on it (or recognise its tracks), evaluate,
+    write the tables."""
     out = Path(out)
     n = sum(counts.values())
     seeds = set_seeds(set_name, n)
     tty = sys.stderr.isatty() and not quiet
     t0 = time.perf_counter()
-    manifest = render_population_set(out / "clips", counts, seed=seeds.start, ranges=ranges,
-                                     jobs=jobs, progress=tty)
-    t1 = time.perf_counter()
-    if tty:
-        print(f"tracking and recognising {n} clips from video (hammer-mv batch --jobs {jobs}) …",
-              file=sys.stderr)
-    cmd = [*hammer_mv(), "batch", str(out / "clips" / "manifest.csv"), "-o", str(out / "report"),
-           "--jobs", str(jobs), "--quiet"]
-    proc = subprocess.run(cmd, capture_output=True, text=True)
-    t2 = time.perf_counter()
-    summary_path = out / "report" / "summary.csv"
-    if not summary_path.is_file():
-        raise RuntimeError(f"hammer-mv batch wrote no summary (exit {proc.returncode}): "
-                           f"{proc.stderr.strip()[-2000:]}")
-    summary = pd.read_csv(summary_path)
+    if source == "tracks":
+        rows = recognise_tracks(generator, set_name, counts, seeds.start, jobs=jobs)
+        t1, t2 = t0, time.perf_counter()  # nothing rendered
+        out.mkdir(parents=True, exist_ok=True)
+        result_keys = ("verdict", "familiarity", "winner", "status", "error")
+        manifest = pd.DataFrame([{k: v for k, v in r.items() if k not in result_keys}
+                                 for r in rows])
+        summary = pd.DataFrame([{k: r.get(k) for k in ("clip", *result_keys)} for r in rows])
+        exit_code = 0
+    else:
+        manifest = render_set(generator, set_name, out / "clips", counts, seeds.start,
+                              jobs=jobs, progress=tty)
+        t1 = time.perf_counter()
+        if tty:
+            print(f"tracking and recognising {n} clips from video (hammer-mv batch "
+                  f"--jobs {jobs}) …", file=sys.stderr)
+        cmd = [*hammer_mv(), "batch", str(out / "clips" / "manifest.csv"), "-o",
+               str(out / "report"), "--jobs", str(jobs), "--quiet"]
+        proc = subprocess.run(cmd, capture_output=True, text=True)
+        t2 = time.perf_counter()
+        summary_path = out / "report" / "summary.csv"
+        if not summary_path.is_file():
+            raise RuntimeError(f"hammer-mv batch wrote no summary (exit {proc.returncode}): "
+                               f"{proc.stderr.strip()[-2000:]}")
+        summary = pd.read_csv(summary_path)
+        exit_code = proc.returncode
     table, by_group = evaluate(summary, manifest)
-    result = {"set": set_name, "seeds": [seeds.start, seeds.stop - 1],
-              "counts": counts, "jobs": jobs, "batch_exit": proc.returncode,
+    result = {"set": set_name, "generator": generator, "source": source,
+              "seeds": [seeds.start, seeds.stop - 1],
+              "counts": counts, "jobs": jobs, "batch_exit": exit_code,
               "timing": {"render_s": t1 - t0, "batch_s": t2 - t1},
               "groups": by_group}
     text = markdown(result, table, list_clips=set_name not in HELD_OUT)
@@ -337,6 +451,13 @@ def build_parser() -> argparse.ArgumentParser:
                    help="population: dev (seeds 1000 + k, for tuning) or heldout (seeds "
                         "9000 + k, never for choosing a parameter); fast-dev / fast-heldout: "
                         "the same with movement times of 0.45-0.65 s")
+    p.add_argument("--generator", choices=GENERATORS, default="independent",
+                   help="independent: the healthy-adult population of the generator the rules "
+                        "are tuned on; sigma-lognormal: the second generator, never tuned on "
+                        "(docs/generators.md); same set names and seeds")
+    p.add_argument("--source", choices=SOURCES, default="video",
+                   help="video: render, track and recognise with hammer-mv batch; tracks: "
+                        "recognise in-memory tracks of the same movements (no video)")
     p.add_argument("-o", "--output", required=True, metavar="OUT",
                    help="folder for clips/, report/, evaluation.md and evaluation.json")
     p.add_argument("--per-condition", type=parse_counts, default=None, metavar="COUNTS",
@@ -357,7 +478,8 @@ def main(argv: list[str] | None = None) -> int:
     counts = (QUICK_COUNTS if args.quick else args.per_condition or DEFAULT_COUNTS)
     if sum(counts.values()) > MAX_CLIPS:
         build_parser().error(f"--per-condition: at most {MAX_CLIPS} clips in a set")
-    _, result = run(args.set, args.output, counts, jobs=args.jobs, quiet=args.quiet)
+    _, result = run(args.set, args.output, counts, jobs=args.jobs, quiet=args.quiet,
+                    generator=args.generator, source=args.source)
     if not args.quiet:
         print(result["markdown"])
         print(f"wrote {Path(args.output) / 'evaluation.md'} and evaluation.json")
