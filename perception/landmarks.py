@@ -40,18 +40,11 @@ from perception.validation import Int, Share, declared
 if TYPE_CHECKING:
     from perception.observation import Observation
 
-__all__ = ["MODEL_SPAN_FRACTION", "OK", "LandmarkParams", "Landmarks", "MeasuredPaths",
+__all__ = ["OK", "LandmarkParams", "Landmarks", "MeasuredPaths",
            "count_peaks", "longest_gap", "model_landmarks", "movement_bounds",
            "movement_landmarks", "movement_time", "observed_landmarks", "speed_bound",
            "wrist_movement_time"]
 
-
-#: The wrist covers the middle 80 % of its path (10 % to 90 %) in this
-#: fraction of a model's movement time: measured on the default grasp
-#: models' own movements at 0.8, 1.0 and 1.2 s (0.458, 0.467, 0.472), never
-#: on test clips. The span between two fractions does not depend on where
-#: the onset is placed, which the start of a movement leaves uncertain.
-MODEL_SPAN_FRACTION = 0.467
 
 @functools.lru_cache(maxsize=64)
 def _butter(order: int, wn: float) -> tuple[np.ndarray, np.ndarray]:
@@ -301,22 +294,25 @@ def _progress_time(time: np.ndarray, w: np.ndarray, fraction: float) -> float:
     return float(t[i - 1] + (t[i] - t[i - 1]) * (fraction - p0) / max(p1 - p0, 1e-12))
 
 
-def movement_time(obs: Observation) -> float:
+def movement_time(obs: Observation, span_fraction: float) -> float:
     """A demonstration's movement time, s, from the wrist's middle 80 % of its path.
 
-    ``(t90 - t10) / MODEL_SPAN_FRACTION``: the time a model would take for
-    a movement that covers its middle 80 % as fast. NaN if the wrist is
-    seen too little.
+    ``(t90 - t10) / span_fraction``: the time a model would take for a
+    movement that covers its middle 80 % as fast. NaN if the wrist is seen
+    too little.
 
     Parameters
     ----------
     obs : Observation
         The demonstration.
+    span_fraction : float
+        The share of a model's movement time its wrist takes for the middle
+        80 % of its path (``VerdictRules.span_fraction``).
     """
-    return wrist_movement_time(obs.time, obs.wrist)
+    return wrist_movement_time(obs.time, obs.wrist, span_fraction)
 
 
-def wrist_movement_time(time: np.ndarray, wrist: np.ndarray) -> float:
+def wrist_movement_time(time: np.ndarray, wrist: np.ndarray, span_fraction: float) -> float:
     """:func:`movement_time` of a wrist path sampled at ``time``, s.
 
     Parameters
@@ -325,10 +321,12 @@ def wrist_movement_time(time: np.ndarray, wrist: np.ndarray) -> float:
         Sample times, s.
     wrist : (N, 2) array
         Wrist positions, m (NaN where lost).
+    span_fraction : float
+        As :func:`movement_time`'s.
     """
     time, wrist = np.asarray(time, dtype=float), np.asarray(wrist, dtype=float)
     return ((_progress_time(time, wrist, 0.9) - _progress_time(time, wrist, 0.1))
-            / MODEL_SPAN_FRACTION)
+            / span_fraction)
 
 
 def longest_gap(time: np.ndarray, values: np.ndarray) -> float:

@@ -19,8 +19,6 @@ from perception.landmarks import LandmarkParams, movement_bounds
 from perception.reach_data import (
     _STILL_RANGE,
     _STILL_WINDOW,
-    APPROACH,
-    RETURNED,
     Movement,
     ReachParams,
 )
@@ -284,12 +282,12 @@ def classify_movements(time: np.ndarray, transport: np.ndarray, movements: list[
 
     Reach-ness is read from the transport, never from the grip. With an
     object (``object_path``, or ``params.object_position``), a reach ends
-    :data:`APPROACH` of its starting distance nearer the object, and it ends
+    ``params.approach`` of its starting distance nearer the object, and it ends
     where the object first moves if that comes before the hand stops (the
     rest of the movement is the object's transport). Without one, a reach
     goes away from where the hand rested; the movements after it are not
     reaches (a transport, a lift, the return) until one ends back within
-    :data:`RETURNED` of the reach's length from where it began, unless one
+    ``params.returned`` of the reach's length from where it began, unless one
     takes the hand on, at least ``min_travel`` farther from its rest, with
     a grip that opens by ``min_opening``: that one is the reach, and the
     movement before it was a preliminary one.
@@ -353,7 +351,7 @@ def classify_movements(time: np.ndarray, transport: np.ndarray, movements: list[
                 m = dataclasses.replace(m, end=moves, end_bound="the object's first motion")
                 stop = hand.at(moves, False)
             d0, d1 = np.linalg.norm(start - at), np.linalg.norm(stop - at)
-            if d0 - d1 >= APPROACH * d0:
+            if d0 - d1 >= params.approach * d0:
                 reached = True
                 out.append(dataclasses.replace(m, kind="reach"))
             elif reached:
@@ -370,7 +368,7 @@ def classify_movements(time: np.ndarray, transport: np.ndarray, movements: list[
         home = start if home is None else home
         if holding is not None:
             k, begin, there = holding
-            back = np.linalg.norm(stop - begin) <= RETURNED * np.linalg.norm(there - begin)
+            back = np.linalg.norm(stop - begin) <= params.returned * np.linalg.norm(there - begin)
             on = (np.linalg.norm(stop - home) >= np.linalg.norm(there - home)
                   + params.min_travel and _opens(aperture, m, params))
             if back:

@@ -127,6 +127,10 @@ class ObserveParams:
         last such frame.
     end_noise_factor : float
         Noise SDs per frame a marker must move to count as moving.
+    end_speed_window : float
+        Time over which those speeds are measured, s (a frame at 30
+        frames/s): over one frame of a 120 frames/s clip the noise floor
+        would be four times as high.
     end_pad_frames : int
         Frames kept after the last moving frame (the finite difference and
         the filter lag the motion by about that much).
@@ -159,6 +163,7 @@ class ObserveParams:
         (0.006, 0.151), (0.008, 0.166), (0.012, 0.190))
     end_speed: Positive = 0.02
     end_noise_factor: Positive = 6.0
+    end_speed_window: Annotated[float, Field(gt=0, le=1)] = 1 / 30
     end_pad_frames: _Frames = 2
     alpha: Annotated[float, Field(gt=0, le=1)] = 0.5
     beta: Annotated[float, Field(ge=0, lt=2)] = 0.15
@@ -497,20 +502,16 @@ def onset_time(filtered: np.ndarray, time: np.ndarray, noise: float, params: Obs
     return float(crossing - params.onset_latency(threshold))
 
 
-#: The time over which the end of a movement reads speeds, s (a frame at 30 frames/s).
-END_SPEED_WINDOW = 1 / 30
-
-
 def _end_row(filtered: np.ndarray, time: np.ndarray, noise: float, dt: float,
              params: ObserveParams) -> int:
     """The last row of the movement: a few frames after any hand marker last moved.
 
-    Speeds are measured over :data:`END_SPEED_WINDOW` (``k`` frames, one at
+    Speeds are measured over ``params.end_speed_window`` (``k`` frames, one at
     30 frames/s or less): over one frame of a 120 frames/s clip the noise
     floor would be four times as high, and a slow movement's approach would
     count as stopped long before it ends.
     """
-    k = max(1, int(round(END_SPEED_WINDOW / dt)))
+    k = max(1, int(round(params.end_speed_window / dt)))
     if len(time) <= k:
         return len(time) - 1
     speed = (np.linalg.norm(filtered[k:] - filtered[:-k], axis=-1)

@@ -24,23 +24,11 @@ from perception.errors import InputError
 from perception.landmarks import LandmarkParams
 from perception.validation import NonNegative, Positive, Tuple, declared
 
-__all__ = ["APPROACH", "MIN_REST", "MIN_SAMPLES", "PX_PER_M", "RETURNED", "WRIST_BEHIND",
+__all__ = ["MIN_SAMPLES", "PX_PER_M",
            "MarkerMap", "Movement", "Reach", "ReachParams", "Unscored", "ever_seen"]
 
 #: The scale of the tracks a reach becomes: one "pixel" per millimetre.
 PX_PER_M = 1000.0
-#: Where a reach without a wrist marker gets one: this far behind the grip midpoint, m.
-WRIST_BEHIND = 0.06
-#: Least stillness before a reach's onset the recognition needs, s.
-MIN_REST = 0.3
-#: With object markers, a movement is a reach when the hand ends at least this share
-#: of its starting distance nearer the object (a marker set on the back of the hand
-#: stops well short of the object's centre).
-APPROACH = 0.4
-#: Without object markers, the hand is back from a reach (the next outward movement may
-#: be a reach again) when a movement ends within this share of the reach's length of
-#: where the reach began.
-RETURNED = 0.5
 #: Fewest samples a trial needs to be searched for reaches (the low-pass filter's own
 #: need is 3 x its order + 1 per seen stretch), and a reach to be scored.
 MIN_SAMPLES = 10
@@ -209,6 +197,23 @@ class ReachParams:
         or where the grip closes).
     object_size : float, optional
         The object's size across the grip, m.
+    approach : float
+        With object markers, a movement is a reach when the hand ends at
+        least this share of its starting distance nearer the object (a marker
+        set on the back of the hand stops well short of the object's centre).
+    returned : float
+        Without object markers, the hand is back from a reach (the next
+        outward movement may be a reach again) when a movement ends within
+        this share of the reach's length of where the reach began.
+    min_rest : float
+        Least stillness before a reach's onset the recognition needs, s: a
+        reach with less is given that much, held at its first position.
+    wrist_behind : float
+        Where a reach without a wrist marker gets one: this far behind the
+        grip midpoint, m (``wrist_synthesised``).
+    tail : float
+        Time kept after a reach's end (up to the next movement's onset), s:
+        the still hand the recognition's end rule reads.
     """
 
     landmarks: LandmarkParams = field(default_factory=LandmarkParams)
@@ -220,6 +225,11 @@ class ReachParams:
     object_moved: Positive = 0.01
     object_position: Annotated[tuple[float, float, float], Tuple] | None = None
     object_size: Annotated[float, Field(gt=0, lt=1)] | None = None
+    approach: Annotated[float, Field(gt=0, le=1)] = 0.4
+    returned: Annotated[float, Field(gt=0, le=1)] = 0.5
+    min_rest: Positive = 0.3
+    wrist_behind: Annotated[float, Field(ge=0, le=0.3)] = 0.06
+    tail: Positive = 0.5
 
 
 @dataclass(frozen=True, eq=False)

@@ -19,7 +19,7 @@ import numpy as np
 from perception.boundary import expect
 from perception.errors import InputError
 from perception.io.tracks import Status, Tracks
-from perception.reach_data import _ORIGIN_PX, MIN_REST, PX_PER_M, WRIST_BEHIND, Reach, ReachParams
+from perception.reach_data import _ORIGIN_PX, PX_PER_M, Reach, ReachParams
 
 __all__ = ["PlaneFit", "ReachTracks", "fit_plane", "reach_tracks"]
 
@@ -150,7 +150,7 @@ def reach_tracks(reach: Reach, params: ReachParams | None = None) -> ReachTracks
         size = 0.005
     # the models' hand: a wrist behind the grip, whatever markers the lab put on it
     # (a marker on the back of the hand projects anywhere near the grip)
-    wrist = mid - np.array([0.0, WRIST_BEHIND])
+    wrist = mid - np.array([0.0, params.wrist_behind])
     across = np.array([1.0, 0.0])
     finger = mid + 0.5 * g[:, None] * across
     thumb = mid - 0.5 * g[:, None] * across
@@ -167,8 +167,8 @@ def reach_tracks(reach: Reach, params: ReachParams | None = None) -> ReachTracks
     first = int(whole[0])
     still = time[reach.onset] - time[first]
     shift = -first
-    if still < MIN_REST:
-        n = int(math.ceil((MIN_REST - still) / dt)) + 1
+    if still < params.min_rest:
+        n = int(math.ceil((params.min_rest - still) / dt)) + 1
         notes.append(f"{max(still, 0) * 1000:.0f} ms of rest before the movement: "
                      f"{n * dt * 1000:.0f} ms of its first clean sample added")
         time = np.r_[time[first] - dt * np.arange(n, 0, -1), time[first:]]
@@ -182,7 +182,7 @@ def reach_tracks(reach: Reach, params: ReachParams | None = None) -> ReachTracks
         # the hand goes on (with the object): what the models read ends at the grasp, held
         # there as a hand at rest on the object (what follows is no part of the reach)
         last = reach.end + shift
-        k = int(math.ceil(MIN_REST / dt))
+        k = int(math.ceil(params.min_rest / dt))
         notes.append(f"the reach ends at {reach.end_bound}: its last sample held "
                      f"{k * dt * 1000:.0f} ms in place of what follows")
         time = np.r_[time[:last + 1], time[last] + dt * np.arange(1, k + 1)]

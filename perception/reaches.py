@@ -21,7 +21,7 @@ describes the rules; in short:
 * **reaches** (:func:`classify_movements`): from the transport alone, not
   from the grip (a whole-hand grasp barely opens it, a late or slight
   opening is still a grasp). With object markers, a movement that ends
-  :data:`APPROACH` of its distance nearer the object is a reach, and it ends
+  :attr:`ReachParams.approach` of its distance nearer the object is a reach, and it ends
   where the object first moves if that comes before the hand stops.
   Without them, a movement away from where the hand rested is a reach;
   what follows it (transport, lift, drink, release) is not, until the hand
@@ -37,14 +37,14 @@ describes the rules; in short:
   placed across the approach at that aperture, the finger on the model's +x
   side (a projection would hide a grip that lies out of the plane, as it
   does when a lab's participants grasp along the line of sight).
-* **the wrist**: a point :data:`WRIST_BEHIND` behind the grip midpoint
+* **the wrist**: a point :attr:`ReachParams.wrist_behind` behind the grip midpoint
   along the approach, the models' own hand (a lab's wrist or hand markers
   carry the transport landmarks, in 3D, not the models' tracks).
 * **the object**: the mean of its markers, a given position, or else where
   the grip midpoint comes to rest at the reach's end (where the hand closes
   on it); its size as given, or else the aperture there less the aperture
   at rest (what the recognition's grip aperture reads at contact).
-* **rest**: a reach with less than :data:`MIN_REST` of stillness before its
+* **rest**: a reach with less than :attr:`ReachParams.min_rest` of stillness before its
   onset (a trial that starts late in its rest, or in motion) is given that
   much rest by holding its first clean sample, with a note; a reach that
   ends where the hand goes on (the object's first motion, the speed minimum
@@ -69,12 +69,8 @@ from perception.cleaning import clean_path
 from perception.errors import InputError
 from perception.movements import classify_movements, find_movements, find_reaches
 from perception.reach_data import (
-    APPROACH,
-    MIN_REST,
     MIN_SAMPLES,
     PX_PER_M,
-    RETURNED,
-    WRIST_BEHIND,
     MarkerMap,
     Movement,
     Reach,
@@ -84,10 +80,9 @@ from perception.reach_data import (
 )
 from perception.reach_plane import PlaneFit, ReachTracks, fit_plane, reach_tracks
 
-__all__ = ["APPROACH", "MIN_REST", "MIN_SAMPLES", "PX_PER_M", "RETURNED", "WRIST_BEHIND",
-           "MarkerMap", "Movement", "PlaneFit", "Reach", "ReachParams", "ReachTracks",
-           "Unscored", "classify_movements", "find_movements", "find_reaches", "fit_plane",
-           "reach_tracks", "recording_reaches", "trial_reaches"]
+__all__ = ["MIN_SAMPLES", "PX_PER_M", "MarkerMap", "Movement", "PlaneFit", "Reach", "ReachParams",
+           "ReachTracks", "Unscored", "classify_movements", "find_movements", "find_reaches",
+           "fit_plane", "reach_tracks", "recording_reaches", "trial_reaches"]
 
 
 def _mean_marker(markers, names, time, params, notes) -> np.ndarray | None:
@@ -227,8 +222,8 @@ def trial_reaches(trial, markers: MarkerMap | None = None,
         prev_end = moves[i - 1].end if i and moves[i - 1].end is not None else 0
         nxt = moves[i + 1].onset if i + 1 < len(moves) and moves[i + 1].onset is not None \
             else len(time) - 1
-        lo = max(prev_end, m.onset - int(round(2 * MIN_REST / dt)))
-        hi = max(m.end, min(nxt, m.end + int(round(0.5 / dt)), len(time) - 1))
+        lo = max(prev_end, m.onset - int(round(2 * params.min_rest / dt)))
+        hi = max(m.end, min(nxt, m.end + int(round(params.tail / dt)), len(time) - 1))
         rows = slice(lo, hi + 1)
         obj_at = None
         if params.object_position is not None:

@@ -16,7 +16,7 @@ from test_reach_finding import _simple_reach
 
 from hammer_mv.cli import main
 from perception.errors import InputError
-from perception.reaches import MarkerMap, reach_tracks, recording_reaches
+from perception.reaches import MarkerMap, ReachParams, reach_tracks, recording_reaches
 from perception.report.tables import LANDMARK_UNITS
 
 
@@ -192,3 +192,25 @@ def test_repeated_subject_marker_names_say_what_each_is_read_as():
     names, notes = strip_subject(["thumb", "thumb", "index"])
     assert names == ["thumb", "thumb_2", "index"]
     assert any("'thumb' as 'thumb', 'thumb_2'" in n for n in notes), notes
+
+
+# -- the numbers that shape a reach are declared ----------------------------------------------
+def test_a_synthesised_wrist_is_placed_wrist_behind_the_grip():
+    trial = _simple_reach([(0.75, 1.05, 1.4, 0.05, 0.04)])
+    reach = recording_reaches(trial, MarkerMap("thumb", "index"))[0]
+    for behind in (0.06, 0.09):
+        tracks = reach_tracks(reach, ReachParams(wrist_behind=behind)).tracks
+        pos = {m: tracks.position[:, i] for i, m in enumerate(tracks.markers)}
+        mid = 0.5 * (pos["thumb"] + pos["finger"])
+        gap = np.linalg.norm(mid - pos["wrist"], axis=1) / 1000  # 1 px = 1 mm
+        assert np.nanmedian(gap) == pytest.approx(behind, abs=1e-9)
+
+
+def test_min_rest_is_the_rest_a_reach_is_given():
+    trial = _simple_reach([(0.75, 1.05, 1.4, 0.05, 0.04)])
+    reach = recording_reaches(trial, MarkerMap("thumb", "index"))[0]
+    rest = {}
+    for need in (0.3, 1.5):
+        info = reach_tracks(reach, ReachParams(min_rest=need)).info
+        rest[need] = [n for n in info["notes"] if "of rest before the movement" in n]
+    assert not rest[0.3] and rest[1.5], rest  # 0.75 s of rest: enough for 0.3 s, not 1.5 s

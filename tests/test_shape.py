@@ -22,13 +22,14 @@ from perception.landmarks import movement_time
 from perception.observation import observe
 from perception.pipeline import recognize_tracks
 from perception.recognition.models import SceneSpec
+from perception.recognition.rules import VerdictRules
 from perception.recognition.shape import canonical, is_mirrored, opens
 
 
 @pytest.mark.parametrize("duration", [0.6, 1.0, 1.4])
 def test_movement_time_is_measured_from_the_wrist(duration):
     obs = observe(demo_tracks("normal", 1, duration=duration)[0])
-    assert movement_time(obs) == pytest.approx(duration, rel=0.1)
+    assert movement_time(obs, VerdictRules().span_fraction) == pytest.approx(duration, rel=0.1)
 
 
 @pytest.mark.parametrize("condition, verdict", [("normal", "normal"), ("reach", "reach")])
@@ -76,11 +77,11 @@ def test_canonical_scales_time_and_transport_but_not_the_grip():
     obs = observe(demo_tracks("normal", 0, duration=1.5, distance=0.35)[0])
     scene = SceneSpec()
     out, norm = canonical(obs, scene, (0.6, 1.2))
-    assert norm.time_scale == pytest.approx(1.2 / movement_time(obs))
+    assert norm.time_scale == pytest.approx(1.2 / movement_time(obs, VerdictRules().span_fraction))
     assert norm.distance_scale == pytest.approx((0.25 - 0.06) / (obs.start_distance - 0.06))
     assert out.start_distance == scene.distance and out.dt == scene.frame_period
     assert np.nanmax(out.g) == pytest.approx(np.nanmax(obs.g), abs=0.002)
-    assert movement_time(out) == pytest.approx(1.2, rel=0.05)
+    assert movement_time(out, VerdictRules().span_fraction) == pytest.approx(1.2, rel=0.05)
     # within the repertoire's range the time is left as it is
     same, norm = canonical(observe(demo_tracks("normal", 0)[0]), scene, (0.6, 1.2))
     assert norm.time_scale == 1.0
@@ -186,3 +187,16 @@ def test_the_transport_is_scaled_about_the_reference_models_own_wrist_goal():
     assert n.wrist_offset == 0.08 and rec.to_dict()["shape"]["wrist_offset"] == 0.08
     start = rec.observation.start_distance
     assert n.distance_scale == pytest.approx((0.25 - 0.08) / (start - 0.08))
+
+
+def test_the_time_scale_is_read_from_the_declared_span_fraction():
+    """`VerdictRules.span_fraction` is the number the movement time is measured with: the
+    report's `verdict_rules` holds it, and another value changes the time scale."""
+    obs = observe(demo_tracks("normal", 0, duration=1.5, distance=0.35)[0])
+    times = {}
+    for fraction in (0.467, 0.5):
+        rules = VerdictRules(span_fraction=fraction)
+        _, norm = canonical(obs, SceneSpec(), (0.6, 1.2), rules)
+        times[fraction] = norm.movement_time
+        assert rules.to_dict()["span_fraction"] == fraction
+    assert times[0.5] == pytest.approx(times[0.467] * 0.467 / 0.5)

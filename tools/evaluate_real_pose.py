@@ -56,7 +56,7 @@ from perception.io.mocap import read_mocap  # noqa: E402
 from perception.io.pose import PoseImport, write_dlc  # noqa: E402
 from perception.io.tracks import Status, Tracks  # noqa: E402
 from perception.observation import ObserveParams  # noqa: E402
-from perception.reaches import WRIST_BEHIND, MarkerMap, fit_plane  # noqa: E402
+from perception.reaches import MarkerMap, ReachParams, fit_plane  # noqa: E402
 from perception.recognition.repertoire import Repertoire  # noqa: E402
 from perception.recordings import MocapImport, read_reaches, recognize_reach  # noqa: E402
 
@@ -95,7 +95,7 @@ def pose_tracks(reach, finger: np.ndarray, thumb: np.ndarray, time: np.ndarray,
     (a keypoint frozen where it was last seen); a lost one is lost. Given the
     cleaned markers, the file holds the motion-capture path's own tracks.
 
-    The wrist, which the recording lacks, is the grip :data:`WRIST_BEHIND`
+    The wrist, which the recording lacks, is the grip `ReachParams.wrist_behind`
     back along the approach: without errors (``wrist`` ``"clean"``: a
     keypoint tracked well) or with the thumb's (``"thumb"``). The object
     sits at the origin.
@@ -111,7 +111,7 @@ def pose_tracks(reach, finger: np.ndarray, thumb: np.ndarray, time: np.ndarray,
     mid = plane.project(0.5 * (true_f + true_t))
     across = np.array([1.0, 0.0])
     true2d = {"finger": mid + 0.5 * g[:, None] * across, "thumb": mid - 0.5 * g[:, None] * across}
-    back = mid - np.array([0.0, WRIST_BEHIND])
+    back = mid - np.array([0.0, ReachParams().wrist_behind])
 
     def seen_as(name, given, truth, image):
         err = plane.project(given) - plane.project(truth)  # the marker's error, in the plane

@@ -287,7 +287,7 @@ class Recognition:
         """Whether the observation's wrist was placed from the grip rather than recorded.
 
         A motion-capture reach's tracks carry the models' wrist
-        (:data:`perception.reach_data.WRIST_BEHIND` behind the grip midpoint,
+        (`ReachParams.wrist_behind` behind the grip midpoint,
         :func:`perception.reach_plane.reach_tracks`): it keeps one offset from
         the grip midpoint, to the micrometre, in every sample, as no tracked
         wrist does. Its paths and speed are the grip midpoint's, moved.

@@ -99,6 +99,15 @@ class VerdictRules:
         (``unfamiliar``: the verdict knows precision grips). By default the
         observation's own rest rule for clips (``ObserveParams.max_rest_aperture``).
         Above 0, at most :data:`HAND_SPAN`.
+    span_fraction : float
+        The time scale the models are compared at: a movement's time is
+        ``(t90 - t10) / span_fraction``, where the wrist covers the middle
+        80 % of its path (10 % to 90 %) between ``t10`` and ``t90``; a model
+        covers it in this share of its movement time (measured on the
+        default grasp models' own movements at 0.8, 1.0 and 1.2 s: 0.458,
+        0.467, 0.472, never on test clips). The span does not depend on
+        where the onset is placed, which the start of a movement leaves
+        uncertain.
     landmarks : LandmarkParams
         How the landmarks the rules read are measured: the movement's
         bounds, the aperture's peaks and opening, the gaps that may hide a
@@ -120,6 +129,7 @@ class VerdictRules:
     min_scored: Share = 0.5
     precision_grip_aperture: Annotated[float, Field(gt=0, le=HAND_SPAN)] = \
         ObserveParams.max_rest_aperture
+    span_fraction: Annotated[float, Field(gt=0, le=1)] = 0.467
     landmarks: LandmarkParams = field(default_factory=LandmarkParams)
 
     def to_dict(self) -> dict:

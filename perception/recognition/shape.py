@@ -106,7 +106,7 @@ def canonical(obs: Observation, scene: SceneSpec, durations: tuple[float, float]
     durations : (float, float)
         The shortest and longest reference movement time, s.
     rules : VerdictRules, optional
-        Its ``min_transport``.
+        Its ``span_fraction`` (the movement time) and ``min_transport``.
     wrist_offset : float
         Where the reference models' wrists stop short of the object centre, m
         (:meth:`~perception.recognition.repertoire.Repertoire.wrist_offset`).
@@ -124,13 +124,14 @@ def canonical(obs: Observation, scene: SceneSpec, durations: tuple[float, float]
         Too little of the movement is seen to measure its time, or the wrist
         travels less than ``rules.min_transport``.
     """
-    mt = movement_time(obs)
+    rules = VerdictRules() if rules is None else rules
+    mt = movement_time(obs, rules.span_fraction)
     if not (np.isfinite(mt) and mt > 0):
         raise InputError("the wrist is seen too little to measure the movement time",
                          obs.clip, field="wrist")
     alpha = float(np.clip(mt, *durations)) / mt
     transport = obs.start_distance - wrist_offset
-    if transport < (VerdictRules() if rules is None else rules).min_transport:
+    if transport < rules.min_transport:
         raise InputError(f"starts {obs.start_distance * 1000:.0f} mm from the object: too near "
                          "to judge a reach", obs.clip, field="wrist")
     s = (scene.distance - wrist_offset) / transport
