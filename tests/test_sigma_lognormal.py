@@ -89,6 +89,22 @@ def test_draws_stay_within_their_declared_distributions():
     assert 0.3 < share < 0.6
 
 
+def test_every_drawn_clip_keeps_the_hand_in_its_frame():
+    from perception.synthetic import sigma_lognormal as sl
+
+    for seed in range(120):
+        for fast in (False, True):
+            clip = draw_sigma_lognormal_clip(CONDITIONS[seed % 4], np.random.default_rng(seed),
+                                             fast=fast)
+            _, paths = sigma_lognormal_paths(clip.params, clip.fps, seed=seed)  # with noise
+            assert sl._fits(paths, clip.camera, clip.style), (seed, fast)
+    fixed = draw_sigma_lognormal_clip("normal", np.random.default_rng(1), fps=30.0,
+                                      duration=0.5)
+    drawn = draw_sigma_lognormal_clip("normal", np.random.default_rng(1))
+    assert (fixed.fps, fixed.params.duration) == (30.0, 0.5)
+    assert fixed.params.distance == drawn.params.distance  # every other draw the same
+
+
 def test_seeds_are_reproducible_and_differ():
     a = draw_sigma_lognormal_clip("delayed", np.random.default_rng(11))
     b = draw_sigma_lognormal_clip("delayed", np.random.default_rng(11))

@@ -603,15 +603,25 @@ def _fits(paths: dict, camera: Camera, style: RenderStyle) -> bool:
 
 
 def draw_sigma_lognormal_clip(condition: str, rng: np.random.Generator, *,
-                              fast: bool = False) -> SigmaLognormalClip:
+                              fast: bool = False, fps: float | None = None,
+                              **fixed: Any) -> SigmaLognormalClip:
     """A movement (:func:`draw_sigma_lognormal`) and its filming (:data:`FILMING`, fps).
 
     The scale is shrunk by 5 % steps until the noise-free paths, with the
     markers' extent, stay inside the 640 x 480 frame.
+
+    Parameters
+    ----------
+    condition, rng, fast, **fixed
+        As :func:`draw_sigma_lognormal`.
+    fps : float, optional
+        Frame rate instead of one drawn from :data:`FPS_CHOICES` (the draw is
+        made either way, so every other draw stays the same).
     """
-    p = draw_sigma_lognormal(condition, rng, fast=fast)
+    p = draw_sigma_lognormal(condition, rng, fast=fast, **fixed)
     f = {k: float(rng.uniform(*r)) for k, r in FILMING.items()}
-    fps = float(FPS_CHOICES[int(rng.integers(len(FPS_CHOICES)))])
+    drawn_fps = float(FPS_CHOICES[int(rng.integers(len(FPS_CHOICES)))])
+    fps = drawn_fps if fps is None else float(fps)
     style = RenderStyle(fps=fps, hand=True, marker_diameter=f["marker_diameter"],
                         noise_sd=f["noise_sd"], blur_sigma=f["blur_sigma"],
                         lighting=f["lighting"], lighting_angle_deg=f["lighting_angle_deg"],
