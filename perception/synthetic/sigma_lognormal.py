@@ -572,18 +572,29 @@ class SigmaLognormalClip:
     style: RenderStyle
 
     def row(self) -> dict[str, Any]:
-        """The manifest's columns for the clip (as the population's, for the evaluation)."""
+        """The manifest's columns for the clip (as the population's, for the evaluation).
+
+        ``peak_velocity_time`` (a share of the movement) and ``curvature`` (the
+        wrist path's largest sideways distance from its chord, m) are measured
+        on the noise-free path: here they follow from the strokes.
+        """
         p = self.params
         t, paths = sigma_lognormal_paths(dataclasses.replace(
             p, jitter=0.0, drift=0.0, spike_rate=0.0), 500.0)
-        speed = np.linalg.norm(np.gradient(paths["clean"]["wrist"], t, axis=0), axis=1)
+        wrist = paths["clean"]["wrist"]
+        speed = np.linalg.norm(np.gradient(wrist, t, axis=0), axis=1)
         peak = (t[int(np.argmax(speed))] - p.rest_before) / p.duration
+        # the path's bow as the independent generator's curvature: the largest signed
+        # sideways distance from the start-to-end line, m (positive: to the left of it)
+        chord = wrist[-1] - wrist[0]
+        side = np.cross(chord, wrist - wrist[0]) / np.linalg.norm(chord)
+        bow = float(side[np.argmax(np.abs(side))])
         return {"movement_time": p.duration, "distance": p.distance,
                 "px_per_m": self.camera.px_per_m, "fps": self.fps,
                 "approach_deg": p.approach_angle_deg, "mga_excess": p.mga_excess,
                 "mga_time": {"delayed": p.delayed_mga_time, "reach": math.nan,
                              "open-close-open": p.oco_reopen_time}.get(p.condition, p.mga_time),
-                "peak_velocity_time": float(peak), "curvature": p.arc_deg,
+                "peak_velocity_time": float(peak), "curvature": bow,
                 "camera_angle_deg": self.camera.angle_deg, "corrective": p.corrective}
 
 
