@@ -112,7 +112,7 @@ class LandmarkParams:
     cutoff: Annotated[float, Field(gt=0, le=100)] | None = 10.0
     order: Annotated[Int, Field(ge=1, le=8)] = 2
     opening_level: Share = 0.10
-    peak_prominence: Share = 0.25
+    peak_prominence: Share = 0.15
     peak_min_prominence: Annotated[float, Field(ge=0, le=0.3)] = 0.005  # m, not a share
     max_gap: Annotated[float, Field(ge=0, le=5)] = 0.1
     max_gap_share: Share = 0.2
