@@ -587,7 +587,8 @@ class SigmaLognormalClip:
         # the path's bow as the independent generator's curvature: the largest signed
         # sideways distance from the start-to-end line, m (positive: to the left of it)
         chord = wrist[-1] - wrist[0]
-        side = np.cross(chord, wrist - wrist[0]) / np.linalg.norm(chord)
+        rel = wrist - wrist[0]
+        side = (chord[0] * rel[:, 1] - chord[1] * rel[:, 0]) / np.linalg.norm(chord)
         bow = float(side[np.argmax(np.abs(side))])
         return {"movement_time": p.duration, "distance": p.distance,
                 "px_per_m": self.camera.px_per_m, "fps": self.fps,
