@@ -179,9 +179,10 @@ class OnlineState:
     time : float
         Its time on the stream's clock, s.
     phase : str
-        ``start`` (first frames: tracking warms up, the scene is not fixed
-        yet), ``rest`` (scene fixed, models planned, no movement yet) or
-        ``moving`` (scored from the onset on).
+        ``start`` (fewer rows than twice the observation's ``rest_frames``;
+        for frames, also while the tracker looks ahead), ``rest`` (the rows
+        so far are not yet a movement ``recognize`` judges: see
+        ``waiting_for``) or ``moving`` (judged).
     names : list of str
         Model names.
     confidence, log_likelihood : (M,) arrays
