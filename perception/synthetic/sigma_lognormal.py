@@ -705,7 +705,15 @@ def sigma_lognormal_tracks(p: SigmaLognormalParams, seed: int | np.random.Genera
 
 def clip_tracks(clip: SigmaLognormalClip,
                 seed: int | np.random.Generator = 0) -> tuple[Tracks, dict[str, Any]]:
-    """:func:`sigma_lognormal_tracks` of a drawn clip, at its frame rate and camera."""
+    """:func:`sigma_lognormal_tracks` of a drawn clip, at its frame rate and camera.
+
+    Parameters
+    ----------
+    clip : SigmaLognormalClip
+        The movement and its filming.
+    seed : int or numpy.random.Generator
+        Source of the noise (see :func:`sigma_lognormal_tracks`).
+    """
     return sigma_lognormal_tracks(clip.params, seed, fps=clip.fps, camera=clip.camera)
 
 
