@@ -50,10 +50,10 @@ class Landmarks:
     aperture_peaks : int or None
         Maxima of the aperture with a prominence of at least
         :attr:`LandmarkParams.peak_prominence` of the opening and
-        ``peak_min_prominence`` (see :func:`count_peaks`); None where the
-        aperture is missing for long enough to hide a second opening
-        (:meth:`LandmarkParams.hides_a_reopening`) or
-        has fewer than 3 samples.
+        ``peak_min_prominence`` (see :func:`count_peaks`); None where fewer
+        than two are seen and the aperture is missing for long enough to
+        hide a second opening (:meth:`LandmarkParams.hides_a_reopening`), or
+        where it has fewer than 3 samples.
     rest_aperture : float
         Grip aperture at the movement's onset, m.
     opening_time : float

@@ -475,11 +475,11 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
     opening = mga - rest
     ts = time[seen]
     gaps = np.r_[ts[0] - time[lo], np.diff(ts), time[hi] - ts[-1]]
-    peaks = None
-    if not params.hides_a_reopening(float(gaps.max()), T):
-        peaks = count_peaks(g[seen], max(params.peak_prominence * opening,
-                                         params.peak_min_prominence))
-    else:
+    peaks: int | None = count_peaks(g[seen], max(params.peak_prominence * opening,
+                                                 params.peak_min_prominence))
+    # a closing and re-opening seen stands; one lost digit long enough can hide one
+    if peaks < 2 and params.hides_a_reopening(float(gaps.max()), T):
+        peaks = None
         flags["aperture_peaks"] = (f"not seen: a digit was lost for {gaps.max() * 1000:.0f} ms, "
                                    "long enough to hide a closing and re-opening")
     lost_grip = ~np.isfinite(g_raw)

@@ -190,6 +190,25 @@ def test_landmarks_survive_missing_markers():
     assert d["aperture_peaks"] is None and Landmarks.from_dict(d).mga == pytest.approx(got.mga)
 
 
+def test_a_reopening_seen_stands_though_a_digit_is_lost_later():
+    """Two peaks seen with their dip are a closing and re-opening whatever a later gap
+    hides; one peak and a gap long enough to hide a dip leave the count unknown, and the
+    verdict then says the digits were unseen (the landmark's own gap, not only the scored
+    span's)."""
+    t = np.linspace(0, 1, 61)
+    wrist = np.c_[np.zeros(61), -0.25 + 0.25 * (t - np.sin(2 * np.pi * t) / (2 * np.pi))]
+    twice = 0.02 + 0.06 * (np.exp(-((t - 0.35) / 0.08) ** 2) + np.exp(-((t - 0.7) / 0.08) ** 2))
+    once = 0.02 + 0.06 * np.exp(-((t - 0.5) / 0.12) ** 2)
+    for g, lost, peaks in ((twice, slice(44, 61), 2), (twice, None, 2),
+                           (once, slice(20, 35), None), (once, None, 1)):
+        g = g.copy()
+        if lost is not None:
+            g[lost] = np.nan
+        got = movement_landmarks(t, wrist, g)
+        assert got.aperture_peaks == peaks, (peaks, lost)
+        assert ("aperture_peaks" in got.flags) == (peaks is None)
+
+
 # -- the reports -----------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def reports(tmp_path_factory):

@@ -141,6 +141,21 @@ def test_a_settle_rule_that_cannot_be_met_leaves_the_verdict_to_the_end(rep):
     assert reachable.decision is not None and reachable.decision.verdict == "normal"
 
 
+def test_an_abnormal_familiarity_waits_for_the_stream_s_end(rep):
+    """A movement's familiarity rises as it completes and comes to rest, so a low one is
+    not conclusive early: an `abnormal` resting on familiarity settles only at the end
+    (as offline), while a normal grasp under the usual threshold settles before it."""
+    tracks = _tracks("normal")
+    strict = RecognitionSettings(rules=VerdictRules(familiarity_threshold=0.999))
+    rec, states = _feed(rep, tracks, settings=strict, settle=SettleRule(margin=0.0))
+    final = rec.finish()
+    assert (final.verdict, final.verdict_rule) == ("abnormal", "familiarity")
+    assert any(s.verdict == "abnormal" for s in states)  # provisional, never settled
+    assert rec.decision is None
+    usual, _ = _feed(rep, tracks, settle=SettleRule(margin=0.0))
+    assert usual.decision is not None and usual.decision.verdict == "normal"
+
+
 def test_bad_rows_and_rules_are_input_errors(rep):
     rec = OnlineRecognizer(rep)
     with pytest.raises(InputError, match="positions"):

@@ -20,6 +20,7 @@ from perception.recognition.rules import (
     Evidence,
     VerdictRules,
     judge,
+    reason,
 )
 
 
@@ -51,6 +52,25 @@ def test_the_rules_are_tried_in_order_and_the_first_that_fires_names_itself():
     assert (d.verdict, d.rule) == ("abnormal", "familiarity")
     d = judge(_evidence(familiarity=np.array([np.nan, 0.9])))
     assert d.verdict is None and d.rule is None
+
+
+def test_peaks_the_landmarks_could_not_count_leave_the_digits_unseen():
+    """A gap the landmarks found long enough to hide a closing and re-opening (within the
+    movement's own bounds) makes a would-be normal `unfamiliar`, though the scored span's
+    own gap is short; its reason quotes the landmark's flag."""
+    said = "not seen: a digit was lost for 250 ms, long enough to hide a closing and re-opening"
+    hidden = Landmarks(movement_time=1.0, aperture_peaks=None, opening_time=0.2,
+                       flags={"aperture_peaks": said})
+    d = judge(_evidence(observed=hidden, aperture_gap=0.05))
+    assert (d.verdict, d.rule, d.detail) == ("unfamiliar", "insufficient-data", "digits-unseen")
+    assert said in reason(d, _evidence(observed=hidden, aperture_gap=0.05))
+    # a count the landmarks made is judged as before
+    d = judge(_evidence(aperture_gap=0.05))
+    assert (d.verdict, d.rule) == ("normal", "familiarity")
+    # two peaks seen stand, whatever a loss elsewhere hides
+    twice = Landmarks(movement_time=1.0, aperture_peaks=2, opening_time=0.2)
+    d = judge(_evidence(observed=twice, aperture_gap=0.5))
+    assert (d.verdict, d.rule, d.detail) == ("abnormal", "grip-departs", "re-opening")
 
 
 def test_every_threshold_is_a_field_that_moves_the_verdict():

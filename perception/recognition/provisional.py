@@ -117,9 +117,17 @@ class SettleRule:
         # before then is `incomplete` at its end
         arrived = grip.slowed >= max(self.slowed, rules.arrival)
         if verdict.rule == "grip-departs":
-            return progress >= self.min_progress and ((grip.peaks or 0) >= 2 or (
+            # two peaks count when the grip opened as a grasp's must before its dip: a
+            # peak is a share of the opening so far, and a late opener's first
+            # millimetres are no opening
+            return progress >= self.min_progress and ((grip.peaks or 0) >= 2 and grip.twice or (
                 arrived and lm.opening_time > rules.late_opening + self.late_margin))
         if verdict.rule != "familiarity" or not arrived:
+            return False
+        if verdict.verdict == "abnormal":
+            # a movement's familiarity rises as it completes and comes to rest (a few
+            # still rows at the end raised 0.02 to 0.07 on the dev sets): a low one is
+            # not conclusive before the stream ends
             return False
         tf = evidence.transport_familiarity
         if self.evidence(verdict, evidence, rules) < self.margin or (
@@ -247,7 +255,10 @@ def grip_course(rec: Recognition) -> SimpleNamespace:
     rest: :func:`~perception.recognition.shape.rest_and_opening` of the
     markers' own aperture), ``closing`` (share of the opening closed since its
     maximum), ``slowed`` (the evidence's), ``progress`` (the largest share of
-    the wrist's way to the models' goal covered so far, 0..1).
+    the wrist's way to the models' goal covered so far, 0..1), ``twice`` (the
+    grip opened as a grasp's must — by ``grasp_opening`` of the object's
+    diameter —, then closed and opened again, each by ``peak_prominence`` of
+    its opening so far).
 
     Parameters
     ----------
@@ -267,7 +278,26 @@ def grip_course(rec: Recognition) -> SimpleNamespace:
     opened = rec.judged is not None and rec.kinds[rec.judged[0]] == "grasp"
     peaks = ev.observed.aperture_peaks if ev.observed is not None else None
     return SimpleNamespace(opened=opened, peaks=peaks, opening=opening, closing=closing,
-                           slowed=ev.slowed, progress=progress)
+                           slowed=ev.slowed, progress=progress,
+                           twice=_opened_twice(g, rec.rules, obs.object_diameter))
+
+
+def _opened_twice(g: np.ndarray, rules, diameter: float) -> bool:
+    """Whether the aperture ``g`` (seen samples) opened as a grasp's, then closed and opened
+    again by ``peak_prominence`` of its opening so far (see :func:`grip_course`)."""
+    from perception.recognition.shape import rest_and_opening
+
+    if g.size < 3:
+        return False
+    rest, _ = rest_and_opening(g, rules)
+    above = np.flatnonzero(g > rest + rules.grasp_opening * diameter)
+    if not above.size:
+        return False
+    after = g[above[0]:]
+    dip = np.maximum.accumulate(after) - after
+    k = int(np.argmax(dip))
+    need = rules.landmarks.peak_prominence * (float(after.max()) - rest)
+    return bool(dip[k] >= need and float(after[k:].max() - after[k]) >= need)
 
 
 def decision_summary(rec: Recognition, decision: Decision | None) -> dict:

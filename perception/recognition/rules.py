@@ -317,10 +317,21 @@ def _movement_time(e: Evidence) -> float:
     return e.observed.movement_time if e.observed is not None else math.nan
 
 
+def _peaks_hidden(e: Evidence) -> bool:
+    """Whether the landmarks could not count the aperture's peaks: the digits were lost,
+    within the movement's own bounds, long enough to hide a closing and re-opening (the
+    scored span's gap, :attr:`Evidence.aperture_gap`, can be shorter)."""
+    o = e.observed
+    return o is not None and o.aperture_peaks is None and "aperture_peaks" in o.flags
+
+
 def _unseen(e: Evidence, r: VerdictRules, base: str | None) -> str | None:
     """Why the movement was not seen well enough to judge, if it was not."""
-    if e.scored_share < r.min_scored or r.landmarks.hides_a_reopening(e.aperture_gap,
-                                                                        _movement_time(e)):
+    # a closing and re-opening seen stands, whatever a loss elsewhere may hide
+    seen_twice = e.observed is not None and (e.observed.aperture_peaks or 0) >= 2
+    if e.scored_share < r.min_scored or not seen_twice and (
+            _peaks_hidden(e) or r.landmarks.hides_a_reopening(e.aperture_gap,
+                                                              _movement_time(e))):
         return "digits-unseen"
     if e.observed is not None and (e.observed.movements or 1) > 1:
         return "several-movements"
@@ -517,7 +528,8 @@ def reason(verdict: Verdict, evidence: Evidence, rules: VerdictRules | None = No
                 f"{_pc(rules.min_scored)} a verdict needs (min_scored)")
     if rule == "insufficient-data":
         lp = rules.landmarks
-        lost = lost or f"the aperture was lost {e.aperture_gap:.2f} s during the movement"
+        lost = lost or (o.flags["aperture_peaks"] if _peaks_hidden(e) else
+                        f"the aperture was lost {e.aperture_gap:.2f} s during the movement")
         return (f"insufficient data: {lost} (a gap over {lp.max_gap:.2f} s and "
                 f"{_pc(lp.max_gap_share)} of the movement may hide a second opening: "
                 "max_gap, max_gap_share)")
