@@ -14,6 +14,8 @@
   hand; ambiguity.
 * :mod:`~perception.tracking.first_detection` — starting the tracks of
   markers not found yet: candidates, the object's scale, the hand, ROIs.
+* :mod:`~perception.tracking.blur` — fast markers: the blur gate and the
+  streak gate that see a motion-blurred marker, a streak's expected size.
 * :mod:`~perception.tracking.marker_track` — one marker's track: motion
   estimate, window, reference mass.
 * :mod:`~perception.tracking.reacquisition` — the global search of lost markers.

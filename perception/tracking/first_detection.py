@@ -30,6 +30,7 @@ import numpy as np
 from perception.errors import InputError
 from perception.io.tracks import Status
 from perception.tracking.blobs import Blob, blob_at
+from perception.tracking.blur import StreakGate, blur_gate
 from perception.tracking.candidates import (
     Candidate,
     describe,
@@ -296,6 +297,14 @@ class FirstDetection:
         tr.found = True
         tr.rivals = []
         tr.ref = meas.mass
+        if not tr.still:
+            x, y, w, h = blob.box
+            own = tr.colour.backproject(self._full_hsv(frame)[y:y + h, x:x + w]) > 0
+            hsv = blur_gate(tr.colour, self._full_hsv(frame), blob.box, meas.mass, p.lost_ratio)
+            if own.any():
+                bgr = np.median(frame[y:y + h, x:x + w][own], axis=0)
+                tr.blur = StreakGate(tuple(float(v) for v in bgr),
+                                     tr.colour if hsv is None else hsv)
         tr.n_obs = 0
         if tr.still and not np.isfinite(tr.diameter):
             tr.diameter = soft_diameter(frame, tr.colour, meas.centre, meas.window, p)

@@ -12,6 +12,7 @@ from collections import Counter
 
 import numpy as np
 
+from perception.tracking.blur import StreakGate
 from perception.tracking.markers import MarkerColour
 from perception.tracking.measurement import Measurement, clamp_window, likelihood
 from perception.tracking.params import TrackerParams
@@ -44,11 +45,14 @@ class MarkerTrack:
     ``ref`` the reference mass (px), ``n_obs`` the measurements since the
     track (re)started, ``seen_at`` the time (s) of its last measurement,
     ``rivals`` the blobs (px) it could be while ambiguous, ``rejected`` why
-    candidates were not taken for it (reason -> count).
+    candidates were not taken for it (reason -> count), ``blur`` the gate it
+    is measured with while fast (:func:`~perception.tracking.blur.blur_gate`;
+    None: none the scene allows).
     """
 
     __slots__ = ("colour", "still", "roi", "found", "lost", "x", "v", "win", "ref", "n_obs",
-                 "diameter", "seen_at", "rivals", "rejected", "offset", "n_lost", "n_merged")
+                 "diameter", "seen_at", "rivals", "rejected", "offset", "n_lost", "n_merged",
+                 "blur", "offset_v")
 
     def __init__(self, colour: MarkerColour, still: bool, roi: ROI | None):
         self.colour = colour
@@ -68,6 +72,8 @@ class MarkerTrack:
         self.offset: tuple[float, float] | None = None  # from the rest of the hand, px
         self.n_lost = 0
         self.n_merged = 0  # consecutive frames measured merged with a neighbour
+        self.blur: StreakGate | None = None
+        self.offset_v = (0.0, 0.0)  # the offset's change over the last frame, px
 
     @property
     def name(self) -> str:
@@ -85,8 +91,18 @@ class MarkerTrack:
             return p.initial_margin_px
         return p.search_margin_px + p.velocity_margin * math.hypot(self.v[0], self.v[1])
 
-    def observe(self, meas: Measurement, p: TrackerParams) -> None:
-        """Feed a measurement to the motion estimate, the window and the reference mass."""
+    @property
+    def speed(self) -> float:
+        """Predicted displacement, px/frame."""
+        return math.hypot(self.v[0], self.v[1])
+
+    def observe(self, meas: Measurement, p: TrackerParams, *, blurred: bool = False) -> None:
+        """Feed a measurement to the motion estimate, the window and the reference mass.
+
+        A ``blurred`` measurement (a streak, :mod:`perception.tracking.blur`)
+        moves the estimate and the window but does not teach the reference
+        mass a streak's size.
+        """
         zx, zy = meas.centre
         x, y = self.x
         if self.still:
@@ -117,6 +133,8 @@ class MarkerTrack:
         self.lost = False
         if not meas.merged:
             self.win = clamp_window(meas.window, self.ref, p)
+            if blurred:
+                return
             ratio = meas.mass / self.ref
             if 1 / p.ref_update_band < ratio < p.ref_update_band:
                 self.ref += p.ref_update * (meas.mass - self.ref)
@@ -130,9 +148,17 @@ class MarkerTrack:
         self.n_obs = 0
         self.n_lost += 1
 
-    def likelihood(self, meas: Measurement, p: TrackerParams) -> float:
-        """``min(r, 1/r)``; at most ``merged_likelihood`` when merged or among clutter."""
-        lik = likelihood(meas.mass / self.ref)
+    def likelihood(self, meas: Measurement, p: TrackerParams, streak: float = 0.0) -> float:
+        """``min(r, 1/r)``; at most ``merged_likelihood`` when merged or among clutter.
+
+        ``streak``: the most mass a blurred measurement may have (px,
+        :func:`~perception.tracking.blur.streak_mass`); from the reference
+        mass to it counts as whole.
+        """
+        mass = meas.mass
+        if streak > self.ref and mass > self.ref:
+            mass = max(self.ref, mass * self.ref / streak)
+        lik = likelihood(mass / self.ref)
         crowded = not self.still and meas.clutter > p.clutter_ratio * self.ref
         return min(lik, p.merged_likelihood) if meas.merged or crowded else lik
 

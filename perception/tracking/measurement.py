@@ -34,7 +34,13 @@ from typing import NamedTuple
 import cv2
 import numpy as np
 
-from perception.tracking.blobs import blob_at, find_blobs, nearest_blob
+from perception.tracking.blobs import (
+    blob_at,
+    find_blobs,
+    label_type,
+    nearest_blob,
+    principal_axes,
+)
 from perception.tracking.markers import MarkerColour
 from perception.tracking.params import TrackerParams
 
@@ -113,6 +119,8 @@ def measure(
     ref: float,
     margin: float,
     params: TrackerParams,
+    along: tuple[float, float] | None = None,
+    width: float = math.inf,
 ) -> Measurement | None:
     """CamShift in the region around ``centre``; centroid and mass of the result.
 
@@ -133,6 +141,13 @@ def measure(
         The region searched is ``window`` plus this margin each side, px.
     params : TrackerParams
         Termination criteria and the split ratios.
+    along : (float, float), optional
+        The direction (x, y) the marker moves in, when it is measured as a
+        motion-blurred streak (:mod:`perception.tracking.blur`): its centre
+        is then the mid-point of the streak along it, not the centroid.
+    width : float
+        A streak wider than this across its motion (px) holds something
+        else too: it is measured ``merged`` (not to be trusted).
 
     Returns
     -------
@@ -140,15 +155,15 @@ def measure(
         None when nothing of the colour is in the region, or the region
         left the frame.
     """
-    found = _measure_region(frame, colour, centre, window, ref, margin, params, window)
+    found = _measure_region(frame, colour, centre, window, ref, margin, params, window, along,
+                            width)
     if found is None:
         return None
     meas, bp, region = found
     if not meas.merged and _cut_off(bp, meas, region, frame.shape):
         # The blob goes on beyond the region: measure again centred on it.
-        again = _measure_region(
-            frame, colour, meas.centre, meas.window, ref, params.search_margin_px, params, window
-        )
+        again = _measure_region(frame, colour, meas.centre, meas.window, ref,
+                                params.search_margin_px, params, window, along, width)
         if again is not None:
             return again[0]
     return meas
@@ -163,6 +178,8 @@ def _measure_region(
     margin: float,
     params: TrackerParams,
     merged_window: tuple[int, int],
+    along: tuple[float, float] | None = None,
+    width: float = math.inf,
 ) -> tuple[Measurement, np.ndarray, tuple[int, int, int, int]] | None:
     """One CamShift measurement; also the region's back-projection and bounds.
 
@@ -182,7 +199,9 @@ def _measure_region(
     if rw < params.min_region_px or rh < params.min_region_px:
         return None  # the prediction left the frame
     region = x0, y0, x1, y1
-    bp = colour.backproject(cv2.cvtColor(frame[y0:y1, x0:x1], cv2.COLOR_BGR2HSV))
+    crop = frame[y0:y1, x0:x1]
+    bp = (colour.backproject(cv2.cvtColor(crop, cv2.COLOR_BGR2HSV))
+          if isinstance(colour, MarkerColour) else colour.backproject_bgr(crop))
     wx = round(cx - ww / 2) - x0
     wx = 0 if wx < 0 else (rw - 1 if wx >= rw else wx)
     wy = round(cy - wh / 2) - y0
@@ -191,6 +210,11 @@ def _measure_region(
     sh = wh if wh < rh - wy else rh - wy
     start = (wx, wy, sw if sw > 1 else 1, sh if sh > 1 else 1)
     pred = (cx - x0, cy - y0)
+    if along is not None:
+        meas = _streak(bp, pred, along, width, params)
+        if meas is None:
+            return None
+        return meas._replace(centre=(meas.centre[0] + x0, meas.centre[1] + y0)), bp, region
     box, (_, _, bw, bh) = cv2.CamShift(bp, start, params.criteria)
     if box[1][0] <= 0 or bw <= 0 or bh <= 0:
         converged = _camshift_again(bp, pred, ref, params)
@@ -213,6 +237,83 @@ def _measure_region(
     meas = Measurement((mo["m10"] / mass + x0 + mx0, mo["m01"] / mass + y0 + my0), mass,
                        _extent(mo, mass, params.rim_px), False, max(total - mass, 0.0))
     return meas, bp, region
+
+
+def _streak(bp: np.ndarray, pred: tuple[float, float], along: tuple[float, float],
+            width: float, params: TrackerParams) -> Measurement | None:
+    """A motion-blurred marker: the blob of ``bp`` nearest ``pred``, at :func:`streak_centre`.
+
+    Its blob alone, not a CamShift window: a loose gate (the blur gate) also
+    takes thin edges elsewhere in the region (a band's blurred rim against
+    the skin), which a window growing along the streak would take in.
+    None when no blob of ``min_area_px`` is there; ``merged`` when the blob
+    is wider than ``width`` across the motion (it holds something else too).
+    """
+    n, labels, stats, cents = cv2.connectedComponentsWithStats(bp, connectivity=8,
+                                                               ltype=label_type(bp.shape))
+    best, dist = 0, math.inf
+    for k in range(1, n):
+        if stats[k, cv2.CC_STAT_AREA] >= params.min_area_px:
+            d = math.dist(cents[k], pred)
+            if d < dist:
+                best, dist = k, d
+    if not best:
+        return None
+    x, y, w, h, area = (int(v) for v in stats[best])
+    mask = (labels[y:y + h, x:x + w] == best).astype(np.uint8)
+    mo = cv2.moments(mask, True)
+    total = cv2.countNonZero(bp)
+    major, minor, angle = principal_axes(mask)
+    if major > _ELONGATED * max(minor, 0.0):
+        # a streak's own long axis: the motion's direction as this frame shows it
+        along = (math.cos(angle), math.sin(angle))
+    across = 4.0 * math.sqrt(max(minor, 0.0))  # a disc's diameter, a streak's width
+    return Measurement(streak_centre(mask, along, (x, y)), float(area),
+                       _extent(mo, area, params.rim_px), across > width,
+                       float(max(total - area, 0)))
+
+
+#: A blob whose major axis variance is this many times its minor one is
+#: long enough for its own axis to give the motion's direction.
+_ELONGATED = 4.0
+#: The ends of a streak are its pixels' projections at these percentiles: a
+#: few stray pixels of the colour beside it do not move them.
+_STREAK_ENDS = (1.0, 99.0)
+
+
+def streak_centre(mask: np.ndarray, along: tuple[float, float],
+                  offset: tuple[int, int] = (0, 0)) -> tuple[float, float]:
+    """Mid-point of a motion-blurred streak along its motion; its median across it.
+
+    A marker smeared over skin at one end and table at the other passes a
+    colour gate further into its faint end on the skin: the centroid leans
+    that way by a good part of the streak's length, while its two ends move
+    by a fraction of the marker's size only.
+
+    Parameters
+    ----------
+    mask : (h, w) uint8
+        The streak's pixels (non-zero).
+    along : (float, float)
+        The motion's direction (x, y), any length but 0.
+    offset : (int, int)
+        Added to the result (the mask's corner), px.
+
+    Returns
+    -------
+    (float, float)
+        The centre (x, y), px (NaN for an empty mask).
+    """
+    ys, xs = np.nonzero(mask)
+    norm = math.hypot(along[0], along[1])
+    if xs.size == 0 or norm == 0:
+        return math.nan, math.nan
+    ux, uy = along[0] / norm, along[1] / norm
+    a = xs * ux + ys * uy
+    c = xs * -uy + ys * ux
+    lo, hi = np.percentile(a, _STREAK_ENDS)
+    mid, across = (lo + hi) / 2, float(np.median(c))
+    return (mid * ux - across * uy + offset[0], mid * uy + across * ux + offset[1])
 
 
 def _camshift_again(

@@ -14,11 +14,15 @@ delegates:
    the expected sizes follow; the hand markers are chosen together by the
    hand's structure. Two equally plausible blobs make the marker *ambiguous*
    (status 4): it is not guessed. A user-given ROI says where a marker is.
-2. **Tracked: follow.** An alpha-beta filter predicts the marker's position;
-   the search region is the window around the prediction plus a margin that
-   grows with speed. CamShift there gives the centroid and mass (pixel
-   count) of the marker's colour, splitting off same-coloured blobs that
-   joined the window (:mod:`perception.tracking.measurement`).
+2. **Tracked: follow.** An alpha-beta filter predicts the marker's position
+   (a digit's: the band's position measured in this frame plus the digit's
+   offset from it and that offset's last change); the search region is the
+   window around the prediction plus a margin that grows with speed.
+   CamShift there gives the centroid and mass (pixel count) of the marker's
+   colour, splitting off same-coloured blobs that joined the window
+   (:mod:`perception.tracking.measurement`). A moving marker with too little
+   of its colour there is looked for as a motion-blurred streak
+   (:mod:`perception.tracking.blur`).
 3. **Lost test.** A mass below ``lost_ratio`` x reference means the marker is
    hidden or gone; above ``max_area_ratio`` it was swallowed by something of
    its colour; a jump faster than a hand (``max_speed``) or a digit leaving
@@ -70,6 +74,14 @@ import numpy as np
 from perception.errors import InputError
 from perception.io.tracks import Status, TracksWriter, tracks_path_for
 from perception.io.video import FrameSource, VideoWriter
+from perception.tracking.blur import (
+    STREAK_SLACK,
+    WHOLE,
+    diameter_px,
+    is_fast,
+    streak_mass,
+    streak_width,
+)
 from perception.tracking.candidates import describe, reject_reason
 from perception.tracking.first_detection import FirstDetection
 from perception.tracking.marker_track import Located, MarkerTrack
@@ -277,7 +289,7 @@ class Tracker:
         for j in self._order:  # the object, the band, then the digits, which move relative to it
             tr = tracks[j]
             if tr.found and not tr.lost and j not in todo:
-                results[j] = self._follow(tr, frame)
+                results[j] = self._follow(tr, frame, results)
         # Lost markers are searched for once every followed one has moved on:
         # the hand's structure is then judged on this frame's positions.
         for j, tr in enumerate(tracks):
@@ -300,7 +312,7 @@ class Tracker:
             position[j] = centre
             if math.isfinite(centre[0]) and math.isfinite(centre[1]):
                 centres[j] = centre
-        self._record_offsets(centres)
+        self._record_offsets(centres, lik)
         self._first.frame_done(self.n_frames)
         self.n_frames += 1
         return position, lik, status
@@ -352,13 +364,26 @@ class Tracker:
         # plain floats: numpy's per-call cost would exceed the arithmetic
         return (sum(xs) / len(xs), sum(ys) / len(ys)) if xs else None
 
-    def _record_offsets(self, centres: list[tuple[float, float] | None]) -> None:
-        """Each measured hand marker's offset from the rest of the hand, for re-acquisition."""
+    def _record_offsets(self, centres: list[tuple[float, float] | None],
+                        lik: np.ndarray) -> None:
+        """Each measured hand marker's offset from the rest of the hand, for re-acquisition.
+
+        And the offset's change since the last frame (the grip opening),
+        from whole measurements only (``lik`` at least 0.5): a centroid among
+        clutter would send the next prediction off.
+        """
         for tr, c in zip(self._tracks, centres):
             if tr.still or c is None:
                 continue
             anchor = self._anchor(tr, centres)
-            tr.offset = None if anchor is None else (c[0] - anchor[0], c[1] - anchor[1])
+            old, tr.offset = tr.offset, (None if anchor is None
+                                         else (c[0] - anchor[0], c[1] - anchor[1]))
+            # how the grip opens or closes, px/frame: with the band's motion
+            # measured first, it predicts a digit better than its own velocity
+            fresh = (old is not None and tr.offset is not None and tr.n_obs >= 2
+                     and lik[self._tracks.index(tr)] >= 0.5)
+            tr.offset_v = ((tr.offset[0] - old[0], tr.offset[1] - old[1]) if fresh
+                           else (0.0, 0.0))
 
     def _expected_here(self, tr: MarkerTrack) -> tuple[tuple[float, float], float]:
         """Where a lost marker should be and how far from it (px) it may be found.
@@ -382,7 +407,30 @@ class Tracker:
         dt = max(self._time - tr.seen_at, 1 / 60)
         return self.params.max_speed * dt * self.px_per_m + max(tr.win)
 
-    def _follow(self, tr: MarkerTrack, frame: np.ndarray) -> Located | None:
+    def _predict(self, tr: MarkerTrack, results: list[Located | None]) -> tuple[float, float]:
+        """Where a marker should be: a digit moves with the band measured in this frame.
+
+        At 30 frames/s a fast grasp's hand speeds up by a marker's width a
+        frame: the band's own measurement in this frame, plus the digit's
+        offset from it and that offset's last change (the grip opening),
+        predicts a digit far better than the digit's own velocity. Other
+        markers, and a digit whose band is not measured, use their velocity.
+        """
+        if tr.still or tr.name == "wrist" or tr.offset is None or tr.n_obs < 2:
+            return tr.predicted
+        xs, ys = [], []
+        for k in self._anchors[self._tracks.index(tr)]:
+            r = results[k]
+            if r is not None and r[2] != Status.LOST:
+                xs.append(r[0][0])
+                ys.append(r[0][1])
+        if not xs:
+            return tr.predicted
+        return (sum(xs) / len(xs) + tr.offset[0] + tr.offset_v[0],
+                sum(ys) / len(ys) + tr.offset[1] + tr.offset_v[1])
+
+    def _follow(self, tr: MarkerTrack, frame: np.ndarray,
+                results: list[Located | None]) -> Located | None:
         """Track from the prediction; None if the marker is not in its region, or jumped.
 
         A jump faster than a hand (:meth:`_reach_px`), or a digit leaving
@@ -391,20 +439,43 @@ class Tracker:
         written out in plain floats.
         """
         p = self.params
+        pred = self._predict(tr, results)
+        # the streak lies along the marker's motion this frame
+        along = (pred[0] - tr.x[0], pred[1] - tr.x[1])
+        if along == (0.0, 0.0):
+            along = tr.v
+        speed = max(tr.speed, math.hypot(along[0], along[1]))
         meas = measure_still(frame, tr.colour, tr.x, tr.win, tr.ref, p) if tr.still else None
         if meas is None and tr.n_obs < 2 and not tr.still:
             # Just (re)started, its velocity unknown: near where it was first,
             # then widely (a wide region lets CamShift's window take in
             # neighbours of the marker's colour).
-            meas = measure(frame, tr.colour, tr.predicted, tr.win, tr.ref, p.search_margin_px, p)
+            meas = measure(frame, tr.colour, pred, tr.win, tr.ref, p.search_margin_px, p)
             if meas is None or not p.lost_ratio <= meas.mass / tr.ref <= p.max_area_ratio:
                 meas = None
+        streak = 0.0
         if meas is None:
-            meas = measure(frame, tr.colour, tr.predicted, tr.win, tr.ref, tr.margin(p), p)
+            meas = measure(frame, tr.colour, pred, tr.win, tr.ref, tr.margin(p), p)
+            blurred = meas is None or meas.mass < WHOLE * tr.ref
+            if blurred and tr.blur is not None and tr.n_obs >= 2 and not tr.still:
+                # Too little of its own colour: a fast marker is a streak of
+                # mixed colour (perception.tracking.blur), up to streak_mass of
+                # it; one that sped up faster than its estimate (a grasp's first
+                # frames) may have gone as far as the region reaches.
+                streak = streak_mass(tr.ref, speed if is_fast(speed, tr.ref)
+                                     else speed + tr.margin(p))
+                smear = measure(frame, tr.blur, pred, tr.win, streak, tr.margin(p), p,
+                                along if along != (0.0, 0.0) else None,
+                                streak_width(tr.ref, p.rim_px))
+                if smear is not None and smear.mass >= p.lost_ratio * tr.ref:
+                    meas = smear
+                else:
+                    streak = 0.0
         if meas is None:
             return None
         ratio = meas.mass / tr.ref
-        if ratio < p.lost_ratio or ratio > p.max_area_ratio:
+        if ratio < p.lost_ratio or meas.mass > (STREAK_SLACK * streak if streak
+                                                else p.max_area_ratio * tr.ref):
             return None  # hidden, or swallowed by something of its colour: search again
         cx, cy = meas.centre
         scale = self._first.scale
@@ -414,9 +485,11 @@ class Tracker:
             offset = tr.offset
             if offset is not None and not tr.still and tr.name != "wrist":
                 anchor = self._anchor(tr)
-                if anchor is not None and not math.hypot(
-                        cx - anchor[0] - offset[0], cy - anchor[1] - offset[1]
-                ) <= p.hand_drift * scale + max(tr.win) / 2:
+                near = p.hand_drift * scale + max(tr.win) / 2
+                ox, oy = offset[0] + tr.offset_v[0], offset[1] + tr.offset_v[1]
+                if anchor is not None and not (
+                        math.hypot(cx - anchor[0] - offset[0], cy - anchor[1] - offset[1])
+                        <= near or math.hypot(cx - anchor[0] - ox, cy - anchor[1] - oy) <= near):
                     return None  # left the rest of the hand: something else
         if tr.still:
             if ratio < p.hold_ratio:
@@ -425,13 +498,18 @@ class Tracker:
                 return tr.x, min(ratio, 1.0), Status.TRACKED
             tr.observe(meas, p)
             return tr.x, likelihood(ratio), Status.TRACKED
-        tr.observe(meas, p)
+        tr.observe(meas, p, blurred=bool(streak))
         tr.n_merged = tr.n_merged + 1 if meas.merged else 0
         if tr.n_merged > p.max_merged_frames:
             # Followed by prediction among its neighbour's pixels for a while:
             # where it is is no longer known, though the window stays on it.
             return (math.nan, math.nan), 0.0, Status.LOST
-        return meas.centre, tr.likelihood(meas, p), Status.TRACKED
+        lik = tr.likelihood(meas, p, streak)
+        if streak and math.dist(meas.centre, pred) > diameter_px(tr.ref):
+            # A streak a marker's width or more from where the motion puts it:
+            # the streak or the motion estimate is wrong (a grasp speeding up).
+            lik = min(lik, p.merged_likelihood)
+        return meas.centre, lik, Status.TRACKED
 
     def _plausible_here(self, tr: MarkerTrack, centre: tuple[float, float]) -> bool:
         """Whether a re-acquired hand marker lies within the hand of the others tracked."""
