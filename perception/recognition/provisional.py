@@ -28,10 +28,12 @@ class SettleRule:
 
     * a grip seen to depart from the transport (``grip-departs``): the wrist
       has covered ``min_progress`` of its way to the models' goal, and the
-      grip has opened twice, or — the hand arrived (below) — started to open
+      grip has opened twice (two aperture peaks, and after opening as a
+      grasp's must it closed and opened again: :func:`grip_course`'s
+      ``twice``), or — the hand arrived (below) — started to open
       after ``late_opening + late_margin`` of the movement (the landmark,
       known once the movement's end is seen);
-    * a verdict resting on familiarity: the hand has arrived — the transport
+    * ``normal`` or ``reach`` resting on familiarity: the hand has arrived — the transport
       has slowed by ``slowed`` (at least the rules' ``arrival``) from its peak
       speed: a stream cut after that is no longer ``incomplete`` —, the
       leading model's familiarity and the transport's are each at least
@@ -45,7 +47,8 @@ class SettleRule:
       ``reach_opening`` m while the wrist has covered ``reach_progress`` of
       its way and slowed by ``reach_slowed`` (a late opener has opened by
       then);
-    * the other rules (``unfamiliar``) settle at the end.
+    * ``abnormal`` by familiarity (a movement's familiarity rises as it
+      comes to rest) and the other rules (``unfamiliar``) settle at the end.
 
     The defaults were chosen on the dev population (seeds 1000 + k,
     ``tools/evaluate_online.py --set dev``) and the shared Optotrak table's
