@@ -19,7 +19,7 @@ from _demos import default_repertoire
 
 from perception.pipeline import recognize_tracks
 from perception.recognition.rules import VerdictRules
-from perception.synthetic import sigma_lognormal as sl
+from perception.synthetic import sigma_lognormal_clips as sl
 from perception.synthetic.independent import draw_independent, independent_tracks
 
 #: condition -> the fields that make it unambiguous (the sigma-lognormal generator's names)

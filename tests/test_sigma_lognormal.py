@@ -19,28 +19,32 @@ from perception.synthetic.sigma_lognormal import (
     CONDITIONS,
     DISTRIBUTIONS,
     FAST_DURATION,
-    FILMING,
     FPS_CHOICES,
     SigmaLognormalParams,
-    clip_tracks,
     draw_sigma_lognormal,
-    draw_sigma_lognormal_clip,
     lognormal_stroke,
-    render_sigma_lognormal_set,
     sigma_lognormal_aperture,
     sigma_lognormal_paths,
 )
+from perception.synthetic.sigma_lognormal_clips import (
+    FILMING,
+    clip_tracks,
+    draw_sigma_lognormal_clip,
+    render_sigma_lognormal_set,
+)
 
 ROOT = Path(__file__).resolve().parents[1]
-MODULE = ROOT / "perception" / "synthetic" / "sigma_lognormal.py"
+MODULES = [ROOT / "perception" / "synthetic" / name
+           for name in ("sigma_lognormal.py", "sigma_lognormal_clips.py")]
 TAU = np.linspace(0.0, 1.0, 2001)
 QUIET = {"jitter": 0.0, "drift": 0.0, "spike_rate": 0.0, "dropout_rate": 0.0}
 
 
 def test_it_imports_neither_the_model_nor_the_tuned_generator():
-    tree = ast.parse(MODULE.read_text())
-    imported = {a.name for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names}
-    imported |= {n.module for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)}
+    trees = [ast.parse(m.read_text()) for m in MODULES]
+    imported = {a.name for t in trees for n in ast.walk(t) if isinstance(n, ast.Import)
+                for a in n.names}
+    imported |= {n.module for t in trees for n in ast.walk(t) if isinstance(n, ast.ImportFrom)}
     banned = [m for m in imported if m and (m.split(".")[0] == "minvar" or m.startswith(
         ("perception.synthetic.independent", "perception.synthetic.population",
          "perception.synthetic.stimuli")))]
@@ -50,7 +54,7 @@ def test_it_imports_neither_the_model_nor_the_tuned_generator():
     code = ("import sys, numpy as np\n"
             "NOT_THE_MODEL = {'minvar._version', 'minvar.errors', 'minvar.limits', "
             "'minvar.validation'}\n"
-            "from perception.synthetic.sigma_lognormal import draw_sigma_lognormal_clip, "
+            "from perception.synthetic.sigma_lognormal_clips import draw_sigma_lognormal_clip, "
             "clip_tracks\n"
             "clip_tracks(draw_sigma_lognormal_clip('open-close-open', "
             "np.random.default_rng(1)), 1)\n"
@@ -90,14 +94,14 @@ def test_draws_stay_within_their_declared_distributions():
 
 
 def test_every_drawn_clip_keeps_the_hand_in_its_frame():
-    from perception.synthetic import sigma_lognormal as sl
+    from perception.synthetic import sigma_lognormal_clips as clips
 
     for seed in range(120):
         for fast in (False, True):
             clip = draw_sigma_lognormal_clip(CONDITIONS[seed % 4], np.random.default_rng(seed),
                                              fast=fast)
             _, paths = sigma_lognormal_paths(clip.params, clip.fps, seed=seed)  # with noise
-            assert sl._fits(paths, clip.camera, clip.style), (seed, fast)
+            assert clips._fits(paths, clip.camera, clip.style), (seed, fast)
     fixed = draw_sigma_lognormal_clip("normal", np.random.default_rng(1), fps=30.0,
                                       duration=0.5)
     drawn = draw_sigma_lognormal_clip("normal", np.random.default_rng(1))

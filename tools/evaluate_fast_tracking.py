@@ -149,13 +149,14 @@ def sigma_clip(k: int, fps: float, exposure: float, duration: tuple[float, float
     dropouts (drawn hidden); the movement time drawn from ``duration`` and the
     shutter ``exposure`` (negative: the generator's own share of the frame).
     """
-    import perception.synthetic.sigma_lognormal as sl
+    from perception.synthetic.sigma_lognormal import sigma_lognormal_paths
+    from perception.synthetic.sigma_lognormal_clips import draw_sigma_lognormal_clip
 
     cond = CONDITIONS[k % len(CONDITIONS)]
     rng = np.random.default_rng(SIGMA_SEED + k)
-    clip = sl.draw_sigma_lognormal_clip(cond, rng, fast=True)
+    clip = draw_sigma_lognormal_clip(cond, rng, fast=True)
     p = dataclasses.replace(clip.params, duration=float(rng.uniform(*duration)))
-    _, paths = sl.sigma_lognormal_paths(p, fps, seed=rng)
+    _, paths = sigma_lognormal_paths(p, fps, seed=rng)
     hidden = tuple(Occlusion(marker=m, start=int(i), stop=int(i) + 1)
                    for m in DIGITS for i in np.flatnonzero(paths["dropped"][m]))
     share = clip.style.exposure * clip.fps

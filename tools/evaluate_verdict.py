@@ -318,7 +318,7 @@ def render_set(generator: str, set_name: str, out: Path, counts: dict[str, int],
                *, jobs: int, progress: bool) -> pd.DataFrame:
     """Render a set of ``generator`` into ``out`` with its ``manifest.csv``."""
     if generator == "sigma-lognormal":
-        from perception.synthetic.sigma_lognormal import render_sigma_lognormal_set
+        from perception.synthetic.sigma_lognormal_clips import render_sigma_lognormal_set
 
         return render_sigma_lognormal_set(out, counts, seed=seed,
                                           fast=set_name.startswith("fast"), jobs=jobs,
@@ -338,7 +338,7 @@ def clip_tracks(generator: str, set_name: str, condition: str, clip_seed: int):
     """
     rng = np.random.default_rng(clip_seed)
     if generator == "sigma-lognormal":
-        from perception.synthetic import sigma_lognormal as sl
+        from perception.synthetic import sigma_lognormal_clips as sl
 
         clip = sl.draw_sigma_lognormal_clip(condition, rng, fast=set_name.startswith("fast"))
         return sl.clip_tracks(clip, rng)[0], clip.row()
