@@ -45,7 +45,8 @@ from perception.synthetic.recipes import load_recipe, synthesize
 from perception.synthetic.render import render_clip
 from perception.synthetic.scene import Camera, RenderStyle, Scene
 from perception.tracking.markers import MarkerSet, default_markers
-from perception.tracking.tracker import Tracker, TrackerParams, track_video
+from perception.tracking.tracker import Tracker, TrackerParams
+from perception.tracking.video_tracks import track_video
 
 __all__ = [
     "MocapImport",

@@ -248,7 +248,7 @@ def load_clip(source: str | os.PathLike | Tracks, *, tracks_out: str | os.PathLi
         current = current_tracks(path, [out, tracks_path_for(path)], setup)
         if current is not None:
             return current
-    from perception.tracking.tracker import track_video  # OpenCV only when there is video
+    from perception.tracking.video_tracks import track_video  # OpenCV only when there is video
 
     kw = {} if setup is None else {"markers": setup.markers, "params": setup.params}
     return Tracks.load(track_video(path, out, progress=progress, keep_truncated=keep_truncated,

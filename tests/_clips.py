@@ -7,7 +7,7 @@ import numpy as np
 
 from perception.io.tracks import Tracks
 from perception.synthetic.demos import HARD, render_demo_clip
-from perception.tracking.tracker import track_video
+from perception.tracking.video_tracks import track_video
 
 __all__ = ["HARD", "render", "track", "errors"]
 

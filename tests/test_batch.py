@@ -221,7 +221,7 @@ def test_an_unexpected_error_is_recorded_and_the_batch_goes_on(clips, tmp_path):
 
 def test_object_scale_from_tracking_is_within_one_percent(clips, tmp_path):
     from perception.io.tracks import Tracks
-    from perception.tracking.tracker import track_video
+    from perception.tracking.video_tracks import track_video
 
     for clip in ("normal-01", "delayed-01"):
         tracked = Tracks.load(track_video(clips / f"{clip}.mp4", tmp_path / f"{clip}.tracks.h5"))

@@ -342,7 +342,7 @@ def test_contact_sheet_from_frames_kept_while_tracking_matches_a_decoded_one(tmp
     from perception.report.tracking import contact_sheet
     from perception.synthetic.demos import render_demo_clip
     from perception.synthetic.scene import Scene
-    from perception.tracking.tracker import track_video
+    from perception.tracking.video_tracks import track_video
 
     scene = Scene.reach_to_grasp(45, 30, start=(0.0, -0.25), onset=0.3, duration=0.8)
     clip, _ = render_demo_clip(tmp_path, "clip.mp4", n=45, angle=0.0, hand=True, scene=scene)
@@ -388,7 +388,7 @@ def test_tracking_does_not_wait_for_the_videos_hash(tmp_path, monkeypatch):
     from perception.io.frame_sample import FrameSample
     from perception.synthetic.demos import render_demo_clip
     from perception.synthetic.scene import Scene
-    from perception.tracking.tracker import track_video
+    from perception.tracking.video_tracks import track_video
 
     scene = Scene.reach_to_grasp(20, 30, start=(0.0, -0.25), onset=0.2, duration=0.4)
     clip, _ = render_demo_clip(tmp_path, "clip.mp4", n=20, angle=0.0, hand=True, scene=scene)
@@ -415,7 +415,7 @@ def test_opencv_threads_are_set_by_the_commands_that_track_not_by_the_library(cl
     import cv2
 
     from hammer_mv.cli import main
-    from perception.tracking.tracker import track_video
+    from perception.tracking.video_tracks import track_video
 
     calls = []
     monkeypatch.setattr(cv2, "setNumThreads", calls.append)

@@ -29,7 +29,7 @@ from perception.io.atomic import owner_tag
 from perception.io.tracks import Tracks
 from perception.io.video import write_video
 from perception.synthetic.demos import render_demo_clip
-from perception.tracking.tracker import track_video
+from perception.tracking.video_tracks import track_video
 
 pytestmark = pytest.mark.slow
 

@@ -98,7 +98,7 @@ def test_plan_cache_key_covers_what_changes_a_plan(tmp_path):
 def test_current_tracks_file_is_reused_and_a_stale_one_is_not(tmp_path, monkeypatch):
     from perception.pipeline import current_tracks, load_clip
     from perception.synthetic.demos import render_demo_clip
-    from perception.tracking import tracker
+    from perception.tracking import video_tracks
 
     clip, _ = render_demo_clip(tmp_path, "a.mp4", n=30)
     other, _ = render_demo_clip(tmp_path, "b.mp4", n=30, seed=1)
@@ -109,12 +109,12 @@ def test_current_tracks_file_is_reused_and_a_stale_one_is_not(tmp_path, monkeypa
     def no_tracking(*args, **kwargs):
         raise AssertionError("tracked again")
 
-    monkeypatch.setattr(tracker, "track_video", no_tracking)
+    monkeypatch.setattr(video_tracks, "track_video", no_tracking)
     again = load_clip(clip.video)
     np.testing.assert_array_equal(again.position, tracks.position)
     monkeypatch.undo()
     roi = tmp_path / "roi.tracks.h5"
-    tracker.track_video(clip.video, roi, rois={"object": (0, 0, 640, 480)})
+    video_tracks.track_video(clip.video, roi, rois={"object": (0, 0, 640, 480)})
     assert current_tracks(clip.video, [roi]) is None  # other tracker settings
 
 

@@ -10,7 +10,8 @@ from perception.synthetic.scene import Distractor, Scene
 from perception.tracking import candidates
 from perception.tracking.markers import default_markers
 from perception.tracking.params import TrackerParams
-from perception.tracking.tracker import Tracker, track_frames
+from perception.tracking.tracker import Tracker
+from perception.tracking.video_tracks import track_frames
 
 
 class _Rows:

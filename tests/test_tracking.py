@@ -6,7 +6,8 @@ from perception.errors import InputError
 from perception.io.tracks import Status, Tracks
 from perception.synthetic.scene import Distractor, Occlusion, Scene
 from perception.tracking.markers import default_markers
-from perception.tracking.tracker import Tracker, TrackerParams, track_video
+from perception.tracking.tracker import Tracker, TrackerParams
+from perception.tracking.video_tracks import track_video
 
 
 def _check_accuracy(tracks, truth, visible, median=1.0, p95=3.0):

@@ -23,7 +23,7 @@ from perception.synthetic.scene import Occlusion, Scene
 from perception.tracking.blur import StreakGate, blur_gate, streak_mass
 from perception.tracking.markers import default_markers
 from perception.tracking.measurement import streak_centre
-from perception.tracking.tracker import track_video
+from perception.tracking.video_tracks import track_video
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tools"))

@@ -183,11 +183,11 @@ def test_every_tunable_is_saved_and_new_fields_are_validated():
 
 
 def test_package_reexports_the_public_names():
-    from perception.tracking import markers, tracker
+    from perception.tracking import markers, tracker, video_tracks
 
-    assert tracking.track_video is tracker.track_video
+    assert tracking.track_video is video_tracks.track_video
     assert tracking.Tracker is tracker.Tracker and tracking.TrackerParams is tracker.TrackerParams
-    assert tracking.track_frames is tracker.track_frames
+    assert tracking.track_frames is video_tracks.track_frames
     for name in ("MarkerColour", "MarkerSet", "default_markers", "load_markers", "MARKER_NAMES"):
         assert getattr(tracking, name) is getattr(markers, name)
     assert sorted(tracking.__all__) == sorted(

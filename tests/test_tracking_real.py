@@ -16,7 +16,7 @@ from perception.tracking.candidates import Candidate, describe, reject_reason
 from perception.tracking.hand import choose_hand
 from perception.tracking.markers import default_markers
 from perception.tracking.params import TrackerParams
-from perception.tracking.tracker import track_video
+from perception.tracking.video_tracks import track_video
 
 P = TrackerParams()
 M = default_markers()

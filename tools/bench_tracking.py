@@ -43,13 +43,13 @@ import numpy as np
 from perception.io.tracks import Tracks
 from perception.synthetic.render import render_clip
 from perception.synthetic.scene import Camera, RenderStyle, Scene
-from perception.tracking.tracker import track_video
+from perception.tracking.video_tracks import track_video
 
 ROOT = Path(__file__).resolve().parents[1]
 
 _CHILD = """
 import resource, sys
-from perception.tracking.tracker import track_video
+from perception.tracking.video_tracks import track_video
 track_video(sys.argv[1], sys.argv[2])
 print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)
 """

@@ -50,7 +50,7 @@ from perception.synthetic.population import (
 from perception.synthetic.render import render_clip
 from perception.synthetic.scene import Camera, Occlusion, RenderStyle, Scene
 from perception.tracking.params import TrackerParams
-from perception.tracking.tracker import track_video
+from perception.tracking.video_tracks import track_video
 
 #: The fast sets' first seed and movement times (as tools/evaluate_verdict.py's fast-dev).
 FAST_SEED = 20000

@@ -105,7 +105,7 @@ def run(set_name: str, out: Path, counts: dict[str, int], jobs: int = 2) -> str:
     from perception.io.tracks import Tracks
     from perception.recognition.repertoire import Repertoire
     from perception.synthetic.population import render_population_set
-    from perception.tracking.tracker import track_video
+    from perception.tracking.video_tracks import track_video
 
     seeds = set_seeds(set_name, sum(counts.values()))
     t0 = time.perf_counter()

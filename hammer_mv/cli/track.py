@@ -78,7 +78,7 @@ def run(args: argparse.Namespace) -> int:
     from perception.io.tracks import Status, Tracks, tracks_path_for
     from perception.tracking.markers import load_markers
     from perception.tracking.setup import TrackingSetup, load_setup
-    from perception.tracking.tracker import track_video
+    from perception.tracking.video_tracks import track_video
 
     inputs = [p for p in (args.video, args.colours, args.setup) if p is not None]
     out = check_output(args.output or tracks_path_for(args.video), inputs)

@@ -24,7 +24,10 @@
 * :mod:`~perception.tracking.overlay` — markers drawn on frames (labelled
   videos, contact sheets).
 * :mod:`~perception.tracking.tracker` — the per-frame loop and motion
-  prediction, :func:`track_frames`, :func:`track_video`.
+  prediction (:class:`Tracker`).
+* :mod:`~perception.tracking.blur` — a fast marker found as a motion-blurred streak.
+* :mod:`~perception.tracking.video_tracks` — a video or stream of frames into a
+  tracks file: :func:`track_frames`, :func:`track_video`.
 
 The tracks file it writes is described in ``docs/tracks-format.md``.
 """
@@ -37,7 +40,8 @@ from perception.tracking.markers import (
     load_markers,
 )
 from perception.tracking.params import TrackerParams
-from perception.tracking.tracker import Tracker, track_frames, track_video
+from perception.tracking.tracker import Tracker
+from perception.tracking.video_tracks import track_frames, track_video
 
 __all__ = [
     "MARKER_NAMES",

@@ -55,25 +55,18 @@ status codes and the ``/tracker`` attributes are described in
 
 from __future__ import annotations
 
-import contextlib
-import itertools
 import json
-import logging
 import math
-import os
-import sys
 from collections import deque
-from collections.abc import Iterable, Mapping
+from collections.abc import Mapping
 from dataclasses import asdict
-from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import cv2
 import numpy as np
 
 from perception.errors import InputError
-from perception.io.tracks import Status, TracksWriter, tracks_path_for
-from perception.io.video import FrameSource, VideoWriter
+from perception.io.tracks import Status
 from perception.tracking.blur import (
     STREAK_SLACK,
     WHOLE,
@@ -87,16 +80,10 @@ from perception.tracking.first_detection import FirstDetection
 from perception.tracking.marker_track import Located, MarkerTrack
 from perception.tracking.markers import MarkerSet, default_markers
 from perception.tracking.measurement import Measurement, likelihood, measure, measure_still
-from perception.tracking.overlay import Labeller
 from perception.tracking.params import TrackerParams
 from perception.tracking.reacquisition import ROI, downscaled_hsv, reacquire, search_scale
 
-if TYPE_CHECKING:
-    from perception.io.frame_sample import FrameSample
-
-__all__ = ["ROI", "Measurement", "Tracker", "TrackerParams", "track_frames", "track_video"]
-
-logger = logging.getLogger(__name__)
+__all__ = ["ROI", "Measurement", "Tracker", "TrackerParams"]
 
 
 class Tracker:
@@ -227,7 +214,7 @@ class Tracker:
         (first detection), each later call at most :attr:`catch_up` frames:
         no call carries the whole look-ahead. A row is ``(index, time_s,
         position, likelihood, status, frame)``, with :meth:`update`'s results;
-        :func:`track_frames` is this and :meth:`flush`.
+        :func:`~perception.tracking.video_tracks.track_frames` is this and :meth:`flush`.
         """
         self._queue.append((index, time_s, frame))
         if self.n_frames or len(self._queue) >= self.params.init_frames:
@@ -562,171 +549,3 @@ def _roi_in_frame(name: str, roi: ROI, shape: tuple[int, ...]) -> None:
         raise InputError(
             f"ROI for {name}: {x} {y} {w} {h} extends past the {shape[1]}x{shape[0]} frame"
         )
-
-
-def track_frames(
-    frames: Iterable[tuple[int, float, np.ndarray]],
-    writer: TracksWriter,
-    tracker: Tracker,
-    *,
-    progress: Any = None,
-    each_frame: Any = None,
-) -> Tracker:
-    """Track a stream of frames into an open :class:`TracksWriter`.
-
-    The frames go through :meth:`Tracker.feed` and :meth:`Tracker.flush`:
-    the first ``tracker.params.init_frames`` are read ahead (the hand at
-    rest) so that first detection can reject candidates that move; memory
-    holds those few frames only.
-
-    Parameters
-    ----------
-    frames : iterable of (int, float, (H, W, 3) uint8)
-        ``(index, time_s, frame)``, as :class:`~perception.io.video.FrameSource` yields.
-    writer : TracksWriter
-        Open writer whose markers are the tracker's.
-    tracker : Tracker
-        Tracker state (updated in place).
-    progress : callable, optional
-        Called with no arguments after each frame.
-    each_frame : callable, optional
-        Called as ``each_frame(index, time_s, frame, position, likelihood,
-        status)`` after each frame (a labelled video, a contact sheet).
-
-    Returns
-    -------
-    Tracker
-        ``tracker``, for chaining.
-    """
-    for item in itertools.chain(frames, [None]):
-        rows = tracker.flush() if item is None else tracker.feed(item[2], item[1], item[0])
-        for index, time_s, *marks, frame in rows:  # marks: position, likelihood, status
-            writer.append(index, time_s, *marks)
-            if each_frame is not None:
-                each_frame(index, time_s, frame, *marks)
-            if progress is not None:
-                progress()
-    return tracker
-
-
-def track_video(
-    video: str | os.PathLike,
-    out: str | os.PathLike | None = None,
-    *,
-    markers: MarkerSet | None = None,
-    params: TrackerParams | None = None,
-    rois: Mapping[str, ROI] | None = None,
-    progress: bool = False,
-    prefetch: int = 8,
-    labelled_video: str | os.PathLike | None = None,
-    keep_truncated: bool = False,
-    fps: float | None = None,
-    frames: FrameSample | None = None,
-    decoder_threads: int = 0,
-) -> Path:
-    """Track a video file into a tracks file (``<stem>.tracks.h5`` beside it by default).
-
-    Parameters
-    ----------
-    video : str or os.PathLike
-        Input video.
-    out : str or os.PathLike, optional
-        Output tracks file.
-    markers, params, rois
-        See :class:`Tracker`.
-    progress : bool
-        Show a progress bar on stderr.
-    prefetch : int
-        Frames decoded ahead in a background thread.
-    labelled_video : str or os.PathLike, optional
-        Also write the video with the markers drawn on it
-        (:class:`~perception.tracking.overlay.Labeller`), atomically.
-    keep_truncated : bool
-        Track the frames a truncated video does hold (its header claims
-        more) instead of refusing it; a warning says how many are missing.
-    fps : float, optional
-        The true frame rate, frames/s, for a container whose rate or times
-        are wrong: frame times become ``index / fps`` (the labelled video
-        is written at this rate too).
-    frames : FrameSample, optional
-        Keeps a few of the frames as they are decoded (for the contact sheet).
-    decoder_threads : int
-        Threads FFmpeg decodes with (0: FFmpeg's choice; a batch worker
-        passes 1, see :class:`~perception.io.video.FrameSource`).
-
-    Returns
-    -------
-    Path
-        The tracks file, written atomically.
-
-    Raises
-    ------
-    InputError
-        Bad video (see :class:`~perception.io.video.FrameSource`: truncated
-        unless ``keep_truncated``, a frame rate no camera has unless ``fps``),
-        a bad ROI, or a marker never found (the message says why: rejected
-        candidates, or ambiguity); no output file is left behind.
-
-    Notes
-    -----
-    OpenCV's thread pool is left as the caller set it: the ``hammer-mv``
-    commands that track turn it off (:func:`hammer_mv.cli.serial_opencv`
-    says why); a Python caller tracking many clips may do the same with
-    ``cv2.setNumThreads(1)``.
-    """
-    from perception.boundary import expect
-
-    expect(params, TrackerParams, "track_video(params=)", optional=True)
-    markers = default_markers() if markers is None else markers
-    out_path = tracks_path_for(video) if out is None else Path(out)
-    tracker = Tracker(markers, params, rois)
-    with contextlib.ExitStack() as stack:
-        src = stack.enter_context(FrameSource(video, prefetch=prefetch,
-                                              keep_truncated=keep_truncated, fps=fps,
-                                              threads=decoder_threads))
-        # /video (with the file's SHA-256, read meanwhile) and /tracker are
-        # written when tracking is done; until then only src.header is read.
-        w = stack.enter_context(TracksWriter(out_path, markers.names))
-        each = None
-        if labelled_video is not None:
-            rate = fps or src.header.fps_nominal or 30.0
-            vw = stack.enter_context(VideoWriter(labelled_video, rate,
-                                                 (src.header.width, src.header.height)))
-            labeller = Labeller(markers.names, [m.bgr for m in markers])
-
-            def each(index, time_s, frame, position, likelihood, status):
-                vw.write(labeller.draw(frame, position, likelihood, status))
-        if frames is not None:
-            frames.start(src.header.n_frames_header, src.header.width * src.header.height * 3)
-            label = each
-
-            def each(index, time_s, frame, *marks):
-                frames.offer(index, frame)
-                if label is not None:
-                    label(index, time_s, frame, *marks)
-
-        bar = None
-        if progress:
-            from tqdm import tqdm
-
-            bar = stack.enter_context(tqdm(total=src.header.n_frames_header or None, unit="frame",
-                                           file=sys.stderr, desc=Path(video).name,
-                                           leave=False))
-        try:
-            track_frames(src, w, tracker, progress=bar.update if bar else None, each_frame=each)
-        except InputError as exc:
-            if exc.path is None:
-                raise InputError(exc.problem, video) from None
-            raise
-        missing = tracker.never_found
-        if missing:
-            why = "; ".join(f"{m}: {tracker.why_not_found(m)}" for m in missing)
-            raise InputError(
-                f"marker{'s' if len(missing) > 1 else ''} {', '.join(missing)} never found "
-                f"in {src.n_decoded} frames ({why}); check the colour models and marker "
-                "sizes (hammer-mv calibrate, --setup), or give --roi MARKER X Y W H",
-                video,
-            )
-        w.update(video=src.attrs(), tracker=tracker.attrs())
-    logger.info("%s: tracked %d frames -> %s", video, src.n_decoded, out_path)
-    return out_path
