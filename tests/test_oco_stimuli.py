@@ -17,7 +17,7 @@ from perception.landmarks import observed_landmarks
 from perception.observation import observe
 from perception.synthetic.independent import render_independent_set
 from perception.synthetic.recipes import load_recipe, render_style, synthesize
-from perception.tracking.tracker import track_video
+from perception.tracking.video_tracks import track_video
 
 pytestmark = pytest.mark.slow
 

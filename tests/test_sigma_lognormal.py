@@ -230,7 +230,7 @@ def test_bad_parameters_are_refused():
 
 def test_a_rendered_clip_is_tracked_into_a_tracks_file(tmp_path):
     """One short clip (seed 6: a 0.47 s grasp at 25 frames/s) through the colour tracker."""
-    from perception.tracking.tracker import track_video
+    from perception.tracking.video_tracks import track_video
 
     manifest = render_sigma_lognormal_set(tmp_path, {"normal": 1}, seed=6, fast=True)
     assert list(pd.read_csv(tmp_path / "manifest.csv")["clip"]) == ["normal-01"]
