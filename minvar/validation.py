@@ -40,6 +40,7 @@ from pydantic import (
     ValidationError,
 )
 from pydantic.dataclasses import dataclass as _pydantic_dataclass
+from pydantic.dataclasses import rebuild_dataclass as _rebuild_dataclass
 
 from minvar.errors import LocatedError, ParameterError, suggest
 from minvar.limits import MAX_POSITION_M
@@ -53,8 +54,12 @@ INT32_MAX = 2**31 - 1
 
 #: What every declared class shares: unknown fields are errors, values are
 #: not coerced from strings or booleans, floats are finite, instances frozen.
+#: A class's validator is built when it is first used, not when its module is
+#: imported (``defer_build``): a command imports many classes it never makes (the
+#: CLI's option tables read only their fields, which are collected at once either
+#: way), and building them all cost ~60 ms of every start-up (issue 45).
 CONFIG = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False,
-                    arbitrary_types_allowed=True)
+                    arbitrary_types_allowed=True, defer_build=True)
 
 
 def _python_int(value: Any) -> Any:
@@ -209,16 +214,44 @@ def declared(cls: type | None = None, /, *, eq: bool = True,
         return functools.partial(declared, eq=eq, error=error)
     # frozen: settings are values
     built = _pydantic_dataclass(cls, frozen=True, eq=eq, config=CONFIG)
-    init = built.__init__
+    init = built.__init__  # pydantic's: validates with whatever validator the class holds
 
     @functools.wraps(init)
     def __init__(self: Any, *args: Any, **kwargs: Any) -> None:
+        if not built.__pydantic_complete__:
+            _complete(built, __init__)
         try:
             init(self, *args, **kwargs)
         except ValidationError as exc:
             raise input_error(exc, built, error) from None
 
     built.__init__ = __init__
+    # the signature pydantic gives a built class, read without building it first
+    built.__signature__ = _BuiltSignature(built, __init__)
+    return built
+
+
+class _BuiltSignature:
+    """A deferred class's ``__signature__``: pydantic's, read after building the class."""
+
+    def __init__(self, built: type, init: Any):
+        self.built, self.init = built, init
+
+    def __get__(self, _instance: Any, _owner: type) -> Any:
+        return _complete(self.built, self.init).__signature__
+
+
+def _complete(built: type, init: Any) -> type:
+    """Build ``built``'s deferred validator (CONFIG's ``defer_build``) now.
+
+    pydantic's build sets the class's ``__init__`` (and its ``__signature__``)
+    anew: the one-line-error ``init`` of :func:`declared` is put back.
+    """
+    built.__init__ = init.__wrapped__  # pydantic's, so that the signature is read from it
+    try:
+        _rebuild_dataclass(built, force=True)
+    finally:
+        built.__init__ = init
     return built
 
 

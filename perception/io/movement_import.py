@@ -14,7 +14,9 @@ imports, and tells ``platformdirs`` not to create folders meanwhile. This
 leans on that module's layout: pyproject.toml pins ``movement<0.16``.
 :func:`movement_loaders` gives its loaders, or one
 :class:`~perception.errors.InputError` naming the optional extra when
-``movement`` is not installed.
+``movement`` is not installed. :func:`dlc_poses` reads a DeepLabCut table
+through movement's own validator without importing ``movement.io`` (whose
+other readers cost a start-up 1.3 s).
 """
 
 from __future__ import annotations
@@ -26,28 +28,47 @@ from pathlib import Path
 
 from perception.errors import InputError
 
-__all__ = ["POSE_EXTRA", "import_movement", "movement_loaders"]
+__all__ = ["POSE_EXTRA", "dlc_poses", "import_movement", "movement_loaders", "require_movement"]
 
 #: The message when the optional ``pose`` extra (``movement``, PyTables) is missing.
 POSE_EXTRA = ("reading and writing pose files needs the optional extra: "
               "pip install 'hammer-mv[pose]'")
 
 
-def import_movement() -> None:
-    """Import ``movement`` without writing under HOME.
+def import_movement(module: str = "movement.io") -> None:
+    """Import ``movement`` (its ``module``) without writing under HOME.
 
     Its own messages are disabled in ``loguru`` (the package's loaders log
     every file they read); a user enables them with
     ``loguru.logger.enable("movement")``, and gets movement's log file by
     calling ``movement.utils.logging.logger.configure()``, as documented.
 
+    Parameters
+    ----------
+    module : str
+        What to import: ``movement.io`` (every loader, which imports pynwb,
+        sleap_io and their dependencies: about 1.3 s), or only
+        ``movement.validators.datasets`` (xarray), which is all a DeepLabCut
+        table needs (:func:`dlc_poses`).
+
     Raises
     ------
     ImportError
         ``movement`` is not installed.
     """
-    if "movement.io" in sys.modules:
+    if module in sys.modules:
         return
+    if "movement" in sys.modules:  # its __init__ (which configures the log) has run
+        _import_quietly(module)
+    else:
+        _import_package(module)
+    from loguru import logger
+
+    logger.disable("movement")
+
+
+def _import_package(module: str) -> None:
+    """Import ``module`` and so the package, its ``logger.configure()`` doing nothing."""
     package = importlib.util.find_spec("movement")  # found, not imported
     if package is None:
         raise ImportError("movement")
@@ -59,6 +80,18 @@ def import_movement() -> None:
     configure = logging.MovementLogger.configure
     logging.MovementLogger.configure = lambda self, *args, **kwargs: None
     sys.modules[name] = logging
+    try:
+        _import_quietly(module)
+    except BaseException:
+        sys.modules.pop(name, None)
+        raise
+    finally:
+        logging.MovementLogger.configure = configure
+    importlib.import_module("movement.utils").logging = logging  # as an import would
+
+
+def _import_quietly(module: str) -> None:
+    """Import ``module`` of movement, creating no folder and loading no OpenCV."""
     import platformdirs
 
     dirs = platformdirs.PlatformDirs
@@ -74,26 +107,82 @@ def import_movement() -> None:
     if hide_cv2:
         sys.modules["cv2"] = None  # import cv2 raises ImportError, which sleap_io allows
     try:
-        importlib.import_module("movement.io")
-    except BaseException:
-        sys.modules.pop(name, None)
-        raise
+        importlib.import_module(module)
     finally:
-        logging.MovementLogger.configure = configure
         platformdirs.PlatformDirs = dirs
         if hide_cv2:
             del sys.modules["cv2"]
-    importlib.import_module("movement.utils").logging = logging  # as an import would
-    from loguru import logger
 
-    logger.disable("movement")
+
+def dlc_poses(df, fps: float | None, source_software: str = "DeepLabCut"):
+    """A DeepLabCut table as a ``movement`` poses dataset, without ``movement.io``.
+
+    What ``movement.io.load_poses.from_dlc_style_df`` does (movement 0.15,
+    pinned), through the same validator (``ValidPosesInputs``) and so the
+    same dataset and the same errors, but without importing ``movement.io``,
+    whose readers of other formats (pynwb, sleap_io, and what they pull in)
+    cost about 1.3 s of a start-up (issue 45).
+
+    Parameters
+    ----------
+    df : pandas.DataFrame
+        Columns a MultiIndex of scorer, (individuals,) bodyparts and coords,
+        as DeepLabCut writes them.
+    fps : float, optional
+        Frame rate; None: time in frames.
+    source_software : str
+        Recorded in the dataset's attributes.
+
+    Raises
+    ------
+    InputError
+        ``movement`` is not installed.
+    """
+    require_movement(_VALIDATOR)
+    from movement.validators.datasets import ValidPosesInputs
+
+    if "individuals" in df.columns.names:
+        individual_names = df.columns.get_level_values("individuals").unique().to_list()
+    else:
+        individual_names = ["individual_0"]
+    keypoint_names = df.columns.get_level_values("bodyparts").unique().to_list()
+    coord_names = df.columns.get_level_values("coords").unique().to_list()
+    n_coords = len(coord_names)
+    tracks = (df.to_numpy()
+              .reshape((-1, len(individual_names), len(keypoint_names), n_coords))
+              .transpose(0, 3, 2, 1))
+    if "likelihood" in coord_names:  # x, y, likelihood
+        likelihood_index = coord_names.index("likelihood")
+        confidence_array = tracks[:, likelihood_index, :, :]
+        position_array = tracks[:, [j for j in range(n_coords) if j != likelihood_index], :, :]
+    else:  # x, y, z
+        position_array, confidence_array = tracks, None
+    return ValidPosesInputs(position_array=position_array, confidence_array=confidence_array,
+                            individual_names=individual_names, keypoint_names=keypoint_names,
+                            fps=fps, source_software=source_software).to_dataset()
+
+
+#: The module of movement a DeepLabCut table needs (:func:`dlc_poses`).
+_VALIDATOR = "movement.validators.datasets"
+
+
+def require_movement(module: str = "movement.io") -> None:
+    """:func:`import_movement`, or a one-line error naming the extra.
+
+    Parameters
+    ----------
+    module : str
+        ``movement.io``, or ``movement.validators.datasets`` for a DeepLabCut table.
+    """
+    try:
+        import_movement(module)
+    except ImportError:
+        raise InputError(POSE_EXTRA) from None
 
 
 def movement_loaders():
     """``movement``'s ``load_dataset`` and ``load_poses``, or a one-line error naming the extra."""
-    try:
-        import_movement()
-        from movement.io import load_dataset, load_poses
-    except ImportError:
-        raise InputError(POSE_EXTRA) from None
+    require_movement()
+    from movement.io import load_dataset, load_poses
+
     return load_dataset, load_poses

@@ -41,6 +41,7 @@ from perception.errors import InputError
 from perception.io.atomic import write_bytes, write_text
 from perception.io.files import input_file
 from perception.io.movement_import import POSE_EXTRA as _EXTRA
+from perception.io.movement_import import dlc_poses, require_movement
 from perception.io.movement_import import movement_loaders as _movement
 from perception.io.names import POSE_SUFFIXES, TRACKS_SUFFIX, VIDEO_SUFFIXES
 from perception.io.tracks import Status, Tracks, position_bounds
@@ -383,7 +384,10 @@ def _own_frames(index, n: int) -> np.ndarray | None:
 
 def _load_dataset(path: Path, source: str, fps: float | None):
     """The file as a ``movement`` poses dataset, and the file's own frame numbers (or None)."""
-    load_dataset, load_poses = _movement()
+    if source == "dlc":  # a DeepLabCut table needs only movement's validator (dlc_poses)
+        require_movement("movement.validators.datasets")
+    else:
+        load_dataset, _ = _movement()
     suffix = path.suffix.lower()
     if suffix in (".h5", ".slp", ".nwb", ".nc"):
         try:
@@ -410,7 +414,7 @@ def _load_dataset(path: Path, source: str, fps: float | None):
             if source == "dlc":
                 df = _dlc_table(path)
                 _check_sizes_table(df, path)
-                ds = load_poses.from_dlc_style_df(df, fps=fps, source_software="DeepLabCut")
+                ds = dlc_poses(df, fps)
                 return ds, _own_frames(df.index, len(df))
             return load_dataset(path, source_software=_SOURCES[source], fps=fps), None
     except InputError:

@@ -1,0 +1,131 @@
+"""What a command does at start-up that it need not (issue 45 item 4).
+
+Nothing here is timed (start-up is measured in ``tools/bench_speed.py``): each test
+checks, in a fresh process where it matters, that work a command does not need is not
+done — a settings class's validator built before it is used, ``movement.io`` (pynwb,
+sleap_io and what they import) loaded for a DeepLabCut table.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from minvar.errors import ParameterError
+from perception.errors import PlanningError
+
+
+def _fresh(code: str) -> str:
+    """Run ``code`` in a fresh interpreter; its stdout."""
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=300)
+    assert res.returncode == 0, res.stderr[-2000:]
+    return res.stdout
+
+
+def test_a_declared_class_is_built_when_first_made_not_when_imported():
+    out = _fresh("import hammer_mv.cli.options\n"
+                 "from perception.observation import ObserveParams as O\n"
+                 "print(O.__pydantic_complete__, len(O.__pydantic_fields__))\n"
+                 "O()\n"
+                 "print(O.__pydantic_complete__)\n")
+    # the option tables read the fields, which are there before the validator is
+    assert out.split() == ["False", "22", "True"]
+
+
+def test_a_deferred_class_refuses_a_bad_value_in_one_line_first_and_every_time():
+    # pydantic's deferred build sets the class's __init__ anew: the one-line error must
+    # survive it, on the first instance (which builds) and on every later one
+    out = _fresh("from minvar.errors import ParameterError\n"
+                 "from minvar.grasp_task import GraspTask\n"
+                 "for _ in range(3):\n"
+                 "    try:\n"
+                 "        GraspTask(object_size=-0.001)\n"
+                 "    except ParameterError as exc:\n"
+                 "        print(exc)\n"
+                 "print(GraspTask().object_size)\n")
+    assert out.splitlines() == ["GraspTask.object_size: expected a number >= 0, got -0.001"] * 3 \
+        + ["0.04"]
+
+
+def test_a_deferred_class_keeps_its_signature_and_its_errors_in_process():
+    import inspect
+
+    from minvar.kinematics import TwoLinkChain
+    from perception.recognition.models import SceneSpec
+
+    assert list(inspect.signature(TwoLinkChain).parameters) == ["args", "l1", "l2", "base"]
+    with pytest.raises(ParameterError, match=r"TwoLinkChain\.l1: expected a number > 0"):
+        TwoLinkChain(l1=0.0)
+    with pytest.raises(PlanningError, match=r"SceneSpec\.distance: expected a number > 0"):
+        SceneSpec(distance=-1.0)
+    assert SceneSpec(distance=0.3).distance == 0.3
+
+
+def _dlc_frame(individuals: int, coords=("x", "y", "likelihood")) -> pd.DataFrame:
+    rng = np.random.default_rng(4)
+    parts = ["thumb", "finger", "wrist", "object"]
+    names = ([f"mouse{i}" for i in range(individuals)] if individuals else [None])
+    tuples = [(("DLC_x", n, b, c) if n else ("DLC_x", b, c))
+              for n in names for b in parts for c in coords]
+    levels = (["scorer", "individuals", "bodyparts", "coords"] if individuals
+              else ["scorer", "bodyparts", "coords"])
+    return pd.DataFrame(rng.uniform(0, 1, (9, len(tuples))),
+                        columns=pd.MultiIndex.from_tuples(tuples, names=levels))
+
+
+@pytest.mark.parametrize("individuals, coords, fps", [
+    (0, ("x", "y", "likelihood"), 30.0), (0, ("x", "y", "likelihood"), None),
+    (2, ("x", "y", "likelihood"), 25.0), (0, ("x", "y", "z"), 30.0),
+    (0, ("x", "y", "likelihood"), -1.0)])
+def test_a_dlc_table_gives_the_dataset_movement_gives(individuals, coords, fps):
+    from perception.io.movement_import import dlc_poses, movement_loaders
+
+    _, load_poses = movement_loaders()
+    df = _dlc_frame(individuals, coords)
+    with pytest.warns(UserWarning) if fps is not None and fps < 0 else _no_warning():
+        ours = dlc_poses(df, fps)
+    with pytest.warns(UserWarning) if fps is not None and fps < 0 else _no_warning():
+        theirs = load_poses.from_dlc_style_df(df, fps=fps, source_software="DeepLabCut")
+    assert ours.identical(theirs)
+
+
+def _no_warning():
+    import contextlib
+
+    return contextlib.nullcontext()
+
+
+def test_a_dlc_table_refused_as_movement_refuses_it():
+    from perception.io.movement_import import dlc_poses, movement_loaders
+
+    _, load_poses = movement_loaders()
+    df = _dlc_frame(0).iloc[:, :-1]  # a column short: the values do not fill the frames
+    with pytest.raises(ValueError) as theirs:
+        load_poses.from_dlc_style_df(df, fps=30.0)
+    with pytest.raises(ValueError) as ours:
+        dlc_poses(df, 30.0)
+    assert str(ours.value) == str(theirs.value)
+
+
+def test_reading_a_dlc_csv_loads_no_movement_io(tmp_path):
+    from perception.synthetic.demos import demo_tracks
+
+    tracks = demo_tracks("normal", 0)[0]
+    columns = pd.MultiIndex.from_product([["DLC_resnet50"], list(tracks.markers),
+                                          ["x", "y", "likelihood"]],
+                                         names=["scorer", "bodyparts", "coords"])
+    xy_p = np.concatenate([tracks.position, tracks.likelihood[..., None]], axis=-1)
+    path = tmp_path / "clip.csv"
+    pd.DataFrame(xy_p.reshape(len(xy_p), -1), columns=columns).to_csv(path)
+    out = _fresh("import sys\n"
+                 "from perception.io.pose import PoseImport, read_pose\n"
+                 f"t = read_pose({str(path)!r}, PoseImport(fps=30.0))\n"
+                 "print(len(t.frame), t.tracker['method'])\n"
+                 "print(*[m for m in ('movement.io', 'pynwb', 'sleap_io', 'cv2')"
+                 " if m in sys.modules] or ['none'])\n")
+    assert out.split() == [str(len(tracks.frame)), "pose:DeepLabCut", "none"]
