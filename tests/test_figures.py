@@ -35,12 +35,14 @@ def rec():
 
 
 def test_the_confidence_figure_draws_every_models_confidence_and_likelihood(rec):
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
     from perception.report import confidence_figure
 
     fig = confidence_figure(rec)
-    assert isinstance(fig, Figure) and type(fig.canvas).__name__ == "FigureCanvasAgg"
+    # an Agg canvas (the report's, which renders each string once), never pyplot's
+    assert isinstance(fig, Figure) and isinstance(fig.canvas, FigureCanvasAgg)
     assert fig.get_suptitle().startswith("c: verdict ") and rec.winner in fig.get_suptitle()
     conf, ll = fig.axes
     assert conf.get_ylabel() == "C (cm, weighted)" and ll.get_ylabel() == "log-likelihood"

@@ -389,9 +389,10 @@ def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,
         from perception.report.figures import confidence_figure, paths_figure, write_figure
         from perception.report.kinematics import kinematics_figure
 
+        # each on this process's kept figure of its kind, saved before the next clip's
         for key, draw in (("confidence_png", confidence_figure), ("paths_png", paths_figure),
                           ("kinematics_png", kinematics_figure)):
-            write_figure(draw(rec), paths[key].with_suffix(""), figure_format, dpi)
+            write_figure(draw(rec, reuse=True), paths[key].with_suffix(""), figure_format, dpi)
     for fmt in FIGURE_FORMATS:
         if not figures or fmt != figure_format:
             for key in FIGURE_KEYS:

@@ -24,19 +24,22 @@ Confidence is drawn in cm (weighted), ×100 of its value in the files.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from perception.io.atomic import save_figure
+from perception.io.atomic import atomic_path, save_figure
 from perception.io.names import printable
+from perception.report.canvas import kept_figure
 
 if TYPE_CHECKING:
     import pandas as pd
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
+    from matplotlib.legend import Legend
 
     from perception.recognition.result import Recognition
     from perception.report.clip import ClipSummary
@@ -48,6 +51,9 @@ __all__ = ["DPI", "FIGURE_FORMATS", "aperture_figure", "condition_colour", "cond
 #: The formats :func:`write_figure` writes, the first the default; and its default resolution.
 FIGURE_FORMATS = ("png", "svg", "pdf")
 DPI = 120
+#: zlib level of PNG figures: 1 draws a clip's figures 10 % faster than the default 6, for
+#: files about a third larger.
+PNG_COMPRESSION = 1
 #: Vector text: SVG text stays text (editable, searchable), PDF fonts are TrueType (Type 42),
 #: which journals' checks take where they refuse Type 3.
 _VECTOR_TEXT = {"svg.fonttype": "none", "pdf.fonttype": 42, "svg.hashsalt": "hammer-mv"}
@@ -58,6 +64,8 @@ CM = 100.0
 CONDITION_COLOURS = {"normal": "C0", "delayed": "C1", "open-close-open": "C3", "reach": "C2",
                      "unlabelled": "0.4"}
 _SPARE = ("C4", "C5", "C6", "C7", "C8", "C9")
+#: Line widths of the models in the confidence figure: the winner, the others.
+THICK, THIN = 2.6, 1.2
 #: Legend font size, points.
 LEGEND_PT = 9.0
 TIME = "time since onset (s)"
@@ -93,39 +101,50 @@ LEGEND_ROW = 0.21
 
 
 def _figure(size: tuple[float, float], panels: int = 1, *, titled: bool = False,
-            legend_rows: int = 0) -> tuple[Figure, np.ndarray]:
-    """A figure on an Agg canvas with ``panels`` axes side by side.
+            legend_rows: int = 0, keep: str | None = None) -> tuple[Figure, np.ndarray]:
+    """A figure on the report's Agg canvas with ``panels`` axes side by side.
 
     The margins are fixed (:data:`LEFT`, ...) rather than found by
     matplotlib's constrained layout, which measures every text once more
     before drawing: a third of a figure's drawing time, 0.1 s a figure. A
     titled figure leaves room for its title; ``legend_rows`` rows of a legend
-    below the panels (its title one of them) get room there.
+    below the panels (its title one of them) get room there. With ``keep``
+    (a figure kind), the figure is this thread's kept one of that kind and
+    layout, emptied (:func:`~perception.report.canvas.kept_figure`): for a
+    figure drawn and saved at once, never one handed to a caller.
     """
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
+    def build() -> tuple[Figure, np.ndarray]:
+        from matplotlib.figure import Figure
 
-    width, height = size
-    fig = Figure(figsize=size)
-    FigureCanvasAgg(fig)
-    panel = (width - LEFT - RIGHT - GAP * (panels - 1)) / panels
-    bottom = BOTTOM + (legend_rows * LEGEND_ROW + 0.1 if legend_rows else 0.0)
-    axes = fig.subplots(1, panels, squeeze=False, gridspec_kw=dict(
-        left=LEFT / width, right=1 - RIGHT / width, wspace=GAP / panel,
-        bottom=bottom / height, top=1 - (TOP_TITLED if titled else TOP) / height))
-    return fig, axes[0]
+        from perception.report.canvas import new_canvas
+
+        width, height = size
+        fig = Figure(figsize=size)
+        new_canvas(fig)
+        panel = (width - LEFT - RIGHT - GAP * (panels - 1)) / panels
+        bottom = BOTTOM + (legend_rows * LEGEND_ROW + 0.1 if legend_rows else 0.0)
+        axes = fig.subplots(1, panels, squeeze=False, gridspec_kw=dict(
+            left=LEFT / width, right=1 - RIGHT / width, wspace=GAP / panel,
+            bottom=bottom / height, top=1 - (TOP_TITLED if titled else TOP) / height))
+        return fig, axes[0]
+
+    if keep is None:
+        return build()
+    return kept_figure((keep, size, panels, titled, legend_rows), build)
 
 
 def _panel(ax: Axes, title: str, xlabel: str, ylabel: str, *, zero: bool = False) -> None:
     if zero:  # under the lines, over any band
         ax.axhline(0.0, color="0.7", lw=0.6, zorder=1.5)
-    # names hold "$" (text, not mathtext) and undecodable bytes (escaped)
-    ax.set_title(printable(title), parse_math=False)
+    # names hold "$" (text, not mathtext) and undecodable bytes (escaped); the title's
+    # height given (where matplotlib would find it, above panels whose ticks are below)
+    # spares measuring every tick label for it at each draw
+    ax.set_title(printable(title), parse_math=False, y=1.0)
     ax.set_xlabel(xlabel)
     ax.set_ylabel(printable(ylabel), parse_math=False)
 
 
-def _legend(where: Axes | Figure, handles: list, loc: str = "best", **kwargs) -> None:
+def _legend(where: Axes | Figure, handles: list, loc: str = "best", **kwargs) -> Legend:
     """A legend of ``handles`` (lines), each labelled with its label as text.
 
     The lines are named rather than found by their labels: matplotlib leaves
@@ -135,6 +154,7 @@ def _legend(where: Axes | Figure, handles: list, loc: str = "best", **kwargs) ->
                           loc=loc, fontsize=LEGEND_PT, title_fontsize=LEGEND_PT, **kwargs)
     for text in (*legend.get_texts(), legend.get_title()):
         text.set_parse_math(False)
+    return legend
 
 
 def _title(fig: Figure, title: str) -> None:
@@ -153,7 +173,7 @@ def _verdict_line(rec: Recognition) -> str:
 
 
 # -- one clip ---------------------------------------------------------------------
-def confidence_figure(rec: Recognition) -> Figure:
+def confidence_figure(rec: Recognition, *, reuse: bool = False) -> Figure:
     """Confidence profiles of every model (thesis rule) and the log-likelihood.
 
     Left, the thesis rule's confidence C; right, the cumulative
@@ -164,28 +184,57 @@ def confidence_figure(rec: Recognition) -> Figure:
     ----------
     rec : Recognition
         A scored clip.
+    reuse : bool
+        Draw on this thread's kept figure of this kind, valid until the next
+        such call (the reports: see :mod:`perception.report.canvas`); default
+        a new figure.
     """
-    columns = min(len(rec.names), 5)
-    fig, (conf, ll) = _figure((12, 5), 2, titled=True,
-                              legend_rows=1 - (-len(rec.names) // columns))
+    if reuse:  # its lines and legend kept: the same models
+        key = ("confidence lines", tuple(rec.names), tuple(rec.kinds))
+        fig, drawn = kept_figure(key, lambda: _confidence_layout(rec.names, rec.kinds),
+                                 clear=False)
+    else:
+        fig, drawn = _confidence_layout(rec.names, rec.kinds)
+    return _confidence_data((fig, *drawn), rec)
+
+
+def _confidence_layout(names: Sequence[str], kinds: Sequence[str]
+                       ) -> tuple[Figure, tuple[list, list, object]]:
+    """The confidence figure without data: the panels, a line per model in each, the legend."""
+    columns = min(len(names), 5)
+    fig, (conf, ll) = _figure((12, 5), 2, titled=True, legend_rows=1 - (-len(names) // columns))
     styles = {"grasp": "-", "reach": "--"}
-    handles = []
-    for k, (name, kind, c, l) in enumerate(zip(rec.names, rec.kinds, rec.confidence,
-                                               rec.log_likelihood)):
-        look = dict(color=f"C{k % 10}", lw=2.6 if name == rec.winner else 1.2,
-                    ls=styles.get(kind, "-"), label=name)
-        handles += conf.plot(rec.time, c * CM, **look)
-        ll.plot(rec.time, l, **look)
+    lines = []
+    for k, (name, kind) in enumerate(zip(names, kinds)):
+        look = dict(color=f"C{k % 10}", lw=THIN, ls=styles.get(kind, "-"), label=name)
+        lines.append((*conf.plot([], [], **look), *ll.plot([], [], **look)))
     _panel(conf, "thesis rule: confidence C (eqs. 5.6-5.8)", TIME, "C (cm, weighted)",
            zero=True)
     _panel(ll, "likelihood rule: cumulative log-likelihood", TIME, "log-likelihood", zero=True)
-    _legend(fig, handles, "lower center", ncols=columns,
-            title="grasp models solid, reach dashed; the winner thick", frameon=False)
+    legend = _legend(fig, [c for c, _ in lines], "lower center", ncols=columns,
+                     title="grasp models solid, reach dashed; the winner thick", frameon=False)
+    return fig, (lines, legend.legend_handles)
+
+
+def _confidence_data(drawn: tuple[Figure, list, list], rec: Recognition) -> Figure:
+    """Draw ``rec`` on a confidence figure's lines: its curves, its winner thick, its title."""
+    fig, lines, keys = drawn
+    for (conf, ll), key, name, c, l in zip(lines, keys, rec.names, rec.confidence,
+                                            rec.log_likelihood):
+        width = THICK if name == rec.winner else THIN
+        for line, y in ((conf, c * CM), (ll, l)):
+            line.set_data(rec.time, y)
+            line.set_linewidth(width)
+        key.set_linewidth(width)
+    for ax in fig.axes:  # the limits of these curves, as a new figure's would be
+        ax.relim()
+        ax.autoscale_view()
     _title(fig, f"{rec.clip}: {_verdict_line(rec)}")
     return fig
 
 
-def paths_figure(rec: Recognition, model: str | None = None) -> Figure:
+def paths_figure(rec: Recognition, model: str | None = None, *, reuse: bool = False
+                 ) -> Figure:
     """The demonstration against a grasp model's own movement (thesis Figs. 5.5-5.7).
 
     Left, the observed wrist, finger and thumb paths and the model's own
@@ -204,12 +253,15 @@ def paths_figure(rec: Recognition, model: str | None = None) -> Figure:
     model : str, optional
         Model drawn (default: the reference grasp model, the grasp model with
         the highest log-likelihood; the winner if there is no grasp model).
+    reuse : bool
+        Draw on this thread's kept figure of this kind (as
+        :func:`confidence_figure`).
     """
     model = model or rec.reference_model or rec.winner
     i = rec.names.index(model)
     # the movement as it was scored (at the repertoire's scale, where the model's own is)
     obs, own = rec.scored_movement, rec.nominal(model)
-    fig, (paths, grip) = _figure((12, 5.5), 2, titled=True)
+    fig, (paths, grip) = _figure((12, 5.5), 2, titled=True, keep="paths" if reuse else None)
     placed = bool(getattr(rec, "wrist_synthesised", False))
     for key, colour in (("finger", "g"), ("thumb", "r"), ("wrist", "b")):
         seen, plan = getattr(obs, key), own[key]
@@ -400,5 +452,13 @@ def write_figure(fig: Figure, path_stem: str | Path, fmt: str = "png", dpi: int 
         raise ValueError(f"figure format must be one of {', '.join(FIGURE_FORMATS)}, not {fmt!r}")
     if not (isinstance(dpi, int | np.integer) and dpi > 0):
         raise ValueError(f"dpi must be a positive whole number, not {dpi!r}")
+    path = Path(f"{path_stem}.{fmt}")
+    if fmt == "png":  # a lighter compression: a tenth of a figure's time for a larger file
+        with atomic_path(path) as tmp, warnings.catch_warnings():
+            warnings.filterwarnings("ignore", message="Glyph .* missing from",
+                                    category=UserWarning)  # drawn as a box, as save_figure
+            fig.savefig(tmp, dpi=int(dpi), format="png",
+                        pil_kwargs={"compress_level": PNG_COMPRESSION})
+        return path
     with rc_context(_VECTOR_TEXT):
-        return save_figure(Path(f"{path_stem}.{fmt}"), fig, dpi=int(dpi))
+        return save_figure(path, fig, dpi=int(dpi))

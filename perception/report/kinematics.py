@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from perception.landmarks import LandmarkParams, Landmarks
+from perception.report.canvas import kept_figure, new_canvas
 from perception.report.figures import LEGEND_PT, _legend, _title
 
 if TYPE_CHECKING:
@@ -161,7 +162,19 @@ def _note(ax: Axes, x: float, y: float, text: str, colour: str, dy: float = 8.0)
                 color=colour, parse_math=False)
 
 
-def kinematics_figure(rec: Recognition) -> Figure:
+def _layout() -> tuple[Figure, np.ndarray]:
+    """The empty figure: two panels sharing the time axis."""
+    from matplotlib.figure import Figure
+
+    width, height = SIZE
+    fig = Figure(figsize=SIZE)
+    new_canvas(fig)
+    return fig, fig.subplots(2, 1, sharex=True, gridspec_kw=dict(
+        left=LEFT / width, right=1 - RIGHT / width, bottom=BOTTOM / height,
+        top=1 - TOP / height, hspace=GAP / ((height - BOTTOM - TOP - GAP) / 2)))
+
+
+def kinematics_figure(rec: Recognition, *, reuse: bool = False) -> Figure:
     """The trial's transport speed and grip aperture with their landmarks.
 
     Above, the transport's speed (mm/s; labelled for what it is: the
@@ -181,9 +194,11 @@ def kinematics_figure(rec: Recognition) -> Figure:
     ----------
     rec : Recognition
         A scored clip.
+    reuse : bool
+        Draw on this thread's kept figure of this kind, valid until the next
+        such call (the reports: :mod:`perception.report.canvas`); default a
+        new figure.
     """
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
@@ -196,12 +211,7 @@ def kinematics_figure(rec: Recognition) -> Figure:
                              end_time=lm.end_time + origin)
     point = transport_label(rec)
 
-    width, height = SIZE
-    fig = Figure(figsize=SIZE)
-    FigureCanvasAgg(fig)
-    top, grip = fig.subplots(2, 1, sharex=True, gridspec_kw=dict(
-        left=LEFT / width, right=1 - RIGHT / width, bottom=BOTTOM / height,
-        top=1 - TOP / height, hspace=GAP / ((height - BOTTOM - TOP - GAP) / 2)))
+    fig, (top, grip) = kept_figure("kinematics", _layout) if reuse else _layout()
     handles = [top.plot(time, speed * MM, color=SPEED_COLOUR, lw=1.8,
                         label=f"{point} speed")[0],
                grip.plot(time, aperture * MM, color=GRIP_COLOUR, lw=1.8,

@@ -288,13 +288,14 @@ def _person_colour(people: list, person) -> tuple:
 
 def _grid(panels: int, legend_rows: int) -> Figure:
     """A figure with ``panels`` axes in rows of three, room below for a legend."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
+
+    from perception.report.canvas import new_canvas
 
     rows, cols = max(1, -(-panels // 3)), min(max(panels, 1), 3)
     width, height = 4.0 * cols, 3.4 * rows + 0.7 + 0.25 * legend_rows
     fig = Figure(figsize=(width, height))
-    FigureCanvasAgg(fig)
+    new_canvas(fig)
     spec = fig.add_gridspec(rows, cols, left=LEFT / width, right=1 - RIGHT / width,
                             bottom=(0.75 + 0.25 * legend_rows) / height, top=1 - 0.7 / height,
                             wspace=0.45, hspace=0.55)

@@ -1,0 +1,200 @@
+"""Figures that cost little (issue 45 item 3): a clip's figures drawn on a kept figure show
+that clip and nothing of the one before, and strings rendered once are drawn as before."""
+
+from __future__ import annotations
+
+import dataclasses
+import io
+import math
+import threading
+from pathlib import Path
+
+import numpy as np
+import pytest
+from _demos import default_repertoire, demo_tracks
+from PIL import Image
+
+from perception.pipeline import recognize_clip
+from perception.recordings import MocapImport, read_reaches, recognize_reach
+from perception.report.canvas import kept_figure, new_canvas
+from perception.report.clip import clip_outputs, write_clip_report
+from perception.report.figures import confidence_figure, paths_figure
+from perception.report.kinematics import kinematics_figure
+
+OPTOTRAK = Path(__file__).parent / "data" / "mocap" / "optotrak-trials.tsv"
+DRAW = {"confidence": confidence_figure, "paths": paths_figure,
+        "kinematics": kinematics_figure}
+
+
+@pytest.fixture(scope="module")
+def clips():
+    """Two video clips (a normal and a delayed grasp), a mocap reach without a wrist, and
+    the normal clip with its onset, MGA and opening not measured."""
+    rep = default_repertoire()
+    normal, delayed = (recognize_clip(demo_tracks(cond, 0)[0], rep, clip=f"{cond}-0")
+                       for cond in ("normal", "delayed"))
+    mocap = recognize_reach(read_reaches(OPTOTRAK, MocapImport(rate=85))[0], rep)[0]
+    unmeasured = dataclasses.replace(normal, clip="unmeasured")
+    unmeasured.__dict__["landmarks"] = (  # the cached property, replaced
+        dataclasses.replace(normal.landmarks[0], onset_time=math.nan, mga=math.nan,
+                            opening_time=math.nan), None)
+    return {"normal": normal, "delayed": delayed, "mocap": mocap, "unmeasured": unmeasured}
+
+
+def _values(x) -> list:
+    """Numbers comparable with ``==`` (NaN as a sentinel), to 1e-9."""
+    return np.round(np.nan_to_num(np.asarray(x, dtype=float), nan=-12345.0), 9).tolist()
+
+
+def _content(fig) -> dict:
+    """What a figure shows: every line's data and look, patch, text, legend and limit."""
+    fig.canvas.draw()  # the limits as drawn (an equal aspect adjusts them)
+    shown = {"suptitle": fig.get_suptitle(),
+             "legends": [([t.get_text() for t in legend.get_texts()],
+                          [h.get_linewidth() for h in legend.legend_handles])
+                         for legend in fig.legends]}
+    for i, ax in enumerate(fig.axes):
+        legend = ax.get_legend()
+        shown[i] = {
+            "lines": [(line.get_label(), line.get_gid(), line.get_linewidth(),
+                       line.get_linestyle(), line.get_marker(), str(line.get_color()),
+                       _values(line.get_xydata())) for line in ax.get_lines()],
+            "patches": [(type(p).__name__, _values(p.get_extents().bounds))
+                        for p in ax.patches],
+            "texts": [(t.get_text(), _values(t.get_position()), t.get_gid())
+                      for t in ax.texts],
+            "labels": (ax.get_title(), ax.get_xlabel(), ax.get_ylabel()),
+            "legend": None if legend is None else [t.get_text() for t in legend.get_texts()],
+            "limits": _values([*ax.get_xlim(), *ax.get_ylim()]),
+        }
+    return shown
+
+
+@pytest.mark.parametrize("kind, first, second", [
+    ("confidence", "normal", "delayed"),
+    ("confidence", "delayed", "normal"),
+    ("paths", "mocap", "normal"),  # a wrist not recorded, then one tracked
+    ("paths", "normal", "mocap"),
+    ("kinematics", "normal", "unmeasured"),  # every landmark, then some not measured
+    ("kinematics", "unmeasured", "delayed"),
+    ("kinematics", "mocap", "normal"),
+])
+def test_a_kept_figure_shows_the_second_clip_and_nothing_of_the_first(clips, kind, first,
+                                                                      second):
+    draw = DRAW[kind]
+    a, b = clips[first], clips[second]
+    kept_a = draw(a, reuse=True)
+    kept_b = draw(b, reuse=True)
+    assert kept_b is kept_a  # the same Figure, drawn again
+    assert _content(kept_b) == _content(draw(b))  # as a new figure of B shows B
+    assert _content(kept_b) != _content(draw(a))
+    assert b.clip in kept_b.get_suptitle() and a.clip not in kept_b.get_suptitle()
+
+
+def test_the_confidence_lines_hold_the_second_clips_values(clips):
+    a, b = clips["normal"], clips["delayed"]
+    confidence_figure(a, reuse=True)
+    fig = confidence_figure(b, reuse=True)
+    conf, ll = fig.axes
+    for ax, values in ((conf, b.confidence * 100), (ll, b.log_likelihood)):
+        lines = ax.get_lines()
+        assert len(lines) == len(b.names) + 1  # a line per model and y = 0, none left over
+        for line, name, want in zip(lines, b.names, values):
+            np.testing.assert_array_equal(line.get_xdata(), b.time)
+            np.testing.assert_array_equal(line.get_ydata(), want)
+            assert line.get_linewidth() == (2.6 if name == b.winner else 1.2)
+        # the panel spans B's curves (limits found again, not the last clip's)
+        (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+        assert x0 <= b.time.min() and x1 >= b.time.max()
+        assert y0 <= np.nanmin(values) and y1 >= np.nanmax(values)
+    (legend,) = fig.legends
+    widths = [h.get_linewidth() for h in legend.legend_handles]
+    assert widths == [2.6 if name == b.winner else 1.2 for name in b.names]
+
+
+def test_the_no_wrist_note_leaves_with_its_reach(clips):
+    fig = paths_figure(clips["mocap"], reuse=True)
+    assert [t for t in fig.axes[0].texts if t.get_gid() == "no-wrist"]
+    fig = paths_figure(clips["normal"], reuse=True)
+    assert not [t for t in fig.axes[0].texts if t.get_gid() == "no-wrist"]
+    assert "wrist observed" in [line.get_label() for line in fig.axes[0].get_lines()]
+
+
+def test_figures_handed_to_a_caller_are_never_kept(clips):
+    rec = clips["normal"]
+    for kind, draw in DRAW.items():
+        kept = draw(rec, reuse=True)
+        mine, again = draw(rec), draw(rec)
+        assert mine is not again and kept not in (mine, again), kind
+        assert rec.plot(kind) is not kept
+
+
+def test_a_thread_keeps_its_own_figures():
+    def build():
+        from matplotlib.figure import Figure
+
+        fig = Figure()
+        new_canvas(fig)
+        return fig, [fig.add_subplot()]
+
+    here, _ = kept_figure(("test", "thread"), build)
+    there = []
+    worker = threading.Thread(target=lambda: there.append(kept_figure(("test", "thread"),
+                                                                      build)[0]))
+    worker.start()
+    worker.join()
+    assert there[0] is not here
+    assert kept_figure(("test", "thread"), build)[0] is here
+
+
+def test_the_clip_report_writes_each_clips_own_figures(clips, tmp_path):
+    for name in ("normal", "delayed"):
+        write_clip_report(clips[name], tmp_path)
+    for name in ("normal", "delayed"):
+        files = clip_outputs(tmp_path, clips[name].clip)
+        for key, kind in (("confidence_png", "confidence"), ("paths_png", "paths"),
+                          ("kinematics_png", "kinematics")):
+            saved = np.asarray(Image.open(files[key]).convert("RGB"), dtype=int)
+            buf = io.BytesIO()
+            DRAW[kind](clips[name]).savefig(buf, format="png", dpi=120)
+            fresh = np.asarray(Image.open(buf).convert("RGB"), dtype=int)
+            assert saved.shape == fresh.shape
+            # the same figure: the curves pixel for pixel, text within a pixel's antialiasing
+            assert (np.abs(saved - fresh).sum(axis=2) > 100).mean() < 0.01, (name, kind)
+
+
+def _ink(fig) -> np.ndarray:
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=100)
+    return np.asarray(Image.open(buf).convert("RGB"), dtype=int)
+
+
+def test_a_string_rendered_once_is_drawn_in_each_colour_and_angle_it_is_given():
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    def figure(canvas):
+        fig = Figure(figsize=(3, 2))
+        canvas(fig)
+        fig.text(0.1, 0.7, "grasp-1.0s", color="red", fontsize=14)
+        fig.text(0.1, 0.3, "grasp-1.0s", color="blue", fontsize=14)  # the same string
+        fig.text(0.9, 0.5, "grasp-1.0s", color="green", fontsize=14, rotation=90,
+                 ha="center", va="center")
+        return fig
+
+    cached, plain = _ink(figure(new_canvas)), _ink(figure(FigureCanvasAgg))
+    for channel, rows, cols in ((0, slice(0, 100), slice(0, 200)),  # red above
+                                (2, slice(100, 200), slice(0, 200)),  # blue below
+                                (1, slice(0, 200), slice(230, 300))):  # green, upright
+        others = [c for c in range(3) if c != channel]
+        inked = ((cached[rows, cols, channel] > 100)
+                 & (cached[rows, cols][..., others] < 80).all(axis=-1))
+        assert inked.sum() > 50, channel
+    # the same text where matplotlib draws it, within a pixel
+    for img in (cached, plain):
+        assert img.shape == cached.shape
+    ys, xs = np.nonzero((cached < 250).any(axis=2))
+    yp, xp = np.nonzero((plain < 250).any(axis=2))
+    for got, want in ((ys.min(), yp.min()), (ys.max(), yp.max()), (xs.min(), xp.min()),
+                      (xs.max(), xp.max())):
+        assert abs(int(got) - int(want)) <= 2
