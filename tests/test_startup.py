@@ -10,13 +10,14 @@ from __future__ import annotations
 
 import subprocess
 import sys
+import warnings
 
 import numpy as np
 import pandas as pd
 import pytest
 
 from minvar.errors import ParameterError
-from perception.errors import PlanningError
+from perception.errors import InputError, PlanningError
 
 
 def _fresh(code: str) -> str:
@@ -83,33 +84,79 @@ def _dlc_frame(individuals: int, coords=("x", "y", "likelihood")) -> pd.DataFram
     (2, ("x", "y", "likelihood"), 25.0), (0, ("x", "y", "z"), 30.0),
     (0, ("x", "y", "likelihood"), -1.0)])
 def test_a_dlc_table_gives_the_dataset_movement_gives(individuals, coords, fps):
-    from perception.io.movement_import import dlc_poses, movement_loaders
+    from perception.io.movement_import import dlc_inputs, movement_loaders
 
     _, load_poses = movement_loaders()
     df = _dlc_frame(individuals, coords)
-    with pytest.warns(UserWarning) if fps is not None and fps < 0 else _no_warning():
-        ours = dlc_poses(df, fps)
-    with pytest.warns(UserWarning) if fps is not None and fps < 0 else _no_warning():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # movement's note on a bad rate, both ways
+        ours = dlc_inputs(df, fps).to_dataset()
         theirs = load_poses.from_dlc_style_df(df, fps=fps, source_software="DeepLabCut")
     assert ours.identical(theirs)
 
 
-def _no_warning():
-    import contextlib
-
-    return contextlib.nullcontext()
-
-
 def test_a_dlc_table_refused_as_movement_refuses_it():
-    from perception.io.movement_import import dlc_poses, movement_loaders
+    from perception.io.movement_import import dlc_inputs, movement_loaders
 
     _, load_poses = movement_loaders()
     df = _dlc_frame(0).iloc[:, :-1]  # a column short: the values do not fill the frames
     with pytest.raises(ValueError) as theirs:
         load_poses.from_dlc_style_df(df, fps=30.0)
     with pytest.raises(ValueError) as ours:
-        dlc_poses(df, 30.0)
+        dlc_inputs(df, 30.0)
     assert str(ours.value) == str(theirs.value)
+
+
+def _read_both_ways(monkeypatch, path, options):
+    """read_pose's tracks (or error) from the table's arrays, and from movement's dataset
+    of them (the way before: ``ValidPosesInputs.to_dataset()``)."""
+    import perception.io.pose as pose
+
+    def read():
+        try:
+            return pose.read_pose(path, options)
+        except InputError as exc:
+            return str(exc)
+
+    class AsDataset:  # what the table was read as before: movement's dataset
+        def __new__(cls, valid):
+            return valid.to_dataset()
+
+    ours = read()
+    with monkeypatch.context() as m:
+        m.setattr(pose, "PoseTable", AsDataset)
+        theirs = read()
+    return ours, theirs
+
+
+@pytest.mark.parametrize("individuals, coords, options", [
+    (0, ("x", "y", "likelihood"), {"fps": 30.0, "object_diameter_px": 80.0}),
+    (0, ("x", "y", "likelihood"), {"fps": 30.0, "pcutoff": 0.3, "cleaning": None}),
+    (0, ("x", "y", "likelihood"), {}),  # no rate, no video beside it
+    (2, ("x", "y", "likelihood"), {"fps": 25.0, "individual": "mouse1"}),
+    (2, ("x", "y", "likelihood"), {"fps": 25.0}),  # which individual?
+    (2, ("x", "y", "likelihood"), {"fps": 25.0, "individual": "cat"}),
+    (0, ("x", "y", "z"), {"fps": 30.0}),
+    (0, ("x", "y", "likelihood"), {"fps": 30.0, "keypoints": {"thumb": "nail"}}),
+])
+def test_a_dlc_table_reads_as_it_did_through_movement_s_dataset(tmp_path, monkeypatch,
+                                                                individuals, coords, options):
+    from perception.io.pose import PoseImport
+
+    df = _dlc_frame(individuals, coords) * 600.0  # pixels; likelihoods in 0..1 below
+    for i, column in enumerate(df.columns):
+        if column[-1] == "likelihood":
+            df.iloc[:, i] = np.linspace(0, 1, len(df))
+    path = tmp_path / "grasp.csv"
+    df.to_csv(path)
+    ours, theirs = _read_both_ways(monkeypatch, path, PoseImport(**options))
+    if isinstance(theirs, str):
+        assert ours == theirs
+        return
+    assert not isinstance(ours, str), ours
+    for name in ("frame", "time", "position", "likelihood", "status"):
+        np.testing.assert_array_equal(getattr(ours, name), getattr(theirs, name), err_msg=name)
+    assert ours.video == theirs.video and ours.tracker == theirs.tracker
 
 
 def test_reading_a_dlc_csv_loads_no_movement_io(tmp_path):
@@ -126,6 +173,6 @@ def test_reading_a_dlc_csv_loads_no_movement_io(tmp_path):
                  "from perception.io.pose import PoseImport, read_pose\n"
                  f"t = read_pose({str(path)!r}, PoseImport(fps=30.0))\n"
                  "print(len(t.frame), t.tracker['method'])\n"
-                 "print(*[m for m in ('movement.io', 'pynwb', 'sleap_io', 'cv2')"
+                 "print(*[m for m in ('movement.io', 'pynwb', 'sleap_io', 'dask', 'cv2')"
                  " if m in sys.modules] or ['none'])\n")
     assert out.split() == [str(len(tracks.frame)), "pose:DeepLabCut", "none"]

@@ -14,7 +14,7 @@ imports, and tells ``platformdirs`` not to create folders meanwhile. This
 leans on that module's layout: pyproject.toml pins ``movement<0.16``.
 :func:`movement_loaders` gives its loaders, or one
 :class:`~perception.errors.InputError` naming the optional extra when
-``movement`` is not installed. :func:`dlc_poses` reads a DeepLabCut table
+``movement`` is not installed. :func:`dlc_inputs` reads a DeepLabCut table
 through movement's own validator without importing ``movement.io`` (whose
 other readers cost a start-up 1.3 s).
 """
@@ -28,7 +28,7 @@ from pathlib import Path
 
 from perception.errors import InputError
 
-__all__ = ["POSE_EXTRA", "dlc_poses", "import_movement", "movement_loaders", "require_movement"]
+__all__ = ["POSE_EXTRA", "dlc_inputs", "import_movement", "movement_loaders", "require_movement"]
 
 #: The message when the optional ``pose`` extra (``movement``, PyTables) is missing.
 POSE_EXTRA = ("reading and writing pose files needs the optional extra: "
@@ -49,7 +49,7 @@ def import_movement(module: str = "movement.io") -> None:
         What to import: ``movement.io`` (every loader, which imports pynwb,
         sleap_io and their dependencies: about 1.3 s), or only
         ``movement.validators.datasets`` (xarray), which is all a DeepLabCut
-        table needs (:func:`dlc_poses`).
+        table needs (:func:`dlc_inputs`).
 
     Raises
     ------
@@ -114,14 +114,15 @@ def _import_quietly(module: str) -> None:
             del sys.modules["cv2"]
 
 
-def dlc_poses(df, fps: float | None, source_software: str = "DeepLabCut"):
-    """A DeepLabCut table as a ``movement`` poses dataset, without ``movement.io``.
+def dlc_inputs(df, fps: float | None, source_software: str = "DeepLabCut"):
+    """A DeepLabCut table as movement's validated poses inputs, without ``movement.io``.
 
     What ``movement.io.load_poses.from_dlc_style_df`` does (movement 0.15,
-    pinned), through the same validator (``ValidPosesInputs``) and so the
-    same dataset and the same errors, but without importing ``movement.io``,
-    whose readers of other formats (pynwb, sleap_io, and what they pull in)
-    cost about 1.3 s of a start-up (issue 45).
+    pinned), through the same validator (``ValidPosesInputs``) and so with
+    the same errors, up to the dataset (its ``to_dataset()``, which
+    :class:`~perception.io.pose_arrays.PoseTable` stands in for), but without
+    importing ``movement.io``, whose readers of other formats (pynwb,
+    sleap_io, and what they pull in) cost about 0.65 s of a start-up (issue 45).
 
     Parameters
     ----------
@@ -159,10 +160,10 @@ def dlc_poses(df, fps: float | None, source_software: str = "DeepLabCut"):
         position_array, confidence_array = tracks, None
     return ValidPosesInputs(position_array=position_array, confidence_array=confidence_array,
                             individual_names=individual_names, keypoint_names=keypoint_names,
-                            fps=fps, source_software=source_software).to_dataset()
+                            fps=fps, source_software=source_software)
 
 
-#: The module of movement a DeepLabCut table needs (:func:`dlc_poses`).
+#: The module of movement a DeepLabCut table needs (:func:`dlc_inputs`).
 _VALIDATOR = "movement.validators.datasets"
 
 

@@ -23,6 +23,7 @@ docs/pose-files.md describes the mapping, the scale and every format.
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import os
@@ -41,9 +42,17 @@ from perception.errors import InputError
 from perception.io.atomic import write_bytes, write_text
 from perception.io.files import input_file
 from perception.io.movement_import import POSE_EXTRA as _EXTRA
-from perception.io.movement_import import dlc_poses, require_movement
+from perception.io.movement_import import dlc_inputs, require_movement
 from perception.io.movement_import import movement_loaders as _movement
 from perception.io.names import POSE_SUFFIXES, TRACKS_SUFFIX, VIDEO_SUFFIXES
+from perception.io.pose_arrays import (
+    PoseTable,
+    check_sizes,
+    check_space,
+    frame_times,
+    marker_keys,
+    pick_individual,
+)
 from perception.io.tracks import Status, Tracks, position_bounds
 from perception.limits import MAX_FPS, MAX_FRAMES, MAX_KEYPOINTS, MAX_MARKERS, MAX_POSE_POINTS
 from perception.track_cleaning import TrackCleaning, clean_tracks
@@ -384,7 +393,7 @@ def _own_frames(index, n: int) -> np.ndarray | None:
 
 def _load_dataset(path: Path, source: str, fps: float | None):
     """The file as a ``movement`` poses dataset, and the file's own frame numbers (or None)."""
-    if source == "dlc":  # a DeepLabCut table needs only movement's validator (dlc_poses)
+    if source == "dlc":  # a DeepLabCut table needs only movement's validator (dlc_inputs)
         require_movement("movement.validators.datasets")
     else:
         load_dataset, _ = _movement()
@@ -414,7 +423,7 @@ def _load_dataset(path: Path, source: str, fps: float | None):
             if source == "dlc":
                 df = _dlc_table(path)
                 _check_sizes_table(df, path)
-                ds = dlc_poses(df, fps)
+                ds = PoseTable(dlc_inputs(df, fps))
                 return ds, _own_frames(df.index, len(df))
             return load_dataset(path, source_software=_SOURCES[source], fps=fps), None
     except InputError:
@@ -428,19 +437,7 @@ def _load_dataset(path: Path, source: str, fps: float | None):
 
 
 def _check_sizes(ds, path: Path) -> None:
-    sizes = dict(ds.sizes)
-    frames, keypoints = sizes.get("time", 0), sizes.get("keypoints", 0)
-    points = frames * keypoints * sizes.get("individuals", 1)
-    if frames > MAX_FRAMES:
-        raise InputError(f"claims {frames} frames, more than the {MAX_FRAMES} a pose file may "
-                         "hold", path, field="time")
-    if keypoints > MAX_KEYPOINTS:
-        raise InputError(f"claims {keypoints} keypoints, more than {MAX_KEYPOINTS}", path,
-                         field="keypoints")
-    if points > MAX_POSE_POINTS:
-        raise InputError(f"claims {points:.3g} points (frames x keypoints x individuals), more "
-                         f"than the {MAX_POSE_POINTS:.3g} a pose file may hold", path,
-                         field="position")
+    check_sizes(dict(ds.sizes), path)
 
 
 def _check_sizes_table(df, path: Path) -> None:
@@ -454,60 +451,18 @@ def _check_sizes_table(df, path: Path) -> None:
 
 def _pick_individual(ds, options: PoseImport, path: Path):
     names = [str(n) for n in ds["individuals"].values] if "individuals" in ds.dims else []
+    name = pick_individual(names, options.individual, path)
     if options.individual is not None:
-        if options.individual not in names:
-            raise InputError(f"`individual` {options.individual!r}: not in the file "
-                             f"(individuals: {', '.join(names) or 'none'})", path)
-        return ds.sel(individuals=options.individual)
-    if len(names) > 1:
-        raise InputError(f"the file holds {len(names)} individuals ({', '.join(names)}): "
-                         "choose one with `individual`", path)
+        return ds.sel(individuals=name)
     return ds.isel(individuals=0) if names else ds
-
-
-def _frame_times(ds, options: PoseImport, path: Path,
-                 own: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, float]:
-    """Frame indices, times (s) and the frame rate of a dataset.
-
-    ``own``: the file's own frame numbers (a DeepLabCut table's index), kept
-    as the tracks' frame indices; times are then ``frame / fps``.
-    """
-    n = ds.sizes["time"]
-    coords = np.asarray(ds["time"].values, dtype=float)
-    unit = ds.attrs.get("time_unit", "frames")
-    fps = ds.attrs.get("fps")
-    try:
-        fps = float(fps) if fps is not None else None
-    except (TypeError, ValueError):
-        fps = None
-    fps = fps if fps is not None and math.isfinite(fps) and 0 < fps <= MAX_FPS else None
-    if own is None and unit == "seconds" and fps:
-        if not np.all(np.isfinite(coords)):
-            raise InputError("time stamps are not finite", path, field="time")
-        return np.rint(coords * fps).astype(np.int64), coords, fps
-    fps = fps or options.fps or _video_rate(path)
-    if own is not None:
-        frames = own
-    elif len(coords) == n and np.all(np.isfinite(coords)) and np.all(np.abs(coords) < 2 ** 53):
-        frames = coords.astype(np.int64)
-    else:
-        frames = np.arange(n)
-    return frames, frames / fps, fps
 
 
 def _marker_arrays(ds, options: PoseImport, path: Path) -> tuple[np.ndarray, np.ndarray]:
     """(T, 4, 2) px positions and (T, 4) likelihoods of the mapped keypoints."""
-    names = [str(k) for k in ds["keypoints"].values]
-    missing = [m for m in MARKERS if options.keypoint(m) not in names]
-    if missing:
-        raise InputError(f"keypoint {options.keypoint(missing[0])!r} (for {missing[0]}) is not "
-                         f"in the file (keypoints: {', '.join(names)}); map the markers with "
-                         "`keypoints` thumb=NAME finger=NAME wrist=NAME object=NAME", path)
+    keys = marker_keys([str(k) for k in ds["keypoints"].values],
+                       {m: options.keypoint(m) for m in MARKERS}, path)
     pos = ds["position"].transpose("time", "keypoints", "space")
-    if pos.sizes["space"] != 2:
-        raise InputError(f"expected 2-D poses (x, y), got {pos.sizes['space']} coordinates",
-                         path)
-    keys = [options.keypoint(m) for m in MARKERS]
+    check_space(pos.sizes["space"], path)
     xy = np.asarray(pos.sel(keypoints=keys).values, dtype=np.float64)
     if "confidence" in ds:
         conf = ds["confidence"].transpose("time", "keypoints").sel(keypoints=keys).values
@@ -515,6 +470,23 @@ def _marker_arrays(ds, options: PoseImport, path: Path) -> tuple[np.ndarray, np.
     else:  # a file without scores: every seen point is as good as the file says
         conf = np.isfinite(xy).all(axis=-1).astype(np.float64)
     return xy, np.clip(conf, 0.0, 1.0)
+
+
+def _markers(ds, options: PoseImport, path: Path, own: np.ndarray | None):
+    """Frames, times (s), frame rate, (T, 4, 2) px positions and (T, 4) likelihoods of a
+    ``movement`` dataset or a DeepLabCut table (:class:`PoseTable`)."""
+    check_sizes(dict(ds.sizes), path)
+    rate = functools.partial(_video_rate, path)
+    if isinstance(ds, PoseTable):
+        who = pick_individual(ds.individuals, options.individual, path)
+        frames, time, fps = frame_times(ds.sizes["time"], ds.time, ds.attrs, options.fps, own,
+                                        rate, path)
+        return (frames, time, fps,
+                *ds.markers(who, {m: options.keypoint(m) for m in MARKERS}, path))
+    ds = _pick_individual(ds, options, path)
+    frames, time, fps = frame_times(ds.sizes["time"], ds["time"].values, ds.attrs, options.fps,
+                                    own, rate, path)
+    return (frames, time, fps, *_marker_arrays(ds, options, path))
 
 
 def _check_positions(xy: np.ndarray, options: PoseImport, path: Path) -> None:
@@ -563,10 +535,7 @@ def read_pose(path: str | os.PathLike, options: PoseImport | None = None) -> Tra
     input_file(path, "pose file")  # a FIFO or device would block or never end
     source = _source(path)
     ds, own = _load_dataset(path, source, options.fps)
-    _check_sizes(ds, path)
-    ds = _pick_individual(ds, options, path)
-    frames, time, fps = _frame_times(ds, options, path, own)
-    xy, conf = _marker_arrays(ds, options, path)
+    frames, time, fps, xy, conf = _markers(ds, options, path, own)
     _check_positions(xy, options, path)
     seen = np.isfinite(xy).all(axis=-1) & (conf >= options.pcutoff)
     position = np.where(seen[..., None], xy, np.nan)
