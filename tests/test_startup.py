@@ -159,7 +159,8 @@ def test_a_dlc_table_reads_as_it_did_through_movement_s_dataset(tmp_path, monkey
     assert ours.video == theirs.video and ours.tracker == theirs.tracker
 
 
-def test_reading_a_dlc_csv_loads_no_movement_io(tmp_path):
+def _grasp_csv(folder):
+    """A DeepLabCut table of a synthetic grasp; its path and frames."""
     from perception.synthetic.demos import demo_tracks
 
     tracks = demo_tracks("normal", 0)[0]
@@ -167,8 +168,13 @@ def test_reading_a_dlc_csv_loads_no_movement_io(tmp_path):
                                           ["x", "y", "likelihood"]],
                                          names=["scorer", "bodyparts", "coords"])
     xy_p = np.concatenate([tracks.position, tracks.likelihood[..., None]], axis=-1)
-    path = tmp_path / "clip.csv"
+    path = folder / "clip.csv"
     pd.DataFrame(xy_p.reshape(len(xy_p), -1), columns=columns).to_csv(path)
+    return path, tracks
+
+
+def test_reading_a_dlc_csv_loads_no_movement_io(tmp_path):
+    path, tracks = _grasp_csv(tmp_path)
     out = _fresh("import sys\n"
                  "from perception.io.pose import PoseImport, read_pose\n"
                  f"t = read_pose({str(path)!r}, PoseImport(fps=30.0))\n"
@@ -176,3 +182,22 @@ def test_reading_a_dlc_csv_loads_no_movement_io(tmp_path):
                  "print(*[m for m in ('movement.io', 'pynwb', 'sleap_io', 'dask', 'cv2')"
                  " if m in sys.modules] or ['none'])\n")
     assert out.split() == [str(len(tracks.frame)), "pose:DeepLabCut", "none"]
+
+
+@pytest.mark.parametrize("kind", ["mocap", "pose"])
+def test_recognize_of_a_mocap_or_dlc_file_loads_no_hdf5(tmp_path, kind):
+    # h5py (~60 ms) is for tracks files, which these commands neither read nor write
+    from pathlib import Path
+
+    if kind == "mocap":
+        args = [str(Path(__file__).parent / "data" / "mocap" / "qualisys-recording.tsv")]
+    else:
+        args = [str(_grasp_csv(tmp_path)[0]), "--fps", "30", "--object-diameter-px", "80"]
+    argv = ["recognize", *args, "-o", str(tmp_path / "out"), "--quiet", "--no-figures"]
+    out = _fresh("import sys\n"
+                 "from hammer_mv.cli import main\n"
+                 f"main({argv!r})\n"
+                 "print(*[m for m in ('h5py', 'movement.io', 'dask', 'cv2', 'matplotlib')"
+                 " if m in sys.modules] or ['none'])\n")
+    assert list((tmp_path / "out").glob("*.recognition.json")), out
+    assert out.split()[-1:] == ["none"], out

@@ -32,10 +32,10 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
-import h5py
 import numpy as np
 
 if TYPE_CHECKING:  # pragma: no cover
+    import h5py  # imported where a file is opened: a pose or motion-capture file needs none
     import pandas as pd  # imported by the table methods: `hammer-mv track` starts without it
 
 from minvar import __version__
@@ -446,6 +446,8 @@ class TracksWriter:
         # An error here exits the atomic output with it (its temporary file is removed);
         # pop_all keeps the file open past the block otherwise.
         with contextlib.ExitStack() as stack:
+            import h5py
+
             fh = stack.enter_context(atomic_hdf5(self.path))
             g = fh.create_group("tracks")
             g.create_dataset("markers", data=np.array(self.markers, dtype=object),
