@@ -41,6 +41,31 @@ MARKER_NAMES: tuple[str, ...] = ("thumb", "finger", "wrist", "object")
 _FIELDS = ("bgr", "rgb", "hue", "sat_min", "val_min")
 
 
+def to_hsv(bgr: np.ndarray) -> np.ndarray:
+    """A BGR image or crop in OpenCV HSV, converted as one row of pixels.
+
+    OpenCV converts row by row, 32 pixels at a time with SIMD and a row's
+    remainder one pixel at a time, five times slower: a 95 px wide crop
+    costs as much as a 300 px one. Copied into one contiguous row, the
+    pixels convert at full speed; the values are the same (the conversion
+    is per pixel, and its SIMD and one-pixel paths agree on every 8-bit
+    colour).
+
+    Parameters
+    ----------
+    bgr : (H, W, 3) uint8
+        Image or a view into one (a crop of a frame).
+
+    Returns
+    -------
+    (H, W, 3) uint8
+        Its hue (0..179), saturation and value.
+    """
+    h, w = bgr.shape[:2]
+    row = np.ascontiguousarray(bgr).reshape(1, h * w, 3)
+    return cv2.cvtColor(row, cv2.COLOR_BGR2HSV).reshape(h, w, 3)
+
+
 def _hue(hue: Any) -> tuple[tuple[int, int], ...]:
     """Accept ``[lo, hi]`` or ``[[lo, hi], ...]``; return a tuple of int pairs."""
     bad = ValueError("[lo, hi] or a list of [lo, hi] ranges with integers 0..179 "

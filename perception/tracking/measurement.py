@@ -41,7 +41,7 @@ from perception.tracking.blobs import (
     nearest_blob,
     principal_axes,
 )
-from perception.tracking.markers import MarkerColour
+from perception.tracking.markers import MarkerColour, to_hsv
 from perception.tracking.params import TrackerParams
 
 #: CamShift's window of a round blob can be as small as 0.71 x its diameter
@@ -200,7 +200,7 @@ def _measure_region(
         return None  # the prediction left the frame
     region = x0, y0, x1, y1
     crop = frame[y0:y1, x0:x1]
-    bp = (colour.backproject(cv2.cvtColor(crop, cv2.COLOR_BGR2HSV))
+    bp = (colour.backproject(to_hsv(crop))
           if isinstance(colour, MarkerColour) else colour.backproject_bgr(crop))
     wx = round(cx - ww / 2) - x0
     wx = 0 if wx < 0 else (rw - 1 if wx >= rw else wx)
@@ -433,7 +433,7 @@ def measure_still(
     x1, y1 = min(int(cx + half) + 2, w), min(int(cy + half) + 2, h)
     if x1 - x0 < params.min_region_px or y1 - y0 < params.min_region_px:
         return None
-    bp = colour.backproject(cv2.cvtColor(frame[y0:y1, x0:x1], cv2.COLOR_BGR2HSV))
+    bp = colour.backproject(to_hsv(frame[y0:y1, x0:x1]))
     mo = cv2.moments(bp, True)
     mass = mo["m00"]
     if mass <= 0 or mass > params.split_ratio * ref:

@@ -19,7 +19,7 @@ import cv2
 import numpy as np
 
 from perception.tracking.blobs import by_distance, find_blobs
-from perception.tracking.markers import MarkerColour
+from perception.tracking.markers import MarkerColour, to_hsv
 from perception.tracking.measurement import Measurement, measure
 from perception.tracking.params import TrackerParams
 
@@ -69,7 +69,7 @@ def downscaled_hsv(frame: np.ndarray, scale: int) -> tuple[np.ndarray, float, fl
     h, w = frame.shape[:2]
     sw, sh = max(w // scale, 1), max(h // scale, 1)
     small = cv2.resize(frame, (sw, sh), interpolation=cv2.INTER_AREA)
-    return cv2.cvtColor(small, cv2.COLOR_BGR2HSV), w / sw, h / sh
+    return to_hsv(small), w / sw, h / sh
 
 
 def reacquire(

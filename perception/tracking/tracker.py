@@ -62,7 +62,6 @@ from collections.abc import Mapping
 from dataclasses import asdict
 from typing import Any
 
-import cv2
 import numpy as np
 
 from perception.errors import InputError
@@ -78,7 +77,7 @@ from perception.tracking.blur import (
 from perception.tracking.candidates import describe, reject_reason
 from perception.tracking.first_detection import FirstDetection
 from perception.tracking.marker_track import Located, MarkerTrack
-from perception.tracking.markers import MarkerSet, default_markers
+from perception.tracking.markers import MarkerSet, default_markers, to_hsv
 from perception.tracking.measurement import Measurement, likelihood, measure, measure_still
 from perception.tracking.params import TrackerParams
 from perception.tracking.reacquisition import ROI, downscaled_hsv, reacquire, search_scale
@@ -323,7 +322,7 @@ class Tracker:
         h, w = frame.shape[:2]
         x0, y0 = max(int(centre[0] - half), 0), max(int(centre[1] - half), 0)
         x1, y1 = min(int(centre[0] + half) + 1, w), min(int(centre[1] + half) + 1, h)
-        hsv = cv2.cvtColor(frame[y0:y1, x0:x1], cv2.COLOR_BGR2HSV)
+        hsv = to_hsv(frame[y0:y1, x0:x1])
         cands = describe(hsv, tr.colour, self.params.min_area_px)
         if not cands:
             return False
