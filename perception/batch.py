@@ -19,6 +19,7 @@ import json
 import logging
 import os
 import sys
+import time
 import traceback
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
@@ -58,22 +59,25 @@ from perception.report.tracking import tracking_columns, write_tracking_report
 if TYPE_CHECKING:
     import pandas as pd
 
-__all__ = ["REPORT_SET", "BatchItem", "ClipResult", "Discovery", "count_trials", "discover",
-           "expand_recordings", "find_clips", "process_clip", "remove_stale_reports",
+    from perception.reach_data import Reach
+
+__all__ = ["REPORT_SET", "BatchItem", "ClipResult", "Discovery", "RunTiming", "count_trials",
+           "discover", "expand_recordings", "find_clips", "process_clip", "remove_stale_reports",
            "run_batch", "summary_table"]
 
 log = logging.getLogger(__name__)
 
 def _recognized(item: BatchItem, out: Path, repertoire: Repertoire,
                 settings: RecognitionSettings, fp: str, progress: bool,
-                plan_cache: PlanCache | None):
+                plan_cache: PlanCache | None, reach: Reach | None = None):
     """The recognition of one item and its report's extra entries."""
     if item.kind == "mocap":
         import dataclasses
 
         from perception.recordings import cached_reaches, recognize_reach
 
-        reach = cached_reaches(item.path, settings.mocap)[item.reach or 0]
+        if reach is None:
+            reach = cached_reaches(item.path, settings.mocap)[item.reach or 0]
         if reach.name != item.clip:  # made safe or unique (expand_recordings)
             reach = dataclasses.replace(reach, name=item.clip)
         rec, info = recognize_reach(reach, repertoire, settings, settings.mocap,
@@ -107,6 +111,29 @@ def _current_report(item: BatchItem, out: Path, fingerprint: str,
 
 
 @dataclass(frozen=True)
+class RunTiming:
+    """Where and when one clip of a batch ran: what a profile of a batch reads
+    (``tools/bench_recognition.py``: each worker's start-up, its idle time between
+    clips, the clips' own cost).
+
+    Attributes
+    ----------
+    process : int
+        The process that ran it (its id).
+    start, end : float
+        ``time.perf_counter()`` there when it began and ended, s (one clock
+        for every process of a machine on Linux and macOS).
+    cpu : float
+        CPU time that process spent on it, s.
+    """
+
+    process: int
+    start: float
+    end: float
+    cpu: float
+
+
+@dataclass(frozen=True)
 class ClipResult:
     """How one clip of a batch went.
 
@@ -137,6 +164,8 @@ class ClipResult:
         A recording's trial's own id (:attr:`BatchItem.trial_number`).
     reach_number : int or None
         Which reach of its trial, from 1 (:attr:`BatchItem.reach_number`).
+    timing : RunTiming or None
+        Where and when it ran (None for a clip a worker did not run).
     """
 
     clip: str
@@ -150,6 +179,7 @@ class ClipResult:
     reason: str = ""
     trial_number: str | None = None
     reach_number: int | None = None
+    timing: RunTiming | None = None
 
     @property
     def scored(self) -> bool:
@@ -165,7 +195,8 @@ class ClipResult:
 def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
                  settings: RecognitionSettings, repertoire_id: str = "", *,
                  progress: bool = False, plan_cache: PlanCache | None = None,
-                 figure_format: str = "png", dpi: int = DPI) -> ClipResult:
+                 figure_format: str = "png", dpi: int = DPI,
+                 reach: Reach | None = None) -> ClipResult:
     """Recognise one clip through the pipeline (:mod:`perception.pipeline`) and report it.
 
     Parameters
@@ -189,6 +220,10 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
         its figures in another format is not current: they are drawn again).
     dpi : int
         Their resolution, dots per inch.
+    reach : Reach, optional
+        A recording's reach ``item`` names, read by the caller: the file is
+        then not read here (a batch reads each recording once, not once per
+        worker process).
 
     Returns
     -------
@@ -210,7 +245,8 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
         done = _current_report(item, out, fp, figure_format)
         if done is not None:
             return ClipResult(**base, status="reused", summary=ClipSummary.from_dict(done))
-        rec, extra = _recognized(item, out, repertoire, settings, fp, progress, plan_cache)
+        rec, extra = _recognized(item, out, repertoire, settings, fp, progress, plan_cache,
+                                 reach)
         write_clip_report(rec, out, extra=extra, figure_format=figure_format, dpi=dpi)
         return ClipResult(**base, status="ok", summary=ClipSummary.from_recognition(rec, extra))
     except (HammerMVError, OSError) as exc:  # the clip's fault; anything else is a bug
@@ -272,6 +308,33 @@ def _guarded(item: BatchItem, out: Path, **kwargs) -> ClipResult:
 
 
 @dataclass(frozen=True)
+class _Work:
+    """A batch item as handed to a worker: with a recording's reach, read once by the
+    batch's own process (every worker reading the whole file cost each of 16 workers
+    the 4 s a 600-trial table takes to read)."""
+
+    item: BatchItem
+    reach: Reach | None = None
+
+
+def _work(items: list[BatchItem], settings: RecognitionSettings) -> list[_Work]:
+    """``items`` with their reaches, from the recordings :func:`expand_recordings` read
+    (cached: not read again); an item whose recording cannot be read now goes without,
+    and fails with its error where it runs."""
+    from perception.recordings import cached_reaches
+
+    def reach(item: BatchItem):
+        if item.kind != "mocap" or item.reach is None or item.unscored is not None:
+            return None
+        try:
+            return cached_reaches(item.path, settings.mocap)[item.reach]
+        except Exception:  # noqa: BLE001 - said where it runs, as without this
+            return None
+
+    return [_Work(item, reach(item)) for item in items]
+
+
+@dataclass(frozen=True)
 class _Job:
     """What every clip of one batch shares (sent to each worker once, when it starts)."""
 
@@ -286,13 +349,17 @@ class _Job:
         """Plans of the batch's scenes, beside its report, shared by every process."""
         return PlanCache(self.out / PLANS_FOLDER)
 
-    def run(self, item: BatchItem, repertoire: Repertoire) -> ClipResult:
-        return _guarded(item, self.out, repertoire=repertoire, settings=self.settings,
-                        repertoire_id=self.repertoire_id, plan_cache=self.plan_cache,
-                        figure_format=self.figure_format, dpi=self.dpi)
+    def run(self, work: _Work, repertoire: Repertoire) -> ClipResult:
+        start, cpu = time.perf_counter(), time.process_time()
+        result = _guarded(work.item, self.out, repertoire=repertoire, settings=self.settings,
+                          repertoire_id=self.repertoire_id, plan_cache=self.plan_cache,
+                          figure_format=self.figure_format, dpi=self.dpi, reach=work.reach)
+        return dataclasses.replace(result, timing=RunTiming(
+            os.getpid(), start, time.perf_counter(), time.process_time() - cpu))
 
-    def lost(self, item: BatchItem, message: str) -> ClipResult:
+    def lost(self, work: _Work, message: str) -> ClipResult:
         """A clip whose worker process died running it: failed, its outputs removed."""
+        item = work.item
         log.error("%s: %s", item.clip, message)
         _remove_outputs(item, self.out)
         return ClipResult(item.clip, item.condition, "failed", f"{item.path}: {message}",
@@ -304,16 +371,20 @@ class _Job:
 PLANS_FOLDER = ".plans"
 
 
-def _file_size(item: BatchItem) -> int:
+def _file_size(item: BatchItem | _Work) -> int:
     """A clip's expected cost, for handing out the largest first (0 if unreadable: a
     missing file fails at once)."""
+    if isinstance(item, _Work):
+        if item.reach is not None:  # its samples, as bytes of a table's row
+            return len(item.reach.time) * 100
+        item = item.item
     try:
         return item.path.stat().st_size
     except OSError:
         return 0
 
 
-def _run_local(items: list[BatchItem], repertoire: Repertoire, job: _Job,
+def _run_local(items: list[_Work], repertoire: Repertoire, job: _Job,
                jobs: int) -> Iterator[ClipResult]:
     """Every item here (``jobs`` 1) or in ``jobs`` worker processes (largest first).
 
@@ -339,7 +410,7 @@ def _prepare_report() -> None:
     import perception.report.batch  # noqa: F401 - pandas
 
 
-def _run_dask(items: list[BatchItem], repertoire: Repertoire, job: _Job,
+def _run_dask(items: list[_Work], repertoire: Repertoire, job: _Job,
               scheduler: str) -> Iterator[ClipResult]:
     """Every item on a dask.distributed cluster (:mod:`perception.cluster`)."""
     try:
@@ -500,7 +571,12 @@ def run_batch(
     pandas.DataFrame
         The summary (see :func:`summary_table`), a row per clip: per reach of a
         recording and per trial or movement of it that gives none (its status
-        and reason); ``attrs["trials"]`` the trials read (:func:`count_trials`).
+        and reason); ``attrs["trials"]`` the trials read (:func:`count_trials`);
+        ``attrs["timing"]`` where the run's time went: ``read`` (finding the
+        clips, reading recordings), ``clips`` (from the first clip handed out
+        to the last result), ``report`` (the batch's report), s, and ``runs``,
+        a row per summary row: the process that ran it, its start and end
+        (``time.perf_counter()``) and its CPU time (:class:`RunTiming`).
         Reports of a recording's trials not scored in this run (no longer in
         the file, or no reach now) are removed from ``out``. The report files
         (:data:`REPORT_SET`) come from one run: the last run's are removed
@@ -524,6 +600,7 @@ def run_batch(
     if figure_format not in FIGURE_FORMATS:
         raise InputError(f"expected one of {', '.join(FIGURE_FORMATS)}, got {figure_format!r}",
                          field="--figure-format")
+    t0 = time.perf_counter()
     # absolute: a worker, a dask one above all, may run in another folder
     items = expand_recordings([dataclasses.replace(i, path=Path(i.path).absolute())
                                for i in items], settings)
@@ -535,8 +612,10 @@ def run_batch(
     parallel = scheduler is not None or min(jobs, len(items)) > 1
     job = _Job(out, dataclasses.replace(settings, decoder_threads=1, planning_threads=1)
                if parallel else settings, repertoire_id, figure_format, dpi)
-    results = (_run_dask(items, repertoire, job, scheduler) if scheduler
-               else _run_local(items, repertoire, job, jobs))
+    work = _work(items, settings)
+    t1 = time.perf_counter()
+    results = (_run_dask(work, repertoire, job, scheduler) if scheduler
+               else _run_local(work, repertoire, job, jobs))
     done: list[ClipResult] = []
     with tqdm(total=len(items), unit="clip", file=sys.stderr, desc="batch",
               disable=quiet or not sys.stderr.isatty()) as bar:
@@ -544,6 +623,7 @@ def run_batch(
             done.append(result)
             bar.update()
     done.sort(key=lambda r: r.clip)
+    t2 = time.perf_counter()
     for path, clips in _recordings(items).items():  # reports of trials no longer in them
         remove_stale_reports(out, path, [r.clip for r in done if r.scored and r.clip in clips])
     summary = summary_table(done)
@@ -567,7 +647,17 @@ def run_batch(
     except BaseException:  # none of the set rather than part of it
         _remove_report(out)
         raise
+    # set last: pandas copies attrs deeply with every frame made from this one
+    summary.attrs["timing"] = {"read": t1 - t0, "clips": t2 - t1,
+                               "report": time.perf_counter() - t2, "runs": _runs(done)}
     return summary
+
+
+def _runs(done: list[ClipResult]) -> np.ndarray:
+    """Each result's :class:`RunTiming` as a row (process, start, end, cpu; NaN for a
+    clip no worker ran), in ``done``'s order."""
+    return np.array([dataclasses.astuple(r.timing) if r.timing else (np.nan,) * 4
+                     for r in done], dtype=float).reshape(len(done), 4)
 
 
 def count_trials(items: Iterable[BatchItem]) -> int:

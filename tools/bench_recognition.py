@@ -157,6 +157,82 @@ def _per_clip(rep, demo_tracks) -> tuple[str, str, str, str]:
             "(issue 42: 83-92 ms before one pass)")
 
 
+def _phases(summary, jobs: int, wall: float) -> tuple[str, str, str, str]:
+    """One row of the phase table: where a batch of ``jobs`` processes spent ``wall`` s.
+
+    From ``run_batch``'s ``attrs["timing"]``: reading the input, the clips
+    (handed out to the last result) and the report; within the clips, each
+    worker's start-up (the clips' start to its first clip: imports, the
+    repertoire), its idle time between clips (hand-offs) and at the end
+    (waiting for the last clips), and the busy share (every clip's time
+    over the clips phase x processes).
+    """
+    import numpy as np
+
+    timing = summary.attrs["timing"]
+    runs = timing["runs"][~np.isnan(timing["runs"][:, 0])]
+    clip_start = runs[:, 1].min()
+    busy = (runs[:, 2] - runs[:, 1]).sum()
+    start_up, between, tail = [], 0.0, []
+    clip_end = runs[:, 2].max()
+    for pid in np.unique(runs[:, 0]):
+        mine = runs[runs[:, 0] == pid]
+        mine = mine[np.argsort(mine[:, 1])]
+        start_up.append(mine[0, 1] - clip_start)
+        between += (mine[1:, 1] - mine[:-1, 2]).sum()
+        tail.append(clip_end - mine[-1, 2])
+    span = clip_end - clip_start
+    cpu = runs[:, 3].sum()
+    return (f"  {jobs} process{'es' * (jobs > 1)}: {wall:.1f} s",
+            f"read {timing['read']:.1f} s, clips {timing['clips']:.1f} s, "
+            f"report {timing['report']:.1f} s",
+            f"busy {busy / (span * jobs):.0%} (CPU {cpu / busy:.0%} of it); start-up "
+            f"{float(np.median(start_up)):.2f} s, between clips {between / len(runs) * 1e3:.0f} "
+            f"ms/clip, idle at the end {float(np.mean(tail)):.1f} s", "")
+
+
+def phase_rows(cores: int, rounds: int = 1, trials: int = 600
+               ) -> list[tuple[str, str, str, str]]:
+    """Where a batch's time goes at 1, 2, 4, ... processes (issue 45 item 1): a
+    ``trials``-trial motion-capture table (the shipped Optotrak trials repeated) with
+    its figures and report. The best of ``rounds`` runs of each."""
+    from bench_mocap import RATE, make_table
+
+    from perception.batch import discover, run_batch
+    from perception.pipeline import RecognitionSettings
+    from perception.recognition.repertoire import Repertoire
+    from perception.recordings import MocapImport, _cached
+
+    work = Path(tempfile.mkdtemp(prefix="hammer-bench-phases-"))
+    rows = []
+    try:
+        (work / "session").mkdir()
+        n = make_table(work / "session" / "trials.tsv", copies=max(1, trials // 4))
+        items = discover(work / "session")
+        rep = Repertoire.default()
+        settings = RecognitionSettings(mocap=MocapImport(rate=float(RATE)))
+        base = None
+        for jobs in _worker_counts(cores):
+            best = None
+            for _ in range(rounds):
+                shutil.rmtree(work / "out", ignore_errors=True)
+                _cached.cache_clear()  # the table read in each run, as by a new command
+                t0 = time.perf_counter()
+                summary = run_batch(items, work / "out", rep, settings, jobs=jobs, quiet=True)
+                wall = time.perf_counter() - t0
+                if best is None or wall < best[0]:
+                    best = wall, summary
+            wall, summary = best
+            base = base or wall
+            rows.append(_phases(summary, jobs, wall))
+            if jobs > 1:
+                rows.append(("", f"efficiency {base / (jobs * wall):.0%}", "target >= 90 % at 16",
+                             ""))
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    return [(f"phases of a batch of {n} motion-capture trials with figures", "", "", ""), *rows]
+
+
 def main(argv: list[str] | None = None) -> None:
     """Print the recognition and scaling figures."""
     import argparse
@@ -164,7 +240,18 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rounds", type=int, default=ROUNDS,
                         help=f"runs of each batch configuration, the best counts ({ROUNDS})")
-    rounds = parser.parse_args(argv).rounds
+    parser.add_argument("--only", choices=("phases",),
+                        help="only the phase table of a motion-capture batch")
+    parser.add_argument("--trials", type=int, default=600,
+                        help="trials of the phase table's table (600)")
+    args = parser.parse_args(argv)
+    rounds = args.rounds
+    cores = (len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
+             else os.cpu_count() or 1)
+    if args.only == "phases":
+        table(f"perception: where a batch's time goes ({cores} cores)",
+              phase_rows(cores, min(rounds, 2), args.trials))
+        return
     from _demos import demo_tracks
 
     from perception.batch import discover

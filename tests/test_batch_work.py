@@ -1,0 +1,59 @@
+"""A batch reads each recording once, in its own process, and says where its time went
+(issue 45 item 1: every one of 16 workers read the whole 600-trial table, 4 s each).
+"""
+
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import perception.recordings as recordings
+from perception.batch import _Job, _work, discover, expand_recordings, run_batch
+from perception.pipeline import RecognitionSettings
+from perception.recognition.repertoire import Repertoire
+from perception.recordings import MocapImport
+
+TABLE = Path(__file__).parent / "data" / "mocap" / "optotrak-trials.tsv"
+SETTINGS = RecognitionSettings(mocap=MocapImport(rate=85.0))
+
+
+@pytest.fixture
+def session(tmp_path):
+    folder = tmp_path / "session"
+    folder.mkdir()
+    shutil.copy(TABLE, folder / "trials.tsv")
+    return folder
+
+
+def test_a_reach_goes_to_its_worker_with_its_samples(session, tmp_path, monkeypatch):
+    items = expand_recordings(discover(session), SETTINGS)
+    work = _work(items, SETTINGS)
+    reaches = [w for w in work if w.item.reach is not None]
+    assert len(reaches) == 4 and all(w.reach is not None for w in reaches)
+    reference = _Job(tmp_path / "read", SETTINGS, "rep").run(reaches[0].__class__(
+        reaches[0].item), Repertoire.default())  # read from the file, as before
+
+    def no_reading(*args, **kwargs):
+        raise AssertionError("the worker read the recording")
+
+    recordings._cached.cache_clear()
+    monkeypatch.setattr(recordings, "cached_reaches", no_reading)
+    monkeypatch.setattr(recordings, "cached_recording", no_reading)
+    shipped = _Job(tmp_path / "shipped", SETTINGS, "rep").run(reaches[0], Repertoire.default())
+    assert shipped.status == reference.status == "ok"
+    assert shipped.summary.verdict == reference.summary.verdict
+    np.testing.assert_array_equal(shipped.summary.confidence, reference.summary.confidence)
+    assert shipped.timing.cpu > 0 and shipped.timing.end > shipped.timing.start
+
+
+def test_the_batch_says_where_its_time_went(session, tmp_path):
+    summary = run_batch(discover(session), tmp_path / "out", Repertoire.default(), SETTINGS,
+                        quiet=True)
+    timing = summary.attrs["timing"]
+    assert {"read", "clips", "report"} <= set(timing) and min(
+        timing[k] for k in ("read", "clips", "report")) > 0
+    runs = timing["runs"]
+    assert runs.shape == (len(summary), 4)  # a row per summary row, every one run here
+    assert not np.isnan(runs).any() and (runs[:, 2] >= runs[:, 1]).all()
+    assert (runs[:, 2] - runs[:, 1]).sum() <= timing["clips"] + 1e-6  # one process: in turn
