@@ -198,3 +198,44 @@ def test_a_string_rendered_once_is_drawn_in_each_colour_and_angle_it_is_given():
     for got, want in ((ys.min(), yp.min()), (ys.max(), yp.max()), (xs.min(), xp.min()),
                       (xs.max(), xp.max())):
         assert abs(int(got) - int(want)) <= 2
+
+
+def test_a_figure_written_as_png_holds_the_pixels_matplotlib_draws():
+    from matplotlib.figure import Figure
+
+    from perception.report.canvas import png_bytes
+
+    fig = Figure(figsize=(3, 2))
+    new_canvas(fig)
+    ax = fig.add_subplot()
+    ax.plot([0, 1, 2], [0, 1, 0.5], color="C3")
+    ax.set_title("a clip")
+    raw = io.BytesIO()
+    fig.savefig(raw, format="rgba", dpi=90)
+    drawn = np.frombuffer(raw.getvalue(), dtype=np.uint8).reshape(180, 270, 4)
+    png = Image.open(io.BytesIO(png_bytes(fig, 90)))
+    assert png.format == "PNG" and png.mode == "RGB" and png.size == (270, 180)
+    assert png.info["dpi"] == pytest.approx((90, 90), abs=0.01)
+    assert png.info["Software"].startswith("Matplotlib")
+    np.testing.assert_array_equal(np.asarray(png), drawn[..., :3])  # lossless, every pixel
+    # a figure with transparency keeps it (RGBA, through matplotlib's own writer)
+    fig.patch.set_alpha(0.0)
+    see_through = Image.open(io.BytesIO(png_bytes(fig, 90)))
+    assert see_through.mode == "RGBA" and np.asarray(see_through)[0, 0, 3] == 0
+
+
+def test_texts_are_measured_and_placed_as_on_matplotlibs_own_canvas(clips):
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    for kind, draw in DRAW.items():
+        ours, plain = draw(clips["mocap"]), draw(clips["mocap"])
+        FigureCanvasAgg(plain)
+        boxes = []
+        for fig in (ours, plain):
+            fig.canvas.draw()
+            renderer = fig.canvas.get_renderer()
+            texts = [fig._suptitle, *(t for ax in fig.axes for t in (
+                ax.title, ax.xaxis.label, ax.yaxis.label, *ax.texts,
+                *ax.get_xticklabels(), *ax.get_yticklabels()))]
+            boxes.append([_values(t.get_window_extent(renderer).bounds) for t in texts])
+        assert boxes[0] == boxes[1], kind
