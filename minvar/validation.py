@@ -28,6 +28,7 @@ line; :mod:`perception`'s classes raise its ``InputError`` instead.
 from __future__ import annotations
 
 import functools
+import threading
 from typing import Annotated, Any
 
 import numpy as np
@@ -39,6 +40,7 @@ from pydantic import (
     TypeAdapter,
     ValidationError,
 )
+from pydantic._internal._mock_val_ser import MockValSer as _MockValSer
 from pydantic.dataclasses import dataclass as _pydantic_dataclass
 from pydantic.dataclasses import rebuild_dataclass as _rebuild_dataclass
 
@@ -228,6 +230,12 @@ def declared(cls: type | None = None, /, *, eq: bool = True,
     built.__init__ = __init__
     # the signature pydantic gives a built class, read without building it first
     built.__signature__ = _BuiltSignature(built, __init__)
+    # pydantic's own stand-in validator rebuilds the class on first use without a lock;
+    # this one builds it through _complete (a thread that finds pydantic's __init__ on the
+    # class while another builds it waits here, and builds nothing)
+    built.__pydantic_validator__ = _MockValSer(
+        f"{built.__name__} is not built", code="class-not-fully-defined", val_or_ser="validator",
+        attempt_rebuild=lambda **_: _complete(built, __init__).__pydantic_validator__)
     return built
 
 
@@ -241,17 +249,23 @@ class _BuiltSignature:
         return _complete(self.built, self.init).__signature__
 
 
+#: Held while a declared class is built: planning threads (and a dask worker's) may make
+#: the first instance of a class at once, and pydantic's build changes the class in steps.
+_BUILDING = threading.RLock()
+
+
 def _complete(built: type, init: Any) -> type:
-    """Build ``built``'s deferred validator (CONFIG's ``defer_build``) now.
+    """Build ``built``'s deferred validator (CONFIG's ``defer_build``) now, once.
 
     pydantic's build sets the class's ``__init__`` (and its ``__signature__``)
     anew: the one-line-error ``init`` of :func:`declared` is put back.
     """
-    built.__init__ = init.__wrapped__  # pydantic's, so that the signature is read from it
-    try:
-        _rebuild_dataclass(built, force=True)
-    finally:
-        built.__init__ = init
+    with _BUILDING:
+        if not built.__pydantic_complete__:
+            try:
+                _rebuild_dataclass(built, force=True)
+            finally:
+                built.__init__ = init
     return built
 
 

@@ -53,6 +53,36 @@ def test_a_deferred_class_refuses_a_bad_value_in_one_line_first_and_every_time()
         + ["0.04"]
 
 
+def test_threads_making_the_first_instances_at_once_all_get_the_one_line_error():
+    # planning threads make a class's first instance at once: pydantic's build changes the
+    # class in steps, and a thread that met its __init__ midway raised pydantic's error
+    out = _fresh("import threading\n"
+                 "from concurrent.futures import ThreadPoolExecutor\n"
+                 "from minvar.errors import ParameterError\n"
+                 "from minvar.grasp_task import GraspTask\n"
+                 "from minvar.kinematics import TwoLinkChain\n"
+                 "from minvar.plant import PointMassPlant\n"
+                 "start = threading.Barrier(16)\n"
+                 "def make(_):\n"
+                 "    start.wait()\n"
+                 "    said = []\n"
+                 "    for cls, bad in ((GraspTask, {'object_size': -1.0}),\n"
+                 "                     (TwoLinkChain, {'l1': 0.0}),\n"
+                 "                     (PointMassPlant, {'mass': 0.0})):\n"
+                 "        cls()\n"
+                 "        try:\n"
+                 "            cls(**bad)\n"
+                 "        except ParameterError:\n"
+                 "            said.append('one line')\n"
+                 "        except Exception as exc:\n"
+                 "            said.append(type(exc).__name__)\n"
+                 "    return said\n"
+                 "with ThreadPoolExecutor(16) as pool:\n"
+                 "    said = {s for one in pool.map(make, range(16)) for s in one}\n"
+                 "print(*sorted(said))\n")
+    assert out.split() == ["one", "line"]
+
+
 def test_a_deferred_class_keeps_its_signature_and_its_errors_in_process():
     import inspect
 
