@@ -13,7 +13,14 @@ start-up is measured here, at the command line, not forbidden imports in tests.
   new scene, default repertoire), whole process on 2 cores, uncached (tracked
   and planned afresh each run), against importing what it imports; with
   figures; its tracks reused; and whether figures (matplotlib) and statistics
-  (statsmodels) stayed unloaded.
+  (statsmodels) stayed unloaded;
+* each input kind (issue 45 item 4): ``recognize`` of a tracks file, a
+  DeepLabCut csv and a Qualisys tsv without figures, and of a 2 s video with
+  its figures, against ``python -c 'import numpy, scipy.signal'`` (the floor:
+  the field's filters need scipy.signal) in the same rounds; with our packages
+  compiled to bytecode (as installed; the targets are for this case) and from
+  source (as under PYTHONDONTWRITEBYTECODE=1); and which of OpenCV, matplotlib
+  and pandas each loaded.
 """
 
 from __future__ import annotations
@@ -51,7 +58,7 @@ def _on_two_cores() -> None:
 
 
 def _timed(cmd: list[str], repeat: int = 5, env: dict | None = None,
-           before_each=None) -> tuple[float, float]:
+           before_each=None, cwd: Path = ROOT) -> tuple[float, float]:
     """Median wall time and median CPU time (user + system) of a fresh process on
     :data:`CORES`, s; ``before_each()`` runs before each, untimed."""
     walls, cpus = [], []
@@ -60,7 +67,7 @@ def _timed(cmd: list[str], repeat: int = 5, env: dict | None = None,
             before_each()
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         t0 = time.perf_counter()
-        subprocess.run(cmd, check=True, capture_output=True, cwd=ROOT, env=env,
+        subprocess.run(cmd, check=True, capture_output=True, cwd=cwd, env=env,
                        preexec_fn=_on_two_cores)
         walls.append(time.perf_counter() - t0)
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -183,10 +190,127 @@ def clip_rows() -> list[tuple[str, str, str, str]]:
     ]
 
 
+#: The floor of a ``recognize`` process: the field's filters need scipy.signal (which
+#: loads scipy.stats); issue 45 measures every start-up against it, in the same run.
+_FLOOR = [sys.executable, "-c", "import numpy, scipy.signal"]
+
+#: ``recognize`` run in-process, then which of OpenCV, matplotlib, pandas it loaded.
+_WHICH = """
+import sys
+from hammer_mv.cli import main
+try:
+    main(sys.argv[1:])
+finally:
+    print(",".join(m for m in ('cv2', 'matplotlib', 'pandas') if m in sys.modules) or "none")
+"""
+
+
+def _project_copy(work: Path, bytecode: bool) -> Path:
+    """The project's packages copied under ``work``: compiled (as a user's installed
+    copy is, its ``.pyc`` files written) or without any ``.pyc`` (compiled from source at
+    every start, as here, where PYTHONDONTWRITEBYTECODE=1 keeps our edits uncompiled)."""
+    import compileall
+
+    root = work / ("bytecode" if bytecode else "source")
+    for package in ("hammer_mv", "perception", "minvar"):
+        shutil.copytree(ROOT / package, root / package,
+                        ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+    if bytecode:
+        assert compileall.compile_dir(root, quiet=1, workers=1)
+    return root
+
+
+def _start_files(work: Path) -> dict[str, list[str]]:
+    """The ``recognize`` arguments of each input kind, its files written under ``work``."""
+    import numpy as np
+    import pandas as pd
+
+    from perception.synthetic.demos import demo_tracks, render_demo_clip
+    from perception.synthetic.scene import Scene
+
+    tracks = demo_tracks("normal", 0)[0]
+    tracks_file = tracks.save(work / "grasp.tracks.h5")
+    columns = pd.MultiIndex.from_product([["DLC_resnet50"], list(tracks.markers),
+                                          ["x", "y", "likelihood"]],
+                                         names=["scorer", "bodyparts", "coords"])
+    xy_p = np.concatenate([tracks.position, tracks.likelihood[..., None]], axis=-1)
+    pose_file = work / "grasp.csv"  # a DeepLabCut table of the same grasp
+    pd.DataFrame(xy_p.reshape(len(xy_p), -1), columns=columns).to_csv(pose_file)
+    scene = Scene.reach_to_grasp(60, 30.0, start=(0.0, -0.30), onset=0.3, duration=1.2,
+                                 object_diameter=0.08)
+    clip, _ = render_demo_clip(work, "clip.mp4", n=60, scene=scene, hand=True)
+    return {
+        "tracks file": [str(tracks_file), "--no-figures"],
+        "pose file (DeepLabCut csv)": [str(pose_file), "--no-figures", "--fps", "30",
+                                       "--object-diameter-px", "80"],
+        "motion-capture file (Qualisys tsv)": [
+            str(ROOT / "tests" / "data" / "mocap" / "qualisys-recording.tsv"), "--no-figures"],
+        "2 s video, with figures": [str(clip.video), "--object-diameter", "0.08"],
+    }
+
+
+#: Target: a whole ``recognize`` within this of the floor, s (issue 45 item 4).
+_MARGINS = {"2 s video, with figures": 0.8}
+
+
+def file_startup_rows(repeat: int = 3) -> list[tuple[str, str, str, str]]:
+    """``recognize`` of each input kind, whole processes, beside the floor of the same run.
+
+    Rounds interleave the floor and every command (so a busy spell costs each alike);
+    the median of ``repeat`` rounds each. Twice: with our packages compiled to bytecode
+    (a user's installation; the targets are for this case) and compiled from source
+    at every start (this machine's PYTHONDONTWRITEBYTECODE=1).
+    """
+    work = Path(tempfile.mkdtemp(prefix="hammer-bench-start-"))
+    rows = []
+    try:
+        files = _start_files(work)
+        for bytecode in (True, False):
+            root = _project_copy(work, bytecode)
+            env = {**os.environ, "PYTHONPATH": str(root), "PYTHONDONTWRITEBYTECODE": "1"}
+            env.pop("PYTHONPYCACHEPREFIX", None)
+            out = work / "out"
+
+
+            def run(args, out=out, env=env, root=root):
+                shutil.rmtree(out, ignore_errors=True)  # nothing reused: tracked, planned
+                cmd = [sys.executable, "-m", "hammer_mv", "recognize", *args, "-o", str(out),
+                       "--quiet"]
+                return _timed(cmd, 1, env, cwd=root)
+
+            times: dict[str, list[tuple[float, float]]] = {"floor": []}
+            run(files["tracks file"])  # warm the disk cache
+            for _ in range(repeat):
+                times["floor"].append(_timed(_FLOOR, 1, env, cwd=root))
+                for what, args in files.items():
+                    times.setdefault(what, []).append(run(args))
+            floor, floor_cpu = (statistics.median(t[i] for t in times["floor"]) for i in (0, 1))
+            how = "bytecode" if bytecode else "from source"
+            rows.append((f"floor: python -c 'import numpy, scipy.signal' ({how})",
+                         f"{floor:.2f} s", f"CPU {floor_cpu:.2f} s; same rounds", ""))
+            for what, args in files.items():
+                shutil.rmtree(out, ignore_errors=True)
+                loaded = subprocess.run(
+                    [sys.executable, "-c", _WHICH, "recognize", *args, "-o", str(out),
+                     "--quiet"], capture_output=True, text=True, cwd=root, env=env,
+                    check=True).stdout.split()[-1]
+                wall, cpu = (statistics.median(t[i] for t in times[what]) for i in (0, 1))
+                margin = _MARGINS.get(what, 0.25)
+                target = (f"floor + {margin:.2f} s (target for bytecode); CPU {cpu:.2f} s "
+                          f"({cpu - floor_cpu:+.2f}); loaded of cv2,matplotlib,pandas: {loaded}")
+                rows.append((f"  recognize, {what} ({how})", f"{wall:.2f} s ({wall - floor:+.2f})",
+                             target, _verdict(wall - floor, margin) if bytecode else ""))
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    return rows
+
+
 def main() -> None:
     """Print the start-up, planning and per-clip table."""
     table("hammer-mv: start-up, planning, one clip (whole processes, median)",
           startup_rows() + planning_rows() + clip_rows())
+    table("hammer-mv recognize of each input kind against the floor (whole processes, "
+          "median of 3)", file_startup_rows())
 
 
 if __name__ == "__main__":
