@@ -75,14 +75,14 @@ def _resume(z, dt, alpha, beta, out) -> tuple[int, AlphaBeta]:
         return 0, AlphaBeta(z.shape[1:], alpha, beta)
     n = len(best[0])
     out[:n] = best[4]
-    return n, copy.deepcopy(best[5])
+    return n, copy.copy(best[5])  # its state is replaced at every frame, never changed
 
 
 def _keep(z, dt, alpha, beta, out, step) -> None:
     """Keep a filtered series and the filter's state after it (:func:`_resume`)."""
     series = [k for k in getattr(_KEPT, "series", ()) if len(k[0]) != len(z)
               or not np.array_equal(k[0], z, equal_nan=True)]
-    _KEPT.series = [(z.copy(), dt.copy(), alpha, beta, out.copy(), copy.deepcopy(step)),
+    _KEPT.series = [(z.copy(), dt.copy(), alpha, beta, out.copy(), copy.copy(step)),
                     *series][:RESUMABLE]
 
 
@@ -105,7 +105,11 @@ class AlphaBeta:
         self.second = np.zeros(shape[:-1] + (1,), dtype=bool)  # first measurement after a (re)start
 
     def __call__(self, zi: np.ndarray, dt: float) -> np.ndarray:
-        """The filtered positions of the next frame ``zi`` (NaN where missing), ``dt`` s later."""
+        """The filtered positions of the next frame ``zi`` (NaN where missing), ``dt`` s later.
+
+        Each frame replaces the state's arrays rather than writing into them: a
+        copy of the filter (:func:`copy.copy`) resumes on its own.
+        """
         x, v, alpha, beta = self.x, self.v, self.alpha, self.beta
         have = np.isfinite(zi).all(axis=-1, keepdims=True)
         pred = x + v * dt

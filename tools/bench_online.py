@@ -12,15 +12,21 @@ rest frames: that frame is reported on its own).
   slow frames are named apart: the tracker's first detection (the first
   frame after its look-ahead, found as the first update that brings a row)
   and the scene fix (the first update past the ``start`` phase).
-* **A 30 s stream** (the reach, then the hand resting on the object): the
-  per-frame cost in each 5 s of it. A frame that costs more the longer the
-  stream has run shows as a later 5 s slower than an earlier one.
+* **A 30 s stream** (the reach, then the hand resting on the object), fed
+  three times: the per-frame cost in each 5 s of the first run, and in each
+  run the trend of the per-second CPU means once the hand is at rest (a
+  straight line fitted from 5 s on), as its rise over the stream with a 95 %
+  interval from the fit's residuals. A frame that costs more the longer the
+  stream has run shows as a rise beyond the interval in every run; a rise
+  within the interval, or one whose sign changes between runs (the spread of
+  the three), is the machine's noise, and the bench says so.
 
-The issue's targets on 2 cores: median <= 2 ms; 99th percentile <= 10 ms in
-the median of the three runs and <= 15 ms in each; no growth with the
-stream's length.
+The issue's targets (issue 45): median <= 2 ms on the device, 99th percentile
+<= 10 ms in every run; the 30 s stream's trend within +-5 % in each of three
+runs.
 
-Run: ``.venv/bin/python tools/bench_online.py [--clips 6] [--runs 3] [--stream 30]``
+Run: ``.venv/bin/python tools/bench_online.py [--clips 6] [--runs 3] [--stream 30]
+[--stream-runs 3]``
 or ``tools/bench.py --only online``.
 """
 
@@ -94,8 +100,41 @@ def _run(rep, videos: list[Path]) -> dict:
     return run
 
 
-def _long_stream(rep, folder: str, seconds: float) -> list[tuple[str, str, str, str]]:
-    """The per-frame cost in each 5 s of a stream ``seconds`` long (the scene-fix frame apart)."""
+def _trend(cpu: np.ndarray, keep: np.ndarray, seconds: float, fps: float = 30.0
+           ) -> tuple[float, float, float]:
+    """The trend of the per-second CPU means after 5 s (the movement over, the hand at rest):
+    slope (s per s), its rise over those seconds as a share of their median, %, and the
+    half-width of the rise's 95 % interval from the fit's own residuals, % (what the noise
+    of one run allows).
+
+    A mean, not a median: a slow movement brought to the repertoire's time scale is scored
+    on every other frame only, and a median of two equal halves jumps between them.
+    """
+    secs = np.arange(5, int(seconds))
+    per_s = np.array([np.mean(cpu[int(k * fps):int((k + 1) * fps)][keep[int(k * fps):
+                                                                        int((k + 1) * fps)]])
+                      for k in secs])
+    if len(secs) <= 3:
+        return math.nan, math.nan, math.nan
+    (slope, icept), cov = np.polyfit(secs, per_s, 1, cov=True)
+    span = (secs[-1] - secs[0]) / np.median(per_s) * 100
+    return float(slope), float(slope * span), float(1.96 * math.sqrt(cov[0, 0]) * span)
+
+
+def _within():
+    """A 2 s clip whose 1.0 s reach-to-grasp starts 0.3 s in (a movement time the default
+    repertoire's models span)."""
+    from perception.geometry import DEFAULT_OBJECT_DIAMETER
+    from perception.synthetic.scene import Scene
+
+    return Scene.reach_to_grasp(60, 30.0, onset=0.3, duration=1.0,
+                                object_diameter=DEFAULT_OBJECT_DIAMETER)
+
+
+def _long_stream(rep, folder: str, seconds: float, runs: int = 3
+                 ) -> list[tuple[str, str, str, str]]:
+    """The per-frame cost in each 5 s of a stream ``seconds`` long (the scene-fix frame
+    apart), and its trend at rest, in each of ``runs`` runs over the same video."""
     from perception.geometry import DEFAULT_OBJECT_DIAMETER
     from perception.synthetic.demos import render_demo_clip
     from perception.synthetic.scene import Scene
@@ -103,31 +142,36 @@ def _long_stream(rep, folder: str, seconds: float) -> list[tuple[str, str, str, 
     n = int(round(seconds * 30))
     scene = Scene.reach_to_grasp(n, 30.0, onset=0.2, duration=2.4,
                                  object_diameter=DEFAULT_OBJECT_DIAMETER)
-    s = _stream(rep, render_demo_clip(folder, "long.mp4", n=n, scene=scene, seed=7)[0].video)
-    upd, cpu, dec = (np.array(s[k]) for k in ("update", "cpu", "decode"))
-    keep = np.ones(len(upd), bool)
-    keep[s["scene"]] = False
-    rows, meds = [], []
-    for start in range(0, int(seconds), 5):
-        span = slice(start * 30, (start + 5) * 30)
-        part, own = upd[span][keep[span]], cpu[span][keep[span]]
-        meds.append(np.median(own) * 1e3)
-        rows.append((f"  {start}-{start + 5} s ({len(part)} frames)",
-                     f"{np.median(part) * 1e3:.2f} ms median, p99 {_ms(part, 99):.2f}",
-                     f"CPU median {meds[-1]:.3f} ms; decode {_ms(dec[span], 50):.2f} ms", ""))
-    grows = meds[-1] / meds[0]
-    # per-second means from 5 s on (the movement over, the hand at rest): their trend. A
-    # mean, not a median: a slow movement brought to the repertoire's time scale is
-    # scored on every other frame only, and a median of two equal halves jumps between them
-    secs = np.arange(5, int(seconds))
-    per_s = [np.mean(cpu[k * 30:(k + 1) * 30][keep[k * 30:(k + 1) * 30]]) for k in secs]
-    slope = np.polyfit(secs, per_s, 1)[0] if len(secs) > 2 else math.nan  # s per s
-    rise = slope * (secs[-1] - secs[0]) / np.median(per_s) * 100 if len(secs) > 2 else math.nan
-    rows += [("  last 5 s over first 5 s (CPU medians; the first hold the movement)",
-              f"{grows:.2f} x", "", ""),
-             ("  trend of the per-second CPU means after 5 s (the hand at rest)",
-              f"{slope * 1e7:+.0f} us per 10 s", f"{rise:+.0f} % over the stream; "
-              "target: no growth", "ok" if rise <= 10 else "GROWS")]
+    video = render_demo_clip(folder, "long.mp4", n=n, scene=scene, seed=7)[0].video
+    rows, rises = [], []
+    for run in range(1, runs + 1):
+        s = _stream(rep, video)
+        upd, cpu, dec = (np.array(s[k]) for k in ("update", "cpu", "decode"))
+        keep = np.ones(len(upd), bool)
+        keep[s["scene"]] = False
+        meds = []
+        for start in range(0, int(seconds), 5):
+            span = slice(start * 30, (start + 5) * 30)
+            part, own = upd[span][keep[span]], cpu[span][keep[span]]
+            meds.append(np.median(own) * 1e3)
+            if run == 1:  # the 5 s parts of the first run; the others' trends below
+                rows.append((f"  {start}-{start + 5} s ({len(part)} frames)",
+                             f"{np.median(part) * 1e3:.2f} ms median, p99 {_ms(part, 99):.2f}",
+                             f"CPU median {meds[-1]:.3f} ms; decode {_ms(dec[span], 50):.2f} ms",
+                             ""))
+        slope, rise, noise = _trend(cpu, keep, seconds)
+        rises.append(rise)
+        flat = abs(rise) <= 5
+        verdict = ("ok" if flat else "GROWS" if rise - noise > 5 else
+                   "SHRINKS" if rise + noise < -5 else "noise: within its spread")
+        rows.append((f"run {run}: trend of the per-second CPU means after 5 s (hand at rest)",
+                     f"{slope * 1e7:+.0f} us per 10 s, {rise:+.1f} % (+-{noise:.1f} %)",
+                     f"last 5 s / first 5 s {meds[-1] / meds[0]:.2f} x; target within "
+                     "+-5 %", verdict))
+    if len(rises) > 1:
+        rows.append((f"the {len(rises)} runs' trends: median, spread (max - min)",
+                     f"{statistics.median(rises):+.1f} %, {max(rises) - min(rises):.1f} %",
+                     "a growth smaller than the spread is the machine's noise", ""))
     rows.insert(0, (f"{n} frames fed at increasing times (wall; CPU time of the update)",
                     "", "", ""))
     return rows
@@ -145,6 +189,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--runs", type=int, default=3, help="runs over the clips")
     ap.add_argument("--stream", type=float, default=30.0,
                     help="length of the long stream, s (0: none)")
+    ap.add_argument("--stream-runs", type=int, default=3,
+                    help="runs over the long stream (each trend printed, and their spread)")
+    ap.add_argument("--within", type=int, default=3,
+                    help="clips of a 1.0 s movement, within the repertoire's durations (one run)")
     args = ap.parse_args([] if argv is None and __name__ != "__main__" else argv)
     cv2.setNumThreads(1)  # as hammer-mv watch runs
     rep = Repertoire.default()
@@ -153,7 +201,10 @@ def main(argv: list[str] | None = None) -> int:
                   for k in range(args.clips + 1)]
         _stream(rep, videos[0])  # plans the scene: warm-up, not timed
         runs = [_run(rep, videos[1:]) for _ in range(args.runs)]
-        long_rows = _long_stream(rep, tmp, args.stream) if args.stream >= 10 else []
+        within = _run(rep, [render_demo_clip(tmp, f"w{k}.mp4", n=60, seed=k, scene=_within())[0]
+                            .video for k in range(args.within)]) if args.within else None
+        long_rows = (_long_stream(rep, tmp, args.stream, args.stream_runs)
+                     if args.stream >= 10 else [])
     med = statistics.median(_ms(r["update"], 50) for r in runs)
     p99s = [_ms(r["update"], 99) for r in runs]
     rows = []
@@ -184,6 +235,15 @@ def main(argv: list[str] | None = None) -> int:
          f"{np.median([x for r in runs for x in r['scene']]) * 1e3:.1f} ms", "once per stream",
          ""),
     ]
+    lo, hi = rep.reference()[1]
+    rows.insert(0, (f"the clips' movement: 2.4 s, slower than the repertoire's {lo:g}-{hi:g} s",
+                    "", "its time scale changes at every frame: each is scored afresh", ""))
+    if within is not None:
+        rows += [(f"{args.within} clips of a 1.0 s movement (within {lo:g}-{hi:g} s: each "
+                  f"frame's scores resume the last's), {len(within['update'])} frames",
+                  f"{_ms(within['update'], 50):.2f} ms median, p99 {_ms(within['update'], 99):.2f}",
+                  f"CPU median {_ms(within['cpu'], 50):.2f} ms, p99 {_ms(within['cpu'], 99):.2f}",
+                  "")]
     table("online recognition: per-frame latency, 640x480 30 fps", rows)
     if long_rows:
         table(f"online recognition: a {args.stream:.0f} s stream, per-frame cost by 5 s",

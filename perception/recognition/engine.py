@@ -22,6 +22,7 @@ is read off its calibration.
 
 from __future__ import annotations
 
+import copy
 import threading
 from collections.abc import Sequence
 from typing import Literal, NamedTuple
@@ -432,10 +433,7 @@ def score_clip(observation: Observation, models: Sequence[MotorModel],
                 and all(a.shape == b.shape and np.array_equal(a, b, equal_nan=True)
                         for a, b in zip(kept[2], arrays))):
             return kept[3]
-    # gains stacked once for the whole clip
-    scorer = StepScorer(models, params, steps=int(round(obs.time[-1] / models[0].dt))
-                        + obs.n_frames + 1)
-    terms = scorer.score(obs.time, obs.wrist, obs.finger, obs.thumb)
+    scorer, terms = _scored(models, params, obs, arrays)
     dC_r, dC_g, dll, maha, valid, pred, _ = terms
     _refuse_broken_models(models, terms.observable, valid)
     _refuse_non_finite(models, {"confidence": dC_r + dC_g, "log-likelihood": dll})
@@ -451,6 +449,58 @@ def score_clip(observation: Observation, models: Sequence[MotorModel],
     _SCORED.kept = [(tuple(models), (params, obs.dt), tuple(np.array(a) for a in arrays),
                      scores), *getattr(_SCORED, "kept", ())][:KEPT_SCORES]
     return scores
+
+
+def _scored(models: list, params: HammerParams, obs: Observation, arrays: tuple
+            ) -> tuple[StepScorer, _Steps]:
+    """The scorer after every frame of ``obs`` and their per-step terms: resumed after the
+    longest movement scored before (in this thread, with these models and settings) that
+    this one begins with, bitwise, else scored from the first frame.
+
+    The online recogniser scores the rows so far after every row: each
+    movement is the last one and a frame more. The filters are causal and the
+    per-step terms of a frame read only it and the frame before, so the
+    frames scored before are scored alike (the same operations on the same
+    numbers); the sums are taken again over every frame, so that they are
+    added in the order a pass from the first frame adds them.
+    """
+    best = None
+    for kept in getattr(_SCORED, "resumable", ()):
+        k_models, k_key, k_arrays = kept[:3]
+        n = len(k_arrays[0])
+        if (k_key == (params, obs.dt) and n < obs.n_frames
+                and (best is None or n > len(best[2][0]))
+                and len(k_models) == len(models) and all(a is b for a, b in zip(k_models, models))
+                and all(np.array_equal(a, b[:n], equal_nan=True)
+                        for a, b in zip(k_arrays, arrays))):
+            best = kept
+    if best is None:
+        # gains stacked once for the whole clip
+        scorer = StepScorer(models, params, steps=int(round(obs.time[-1] / models[0].dt))
+                            + obs.n_frames + 1)
+        terms = scorer.score(*arrays)
+        terms = terms._replace(predicted=terms.predicted._replace(cov=None))
+    else:
+        n, old = len(best[2][0]), best[4]
+        scorer = copy.copy(best[3])  # kept as it was after its frames: resumed on a copy
+        for name in ("confidence", "log_likelihood", "mahalanobis", "scored"):
+            setattr(scorer, name, getattr(scorer, name).copy())
+        new = scorer.score(*(a[n:] for a in arrays))
+        both = lambda a, b: np.concatenate([a, b], axis=-1 if a.ndim == 1 else 1)  # noqa: E731
+        terms = _Steps(*(both(a, b) for a, b in zip(old[:5], new[:5])),
+                       _Predicted(*(both(a, b) for a, b in zip(old.predicted[:3],
+                                                               new.predicted[:3])), None),
+                       both(old.observable, new.observable))
+        # the sums in the order one pass adds them (a sum in two parts may differ in its
+        # last bit)
+        scorer.confidence = (terms.dC_r + terms.dC_g).sum(axis=1)
+        scorer.log_likelihood = terms.log_likelihood.sum(axis=1)
+        scorer.mahalanobis = terms.mahalanobis.sum(axis=1)
+        scorer.scored = terms.valid.sum(axis=1)
+    _SCORED.resumable = [
+        (tuple(models), (params, obs.dt), tuple(np.array(a) for a in arrays), scorer, terms),
+        *(k for k in getattr(_SCORED, "resumable", ()) if k is not best)][:KEPT_SCORES]
+    return scorer, terms
 
 
 #: Scores kept per thread (the verdict's pass and the transport's of the last movements),

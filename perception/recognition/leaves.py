@@ -76,11 +76,13 @@ class Leaves:
         """
         key = tuple(id(m) for m in models)
         hit = _CACHE.get(key)
-        if hit is not None and all(a is b for a, b in zip(hit[0], models)) \
-                and len(hit[1].P) >= steps:
+        same = hit is not None and all(a is b for a, b in zip(hit[0], models))
+        if same and len(hit[1].P) >= steps:
             _CACHE.move_to_end(key)
             return hit[1]
-        leaves = cls(models, steps)
+        # a stream's movement grows a few steps a frame: stacked again, then for twice as
+        # many, not for every few steps more
+        leaves = cls(models, max(steps, 2 * len(hit[1].P)) if same else steps)
         _CACHE[key] = (tuple(models), leaves)
         while len(_CACHE) > CACHED_SETS:
             _CACHE.popitem(last=False)
