@@ -228,14 +228,16 @@ def declared(cls: type | None = None, /, *, eq: bool = True,
             raise input_error(exc, built, error) from None
 
     built.__init__ = __init__
-    # the signature pydantic gives a built class, read without building it first
-    built.__signature__ = _BuiltSignature(built, __init__)
-    # pydantic's own stand-in validator rebuilds the class on first use without a lock;
-    # this one builds it through _complete (a thread that finds pydantic's __init__ on the
-    # class while another builds it waits here, and builds nothing)
-    built.__pydantic_validator__ = _MockValSer(
-        f"{built.__name__} is not built", code="class-not-fully-defined", val_or_ser="validator",
-        attempt_rebuild=lambda **_: _complete(built, __init__).__pydantic_validator__)
+    if not built.__pydantic_complete__:  # deferred (CONFIG): built on first use
+        # the signature pydantic gives a built class, read without building it first
+        built.__signature__ = _BuiltSignature(built, __init__)
+        # pydantic's own stand-in validator rebuilds the class on first use without a
+        # lock; this one builds it through _complete (a thread that finds pydantic's
+        # __init__ on the class while another builds it waits here, and builds nothing)
+        built.__pydantic_validator__ = _MockValSer(
+            f"{built.__name__} is not built", code="class-not-fully-defined",
+            val_or_ser="validator",
+            attempt_rebuild=lambda **_: _complete(built, __init__).__pydantic_validator__)
     return built
 
 
