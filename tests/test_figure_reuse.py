@@ -28,17 +28,18 @@ DRAW = {"confidence": confidence_figure, "paths": paths_figure,
 
 @pytest.fixture(scope="module")
 def clips():
-    """Two video clips (a normal and a delayed grasp), a mocap reach without a wrist, and
-    the normal clip with its onset, MGA and opening not measured."""
+    """Video clips (two normal grasps, a delayed one), a mocap reach without a wrist, and
+    the first normal clip with its onset, MGA and opening not measured."""
     rep = default_repertoire()
-    normal, delayed = (recognize_clip(demo_tracks(cond, 0)[0], rep, clip=f"{cond}-0")
-                       for cond in ("normal", "delayed"))
+    normal, delayed, normal1 = (recognize_clip(demo_tracks(cond, i)[0], rep, clip=f"{cond}-{i}")
+                                for cond, i in (("normal", 0), ("delayed", 0), ("normal", 1)))
     mocap = recognize_reach(read_reaches(OPTOTRAK, MocapImport(rate=85))[0], rep)[0]
     unmeasured = dataclasses.replace(normal, clip="unmeasured")
     unmeasured.__dict__["landmarks"] = (  # the cached property, replaced
         dataclasses.replace(normal.landmarks[0], onset_time=math.nan, mga=math.nan,
                             opening_time=math.nan), None)
-    return {"normal": normal, "delayed": delayed, "mocap": mocap, "unmeasured": unmeasured}
+    return {"normal": normal, "delayed": delayed, "normal1": normal1, "mocap": mocap,
+            "unmeasured": unmeasured}
 
 
 def _values(x) -> list:
@@ -70,22 +71,44 @@ def _content(fig) -> dict:
     return shown
 
 
-@pytest.mark.parametrize("kind, first, second", [
-    ("confidence", "normal", "delayed"),
-    ("confidence", "delayed", "normal"),
-    ("paths", "mocap", "normal"),  # a wrist not recorded, then one tracked
-    ("paths", "normal", "mocap"),
-    ("kinematics", "normal", "unmeasured"),  # every landmark, then some not measured
-    ("kinematics", "unmeasured", "delayed"),
-    ("kinematics", "mocap", "normal"),
+def _spans_its_data(fig) -> None:
+    """Each panel's limits hold its curves and fit them (within margins) in x or y: limits
+    found for this figure's data, not left from another's."""
+    fig.canvas.draw()
+    for ax in fig.axes:
+        xy = np.concatenate([line.get_xydata() for line in ax.get_lines()
+                             if line.get_transform() == ax.transData])
+        xy = xy[np.isfinite(xy).all(axis=1)]
+        fits = []
+        for k, (lo, hi) in enumerate((ax.get_xlim(), ax.get_ylim())):
+            assert lo <= xy[:, k].min() and xy[:, k].max() <= hi
+            fits.append(np.ptp(xy[:, k]) >= 0.8 * (hi - lo))
+        assert any(fits)
+
+
+@pytest.mark.parametrize("kind, first, second, same", [
+    ("confidence", "normal", "delayed", True),
+    ("confidence", "delayed", "normal", True),
+    ("paths", "normal", "normal1", True),  # the same reference model
+    ("paths", "normal1", "normal", True),
+    ("paths", "normal", "delayed", False),  # another model: a figure of its own
+    # a wrist not recorded, then one tracked: a figure of its own (one line fewer)
+    ("paths", "mocap", "normal", False),
+    ("paths", "normal", "mocap", False),
+    ("kinematics", "normal", "unmeasured", True),  # every landmark, then some not measured
+    ("kinematics", "unmeasured", "delayed", True),
+    ("kinematics", "mocap", "normal", True),
 ])
 def test_a_kept_figure_shows_the_second_clip_and_nothing_of_the_first(clips, kind, first,
-                                                                      second):
+                                                                      second, same):
     draw = DRAW[kind]
     a, b = clips[first], clips[second]
+    if kind == "paths":  # kept per reference model and wrist
+        assert (a.reference_model == b.reference_model) == same or "mocap" in (first, second)
     kept_a = draw(a, reuse=True)
     kept_b = draw(b, reuse=True)
-    assert kept_b is kept_a  # the same Figure, drawn again
+    assert (kept_b is kept_a) == same  # the same Figure, drawn again
+    _spans_its_data(kept_b)
     assert _content(kept_b) == _content(draw(b))  # as a new figure of B shows B
     assert _content(kept_b) != _content(draw(a))
     assert b.clip in kept_b.get_suptitle() and a.clip not in kept_b.get_suptitle()

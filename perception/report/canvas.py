@@ -1,14 +1,16 @@
 """The figures' Agg canvas: strings rendered once per process, figures kept per kind.
 
-Two costs dominate a report's per-clip figures, and neither is the data:
+What a report's per-clip figures cost is drawing, not data; measured on
+motion-capture trials (tools/bench_mocap.py), and removed here:
 
 * **Text.** matplotlib 3.11 lays out and renders every string glyph by glyph
-  on every draw (about 1 ms a string); a clip's three figures draw some 130
-  strings, most of them the same in every clip (tick labels, axis labels,
-  legend entries). :func:`new_canvas` gives a figure an Agg canvas whose
-  renderer keeps each string's rendered coverage mask (as matplotlib up to
-  3.10 drew a string: whole, at a pixel position) and stamps it again in the
-  string's colour and angle, so a string is rendered once per process.
+  on every draw (about 1 ms a string), and looks up its font's heights at
+  every measure; a clip's three figures draw some 130 strings, most of them
+  the same in every clip (tick labels, axis labels, legend entries).
+  :func:`new_canvas` gives a figure an Agg canvas whose renderer keeps each
+  string's rendered coverage mask (as matplotlib up to 3.10 drew a string:
+  whole, at a pixel position) and stamps it again in the string's colour and
+  angle, and keeps each font's heights per size.
 * **PNG.** Pillow's encoder tries five filters on every row; :func:`png_bytes`
   filters each row of an opaque figure one way (``Sub``, which suits flat
   backgrounds), as RGB, and deflates it at zlib level 1: half the time, for
@@ -252,11 +254,11 @@ def png_bytes(fig: Figure, dpi: int) -> bytes:
         fig.savefig(out, format="png", dpi=dpi, pil_kwargs={"compress_level": 1})
         return out.getvalue()
     height = rgba.shape[0]
-    rgb = rgba[..., :3].reshape(height, width * 3)
     rows = np.empty((height, width * 3 + 1), dtype=np.uint8)
     rows[:, 0] = 1  # Sub: each byte less the one a pixel before it (mod 256)
-    rows[:, 1:4] = rgb[:, :3]
-    np.subtract(rgb[:, 3:], rgb[:, :-3], out=rows[:, 4:])
+    pixels = rows[:, 1:].reshape(height, width, 3)  # a view: filtered in place, no copies
+    pixels[:, 0] = rgba[:, 0, :3]
+    np.subtract(rgba[:, 1:, :3], rgba[:, :-1, :3], out=pixels[:, 1:])
     per_metre = int(dpi / 0.0254 + 0.5)
     software = f"Matplotlib version{matplotlib.__version__}, https://matplotlib.org/"
     return b"".join([
@@ -264,6 +266,6 @@ def png_bytes(fig: Figure, dpi: int) -> bytes:
         _chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)),
         _chunk(b"pHYs", struct.pack(">IIB", per_metre, per_metre, 1)),
         _chunk(b"tEXt", b"Software\0" + software.encode("latin-1")),
-        _chunk(b"IDAT", zlib.compress(rows.tobytes(), 1)),
+        _chunk(b"IDAT", zlib.compress(rows, 1)),
         _chunk(b"IEND", b""),
     ])

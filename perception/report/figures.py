@@ -255,21 +255,24 @@ def paths_figure(rec: Recognition, model: str | None = None, *, reuse: bool = Fa
         :func:`confidence_figure`).
     """
     model = model or rec.reference_model or rec.winner
-    i = rec.names.index(model)
-    # the movement as it was scored (at the repertoire's scale, where the model's own is)
-    obs, own = rec.scored_movement, rec.nominal(model)
-    fig, (paths, grip) = _figure((12, 5.5), 2, titled=True, keep="paths" if reuse else None)
+    rec.names.index(model)  # a model it was not scored on: ValueError
     placed = bool(getattr(rec, "wrist_synthesised", False))
+    if reuse:  # its lines, note and legends kept: the same model, the wrist drawn or not
+        fig, lines = kept_figure(("paths lines", model, placed),
+                                 lambda: _paths_layout(model, placed), clear=False)
+    else:
+        fig, lines = _paths_layout(model, placed)
+    return _paths_data(fig, lines, rec, model, placed)
+
+
+def _paths_layout(model: str, placed: bool) -> tuple[Figure, list]:
+    """The paths figure without data: its lines (paths panel, then grip), note, legends."""
+    fig, (paths, grip) = _figure((12, 5.5), 2, titled=True)
     for key, colour in (("finger", "g"), ("thumb", "r"), ("wrist", "b")):
-        seen, plan = getattr(obs, key), own[key]
         if not (key == "wrist" and placed):
-            paths.plot(seen[:, 0], seen[:, 1], "-", color=colour, lw=1.8,
-                       label=f"{key} observed")
-        paths.plot(plan[:, 0], plan[:, 1], "--", color=colour, lw=1.5, label=f"{key}, {model}")
-    circle = np.linspace(0, 2 * np.pi, 100)
-    rad = obs.object_diameter / 2
-    paths.plot(rad * np.cos(circle), rad * np.sin(circle), "-", color="y", lw=2.0,
-               label="object")
+            paths.plot([], [], "-", color=colour, lw=1.8, label=f"{key} observed")
+        paths.plot([], [], "--", color=colour, lw=1.5, label=f"{key}, {model}")
+    paths.plot([], [], "-", color="y", lw=2.0, label="object")
     paths.set_aspect("equal", adjustable="datalim")
     _panel(paths, f"paths: observed (solid) and {model}'s own movement (dashed)", "x (m)",
            "y (m), toward the object")
@@ -278,13 +281,35 @@ def paths_figure(rec: Recognition, model: str | None = None, *, reuse: bool = Fa
                        xycoords="axes fraction", xytext=(0, -12), textcoords="offset points",
                        ha="center", va="top", fontsize=LEGEND_PT, color="0.3", gid="no-wrist")
     _legend(paths, paths.get_lines(), ncols=2)
-    own_g = np.linalg.norm(own["finger"] - own["thumb"], axis=1)
-    grip.plot(rec.time, obs.g * CM, "-", color="k", lw=2.0, label="observed")
-    grip.plot(rec.time, own_g * CM, "--", color="k", lw=1.5, label=f"{model}'s own movement")
-    grip.plot(rec.time, rec.predicted_g[i] * CM, ":", color="0.45", lw=1.2,
-              label=f"{model}, one step ahead")
+    grip.plot([], [], "-", color="k", lw=2.0, label="observed")
+    grip.plot([], [], "--", color="k", lw=1.5, label=f"{model}'s own movement")
+    grip.plot([], [], ":", color="0.45", lw=1.2, label=f"{model}, one step ahead")
     _panel(grip, "grip aperture", TIME, "grip aperture (cm)")
     _legend(grip, grip.get_lines())
+    return fig, [*paths.get_lines(), *grip.get_lines()]
+
+
+def _paths_data(fig: Figure, lines: list, rec: Recognition, model: str, placed: bool
+                ) -> Figure:
+    """Draw ``rec`` on a paths figure's lines (in :func:`_paths_layout`'s order) and title."""
+    # the movement as it was scored (at the repertoire's scale, where the model's own is)
+    obs, own = rec.scored_movement, rec.nominal(model)
+    data = []
+    for key in ("finger", "thumb", "wrist"):
+        seen, plan = getattr(obs, key), own[key]
+        if not (key == "wrist" and placed):
+            data.append((seen[:, 0], seen[:, 1]))
+        data.append((plan[:, 0], plan[:, 1]))
+    circle, rad = np.linspace(0, 2 * np.pi, 100), obs.object_diameter / 2
+    data.append((rad * np.cos(circle), rad * np.sin(circle)))
+    own_g = np.linalg.norm(own["finger"] - own["thumb"], axis=1)
+    data += [(rec.time, obs.g * CM), (rec.time, own_g * CM),
+             (rec.time, rec.predicted_g[rec.names.index(model)] * CM)]
+    for line, (x, y) in zip(lines, data, strict=True):
+        line.set_data(x, y)
+    for ax in fig.axes:  # the limits of these curves, as a new figure's would be
+        ax.relim()
+        ax.autoscale_view()
     _title(fig, f"{rec.clip}: {_verdict_line(rec)}")
     return fig
 
