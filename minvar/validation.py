@@ -220,7 +220,7 @@ def declared(cls: type | None = None, /, *, eq: bool = True,
 
     @functools.wraps(init)
     def __init__(self: Any, *args: Any, **kwargs: Any) -> None:
-        if not built.__pydantic_complete__:
+        if not getattr(built, "__pydantic_complete__", True):
             _complete(built, __init__)
         try:
             init(self, *args, **kwargs)
@@ -228,7 +228,7 @@ def declared(cls: type | None = None, /, *, eq: bool = True,
             raise input_error(exc, built, error) from None
 
     built.__init__ = __init__
-    if not built.__pydantic_complete__:  # deferred (CONFIG): built on first use
+    if not getattr(built, "__pydantic_complete__", True):  # deferred: built when first used
         # the signature pydantic gives a built class, read without building it first
         built.__signature__ = _BuiltSignature(built, __init__)
         # pydantic's own stand-in validator rebuilds the class on first use without a
