@@ -20,7 +20,6 @@ import logging
 import os
 import sys
 import time
-import traceback
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -29,6 +28,14 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 import perception.workers as workers
+from perception.batch_clip import (
+    ClipResult,
+    RunTiming,
+    _guarded,
+    _numbers,
+    _remove_outputs,
+    process_clip,
+)
 from perception.discovery import (
     ERRORS_LOG,
     REPORT_SET,
@@ -37,24 +44,17 @@ from perception.discovery import (
     discover,
     expand_recordings,
     find_clips,
+    stream_recordings,
 )
-from perception.errors import HammerMVError, InputError
+from perception.errors import InputError
 from perception.io.atomic import write_json, write_text
-from perception.io.files import input_file
-from perception.io.frame_sample import FrameSample
 from perception.io.names import output_folder, output_stem
-from perception.pipeline import (
-    TRACKS_SUFFIX,
-    RecognitionSettings,
-    clip_fingerprint,
-    load_clip,
-    recognize_tracks,
-)
+from perception.pipeline import RecognitionSettings
 from perception.provenance import code_digest
 from perception.recognition.repertoire import PlanCache, Repertoire
-from perception.report.clip import ClipSummary, clip_outputs, remove_output, write_clip_report
+from perception.report.clip import ClipSummary, clip_outputs, remove_output
 from perception.report.figures import DPI, FIGURE_FORMATS
-from perception.report.tracking import tracking_columns, write_tracking_report
+from perception.report.tracking import tracking_columns
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -66,246 +66,6 @@ __all__ = ["REPORT_SET", "BatchItem", "ClipResult", "Discovery", "RunTiming", "c
            "run_batch", "summary_table"]
 
 log = logging.getLogger(__name__)
-
-def _recognized(item: BatchItem, out: Path, repertoire: Repertoire,
-                settings: RecognitionSettings, fp: str, progress: bool,
-                plan_cache: PlanCache | None, reach: Reach | None = None):
-    """The recognition of one item and its report's extra entries."""
-    if item.kind == "mocap":
-        import dataclasses
-
-        from perception.recordings import cached_reaches, recognize_reach
-
-        if reach is None:
-            reach = cached_reaches(item.path, settings.mocap)[item.reach or 0]
-        if reach.name != item.clip:  # made safe or unique (expand_recordings)
-            reach = dataclasses.replace(reach, name=item.clip)
-        rec, info = recognize_reach(reach, repertoire, settings, settings.mocap,
-                                    plan_cache=plan_cache)
-        return rec, {"fingerprint": fp, "condition": item.condition, "input": str(item.path),
-                     "mocap": info}
-    frames = FrameSample()
-    tracks_out = output_folder(out, "tracks") / f"{output_stem(item.clip)}{TRACKS_SUFFIX}"
-    tracks = load_clip(item.path, tracks_out=tracks_out,
-                       progress=progress, setup=settings.tracking, pose=settings.pose,
-                       frames=frames, **settings.video_options())
-    rec = recognize_tracks(tracks, repertoire, settings, clip=item.clip, source=item.path,
-                           plan_cache=plan_cache)
-    tracking = write_tracking_report(tracks, out, item.clip, frames=frames)
-    return rec, {"fingerprint": fp, "condition": item.condition, "input": str(item.path),
-                 "tracking": tracking}
-
-
-def _current_report(item: BatchItem, out: Path, fingerprint: str,
-                    figure_format: str = "png") -> dict | None:
-    """The clip's finished report if it was made from this input and these settings
-    (its figures in ``figure_format``)."""
-    p = clip_outputs(out, item.clip, figure_format)
-    if not all(path.exists() for path in p.values()):
-        return None
-    try:
-        data = json.loads(p["json"].read_text())
-    except (OSError, ValueError):
-        return None
-    return data if data.get("fingerprint") == fingerprint else None
-
-
-@dataclass(frozen=True)
-class RunTiming:
-    """Where and when one clip of a batch ran: what a profile of a batch reads
-    (``tools/bench_recognition.py``: each worker's start-up, its idle time between
-    clips, the clips' own cost).
-
-    Attributes
-    ----------
-    process : int
-        The process that ran it (its id).
-    start, end : float
-        ``time.perf_counter()`` there when it began and ended, s (one clock
-        for every process of a machine on Linux and macOS).
-    cpu : float
-        CPU time that process spent on it, s.
-    """
-
-    process: int
-    start: float
-    end: float
-    cpu: float
-
-
-@dataclass(frozen=True)
-class ClipResult:
-    """How one clip of a batch went.
-
-    Attributes
-    ----------
-    clip : str
-        Clip name.
-    condition : str or None
-        Its stimulus condition, if known.
-    status : str
-        ``ok``, ``reused`` (its report was already current), ``failed``, or
-        the status of a recording's trial or movement that gives no reach to
-        score (``no reach``, ``starts in motion``, ...: :attr:`BatchItem.unscored`).
-    error : str
-        One line saying why it failed (empty otherwise).
-    rule : str
-        Rule that picks the winner.
-    summary : ClipSummary or None
-        The scored clip (None if it failed).
-    traceback : str
-        The traceback of a failure that is a bug, not bad input (empty otherwise).
-    factors : tuple of (str, str)
-        The manifest's other columns for this clip (:attr:`BatchItem.factors`).
-    reason : str
-        Why it has no result, in a sentence (a failure's error, or a trial's
-        reason: ``no reach: the hand never moved``); empty for a scored clip.
-    trial_number : str or None
-        A recording's trial's own id (:attr:`BatchItem.trial_number`).
-    reach_number : int or None
-        Which reach of its trial, from 1 (:attr:`BatchItem.reach_number`).
-    timing : RunTiming or None
-        Where and when it ran (None for a clip a worker did not run).
-    """
-
-    clip: str
-    condition: str | None
-    status: str
-    error: str = ""
-    rule: str = "likelihood"
-    summary: ClipSummary | None = None
-    traceback: str = ""
-    factors: tuple[tuple[str, str], ...] = ()
-    reason: str = ""
-    trial_number: str | None = None
-    reach_number: int | None = None
-    timing: RunTiming | None = None
-
-    @property
-    def scored(self) -> bool:
-        """Whether the clip has a result (``ok`` or ``reused``)."""
-        return self.status in ("ok", "reused")
-
-    @property
-    def winner(self) -> str | None:
-        """The winning model, if the clip was scored."""
-        return None if self.summary is None else self.summary.winner
-
-
-def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
-                 settings: RecognitionSettings, repertoire_id: str = "", *,
-                 progress: bool = False, plan_cache: PlanCache | None = None,
-                 figure_format: str = "png", dpi: int = DPI,
-                 reach: Reach | None = None) -> ClipResult:
-    """Recognise one clip through the pipeline (:mod:`perception.pipeline`) and report it.
-
-    Parameters
-    ----------
-    item : BatchItem
-        The clip.
-    out : Path
-        Report folder; tracks of videos go to ``out/tracks/``.
-    repertoire : Repertoire
-        Models to score against.
-    settings : RecognitionSettings
-        Observation and engine settings.
-    repertoire_id : str
-        Identity of the repertoire, part of the report's fingerprint.
-    progress : bool
-        Show a progress bar while tracking a video.
-    plan_cache : PlanCache, optional
-        Models re-planned for a scene, shared with the batch's other processes.
-    figure_format : str
-        The clip's figures' format, ``png``, ``svg`` or ``pdf`` (a report with
-        its figures in another format is not current: they are drawn again).
-    dpi : int
-        Their resolution, dots per inch.
-    reach : Reach, optional
-        A recording's reach ``item`` names, read by the caller: the file is
-        then not read here (a batch reads each recording once, not once per
-        worker process).
-
-    Returns
-    -------
-    ClipResult
-        ``reused`` with the summary of the existing report when it is current
-        for this input, settings and repertoire; ``failed`` with the error of
-        a bad clip (its stale outputs removed).
-    """
-    base = dict(clip=item.clip, condition=item.condition, rule=settings.hammer.rule,
-                factors=item.factors, **_numbers(item))
-    if item.unscored is not None:  # a trial that gives no reach: its row says why
-        _remove_outputs(item, out)  # an earlier run's report of it is not current
-        status, reason = item.unscored
-        return ClipResult(**base, status=status, reason=reason)
-    try:
-        input_file(item.path, "clip")  # before hashing: a FIFO or device would never end
-        fp = clip_fingerprint(item.path, settings, repertoire_id + (
-            f"#reach{item.reach}" if item.reach is not None else ""))
-        done = _current_report(item, out, fp, figure_format)
-        if done is not None:
-            return ClipResult(**base, status="reused", summary=ClipSummary.from_dict(done))
-        rec, extra = _recognized(item, out, repertoire, settings, fp, progress, plan_cache,
-                                 reach)
-        write_clip_report(rec, out, extra=extra, figure_format=figure_format, dpi=dpi)
-        return ClipResult(**base, status="ok", summary=ClipSummary.from_recognition(rec, extra))
-    except (HammerMVError, OSError) as exc:  # the clip's fault; anything else is a bug
-        msg = _first_line(exc)
-        if isinstance(exc, OSError) and item.path.name not in msg:
-            msg = f"{item.path}: {msg}"
-        log.info("%s failed: %s", item.clip, msg)
-        _remove_outputs(item, out)
-        return ClipResult(**base, status="failed", error=msg, reason=msg)
-
-
-def _numbers(item: BatchItem) -> dict:
-    """A recording's item's trial and reach numbers, for its :class:`ClipResult`."""
-    return {"trial_number": getattr(item, "trial_number", None),
-            "reach_number": getattr(item, "reach_number", None)}
-
-
-def _first_line(exc: BaseException) -> str:
-    text = str(exc).strip()
-    return text.splitlines()[0] if text else type(exc).__name__
-
-
-def _remove_outputs(item: BatchItem, out: Path) -> None:
-    """A clip that fails now must not keep a report from an earlier run.
-
-    Never raises: it runs while a failure is being recorded (a name too long
-    for the file system, a read-only folder) and must not end the batch.
-    """
-    try:
-        paths = list(dict.fromkeys(p for fmt in FIGURE_FORMATS
-                                   for p in clip_outputs(out, item.clip, fmt).values()))
-    except (OSError, ValueError) as exc:
-        log.warning("%s: cannot list its outputs to remove them: %s", item.clip, exc)
-        return
-    for path in paths:
-        try:
-            remove_output(path)
-        except OSError as exc:
-            log.warning("%s: %s", item.clip, exc)
-
-
-def _guarded(item: BatchItem, out: Path, **kwargs) -> ClipResult:
-    """:func:`process_clip` that records an unexpected error instead of raising it.
-
-    A batch goes on past any clip; the error (a bug, not bad input) is logged
-    with its traceback, reported with its type and kept with its traceback
-    (``errors.log`` in the report folder).
-    """
-    try:
-        return process_clip(item, out, **kwargs)
-    except Exception as exc:  # noqa: BLE001 - one clip must not end the batch
-        log.exception("%s: unexpected error (a bug in hammer-mv)", item.clip)
-        _remove_outputs(item, out)
-        msg = (f"{item.path}: unexpected {type(exc).__name__} (a bug in hammer-mv; "
-               f"see errors.log): {_first_line(exc)}")
-        return ClipResult(item.clip, item.condition, "failed", msg,
-                          kwargs["settings"].hammer.rule, traceback=traceback.format_exc(),
-                          factors=item.factors, reason=msg, **_numbers(item))
-
 
 @dataclass(frozen=True)
 class _Work:
@@ -398,6 +158,21 @@ def _run_local(items: list[_Work], repertoire: Repertoire, job: _Job,
         left -= 1
         if used > 1 and left == used - 1:  # a worker has nothing more to do
             _prepare_report()
+
+
+def _take_back(found: list[BatchItem], late: list[tuple[BatchItem, list[str]]],
+               done: list[ClipResult], job: _Job, repertoire: Repertoire) -> list[BatchItem]:
+    """The items of a streamed batch, each recording that failed at its end (a marker
+    never seen) as one failed item in place of the trials handed out for it, as a
+    batch that reads every recording first gives it; their outputs removed."""
+    for item, names in late:
+        gone = set(names)
+        for given in (i for i in found if i.clip in gone):
+            _remove_outputs(given, job.out)
+        found = [i for i in found if i.clip not in gone] + [item]
+        done[:] = [r for r in done if r.clip not in gone]
+        done.append(job.run(_Work(item), repertoire))  # reads it: fails with its error
+    return found
 
 
 def _prepare_report() -> None:
@@ -602,26 +377,44 @@ def run_batch(
                          field="--figure-format")
     t0 = time.perf_counter()
     # absolute: a worker, a dask one above all, may run in another folder
-    items = expand_recordings([dataclasses.replace(i, path=Path(i.path).absolute())
-                               for i in items], settings)
+    items = [dataclasses.replace(i, path=Path(i.path).absolute()) for i in items]
     out = Path(out).absolute()
     out.mkdir(parents=True, exist_ok=True)
     for sub in ("tracks", PLANS_FOLDER):  # a link leading out of the report: refused now
         output_folder(out, sub)
+    # Recordings for local workers are read while the workers score what has been
+    # read (a 600-trial table took 4.3 s to read before the first reach went out).
+    streamed = scheduler is None and jobs > 1 and any(i.kind == "mocap" for i in items)
+    late: list[tuple[BatchItem, list[str]]] = []  # recordings that failed at their end
+    if streamed:
+        found: list[BatchItem] = []
+
+        def work() -> Iterator[_Work]:
+            for item, reach in stream_recordings(items, settings, late):
+                found.append(item)
+                yield _Work(item, reach)
+            _prepare_report()  # while the workers finish the last clips
+    else:
+        items = expand_recordings(items, settings)
     # each worker one decoding and one planning thread: the parallelism is the workers'
-    parallel = scheduler is not None or min(jobs, len(items)) > 1
+    parallel = scheduler is not None or streamed or min(jobs, len(items)) > 1
     job = _Job(out, dataclasses.replace(settings, decoder_threads=1, planning_threads=1)
                if parallel else settings, repertoire_id, figure_format, dpi)
-    work = _work(items, settings)
     t1 = time.perf_counter()
-    results = (_run_dask(work, repertoire, job, scheduler) if scheduler
-               else _run_local(work, repertoire, job, jobs))
+    if streamed:
+        results = workers.run_pool(work(), job, jobs, shared=repertoire)
+    elif scheduler:
+        results = _run_dask(_work(items, settings), repertoire, job, scheduler)
+    else:
+        results = _run_local(_work(items, settings), repertoire, job, jobs)
     done: list[ClipResult] = []
-    with tqdm(total=len(items), unit="clip", file=sys.stderr, desc="batch",
-              disable=quiet or not sys.stderr.isatty()) as bar:
+    with tqdm(total=None if streamed else len(items), unit="clip", file=sys.stderr,
+              desc="batch", disable=quiet or not sys.stderr.isatty()) as bar:
         for result in results:
             done.append(result)
             bar.update()
+    if streamed:
+        items = _take_back(found, late, done, job, repertoire)
     done.sort(key=lambda r: r.clip)
     t2 = time.perf_counter()
     for path, clips in _recordings(items).items():  # reports of trials no longer in them

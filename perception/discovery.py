@@ -12,7 +12,7 @@ import dataclasses
 import logging
 import os
 import re
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -25,9 +25,11 @@ from perception.recordings import unknown_layout
 
 if TYPE_CHECKING:
     from perception.pipeline import RecognitionSettings
+    from perception.reaches import Reach
 
 __all__ = ["COMPANION_NAMES", "ERRORS_LOG", "REPORT_SET", "BatchItem", "Discovery",
-           "check_clip_name", "discover", "expand_recordings", "find_clips", "safe_clip_name"]
+           "check_clip_name", "discover", "expand_recordings", "find_clips", "safe_clip_name",
+           "stream_recordings"]
 
 log = logging.getLogger(__name__)
 
@@ -311,15 +313,13 @@ def expand_recordings(items: Iterable[BatchItem], settings: RecognitionSettings
         A factor with one value in the manifest and another in a trial's
         columns or a file's name (or a bad ``factors_from_name``).
     """
-    from perception.reaches import Reach
     from perception.recordings import MocapImport, cached_recording
 
     mocap = getattr(settings, "mocap", None) or MocapImport()
     out = []
     for item in items:
-        if item.kind != "mocap" or item.reach is not None or item.unscored is not None:
-            out.append(_with_factors(item, mocap.name_factors(item.path) if item.reach is None
-                                     and item.unscored is None else {}))
+        if not _a_recording(item):
+            out.append(_as_given(item, mocap))
             continue
         try:
             recording = cached_recording(item.path, settings.mocap)
@@ -332,13 +332,103 @@ def expand_recordings(items: Iterable[BatchItem], settings: RecognitionSettings
             # processed, it fails with its traceback in errors.log
             out.append(_with_factors(item, mocap.name_factors(item.path)))
             continue
-        stem, k = item.path.stem, 0
-        for entry in recording.entries:
+        by_trial = ((next((t for t in sorted(recording.trials, key=len, reverse=True)
+                           if e.name == t or e.name.startswith(f"{t}-")), e.name), [e])
+                    for e in recording.entries)
+        out += [new for new, _ in _recording_items(item, by_trial)]
+    return _unique_clips(out)
+
+
+def stream_recordings(items: Iterable[BatchItem], settings: RecognitionSettings,
+                      failed: list[tuple[BatchItem, list[str]]]
+                      ) -> Iterator[tuple[BatchItem, Reach | None]]:
+    """:func:`expand_recordings`' items one trial at a time, as each is read, each reach
+    with its samples: a batch hands them out while it reads the rest.
+
+    Names are made unique as they come, in the same order, so the items are
+    :func:`expand_recordings`' while every recording reads to its end. One that
+    cannot be read at all is one item (it fails where it runs), as there; one
+    found at its end to give nothing (a marker never seen in any trial) has
+    had its trials handed out already: it is appended to ``failed`` with the
+    names of the items given for it, for its caller to take back.
+
+    Parameters
+    ----------
+    items : iterable of BatchItem
+        Clips (see :func:`discover`).
+    settings : RecognitionSettings
+        Their ``mocap`` settings say how recordings are read.
+    failed : list
+        Where a recording that fails at its end goes, as ``(item, names)``.
+
+    Yields
+    ------
+    (BatchItem, Reach or None)
+        Each item, with its reach for a recording's reach.
+
+    Raises
+    ------
+    InputError
+        As :func:`expand_recordings` (a factor given two values), once the
+        trial that says so is read.
+    """
+    from perception.recordings import MocapImport
+
+    mocap = getattr(settings, "mocap", None) or MocapImport()
+    seen: set[str] = set()
+    for item in items:
+        if not _a_recording(item):
+            yield _unique(_as_given(item, mocap), seen), None
+            continue
+        fault: list[BaseException] = []
+        given: list[str] = []
+        for new, reach in _recording_items(item, _read(item.path, settings.mocap, fault)):
+            new = _unique(new, seen)
+            given.append(new.clip)
+            yield new, reach
+        if fault:  # as expand_recordings: one item, which fails where it runs
+            whole = _unique(_with_factors(item, mocap.name_factors(item.path)), seen)
+            if given:
+                failed.append((whole, given))
+            else:
+                yield whole, None
+
+
+def _read(path: Path, options, fault: list[BaseException]):
+    """:func:`~perception.recordings.iter_recording`, its failure put in ``fault``."""
+    from perception.recordings import iter_recording
+
+    try:
+        yield from iter_recording(path, options)
+    except (HammerMVError, OSError) as exc:
+        fault.append(exc)
+    except Exception as exc:  # noqa: BLE001 - a bug reading one file must not end the batch
+        log.debug("%s: unreadable (a bug); it fails when processed", path, exc_info=True)
+        fault.append(exc)
+
+
+def _a_recording(item: BatchItem) -> bool:
+    """Whether ``item`` is a motion-capture recording still to be read into reaches."""
+    return item.kind == "mocap" and item.reach is None and item.unscored is None
+
+
+def _as_given(item: BatchItem, mocap) -> BatchItem:
+    """An item that is not a recording to read, with the factors its file name gives."""
+    return _with_factors(item, mocap.name_factors(item.path) if item.reach is None
+                         and item.unscored is None else {})
+
+
+def _recording_items(item: BatchItem, trials) -> Iterator[tuple[BatchItem, Reach | None]]:
+    """A recording's items, from its trials' entries (``(trial name, entries)``, in
+    order), each reach with its samples; names not yet unique."""
+    from perception.reaches import Reach
+
+    stem, k = item.path.stem, 0
+    for trial, entries in trials:
+        for entry in entries:
             name = entry.name
             if item.clip != stem and name.startswith(stem):  # named by its file's name
                 name = item.clip + name[len(stem):]
-            trial = next((t for t in sorted(recording.trials, key=len, reverse=True)
-                          if entry.name == t or entry.name.startswith(f"{t}-")), entry.name)
             common = dict(clip=safe_clip_name(name, str(item.path)), path=item.path,
                           kind="mocap", condition=item.condition, factors=item.factors,
                           trial=trial, trial_number=entry.trial_number or None,
@@ -348,9 +438,9 @@ def expand_recordings(items: Iterable[BatchItem], settings: RecognitionSettings
                 k += 1
             else:
                 new = BatchItem(**common, unscored=(entry.status, entry.reason))
-            out.append(_with_factors(new, entry.factors,
-                                     f"{item.path.name}'s trial columns or file name"))
-    return _unique_clips(out)
+            yield (_with_factors(new, entry.factors,
+                                 f"{item.path.name}'s trial columns or file name"),
+                   entry if isinstance(entry, Reach) else None)
 
 
 def _with_factors(item: BatchItem, found, source: str | None = None) -> BatchItem:
@@ -405,12 +495,14 @@ def _unique_clips(items: list[BatchItem]) -> list[BatchItem]:
     """``items`` with a clip name taken twice made unique (``~2``, ``~3``, ...): no two
     clips' reports overwrite each other."""
     seen: set[str] = set()
-    out = []
-    for item in items:
-        name, k = item.clip, 1
-        while name in seen:
-            k += 1
-            name = f"{item.clip}~{k}"
-        seen.add(name)
-        out.append(item if name == item.clip else dataclasses.replace(item, clip=name))
-    return out
+    return [_unique(item, seen) for item in items]
+
+
+def _unique(item: BatchItem, seen: set[str]) -> BatchItem:
+    """``item`` with a name none of ``seen`` has (``~2``, ``~3``, ...), added to it."""
+    name, k = item.clip, 1
+    while name in seen:
+        k += 1
+        name = f"{item.clip}~{k}"
+    seen.add(name)
+    return item if name == item.clip else dataclasses.replace(item, clip=name)

@@ -25,6 +25,7 @@ import itertools
 import logging
 import math
 import re
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Annotated, Literal, NamedTuple
 
@@ -50,8 +51,8 @@ from perception.reaches import (
 from perception.validation import Tuple, declared
 
 __all__ = ["MocapImport", "PreparedReach", "Recording", "cached_reaches", "cached_recording",
-           "prepare_reach", "read_reaches", "read_recording", "recognize_reach",
-           "trial_summary", "unknown_layout"]
+           "iter_recording", "prepare_reach", "read_reaches", "read_recording",
+           "recognize_reach", "trial_summary", "unknown_layout"]
 
 log = logging.getLogger(__name__)
 
@@ -319,6 +320,33 @@ def read_recording(path, options: MocapImport | None = None) -> Recording:
         or a digit's (or a mapped wrist's) marker is never seen in any trial
         (mistakes that hold for every trial).
     """
+    trials = list(iter_recording(path, options))
+    return Recording(str(path), tuple(name for name, _ in trials),
+                     tuple(e for _, entries in trials for e in entries))
+
+
+def iter_recording(path, options: MocapImport | None = None
+                   ) -> Iterator[tuple[str, list[Reach | Unscored]]]:
+    """:func:`read_recording` trial by trial, each as soon as it is read: what a batch
+    hands out while it reads the rest.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The recording.
+    options : MocapImport, optional
+
+    Yields
+    ------
+    (str, list of Reach or Unscored)
+        A trial's name and its entries (:attr:`Recording.entries`).
+
+    Raises
+    ------
+    InputError
+        As :func:`read_recording`; a marker never seen in any trial only once
+        every trial has been yielded.
+    """
     from perception.io.mocap import read_mocap
     from perception.plausibility import SCALE_TRIALS, check_scale
 
@@ -326,15 +354,14 @@ def read_recording(path, options: MocapImport | None = None) -> Recording:
     options = MocapImport() if options is None else options
     trials = read_mocap(path, **options.read_options())
     from_name = options.name_factors(path)
-    entries: list[Reach | Unscored] = []
     # one pass: a large table's trials are read from the file on each (TrialStream)
-    names, seen = [], {}
+    count, seen = 0, {}
     # a unit or a rate no human hand fits is every trial's: said before any reach is sought
     read = iter(trials)
     first = list(itertools.islice(read, SCALE_TRIALS))
     check_scale(first, path, options)
     for trial in itertools.chain(first, read):
-        names.append(trial.name)
+        count += 1
         _note_seen(seen, trial, options.markers)
         source = str(trial.source)
         factors = merge_factors([("the table's columns", trial.factors),
@@ -354,10 +381,9 @@ def read_recording(path, options: MocapImport | None = None) -> Recording:
                 f"(a bug in hammer-mv){': ' + said[0] if said else ''}", **labels)]
         if not reaches and not unscored:  # every trial leaves a word
             unscored = [Unscored(trial.name, source, "no reach", "no reach found", **labels)]
-        entries += sorted([*reaches, *unscored], key=_start)
-    if (lost := _never_seen(seen, len(names))) is not None:
+        yield trial.name, sorted([*reaches, *unscored], key=_start)
+    if (lost := _never_seen(seen, count)) is not None:
         raise InputError(lost, path)
-    return Recording(str(path), tuple(names), tuple(entries))
 
 
 def _note_seen(seen: dict, trial, markers: MarkerMap | None) -> None:

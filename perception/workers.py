@@ -22,11 +22,11 @@ by SIGKILL: it watches its end of multiprocessing's pipe from this process.
 
 from __future__ import annotations
 
+import itertools
 import multiprocessing
 import os
 import pickle
 import threading
-from collections import deque
 from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
@@ -101,7 +101,8 @@ def run_pool(items: Iterable, job: Job, jobs: int, *, shared: Any = None,
     Parameters
     ----------
     items : iterable
-        The work (picklable).
+        The work (picklable); without ``size``, taken one at a time as
+        workers come free (a generator may still be making them).
     job : Job
         Picklable; ``job.run`` returns each item's (picklable) result.
     jobs : int
@@ -117,26 +118,35 @@ def run_pool(items: Iterable, job: Job, jobs: int, *, shared: Any = None,
     object
         Each item's result, in the order they finish.
     """
-    items = list(items)
     if size is not None:
-        items.sort(key=size, reverse=True)  # stable: equal sizes keep their order
-    if jobs <= 1 or len(items) <= 1:
-        for item in items:
+        items = sorted(items, key=size, reverse=True)  # stable: equal sizes keep their order
+    todo = iter(items)  # else taken as they come: the caller may still be making them
+    first = list(itertools.islice(todo, 2))
+    if jobs <= 1 or len(first) <= 1:
+        for item in itertools.chain(first, todo):
             yield job.run(item, shared)
         return
+    todo = itertools.chain(first, todo)
     state = pickle.dumps((job, shared), protocol=pickle.HIGHEST_PROTOCOL)
 
     def worker() -> ProcessPoolExecutor:  # starts its process when first given an item
         return ProcessPoolExecutor(1, mp_context=_context(), initializer=init_worker,
                                    initargs=(state,))
 
-    todo, idle = deque(items), [worker() for _ in range(min(jobs, len(items)))]
+    idle = [worker() for _ in range(jobs)]
     running: dict = {}  # future: (its worker, its item)
+    more = True
     try:
-        while todo or running:
-            while todo and idle:
-                w, item = idle.pop(), todo.popleft()
+        while more or running:
+            while more and idle:
+                item = next(todo, _END)
+                if item is _END:
+                    more = False
+                    break
+                w = idle.pop()
                 running[w.submit(_run, item)] = w, item
+            if not running:
+                break
             for future in wait(running, return_when=FIRST_COMPLETED).done:
                 w, item = running.pop(future)
                 try:
@@ -149,6 +159,10 @@ def run_pool(items: Iterable, job: Job, jobs: int, *, shared: Any = None,
     finally:  # interrupted, or a consumer that stops early: nothing more starts
         for w in idle + [w for w, _ in running.values()]:
             w.shutdown(wait=True)
+
+
+#: What the items' iterator gives when it has no more.
+_END = object()
 
 
 def _lost(job: Job, item: Any, exc: BaseException) -> Any:

@@ -6,6 +6,7 @@ import shutil
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 
 import perception.recordings as recordings
@@ -57,3 +58,50 @@ def test_the_batch_says_where_its_time_went(session, tmp_path):
     assert runs.shape == (len(summary), 4)  # a row per summary row, every one run here
     assert not np.isnan(runs).any() and (runs[:, 2] >= runs[:, 1]).all()
     assert (runs[:, 2] - runs[:, 1]).sum() <= timing["clips"] + 1e-6  # one process: in turn
+
+
+def _same(a, b):
+    pd.testing.assert_frame_equal(a.reset_index(drop=True), b.reset_index(drop=True))
+
+
+def test_a_recording_read_while_its_reaches_are_scored(session, tmp_path):
+    """--jobs 2 hands out a recording's reaches as it reads them: the same rows as one
+    process that reads it whole first, every trial counted, the timing of each."""
+    shutil.copy(TABLE, session / "more.tsv")
+    one = run_batch(discover(session), tmp_path / "one", Repertoire.default(), SETTINGS,
+                    quiet=True)
+    two = run_batch(discover(session), tmp_path / "two", Repertoire.default(), SETTINGS,
+                    quiet=True, jobs=2)
+    assert len(one) == 8 and one.attrs["trials"] == two.attrs["trials"] == 8
+    _same(one, two)
+    runs = two.attrs["timing"]["runs"]
+    assert len(np.unique(runs[:, 0])) == 2  # two workers ran them
+    for out in ("one", "two"):
+        assert len(list((tmp_path / out).glob("*.recognition.json"))) == 8
+
+
+def test_a_recording_that_fails_at_its_end_is_taken_back(session, tmp_path, monkeypatch):
+    """A recording found at its end to give nothing (a marker never seen) has had its
+    trials handed out: they are taken back, outputs and rows, and the recording is
+    one failed row, as when it is read whole first."""
+    from perception.errors import InputError
+
+    real = recordings.iter_recording
+
+    def fails_at_the_end(path, options=None):
+        yield from real(path, options)
+        raise InputError("marker 'thumb' is never seen in any of its 4 trials", path)
+
+    monkeypatch.setattr(recordings, "iter_recording", fails_at_the_end)
+    recordings._cached.cache_clear()
+    shutil.copy(TABLE, session / "other.tsv")  # a recording read to its end, for contrast
+    out = {}
+    for jobs in (1, 2):
+        out[jobs] = run_batch(discover(session), tmp_path / f"j{jobs}", Repertoire.default(),
+                              SETTINGS, quiet=True, jobs=jobs)
+        recordings._cached.cache_clear()
+    _same(out[1], out[2])
+    failed = out[2][out[2]["status"] == "failed"]
+    assert list(failed["clip"]) == ["other", "trials"]  # both fail: the patch holds for each
+    assert failed["error"].str.contains("never seen").all()
+    assert not list((tmp_path / "j2").glob("*.recognition.json"))  # the trials' taken back

@@ -202,32 +202,33 @@ def test_a_silent_scheduler_fails_in_bounded_time(tracks_folder, repfile, tmp_pa
 def test_a_failure_while_recording_a_failure_does_not_end_the_batch(tracks_folder, tmp_path,
                                                                      monkeypatch):
     import perception.batch as batch
+    import perception.batch_clip as batch_clip
 
     def broken(out, clip, *figure_format):
         raise OSError(36, "File name too long")
 
     (tracks_folder / "empty.tracks.h5").write_bytes(b"")  # fails: its error handler runs
-    monkeypatch.setattr(batch, "clip_outputs", broken)
+    monkeypatch.setattr(batch_clip, "clip_outputs", broken)
     items = discover(tracks_folder)
-    summary = batch.summary_table([batch._guarded(i, tmp_path / "out",
-                                                  repertoire=default_repertoire(),
-                                                  settings=batch.RecognitionSettings(),
-                                                  repertoire_id="")
+    summary = batch.summary_table([batch_clip._guarded(i, tmp_path / "out",
+                                                       repertoire=default_repertoire(),
+                                                       settings=batch.RecognitionSettings(),
+                                                       repertoire_id="")
                                    for i in items if i.clip == "empty"])
     assert summary.loc[0, "status"] == "failed"
 
 
 def test_a_bug_in_one_clip_is_kept_with_its_traceback(tracks_folder, tmp_path, monkeypatch):
-    import perception.batch as batch
+    import perception.batch_clip as batch_clip
 
-    real = batch.recognize_tracks
+    real = batch_clip.recognize_tracks
 
     def buggy(tracks, *args, clip=None, **kwargs):
         if clip == "delayed":
             raise ZeroDivisionError("a bug")
         return real(tracks, *args, clip=clip, **kwargs)
 
-    monkeypatch.setattr(batch, "recognize_tracks", buggy)
+    monkeypatch.setattr(batch_clip, "recognize_tracks", buggy)
     out = tmp_path / "out"
     summary = run_batch(discover(tracks_folder), out, default_repertoire(), quiet=True)
     s = summary.set_index("clip")
@@ -236,7 +237,7 @@ def test_a_bug_in_one_clip_is_kept_with_its_traceback(tracks_folder, tmp_path, m
     log = (out / "errors.log").read_text()
     assert "Traceback" in log and "ZeroDivisionError: a bug" in log and "== delayed" in log
     # a later clean run removes the stale log
-    monkeypatch.setattr(batch, "recognize_tracks", real)
+    monkeypatch.setattr(batch_clip, "recognize_tracks", real)
     run_batch(discover(tracks_folder), out, default_repertoire(), quiet=True)
     assert not (out / "errors.log").exists()
 

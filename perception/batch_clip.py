@@ -1,0 +1,280 @@
+"""One clip of a batch: recognised, reported, and how it went (:class:`ClipResult`).
+
+:func:`process_clip` is what each worker of a batch (:mod:`perception.batch`)
+runs for a clip: the pipeline (:mod:`perception.pipeline`) and the clip's
+report, or the reason it has none; a report already current for the same
+input, settings, repertoire and code is reused.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import traceback
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from perception.discovery import BatchItem
+from perception.errors import HammerMVError
+from perception.io.files import input_file
+from perception.io.frame_sample import FrameSample
+from perception.io.names import output_folder, output_stem
+from perception.pipeline import (
+    TRACKS_SUFFIX,
+    RecognitionSettings,
+    clip_fingerprint,
+    load_clip,
+    recognize_tracks,
+)
+from perception.recognition.repertoire import PlanCache, Repertoire
+from perception.report.clip import ClipSummary, clip_outputs, remove_output, write_clip_report
+from perception.report.figures import DPI, FIGURE_FORMATS
+from perception.report.tracking import write_tracking_report
+
+if TYPE_CHECKING:
+    from perception.reach_data import Reach
+
+__all__ = ["ClipResult", "RunTiming", "process_clip"]
+
+log = logging.getLogger("perception.batch")
+
+
+def _recognized(item: BatchItem, out: Path, repertoire: Repertoire,
+                settings: RecognitionSettings, fp: str, progress: bool,
+                plan_cache: PlanCache | None, reach: Reach | None = None):
+    """The recognition of one item and its report's extra entries."""
+    if item.kind == "mocap":
+        import dataclasses
+
+        from perception.recordings import cached_reaches, recognize_reach
+
+        if reach is None:
+            reach = cached_reaches(item.path, settings.mocap)[item.reach or 0]
+        if reach.name != item.clip:  # made safe or unique (expand_recordings)
+            reach = dataclasses.replace(reach, name=item.clip)
+        rec, info = recognize_reach(reach, repertoire, settings, settings.mocap,
+                                    plan_cache=plan_cache)
+        return rec, {"fingerprint": fp, "condition": item.condition, "input": str(item.path),
+                     "mocap": info}
+    frames = FrameSample()
+    tracks_out = output_folder(out, "tracks") / f"{output_stem(item.clip)}{TRACKS_SUFFIX}"
+    tracks = load_clip(item.path, tracks_out=tracks_out,
+                       progress=progress, setup=settings.tracking, pose=settings.pose,
+                       frames=frames, **settings.video_options())
+    rec = recognize_tracks(tracks, repertoire, settings, clip=item.clip, source=item.path,
+                           plan_cache=plan_cache)
+    tracking = write_tracking_report(tracks, out, item.clip, frames=frames)
+    return rec, {"fingerprint": fp, "condition": item.condition, "input": str(item.path),
+                 "tracking": tracking}
+
+
+def _current_report(item: BatchItem, out: Path, fingerprint: str,
+                    figure_format: str = "png") -> dict | None:
+    """The clip's finished report if it was made from this input and these settings
+    (its figures in ``figure_format``)."""
+    p = clip_outputs(out, item.clip, figure_format)
+    if not all(path.exists() for path in p.values()):
+        return None
+    try:
+        data = json.loads(p["json"].read_text())
+    except (OSError, ValueError):
+        return None
+    return data if data.get("fingerprint") == fingerprint else None
+
+
+@dataclass(frozen=True)
+class RunTiming:
+    """Where and when one clip of a batch ran: what a profile of a batch reads
+    (``tools/bench_recognition.py``: each worker's start-up, its idle time between
+    clips, the clips' own cost).
+
+    Attributes
+    ----------
+    process : int
+        The process that ran it (its id).
+    start, end : float
+        ``time.perf_counter()`` there when it began and ended, s (one clock
+        for every process of a machine on Linux and macOS).
+    cpu : float
+        CPU time that process spent on it, s.
+    """
+
+    process: int
+    start: float
+    end: float
+    cpu: float
+
+
+@dataclass(frozen=True)
+class ClipResult:
+    """How one clip of a batch went.
+
+    Attributes
+    ----------
+    clip : str
+        Clip name.
+    condition : str or None
+        Its stimulus condition, if known.
+    status : str
+        ``ok``, ``reused`` (its report was already current), ``failed``, or
+        the status of a recording's trial or movement that gives no reach to
+        score (``no reach``, ``starts in motion``, ...: :attr:`BatchItem.unscored`).
+    error : str
+        One line saying why it failed (empty otherwise).
+    rule : str
+        Rule that picks the winner.
+    summary : ClipSummary or None
+        The scored clip (None if it failed).
+    traceback : str
+        The traceback of a failure that is a bug, not bad input (empty otherwise).
+    factors : tuple of (str, str)
+        The manifest's other columns for this clip (:attr:`BatchItem.factors`).
+    reason : str
+        Why it has no result, in a sentence (a failure's error, or a trial's
+        reason: ``no reach: the hand never moved``); empty for a scored clip.
+    trial_number : str or None
+        A recording's trial's own id (:attr:`BatchItem.trial_number`).
+    reach_number : int or None
+        Which reach of its trial, from 1 (:attr:`BatchItem.reach_number`).
+    timing : RunTiming or None
+        Where and when it ran (None for a clip a worker did not run).
+    """
+
+    clip: str
+    condition: str | None
+    status: str
+    error: str = ""
+    rule: str = "likelihood"
+    summary: ClipSummary | None = None
+    traceback: str = ""
+    factors: tuple[tuple[str, str], ...] = ()
+    reason: str = ""
+    trial_number: str | None = None
+    reach_number: int | None = None
+    timing: RunTiming | None = None
+
+    @property
+    def scored(self) -> bool:
+        """Whether the clip has a result (``ok`` or ``reused``)."""
+        return self.status in ("ok", "reused")
+
+    @property
+    def winner(self) -> str | None:
+        """The winning model, if the clip was scored."""
+        return None if self.summary is None else self.summary.winner
+
+
+def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
+                 settings: RecognitionSettings, repertoire_id: str = "", *,
+                 progress: bool = False, plan_cache: PlanCache | None = None,
+                 figure_format: str = "png", dpi: int = DPI,
+                 reach: Reach | None = None) -> ClipResult:
+    """Recognise one clip through the pipeline (:mod:`perception.pipeline`) and report it.
+
+    Parameters
+    ----------
+    item : BatchItem
+        The clip.
+    out : Path
+        Report folder; tracks of videos go to ``out/tracks/``.
+    repertoire : Repertoire
+        Models to score against.
+    settings : RecognitionSettings
+        Observation and engine settings.
+    repertoire_id : str
+        Identity of the repertoire, part of the report's fingerprint.
+    progress : bool
+        Show a progress bar while tracking a video.
+    plan_cache : PlanCache, optional
+        Models re-planned for a scene, shared with the batch's other processes.
+    figure_format : str
+        The clip's figures' format, ``png``, ``svg`` or ``pdf`` (a report with
+        its figures in another format is not current: they are drawn again).
+    dpi : int
+        Their resolution, dots per inch.
+    reach : Reach, optional
+        A recording's reach ``item`` names, read by the caller: the file is
+        then not read here (a batch reads each recording once, not once per
+        worker process).
+
+    Returns
+    -------
+    ClipResult
+        ``reused`` with the summary of the existing report when it is current
+        for this input, settings and repertoire; ``failed`` with the error of
+        a bad clip (its stale outputs removed).
+    """
+    base = dict(clip=item.clip, condition=item.condition, rule=settings.hammer.rule,
+                factors=item.factors, **_numbers(item))
+    if item.unscored is not None:  # a trial that gives no reach: its row says why
+        _remove_outputs(item, out)  # an earlier run's report of it is not current
+        status, reason = item.unscored
+        return ClipResult(**base, status=status, reason=reason)
+    try:
+        input_file(item.path, "clip")  # before hashing: a FIFO or device would never end
+        fp = clip_fingerprint(item.path, settings, repertoire_id + (
+            f"#reach{item.reach}" if item.reach is not None else ""))
+        done = _current_report(item, out, fp, figure_format)
+        if done is not None:
+            return ClipResult(**base, status="reused", summary=ClipSummary.from_dict(done))
+        rec, extra = _recognized(item, out, repertoire, settings, fp, progress, plan_cache,
+                                 reach)
+        write_clip_report(rec, out, extra=extra, figure_format=figure_format, dpi=dpi)
+        return ClipResult(**base, status="ok", summary=ClipSummary.from_recognition(rec, extra))
+    except (HammerMVError, OSError) as exc:  # the clip's fault; anything else is a bug
+        msg = _first_line(exc)
+        if isinstance(exc, OSError) and item.path.name not in msg:
+            msg = f"{item.path}: {msg}"
+        log.info("%s failed: %s", item.clip, msg)
+        _remove_outputs(item, out)
+        return ClipResult(**base, status="failed", error=msg, reason=msg)
+
+
+def _numbers(item: BatchItem) -> dict:
+    """A recording's item's trial and reach numbers, for its :class:`ClipResult`."""
+    return {"trial_number": getattr(item, "trial_number", None),
+            "reach_number": getattr(item, "reach_number", None)}
+
+
+def _first_line(exc: BaseException) -> str:
+    text = str(exc).strip()
+    return text.splitlines()[0] if text else type(exc).__name__
+
+
+def _remove_outputs(item: BatchItem, out: Path) -> None:
+    """A clip that fails now must not keep a report from an earlier run.
+
+    Never raises: it runs while a failure is being recorded (a name too long
+    for the file system, a read-only folder) and must not end the batch.
+    """
+    try:
+        paths = list(dict.fromkeys(p for fmt in FIGURE_FORMATS
+                                   for p in clip_outputs(out, item.clip, fmt).values()))
+    except (OSError, ValueError) as exc:
+        log.warning("%s: cannot list its outputs to remove them: %s", item.clip, exc)
+        return
+    for path in paths:
+        try:
+            remove_output(path)
+        except OSError as exc:
+            log.warning("%s: %s", item.clip, exc)
+
+
+def _guarded(item: BatchItem, out: Path, **kwargs) -> ClipResult:
+    """:func:`process_clip` that records an unexpected error instead of raising it.
+
+    A batch goes on past any clip; the error (a bug, not bad input) is logged
+    with its traceback, reported with its type and kept with its traceback
+    (``errors.log`` in the report folder).
+    """
+    try:
+        return process_clip(item, out, **kwargs)
+    except Exception as exc:  # noqa: BLE001 - one clip must not end the batch
+        log.exception("%s: unexpected error (a bug in hammer-mv)", item.clip)
+        _remove_outputs(item, out)
+        msg = (f"{item.path}: unexpected {type(exc).__name__} (a bug in hammer-mv; "
+               f"see errors.log): {_first_line(exc)}")
+        return ClipResult(item.clip, item.condition, "failed", msg,
+                          kwargs["settings"].hammer.rule, traceback=traceback.format_exc(),
+                          factors=item.factors, reason=msg, **_numbers(item))
