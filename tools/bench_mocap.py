@@ -92,8 +92,9 @@ def scoring() -> None:
             (f"recognize, {n} trials, no figures", f"{wall:.1f} s (CPU {cpu:.1f} s)",
              f"target <= 60 s; one trial {base_wall:.2f} s x {n} = {base_wall * n:.0f} s",
              "ok" if wall <= 60 else "MISSED"),
-            (f"batch --jobs 2, {n} trials, figures and report", f"{batch[2][0]:.1f} s "
-             f"(CPU {batch[2][1]:.1f} s)", "target <= 20 s (2 cores)",
+            # the workers' CPU is not the parent's (forkserver's children): not shown
+            (f"batch --jobs 2, {n} trials, figures and report", f"{batch[2][0]:.1f} s",
+             "target <= 20 s (2 cores)",
              "ok" if batch[2][0] <= 20 else "MISSED"),
             (f"batch --jobs 1, {n} trials, figures and report", f"{batch[1][0]:.1f} s "
              f"(CPU {batch[1][1]:.1f} s)", "target <= 15 s on a quiet 16-core machine; "
