@@ -39,6 +39,7 @@ reaches at 1 m/s), while the spikes seen in real recordings are 15-80 mm.
 from __future__ import annotations
 
 import math
+import threading
 from dataclasses import dataclass
 from typing import Annotated
 
@@ -210,6 +211,13 @@ def spikes(time: np.ndarray, path: np.ndarray, ok: np.ndarray | None = None,
            params: CleaningParams | None = None) -> np.ndarray:
     """(N,) samples off the running median of the seen samples around them: spikes.
 
+    A path that begins with one tested before in this thread (the same seen
+    samples and times, bitwise, the same window) is tested again only from
+    ``3 x window`` samples before that one's end: a sample's flag reads the
+    samples within three windows of it, so those before are as they were
+    (:func:`_resumed`; a stream's landmarks test a path one row longer at
+    every row).
+
     Parameters
     ----------
     time : (N,) array
@@ -229,18 +237,22 @@ def spikes(time: np.ndarray, path: np.ndarray, ok: np.ndarray | None = None,
     if len(idx) < 2 * half + 1:
         return np.zeros(len(path), dtype=bool)
     seen = path[idx]
+    ts = np.asarray(time, dtype=float)[idx]
+    start, before, best = _resumed(ts, seen, half, params)
     # mirrored at the ends, so that a first sample off the path meets the
-    # samples after it, not copies of itself
-    med = median_filter(seen, size=(2 * half + 1, 1), mode="mirror")
-    off = np.linalg.norm(seen - med, axis=1) > params.spike_distance
+    # samples after it, not copies of itself; a sample's median reads ``half``
+    # either side, so from ``start - half`` on the medians from ``start`` are
+    # those of the whole path
+    lo = max(0, start - half)
+    med = median_filter(seen[lo:], size=(2 * half + 1, 1), mode="mirror")[start - lo:]
+    off = np.r_[before, np.linalg.norm(seen[start:] - med, axis=1) > params.spike_distance]
     # A spike in the window shifts its neighbours' median by one sample's motion,
     # which at video rates (33 ms a frame) is a centimetre of a fast reach: a
     # sample found off is judged again against the samples around it that are
     # not (the line between the nearest on either side, within twice the window;
     # at an end of the path the median of those within the window), and
     # kept if it lies on their path.
-    ts = np.asarray(time, dtype=float)[idx]
-    for i in np.flatnonzero(off):
+    for i in np.flatnonzero(off[start:]) + start:
         # the nearest samples not found off, within twice the window either side
         near = np.arange(max(0, i - 2 * half), min(len(seen), i + 2 * half + 1))
         near = near[~off[near]]
@@ -253,9 +265,51 @@ def spikes(time: np.ndarray, path: np.ndarray, ok: np.ndarray | None = None,
             ref = np.median(seen[close], axis=0) if len(close) else None
         if ref is not None and np.linalg.norm(seen[i] - ref) <= params.spike_distance:
             off[i] = False
+    # the path this one resumed is superseded by it
+    _SPIKES.kept = [(half, params, ts, seen, off),
+                    *(k for k in getattr(_SPIKES, "kept", ()) if k is not best)][:KEPT_PATHS]
     out = np.zeros(len(path), dtype=bool)
     out[idx[off]] = True
     return out
+
+
+def _begins(ts: np.ndarray, seen: np.ndarray, kept: tuple) -> bool:
+    """Whether the seen samples ``ts, seen`` begin with a kept path's, bitwise."""
+    n = len(kept[2])
+    # another marker's path differs at its last sample: told apart before comparing all
+    return (0 < n <= len(ts) and kept[3].shape[1:] == seen.shape[1:]
+            and np.array_equal(kept[3][-1], seen[n - 1], equal_nan=True)
+            and np.array_equal(kept[3], seen[:n], equal_nan=True)
+            and np.array_equal(kept[2], ts[:n]))
+
+
+def _resumed(ts: np.ndarray, seen: np.ndarray, half: int, params: CleaningParams
+             ) -> tuple[int, np.ndarray, tuple | None]:
+    """The first seen sample to test again, the final flags of those before it, and the
+    path kept that they come from.
+
+    A sample's first flag reads the ``half`` samples either side (the
+    median; mirrored at the path's end), and its final flag the first flags
+    within ``2 x half`` of it and the final flags before it. The samples
+    ``3 x half`` or more before the end of the longest path kept (in this
+    thread, with this window) that this one begins with never read past that
+    end: their flags are that path's. (0, no flags, None) when none is kept.
+    """
+    best = None
+    for kept in getattr(_SPIKES, "kept", ()):
+        if (kept[0] == half and kept[1] == params and _begins(ts, seen, kept)
+                and (best is None or len(kept[2]) > len(best[2]))):
+            best = kept
+    if best is None:
+        return 0, np.zeros(0, dtype=bool), None
+    start = max(0, len(best[2]) - 3 * half - 1)
+    return start, best[4][:start], best
+
+
+#: Paths tested for spikes in this thread and their flags, longest-resumable (:func:`spikes`).
+_SPIKES = threading.local()
+#: Paths kept per thread: a recognition's landmarks test three markers' paths.
+KEPT_PATHS = 6
 
 
 def clean_path(time: np.ndarray, path: np.ndarray, params: CleaningParams | None = None, *,

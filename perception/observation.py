@@ -482,7 +482,15 @@ def onset_time(filtered: np.ndarray, time: np.ndarray, noise: float, params: Obs
     InputError
         The wrist never leaves its rest position.
     """
+    # the onset found in rows this one begins with (a stream's last recognition): the
+    # rows up to the crossing's hold decide it, and they are the same numbers
+    kept = getattr(_ONSET, "last", None) if rest is None else None
+    if (kept is not None and kept[0] == (params, noise) and len(kept[1]) <= len(filtered)
+            and np.array_equal(kept[1], filtered[: len(kept[1])], equal_nan=True)
+            and np.array_equal(kept[2], time[: len(kept[2])])):
+        return kept[3]
     w = filtered[:, 0]
+    given = rest is not None
     rest = np.median(w[: params.rest_frames], axis=0) if rest is None else rest
     disp = np.linalg.norm(w - rest, axis=1)
     threshold = max(params.onset_displacement, params.onset_noise_factor * noise)
@@ -500,7 +508,18 @@ def onset_time(filtered: np.ndarray, time: np.ndarray, noise: float, params: Obs
         crossing = time[i - 1] + frac * (time[i] - time[i - 1])
     else:
         crossing = time[i]
-    return float(crossing - params.onset_latency(threshold))
+    onset = float(crossing - params.onset_latency(threshold))
+    m = max(i + hold, params.rest_frames)
+    if not given and m <= len(filtered):
+        # rows after the crossing's hold never change it: more rows, the same onset
+        _ONSET.last = ((params, noise), np.array(filtered[:m]), np.array(time[:m]), onset)
+    return onset
+
+
+#: The last onset found in this thread and the rows that decided it (:func:`onset_time`).
+_ONSET = threading.local()
+#: The last end scanned in this thread: its rule, rows and last moving row (:func:`_end_row`).
+_END = threading.local()
 
 
 def _end_row(filtered: np.ndarray, time: np.ndarray, noise: float, dt: float,
@@ -515,13 +534,22 @@ def _end_row(filtered: np.ndarray, time: np.ndarray, noise: float, dt: float,
     k = max(1, int(round(params.end_speed_window / dt)))
     if len(time) <= k:
         return len(time) - 1
-    speed = (np.linalg.norm(filtered[k:] - filtered[:-k], axis=-1)
-             / (time[k:] - time[:-k])[:, None])
     floor = max(params.end_speed, params.end_noise_factor * noise / (k * dt))
-    moving = np.nanmax(np.where(np.isfinite(speed), speed, 0), axis=1) > floor
-    active = np.flatnonzero(moving)
+    # A row's speed reads it and the row k after: with the rule of the last scan and
+    # rows that begin with its rows, the rows it measured are as it found them, and
+    # the scan goes on from its end (a stream's rows at rest, one more each time).
+    kept, start, active = getattr(_END, "last", None), 0, -1
+    if (kept is not None and kept[0] == (params, k, floor) and len(kept[1]) <= len(time)
+            and np.array_equal(kept[1], filtered[: len(kept[1])], equal_nan=True)
+            and np.array_equal(kept[2], time[: len(kept[2])])):
+        start, active = len(kept[1]) - k, kept[3]
+    f, t = filtered[start:], time[start:]
+    speed = np.linalg.norm(f[k:] - f[:-k], axis=-1) / (t[k:] - t[:-k])[:, None]
+    moving = np.flatnonzero(np.nanmax(np.where(np.isfinite(speed), speed, 0), axis=1) > floor)
+    active = int(moving[-1]) + start if len(moving) else active
+    _END.last = ((params, k, floor), np.array(filtered), np.array(time), active)
     last = len(time) - 1
-    return int(min(last, active[-1] + k * params.end_pad_frames)) if len(active) else last
+    return int(min(last, active + k * params.end_pad_frames)) if active >= 0 else last
 
 
 def rest_scene(tracks, params: ObserveParams | None = None, *,
@@ -551,18 +579,19 @@ def rest_scene(tracks, params: ObserveParams | None = None, *,
     key = (where, params, tuple(tracks.markers),
            tracks.object_diameter_px() if params.px_per_m is None else None)
     kept = getattr(_SCENES, "last", None)
-    if (kept is not None and kept[0] == key and kept[1].shape == np.shape(tracks.time)
-            and kept[2].shape == np.shape(tracks.position)
-            and np.array_equal(kept[1], tracks.time, equal_nan=True)
-            and np.array_equal(kept[2], tracks.position, equal_nan=True)):
-        return kept[3]
-    px = _marker_pixels(tracks, params, where)
-    time, dts = _frame_times(tracks, params, where)
-    transform = _scene_transform(px, tracks, params, where)
-    raw = np.stack([transform.to_model(px[m]) for m in DIGIT_MARKERS], axis=1)
-    noise, rest = _rest_noise(raw, params, where)
-    scene = RestScene(where, time, dts, float(np.median(dts)), transform, raw, rest, noise)
-    for a in (dts, raw, rest):
+    scene = None
+    if kept is not None and kept[0] == key and _begins(tracks, kept[1], kept[2]):
+        if len(kept[1]) == len(tracks.time):
+            return kept[3]
+        scene = _extended(kept[3], len(kept[1]), tracks, params)
+    if scene is None:
+        px = _marker_pixels(tracks, params, where)
+        time, dts = _frame_times(tracks, params, where)
+        transform = _scene_transform(px, tracks, params, where)
+        raw = np.stack([transform.to_model(px[m]) for m in DIGIT_MARKERS], axis=1)
+        noise, rest = _rest_noise(raw, params, where)
+        scene = RestScene(where, time, dts, float(np.median(dts)), transform, raw, rest, noise)
+    for a in (scene.dts, scene.raw, scene.rest):
         a.flags.writeable = False  # shared by the observations made from the same rows
     _SCENES.last = (key, np.array(tracks.time), np.array(tracks.position), scene)
     return scene
@@ -570,6 +599,44 @@ def rest_scene(tracks, params: ObserveParams | None = None, *,
 
 #: The last scene fixed in this thread, and the rows it was fixed from (:func:`rest_scene`).
 _SCENES = threading.local()
+
+
+def _begins(tracks, time: np.ndarray, position: np.ndarray) -> bool:
+    """Whether the rows of ``tracks`` begin with ``time`` and ``position``, bitwise."""
+    n = len(time)
+    return (n <= len(tracks.time) and np.shape(tracks.position)[1:] == position.shape[1:]
+            and np.array_equal(time, tracks.time[:n], equal_nan=True)
+            and np.array_equal(position, tracks.position[:n], equal_nan=True))
+
+
+def _extended(scene: RestScene, n: int, tracks, params: ObserveParams) -> RestScene | None:
+    """The scene fixed from the first ``n`` rows of ``tracks``, with the rows after them.
+
+    What the first rows fix (the transform, the rest posture and its noise,
+    the checks on them) stands; the new rows are checked and the frame
+    periods' median taken again; the model-frame positions are mapped again
+    whole (a mapping of the new rows alone is not promised to round alike).
+    None where a new row would be refused: :func:`rest_scene` then refuses
+    the rows as a fresh pass does.
+    """
+    pos = np.asarray(tracks.position, dtype=float)
+    time = np.asarray(tracks.time, dtype=float)
+    markers = list(tracks.markers)
+    if not np.isfinite(time[n:]).all() or np.isinf(
+            pos[n:, [markers.index(m) for m in NEEDED_MARKERS]]).any():
+        return None
+    dts = np.concatenate([scene.dts, np.diff(time[n - 1:])])
+    if np.any(dts[n - 1:] <= 0):
+        return None
+    dt = float(np.median(dts))
+    lo, hi = params.frame_period_range
+    if not lo * (1 - 1e-6) <= dt <= hi * (1 + 1e-6):
+        return None
+    raw = np.stack([scene.transform.to_model(pos[:, markers.index(m)])
+                    for m in DIGIT_MARKERS], axis=1)
+    if not np.array_equal(raw[: params.rest_frames], scene.raw[: params.rest_frames]):
+        return None  # the rest fixed from other numbers: fixed again
+    return scene._replace(time=time, dts=dts, dt=dt, raw=raw)
 
 
 def _prepare(tracks, params: ObserveParams, name: str) -> _Prepared:

@@ -92,12 +92,14 @@ def _clamp_reach(p: np.ndarray, l1: float, l2: float) -> np.ndarray:
     return np.where((d < lo) | (d > hi), p / safe * np.clip(d, lo, hi), p)
 
 
-def _ik(p: np.ndarray, c: ChainModel) -> np.ndarray:
-    """Joint angles (..., 2) for tip positions relative to the chain base; NaN stays NaN."""
+def _ik(p: np.ndarray, c: ChainModel, chain: TwoLinkChain | None = None) -> np.ndarray:
+    """Joint angles (..., 2) for tip positions relative to the chain base; NaN stays NaN
+    (``chain``: ``c``'s links, where the caller holds them)."""
     p = _clamp_reach(p, c.l1, c.l2)
     ok = np.isfinite(p).all(axis=-1)
     q = np.full(p.shape, np.nan)
-    q[ok] = TwoLinkChain(c.l1, c.l2).inverse(p[ok], elbow=c.elbow)
+    chain = TwoLinkChain(c.l1, c.l2) if chain is None else chain
+    q[ok] = chain.inverse(p[ok], elbow=c.elbow)
     return q
 
 
@@ -117,17 +119,39 @@ def _observed_angles(w: np.ndarray, f: np.ndarray, t: np.ndarray,
     about the wrist.
     """
     q = np.empty((len(w), len(chains), 2))
-    cache: dict[tuple, np.ndarray] = {}
+    for c, chain, cols in _chain_groups(chains):
+        if c.role == "arm":
+            rel = w - c.base
+        else:
+            rel = (f if c.role == "finger" else t) - w - c.base
+        q[:, cols] = _ik(rel, c, chain)[:, None]
+    return q
+
+
+def _chain_groups(chains: list[ChainModel]) -> list[tuple[ChainModel, TwoLinkChain, np.ndarray]]:
+    """The leaves whose angles are the same (one role, geometry and base): the first
+    chain of each group, its links and the group's columns.
+
+    A stream scores the same leaves at every frame: grouped once per list of
+    chains, not at each call (grouping 48 chains cost a frame more than their
+    kinematics).
+    """
+    hit = _GROUPS.get(id(chains))
+    if hit is not None and hit[0] is chains:
+        return hit[1]
+    groups: dict[tuple, tuple[ChainModel, list[int]]] = {}
     for i, c in enumerate(chains):
         key = (c.role, c.l1, c.l2, tuple(c.base), c.elbow)
-        if key not in cache:
-            if c.role == "arm":
-                rel = w - c.base
-            else:
-                rel = (f if c.role == "finger" else t) - w - c.base
-            cache[key] = _ik(rel, c)
-        q[:, i] = cache[key]
-    return q
+        groups.setdefault(key, (c, []))[1].append(i)
+    out = [(c, TwoLinkChain(c.l1, c.l2), np.array(cols)) for c, cols in groups.values()]
+    _GROUPS[id(chains)] = (chains, out)  # the list held: its id is not reused while kept
+    while len(_GROUPS) > 8:
+        _GROUPS.pop(next(iter(_GROUPS)))
+    return out
+
+
+#: :func:`_chain_groups` per list of chains (the stacked leaves' ``chains``).
+_GROUPS: dict[int, tuple[list, list]] = {}
 
 
 def _start(leaves: Leaves, steps: int) -> np.ndarray:

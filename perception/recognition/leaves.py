@@ -125,10 +125,26 @@ def forward_kinematics(q: np.ndarray, l1: np.ndarray, l2: np.ndarray
     """
     tip = np.empty(q.shape)
     J = np.empty(q.shape + (2,))
-    geometry = np.stack([l1, l2], axis=1)
-    for g in np.unique(geometry, axis=0):  # one chain per distinct geometry (a few at most)
-        cols = np.flatnonzero((geometry == g).all(axis=1))
-        chain = TwoLinkChain(*g)
+    for chain, cols in _geometries(l1, l2):
         tip[:, cols] = chain.forward(q[:, cols])
         J[:, cols] = chain.jacobian(q[:, cols])
     return tip, J
+
+
+def _geometries(l1: np.ndarray, l2: np.ndarray) -> list[tuple[TwoLinkChain, np.ndarray]]:
+    """One chain per distinct geometry (a few at most) and the leaves that have it; found
+    once per set of link lengths (a stream's frames all score the same leaves)."""
+    key = (np.asarray(l1, dtype=float).tobytes(), np.asarray(l2, dtype=float).tobytes())
+    hit = _GEOMETRIES.get(key)
+    if hit is None:
+        geometry = np.stack([l1, l2], axis=1)
+        hit = [(TwoLinkChain(*g), np.flatnonzero((geometry == g).all(axis=1)))
+               for g in np.unique(geometry, axis=0)]
+        _GEOMETRIES[key] = hit
+        while len(_GEOMETRIES) > 8:
+            _GEOMETRIES.pop(next(iter(_GEOMETRIES)))
+    return hit
+
+
+#: :func:`_geometries` per set of link lengths (bytes of ``l1`` and ``l2``).
+_GEOMETRIES: dict[tuple[bytes, bytes], list] = {}
