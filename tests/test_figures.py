@@ -208,6 +208,8 @@ def test_the_aperture_figure_draws_each_conditions_mean_over_its_sd_band():
 
 
 def test_the_confidence_figures_of_a_batch_draw_one_clip_per_condition_and_every_clip():
+    from matplotlib.colors import to_rgba
+
     from perception.report import confidence_all_figure, confidence_single_figure
 
     recs, conds = _summaries()
@@ -219,12 +221,17 @@ def test_the_confidence_figures_of_a_batch_draw_one_clip_per_condition_and_every
     assert every.get_title() == "every clip (5)"
     assert every.get_ylabel() == "C of m (cm, weighted)"
     assert _legend_texts(every.get_legend()) == ["normal", "delayed", "odd"]  # once each
-    lines = every.get_lines()
-    assert len(lines) == 6  # a line a clip and y = 0
-    assert [ln.get_color() for ln in lines[:5]] == ["C0", "C0", "C1", "C4", "C4"]
-    x, y = _xy(lines[3])
-    np.testing.assert_allclose(x, recs[3].time)
-    np.testing.assert_allclose(y, recs[3].confidence[0] * 100)
+    (clips,) = every.collections  # a line a clip, in the clips' order
+    assert len(every.get_lines()) == 1  # y = 0
+    segments = clips.get_segments()
+    assert len(segments) == 5
+    np.testing.assert_allclose(clips.get_colors(), [to_rgba(c) for c in
+                                                    ("C0", "C0", "C1", "C4", "C4")])
+    np.testing.assert_allclose(segments[3][:, 0], recs[3].time)
+    np.testing.assert_allclose(segments[3][:, 1], recs[3].confidence[0] * 100)
+    lo, hi = every.get_ylim()  # every line inside the limits
+    assert lo <= min(s[:, 1].min() for s in segments) and hi >= max(s[:, 1].max()
+                                                                   for s in segments)
     # a name matplotlib would leave out of a legend (a leading "_") is in it
     hidden = ["_odd" if c == "odd" else c for c in conds]
     (every,) = confidence_all_figure(recs, hidden, "m").axes

@@ -235,7 +235,8 @@ def _models_table(summary: pd.DataFrame) -> str:
     if not cols:
         return ""
     rows = [[_e(r["clip"])] + [_num(r[c] * 100, ".2f") for c in cols]
-            for _, r in summary[summary["status"] == "ok"].iterrows()]
+            # dicts, not iterrows' Series a row: 1 s of a 6,000-clip report a table
+            for r in summary[summary["status"] == "ok"].to_dict("records")]
     table = _table(["clip"] + [c[len("conf_"):] for c in cols], rows,
                    numeric=set(range(1, len(cols) + 1)))
     return ("<details><summary>Final thesis-rule confidence C of every model (cm, "
@@ -256,8 +257,8 @@ def _other_columns_table(summary: pd.DataFrame) -> str:
     if not cols:
         return ""
     rows = [[_e(r["clip"])] + [_num(r[c], ".3g") if isinstance(r[c], int | float | np.number)
-                               else _e(r[c]) for c in cols]
-            for _, r in summary[summary["status"] == "ok"].iterrows()]
+                               and not isinstance(r[c], bool) else _e(r[c]) for c in cols]
+            for r in summary[summary["status"] == "ok"].to_dict("records")]
     table = _table(["clip", *cols], rows, numeric=set(range(1, len(cols) + 1)))
     return ("<details><summary>Tracking quality and other columns of summary.csv</summary>"
             f'<div class="scroll">{table}</div></details>')

@@ -293,8 +293,13 @@ def clip_outputs(out: Path, clip: str, figure_format: str = "png") -> dict[str, 
     return {
         "json": out / f"{stem}.recognition.json",
         "csv": out / f"{stem}.confidence.csv",
-        **{key: out / f"{stem}.{key[:-4]}.{figure_format}" for key in FIGURE_KEYS},
+        **{key: out / _figure_name(stem, key, figure_format) for key in FIGURE_KEYS},
     }
+
+
+def _figure_name(stem: str, key: str, figure_format: str) -> str:
+    """The file name of a clip's figure ``key`` (one of :data:`FIGURE_KEYS`)."""
+    return f"{stem}.{key[:-4]}.{figure_format}"
 
 
 def clip_figures(out: Path, clip: str, names: Sequence[str] | None = None) -> list[Path]:
@@ -316,8 +321,10 @@ def clip_figures(out: Path, clip: str, names: Sequence[str] | None = None) -> li
     """
     if names is None:
         names = sorted(os.listdir(out)) if out.is_dir() else []
-    own = [clip_outputs(out, clip, f)[k].name for k in FIGURE_KEYS for f in FIGURE_FORMATS]
-    prefix = f"{output_stem(clip)}."
+    stem = output_stem(clip)
+    # names, not paths: a batch report of 6,000 clips built 300,000 paths here (1.8 s)
+    own = [_figure_name(stem, k, f) for k in FIGURE_KEYS for f in FIGURE_FORMATS]
+    prefix = f"{stem}."
     mine = []
     # the names starting with the prefix are one run of the sorted list
     for name in names[bisect.bisect_left(names, prefix):]:

@@ -425,8 +425,8 @@ def confidence_all_figure(clips: Sequence[ClipSummary], conditions: Sequence[str
                           model: str) -> Figure:
     """The model's confidence on every clip, coloured by condition (thesis Fig. 5.8b).
 
-    One thin line a clip, in the clips' order; the legend names each
-    condition once.
+    One thin line a clip, in the clips' order (one ``LineCollection``); the
+    legend names each condition once.
 
     Parameters
     ----------
@@ -437,12 +437,21 @@ def confidence_all_figure(clips: Sequence[ClipSummary], conditions: Sequence[str
     model : str
         The model whose confidence is drawn.
     """
-    lines, labelled = [], set()
-    for rec, cond in zip(clips, conditions):
-        lines.append((rec, condition_colour(cond, conditions), 1.0,
-                      None if cond in labelled else cond))
-        labelled.add(cond)
-    return _confidence_panel(model, f"every clip ({len(clips)})", lines)
+    from matplotlib.collections import LineCollection
+    from matplotlib.lines import Line2D
+
+    fig, (ax,) = _figure((7.5, 5))
+    colours = [condition_colour(cond, conditions) for cond in conditions]
+    # one artist for every clip's line, in the clips' order: a Line2D a clip cost a
+    # batch of 6,000 clips 3.6 s to build and 2 s to draw
+    ax.add_collection(LineCollection(
+        [np.column_stack([rec.time, rec.confidence[rec.index(model)] * CM]) for rec in clips],
+        colors=colours, linewidths=1.0))
+    ax.autoscale_view()
+    _panel(ax, f"every clip ({len(clips)})", TIME, f"C of {model} (cm, weighted)", zero=True)
+    _legend(ax, [Line2D([], [], color=condition_colour(cond, conditions), lw=1.0, label=cond)
+                 for cond in dict.fromkeys(conditions)])
+    return fig
 
 
 def write_figure(fig: Figure, path_stem: str | Path, fmt: str = "png", dpi: int = DPI) -> Path:
