@@ -31,6 +31,7 @@ from perception.errors import InputError
 from perception.filtering import alpha_beta
 from perception.geometry import DEFAULT_OBJECT_DIAMETER, SimilarityTransform
 from perception.io.pose import is_pose_file
+from perception.movement_bounds import end_row, onset_time
 from perception.track_cleaning import cleaning_notes
 from perception.validation import Int, Positive, Tuple, declared
 
@@ -43,7 +44,6 @@ __all__ = [
     "check_hand",
     "movement_span",
     "observe",
-    "onset_time",
     "rest_scene",
 ]
 
@@ -452,106 +452,6 @@ def _rest_noise(raw: np.ndarray, params: ObserveParams, name: str) -> tuple[floa
     return float(noise), mean
 
 
-def onset_time(filtered: np.ndarray, time: np.ndarray, noise: float, params: ObserveParams,
-               name: str, rest: np.ndarray | None = None) -> float:
-    """When the movement's command began, s: the wrist's crossing less the model's latency.
-
-    The crossing is where the wrist's displacement from rest first exceeds
-    the threshold for ``onset_hold_frames`` frames, interpolated between
-    frames. It looks at no frame past those ``onset_hold_frames``, so the
-    online recogniser applies it to the rows seen so far.
-
-    Parameters
-    ----------
-    filtered : (T, 3, 2) array
-        Smoothed wrist, finger and thumb positions in the model frame, m.
-    time : (T,) array
-        Their times, s.
-    noise : float
-        Tracking noise at rest, m (:attr:`RestScene.noise`).
-    params : ObserveParams
-        The onset rule's settings.
-    name : str
-        What an error names.
-    rest : (2,) array, optional
-        The wrist's rest position, m (default: the median of the first
-        ``rest_frames``): given, the rows may be the latest few of a stream.
-
-    Raises
-    ------
-    InputError
-        The wrist never leaves its rest position.
-    """
-    # the onset found in rows this one begins with (a stream's last recognition): the
-    # rows up to the crossing's hold decide it, and they are the same numbers
-    kept = getattr(_ONSET, "last", None) if rest is None else None
-    if (kept is not None and kept[0] == (params, noise) and len(kept[1]) <= len(filtered)
-            and np.array_equal(kept[1], filtered[: len(kept[1])], equal_nan=True)
-            and np.array_equal(kept[2], time[: len(kept[2])])):
-        return kept[3]
-    w = filtered[:, 0]
-    given = rest is not None
-    rest = np.median(w[: params.rest_frames], axis=0) if rest is None else rest
-    disp = np.linalg.norm(w - rest, axis=1)
-    threshold = max(params.onset_displacement, params.onset_noise_factor * noise)
-    above = np.nan_to_num(disp, nan=0.0) > threshold
-    hold = params.onset_hold_frames
-    held = np.ones_like(above)
-    for k in range(hold):
-        held &= np.roll(above, -k)
-    held[len(held) - hold + 1:] = False  # np.roll wrapped the last frames around
-    if not held.any():
-        raise InputError("no movement found: the wrist never leaves its rest position", name)
-    i = int(np.argmax(held))
-    if i > 0 and np.isfinite(disp[i - 1]):
-        frac = (threshold - disp[i - 1]) / (disp[i] - disp[i - 1])
-        crossing = time[i - 1] + frac * (time[i] - time[i - 1])
-    else:
-        crossing = time[i]
-    onset = float(crossing - params.onset_latency(threshold))
-    m = max(i + hold, params.rest_frames)
-    if not given and m <= len(filtered):
-        # rows after the crossing's hold never change it: more rows, the same onset
-        _ONSET.last = ((params, noise), np.array(filtered[:m]), np.array(time[:m]), onset)
-    return onset
-
-
-#: The last onset found in this thread and the rows that decided it (:func:`onset_time`).
-_ONSET = threading.local()
-#: The last end scanned in this thread: its rule, rows and last moving row (:func:`_end_row`).
-_END = threading.local()
-
-
-def _end_row(filtered: np.ndarray, time: np.ndarray, noise: float, dt: float,
-             params: ObserveParams) -> int:
-    """The last row of the movement: a few frames after any hand marker last moved.
-
-    Speeds are measured over ``params.end_speed_window`` (``k`` frames, one at
-    30 frames/s or less): over one frame of a 120 frames/s clip the noise
-    floor would be four times as high, and a slow movement's approach would
-    count as stopped long before it ends.
-    """
-    k = max(1, int(round(params.end_speed_window / dt)))
-    if len(time) <= k:
-        return len(time) - 1
-    floor = max(params.end_speed, params.end_noise_factor * noise / (k * dt))
-    # A row's speed reads it and the row k after: with the rule of the last scan and
-    # rows that begin with its rows, the rows it measured are as it found them, and
-    # the scan goes on from its end (a stream's rows at rest, one more each time).
-    kept, start, active = getattr(_END, "last", None), 0, -1
-    if (kept is not None and kept[0] == (params, k, floor) and len(kept[1]) <= len(time)
-            and np.array_equal(kept[1], filtered[: len(kept[1])], equal_nan=True)
-            and np.array_equal(kept[2], time[: len(kept[2])])):
-        start, active = len(kept[1]) - k, kept[3]
-    f, t = filtered[start:], time[start:]
-    speed = np.linalg.norm(f[k:] - f[:-k], axis=-1) / (t[k:] - t[:-k])[:, None]
-    moving = np.flatnonzero(np.nanmax(np.where(np.isfinite(speed), speed, 0), axis=1) > floor)
-    active = int(moving[-1]) + start if len(moving) else active
-    _END.last = ((params, k, floor), np.array(filtered), np.array(time), active)
-    last = len(time) - 1
-    return int(min(last, active + k * params.end_pad_frames)) if active >= 0 else last
-
-
 def rest_scene(tracks, params: ObserveParams | None = None, *,
                clip: str | None = None) -> RestScene:
     """The scene a clip's first frames fix: transform, rest posture and noise.
@@ -645,7 +545,7 @@ def _prepare(tracks, params: ObserveParams, name: str) -> _Prepared:
     filtered = alpha_beta(sc.raw, np.concatenate([[sc.dt], sc.dts]), params.alpha, params.beta)
     onset = onset_time(filtered, sc.time, sc.noise, params, sc.source)
     start = int(np.searchsorted(sc.time, onset))
-    end = _end_row(filtered, sc.time, sc.noise, sc.dt, params)
+    end = end_row(filtered, sc.time, sc.noise, sc.dt, params)
     if end - start + 1 < params.min_frames:
         raise InputError(f"movement too short to score: {end - start + 1} frames "
                          f"(need at least {params.min_frames})", sc.source)

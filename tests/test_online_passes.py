@@ -7,8 +7,8 @@ cannot change, and works on the rest:
 
 * the scene (:func:`perception.observation.rest_scene`) is extended with
   the new rows, not fixed again;
-* the onset (:func:`perception.observation.onset_time`) is found once the
-  rows that decide it are seen; the end (``_end_row``) is scanned from the
+* the onset (:func:`perception.movement_bounds.onset_time`) is found once the
+  rows that decide it are seen; the end (``end_row``) is scanned from the
   last row scanned;
 * the landmarks' spike test (:func:`perception.cleaning.spikes`) tests again
   only the samples within three windows of the last path's end;
@@ -29,6 +29,7 @@ from _demos import default_repertoire
 
 import perception.cleaning as cleaning
 import perception.filtering as filtering
+import perception.movement_bounds as movement_bounds
 import perception.observation as observation
 import perception.recognition.engine as engine
 import perception.recognition.leaves as leaves
@@ -40,7 +41,7 @@ from perception.synthetic.demos import demo_tracks
 from perception.synthetic.independent import draw_independent, independent_tracks
 
 #: what the passes keep between calls, per thread
-KEPT = (observation._SCENES, observation._ONSET, observation._END, cleaning._SPIKES,
+KEPT = (observation._SCENES, movement_bounds._ONSET, movement_bounds._END, cleaning._SPIKES,
         engine._SCORED, filtering._KEPT)
 
 
