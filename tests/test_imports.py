@@ -10,8 +10,8 @@ import sys
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 import pytest
+from _demos import dlc_csv
 
 import minvar
 from minvar import lqg, moments, problem
@@ -60,20 +60,6 @@ def _tracks(folder: Path) -> Path:
     return demo_tracks("normal", 0)[0].save(folder / "clip.tracks.h5")
 
 
-def _dlc_csv(folder: Path) -> Path:
-    """A DeepLabCut CSV (scorer / bodyparts / coords header rows) of a synthetic grasp."""
-    from perception.synthetic.demos import demo_tracks
-
-    tracks = demo_tracks("normal", 0)[0]
-    columns = pd.MultiIndex.from_product([["DLC_resnet50"], list(tracks.markers),
-                                          ["x", "y", "likelihood"]],
-                                         names=["scorer", "bodyparts", "coords"])
-    xy_p = np.concatenate([tracks.position, tracks.likelihood[..., None]], axis=-1)
-    path = folder / "clip.csv"
-    pd.DataFrame(xy_p.reshape(len(xy_p), -1), columns=columns).to_csv(path)
-    return path
-
-
 def _mp4(folder: Path) -> Path:
     """Ten black frames: enough to be read (the markers are then never found)."""
     import cv2
@@ -102,7 +88,7 @@ def test_recognize_of_a_file_that_is_not_video_loads_no_opencv(tmp_path, kind):
     if kind == "tracks":
         res, rows = _recognize(_tracks(tmp_path), tmp_path / "out")
     elif kind == "pose":
-        res, rows = _recognize(_dlc_csv(tmp_path), tmp_path / "out", "--fps", "30",
+        res, rows = _recognize(dlc_csv(tmp_path)[0], tmp_path / "out", "--fps", "30",
                                "--object-diameter-px", "80")
     else:
         res, rows = _recognize(MOCAP, tmp_path / "out", "--rate", "85")

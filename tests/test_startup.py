@@ -15,6 +15,7 @@ import warnings
 import numpy as np
 import pandas as pd
 import pytest
+from _demos import dlc_csv
 
 from minvar.errors import ParameterError
 from perception.errors import InputError, PlanningError
@@ -189,22 +190,8 @@ def test_a_dlc_table_reads_as_it_did_through_movement_s_dataset(tmp_path, monkey
     assert ours.video == theirs.video and ours.tracker == theirs.tracker
 
 
-def _grasp_csv(folder):
-    """A DeepLabCut table of a synthetic grasp; its path and frames."""
-    from perception.synthetic.demos import demo_tracks
-
-    tracks = demo_tracks("normal", 0)[0]
-    columns = pd.MultiIndex.from_product([["DLC_resnet50"], list(tracks.markers),
-                                          ["x", "y", "likelihood"]],
-                                         names=["scorer", "bodyparts", "coords"])
-    xy_p = np.concatenate([tracks.position, tracks.likelihood[..., None]], axis=-1)
-    path = folder / "clip.csv"
-    pd.DataFrame(xy_p.reshape(len(xy_p), -1), columns=columns).to_csv(path)
-    return path, tracks
-
-
 def test_reading_a_dlc_csv_loads_no_movement_io(tmp_path):
-    path, tracks = _grasp_csv(tmp_path)
+    path, tracks = dlc_csv(tmp_path)
     out = _fresh("import sys\n"
                  "from perception.io.pose import PoseImport, read_pose\n"
                  f"t = read_pose({str(path)!r}, PoseImport(fps=30.0))\n"
@@ -222,7 +209,7 @@ def test_recognize_of_a_mocap_or_dlc_file_loads_no_hdf5(tmp_path, kind):
     if kind == "mocap":
         args = [str(Path(__file__).parent / "data" / "mocap" / "qualisys-recording.tsv")]
     else:
-        args = [str(_grasp_csv(tmp_path)[0]), "--fps", "30", "--object-diameter-px", "80"]
+        args = [str(dlc_csv(tmp_path)[0]), "--fps", "30", "--object-diameter-px", "80"]
     argv = ["recognize", *args, "-o", str(tmp_path / "out"), "--quiet", "--no-figures"]
     out = _fresh("import sys\n"
                  "from hammer_mv.cli import main\n"
