@@ -124,3 +124,26 @@ def test_the_clip_report_writes_it_and_the_batch_page_shows_it(recs, tmp_path):
     assert not clip_outputs(none, rec.clip)["kinematics_png"].exists()
     write_clip_report(rec, tmp_path, figures=False)  # an earlier run's figure goes
     assert not png.exists()
+
+
+def test_the_curves_and_the_speed_bound_are_those_the_landmarks_were_measured_by():
+    """A user's [verdict.landmarks] (cutoff, threshold) draws the figure, the JSON's
+    traces and the batch's profiles, not the defaults."""
+    from perception.landmarks import LandmarkParams
+    from perception.pipeline import RecognitionSettings
+    from perception.recognition.rules import VerdictRules
+    from perception.report.clip import clip_traces
+
+    own = LandmarkParams(cutoff=4.0, threshold=0.1)
+    rec = recognize_clip(demo_tracks("normal", 0)[0], default_repertoire(),
+                         RecognitionSettings(rules=VerdictRules(landmarks=own)), clip="own")
+    time, speed, _ = kinematic_traces(rec.observation, own)
+    _, default_speed, _ = kinematic_traces(rec.observation)
+    assert np.nanmax(np.abs(speed - default_speed)) > 1e-3  # the cutoff matters here
+    np.testing.assert_allclose(clip_traces(rec)["wrist_speed"], np.round(speed, 6))
+    top, _ = kinematics_figure(rec).axes
+    (drawn,) = [ln for ln in top.get_lines() if ln.get_label().endswith("speed")
+                and len(ln.get_xdata()) > 2]
+    np.testing.assert_allclose(drawn.get_ydata(), speed * 1000)
+    (bound,) = _gid(top, "bound")
+    np.testing.assert_allclose(bound.get_ydata()[0], 0.1 * rec.landmarks[0].peak_speed * 1000)

@@ -60,7 +60,8 @@ def clip_traces(rec: Recognition) -> dict[str, np.ndarray]:
     from perception.report.kinematics import kinematic_traces
 
     return dict(zip(("time", "wrist_speed", "aperture"),
-                    (np.round(x, 6) for x in kinematic_traces(rec.observation))))
+                    (np.round(x, 6) for x in kinematic_traces(rec.observation,
+                                                              rec.rules.landmarks))))
 
 
 def _floats(values, n: int | None = None) -> np.ndarray:

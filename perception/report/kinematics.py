@@ -203,7 +203,7 @@ def kinematics_figure(rec: Recognition, *, reuse: bool = False) -> Figure:
     from matplotlib.patches import Patch
 
     lm = rec.landmarks[0]
-    params = LandmarkParams()
+    params = rec.rules.landmarks  # the definitions its landmarks were measured by
     time, speed, aperture = kinematic_traces(rec.observation, params)
     origin, xlabel = time_axis(rec)
     time = time + origin

@@ -75,7 +75,8 @@ def _trial(rec: Recognition | ClipSummary) -> tuple[np.ndarray, np.ndarray, np.n
     """A trial's time (s), wrist speed (m/s), aperture (m), onset and end (s)."""
     if not isinstance(rec, ClipSummary):
         lm = rec.landmarks[0]
-        return (*kinematic_traces(rec.observation), lm.onset_time, lm.end_time)
+        return (*kinematic_traces(rec.observation, rec.rules.landmarks), lm.onset_time,
+                lm.end_time)
     traces = getattr(rec, "traces", None) or rec.extras.get("traces")
     if traces:
         curves = [np.array(traces[k], dtype=float) for k in ("time", "wrist_speed", "aperture")]
