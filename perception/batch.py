@@ -192,7 +192,7 @@ def _run_dask(items: list[_Work], repertoire: Repertoire, job: _Job,
         from perception.cluster import run_on_cluster
     except ImportError as exc:  # dask is the optional "cluster" extra
         raise InputError(f"needs dask.distributed ({exc}): pip install 'hammer-mv[cluster]'",
-                         field="--scheduler") from None
+                         field="scheduler") from None
     # largest first: the cluster's last clips are its shortest
     return run_on_cluster(sorted(items, key=_file_size, reverse=True), job.run, repertoire,
                           scheduler, while_waiting=_prepare_report, lost=job.lost)
@@ -371,10 +371,10 @@ def run_batch(
     if not items:  # as the command line says it, not a KeyError from an empty summary
         raise InputError("no clips found: the batch was given none", field="items")
     if jobs < 1:
-        raise InputError(f"expected at least 1, got {jobs}", field="--jobs")
+        raise InputError(f"expected at least 1, got {jobs}", field="jobs")
     if figure_format not in FIGURE_FORMATS:
         raise InputError(f"expected one of {', '.join(FIGURE_FORMATS)}, got {figure_format!r}",
-                         field="--figure-format")
+                         field="figure_format")
     t0 = time.perf_counter()
     # absolute: a worker, a dask one above all, may run in another folder
     items = [dataclasses.replace(i, path=Path(i.path).absolute()) for i in items]

@@ -89,10 +89,10 @@ def check_scheduler(address: str) -> None:
             first = (str(exc).strip().splitlines() or [type(exc).__name__])[0]
             raise InputError(f"no dask scheduler answered at {address!r} within "
                              f"{SCHEDULER_TIMEOUT_S:g} s ({type(exc).__name__}: {first})",
-                             field="--scheduler") from None
+                             field="scheduler") from None
     if not isinstance(answer, dict) or answer.get("type") != "Scheduler":
         raise InputError(f"{address!r} answered, but not as a dask scheduler",
-                         field="--scheduler")
+                         field="scheduler")
 
 
 def run_on_cluster(items: list, run, repertoire, scheduler: str, *, while_waiting=None,

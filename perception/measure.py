@@ -238,10 +238,9 @@ def measure(source, *, params: LandmarkParams | None = None, mocap=None,
         dpx = tracks.object_diameter_px() if object_diameter_px is None else object_diameter_px
         if dpx is None or object_diameter is None:
             where = tracks.path or (source if not isinstance(source, Tracks) else "tracks")
-            raise InputError("the scale is unknown: give px_per_m (--px-per-m), or the object's "
-                             "diameter (--object-diameter) with its apparent size in the "
-                             "tracks (a tracker's, or --object-diameter-px)",
-                             where, field="--px-per-m")
+            raise InputError("the scale is unknown: give `px_per_m`, or the object's diameter "
+                             "(`object_diameter`) with its apparent size in the tracks (a "
+                             "tracker's, or `object_diameter_px`)", where, field="px_per_m")
         scale = dpx / object_diameter
     time, transport, aperture = _tracks_movement(tracks, scale)
     lm = movement_landmarks(time, transport, aperture, params)

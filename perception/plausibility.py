@@ -94,10 +94,11 @@ def _hand(trials: Sequence) -> tuple[float, float]:
 
 
 def _where(options, trial, what: str) -> str:
-    """How the unit or the rate was chosen: the flag, the file, or an inference."""
+    """How the unit or the rate was chosen: the setting (named as a field, which the command
+    line gives as its flag), the file, or an inference."""
     given = getattr(options, what, None)
     if given is not None:
-        return f"--{what} {given:g}" if what == "rate" else f"--{what} {given}"
+        return f"`{what}` {given:g}" if what == "rate" else f"`{what}` {given}"
     if what == "units":
         inferred = any(n.startswith("units inferred") for n in trial.notes)
         return "inferred from the positions' spread" if inferred else "as the file declares"
@@ -133,16 +134,16 @@ def check_scale(trials: Sequence, path, options=None) -> None:
         raise InputError(
             f"the hand moves without a pause for {span:.3g} s at {trial.rate:g} samples/s "
             f"({_where(options, trial, 'rate')}): a reach and its return last under "
-            f"{MAX_MOVEMENT:g} s; is the rate right (--rate)?", path, field="--rate")
+            f"{MAX_MOVEMENT:g} s; is the rate right (`rate`)?", path, field="rate")
     if speed > MAX_PEAK_SPEED:
         units = trial.units
         fits = [(u, speed * _UNITS[u] / _UNITS[units]) for u in _UNITS
                 if _UNITS[u] < _UNITS[units]]
         # the unit that brings the hand nearest a typical reach's 1 m/s
         fits = sorted(((abs(math.log(s)), u, s) for u, s in fits if s <= MAX_PEAK_SPEED))
-        hint = (f"; in {fits[0][1]} it would be {fits[0][2]:.2g} m/s (--units {fits[0][1]})"
-                if fits else "; are the units (--units) and the rate (--rate) right?")
+        hint = (f"; in {fits[0][1]} it would be {fits[0][2]:.2g} m/s (`units` {fits[0][1]})"
+                if fits else "; are the units (`units`) and the rate (`rate`) right?")
         raise InputError(
             f"the hand moves at up to {speed:.3g} m/s with the positions in {units} "
             f"({_where(options, trial, 'units')}): no arm moves over {MAX_PEAK_SPEED:g} m/s"
-            f"{hint}", path, field="--units")
+            f"{hint}", path, field="units")

@@ -141,8 +141,8 @@ def test_ctrl_c_while_a_stream_opens_is_delivered_at_once(camera):
 
 @pytest.mark.parametrize(("source", "kwargs", "words"), [
     ("3000000000", {}, "below 2**31"),
-    ("0", {"stall_timeout": 1e7}, "--stall-timeout"),
-    ("0", {"stall_timeout": float("inf")}, "--stall-timeout"),
+    ("0", {"stall_timeout": 1e7}, "stall_timeout"),  # the library names the field; watch
+    ("0", {"stall_timeout": float("inf")}, "stall_timeout"),  # gives its flag (below)
 ])
 def test_out_of_range_cameras_and_stall_timeouts_are_input_errors(camera, source, kwargs,
                                                                   words):

@@ -68,17 +68,18 @@ def test_the_right_units_and_rate_pass(tmp_path):
 @pytest.mark.parametrize(("units", "right"), [("m", "mm"), ("cm", "mm")])
 def test_wrong_units_are_refused_naming_the_unit_that_fits(tmp_path, units, right):
     trials, o = _trials(_table(tmp_path / "t.tsv"), rate=RATE, units=units)
-    with pytest.raises(InputError, match=rf"--units {units}\): no arm moves over") as e:
+    # the library names the setting; the command line gives it as its flag (below)
+    with pytest.raises(InputError, match=rf"`units` {units}\): no arm moves over") as e:
         check_scale(trials, "t.tsv", o)
-    assert e.value.field == "--units" and f"(--units {right})" in str(e.value)
+    assert e.value.field == "units" and f"(`units` {right})" in str(e.value)
     assert "--px-per-m" not in str(e.value) and "\n" not in str(e.value)
 
 
 def test_a_rate_ten_times_too_low_is_refused_naming_the_rate(tmp_path):
     trials, o = _trials(_table(tmp_path / "t.tsv"), rate=RATE / 10, units="mm")
-    with pytest.raises(InputError, match=r"at 10 samples/s \(--rate 10\).*is the rate right") as e:
+    with pytest.raises(InputError, match=r"at 10 samples/s \(`rate` 10\).*is the rate right") as e:
         check_scale(trials, "t.tsv", o)
-    assert e.value.field == "--rate"
+    assert e.value.field == "rate"
 
 
 @pytest.mark.parametrize(("name", "options"), [
@@ -107,7 +108,7 @@ def test_recognize_and_landmarks_refuse_in_one_line(tmp_path, flags, named):
         assert run.returncode == 2, run.stderr
         lines = run.stderr.strip().splitlines()
         assert len(lines) == 1 and named in lines[0] and "Traceback" not in run.stderr
-        assert "--px-per-m" not in lines[0]
+        assert "--px-per-m" not in lines[0] and "`" not in lines[0]  # every field as its flag
 
 
 def test_centimetres_read_as_millimetres_get_a_peak_speed_warning(tmp_path):

@@ -8,7 +8,7 @@ from collections import Counter
 from pathlib import Path
 
 from hammer_mv.cli.checks import cap_jobs, output_folder
-from hammer_mv.cli.flags import flag_text
+from hammer_mv.cli.flags import field_flag, flag_text
 from hammer_mv.cli.options import add_recognition_options, load_repertoire, recognition_settings
 from hammer_mv.cli.recognize import add_figure_options
 from perception.batch import find_clips, run_batch
@@ -40,6 +40,8 @@ def register(sub) -> None:
                    "process)")
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="run on a dask.distributed scheduler, e.g. tcp://host:8786")
+    field_flag("jobs", "--jobs")
+    field_flag("scheduler", "--scheduler")
     add_figure_options(p)
     add_recognition_options(p)
     p.set_defaults(func=run)

@@ -58,11 +58,13 @@ def add_figure_options(p: argparse.ArgumentParser) -> None:
     p : argparse.ArgumentParser
         The subcommand's parser.
     """
+    from hammer_mv.cli.flags import field_flag
     from perception.report.figures import DPI, FIGURE_FORMATS
 
     p.add_argument("--figure-format", choices=FIGURE_FORMATS, default=FIGURE_FORMATS[0],
                    help="format of the figures: png, or svg / pdf (vector, for a paper; "
                         f"default: {FIGURE_FORMATS[0]})")
+    field_flag("figure_format", "--figure-format")
     p.add_argument("--dpi", type=_dpi, default=DPI, metavar="N",
                    help=f"resolution of PNG figures, dots per inch (default: {DPI})")
 

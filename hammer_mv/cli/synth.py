@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from hammer_mv.cli.checks import cap_jobs, check_seed, output_folder
+from hammer_mv.cli.flags import field_flag
 
 
 def register(sub) -> None:
@@ -23,6 +24,7 @@ def register(sub) -> None:
     p.add_argument("--seed", type=int, default=0, metavar="N", help="master seed (default: 0)")
     p.add_argument("--jobs", type=int, default=1, metavar="N",
                    help="processes rendering clips (default: 1); the clips do not depend on it")
+    field_flag("jobs", "--jobs")
     p.set_defaults(func=run)
 
 

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from hammer_mv.cli.flags import field_flag
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``tracks`` subcommand and its actions to ``subparsers``."""
@@ -25,6 +27,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="dlc: DeepLabCut table, a real .h5 (pandas HDF, key df_with_missing) or a .csv "
         "by OUT's ending, plus OUT's stem .status.csv; movement: a movement poses dataset "
         "(.nc); trackpy: long table, one row per frame and seen marker; csv: plain wide table")
+    field_flag("format", "--format")
     export.add_argument("-o", "--output", type=Path, required=True, metavar="OUT",
                         help="output file")
     export.add_argument("--max-gap", type=int, default=0, metavar="N",

@@ -49,6 +49,9 @@ def register(sub) -> None:
                    help="also write the frames with the markers and confidence bars drawn")
     p.add_argument("--stall-timeout", type=float, default=5.0, metavar="S",
                    help="a camera or stream that sends no frame for this long has ended")
+    from hammer_mv.cli.flags import field_flag
+
+    field_flag("stall_timeout", "--stall-timeout")
     p.add_argument("--no-figures", action="store_true",
                    help="write the JSON and CSV only, not the figures")
     add_recognition_options(p)

@@ -212,7 +212,7 @@ class LiveSource(Source):
         self.path, self.kind, self.stall = str(source), source_kind(source), stall_timeout
         if not (math.isfinite(stall_timeout) and 0 < stall_timeout <= 2147483.647):
             raise InputError(f"expected a positive number of seconds (at most 2147483.647), "
-                             f"got {stall_timeout}", field="--stall-timeout")  # int32 ms
+                             f"got {stall_timeout}", field="stall_timeout")  # int32 ms
         if self.kind == "camera" and int(source) >= 2**31:
             raise InputError("not a camera (camera indices are below 2**31)", self.path)
         self._started, self._ahead = False, ReadAhead(

@@ -73,7 +73,7 @@ def export_tracks(tracks: Tracks, path: str | os.PathLike, format: str) -> list[
     path = Path(path)
     if format not in EXPORT_FORMATS:
         raise InputError(f"expected one of {', '.join(EXPORT_FORMATS)}, got {format!r}",
-                         field="--format")
+                         field="format")
     _check_markers(tracks, tracks.path)
     if format == "dlc":
         write_dlc(tracks, path)

@@ -235,7 +235,7 @@ def synthesize(recipe: Recipe, out: str | os.PathLike, *, seed: int = 0,
     from tqdm import tqdm
 
     if int(jobs) < 1:
-        raise InputError(f"expected at least 1, got {jobs}", field="--jobs")
+        raise InputError(f"expected at least 1, got {jobs}", field="jobs")
     render_style(recipe.style)
     plans = clip_plans(recipe, seed)  # all of them first: a bad draw renders nothing
     out = Path(out)
