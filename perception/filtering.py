@@ -18,6 +18,8 @@ import threading
 
 import numpy as np
 
+from perception.resume import begins_with
+
 __all__ = ["AlphaBeta", "alpha_beta"]
 
 #: Filtered series kept per thread to resume from (:func:`alpha_beta`).
@@ -67,9 +69,8 @@ def _resume(z, dt, alpha, beta, out) -> tuple[int, AlphaBeta]:
     for kept in getattr(_KEPT, "series", ()):
         kz, kdt, ka, kb, kout, kstep = kept
         n = len(kz)
-        if (ka == alpha and kb == beta and kz.shape[1:] == z.shape[1:] and n <= len(z)
-                and (best is None or n > len(best[0]))
-                and np.array_equal(kz, z[:n], equal_nan=True) and np.array_equal(kdt, dt[:n])):
+        if (ka == alpha and kb == beta and (best is None or n > len(best[0]))
+                and begins_with((z, dt), (kz, kdt))):
             best = kept
     if best is None:
         return 0, AlphaBeta(z.shape[1:], alpha, beta)

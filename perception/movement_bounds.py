@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from perception.errors import InputError
+from perception.resume import begins_with
 
 if TYPE_CHECKING:
     from perception.observation import ObserveParams
@@ -56,9 +57,8 @@ def onset_time(filtered: np.ndarray, time: np.ndarray, noise: float, params: Obs
     # the onset found in rows this one begins with (a stream's last recognition): the
     # rows up to the crossing's hold decide it, and they are the same numbers
     kept = getattr(_ONSET, "last", None) if rest is None else None
-    if (kept is not None and kept[0] == (params, noise) and len(kept[1]) <= len(filtered)
-            and np.array_equal(kept[1], filtered[: len(kept[1])], equal_nan=True)
-            and np.array_equal(kept[2], time[: len(kept[2])])):
+    if kept is not None and kept[0] == (params, noise) and begins_with((filtered, time),
+                                                                       kept[1:3]):
         return kept[3]
     w = filtered[:, 0]
     given = rest is not None
@@ -123,9 +123,8 @@ def end_row(filtered: np.ndarray, time: np.ndarray, noise: float, dt: float,
     # rows that begin with its rows, the rows it measured are as it found them, and
     # the scan goes on from its end (a stream's rows at rest, one more each time).
     kept, start, active = getattr(_END, "last", None), 0, -1
-    if (kept is not None and kept[0] == (params, k, floor) and len(kept[1]) <= len(time)
-            and np.array_equal(kept[1], filtered[: len(kept[1])], equal_nan=True)
-            and np.array_equal(kept[2], time[: len(kept[2])])):
+    if kept is not None and kept[0] == (params, k, floor) and begins_with((filtered, time),
+                                                                          kept[1:3]):
         start, active = len(kept[1]) - k, kept[3]
     f, t = filtered[start:], time[start:]
     speed = np.linalg.norm(f[k:] - f[:-k], axis=-1) / (t[k:] - t[:-k])[:, None]

@@ -32,6 +32,7 @@ from perception.filtering import alpha_beta
 from perception.geometry import DEFAULT_OBJECT_DIAMETER, SimilarityTransform
 from perception.io.pose import is_pose_file
 from perception.movement_bounds import end_row, onset_time
+from perception.resume import begins_with
 from perception.track_cleaning import cleaning_notes
 from perception.validation import Int, Positive, Tuple, declared
 
@@ -503,10 +504,7 @@ _SCENES = threading.local()
 
 def _begins(tracks, time: np.ndarray, position: np.ndarray) -> bool:
     """Whether the rows of ``tracks`` begin with ``time`` and ``position``, bitwise."""
-    n = len(time)
-    return (n <= len(tracks.time) and np.shape(tracks.position)[1:] == position.shape[1:]
-            and np.array_equal(time, tracks.time[:n], equal_nan=True)
-            and np.array_equal(position, tracks.position[:n], equal_nan=True))
+    return begins_with((tracks.time, tracks.position), (time, position))
 
 
 def _extended(scene: RestScene, n: int, tracks, params: ObserveParams) -> RestScene | None:

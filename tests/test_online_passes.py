@@ -272,3 +272,19 @@ def test_rows_changed_before_the_end_are_not_resumed():
     second = observation.rest_scene(longer, params)
     assert not np.array_equal(first.transform.origin_px, second.transform.origin_px)
     _same(tuple(second), tuple(_fresh(lambda: observation.rest_scene(longer, params))), "scene")
+
+
+def test_one_prefix_test_for_every_resumed_pass():
+    from perception.resume import begins_with
+
+    t = np.arange(6.0)
+    xy = np.arange(12.0).reshape(6, 2)
+    xy[2] = np.nan
+    assert begins_with((t, xy), (t[:4], xy[:4].copy()))  # NaN equal to NaN
+    assert begins_with((t, xy), (t, xy))
+    assert not begins_with((t[:3], xy[:3]), (t[:4], xy[:4]))  # longer than the new series
+    other = xy[:4].copy()
+    other[1, 0] += 1e-12  # one bit off, not at the last row
+    assert not begins_with((t, xy), (t[:4], other))
+    assert not begins_with((t, xy), (t[:4], xy[:4, :1]))  # another shape
+    assert begins_with((t, xy), (t[:0], xy[:0]))  # nothing kept: a prefix of anything

@@ -37,6 +37,7 @@ from perception.recognition.models import ChainModel, MotorModel
 from perception.recognition.result import Recognition
 from perception.recognition.rules import VerdictRules, judge
 from perception.recognition.scoring import RULES, THESIS_SIGNS, likelihood_rule, thesis_rule
+from perception.resume import begins_with
 from perception.validation import NonNegative, Positive, Share, declared
 
 __all__ = ["ClipScores", "HammerParams", "RULES", "StepScorer", "recognize", "score_clip"]
@@ -495,8 +496,7 @@ def _scored(models: list, params: HammerParams, obs: Observation, arrays: tuple
         if (k_key == (params, obs.dt) and n < obs.n_frames
                 and (best is None or n > len(best[2][0]))
                 and len(k_models) == len(models) and all(a is b for a, b in zip(k_models, models))
-                and all(np.array_equal(a, b[:n], equal_nan=True)
-                        for a, b in zip(k_arrays, arrays))):
+                and begins_with(arrays, k_arrays)):
             best = kept
     if best is None:
         # gains stacked once for the whole clip
