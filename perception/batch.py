@@ -44,6 +44,7 @@ from perception.discovery import (
     discover,
     expand_recordings,
     find_clips,
+    recording_items,
     stream_recordings,
 )
 from perception.errors import InputError
@@ -75,23 +76,6 @@ class _Work:
 
     item: BatchItem
     reach: Reach | None = None
-
-
-def _work(items: list[BatchItem], settings: RecognitionSettings) -> list[_Work]:
-    """``items`` with their reaches, from the recordings :func:`expand_recordings` read
-    (cached: not read again); an item whose recording cannot be read now goes without,
-    and fails with its error where it runs."""
-    from perception.recordings import cached_reaches
-
-    def reach(item: BatchItem):
-        if item.kind != "mocap" or item.reach is None or item.unscored is not None:
-            return None
-        try:
-            return cached_reaches(item.path, settings.mocap)[item.reach]
-        except Exception:  # noqa: BLE001 - said where it runs, as without this
-            return None
-
-    return [_Work(item, reach(item)) for item in items]
 
 
 @dataclass(frozen=True)
@@ -395,7 +379,8 @@ def run_batch(
                 yield _Work(item, reach)
             _prepare_report()  # while the workers finish the last clips
     else:
-        items = expand_recordings(items, settings)
+        pairs = recording_items(items, settings)
+        items = [item for item, _ in pairs]
     # each worker one decoding and one planning thread: the parallelism is the workers'
     parallel = scheduler is not None or streamed or min(jobs, len(items)) > 1
     job = _Job(out, dataclasses.replace(settings, decoder_threads=1, planning_threads=1)
@@ -404,9 +389,9 @@ def run_batch(
     if streamed:
         results = workers.run_pool(work(), job, jobs, shared=repertoire)
     elif scheduler:
-        results = _run_dask(_work(items, settings), repertoire, job, scheduler)
+        results = _run_dask([_Work(*pair) for pair in pairs], repertoire, job, scheduler)
     else:
-        results = _run_local(_work(items, settings), repertoire, job, jobs)
+        results = _run_local([_Work(*pair) for pair in pairs], repertoire, job, jobs)
     done: list[ClipResult] = []
     with tqdm(total=None if streamed else len(items), unit="clip", file=sys.stderr,
               desc="batch", disable=quiet or not sys.stderr.isatty()) as bar:

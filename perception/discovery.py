@@ -28,8 +28,8 @@ if TYPE_CHECKING:
     from perception.reaches import Reach
 
 __all__ = ["COMPANION_NAMES", "ERRORS_LOG", "REPORT_SET", "BatchItem", "Discovery",
-           "check_clip_name", "discover", "expand_recordings", "find_clips", "safe_clip_name",
-           "stream_recordings"]
+           "check_clip_name", "discover", "expand_recordings", "find_clips", "recording_items",
+           "safe_clip_name", "stream_recordings"]
 
 log = logging.getLogger(__name__)
 
@@ -313,30 +313,46 @@ def expand_recordings(items: Iterable[BatchItem], settings: RecognitionSettings
         A factor with one value in the manifest and another in a trial's
         columns or a file's name (or a bad ``factors_from_name``).
     """
+    return [item for item, _ in recording_items(items, settings)]
+
+
+def recording_items(items: Iterable[BatchItem], settings: RecognitionSettings
+                    ) -> list[tuple[BatchItem, Reach | None]]:
+    """:func:`expand_recordings`' items, each recording's reach with its samples (read
+    here once: a batch hands them to its workers, which then read no file).
+
+    Parameters
+    ----------
+    items : iterable of BatchItem
+        Clips (see :func:`discover`).
+    settings : RecognitionSettings
+        Their ``mocap`` settings say how recordings are read.
+    """
     from perception.recordings import MocapImport, cached_recording
 
     mocap = getattr(settings, "mocap", None) or MocapImport()
     out = []
     for item in items:
         if not _a_recording(item):
-            out.append(_as_given(item, mocap))
+            out.append((_as_given(item, mocap), None))
             continue
         try:
             recording = cached_recording(item.path, settings.mocap)
         except (HammerMVError, OSError):
-            out.append(_with_factors(item, mocap.name_factors(item.path)))
+            out.append((_with_factors(item, mocap.name_factors(item.path)), None))
             continue
         except Exception:  # noqa: BLE001 - a bug reading one file must not end the batch
             log.debug("%s: unreadable (a bug); it fails when processed", item.path,
                       exc_info=True)
             # processed, it fails with its traceback in errors.log
-            out.append(_with_factors(item, mocap.name_factors(item.path)))
+            out.append((_with_factors(item, mocap.name_factors(item.path)), None))
             continue
         by_trial = ((next((t for t in sorted(recording.trials, key=len, reverse=True)
                            if e.name == t or e.name.startswith(f"{t}-")), e.name), [e])
                     for e in recording.entries)
-        out += [new for new, _ in _recording_items(item, by_trial)]
-    return _unique_clips(out)
+        out += _recording_items(item, by_trial)
+    seen: set[str] = set()
+    return [(_unique(item, seen), reach) for item, reach in out]
 
 
 def stream_recordings(items: Iterable[BatchItem], settings: RecognitionSettings,
@@ -489,13 +505,6 @@ def safe_clip_name(name: str, where: str) -> str:
             safe = "_" + output_stem(name).lstrip(".")[:180].split("~")[0] + tag
         log.warning("%s: trial %r named %r in the report", where, name, safe)
         return safe
-
-
-def _unique_clips(items: list[BatchItem]) -> list[BatchItem]:
-    """``items`` with a clip name taken twice made unique (``~2``, ``~3``, ...): no two
-    clips' reports overwrite each other."""
-    seen: set[str] = set()
-    return [_unique(item, seen) for item in items]
 
 
 def _unique(item: BatchItem, seen: set[str]) -> BatchItem:

@@ -10,7 +10,8 @@ import pandas as pd
 import pytest
 
 import perception.recordings as recordings
-from perception.batch import _Job, _work, discover, expand_recordings, run_batch
+from perception.batch import _Job, _Work, discover, run_batch
+from perception.discovery import expand_recordings, recording_items
 from perception.pipeline import RecognitionSettings
 from perception.recognition.repertoire import Repertoire
 from perception.recordings import MocapImport
@@ -28,8 +29,9 @@ def session(tmp_path):
 
 
 def test_a_reach_goes_to_its_worker_with_its_samples(session, tmp_path, monkeypatch):
-    items = expand_recordings(discover(session), SETTINGS)
-    work = _work(items, SETTINGS)
+    pairs = recording_items(discover(session), SETTINGS)
+    assert [i for i, _ in pairs] == expand_recordings(discover(session), SETTINGS)
+    work = [_Work(*pair) for pair in pairs]
     reaches = [w for w in work if w.item.reach is not None]
     assert len(reaches) == 4 and all(w.reach is not None for w in reaches)
     reference = _Job(tmp_path / "read", SETTINGS, "rep").run(reaches[0].__class__(
