@@ -276,7 +276,11 @@ def spikes(time: np.ndarray, path: np.ndarray, ok: np.ndarray | None = None,
 
 def _begins(ts: np.ndarray, seen: np.ndarray, kept: tuple) -> bool:
     """Whether the seen samples ``ts, seen`` begin with a kept path's, bitwise."""
-    return len(kept[2]) > 0 and begins_with((ts, seen), (kept[2], kept[3]))
+    n = len(kept[2])
+    # another marker's path differs at its last sample: told apart before comparing all
+    return (0 < n <= len(ts) and kept[3].shape[1:] == seen.shape[1:]
+            and np.array_equal(kept[3][-1], seen[n - 1], equal_nan=True)
+            and begins_with((ts, seen), (kept[2], kept[3])))
 
 
 def _resumed(ts: np.ndarray, seen: np.ndarray, half: int, params: CleaningParams

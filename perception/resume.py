@@ -21,9 +21,7 @@ def begins_with(arrays: Sequence[np.ndarray], kept: Sequence[np.ndarray]) -> boo
 
     Each kept array must be no longer than its counterpart, of the same
     shape past the first axis, and equal to its first rows, NaN equal to
-    NaN. The last kept row is compared first: another series (another
-    marker's, another clip's) differs there, and is told apart without
-    comparing every row.
+    NaN.
 
     Parameters
     ----------
@@ -32,8 +30,7 @@ def begins_with(arrays: Sequence[np.ndarray], kept: Sequence[np.ndarray]) -> boo
     kept : sequence of array
         The series kept, in the same order.
     """
-    pairs = [(np.asarray(a), np.asarray(k)) for a, k in zip(arrays, kept, strict=True)]
-    if any(len(k) > len(a) or a.shape[1:] != k.shape[1:] for a, k in pairs):
-        return False
-    return (all(np.array_equal(k[-1], a[len(k) - 1], equal_nan=True) for a, k in pairs if len(k))
-            and all(np.array_equal(k, a[: len(k)], equal_nan=True) for a, k in pairs))
+    for a, k in zip(arrays, kept, strict=True):  # shapes first: nothing compared
+        if len(k) > len(a) or a.shape[1:] != k.shape[1:]:
+            return False
+    return all(np.array_equal(k, a[:len(k)], equal_nan=True) for a, k in zip(arrays, kept))
