@@ -137,34 +137,6 @@ def test_own_demonstrations_are_familiar(small):
     assert np.mean(fam >= DEFAULT_THRESHOLD) >= 0.85
 
 
-def test_the_demonstrations_markers_drift_as_declared():
-    from perception.recognition.calibration import _wander
-
-    period, tau, sd = 1 / 30, 0.07, 0.001
-    x = _wander(200_000, period, sd, tau, np.random.default_rng(5))
-    assert x.std(axis=0) == pytest.approx([sd, sd], rel=0.03)
-    for lag in (1, 3):  # the correlation falls by 1/e in tau
-        r = np.mean(x[:-lag] * x[lag:]) / np.mean(x * x)
-        assert r == pytest.approx(np.exp(-lag * period / tau), abs=0.02)
-    # stationary from the first sample: no warm-up with a smaller spread
-    starts = np.stack([_wander(3, period, sd, tau, np.random.default_rng(k))[0]
-                       for k in range(4000)])
-    assert starts.std() == pytest.approx(sd, rel=0.05)
-
-
-def test_a_demonstration_without_drift_is_the_white_noise_one(small):
-    model = small.models[0]
-    run = rollout([model], 130, trials=2, cv=0.01, rng=np.random.default_rng(1))
-    still = CalibrationParams(drift=0.0)
-    a = own_demonstration(model, run, 0, still, np.random.default_rng(9))
-    b = own_demonstration(model, run, 0, CalibrationParams(), np.random.default_rng(9))
-    obj = a.markers.index("object")
-    # the object stands still in both; the markers on skin wander only with drift
-    np.testing.assert_array_equal(a.position[:, obj], b.position[:, obj])
-    moved = np.linalg.norm(a.position - b.position, axis=-1)
-    assert moved[:, [i for i, m in enumerate(a.markers) if m != "object"]].max() > 0.1
-
-
 # -- the verdict on demonstrations of both generators (in memory) -----------------------
 def _tracks(generator: str, condition: str, i: int):
     if generator == "thesis":

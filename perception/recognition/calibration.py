@@ -4,8 +4,8 @@ For every model, :func:`calibrate` makes ``CalibrationParams.demonstrations``
 demonstrations of the model's own movement (:func:`~perception.recognition.rollout.rollout`
 from its stored gains, with command noise) varied the way one person's
 grasps vary (movement time, the grip's timing against the transport, the
-size of the opening, a bowed path), lets their markers drift as markers on
-skin do, puts them through a camera with tracking noise, observes them like a clip (:func:`~perception.observation.observe`:
+size of the opening, a bowed path), puts them through a camera with tracking
+noise, observes them like a clip (:func:`~perception.observation.observe`:
 smoothing, onset, end) and scores each against the model
 (:func:`~perception.recognition.engine.recognize`). The misfits are the
 model's :class:`~perception.recognition.verdict.Calibration`. It is done once
@@ -43,19 +43,6 @@ def _skewed(tau: np.ndarray, skew: float) -> np.ndarray:
     ahead early (the speed peaks earlier, a longer deceleration), < 0 behind."""
     tau = np.clip(tau, 0.0, 1.0)
     return tau + skew * np.sin(np.pi * tau) / np.pi
-
-
-def _wander(n: int, period: float, sd: float, time_constant: float,
-            rng: np.random.Generator) -> np.ndarray:
-    """(n, 2) stationary first-order autoregressive motion of SD ``sd``, m, whose
-    correlation falls by 1/e in ``time_constant`` s."""
-    from scipy.signal import lfilter
-
-    a = math.exp(-period / time_constant)
-    first = sd * rng.standard_normal(2)
-    steps = sd * math.sqrt(1 - a * a) * rng.standard_normal((n, 2))
-    # x[i] = a x[i-1] + step[i], from x[-1] = first: stationary from the first sample
-    return lfilter([1.0], [1.0, -a], steps, axis=0, zi=a * first[None, :])[0]
 
 
 def _interp(t: np.ndarray, ref: np.ndarray, xy: np.ndarray) -> np.ndarray:
@@ -100,9 +87,6 @@ def own_demonstration(model: MotorModel, run: Rollout, index: int, params: Calib
     across = np.array([p.marker_offset, 0.0])
     world = {"wrist": wrist, "finger": wrist + mid + half + across,
              "thumb": wrist + mid - half - across, "object": np.zeros_like(wrist)}
-    drift = rng.uniform(0.0, 2 * p.drift)
-    for m in ("wrist", "finger", "thumb"):  # markers on skin; the object's stands still
-        world[m] = world[m] + _wander(len(t), period, drift, p.drift_time, rng)
     camera = SimilarityTransform((320.0, 144.0), p.px_per_m, math.pi / 2)
     pos = np.stack([camera.to_pixels(world[m]) for m in _MARKERS], axis=1)
     pos = pos + noise_px * rng.standard_normal(pos.shape)

@@ -553,8 +553,7 @@ def _model(s: StoredModel) -> MotorModel:
         raise ValueError(f"model '{s.name}': {exc}") from None
     cal = s.calibration
     # files written before these variations existed were made without them
-    made = {"transport_skew": 0.0, "noise_spread": 0.0, "drift": 0.0,
-            **(cal.params if cal else {})}
+    made = {"transport_skew": 0.0, "noise_spread": 0.0, **(cal.params if cal else {})}
     calibration = None if cal is None else Calibration(
         cal.misfit, cal.frame_period, CalibrationParams(**made))
     return MotorModel(spec=spec, scene=SceneSpec(**s.scene), substeps=s.substeps, dt=s.dt,

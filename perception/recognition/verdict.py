@@ -85,12 +85,6 @@ class CalibrationParams:
         Tracking noise, px, at ``px_per_m``.
     noise_spread : float
         Each demonstration's tracking noise is ``noise_px`` × (1 ± this).
-    drift : float
-        Markers on skin wander: each of the wrist's and digits' markers of a
-        demonstration drifts by a coloured (first-order autoregressive) motion
-        of SD drawn uniformly from 0 to twice this, m.
-    drift_time : float
-        The drift's correlation time, s.
     px_per_m : float
         Image scale of the demonstrations' camera, px/m.
     rest : float
@@ -110,8 +104,6 @@ class CalibrationParams:
     transport_skew: Annotated[float, Field(ge=0, lt=1)] = 0.8
     noise_px: NonNegative = 0.4
     noise_spread: Annotated[float, Field(ge=0, lt=1)] = 0.5
-    drift: NonNegative = 0.001
-    drift_time: Positive = 0.07
     px_per_m: Positive = 800.0
     rest: Positive = 0.3
     marker_offset: NonNegative = 0.0065
