@@ -169,17 +169,18 @@ def _prepare_report() -> None:
     import perception.report.batch  # noqa: F401 - pandas
 
 
-def _run_dask(items: list[_Work], repertoire: Repertoire, job: _Job,
+def _run_dask(items: Iterable[_Work], repertoire: Repertoire, job: _Job,
               scheduler: str) -> Iterator[ClipResult]:
-    """Every item on a dask.distributed cluster (:mod:`perception.cluster`)."""
+    """Every item on a dask.distributed cluster (:mod:`perception.cluster`), submitted
+    as ``items`` gives them (a stream of recordings' reaches is scored while it is
+    read); this process imports the report's libraries once a worker is idle."""
     try:
         from perception.cluster import run_on_cluster
     except ImportError as exc:  # dask is the optional "cluster" extra
         raise InputError(f"needs dask.distributed ({exc}): pip install 'hammer-mv[cluster]'",
                          field="scheduler") from None
-    # largest first: the cluster's last clips are its shortest
-    return run_on_cluster(sorted(items, key=_file_size, reverse=True), job.run, repertoire,
-                          scheduler, while_waiting=_prepare_report, lost=job.lost)
+    return run_on_cluster(items, job.run, repertoire, scheduler, at_tail=_prepare_report,
+                          lost=job.lost)
 
 
 def _model_value(s: ClipSummary, name: str, values: np.ndarray) -> float:
@@ -366,9 +367,9 @@ def run_batch(
     out.mkdir(parents=True, exist_ok=True)
     for sub in ("tracks", PLANS_FOLDER):  # a link leading out of the report: refused now
         output_folder(out, sub)
-    # Recordings for local workers are read while the workers score what has been
-    # read (a 600-trial table took 4.3 s to read before the first reach went out).
-    streamed = scheduler is None and jobs > 1 and any(i.kind == "mocap" for i in items)
+    # Recordings for workers, local or dask's, are read while the workers score what
+    # has been read (a 600-trial table took 4.3 s to read before the first reach went out).
+    streamed = (scheduler is not None or jobs > 1) and any(i.kind == "mocap" for i in items)
     late: list[tuple[BatchItem, list[str]]] = []  # recordings that failed at their end
     if streamed:
         found: list[BatchItem] = []
@@ -377,7 +378,8 @@ def run_batch(
             for item, reach in stream_recordings(items, settings, late):
                 found.append(item)
                 yield _Work(item, reach)
-            _prepare_report()  # while the workers finish the last clips
+            if scheduler is None:  # while the workers finish the last clips (dask: _run_dask)
+                _prepare_report()
     else:
         pairs = recording_items(items, settings)
         items = [item for item, _ in pairs]
@@ -386,10 +388,12 @@ def run_batch(
     job = _Job(out, dataclasses.replace(settings, decoder_threads=1, planning_threads=1)
                if parallel else settings, repertoire_id, figure_format, dpi)
     t1 = time.perf_counter()
-    if streamed:
+    if scheduler:  # largest first, unless streamed: the cluster's last clips are its shortest
+        results = _run_dask(work() if streamed else sorted(
+            (_Work(*pair) for pair in pairs), key=_file_size, reverse=True),
+            repertoire, job, scheduler)
+    elif streamed:
         results = workers.run_pool(work(), job, jobs, shared=repertoire)
-    elif scheduler:
-        results = _run_dask([_Work(*pair) for pair in pairs], repertoire, job, scheduler)
     else:
         results = _run_local([_Work(*pair) for pair in pairs], repertoire, job, jobs)
     done: list[ClipResult] = []
