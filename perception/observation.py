@@ -257,6 +257,10 @@ class Observation:
     clip_raw : (T, 3, 2) array, optional
         Unfiltered wrist, finger and thumb positions over the whole clip, m
         (the landmarks' movement may end after the scored span).
+    clip_wrist : (T, 2) array, optional
+        The causally filtered wrist over the whole clip, m (as ``wrist``):
+        the hand may come to rest after the scored span ends, which the end
+        rule closes early when the tracking is noisy.
     notes : tuple of str
         What was done to the tracks before they were observed: the cleaning's
         repairs per marker (:func:`perception.track_cleaning.cleaning_notes`).
@@ -280,6 +284,7 @@ class Observation:
     noise: float = 0.0
     clip_time: np.ndarray | None = field(default=None, repr=False)
     clip_raw: np.ndarray | None = field(default=None, repr=False)
+    clip_wrist: np.ndarray | None = field(default=None, repr=False)
     notes: tuple[str, ...] = ()
 
     @property
@@ -669,5 +674,6 @@ def observe(tracks, params: ObserveParams | None = None, *, clip: str | None = N
         marker_separation=float(np.linalg.norm(2 * half)),
         clip_time=sc.time - p.span.onset_time,
         clip_raw=sc.raw,
+        clip_wrist=filt[:, 0],
         notes=cleaning_notes(tracks),
     )

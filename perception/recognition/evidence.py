@@ -211,5 +211,17 @@ def movement_evidence(observation: Observation, kinds: Sequence[str],
                     rest_aperture=obs.marker_separation, observed=landmarks[0],
                     reference=landmarks[1],
                     aperture_gap=longest_gap(obs.time, marker_aperture(obs)),
-                    slowed=slowed(obs.time, obs.wrist), scored_share=float(scored_share),
+                    slowed=_arrival(obs), scored_share=float(scored_share),
                     opening_progress=float(opening_progress))
+
+
+def _arrival(obs) -> float:
+    """How far the transport slowed from its peak in the scored movement, read to the
+    clip's last sample: the end rule closes the movement early under noisy tracking
+    (its speed floor rises with the noise), and a clip that goes on with the hand at
+    rest is not cut before the hand arrives."""
+    if obs.clip_wrist is None or obs.clip_time is None or not len(obs.time):
+        return slowed(obs.time, obs.wrist)
+    start = int(np.searchsorted(obs.clip_time, obs.time[0]))
+    return slowed(obs.clip_time[start:], obs.clip_wrist[start:], movement=len(obs.time))
+

@@ -231,7 +231,7 @@ class Evidence:
     opening_progress: float = math.nan
 
 
-def slowed(time: np.ndarray, wrist: np.ndarray) -> float:
+def slowed(time: np.ndarray, wrist: np.ndarray, movement: int | None = None) -> float:
     """How far the wrist's speed fell after its peak, as a share of the peak: 0..1.
 
     The speed between consecutive samples (NaN skipped), as the online
@@ -244,13 +244,20 @@ def slowed(time: np.ndarray, wrist: np.ndarray) -> float:
         Times, s.
     wrist : (N, 2) array
         Positions, m (the observation's filtered wrist).
+    movement : int, optional
+        The first ``movement`` samples are the movement, whose peak counts;
+        the samples after it count for how far the speed fell (default:
+        every sample is the movement's).
     """
     speed = np.linalg.norm(np.diff(wrist, axis=0), axis=1) / np.maximum(np.diff(time), 1e-9)
-    speed = speed[np.isfinite(speed)]
-    if not speed.size or speed.max() <= 0:
+    within = np.isfinite(speed)
+    if movement is not None:
+        within[max(movement - 1, 0):] = False
+    if not within.any() or speed[within].max() <= 0:
         return 0.0
-    peak = int(np.argmax(speed))
-    return float(1.0 - speed[peak:].min() / speed[peak])
+    peak = int(np.flatnonzero(within)[np.argmax(speed[within])])
+    after = speed[peak:]
+    return float(1.0 - after[np.isfinite(after)].min() / speed[peak])
 
 
 def grip_departs(observed: Landmarks, rules: VerdictRules | None = None) -> bool:
