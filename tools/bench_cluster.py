@@ -6,13 +6,15 @@ Run ``python tools/bench_cluster.py [--only parity|nanny]`` or ``make bench``
 section). Prints, asserts nothing. Needs the ``cluster`` extra (dask.distributed).
 
 ``parity`` (issue 45 item 2: dask within 95 % of local processes, the same
-summaries): a batch of rendered clips and one of a motion-capture table
-(the shared Optotrak table where there is one, else the shipped trials
-repeated), each run by ``--jobs N`` and by a running dask cluster of ``N``
-single-threaded worker processes (``LocalCluster``, started and warmed by one
-batch before the clock), ``N`` the cores, taking turns for several rounds
-(median clips/s). Each configuration's phase row says where its time went
-(:func:`phase_row`).
+summaries): a batch of rendered clips (8 a core) and one of a
+motion-capture table (30 trials a core: on 2 cores the shared 60-trial
+Optotrak table where there is one, else the shipped trials repeated), each
+run by ``--jobs N`` and by a running dask cluster of ``N`` single-threaded
+worker processes (``LocalCluster``, its nannies dask's default or as
+docs/recognition.md says, started and warmed by a clip a worker before the
+clock, closed after), ``N`` the cores, taking turns for several rounds
+(median clips/s). Each run's phase row says where its time went
+(:func:`phase_row`); a clip's CPU time compares the workers' own cost.
 
 ``nanny``: dask's nanny starts a worker with ``distributed.nanny.pre-spawn-environ``,
 whose default ``MALLOC_TRIM_THRESHOLD_=65536`` also fixes glibc's mmap
@@ -42,9 +44,11 @@ sys.path.insert(0, str(ROOT))
 
 from bench import table  # noqa: E402
 
-#: Rendered clips per core in the parity runs, and rounds of each configuration.
-PARITY_CLIPS_PER_CORE, PARITY_ROUNDS = 8, 3
-#: The shared 60-trial Optotrak table (85 Hz, no time column), where this machine has it.
+#: Rendered clips and motion-capture trials per core in the parity runs, and rounds of
+#: each configuration.
+PARITY_CLIPS_PER_CORE, PARITY_TRIALS_PER_CORE, PARITY_ROUNDS = 8, 30, 3
+#: The shared 60-trial Optotrak table (85 Hz, no time column), where this machine has
+#: it: the table of 2 cores (more cores: the shipped trials, repeated).
 SHARED_TABLE = Path("/work/shared/realdata/optotrak-grasps/trials.tsv")
 
 #: What docs/recognition.md tells a cluster's owner to give its nannies: glibc's
@@ -186,12 +190,13 @@ def _parity_sets(work: Path, cores: int):
         counts={c: total // 3 + (i < total % 3) for i, c in enumerate(names)})
     synthesize(recipe, work / "clips", seed=0, jobs=cores)
     (work / "mocap").mkdir()
-    if SHARED_TABLE.is_file():
+    trials = max(60, PARITY_TRIALS_PER_CORE * cores)
+    if trials == 60 and SHARED_TABLE.is_file():
         (work / "mocap" / "trials.tsv").symlink_to(SHARED_TABLE)
         what = "the shared Optotrak table"
     else:
-        make_table(work / "mocap" / "trials.tsv", copies=15)
-        what = "the shipped Optotrak trials x 15"
+        trials = make_table(work / "mocap" / "trials.tsv", copies=-(-trials // 4))
+        what = f"the shipped Optotrak trials repeated ({trials})"
     return [(f"{recipe.n_clips} rendered clips", discover(work / "clips"), None),
             (what, discover(work / "mocap"), dict(mocap=MocapImport(rate=float(RATE))))]
 
