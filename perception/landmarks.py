@@ -94,6 +94,12 @@ class LandmarkParams:
     second_movement : float
         Outside the movement (before its onset, after its end), the transport
         going faster than this share of its peak speed is another movement.
+    second_movement_time : float
+        ... for at least this long, s: a human movement stays above half its
+        peak speed for well over a tenth of a second, while one or two
+        samples above it are a derivative's noise (at a recording's first
+        and last samples above all, where the filter and the difference are
+        one-sided).
     max_gap, max_gap_share : float
         A gap in the aperture may hide a closing and re-opening when it is
         longer than ``max_gap`` s and than ``max_gap_share`` of the movement:
@@ -117,6 +123,7 @@ class LandmarkParams:
     max_gap: Annotated[float, Field(ge=0, le=5)] = 0.1
     max_gap_share: Share = 0.2
     second_movement: Share = 0.5
+    second_movement_time: Annotated[float, Field(ge=0, le=1)] = 0.1
 
     def hides_a_reopening(self, gap: float, movement_time: float) -> bool:
         """Whether a gap of ``gap`` s in the aperture could hide a closing and re-opening.
@@ -448,7 +455,9 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
     # another movement: a stretch outside this one going faster than a share of its peak
     fast = np.nan_to_num(speed) > params.second_movement * speed[peak]
     fast[lo:hi + 1] = False
-    others = int(np.count_nonzero(np.diff(np.r_[0, fast.astype(np.int8)]) == 1))
+    edges = np.diff(np.r_[0, fast.astype(np.int8), 0])
+    others = sum(time[b - 1] - time[a] >= params.second_movement_time - 1e-9
+                 for a, b in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)))
     base = {"onset_time": t_on, "end_time": t_end, "movement_time": T, "movements": 1 + others,
             "peak_speed": float(speed[peak]), "peak_speed_time": share(time[peak]),
             "deceleration_time": t_end - float(time[peak])}
