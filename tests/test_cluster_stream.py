@@ -61,13 +61,18 @@ def _same_reports(a: Path, b: Path) -> None:
         assert json.loads((a / name).read_text()) == json.loads((b / name).read_text()), name
 
 
-def test_a_recording_on_dask_gives_one_process_rows(session, tmp_path, cluster):
-    shutil.copy(TABLE, session / "more.tsv")
+def _here_and_on_dask(session, tmp_path, cluster):
+    """The session's batch in this process, then on the cluster (read afresh)."""
     rep = Repertoire.default()
     one = run_batch(discover(session), tmp_path / "one", rep, SETTINGS, quiet=True)
     recordings._cached.cache_clear()
-    remote = run_batch(discover(session), tmp_path / "dask", rep, SETTINGS, quiet=True,
-                       scheduler=cluster)
+    return one, run_batch(discover(session), tmp_path / "dask", rep, SETTINGS, quiet=True,
+                          scheduler=cluster)
+
+
+def test_a_recording_on_dask_gives_one_process_rows(session, tmp_path, cluster):
+    shutil.copy(TABLE, session / "more.tsv")
+    one, remote = _here_and_on_dask(session, tmp_path, cluster)
     assert len(one) == 8 and one.attrs["trials"] == remote.attrs["trials"] == 8
     pd.testing.assert_frame_equal(one, remote)  # timing is in attrs, not the rows
     _same_reports(tmp_path / "one", tmp_path / "dask")
@@ -109,11 +114,7 @@ def test_a_recording_that_fails_at_its_end_on_dask(session, tmp_path, cluster, m
 
     monkeypatch.setattr(recordings, "iter_recording", fails_at_the_end)
     shutil.copy(TABLE, session / "other.tsv")
-    rep = Repertoire.default()
-    one = run_batch(discover(session), tmp_path / "one", rep, SETTINGS, quiet=True)
-    recordings._cached.cache_clear()
-    remote = run_batch(discover(session), tmp_path / "dask", rep, SETTINGS, quiet=True,
-                       scheduler=cluster)
+    one, remote = _here_and_on_dask(session, tmp_path, cluster)
     pd.testing.assert_frame_equal(one, remote)
     assert list(remote["clip"]) == ["other", "trials"]
     assert (remote["status"] == "failed").all()
