@@ -95,11 +95,11 @@ class LandmarkParams:
         Outside the movement (before its onset, after its end), the transport
         going faster than this share of its peak speed is another movement.
     second_movement_time : float
-        ... for at least this long, s: a human movement stays above half its
-        peak speed for well over a tenth of a second, while one or two
-        samples above it are a derivative's noise (at a recording's first
-        and last samples above all, where the filter and the difference are
-        one-sided).
+        ... for at least this long (its samples times the frame period), s:
+        a human movement stays above half its peak speed for about a tenth of
+        a second or more, while one or two samples above it are a
+        derivative's noise (at a recording's first and last samples above
+        all, where the filter and the difference are one-sided).
     max_gap, max_gap_share : float
         A gap in the aperture may hide a closing and re-opening when it is
         longer than ``max_gap`` s and than ``max_gap_share`` of the movement:
@@ -456,7 +456,8 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
     fast = np.nan_to_num(speed) > params.second_movement * speed[peak]
     fast[lo:hi + 1] = False
     edges = np.diff(np.r_[0, fast.astype(np.int8), 0])
-    others = sum(time[b - 1] - time[a] >= params.second_movement_time - 1e-9
+    step = float(np.median(np.diff(time)))  # a sample stands for a frame period of time
+    others = sum((b - a) * step >= params.second_movement_time - 1e-9
                  for a, b in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)))
     base = {"onset_time": t_on, "end_time": t_end, "movement_time": T, "movements": 1 + others,
             "peak_speed": float(speed[peak]), "peak_speed_time": share(time[peak]),
