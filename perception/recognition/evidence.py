@@ -224,4 +224,3 @@ def _arrival(obs) -> float:
         return slowed(obs.time, obs.wrist)
     start = int(np.searchsorted(obs.clip_time, obs.time[0]))
     return slowed(obs.clip_time[start:], obs.clip_wrist[start:], movement=len(obs.time))
-
