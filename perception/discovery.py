@@ -321,6 +321,9 @@ def recording_items(items: Iterable[BatchItem], settings: RecognitionSettings
     """:func:`expand_recordings`' items, each recording's reach with its samples (read
     here once: a batch hands them to its workers, which then read no file).
 
+    :func:`stream_recordings` run to the end: a recording found at its end to
+    give nothing is one item, in the place of the trials it had given.
+
     Parameters
     ----------
     items : iterable of BatchItem
@@ -328,31 +331,20 @@ def recording_items(items: Iterable[BatchItem], settings: RecognitionSettings
     settings : RecognitionSettings
         Their ``mocap`` settings say how recordings are read.
     """
-    from perception.recordings import MocapImport, cached_recording
-
-    mocap = getattr(settings, "mocap", None) or MocapImport()
-    out = []
-    for item in items:
-        if not _a_recording(item):
-            out.append((_as_given(item, mocap), None))
-            continue
-        try:
-            recording = cached_recording(item.path, settings.mocap)
-        except (HammerMVError, OSError):
-            out.append((_with_factors(item, mocap.name_factors(item.path)), None))
-            continue
-        except Exception:  # noqa: BLE001 - a bug reading one file must not end the batch
-            log.debug("%s: unreadable (a bug); it fails when processed", item.path,
-                      exc_info=True)
-            # processed, it fails with its traceback in errors.log
-            out.append((_with_factors(item, mocap.name_factors(item.path)), None))
-            continue
-        by_trial = ((next((t for t in sorted(recording.trials, key=len, reverse=True)
-                           if e.name == t or e.name.startswith(f"{t}-")), e.name), [e])
-                    for e in recording.entries)
-        out += _recording_items(item, by_trial)
-    seen: set[str] = set()
-    return [(_unique(item, seen), reach) for item, reach in out]
+    failed: list[tuple[BatchItem, list[str]]] = []
+    out = list(stream_recordings(items, settings, failed))
+    taken = {name: whole for whole, names in failed for name in names}
+    if not taken:
+        return out
+    kept, placed = [], set()
+    for item, reach in out:
+        whole = taken.get(item.clip)
+        if whole is None:
+            kept.append((item, reach))
+        elif whole.clip not in placed:
+            placed.add(whole.clip)
+            kept.append((whole, None))
+    return kept
 
 
 def stream_recordings(items: Iterable[BatchItem], settings: RecognitionSettings,

@@ -200,14 +200,14 @@ def test_a_bug_reading_one_recording_does_not_end_the_batch(tmp_path, monkeypatc
     folder.mkdir()
     write_trials(folder / "good.tsv", trial_column=False)
     write_trials(folder / "bad.tsv", trial_column=False)
-    real = recordings.read_recording
+    real = recordings.iter_recording
 
-    def buggy(path, options=None):
+    def buggy(path, options=None):  # read_recording reads through it too
         if Path(path).name == "bad.tsv":
             raise ValueError("Duplicate names are not allowed.")   # pandas, on a doubled column
         return real(path, options)
 
-    monkeypatch.setattr(recordings, "read_recording", buggy)
+    monkeypatch.setattr(recordings, "iter_recording", buggy)
     recordings._cached.cache_clear()
     summary = run_batch(find_clips(folder).items, tmp_path / "report", default_repertoire(),
                         RecognitionSettings(mocap=MocapImport(rate=RATE)), quiet=True)
