@@ -96,10 +96,11 @@ class LandmarkParams:
         going faster than this share of its peak speed is another movement.
     second_movement_time : float
         ... for at least this long (its samples times the frame period), s:
-        a human movement stays above half its peak speed for about a tenth of
-        a second or more, while one or two samples above it are a
-        derivative's noise (at a recording's first and last samples above
-        all, where the filter and the difference are one-sided).
+        a minimum-jerk movement stays above half its peak speed for 54 % of
+        its time, so one of 0.2 s or more counts, while one or two samples
+        above it are a derivative's noise (at a recording's first and last
+        samples above all, where the filter and the difference are
+        one-sided).
     max_gap, max_gap_share : float
         A gap in the aperture may hide a closing and re-opening when it is
         longer than ``max_gap`` s and than ``max_gap_share`` of the movement:

@@ -89,7 +89,7 @@ def test_a_movement_whose_noisy_end_comes_early_but_goes_on_at_rest_is_not_incom
 
 def test_one_fast_sample_at_a_recordings_edge_is_no_second_movement():
     """A derivative's noise at the first or last sample is not a movement: before, one
-    sample above half the peak speed made `several-movements` (5 of 60 grasps of the
+    sample above half the peak speed made `several-movements` (3 of 60 grasps of the
     independent generator's dev set under 2 mm of white jitter)."""
     from perception.landmarks import LandmarkParams, movement_landmarks
 
