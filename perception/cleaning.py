@@ -39,7 +39,6 @@ reaches at 1 m/s), while the spikes seen in real recordings are 15-80 mm.
 from __future__ import annotations
 
 import math
-import threading
 from dataclasses import dataclass
 from typing import Annotated
 
@@ -48,7 +47,7 @@ from pydantic import Field
 from scipy.interpolate import PchipInterpolator
 from scipy.ndimage import median_filter
 
-from perception.resume import begins_with
+from perception.resume import Kept
 from perception.validation import Int, NonNegative, declared
 
 __all__ = ["CleaningParams", "Repairs", "clean_path", "held", "quantum", "spikes"]
@@ -216,8 +215,7 @@ def spikes(time: np.ndarray, path: np.ndarray, ok: np.ndarray | None = None,
     samples and times, bitwise, the same window) is tested again only from
     ``3 x window`` samples before that one's end: a sample's flag reads the
     samples within three windows of it, so those before are as they were
-    (:func:`_resumed`; a stream's landmarks test a path one row longer at
-    every row).
+    (a stream's landmarks test a path one row longer at every row).
 
     Parameters
     ----------
@@ -239,7 +237,14 @@ def spikes(time: np.ndarray, path: np.ndarray, ok: np.ndarray | None = None,
         return np.zeros(len(path), dtype=bool)
     seen = path[idx]
     ts = np.asarray(time, dtype=float)[idx]
-    start, before, best = _resumed(ts, seen, half, params)
+    kept = _SPIKES.longest((half, params), (ts, seen), first=lambda series: _last_alike(
+        series, seen))
+    # A sample's first flag reads the ``half`` samples either side (the median; mirrored
+    # at the path's end), and its final flag the first flags within ``2 x half`` of it
+    # and the final flags before it: those ``3 x half`` or more before the kept path's
+    # end never read past it, and their flags are that path's
+    start = 0 if kept is None else max(0, len(kept[0][0]) - 3 * half - 1)
+    before = np.zeros(0, dtype=bool) if kept is None else kept[1][:start]
     # mirrored at the ends, so that a first sample off the path meets the
     # samples after it, not copies of itself; a sample's median reads ``half``
     # either side, so from ``start - half`` on the medians from ``start`` are
@@ -266,50 +271,23 @@ def spikes(time: np.ndarray, path: np.ndarray, ok: np.ndarray | None = None,
             ref = np.median(seen[close], axis=0) if len(close) else None
         if ref is not None and np.linalg.norm(seen[i] - ref) <= params.spike_distance:
             off[i] = False
-    # the path this one resumed is superseded by it
-    _SPIKES.kept = [(half, params, ts, seen, off),
-                    *(k for k in getattr(_SPIKES, "kept", ()) if k is not best)][:KEPT_PATHS]
+    _SPIKES.keep((half, params), (ts, seen), off, kept)  # the path it resumed superseded
     out = np.zeros(len(path), dtype=bool)
     out[idx[off]] = True
     return out
 
 
-def _begins(ts: np.ndarray, seen: np.ndarray, kept: tuple) -> bool:
-    """Whether the seen samples ``ts, seen`` begin with a kept path's, bitwise."""
-    n = len(kept[2])
-    # another marker's path differs at its last sample: told apart before comparing all
-    return (0 < n <= len(ts) and kept[3].shape[1:] == seen.shape[1:]
-            and np.array_equal(kept[3][-1], seen[n - 1], equal_nan=True)
-            and begins_with((ts, seen), (kept[2], kept[3])))
+def _last_alike(series: tuple, seen: np.ndarray) -> bool:
+    """Whether a kept path's last sample is ``seen``'s at that row: another marker's path
+    differs there, told apart before comparing all."""
+    n = len(series[0])
+    return 0 < n <= len(seen) and np.array_equal(series[1][-1], seen[n - 1], equal_nan=True)
 
 
-def _resumed(ts: np.ndarray, seen: np.ndarray, half: int, params: CleaningParams
-             ) -> tuple[int, np.ndarray, tuple | None]:
-    """The first seen sample to test again, the final flags of those before it, and the
-    path kept that they come from.
-
-    A sample's first flag reads the ``half`` samples either side (the
-    median; mirrored at the path's end), and its final flag the first flags
-    within ``2 x half`` of it and the final flags before it. The samples
-    ``3 x half`` or more before the end of the longest path kept (in this
-    thread, with this window) that this one begins with never read past that
-    end: their flags are that path's. (0, no flags, None) when none is kept.
-    """
-    best = None
-    for kept in getattr(_SPIKES, "kept", ()):
-        if (kept[0] == half and kept[1] == params and _begins(ts, seen, kept)
-                and (best is None or len(kept[2]) > len(best[2]))):
-            best = kept
-    if best is None:
-        return 0, np.zeros(0, dtype=bool), None
-    start = max(0, len(best[2]) - 3 * half - 1)
-    return start, best[4][:start], best
-
-
-#: Paths tested for spikes in this thread and their flags, longest-resumable (:func:`spikes`).
-_SPIKES = threading.local()
 #: Paths kept per thread: a recognition's landmarks test three markers' paths.
 KEPT_PATHS = 6
+#: Paths tested for spikes in this thread with their flags (:func:`spikes`).
+_SPIKES = Kept(KEPT_PATHS)
 
 
 def clean_path(time: np.ndarray, path: np.ndarray, params: CleaningParams | None = None, *,

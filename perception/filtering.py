@@ -14,17 +14,17 @@ of the small per-frame changes the thesis's confidence rule counts.
 from __future__ import annotations
 
 import copy
-import threading
 
 import numpy as np
 
-from perception.resume import begins_with
+from perception.resume import Kept
 
 __all__ = ["AlphaBeta", "alpha_beta"]
 
-#: Filtered series kept per thread to resume from (:func:`alpha_beta`).
+#: Filtered series kept per thread to resume from (:func:`alpha_beta`): each with its
+#: output and the filter's state after it.
 RESUMABLE = 4
-_KEPT = threading.local()
+_KEPT = Kept(RESUMABLE)
 
 
 def alpha_beta(z: np.ndarray, dt: np.ndarray | float, alpha: float, beta: float) -> np.ndarray:
@@ -48,43 +48,20 @@ def alpha_beta(z: np.ndarray, dt: np.ndarray | float, alpha: float, beta: float)
     z = np.asarray(z, dtype=float)
     dt = np.broadcast_to(np.asarray(dt, dtype=float), (z.shape[0],))
     out = np.full_like(z, np.nan)
-    start, step = _resume(z, dt, alpha, beta, out)
+    # the online recogniser observes the rows so far after every row: each call is the
+    # last one's series and a row more; the filter is causal, so the rows it filtered
+    # are filtered alike (the same operations on the same numbers)
+    kept = _KEPT.longest((alpha, beta), (z, dt))
+    if kept is None:
+        start, step = 0, AlphaBeta(z.shape[1:], alpha, beta)
+    else:
+        start = len(kept[0][0])
+        out[:start] = kept[1][0]
+        step = copy.copy(kept[1][1])  # its state is replaced at every frame, never changed
     for i in range(start, z.shape[0]):
         out[i] = step(z[i], dt[i])
-    _keep(z, dt, alpha, beta, out, step)
+    _KEPT.keep((alpha, beta), (z.copy(), dt.copy()), (out.copy(), copy.copy(step)), kept)
     return out
-
-
-def _resume(z, dt, alpha, beta, out) -> tuple[int, AlphaBeta]:
-    """Where to start filtering ``z``: after the longest series filtered before (in this
-    thread, with these gains) that ``z`` and ``dt`` begin with, its output copied into
-    ``out``; else at 0.
-
-    The online recogniser observes the rows so far after every row: each call
-    is the last one's series and one row more. The filter is causal, so the
-    rows it has filtered are filtered alike (the same operations on the same
-    numbers) and only the new ones cost anything.
-    """
-    best = None
-    for kept in getattr(_KEPT, "series", ()):
-        kz, kdt, ka, kb, kout, kstep = kept
-        n = len(kz)
-        if (ka == alpha and kb == beta and (best is None or n > len(best[0]))
-                and begins_with((z, dt), (kz, kdt))):
-            best = kept
-    if best is None:
-        return 0, AlphaBeta(z.shape[1:], alpha, beta)
-    n = len(best[0])
-    out[:n] = best[4]
-    return n, copy.copy(best[5])  # its state is replaced at every frame, never changed
-
-
-def _keep(z, dt, alpha, beta, out, step) -> None:
-    """Keep a filtered series and the filter's state after it (:func:`_resume`)."""
-    series = [k for k in getattr(_KEPT, "series", ()) if len(k[0]) != len(z)
-              or not np.array_equal(k[0], z, equal_nan=True)]
-    _KEPT.series = [(z.copy(), dt.copy(), alpha, beta, out.copy(), copy.copy(step)),
-                    *series][:RESUMABLE]
 
 
 class AlphaBeta:

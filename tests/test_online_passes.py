@@ -41,8 +41,9 @@ from perception.synthetic.demos import demo_tracks
 from perception.synthetic.independent import draw_independent, independent_tracks
 
 #: what the passes keep between calls, per thread
-KEPT = (observation._SCENES, movement_bounds._ONSET, movement_bounds._END, cleaning._SPIKES,
-        engine._SCORED, filtering._KEPT)
+KEPT = (observation._SCENES, movement_bounds._ONSET, movement_bounds._END,
+        cleaning._SPIKES.local, engine._SCORED.local, engine._RESUMABLE.local,
+        filtering._KEPT.local)
 
 
 def _forget():
@@ -180,7 +181,7 @@ def test_the_spike_test_of_every_prefix_is_the_fresh_one():
         spiked = rng.choice(n, n // 10, replace=False)
         path[spiked] += rng.normal(0, 0.03, (len(spiked), 2))
         path[rng.choice(n, n // 12, replace=False)] = np.nan
-        cleaning._SPIKES.__dict__.clear()
+        cleaning._SPIKES.local.__dict__.clear()
         found = 0
         for m in range(1, n + 1):
             resumed = cleaning.spikes(time[:m], path[:m])
@@ -201,7 +202,7 @@ def test_a_path_a_sample_longer_is_tested_near_its_end_only(monkeypatch):
     monkeypatch.setattr(cleaning, "median_filter", counted)
     time = np.arange(300) / 30.0
     path = np.cumsum(np.random.default_rng(1).normal(0, 0.002, (300, 2)), axis=0)
-    cleaning._SPIKES.__dict__.clear()
+    cleaning._SPIKES.local.__dict__.clear()
     cleaning.spikes(time[:299], path[:299])
     assert calls == [299]
     cleaning.spikes(time, path)

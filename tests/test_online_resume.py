@@ -53,7 +53,8 @@ def _first(obs, n):
 
 def _forget():
     """No scores kept from before (a pass from the first frame)."""
-    engine._SCORED.__dict__.clear()
+    engine._SCORED.local.__dict__.clear()
+    engine._RESUMABLE.local.__dict__.clear()
 
 
 def _same(a, b):

@@ -23,7 +23,6 @@ is read off its calibration.
 from __future__ import annotations
 
 import copy
-import threading
 from collections.abc import Sequence
 from typing import Literal, NamedTuple
 
@@ -37,7 +36,7 @@ from perception.recognition.models import ChainModel, MotorModel
 from perception.recognition.result import Recognition
 from perception.recognition.rules import VerdictRules, judge
 from perception.recognition.scoring import RULES, THESIS_SIGNS, likelihood_rule, thesis_rule
-from perception.resume import begins_with
+from perception.resume import Kept
 from perception.validation import NonNegative, Positive, Share, declared
 
 __all__ = ["ClipScores", "HammerParams", "RULES", "StepScorer", "recognize", "score_clip"]
@@ -451,14 +450,12 @@ def score_clip(observation: Observation, models: Sequence[MotorModel],
     obs, models = observation, list(models)
     params = HammerParams() if params is None else params
     arrays = (obs.time, obs.wrist, obs.finger, obs.thumb)
+    key = _key(models, params, obs.dt)
     # a stream judged row by row scores the same movement again once it has ended
-    for kept in getattr(_SCORED, "kept", ()):
-        if (kept[1] == (params, obs.dt) and len(kept[0]) == len(models)
-                and all(a is b for a, b in zip(kept[0], models))
-                and all(a.shape == b.shape and np.array_equal(a, b, equal_nan=True)
-                        for a, b in zip(kept[2], arrays))):
-            return kept[3]
-    scorer, terms = _scored(models, params, obs, arrays)
+    same = _SCORED.longest(key, arrays, first=lambda series: len(series[0]) == len(obs.time))
+    if same is not None:
+        return same[1][1]
+    scorer, terms = _scored(models, key, obs, arrays)
     dC_r, dC_g, dll, maha, valid, pred, _ = terms
     _refuse_broken_models(models, terms.observable, valid)
     _refuse_non_finite(models, {"confidence": dC_r + dC_g, "log-likelihood": dll})
@@ -471,12 +468,17 @@ def score_clip(observation: Observation, models: Sequence[MotorModel],
         rule=scorer.params.rule)
     for a in (*scores[2:9], *scores.predicted.values()):
         a.flags.writeable = False  # shared by every result made from the same scores
-    _SCORED.kept = [(tuple(models), (params, obs.dt), tuple(np.array(a) for a in arrays),
-                     scores), *getattr(_SCORED, "kept", ())][:KEPT_SCORES]
+    _SCORED.keep(key, tuple(np.array(a) for a in arrays), (models, scores))
     return scores
 
 
-def _scored(models: list, params: HammerParams, obs: Observation, arrays: tuple
+def _key(models: list, params: HammerParams, dt: float) -> tuple:
+    """What scores are kept under: the models themselves (by identity: the entries
+    hold them, so their ids stay theirs), the settings and the frame period."""
+    return tuple(map(id, models)), params, dt
+
+
+def _scored(models: list, key: tuple, obs: Observation, arrays: tuple
             ) -> tuple[StepScorer, _Steps]:
     """The scorer after every frame of ``obs`` and their per-step terms: resumed after the
     longest movement scored before (in this thread, with these models and settings) that
@@ -489,15 +491,8 @@ def _scored(models: list, params: HammerParams, obs: Observation, arrays: tuple
     numbers); the sums are taken again over every frame, so that they are
     added in the order a pass from the first frame adds them.
     """
-    best = None
-    for kept in getattr(_SCORED, "resumable", ()):
-        k_models, k_key, k_arrays = kept[:3]
-        n = len(k_arrays[0])
-        if (k_key == (params, obs.dt) and n < obs.n_frames
-                and (best is None or n > len(best[2][0]))
-                and len(k_models) == len(models) and all(a is b for a, b in zip(k_models, models))
-                and begins_with(arrays, k_arrays)):
-            best = kept
+    params = key[1]
+    best = _RESUMABLE.longest(key, arrays, shorter=True)
     if best is None:
         # gains stacked once for the whole clip
         scorer = StepScorer(models, params, steps=int(round(obs.time[-1] / models[0].dt))
@@ -505,8 +500,8 @@ def _scored(models: list, params: HammerParams, obs: Observation, arrays: tuple
         terms = scorer.score(*arrays)
         terms = terms._replace(predicted=terms.predicted._replace(cov=None))
     else:
-        n, old = len(best[2][0]), best[4]
-        scorer = copy.copy(best[3])  # kept as it was after its frames: resumed on a copy
+        n, (_, kept_scorer, old) = len(best[0][0]), best[1]
+        scorer = copy.copy(kept_scorer)  # kept as it was after its frames: resumed on a copy
         for name in ("confidence", "log_likelihood", "mahalanobis", "scored"):
             setattr(scorer, name, getattr(scorer, name).copy())
         new = scorer.score(*(a[n:] for a in arrays))
@@ -521,16 +516,16 @@ def _scored(models: list, params: HammerParams, obs: Observation, arrays: tuple
         scorer.log_likelihood = terms.log_likelihood.sum(axis=1)
         scorer.mahalanobis = terms.mahalanobis.sum(axis=1)
         scorer.scored = terms.valid.sum(axis=1)
-    _SCORED.resumable = [
-        (tuple(models), (params, obs.dt), tuple(np.array(a) for a in arrays), scorer, terms),
-        *(k for k in getattr(_SCORED, "resumable", ()) if k is not best)][:KEPT_SCORES]
+    _RESUMABLE.keep(key, tuple(np.array(a) for a in arrays), (models, scorer, terms), best)
     return scorer, terms
 
 
 #: Scores kept per thread (the verdict's pass and the transport's of the last movements),
-#: reused for the same movement, models and settings (:func:`score_clip`).
+#: reused for the same movement, models and settings (:func:`score_clip`), and the
+#: scorers after them, resumed by a longer movement that begins with one (:func:`_scored`).
 KEPT_SCORES = 4
-_SCORED = threading.local()
+_SCORED = Kept(KEPT_SCORES)
+_RESUMABLE = Kept(KEPT_SCORES)
 
 
 def recognize(
