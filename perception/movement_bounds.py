@@ -10,13 +10,12 @@ bitwise as a pass over every row.
 
 from __future__ import annotations
 
-import threading
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from perception.errors import InputError
-from perception.resume import begins_with
+from perception.resume import Kept
 
 if TYPE_CHECKING:
     from perception.observation import ObserveParams
@@ -56,10 +55,9 @@ def onset_time(filtered: np.ndarray, time: np.ndarray, noise: float, params: Obs
     """
     # the onset found in rows this one begins with (a stream's last recognition): the
     # rows up to the crossing's hold decide it, and they are the same numbers
-    kept = getattr(_ONSET, "last", None) if rest is None else None
-    if kept is not None and kept[0] == (params, noise) and begins_with((filtered, time),
-                                                                       kept[1:3]):
-        return kept[3]
+    kept = _ONSET.longest((params, noise), (filtered, time)) if rest is None else None
+    if kept is not None:
+        return kept[1]
     w = filtered[:, 0]
     given = rest is not None
     rest = np.median(w[: params.rest_frames], axis=0) if rest is None else rest
@@ -83,14 +81,14 @@ def onset_time(filtered: np.ndarray, time: np.ndarray, noise: float, params: Obs
     m = max(i + hold, params.rest_frames)
     if not given and m <= len(filtered):
         # rows after the crossing's hold never change it: more rows, the same onset
-        _ONSET.last = ((params, noise), np.array(filtered[:m]), np.array(time[:m]), onset)
+        _ONSET.keep((params, noise), (np.array(filtered[:m]), np.array(time[:m])), onset)
     return onset
 
 
 #: The last onset found in this thread and the rows that decided it (:func:`onset_time`).
-_ONSET = threading.local()
+_ONSET = Kept(1)
 #: The last end scanned in this thread: its rule, rows and last moving row (:func:`end_row`).
-_END = threading.local()
+_END = Kept(1)
 
 
 def end_row(filtered: np.ndarray, time: np.ndarray, noise: float, dt: float,
@@ -122,14 +120,14 @@ def end_row(filtered: np.ndarray, time: np.ndarray, noise: float, dt: float,
     # A row's speed reads it and the row k after: with the rule of the last scan and
     # rows that begin with its rows, the rows it measured are as it found them, and
     # the scan goes on from its end (a stream's rows at rest, one more each time).
-    kept, start, active = getattr(_END, "last", None), 0, -1
-    if kept is not None and kept[0] == (params, k, floor) and begins_with((filtered, time),
-                                                                          kept[1:3]):
-        start, active = len(kept[1]) - k, kept[3]
+    start, active = 0, -1
+    kept = _END.longest((params, k, floor), (filtered, time))
+    if kept is not None:
+        start, active = len(kept[0][0]) - k, kept[1]
     f, t = filtered[start:], time[start:]
     speed = np.linalg.norm(f[k:] - f[:-k], axis=-1) / (t[k:] - t[:-k])[:, None]
     moving = np.flatnonzero(np.nanmax(np.where(np.isfinite(speed), speed, 0), axis=1) > floor)
     active = int(moving[-1]) + start if len(moving) else active
-    _END.last = ((params, k, floor), np.array(filtered), np.array(time), active)
+    _END.keep((params, k, floor), (np.array(filtered), np.array(time)), active)
     last = len(time) - 1
     return int(min(last, active + k * params.end_pad_frames)) if active >= 0 else last

@@ -20,7 +20,6 @@ the sign of the small per-frame changes the thesis's confidence rule counts
 from __future__ import annotations
 
 import logging
-import threading
 from dataclasses import dataclass, field
 from typing import Annotated, NamedTuple
 
@@ -32,7 +31,7 @@ from perception.filtering import alpha_beta
 from perception.geometry import DEFAULT_OBJECT_DIAMETER, SimilarityTransform
 from perception.io.pose import is_pose_file
 from perception.movement_bounds import end_row, onset_time
-from perception.resume import begins_with
+from perception.resume import Kept
 from perception.track_cleaning import cleaning_notes
 from perception.validation import Int, Positive, Tuple, declared
 
@@ -484,12 +483,12 @@ def rest_scene(tracks, params: ObserveParams | None = None, *,
     # the pipeline settles a clip's start, then observes it: one scene for both
     key = (where, params, tuple(tracks.markers),
            tracks.object_diameter_px() if params.px_per_m is None else None)
-    kept = getattr(_SCENES, "last", None)
+    kept = _SCENES.longest(key, (tracks.time, tracks.position))
     scene = None
-    if kept is not None and kept[0] == key and _begins(tracks, kept[1], kept[2]):
-        if len(kept[1]) == len(tracks.time):
-            return kept[3]
-        scene = _extended(kept[3], len(kept[1]), tracks, params)
+    if kept is not None:
+        if len(kept[0][0]) == len(tracks.time):
+            return kept[1]
+        scene = _extended(kept[1], len(kept[0][0]), tracks, params)
     if scene is None:
         px = _marker_pixels(tracks, params, where)
         time, dts = _frame_times(tracks, params, where)
@@ -499,17 +498,12 @@ def rest_scene(tracks, params: ObserveParams | None = None, *,
         scene = RestScene(where, time, dts, float(np.median(dts)), transform, raw, rest, noise)
     for a in (scene.dts, scene.raw, scene.rest):
         a.flags.writeable = False  # shared by the observations made from the same rows
-    _SCENES.last = (key, np.array(tracks.time), np.array(tracks.position), scene)
+    _SCENES.keep(key, (np.array(tracks.time), np.array(tracks.position)), scene)
     return scene
 
 
 #: The last scene fixed in this thread, and the rows it was fixed from (:func:`rest_scene`).
-_SCENES = threading.local()
-
-
-def _begins(tracks, time: np.ndarray, position: np.ndarray) -> bool:
-    """Whether the rows of ``tracks`` begin with ``time`` and ``position``, bitwise."""
-    return begins_with((tracks.time, tracks.position), (time, position))
+_SCENES = Kept(1)
 
 
 def _extended(scene: RestScene, n: int, tracks, params: ObserveParams) -> RestScene | None:

@@ -5,8 +5,7 @@ so each call's series is the last call's and a row more. The passes that
 keep their last result per thread (the scene, the onset and end scans, the
 spike test, the causal filter, the scores) resume only from a series the new
 one begins with bit for bit: :func:`begins_with` is that one test, and
-:class:`Kept` the one store the passes that keep several (the spike test,
-the causal filter, the scores) look in.
+:class:`Kept` the one store each of them keeps its results in.
 """
 
 from __future__ import annotations

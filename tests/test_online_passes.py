@@ -41,7 +41,7 @@ from perception.synthetic.demos import demo_tracks
 from perception.synthetic.independent import draw_independent, independent_tracks
 
 #: what the passes keep between calls, per thread
-KEPT = (observation._SCENES, movement_bounds._ONSET, movement_bounds._END,
+KEPT = (observation._SCENES.local, movement_bounds._ONSET.local, movement_bounds._END.local,
         cleaning._SPIKES.local, engine._SCORED.local, engine._RESUMABLE.local,
         filtering._KEPT.local)
 

@@ -123,7 +123,7 @@ def test_a_recognition_fixes_the_scene_once(rep, monkeypatch):
         return fix(*args)
 
     monkeypatch.setattr(observation, "_scene_transform", counted)
-    observation._SCENES.__dict__.clear()
+    observation._SCENES.local.__dict__.clear()
     first = recognize_tracks(tracks, rep)
     assert len(calls) == 1  # settling the start and observing share it
     # rows changed in place are new rows: the scene is fixed from them
