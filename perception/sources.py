@@ -10,8 +10,9 @@ field) and the commands that take it.
 
 The order of :data:`KINDS` is the order of the tests: a live source by its
 name alone, then a tracks file (``.tracks.h5``, before the pose files'
-``.h5``), a video by its ending, a motion-capture recording by its first
-lines (a ``.csv`` may be either), then a pose file.
+``.h5``), a video by its ending, a motion-capture recording (a ``.c3d`` or
+an OpenSim ``.trc`` by its ending, a table by its first lines: a ``.csv``
+may be either; :data:`perception.io.mocap.MOCAP_SUFFIXES`), then a pose file.
 """
 
 from __future__ import annotations
@@ -64,7 +65,9 @@ def _suffix(spec: str) -> str:
 
 
 def _is_mocap(spec: str) -> bool:
-    from perception.io.mocap import is_mocap_file  # reads the first lines only
+    # every layout perception.io.mocap reads (C3D, TRC, the vendors' and labs' tables);
+    # a table's first lines only are read
+    from perception.io.mocap import is_mocap_file
 
     return Path(spec).is_file() and is_mocap_file(spec)
 

@@ -3,7 +3,9 @@
 The layouts read, each by its own module: Qualisys Track Manager TSV exports
 (:mod:`~perception.io.mocap_qtm`), Vicon Nexus CSV exports
 (:mod:`~perception.io.vicon`), OptiTrack Motive CSV exports
-(:mod:`~perception.io.motive`), tables whose header names X, Y and Z columns
+(:mod:`~perception.io.motive`), OpenSim TRC files (:mod:`~perception.io.mocap_trc`:
+Motion Analysis Cortex, and the TRC exports of Vicon, Qualisys, OpenCap,
+Pose2Sim, ...), tables whose header names X, Y and Z columns
 per marker and headerless tables of X, Y, Z per marker
 (:mod:`~perception.io.mocap_tables`), and C3D files through ``ezc3d``
 (:mod:`~perception.io.mocap_c3d`, an optional extra: ``pip install
@@ -31,6 +33,7 @@ from perception.io.mocap_tables import (
     read_xyz_table,
 )
 from perception.io.mocap_text import TableText, delimiter, is_number, split, table_text
+from perception.io.mocap_trc import is_trc, read_trc
 from perception.io.mocap_trial import UNITS, MocapTrial, TrialStream, check_rate, check_unit
 from perception.io.motive import is_motive, read_motive
 from perception.io.vicon import is_vicon, read_vicon
@@ -38,20 +41,25 @@ from perception.io.vicon import is_vicon, read_vicon
 __all__ = ["LAYOUTS", "LAYOUTS_READ", "MOCAP_SUFFIXES", "UNITS", "MocapTrial", "is_mocap_file",
            "read_mocap", "table_layout", "unknown_layout"]
 
-#: File endings read as motion-capture files (a table's first lines decide on reading).
-MOCAP_SUFFIXES = (".c3d", ".tsv", ".txt", ".csv")
+#: File endings read as motion-capture files (a table's first lines decide on reading; a
+#: ``.c3d`` and a ``.trc`` are of their layout by name).
+MOCAP_SUFFIXES = (".c3d", ".tsv", ".txt", ".csv", ".trc")
+#: The layouts that name their own markers and hold one trial (vendor exports).
+_VENDOR = ("qtm", "vicon-nexus", "motive", "trc")
 #: Each layout :func:`table_layout` names, and what it is, in words.
 LAYOUTS = {
     "qtm": "a Qualisys TSV export (NO_OF_FRAMES, FREQUENCY, MARKER_NAMES, ...)",
     "vicon-nexus": "a Vicon Nexus CSV export (a Trajectories block)",
     "motive": "an OptiTrack Motive CSV export (Format Version, ...)",
+    "trc": "an OpenSim TRC file (PathFileType, DataRate ..., Frame# Time and the markers' "
+           "names)",
     "xyz-table": "a table whose header names X, Y and Z columns per marker (thumb_x, thumb_y, "
                  "thumb_z, ...)",
     "headerless": "a table of numbers without a header, X Y Z per marker (named with `columns`)",
     "c3d": "a C3D file",
 }
 #: The layouts read, in one line (for a message that a file is none of them).
-LAYOUTS_READ = ("expected " + ", ".join(LAYOUTS[k] for k in ("qtm", "vicon-nexus", "motive"))
+LAYOUTS_READ = ("expected " + ", ".join(LAYOUTS[k] for k in _VENDOR)
                 + ", " + LAYOUTS["xyz-table"] + ", or " + LAYOUTS["headerless"])
 #: Bytes read to tell a file's layout.
 _SNIFF = 65536
@@ -62,6 +70,8 @@ def _sniff(text: TableText) -> str | None:
     first = text.first
     if not first:
         return None
+    if is_trc(first):
+        return "trc"
     if is_qtm(first):
         return "qtm"
     if is_motive(first):
@@ -88,9 +98,11 @@ def _head(path: Path) -> TableText | None:
 def table_layout(path: str | os.PathLike) -> str | None:
     """The layout of a motion-capture file, by its name and first bytes, or None.
 
-    One of ``"qtm"``, ``"vicon-nexus"``, ``"motive"``, ``"xyz-table"``,
-    ``"headerless"`` (numbers only, a multiple of 3 per line) or ``"c3d"``
-    (:data:`LAYOUTS`); None for a file of another kind or layout.
+    One of ``"qtm"``, ``"vicon-nexus"``, ``"motive"``, ``"trc"``,
+    ``"xyz-table"``, ``"headerless"`` (numbers only, a multiple of 3 per line)
+    or ``"c3d"`` (:data:`LAYOUTS`); None for a file of another kind or layout.
+    A ``.c3d`` and a ``.trc`` are of their layout by name (their reader
+    refuses one that is not, saying what it found).
 
     Parameters
     ----------
@@ -99,8 +111,8 @@ def table_layout(path: str | os.PathLike) -> str | None:
     """
     p = Path(path)
     suffix = p.suffix.lower()
-    if suffix == ".c3d":
-        return "c3d"
+    if suffix in (".c3d", ".trc"):
+        return suffix[1:]
     if suffix not in MOCAP_SUFFIXES or not is_regular_file(p):
         return None
     text = _head(p)
@@ -110,7 +122,7 @@ def table_layout(path: str | os.PathLike) -> str | None:
 def is_mocap_file(path: str | os.PathLike) -> bool:
     """Whether ``path`` looks like a motion-capture file.
 
-    A ``.c3d`` is one by its name; a ``.tsv``, ``.txt`` or ``.csv`` is one when
+    A ``.c3d`` or ``.trc`` is one by its name; a ``.tsv``, ``.txt`` or ``.csv`` is one when
     its first lines are of a layout :func:`table_layout` names. Only the
     file's first bytes are read.
 
@@ -157,7 +169,7 @@ def read_mocap(path: str | os.PathLike, *, rate: float | None = None, units: str
     Parameters
     ----------
     path : str or os.PathLike
-        A ``.tsv``, ``.txt``, ``.csv`` or ``.c3d`` file.
+        A ``.tsv``, ``.txt``, ``.csv``, ``.trc`` or ``.c3d`` file.
     rate : float, optional
         Samples/s (up to 1000). Needed for a table without a time column. A
         file whose times come from its header's rate (C3D, Vicon, a table
@@ -207,7 +219,7 @@ def read_mocap(path: str | os.PathLike, *, rate: float | None = None, units: str
     """
     p = input_file(path, "motion-capture file")
     if p.suffix.lower() not in MOCAP_SUFFIXES:
-        raise InputError("expected a .c3d, .tsv, .txt or .csv motion-capture file", p)
+        raise InputError("expected a .c3d, .trc, .tsv, .txt or .csv motion-capture file", p)
     if units is not None:
         units = check_unit(units, p, "units")
     if rate is not None:
@@ -224,21 +236,21 @@ def read_mocap(path: str | os.PathLike, *, rate: float | None = None, units: str
                              "`columns` are for tables", p, field="columns"
                              if columns is not None else "trial_column")
         return read_c3d(p, source, rate, units)
-    if p.stat().st_size > mocap_stream.STREAM_BYTES:
+    if p.stat().st_size > mocap_stream.STREAM_BYTES and p.suffix.lower() != ".trc":
         trials = _streamed(p, source, rate, units, trial_column, time_column, columns, factors)
         if trials is not None:
             return trials
     text = table_text(p)
     if not text.first:
         raise InputError("the file is empty", p)
-    layout = _sniff(text)
+    layout = "trc" if p.suffix.lower() == ".trc" else _sniff(text)
     args = (p, source, text, rate, units, trial_column, time_column)
-    if layout in ("qtm", "vicon-nexus", "motive") and columns is not None:
+    if layout in _VENDOR and columns is not None:
         raise InputError(f"`columns` names the markers of a table without a header; this is "
                          f"{LAYOUTS[layout]}, which names its own", p, field="columns")
     cells = split(text.first, delimiter(text.first))
     headerless = bool(cells) and all(is_number(c) for c in cells if c)
-    if factors and (layout in ("qtm", "vicon-nexus", "motive") or headerless):
+    if factors and (layout in _VENDOR or headerless):
         raise InputError(f"this is {LAYOUTS['headerless' if headerless else layout]}, with no "
                          "columns to read factors from: `factors` names the columns of a "
                          "table whose header names X, Y and Z per marker (`factors_from_name` "
@@ -249,6 +261,8 @@ def read_mocap(path: str | os.PathLike, *, rate: float | None = None, units: str
         return read_vicon(*args)
     if layout == "motive":
         return read_motive(*args)
+    if layout == "trc":
+        return read_trc(*args)
     if headerless:
         return read_headerless(*args, columns)
     return read_xyz_table(*args, columns, factors)
