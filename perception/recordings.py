@@ -1,7 +1,7 @@
 """3D motion-capture recordings in, one recognition per reach out, every trial accounted for.
 
 :func:`read_recording` reads a recording (:func:`perception.io.mocap.read_mocap`:
-C3D, Qualisys TSV, lab tables with X/Y/Z per marker, long tables with a
+C3D, OpenSim TRC, Qualisys TSV, lab tables with X/Y/Z per marker, long tables with a
 trial column, headerless tables with ``columns``), finds every reach to grasp
 in each of its trials (:func:`perception.reaches.trial_reaches`) and says why
 of every trial or movement that gives none (:class:`~perception.reaches.Unscored`):

@@ -61,7 +61,8 @@ def test_each_layout_is_named(tmp_path):
     assert table_layout(dlc) is None and not is_mocap_file(dlc)
     for path in (VICON, MOTIVE, HEADERLESS):
         assert is_mocap_file(path)
-    assert set(LAYOUTS) == {"qtm", "vicon-nexus", "motive", "xyz-table", "headerless", "c3d"}
+    assert set(LAYOUTS) == {"qtm", "vicon-nexus", "motive", "xyz-table", "headerless", "c3d",
+                            "trc"}
 
 
 def test_unknown_layout_is_one_line_naming_what_was_expected(tmp_path):

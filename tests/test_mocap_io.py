@@ -402,7 +402,7 @@ def test_is_mocap_file(tmp_path):
     plain.write_text("time,a,b\n0,1,2\n")
     assert not is_mocap_file(dlc) and not is_mocap_file(plain)
     assert not is_mocap_file(DATA / "LICENSE-qualisys") and not is_mocap_file(tmp_path / "x.tsv")
-    assert set(MOCAP_SUFFIXES) == {".c3d", ".tsv", ".txt", ".csv"}
+    assert set(MOCAP_SUFFIXES) == {".c3d", ".tsv", ".txt", ".csv", ".trc"}
 
 
 def test_trial_pickles_and_its_mappings_are_read_only(qtm):

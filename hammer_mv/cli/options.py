@@ -159,8 +159,8 @@ def add_mocap_options(p: argparse.ArgumentParser) -> None:
     p : argparse.ArgumentParser
         The subcommand's parser.
     """
-    add_settings(p.add_argument_group("motion capture (C3D, Qualisys TSV, X/Y/Z tables; "
-                                      "docs/mocap.md)"), MOCAP)
+    add_settings(p.add_argument_group("motion capture (C3D, OpenSim TRC, Qualisys TSV, X/Y/Z "
+                                      "tables; docs/mocap.md)"), MOCAP)
     add_settings(p.add_argument_group("factors (the design's participant, condition, ...; "
                                       "docs/mocap.md)"), FACTORS)
 

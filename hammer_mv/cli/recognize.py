@@ -30,7 +30,7 @@ def register(sub) -> None:
     # kept as typed (a Path would make "udp://host" "udp:/host"): its kind is read first
     p.add_argument("input", metavar="INPUT",
                    help="video, .tracks.h5, pose file (.h5, .csv, .slp, .nc, .nwb) or "
-                        "motion-capture file (.c3d, Qualisys .tsv, X/Y/Z table)")
+                        "motion-capture file (.c3d, .trc, Qualisys .tsv, X/Y/Z table)")
     p.add_argument("-o", "--output", type=Path, required=True, metavar="DIR",
                    help="folder for the clip's report")
     p.add_argument("--no-figures", action="store_true",
