@@ -150,10 +150,11 @@ def quantum(path: np.ndarray) -> float | None:
 
 def held(path: np.ndarray, run: int, step: float | None = None,
          still: np.ndarray | None = None) -> np.ndarray:
-    """(N,) samples that repeat the previous one exactly while the marker was lost.
+    """(N,) samples that repeat the previous one seen exactly while the marker was lost.
 
-    A run of ``run`` or more identical samples (all coordinates) is held
-    (all but its first, the last real sample), unless
+    A run of ``run`` or more identical seen samples (all coordinates; samples
+    missing between them are passed over) is held (all but its first, the
+    last real sample), unless
 
     * it spans every seen sample (a marker that never moves);
     * ``still`` is true through it (every other marker repeats too: the
@@ -176,15 +177,19 @@ def held(path: np.ndarray, run: int, step: float | None = None,
         Samples at which every other marker repeats its previous sample too.
     """
     path = np.asarray(path, dtype=float)
-    same = np.r_[False, (np.diff(path, axis=0) == 0).all(axis=1)]
     seen = np.flatnonzero(np.isfinite(path).all(axis=1))
+    # a sample that repeats the last one seen, across any samples missing between them:
+    # a system that holds a lost marker may also leave some of its samples empty
+    same = np.zeros(len(seen), dtype=bool)
+    same[1:] = (path[seen[1:]] == path[seen[:-1]]).all(axis=1)
     out = np.zeros(len(path), dtype=bool)
     for start, stop in _runs(same):
-        first = start - 1  # the run's first sample is the last real one
-        if stop - first < run:
+        first = seen[start - 1]  # the run's first sample is the last real one
+        if stop - start + 1 < run:
             continue
         before = seen[seen < first]
-        after = seen[seen >= stop][:run]
+        after = seen[stop:stop + run]
+        start, stop = seen[start], seen[stop - 1] + 1  # rows, the missing ones among them
         if not len(before) and not len(after):
             continue
         if still is not None and still[start:stop].all():

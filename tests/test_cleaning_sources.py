@@ -197,6 +197,28 @@ def test_a_truly_held_marker_is_still_found_in_a_1mm_export():
                       CleaningParams(quantum=0.0))[1].held > 0
 
 
+def test_a_held_marker_with_samples_missing_among_its_repeats_is_still_held():
+    # a system that holds a lost marker may leave some of its samples empty: a repeat of
+    # the last sample seen across them is held too (before: a lone repeat between two
+    # missing samples was kept, the frozen thumb's one sample made a second aperture peak
+    # and a real healthy grasp `abnormal (re-opening)`)
+    t, path = _reach_path()
+    k = int(np.searchsorted(t, 1.4))  # mid-reach, fast
+    frozen = path.copy()
+    frozen[k:k + 12] = frozen[k]
+    frozen[k + 5:k + 7] = np.nan  # two samples missing within the hold
+    frozen[k + 8] = np.nan
+    assert held(frozen, 3)[[k + 7, *range(k + 9, k + 12)]].all()
+    out, rep = clean_path(t, frozen)
+    assert rep.held == 11 - 3 and rep.missing == 3
+    assert np.isnan(out[k + 1:k + 12]).all()
+    # a repeat that does not reach the run's length across the gap is no hold
+    short = path.copy()
+    short[k + 1] = short[k]
+    short[k + 2] = np.nan
+    assert not held(short, 3).any()
+
+
 def test_a_quantised_marker_held_at_rest_and_released_at_rest_is_not_lost():
     t, path = _reach_path()
     rounded = np.round(path * 1000) / 1000
