@@ -75,7 +75,7 @@ def run(args: argparse.Namespace) -> int:
     (run by the command line for every command that tracks) says why.
     """
     from perception.io.atomic import check_output
-    from perception.io.tracks import Status, Tracks, tracks_path_for
+    from perception.io.tracks import tracks_path_for
     from perception.tracking.markers import load_markers
     from perception.tracking.setup import TrackingSetup, load_setup
     from perception.tracking.video_tracks import track_video
@@ -92,12 +92,31 @@ def run(args: argparse.Namespace) -> int:
                       progress=progress, labelled_video=args.labelled_video,
                       keep_truncated=args.keep_truncated, fps=args.fps)
     if not args.quiet:
-        tracks = Tracks.load(out)
-        found = ", ".join(
-            f"{name} {100 * tracks.valid[:, j].mean():.0f} %"
-            + (f" ({int(n)} frames ambiguous)"
-               if (n := (tracks.status[:, j] == Status.AMBIGUOUS).sum()) else "")
-            for j, name in enumerate(tracks.markers)
-        )
-        print(f"{out}: {tracks.n_frames} frames; found {found}")
+        print(summary_line(out))
     return 0
+
+
+def summary_line(out: Path) -> str:
+    """``OUT: N frames; found thumb 100 %, ...``: the share of frames in which each marker
+    was placed, and its ambiguous frames.
+
+    Read from the three datasets it needs (``docs/tracks-format.md``):
+    :meth:`~perception.io.tracks.Tracks.load` checks the whole file, 10 ms at
+    the end of every run, for the file this command has just written.
+    """
+    import h5py
+    import numpy as np
+
+    from perception.io.tracks import Status
+
+    with h5py.File(out, "r") as fh:
+        markers = [m.decode("utf-8") if isinstance(m, bytes) else str(m)
+                   for m in fh["tracks/markers"][()]]
+        placed = np.isfinite(fh["tracks/position"][()]).all(axis=-1)
+        ambiguous = (fh["tracks/status"][()] == Status.AMBIGUOUS).sum(axis=0)
+    found = ", ".join(
+        f"{name} {100 * placed[:, j].mean():.0f} %"
+        + (f" ({int(ambiguous[j])} frames ambiguous)" if ambiguous[j] else "")
+        for j, name in enumerate(markers)
+    )
+    return f"{out}: {len(placed)} frames; found {found}"

@@ -23,6 +23,7 @@ import contextlib
 import logging
 import math
 import os
+import sys
 from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
@@ -56,6 +57,79 @@ TIME_SOURCES = ("container", "index/fps", "mixed")
 #: A stream counts as truncated when it ends this fraction (and at least 2
 #: frames) short of the count its header claims.
 TRUNCATION_TOLERANCE = 0.02
+
+
+def _refs_when_free() -> int:
+    """What :func:`sys.getrefcount` says of a list's item that nothing else holds."""
+    probe = [np.empty(1)]
+    return sys.getrefcount(probe[0])
+
+
+class FramePool:
+    """Decoding into the buffers of frames that nothing holds any more.
+
+    Decoded into fresh memory, a frame costs a page fault for each 4 KiB
+    written (225 for 640 x 480): frames read ahead by one thread and dropped
+    by another come from memory the allocator has handed back to the
+    system, and tracking a 3,510-frame clip took 9,000-30,000 faults more
+    than decoding it in one thread, 0.1-0.25 s of system time, in the
+    decoding thread, which sets the pace (tools/bench_tracking.py). A buffer is
+    decoded into again only when its reference count says that nothing but
+    the pool holds it (no frame in the tracker's look-ahead, no crop of it,
+    no frame kept for a contact sheet); otherwise the frame is decoded into
+    new memory, kept for later while the pool has room. The pixels are the
+    same either way (OpenCV copies the converted frame into the buffer).
+
+    Parameters
+    ----------
+    size : int
+        Most buffers kept.
+
+    Attributes
+    ----------
+    n_reused : int
+        Frames decoded into a buffer decoded into before.
+    """
+
+    _FREE = _refs_when_free()
+
+    def __init__(self, size: int):
+        self.size = max(int(size), 1)
+        self.n_reused = 0
+        self._buffers: list[np.ndarray] = []
+
+    def _free(self) -> np.ndarray | None:
+        """A buffer nothing else holds, or None."""
+        buffers = self._buffers
+        for i in range(len(buffers)):
+            if sys.getrefcount(buffers[i]) == self._FREE:
+                return buffers[i]
+        return None
+
+    def read_one(self, cap: Any) -> tuple[bool, np.ndarray | None]:
+        """``cap.read()`` of an OpenCV capture, into a free buffer where there is one."""
+        buffer = self._free()
+        if buffer is None:
+            ok, frame = cap.read()
+        else:
+            ok, frame = cap.read(buffer)
+            if ok and frame is buffer:
+                self.n_reused += 1
+            elif ok and frame is not None:  # another size: decoded into new memory
+                self._buffers = [b for b in self._buffers if b is not buffer]
+        if ok and frame is not None and frame is not buffer and len(self._buffers) < self.size:
+            self._buffers.append(frame)
+        return ok, frame
+
+    def read(self, cap: Any) -> Iterator[tuple[np.ndarray, float]]:
+        """``(frame, CAP_PROP_POS_MSEC)`` of an OpenCV capture until a read fails."""
+        while True:
+            ok, frame = self.read_one(cap)
+            if not ok or frame is None:
+                return
+            yield frame, cap.get(cv2.CAP_PROP_POS_MSEC)
+            frame = None  # not held here while the next buffer is chosen
+
 
 @dataclass(frozen=True)
 class VideoInfo:
@@ -93,7 +167,8 @@ class FrameSource(capture.Source):
     ``(index, time_s, frame)`` once, front to back. Decoding runs in a
     background thread a few frames ahead (OpenCV releases the GIL while
     decoding), so work done on each frame overlaps the next frame's decoding;
-    at most ``prefetch`` frames are held.
+    at most ``prefetch`` frames are held. Frames are decoded into the buffers
+    of earlier frames that nothing holds any more (:class:`FramePool`).
 
     Parameters
     ----------
@@ -168,7 +243,9 @@ class FrameSource(capture.Source):
             raise InputError(f"the container claims {claimed:.0f} frames, more than the "
                              f"{MAX_FRAMES} a tracks file may hold", self.path,
                              field="frame count")
-        ok, first = cap.read()
+        # frames held at once: those read ahead, the one being decoded, a tracker's look-ahead
+        self._pool = FramePool(self.prefetch + 16)
+        ok, first = self._pool.read_one(cap)
         if not ok or first is None:
             cap.release()
             raise InputError("no decodable frames (empty, truncated or corrupt video)", self.path)
@@ -203,10 +280,10 @@ class FrameSource(capture.Source):
             self._first = None
             self.n_decoded = 1
             if self.prefetch > 0:  # decoded in a thread, overlapping the caller's work
-                self._ahead = capture.ReadAhead(lambda: capture.read_frames(self._cap),
+                self._ahead = capture.ReadAhead(lambda: self._pool.read(self._cap),
                                                 self.prefetch, name=f"decode:{self.path.name}")
             for frame, msec in (iter(self._ahead.next, None) if self._ahead
-                                else capture.read_frames(self._cap)):
+                                else self._pool.read(self._cap)):
                 self.n_decoded += 1
                 yield self.n_decoded - 1, self._times(msec), frame
             self.complete = True
