@@ -103,3 +103,14 @@ def test_the_pool_keeps_at_most_its_size():
     held = [pool.read_one(_Capture())[1] for _ in range(5)]  # all held: none free
     assert len(pool._buffers) == 2 and pool.n_reused == 0
     assert len({id(f) for f in held}) == 5
+
+
+@pytest.mark.parametrize("size, ahead", [((96, 64), 32), ((1280, 720), 12), ((1920, 1080), 8)])
+def test_read_ahead_by_default_is_what_fits_in_32_mib(tmp_path, size, ahead):
+    path = tmp_path / "clip.mp4"
+    w, h = size
+    write_video([np.full((h, w, 3), 90, np.uint8)] * 2, path, 30)
+    src = FrameSource(path, prefetch=None)
+    assert src.prefetch == ahead
+    assert [i for i, _, _ in src] == [0, 1]
+    assert FrameSource(path).prefetch == 8  # the class's own default stays

@@ -57,6 +57,10 @@ TIME_SOURCES = ("container", "index/fps", "mixed")
 #: A stream counts as truncated when it ends this fraction (and at least 2
 #: frames) short of the count its header claims.
 TRUNCATION_TOLERANCE = 0.02
+#: ``FrameSource(prefetch=None)`` reads ahead as many frames as fit in this
+#: many bytes, :data:`READ_AHEAD_FRAMES` frames at most and at least.
+READ_AHEAD_BYTES = 32 * 2**20
+READ_AHEAD_FRAMES = (8, 32)
 
 
 def _refs_when_free() -> int:
@@ -174,8 +178,10 @@ class FrameSource(capture.Source):
     ----------
     path : str or os.PathLike
         Video file.
-    prefetch : int
-        Frames decoded ahead (0: decode in the caller's thread).
+    prefetch : int or None
+        Frames decoded ahead (0: decode in the caller's thread; None: as many
+        as fit in :data:`READ_AHEAD_BYTES`, 8 to 32: 32 of 640 x 480, 8 of
+        1920 x 1080).
     hash : bool
         Compute the file's SHA-256 (one extra sequential read of the file,
         in a background thread while frames are decoded; :attr:`info` waits
@@ -209,10 +215,10 @@ class FrameSource(capture.Source):
         True once the stream has been read to its end.
     """
 
-    def __init__(self, path: str | os.PathLike, *, prefetch: int = 8, hash: bool = True,
+    def __init__(self, path: str | os.PathLike, *, prefetch: int | None = 8, hash: bool = True,
                  keep_truncated: bool = False, fps: float | None = None, threads: int = 0):
         self.path = Path(path)
-        self.prefetch = int(prefetch)
+        self.prefetch = prefetch
         self.keep_truncated = bool(keep_truncated)
         if fps is not None and not (math.isfinite(fps) and 0 < fps <= MAX_FPS):
             raise InputError(f"expected a frame rate in (0, {MAX_FPS:g}] frames/s, "
@@ -243,6 +249,12 @@ class FrameSource(capture.Source):
             raise InputError(f"the container claims {claimed:.0f} frames, more than the "
                              f"{MAX_FRAMES} a tracks file may hold", self.path,
                              field="frame count")
+        if prefetch is None:
+            least, most = READ_AHEAD_FRAMES
+            frame_bytes = max(3 * width * height, 1.0)  # 0 where the header gives no size
+            self.prefetch = min(max(int(READ_AHEAD_BYTES // frame_bytes), least), most)
+        else:
+            self.prefetch = int(prefetch)
         # frames held at once: those read ahead, the one being decoded, a tracker's look-ahead
         self._pool = FramePool(self.prefetch + 16)
         ok, first = self._pool.read_one(cap)
