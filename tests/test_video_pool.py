@@ -9,6 +9,8 @@ decoded into.
 
 from __future__ import annotations
 
+import threading
+
 import cv2
 import numpy as np
 import pytest
@@ -114,3 +116,20 @@ def test_read_ahead_by_default_is_what_fits_in_32_mib(tmp_path, size, ahead):
     assert src.prefetch == ahead
     assert [i for i, _, _ in src] == [0, 1]
     assert FrameSource(path).prefetch == 8  # the class's own default stays
+
+
+def _decoding(path) -> bool:
+    return any(t.name == f"decode:{path.name}" and t.is_alive() for t in threading.enumerate())
+
+
+def test_decoding_ahead_starts_with_the_first_frame_taken(tmp_path):
+    path = tmp_path / "clip.mkv"
+    write_video(_frames(12), path, 30)
+    src = FrameSource(path, prefetch=4)
+    assert not _decoding(path)  # opening decodes the first frame only
+    frames = iter(src)
+    next(frames)
+    assert _decoding(path)  # the caller's work on frame 0 overlaps decoding
+    assert [i for i, _, _ in frames] == list(range(1, 12))
+    src.close()
+    assert not _decoding(path)

@@ -288,12 +288,14 @@ class FrameSource(capture.Source):
     # -- iteration ---------------------------------------------------------
     def _frames(self) -> Iterator[tuple[int, float, np.ndarray]]:
         try:
+            # decoded in a thread from the first frame taken on, overlapping the caller's work
+            # (what it opens or computes once before it asks for the second frame too)
+            if self.prefetch > 0:
+                self._ahead = capture.ReadAhead(lambda: self._pool.read(self._cap),
+                                                self.prefetch, name=f"decode:{self.path.name}")
             yield 0, self._times(self._first_msec), self._first
             self._first = None
             self.n_decoded = 1
-            if self.prefetch > 0:  # decoded in a thread, overlapping the caller's work
-                self._ahead = capture.ReadAhead(lambda: self._pool.read(self._cap),
-                                                self.prefetch, name=f"decode:{self.path.name}")
             for frame, msec in (iter(self._ahead.next, None) if self._ahead
                                 else self._pool.read(self._cap)):
                 self.n_decoded += 1
