@@ -30,6 +30,12 @@ markers, clutter of the markers' hues, a sleeve touching the band) is
 tracked, scored against its ground truth, and recognised beside its clean
 twins. Prints tables of targets and measured figures; asserts nothing.
 
+``--startup N`` instead times N fresh ``hammer-mv track`` processes on a
+10-frame clip and prints the median CPU of each step before and after the
+frames (imports, set-up, the video opened, the tracks file, first detection,
+writing, the summary), beside ``python -c 'import cv2'`` and the 10-frame
+decode: the part of the ratio no per-frame work changes.
+
 ``--profile N`` instead tracks an N-frame clip in this process, decoding in
 the same thread, and prints where each frame's time goes: decoding, colour
 conversion, thresholding, blobs, CamShift and moments, the streak search,
@@ -37,7 +43,7 @@ re-acquisition's downscaling, the tracker's own Python, the tracks file;
 then the first frame (first detection) and cProfile's costliest functions.
 
 Run: ``.venv/bin/python tools/bench_tracking.py [--frames 3000] [--long 3000] [--no-realistic]
-[--profile 1000]``
+[--profile 1000] [--startup 7]``
 """
 
 from __future__ import annotations
@@ -87,6 +93,49 @@ import sys, cv2
 cv2.setNumThreads(1)
 from perception.tracking.video_tracks import track_video
 track_video(sys.argv[1], sys.argv[2], decoder_threads=1)
+"""
+
+#: ``--startup``'s child: ``hammer-mv track`` with the process CPU time taken at
+#: the end of each step (functions wrapped where they return); prints them as JSON.
+_STEPS = """
+import json, sys, time
+marks = [("interpreter, site", time.process_time())]
+def mark(name):
+    marks.append((name, time.process_time()))
+def after(owner, attr, name, once=True):
+    fn = getattr(owner, attr)
+    def call(*args, **kwargs):
+        out = fn(*args, **kwargs)
+        if not once or name not in dict(marks):
+            mark(name)
+        return out
+    setattr(owner, attr, call)
+import hammer_mv.cli as cli
+mark("import hammer_mv.cli")
+after(cli, "build_parser", "parser")
+after(cli, "serial_opencv", "import cv2 (serial_opencv)")
+blas = cli.one_blas_thread
+def patched():  # the command's own modules, wrapped once imported (as the command would)
+    blas()
+    mark("threadpoolctl (one_blas_thread)")
+    from perception.io import tracks, video
+    from perception.tracking import tracker, video_tracks
+    mark("imports: perception.io, perception.tracking (pydantic)")
+    after(video_tracks, "track_video", "writing the tracks file (/video, /tracker, close)")
+    fn = video_tracks.track_video
+    def entered(*args, **kwargs):
+        mark("track.run: settings, markers, output checks")
+        return fn(*args, **kwargs)
+    video_tracks.track_video = entered
+    after(video.FrameSource, "__init__", "opening the video (first frame)")
+    after(tracks.TracksWriter, "__enter__", "the tracks file opened (h5py)")
+    after(tracker.Tracker, "update", "first detection (frame 0, look-ahead)")
+    after(video.FrameSource, "_check_count", "tracking the other frames")
+cli.one_blas_thread = patched
+sys.argv = ["hammer-mv", *sys.argv[1:]]
+cli.main(sys.argv[1:])
+mark("summary line")
+print(json.dumps(marks))
 """
 
 #: The baseline process: import OpenCV, read every frame, exit.
@@ -286,6 +335,44 @@ def profile(n_frames: int, top: int = 15) -> None:
     pstats.Stats(pr, stream=sys.stdout).sort_stats("tottime").print_stats(top)
 
 
+def startup(rounds: int) -> None:
+    """Print the median CPU of each step of a fresh ``hammer-mv track`` of a 10-frame clip
+    (``--startup``), beside ``import cv2`` and decoding the clip, in alternating rounds."""
+    import json
+
+    for pkg in ("minvar", "perception", "hammer_mv"):
+        compileall.compile_dir(ROOT / pkg, quiet=1)
+    with tempfile.TemporaryDirectory(prefix="bench_startup_") as tmp:
+        tiny = render(Path(tmp) / "tiny.mp4", _TINY, seed=3).video
+        out = Path(tmp) / "tiny.tracks.h5"
+        steps: dict[str, list[float]] = {}
+        floor, decode, whole = [], [], []
+        for _ in range(rounds):
+            floor.append(_timed([sys.executable, "-c", "import cv2"])[1])
+            decode.append(decode_process(tiny)[1])
+            r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+            cmd = [sys.executable, "-c", _STEPS, "track", str(tiny), "-o", str(out)]
+            proc = subprocess.run(cmd, check=True, env=_child_env(), capture_output=True, text=True)
+            r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+            whole.append((r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime))
+            marks = json.loads(proc.stdout.splitlines()[-1])
+            last = 0.0
+            for name, cpu in marks:
+                steps.setdefault(name, []).append(cpu - last)
+                last = cpu
+            steps.setdefault("exit (modules torn down)", []).append(whole[-1] - last)
+    med = statistics.median
+    print(f"start-up of hammer-mv track, {_TINY}-frame clip: CPU (user + sys) of each step, "
+          f"median of {rounds} fresh processes; load average {os.getloadavg()[0]:.1f}")
+    width = max(map(len, steps))
+    for name, values in steps.items():
+        print(f"  {name:<{width}}  {1e3 * med(values):6.1f} ms")
+    print(f"  {'whole process':<{width}}  {1e3 * med(whole):6.1f} ms")
+    print(f"beside it: python -c 'import cv2' {1e3 * med(floor):.1f} ms, decoding the clip "
+          f"(the baseline process) {1e3 * med(decode):.1f} ms: tracking costs "
+          f"{1e3 * (med(whole) - med(decode)):.0f} ms more whatever the clip's length")
+
+
 def _first_frame_ms(video: Path) -> float:
     """Best of 3: the tracker's first frame (look-ahead and first detection), ms."""
     from perception.tracking.tracker import Tracker
@@ -313,10 +400,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--no-realistic", action="store_true", help="skip the realistic set")
     ap.add_argument("--profile", type=int, metavar="N", default=0,
                     help="only profile tracking an N-frame clip, phase by phase")
+    ap.add_argument("--startup", type=int, metavar="N", default=0,
+                    help="only time the start-up steps of N fresh track processes")
     # called from tools/bench.py with that script's own arguments in sys.argv
     args = ap.parse_args([] if argv is None and __name__ != "__main__" else argv)
     if args.profile:
         profile(args.profile)
+        return 0
+    if args.startup:
+        startup(args.startup)
         return 0
 
     load = os.getloadavg()[0]
