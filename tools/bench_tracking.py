@@ -362,8 +362,9 @@ def startup(rounds: int) -> None:
                 last = cpu
             steps.setdefault("exit (modules torn down)", []).append(whole[-1] - last)
     med = statistics.median
-    print(f"start-up of hammer-mv track, {_TINY}-frame clip: CPU (user + sys) of each step, "
-          f"median of {rounds} fresh processes; load average {os.getloadavg()[0]:.1f}")
+    print(f"start-up of hammer-mv track, {_TINY}-frame clip: CPU (user + sys, all threads: "
+          "decoding runs from the tracks file's step on) of each step, median of "
+          f"{rounds} fresh processes; load average {os.getloadavg()[0]:.1f}")
     width = max(map(len, steps))
     for name, values in steps.items():
         print(f"  {name:<{width}}  {1e3 * med(values):6.1f} ms")
