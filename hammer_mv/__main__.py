@@ -2,6 +2,6 @@
 
 import sys
 
-from hammer_mv.cli import main
+from hammer_mv.cli import entry
 
-sys.exit(main())
+sys.exit(entry())

@@ -36,7 +36,8 @@ def register(sub) -> None:
                    help="camera index (0), video file, stream URL FFmpeg opens "
                         "(udp://127.0.0.1:5000, tcp://HOST:PORT, rtsp://...), a pose "
                         "file (DeepLabCut, SLEAP, ...) fed row by row, or a motion-capture "
-                        "recording (C3D, OpenSim TRC, Qualisys TSV, a lab table) replayed reach by reach")
+                        "recording (C3D, OpenSim TRC, Qualisys TSV, a lab table) replayed "
+                        "reach by reach")
     p.add_argument("-o", "--output", type=Path, required=True, metavar="DIR",
                    help="folder for the clip's report")
     p.add_argument("--clip", metavar="NAME",
