@@ -20,7 +20,12 @@ from perception.resume import Kept
 if TYPE_CHECKING:
     from perception.observation import ObserveParams
 
-__all__ = ["end_row", "onset_time"]
+__all__ = ["FIT_SPAN", "end_row", "onset_time"]
+
+#: The onset's time scale is fitted only to crossings whose displacements span this
+#: ratio (the highest passed over the threshold): closer together, at 30 frames/s and
+#: a noise-raised threshold, the crossing times' own noise would decide the scale.
+FIT_SPAN = 3.0
 
 
 def onset_time(filtered: np.ndarray, time: np.ndarray, noise: float, params: ObserveParams,
@@ -29,8 +34,12 @@ def onset_time(filtered: np.ndarray, time: np.ndarray, noise: float, params: Obs
 
     The crossing is where the wrist's displacement from rest first exceeds
     the threshold for ``onset_hold_frames`` frames, interpolated between
-    frames. It looks at no frame past those ``onset_hold_frames``, so the
-    online recogniser applies it to the rows seen so far.
+    frames. With ``params.onset_scale_range``, the latency is the profile's
+    at the time scale of the movement's own start: the crossings of the
+    profile's larger displacements (each held as the first) are fitted as
+    onset + scale x latency. It looks at no frame past the last crossing's
+    hold, so the online recogniser applies it to the rows seen so far (a
+    prefix that has not passed every displacement yet fits those it has).
 
     Parameters
     ----------
@@ -63,26 +72,54 @@ def onset_time(filtered: np.ndarray, time: np.ndarray, noise: float, params: Obs
     rest = np.median(w[: params.rest_frames], axis=0) if rest is None else rest
     disp = np.linalg.norm(w - rest, axis=1)
     threshold = max(params.onset_displacement, params.onset_noise_factor * noise)
-    above = np.nan_to_num(disp, nan=0.0) > threshold
-    hold = params.onset_hold_frames
+    i = _held_above(disp, threshold, params.onset_hold_frames)
+    if i is None:
+        raise InputError("no movement found: the wrist never leaves its rest position", name)
+    latency = [params.onset_latency(threshold)]
+    crossing = [_crossing(disp, time, i, threshold)]
+    m = i + params.onset_hold_frames
+    levels = ([d for d, _ in params.onset_profile if d > threshold]
+              if params.onset_scale_range is not None else [])
+    passed = threshold  # the highest displacement passed
+    for level in levels:
+        j = _held_above(disp[i:], level, params.onset_hold_frames)
+        if j is None or not np.isfinite(disp[i:i + j + 1]).all():
+            # not passed yet (a stream's prefix, a short reach), or passed unseen (the
+            # wrist lost on the way): what it has
+            break
+        passed = level
+        latency.append(params.onset_latency(level))
+        crossing.append(_crossing(disp, time, i + j, level))
+        m = i + j + params.onset_hold_frames
+    t0, tc = np.array(latency), np.array(crossing)
+    onset = float(tc[0] - t0[0])  # the first crossing less its latency, unscaled
+    if passed >= FIT_SPAN * threshold:
+        lo, hi = params.onset_scale_range
+        scale = float(np.clip(np.polyfit(t0, tc, 1)[0], lo, hi))
+        onset = float(np.mean(tc - scale * t0))
+    m = max(m, params.rest_frames)
+    if not given and m <= len(filtered) and len(t0) == len(levels) + 1:
+        # rows after the last crossing's hold never change it: more rows, the same onset
+        _ONSET.keep((params, noise), (np.array(filtered[:m]), np.array(time[:m])), onset)
+    return onset
+
+
+def _held_above(disp: np.ndarray, level: float, hold: int) -> int | None:
+    """The first row from which ``disp`` stays above ``level`` for ``hold`` rows (None)."""
+    above = np.nan_to_num(disp, nan=0.0) > level
     held = np.ones_like(above)
     for k in range(hold):
         held &= np.roll(above, -k)
-    held[len(held) - hold + 1:] = False  # np.roll wrapped the last frames around
-    if not held.any():
-        raise InputError("no movement found: the wrist never leaves its rest position", name)
-    i = int(np.argmax(held))
+    held[len(held) - hold + 1:] = False  # np.roll wrapped the last rows around
+    return int(np.argmax(held)) if held.any() else None
+
+
+def _crossing(disp: np.ndarray, time: np.ndarray, i: int, level: float) -> float:
+    """When ``disp`` rose through ``level`` between rows ``i - 1`` and ``i``, interpolated, s."""
     if i > 0 and np.isfinite(disp[i - 1]):
-        frac = (threshold - disp[i - 1]) / (disp[i] - disp[i - 1])
-        crossing = time[i - 1] + frac * (time[i] - time[i - 1])
-    else:
-        crossing = time[i]
-    onset = float(crossing - params.onset_latency(threshold))
-    m = max(i + hold, params.rest_frames)
-    if not given and m <= len(filtered):
-        # rows after the crossing's hold never change it: more rows, the same onset
-        _ONSET.keep((params, noise), (np.array(filtered[:m]), np.array(time[:m])), onset)
-    return onset
+        frac = (level - disp[i - 1]) / (disp[i] - disp[i - 1])
+        return float(time[i - 1] + frac * (time[i] - time[i - 1]))
+    return float(time[i])
 
 
 #: The last onset found in this thread and the rows that decided it (:func:`onset_time`).

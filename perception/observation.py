@@ -122,6 +122,16 @@ class ObserveParams:
         command (the muscle filter), so the onset is the crossing time less
         this latency. The default is the 1 s minimum variance grasp's
         (``tests/test_observe.py`` checks it against the model).
+    onset_scale_range : (float, float), optional
+        A movement that starts faster or slower than the profile's (a faster
+        or nearer reach, a person's quicker rise) is aligned by a time scale:
+        the crossing times of the profile's displacements the wrist has
+        passed, fitted (least squares) as the profile's latencies times that
+        scale plus the onset, the scale kept within this range. The model's
+        own 1 s grasps come out near 1 and its 0.6 s ones near 0.75; real
+        reaches near 0.6 (1.3-1.8 s, Optotrak) and 0.35 (0.4-0.5 s,
+        RTMocap), whose onset the unscaled profile put 40-70 ms early.
+        None: the profile as it is (the latency of the first crossing alone).
     end_speed : float
         A hand marker faster than this, m/s (or ``end_noise_factor`` noise SDs
         per frame, if larger), is still moving: the movement ends after the
@@ -162,6 +172,7 @@ class ObserveParams:
                              AfterValidator(_profile)] = (
         (0.001, 0.091), (0.002, 0.110), (0.003, 0.123), (0.004, 0.133),
         (0.006, 0.151), (0.008, 0.166), (0.012, 0.190))
+    onset_scale_range: _Range | None = (0.2, 2.0)
     end_speed: Positive = 0.02
     end_noise_factor: Positive = 6.0
     end_speed_window: Annotated[float, Field(gt=0, le=1)] = 1 / 30

@@ -112,6 +112,51 @@ def test_too_short_and_no_scale_and_no_movement():
         observe(tracks.replace(position=still))
 
 
+def _minimum_jerk(duration, rate, start=0.5, distance=0.25):
+    """A wrist's minimum-jerk reach from rest at ``start`` s, as the onset rule reads it."""
+    t = np.arange(0.0, start + duration + 0.5, 1.0 / rate)
+    s = np.clip((t - start) / duration, 0.0, 1.0)
+    path = np.zeros((len(t), 3, 2))
+    path[:, 0, 1] = distance * (10 * s ** 3 - 15 * s ** 4 + 6 * s ** 5)
+    return path, t
+
+
+def test_a_movement_that_starts_faster_or_slower_is_aligned_by_its_own_start():
+    # the latency profile is the 1 s model's: a 0.4 s reach passes 2 mm sooner after its
+    # command, a 1.6 s one later; fitted to the crossings of the profile's displacements
+    # the onset stays within 45 ms of the true start from 0.4 to 1.6 s, where the profile
+    # alone misses by -73 to +46 ms (real 0.4-0.5 s reaches were scored 40-70 ms early)
+    from perception.movement_bounds import onset_time
+
+    fitted, unscaled = [], []
+    for duration in (0.4, 0.6, 1.0, 1.6):
+        for rate in (30.0, 200.0):
+            path, t = _minimum_jerk(duration, rate)
+            fitted.append(onset_time(path, t, 0.0, ObserveParams(), "reach") - 0.5)
+            unscaled.append(onset_time(path, t, 0.0, ObserveParams(onset_scale_range=None),
+                                       "reach") - 0.5)
+    assert max(abs(e) for e in fitted) < 0.045
+    assert max(fitted) - min(fitted) < 0.035 < 0.1 < max(unscaled) - min(unscaled)
+
+
+def test_the_onset_of_a_prefix_fits_the_crossings_it_has_passed():
+    from perception.movement_bounds import onset_time
+
+    path, t = _minimum_jerk(0.5, 200.0)
+    whole = onset_time(path, t, 0.0, ObserveParams(), "reach")
+    disp = np.abs(path[:, 0, 1])
+    # rows until 3 mm held: two crossings, the span too short to fit a time scale
+    n = int(np.argmax(disp > 0.003)) + 3
+    assert onset_time(path[:n], t[:n], 0.0, ObserveParams(), "reach") == pytest.approx(
+        onset_time(path[:n], t[:n], 0.0, ObserveParams(onset_scale_range=None), "reach"))
+    # past the profile's last displacement: what more rows bring changes nothing
+    n = int(np.argmax(disp > 0.012)) + 3
+    assert onset_time(path[:n], t[:n], 0.0, ObserveParams(), "reach") == whole
+    # a noisy start raises the threshold: too little span left to fit, the profile as is
+    assert onset_time(path, t, 0.002, ObserveParams(), "reach") == onset_time(
+        path, t, 0.002, ObserveParams(onset_scale_range=None), "reach")
+
+
 def test_onset_and_end_hold_at_one_pixel_of_noise():
     for seed in range(3):
         tracks, truth = demo_tracks("normal", seed, noise_px=1.0)

@@ -147,7 +147,7 @@ def test_every_frame_of_a_stream_is_a_fresh_pass_over_its_rows_bit_for_bit(rep, 
             _same(getattr(rec.prefix, field), getattr(fresh, field), f"{field} at row {n}")
         _same(rec.prefix.evidence.familiarity, fresh.evidence.familiarity, f"familiarity {n}")
         assert repr(rec.prefix.evidence) == repr(fresh.evidence), n
-    assert judged >= 15
+    assert judged >= 12
 
 
 @pytest.mark.parametrize("name", ["normal-rest", "delayed-rest-60"])
@@ -212,7 +212,8 @@ def test_a_path_a_sample_longer_is_tested_near_its_end_only(monkeypatch):
 
 def test_a_stream_fixes_its_scene_and_finds_its_onset_once(rep, monkeypatch):
     """Row after row, the scene is fixed at the first recognition and extended after; the
-    onset is found once its crossing has held."""
+    onset is found again only until the wrist has passed the onset profile's displacements
+    (their crossings fit its time scale), then kept."""
     fixed, onsets = [], []
     transform, latency = observation._scene_transform, ObserveParams.onset_latency
 
@@ -221,7 +222,7 @@ def test_a_stream_fixes_its_scene_and_finds_its_onset_once(rep, monkeypatch):
         return transform(*args)
 
     def counted_onset(self, displacement):
-        onsets.append(1)
+        onsets.append(displacement)  # each pass starts again from the threshold's
         return latency(self, displacement)
 
     monkeypatch.setattr(observation, "_scene_transform", counted_fix)
@@ -233,7 +234,9 @@ def test_a_stream_fixes_its_scene_and_finds_its_onset_once(rep, monkeypatch):
         rec.update(tracks.position[i], tracks.time[i])
     assert rec.prefix is not None
     assert len(fixed) == 1
-    assert 1 <= len(onsets) <= 3  # found once the wrist has held beyond the threshold
+    passes = 1 + sum(b <= a for a, b in zip(onsets, onsets[1:]))
+    # from the threshold's hold to the last displacement's, not at every row of the stream
+    assert 1 <= passes <= 10 < tracks.n_frames // 4, passes
 
 
 def test_scoring_a_frame_builds_no_chain(rep, monkeypatch):

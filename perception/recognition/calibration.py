@@ -6,7 +6,8 @@ from its stored gains, with command noise) varied the way one person's
 grasps vary (movement time, the grip's timing against the transport, the
 size of the opening, a bowed path), puts them through a camera with tracking
 noise, observes them like a clip (:func:`~perception.observation.observe`:
-smoothing, onset, end) and scores each against the model
+smoothing, onset, end; the onset by the model's own latency, unscaled: a
+demonstration starts as the model does) and scores each against the model
 (:func:`~perception.recognition.engine.recognize`). The misfits are the
 model's :class:`~perception.recognition.verdict.Calibration`. It is done once
 per repertoire (``Repertoire.build``, or on loading a file that lacks it)
@@ -22,7 +23,7 @@ import numpy as np
 
 from perception.geometry import SimilarityTransform
 from perception.io.tracks import Status, Tracks
-from perception.observation import observe
+from perception.observation import ObserveParams, observe
 from perception.recognition.engine import recognize
 from perception.recognition.models import MotorModel
 from perception.recognition.rollout import Rollout, rollout
@@ -106,8 +107,12 @@ def _calibrate_one(model: MotorModel, params: CalibrationParams, seed: list[int]
     cv = params.execution_cv
     run = rollout([model], steps, trials=params.demonstrations, cv=cv, rng=rng)
     values = []
+    # a model's own demonstrations start as the model does: their onset is the crossing
+    # less the model's own latency, not a time scale fitted to their start (a person's)
+    own = ObserveParams(onset_scale_range=None)
     for j in range(params.demonstrations):
-        obs = observe(own_demonstration(model, run, j, params, rng), clip=f"{model.name}-own")
+        obs = observe(own_demonstration(model, run, j, params, rng), own,
+                      clip=f"{model.name}-own")
         rec = recognize(obs, [model])
         values.append(misfit(rec.mahalanobis, rec.scored)[0])
     return Calibration(np.array(values), model.scene.frame_period, params)
