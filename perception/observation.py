@@ -680,5 +680,14 @@ def observe(tracks, params: ObserveParams | None = None, *, clip: str | None = N
         clip_time=sc.time - p.span.onset_time,
         clip_raw=sc.raw,
         clip_wrist=filt[:, 0],
-        notes=cleaning_notes(tracks),
+        notes=(*_reading_notes(tracks), *cleaning_notes(tracks)),
     )
+
+
+def _reading_notes(tracks) -> tuple[str, ...]:
+    """What reading the tracks took on trust (a pose file's keypoints guessed from their
+    names, an object placed where the grip ends): ``/tracker`` ``reading_notes``."""
+    import json
+
+    raw = getattr(tracks, "tracker", {}).get("reading_notes")
+    return tuple(str(n) for n in json.loads(raw)) if isinstance(raw, str) and raw else ()

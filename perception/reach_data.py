@@ -24,7 +24,7 @@ from perception.errors import InputError
 from perception.landmarks import LandmarkParams
 from perception.validation import NonNegative, Positive, Tuple, declared
 
-__all__ = ["MIN_SAMPLES", "PX_PER_M",
+__all__ = ["MIN_SAMPLES", "OBJECT_WORDS", "PX_PER_M",
            "MarkerMap", "Movement", "Reach", "ReachParams", "Unscored", "ever_seen"]
 
 #: The scale of the tracks a reach becomes: one "pixel" per millimetre.
@@ -37,6 +37,11 @@ MIN_SAMPLES = 10
 _STILL_RANGE = 0.002
 _STILL_WINDOW = 0.2
 _ORIGIN_PX = np.array([2000.0, 2000.0])
+
+
+#: Words in a marker's (or keypoint's) name that make it the object (:meth:`MarkerMap.guess`).
+OBJECT_WORDS = ("object", "pillow", "target", "cube", "block", "cup", "mug", "ball", "bottle",
+                "cylinder", "sphere", "dowel")
 
 
 def ever_seen(path) -> bool:
@@ -110,10 +115,11 @@ class MarkerMap:
         """The mapping a recording's marker names suggest (``thumb*``, ``index*``, ...).
 
         Tips are preferred (``thumb_tip`` over ``thumb_middle``); markers
-        whose name says hand or wrist are the wrist; ``object``, ``pillow``,
-        ``target`` or ``cube`` the object. Given the markers' paths, a marker
-        never seen (every sample missing) is no wrist or object, and a digit
-        only where no other marker's name says that digit.
+        whose name says hand or wrist are the wrist; a name with one of
+        :data:`OBJECT_WORDS` (``object``, ``target``, ``cube``, ``cup``, ...) the
+        object. Given the markers' paths, a marker never seen (every sample
+        missing) is no wrist or object, and a digit only where no other marker's
+        name says that digit.
 
         Parameters
         ----------
@@ -135,9 +141,7 @@ class MarkerMap:
         finger = pick("index", "finger")
         wrist = tuple(n for n in names if "wrist" in low[n] and seen[n]) or tuple(
             n for n in names if low[n].startswith("hand") and seen[n])
-        obj = tuple(n for n in names if seen[n] and any(w in low[n] for w in
-                                                        ("object", "pillow", "target", "cube",
-                                                         "block")))
+        obj = tuple(n for n in names if seen[n] and any(w in low[n] for w in OBJECT_WORDS))
         return cls(thumb or "thumb", finger or "index", wrist, obj)
 
     def roles(self) -> list[tuple[str, str]]:

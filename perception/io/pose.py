@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import functools
 import json
+import logging
 import math
 import os
 import re
@@ -53,6 +54,7 @@ from perception.io.pose_arrays import (
     marker_keys,
     pick_individual,
 )
+from perception.io.pose_mapping import keypoint_mapping, object_at_grip
 from perception.io.tracks import Status, Tracks, position_bounds
 from perception.limits import MAX_FPS, MAX_FRAMES, MAX_KEYPOINTS, MAX_MARKERS, MAX_POSE_POINTS
 from perception.track_cleaning import TrackCleaning, clean_tracks
@@ -71,6 +73,8 @@ __all__ = [
     "write_dlc",
     "write_movement",
 ]
+
+log = logging.getLogger(__name__)
 
 #: The markers recognition needs, in the tracks' column order.
 MARKERS = ("thumb", "finger", "wrist", "object")
@@ -457,10 +461,9 @@ def _pick_individual(ds, options: PoseImport, path: Path):
     return ds.isel(individuals=0) if names else ds
 
 
-def _marker_arrays(ds, options: PoseImport, path: Path) -> tuple[np.ndarray, np.ndarray]:
-    """(T, 4, 2) px positions and (T, 4) likelihoods of the mapped keypoints."""
-    keys = marker_keys([str(k) for k in ds["keypoints"].values],
-                       {m: options.keypoint(m) for m in MARKERS}, path)
+def _marker_arrays(ds, keys: Mapping[str, str], path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """(T, M, 2) px positions and (T, M) likelihoods of the markers' keypoints ``keys``."""
+    keys = marker_keys([str(k) for k in ds["keypoints"].values], keys, path)
     pos = ds["position"].transpose("time", "keypoints", "space")
     check_space(pos.sizes["space"], path)
     xy = np.asarray(pos.sel(keypoints=keys).values, dtype=np.float64)
@@ -473,30 +476,42 @@ def _marker_arrays(ds, options: PoseImport, path: Path) -> tuple[np.ndarray, np.
 
 
 def _markers(ds, options: PoseImport, path: Path, own: np.ndarray | None):
-    """Frames, times (s), frame rate, (T, 4, 2) px positions and (T, 4) likelihoods of a
-    ``movement`` dataset or a DeepLabCut table (:class:`PoseTable`)."""
+    """Frames, times (s), frame rate, (T, 4, 2) px positions, (T, 4) likelihoods and the
+    keypoint of each marker (None: an object placed where the grip ends its reach), with
+    notes on what was guessed, of a ``movement`` dataset or a DeepLabCut table
+    (:class:`PoseTable`)."""
     check_sizes(dict(ds.sizes), path)
     rate = functools.partial(_video_rate, path)
-    if isinstance(ds, PoseTable):
+    table = isinstance(ds, PoseTable)
+    names = ds.keypoints if table else [str(k) for k in ds["keypoints"].values]
+    mapping, notes = keypoint_mapping(names, options.keypoints, MARKERS)
+    keys = {m: k for m, k in mapping.items() if k is not None}
+    if table:
         who = pick_individual(ds.individuals, options.individual, path)
         frames, time, fps = frame_times(ds.sizes["time"], ds.time, ds.attrs, options.fps, own,
                                         rate, path)
-        return (frames, time, fps,
-                *ds.markers(who, {m: options.keypoint(m) for m in MARKERS}, path))
-    ds = _pick_individual(ds, options, path)
-    frames, time, fps = frame_times(ds.sizes["time"], ds["time"].values, ds.attrs, options.fps,
-                                    own, rate, path)
-    return (frames, time, fps, *_marker_arrays(ds, options, path))
+        xy, conf = ds.markers(who, keys, path)
+    else:
+        ds = _pick_individual(ds, options, path)
+        frames, time, fps = frame_times(ds.sizes["time"], ds["time"].values, ds.attrs,
+                                        options.fps, own, rate, path)
+        xy, conf = _marker_arrays(ds, keys, path)
+    if mapping["object"] is None:
+        hand = np.where((conf >= options.pcutoff)[..., None], xy, np.nan)
+        place = object_at_grip(hand)
+        xy = np.concatenate([xy, place[:, None]], axis=1)
+        conf = np.concatenate([conf, np.isfinite(place).all(axis=1)[:, None] * 1.0], axis=1)
+    return frames, time, fps, xy, conf, mapping, notes
 
 
-def _check_positions(xy: np.ndarray, options: PoseImport, path: Path) -> None:
+def _check_positions(xy: np.ndarray, mapping: Mapping[str, str | None], path: Path) -> None:
     """Positions NaN (not found) or within a believable distance of any frame, px."""
     lo, hi = position_bounds({})
     with np.errstate(invalid="ignore"):
         bad = np.isinf(xy) | (xy < lo) | (xy > hi)
     if bad.any():
         t, j, _ = np.argwhere(bad)[0]
-        raise InputError(f"keypoint {options.keypoint(MARKERS[j])!r} at row {t} lies at "
+        raise InputError(f"keypoint {mapping[MARKERS[j]]!r} at row {t} lies at "
                          f"({xy[t, j, 0]:.6g}, {xy[t, j, 1]:.6g}) px, beyond any frame "
                          f"(at most {hi[0]:g} px)", path, field="position")
 
@@ -535,15 +550,17 @@ def read_pose(path: str | os.PathLike, options: PoseImport | None = None) -> Tra
     input_file(path, "pose file")  # a FIFO or device would block or never end
     source = _source(path)
     ds, own = _load_dataset(path, source, options.fps)
-    frames, time, fps, xy, conf = _markers(ds, options, path, own)
-    _check_positions(xy, options, path)
+    frames, time, fps, xy, conf, mapping, notes = _markers(ds, options, path, own)
+    _check_positions(xy, mapping, path)
     seen = np.isfinite(xy).all(axis=-1) & (conf >= options.pcutoff)
     position = np.where(seen[..., None], xy, np.nan)
     diameter = [options.object_diameter_px if m == "object" and options.object_diameter_px
                 else math.nan for m in MARKERS]
     software = ds.attrs.get("source_software") or _SOURCES.get(source, "movement")
+    for note in notes:  # the one line a command shows of what it took on trust
+        log.warning("%s: %s", path.name, note)
     tracker = {"method": f"pose:{software}", "source_file": os.fspath(path),
-               "keypoints": json.dumps({m: options.keypoint(m) for m in MARKERS}),
+               "keypoints": json.dumps(mapping), "reading_notes": json.dumps(notes),
                "individual": options.individual or "", "pcutoff": options.pcutoff,
                "diameter_px": diameter}
     video = {"path": os.fspath(path), "fps_nominal": fps, "n_frames": int(len(time))}
