@@ -62,7 +62,7 @@ def test_each_layout_is_named(tmp_path):
     for path in (VICON, MOTIVE, HEADERLESS):
         assert is_mocap_file(path)
     assert set(LAYOUTS) == {"qtm", "vicon-nexus", "motive", "xyz-table", "headerless", "c3d",
-                            "trc"}
+                            "trc", "dlc-3d"}
 
 
 def test_unknown_layout_is_one_line_naming_what_was_expected(tmp_path):

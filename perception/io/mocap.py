@@ -25,6 +25,7 @@ from perception.factors import FACTOR_FLAG, factor_names
 from perception.io import mocap_stream
 from perception.io.files import input_file, is_regular_file
 from perception.io.mocap_c3d import read_c3d
+from perception.io.mocap_dlc3d import is_dlc3d, read_dlc3d
 from perception.io.mocap_qtm import is_qtm, read_qtm
 from perception.io.mocap_stream import stream_xyz_table
 from perception.io.mocap_tables import (
@@ -45,7 +46,7 @@ __all__ = ["LAYOUTS", "LAYOUTS_READ", "MOCAP_SUFFIXES", "UNITS", "MocapTrial", "
 #: ``.c3d`` and a ``.trc`` are of their layout by name).
 MOCAP_SUFFIXES = (".c3d", ".tsv", ".txt", ".csv", ".trc")
 #: The layouts that name their own markers and hold one trial (vendor exports).
-_VENDOR = ("qtm", "vicon-nexus", "motive", "trc")
+_VENDOR = ("qtm", "vicon-nexus", "motive", "trc", "dlc-3d")
 #: Each layout :func:`table_layout` names, and what it is, in words.
 LAYOUTS = {
     "qtm": "a Qualisys TSV export (NO_OF_FRAMES, FREQUENCY, MARKER_NAMES, ...)",
@@ -53,6 +54,7 @@ LAYOUTS = {
     "motive": "an OptiTrack Motive CSV export (Format Version, ...)",
     "trc": "an OpenSim TRC file (PathFileType, DataRate ..., Frame# Time and the markers' "
            "names)",
+    "dlc-3d": "a DeepLabCut 3-D table (the rows scorer, bodyparts and coords x, y, z)",
     "xyz-table": "a table whose header names X, Y and Z columns per marker (thumb_x, thumb_y, "
                  "thumb_z, ...)",
     "headerless": "a table of numbers without a header, X Y Z per marker (named with `columns`)",
@@ -78,6 +80,8 @@ def _sniff(text: TableText) -> str | None:
         return "motive"
     if is_vicon(text.lines, text.skip):
         return "vicon-nexus"
+    if is_dlc3d(text.lines[text.skip:text.skip + 4]):
+        return "dlc-3d"
     cells = split(first, delimiter(first))
     if marker_columns(cells):
         return "xyz-table"
@@ -263,6 +267,8 @@ def read_mocap(path: str | os.PathLike, *, rate: float | None = None, units: str
         return read_motive(*args)
     if layout == "trc":
         return read_trc(*args)
+    if layout == "dlc-3d":
+        return read_dlc3d(*args)
     if headerless:
         return read_headerless(*args, columns)
     return read_xyz_table(*args, columns, factors)
