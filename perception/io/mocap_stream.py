@@ -21,6 +21,7 @@ from perception.io.mocap_tables import (
     _clock,
     _find_column,
     _mixed_spaces,
+    _stated_unit,
     marker_columns,
     time_column_of,
     trial_spans,
@@ -129,6 +130,8 @@ def _checked_stream(path: Path, source: str, text: TableText, sep: str, rate, un
                              and c not in asked])
     if not groups:
         return None
+    if units is None and (own := _stated_unit(groups, path)) is not None:
+        units = own[0]  # the columns say it, as read_xyz_table reads them
     used = {c for cols in groups.values() for c in cols} | {time_col, trial_col}
     # the columns a check reads down the whole table: the clock, the factors
     keep = [c for c in names if c == time_col or c in asked

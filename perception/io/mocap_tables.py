@@ -75,7 +75,10 @@ def marker_columns(columns) -> dict[str, tuple]:
         cols = (entry["x"], entry["y"], entry["z"])
         if used & set(cols) or len(set(cols)) < 3:
             continue
-        before, after = (part.strip(_SEPS) for part in entry["parts"])
+        # "Thumb (X)": the brackets around the axis letter are no part of the name
+        before, after = (part.strip(_SEPS).removesuffix("(").removesuffix("[")
+                         .removeprefix(")").removeprefix("]").strip(_SEPS)
+                         for part in entry["parts"])
         name = before or after or "marker"
         groups[unique_name(f"{before}_{after}".strip(_SEPS) if name in groups else name,
                            groups)] = cols
@@ -373,8 +376,42 @@ def read_xyz_table(path: Path, source: str, text: TableText, rate, units, trial_
     if not groups:
         raise InputError("no marker columns: expected X, Y and Z columns for each marker "
                          "(such as thumb_x, thumb_y, thumb_z)", path, field="header")
-    return table_trials(path, source, df, groups, time_col, trial_col, rate, units, None, notes,
+    # a unit given wins over the columns' own (and settles columns that disagree)
+    own = _stated_unit(groups, path) if units is None else None
+    return table_trials(path, source, df, groups, time_col, trial_col, rate, units, own, notes,
                         factors=factors)
+
+
+#: A unit in a coordinate column's name: ``(cm)``, ``[mm]``, ``(m)``, or ``_mm``, `` cm``
+#: at its end (a bare ``m`` only in brackets: ``thumb_x_m`` may be anything).
+_UNIT = re.compile(r"[(\[]\s*(mm|cm|m)\s*[)\]]|(?:^|[\s_.-])(mm|cm)$", re.IGNORECASE)
+
+
+def _stated_unit(groups: dict[str, tuple], path: Path) -> tuple[str, str] | None:
+    """The unit every coordinate column that states one states (``Thumb X (cm)``), and the
+    field that says it; None where none does. Columns that state different ones are
+    refused: which is meant is not ours to choose.
+
+    Parameters
+    ----------
+    groups : dict of str to tuple
+        Marker name -> its X, Y, Z columns (:func:`marker_columns`).
+    path : Path
+        The file.
+    """
+    stated = {}
+    for cols in groups.values():
+        for col in cols:
+            match = _UNIT.search(str(col).strip())
+            if match:
+                stated[col] = (match.group(1) or match.group(2)).lower()
+    if len(set(stated.values())) > 1:
+        shown = ", ".join(f"{c!r} ({u})" for c, u in list(stated.items())[:4])
+        raise InputError(f"the coordinate columns state different units ({shown}): give "
+                         "`units`", path, field="units")
+    if not stated:
+        return None
+    return next(iter(stated.values())), f"the column names ({next(iter(stated))!r})"
 
 
 def _mixed_spaces(text: TableText, sep: str, path: Path) -> tuple[str, list[str]]:
