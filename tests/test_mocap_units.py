@@ -77,3 +77,42 @@ def test_a_large_table_read_trial_by_trial_states_its_unit_alike(trial, tmp_path
     for got in trials:
         assert got.units == "cm"
         np.testing.assert_allclose(got.markers["thumb"], trial.markers["thumb"], atol=1e-9)
+
+
+def _two_row(trial, path, units_row=None, scale=1000.0):
+    """``trial``'s thumb and index under a header of two rows (the markers' names above
+    their x, y, z), with a row of units below it if given."""
+    rows = ["time,thumb,,,index,,", ",x,y,z,x,y,z"] + ([units_row] if units_row else [])
+    for i, t in enumerate(trial.time - trial.time[0]):
+        values = [v * scale for m in ("thumb", "index") for v in trial.markers[m][i]]
+        rows.append(",".join([f"{t:.6f}", *(f"{v:.6f}" for v in values)]))
+    path.write_text("\n".join(rows) + "\n")
+    return path
+
+
+@pytest.mark.parametrize("units_row, scale, unit", [
+    (None, 1000.0, "mm"),            # inferred
+    ("s,cm,cm,cm,cm,cm,cm", 100.0, "cm"),  # said by the units row
+])
+def test_a_header_of_two_rows_names_each_markers_x_y_z(trial, tmp_path, units_row, scale,
+                                                       unit):
+    from perception.io.mocap import table_layout
+
+    path = _two_row(trial, tmp_path / "take.csv", units_row, scale)
+    assert table_layout(path) == "xyz-table"
+    (got,) = read_mocap(path)
+    assert got.marker_names() == ("thumb", "index") and got.units == unit
+    assert got.rate == pytest.approx(85.0, rel=1e-3)
+    for marker in ("thumb", "index"):
+        np.testing.assert_allclose(got.markers[marker], trial.markers[marker], atol=1e-6)
+    assert any("two rows" in n for n in got.notes)
+
+
+def test_an_axis_without_its_markers_name_is_no_two_row_header(trial, tmp_path):
+    from perception.io.mocap import table_layout
+
+    path = _two_row(trial, tmp_path / "take.csv")
+    lines = path.read_text().splitlines()
+    lines[0] = "time,,,,index,,"  # the thumb's name left out
+    path.write_text("\n".join(lines) + "\n")
+    assert table_layout(path) is None

@@ -32,6 +32,7 @@ from perception.io.mocap_tables import (
     marker_columns,
     read_headerless,
     read_xyz_table,
+    two_row_header,
 )
 from perception.io.mocap_text import TableText, delimiter, is_number, split, table_text
 from perception.io.mocap_trc import is_trc, read_trc
@@ -83,7 +84,7 @@ def _sniff(text: TableText) -> str | None:
     if is_dlc3d(text.lines[text.skip:text.skip + 4]):
         return "dlc-3d"
     cells = split(first, delimiter(first))
-    if marker_columns(cells):
+    if marker_columns(cells) or two_row_header(text, delimiter(first)):
         return "xyz-table"
     while cells and not cells[-1]:
         cells.pop()
@@ -281,6 +282,7 @@ def _streamed(p: Path, source: str, rate, units, trial_column, time_column, colu
     text = table_text(p, head=mocap_stream.HEAD_BYTES)
     cells = split(text.first, delimiter(text.first))
     if (columns is not None or _sniff(text) != "xyz-table"
-            or all(is_number(c) for c in cells if c)):
+            or all(is_number(c) for c in cells if c)
+            or two_row_header(text, delimiter(text.first))):  # read whole: a rare layout
         return None
     return stream_xyz_table(p, source, text, rate, units, trial_column, time_column, factors)

@@ -86,6 +86,50 @@ def marker_columns(columns) -> dict[str, tuple]:
     return groups
 
 
+#: A units row's cells under a two-row header (``mm, mm, mm, ...``; the clock's ``s``).
+_UNIT_CELL = re.compile(r"\(?\[?\s*(mm|cm|m|s|ms|sec)?\s*\]?\)?", re.IGNORECASE)
+
+
+def two_row_header(text: TableText, sep: str) -> tuple[list[str], int] | None:
+    """A header of two rows, the markers' names above their ``X Y Z`` (a third of units
+    below them is passed over): each column's name as one row would give it
+    (``thumb_X``), and the header's rows; None for any other table.
+
+    Parameters
+    ----------
+    text : TableText
+        The table's text.
+    sep : str
+        Its separator.
+    """
+    lines = text.lines[text.skip:text.skip + 3]
+    if len(lines) < 2:
+        return None
+    top, axes = split(lines[0], sep), split(lines[1], sep)
+    labels = [a.strip().lower() for a in axes]
+    at = [i for i, a in enumerate(labels) if a in ("x", "y", "z")]
+    if not at or any(labels[i] for i in range(len(labels)) if i not in at) \
+            or len(at) % 3 or any(labels[i:i + 3] != ["x", "y", "z"] for i in at[::3]):
+        return None
+    names, owner = [], ""
+    for i in range(max(len(top), len(labels))):
+        cell = top[i].strip() if i < len(top) else ""
+        if i in at:
+            if labels[i] == "x":
+                owner = cell
+            if not owner or (cell and cell != owner):
+                return None  # an axis without its marker's name above its X
+            names.append(f"{owner}_{axes[i].strip()}")
+        else:
+            names.append(cell)
+    units = split(lines[2], sep) if len(lines) > 2 else []
+    if not units or not all(_UNIT_CELL.fullmatch(c.strip()) for c in units):
+        return names, 2
+    # a units row: each coordinate's unit goes with its name, as a one-row header says it
+    return [f"{n} ({u.strip()})" if i in at and u.strip() else n
+            for i, (n, u) in enumerate(zip(names, [*units, *[""] * len(names)]))], 3
+
+
 def _find_column(columns, asked: str | None, pattern: re.Pattern, path: Path, flag: str):
     if asked is not None:
         if asked not in columns:
@@ -364,9 +408,16 @@ def read_xyz_table(path: Path, source: str, text: TableText, rate, units, trial_
                          path, field="columns")
     sep = delimiter(text.first)
     sep, mixed = _mixed_spaces(text, sep, path)
-    check_header(split(text.first, sep), path)
-    decimal = decimal_mark(text.lines[text.skip + 1:], sep)
-    df = load(path, text.raw, sep, text.skip, 0, decimal)
+    two = None if marker_columns(split(text.first, sep)) else two_row_header(text, sep)
+    rows = 1 if two is None else two[1]
+    check_header(split(text.first, sep) if two is None else [n for n in two[0] if n], path)
+    decimal = decimal_mark(text.lines[text.skip + rows:], sep)
+    if two is None:
+        df = load(path, text.raw, sep, text.skip, 0, decimal)
+    else:  # the markers' names above their X, Y, Z: one name per column, as one row gives
+        df = load(path, text.raw, sep, text.skip + rows, None, decimal)
+        df.columns = [n or f"column {k + 1}" for k, n in enumerate(two[0][:df.shape[1]])]
+        mixed = [*mixed, "a header of two rows: the markers' names above their X, Y, Z"]
     names = list(df.columns)
     notes = list(text.notes) + (["decimal commas read"] if decimal == "," else []) + mixed
     time_col = time_column_of(names, time_column, path, notes)
