@@ -12,6 +12,7 @@ the rules.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Annotated
@@ -53,6 +54,38 @@ def ever_seen(path) -> bool:
     return bool(np.isfinite(np.asarray(path, dtype=float)).all(axis=1).any())
 
 
+
+
+#: A side of the body in a marker's name: ``L_``, ``Left.``, ``_R``, or a bare ``L``/``R``
+#: before a hand word (``LTHUMB``, ``RWRIST``, ``RINDEX``).
+_SIDE = re.compile(r"^(left|right|l|r)[\s_.:-]|[\s_.:-](left|right|l|r)$|"
+                   r"^(l|r)(?=thumb|index|finger|wrist|wr[ab]|hand)", re.IGNORECASE)
+#: Words of the digits a hand is told by.
+_DIGITS = ("thumb", "index", "finger")
+
+
+def _side(name: str) -> str | None:
+    """``"l"`` or ``"r"`` where a marker's name says a side, else None."""
+    match = _SIDE.search(name)
+    return None if match is None else next(g for g in match.groups() if g)[0].lower()
+
+
+def _one_hand(names: list[str], paths) -> str | None:
+    """The side whose hand the digits are taken from where the names say two (None if
+    they do not): the one whose thumb and finger markers move farthest, else the right."""
+    sides = {_side(n) for n in names if any(w in n.lower() for w in _DIGITS)} - {None}
+    if len(sides) < 2:
+        return None
+    if paths is None:
+        return "r"
+
+    def travel(side):
+        ranges = [np.nanmax(np.ptp(np.asarray(paths[n], dtype=float), axis=0))
+                  for n in names if _side(n) == side and any(w in n.lower() for w in _DIGITS)
+                  and ever_seen(paths[n])]
+        return max(ranges, default=0.0)
+
+    return max(("r", "l"), key=travel)
 
 
 def _marker_name(name: str) -> str:
@@ -119,7 +152,10 @@ class MarkerMap:
         :data:`OBJECT_WORDS` (``object``, ``target``, ``cube``, ``cup``, ...) the
         object. Given the markers' paths, a marker never seen (every sample
         missing) is no wrist or object, and a digit only where no other marker's
-        name says that digit.
+        name says that digit. Where the names say two hands (``L_THUMB`` and
+        ``R_THUMB``, ``Left_index``, ``RWRIST``), the thumb, finger and wrist
+        are one hand's: the one whose digits move farthest, given the paths,
+        else the right.
 
         Parameters
         ----------
@@ -130,6 +166,9 @@ class MarkerMap:
         names = list(names)
         low = {n: n.lower() for n in names}
         seen = {n: paths is None or ever_seen(paths[n]) for n in names}
+        hand = _one_hand(names, paths)
+        if hand is not None:  # the other hand's markers are no part of the grasp
+            names = [n for n in names if _side(n) in (None, hand)]
 
         def pick(*words):
             hits = [n for n in names if any(w in low[n] for w in words)]

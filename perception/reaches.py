@@ -151,7 +151,8 @@ def trial_reaches(trial, markers: MarkerMap | None = None,
         # a marker the names suggest but never seen is passed over, said
         used = {m for m, _ in markers.roles()}
         notes += [f"marker {m!r} is never seen: not taken as the {role}"
-                  for m, role in MarkerMap.guess(list(trial.markers)).roles() if m not in used]
+                  for m, role in MarkerMap.guess(list(trial.markers)).roles()
+                  if m not in used and not ever_seen(trial.markers[m])]
     markers.check(trial.markers, trial.source)
     source = str(trial.source)
     time = np.asarray(trial.time, dtype=float)

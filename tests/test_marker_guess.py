@@ -1,0 +1,63 @@
+"""A recording of both hands: the digits and the wrist are taken from one hand.
+
+Full-body and bimanual marker sets name each hand's markers (``L_THUMB_TIP``,
+``RTHUMB``, ``Left_index``). The guess took the first thumb and the first
+index whatever their side (a left thumb with a right index), and averaged
+both wrists; it now takes one hand's: the one whose digits move farthest.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from perception.io.mocap import read_mocap
+from perception.io.mocap_trial import MocapTrial
+from perception.reach_data import MarkerMap
+from perception.reaches import trial_reaches
+from perception.recordings import MocapImport, recognize_reach
+
+DATA = Path(__file__).parent / "data" / "mocap"
+
+
+@pytest.mark.parametrize("names, hand", [
+    (["L_THUMB_TIP", "L_INDEX_TIP", "L_WRIST", "R_THUMB_TIP", "R_INDEX_TIP", "R_WRIST"],
+     ("R_THUMB_TIP", "R_INDEX_TIP", ("R_WRIST",))),
+    (["LTHUMB", "RTHUMB", "LINDEX", "RINDEX", "LWRIST", "RWRIST"],
+     ("RTHUMB", "RINDEX", ("RWRIST",))),
+    (["Left_thumb", "Right_index", "Right_thumb", "Left_index"],
+     ("Right_thumb", "Right_index", ())),
+    (["thumb", "index", "eyeL", "eyeR"], ("thumb", "index", ())),  # one hand: as before
+])
+def test_names_of_two_hands_give_one_hands_markers(names, hand):
+    guess = MarkerMap.guess(names)
+    assert (guess.thumb, guess.finger, guess.wrist) == hand
+
+
+def _two_hands(trial, moving: str) -> MocapTrial:
+    """``trial``'s thumb and index as the ``moving`` side's, the other hand at rest."""
+    rest = {m: np.repeat(trial.markers[m][:1] + [0.3, 0.0, 0.0], len(trial.time), axis=0)
+            for m in ("thumb", "index")}
+    other = "L" if moving == "R" else "R"
+    markers = {f"{moving}_thumb": trial.markers["thumb"], f"{moving}_index": trial.markers["index"],
+               f"{other}_thumb": rest["thumb"], f"{other}_index": rest["index"]}
+    return MocapTrial(trial.name, trial.source, trial.time, markers, trial.rate, trial.units)
+
+
+@pytest.mark.parametrize("moving", ["R", "L"])
+def test_the_hand_that_moves_is_the_one_scored(moving):
+    from perception.recognition.repertoire import Repertoire
+
+    trial = read_mocap(DATA / "optotrak-trials.tsv", rate=85.0)[0]
+    both = _two_hands(trial, moving)
+    guess = MarkerMap.guess(both.markers)
+    assert (guess.thumb, guess.finger) == (f"{moving}_thumb", f"{moving}_index")
+    reaches, _ = trial_reaches(both)
+    assert len(reaches) == 1 and not any("never seen" in n for n in reaches[0].notes)
+    rec, _ = recognize_reach(reaches[0], Repertoire.default(), None, MocapImport(rate=85.0))
+    alone, _ = recognize_reach(trial_reaches(trial, MarkerMap("thumb", "index"))[0][0],
+                               Repertoire.default(), None, MocapImport(rate=85.0))
+    assert rec.verdict == alone.verdict == "normal"
+    assert rec.decision.familiarity == pytest.approx(alone.decision.familiarity, abs=1e-9)
