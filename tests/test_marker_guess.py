@@ -61,3 +61,25 @@ def test_the_hand_that_moves_is_the_one_scored(moving):
                                Repertoire.default(), None, MocapImport(rate=85.0))
     assert rec.verdict == alone.verdict == "normal"
     assert rec.decision.familiarity == pytest.approx(alone.decision.familiarity, abs=1e-9)
+
+
+def test_a_vicon_c3ds_subject_prefixed_two_hands_give_one_hand(tmp_path):
+    # Vicon writes C3D labels Subject:Marker, as its CSV: read alike, then one hand taken
+    ezc3d = pytest.importorskip("ezc3d")
+    rng = np.random.default_rng(5)
+    labels = ("P01:LTHUMB", "P01:LINDEX", "P01:RTHUMB", "P01:RINDEX")
+    points = np.ones((4, 4, 40))
+    points[:3] = rng.uniform(-400, 400, (3, 4, 1))  # all still ...
+    points[:3, 2:, :] += np.linspace(0, 300, 40)  # ... but the right hand, which moves
+    c3d = ezc3d.c3d()
+    c3d["parameters"]["POINT"]["RATE"]["value"] = [100]
+    c3d["parameters"]["POINT"]["LABELS"]["value"] = labels
+    c3d["parameters"]["POINT"]["UNITS"]["value"] = ["mm"]
+    c3d["data"]["points"] = points
+    path = tmp_path / "both.c3d"
+    c3d.write(str(path))
+    (trial,) = read_mocap(path)
+    assert trial.marker_names() == ("LTHUMB", "LINDEX", "RTHUMB", "RINDEX")
+    assert any("P01" in n for n in trial.notes)
+    guess = MarkerMap.guess(trial.markers)
+    assert (guess.thumb, guess.finger) == ("RTHUMB", "RINDEX")

@@ -16,7 +16,13 @@ from pathlib import Path
 import numpy as np
 
 from perception.errors import InputError
-from perception.io.mocap_trial import MocapTrial, assemble, header_rate, unique_name
+from perception.io.mocap_trial import (
+    MocapTrial,
+    assemble,
+    header_rate,
+    strip_subject,
+    unique_name,
+)
 
 __all__ = ["read_c3d"]
 
@@ -124,6 +130,9 @@ def read_c3d(path: Path, source: str, rate, units) -> list[MocapTrial]:
         notes.append(f"{modelled_read} modelled points (angles, forces, ...) not read")
     if not markers:
         raise InputError("no marker points", path, field="POINT:LABELS")
+    # Vicon writes its labels Subject:Marker, as in its CSV export: read alike
+    short, more = strip_subject(list(markers))
+    markers, notes = dict(zip(short, markers.values())), notes + more
     first = int(c3d["header"]["points"].get("first_frame", 0))
     time = (first + np.arange(points.shape[2])) / rate
     stated = [str(u).strip() for u in _c3d_values(point, "UNITS") if str(u).strip()]
