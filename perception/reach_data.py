@@ -64,6 +64,12 @@ _SIDE = re.compile(r"^(left|right|l|r)[\s_.:-]|[\s_.:-](left|right|l|r)$|"
 _DIGITS = ("thumb", "index", "finger")
 
 
+def _joint(name: str) -> int:
+    """A point's number along its digit (``thumb_4`` 4, ``index3`` 3); 0 without one."""
+    match = re.search(r"(\d+)$", name)
+    return int(match.group(1)) if match else 0
+
+
 def _side(name: str) -> str | None:
     """``"l"`` or ``"r"`` where a marker's name says a side, else None."""
     match = _SIDE.search(name)
@@ -147,7 +153,8 @@ class MarkerMap:
     def guess(cls, names) -> MarkerMap:
         """The mapping a recording's marker names suggest (``thumb*``, ``index*``, ...).
 
-        Tips are preferred (``thumb_tip`` over ``thumb_middle``); markers
+        Tips are preferred (``thumb_tip`` over ``thumb_middle``, then the
+        highest-numbered point: ``thumb_4`` as OpenPose numbers them); markers
         whose name says hand or wrist are the wrist; a name with one of
         :data:`OBJECT_WORDS` (``object``, ``target``, ``cube``, ``cup``, ...) the
         object. Given the markers' paths, a marker never seen (every sample
@@ -172,8 +179,9 @@ class MarkerMap:
 
         def pick(*words):
             hits = [n for n in names if any(w in low[n] for w in words)]
-            # a marker seen before one never seen, then a tip before another point
-            hits.sort(key=lambda n: (not seen[n], "tip" not in low[n]))
+            # a marker seen before one never seen, then a tip before another point, then the
+            # most distal of numbered points (OpenPose's thumb_1 ... thumb_4: 4 the tip)
+            hits.sort(key=lambda n: (not seen[n], "tip" not in low[n], -_joint(low[n])))
             return (hits or [None])[0]
 
         thumb = pick("thumb")

@@ -30,6 +30,13 @@ DATA = Path(__file__).parent / "data" / "mocap"
     (["Left_thumb", "Right_index", "Right_thumb", "Left_index"],
      ("Right_thumb", "Right_index", ())),
     (["thumb", "index", "eyeL", "eyeR"], ("thumb", "index", ())),  # one hand: as before
+    # OpenPose's hand points, numbered from the base: 4 is the tip; both hands named
+    (["right_wrist", "right_hand_thumb_1", "right_hand_thumb_4", "right_hand_index_1",
+      "right_hand_index_4", "left_hand_thumb_4", "left_hand_index_4", "left_wrist"],
+     ("right_hand_thumb_4", "right_hand_index_4", ("right_wrist",))),
+    # MediaPipe's: the tips by name
+    (["WRIST", "THUMB_CMC", "THUMB_TIP", "INDEX_FINGER_MCP", "INDEX_FINGER_TIP"],
+     ("THUMB_TIP", "INDEX_FINGER_TIP", ("WRIST",))),
 ])
 def test_names_of_two_hands_give_one_hands_markers(names, hand):
     guess = MarkerMap.guess(names)
