@@ -153,8 +153,9 @@ class MarkerMap:
     def guess(cls, names) -> MarkerMap:
         """The mapping a recording's marker names suggest (``thumb*``, ``index*``, ...).
 
-        Tips are preferred (``thumb_tip`` over ``thumb_middle``, then the
-        highest-numbered point: ``thumb_4`` as OpenPose numbers them); markers
+        Tips are preferred (``thumb_tip`` over ``thumb_middle``), then a
+        point not numbered, then the highest-numbered (``thumb_4`` as OpenPose
+        numbers them); markers
         whose name says hand or wrist are the wrist; a name with one of
         :data:`OBJECT_WORDS` (``object``, ``target``, ``cube``, ``cup``, ...) the
         object. Given the markers' paths, a marker never seen (every sample
@@ -179,9 +180,11 @@ class MarkerMap:
 
         def pick(*words):
             hits = [n for n in names if any(w in low[n] for w in words)]
-            # a marker seen before one never seen, then a tip before another point, then the
-            # most distal of numbered points (OpenPose's thumb_1 ... thumb_4: 4 the tip)
-            hits.sort(key=lambda n: (not seen[n], "tip" not in low[n], -_joint(low[n])))
+            # a marker seen before one never seen, then a tip before another point, then
+            # one not numbered (index beside index2), then the most distal of numbered
+            # points (OpenPose's thumb_1 ... thumb_4: 4 the tip)
+            hits.sort(key=lambda n: (not seen[n], "tip" not in low[n], _joint(low[n]) > 0,
+                                     -_joint(low[n])))
             return (hits or [None])[0]
 
         thumb = pick("thumb")

@@ -34,6 +34,7 @@ DATA = Path(__file__).parent / "data" / "mocap"
     (["right_wrist", "right_hand_thumb_1", "right_hand_thumb_4", "right_hand_index_1",
       "right_hand_index_4", "left_hand_thumb_4", "left_hand_index_4", "left_wrist"],
      ("right_hand_thumb_4", "right_hand_index_4", ("right_wrist",))),
+    (["index2", "index", "thumb"], ("thumb", "index", ())),  # a plain name first
     # MediaPipe's: the tips by name
     (["WRIST", "THUMB_CMC", "THUMB_TIP", "INDEX_FINGER_MCP", "INDEX_FINGER_TIP"],
      ("THUMB_TIP", "INDEX_FINGER_TIP", ("WRIST",))),
