@@ -199,6 +199,24 @@ class MarkerMap:
         return [(self.thumb, "thumb"), (self.finger, "finger"),
                 *((m, "wrist") for m in self.wrist), *((m, "object") for m in self.object)]
 
+    def matched(self, names) -> MarkerMap:
+        """This mapping with each ``Subject:Marker`` name the recording holds without its
+        subject (the readers read Vicon's labels so) given as the recording's own.
+
+        Parameters
+        ----------
+        names : collection of str
+            The recording's marker names.
+        """
+        names = set(names)
+
+        def own(name: str) -> str:
+            short = name.rpartition(":")[2]
+            return short if name not in names and short in names else name
+
+        return MarkerMap(own(self.thumb), own(self.finger), tuple(map(own, self.wrist)),
+                         tuple(map(own, self.object)))
+
     def check(self, names, source) -> None:
         """Refuse a mapping that names a marker the recording lacks."""
         names = set(names)

@@ -153,6 +153,7 @@ def trial_reaches(trial, markers: MarkerMap | None = None,
         notes += [f"marker {m!r} is never seen: not taken as the {role}"
                   for m, role in MarkerMap.guess(list(trial.markers)).roles()
                   if m not in used and not ever_seen(trial.markers[m])]
+    markers = markers.matched(trial.markers)
     markers.check(trial.markers, trial.source)
     source = str(trial.source)
     time = np.asarray(trial.time, dtype=float)

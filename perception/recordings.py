@@ -389,7 +389,8 @@ def iter_recording(path, options: MocapImport | None = None
 def _note_seen(seen: dict, trial, markers: MarkerMap | None) -> None:
     """Mark in ``seen`` (``(name, role) -> bool``) whether ``trial`` sees each marker its
     mapping (``markers``, or the guess) gives a digit or the wrist."""
-    mapped = MarkerMap.guess(trial.markers) if markers is None else markers
+    mapped = MarkerMap.guess(trial.markers) if markers is None else markers.matched(
+        trial.markers)
     for name, role in mapped.roles():
         if role != "object" and name in trial.markers:  # a missing one: check() says
             seen[name, role] = seen.get((name, role), False) or ever_seen(trial.markers[name])

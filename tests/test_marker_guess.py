@@ -91,3 +91,7 @@ def test_a_vicon_c3ds_subject_prefixed_two_hands_give_one_hand(tmp_path):
     assert any("P01" in n for n in trial.notes)
     guess = MarkerMap.guess(trial.markers)
     assert (guess.thumb, guess.finger) == ("RTHUMB", "RINDEX")
+    # a mapping written with the labels as the C3D stores them still names them
+    given = MarkerMap("P01:RTHUMB", "P01:RINDEX").matched(trial.markers)
+    assert (given.thumb, given.finger) == ("RTHUMB", "RINDEX")
+    given.check(trial.markers, path)
