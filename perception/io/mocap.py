@@ -253,6 +253,9 @@ def read_mocap(path: str | os.PathLike, *, rate: float | None = None, units: str
     if layout in _VENDOR and columns is not None:
         raise InputError(f"`columns` names the markers of a table without a header; this is "
                          f"{LAYOUTS[layout]}, which names its own", p, field="columns")
+    if layout in _VENDOR and trial_column is not None:
+        raise InputError(f"this is {LAYOUTS[layout]}, which holds one trial: it has no trial "
+                         "column", p, field="trial_column")
     cells = split(text.first, delimiter(text.first))
     headerless = bool(cells) and all(is_number(c) for c in cells if c)
     if factors and (layout in _VENDOR or headerless):

@@ -17,7 +17,7 @@ import io
 from pathlib import Path
 
 from perception.errors import InputError
-from perception.io.mocap_tables import table_trials
+from perception.io.mocap_tables import no_clock, table_trials
 from perception.io.mocap_text import TableText, delimiter, split
 from perception.io.mocap_trial import MocapTrial
 
@@ -65,10 +65,7 @@ def read_dlc3d(path: Path, source: str, text: TableText, rate, units, trial_colu
     """
     import pandas as pd
 
-    if trial_column is not None:
-        raise InputError("a DeepLabCut 3-D table holds one video's frames: it has no trial "
-                         "column", path, field="trial_column")
-    if time_column is not None and str(time_column).strip().lower() != "none":
+    if time_column is not None and not no_clock(time_column):
         raise InputError("a DeepLabCut 3-D table has no time column: its samples are timed "
                          "by `rate`", path, field="time_column")
     lines = text.all_lines()[text.skip:]

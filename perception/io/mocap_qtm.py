@@ -72,9 +72,6 @@ def read_qtm(path: Path, source: str, text: TableText, rate, units, trial_column
     rate, units, trial_column, time_column
         As :func:`perception.io.mocap.read_mocap` takes them.
     """
-    if trial_column is not None:
-        raise InputError("a Qualisys export holds one recording: it has no trial column",
-                         path, field="trial_column")
     lines = text.lines
     header: dict[str, list[str]] = {}
     skip = text.skip

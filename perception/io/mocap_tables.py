@@ -37,7 +37,7 @@ from perception.io.mocap_trial import (
     unique_name,
 )
 
-__all__ = ["marker_columns", "read_headerless", "read_xyz_table", "table_trials"]
+__all__ = ["marker_columns", "no_clock", "read_headerless", "read_xyz_table", "table_trials"]
 
 TIME = re.compile(r"(?:t|time|times|timestamp)(?:[\s_]*[(\[]?(s|sec|secs|seconds|ms|msec)[)\]]?)?",
                   re.IGNORECASE)
@@ -139,7 +139,9 @@ def _find_column(columns, asked: str | None, pattern: re.Pattern, path: Path, fl
     return next((c for c in columns if pattern.fullmatch(c)), None)
 
 
-def _no_clock(time_column) -> bool:
+def no_clock(time_column) -> bool:
+    """Whether ``time_column`` is ``"none"``: any time column is ignored, the samples timed by
+    the rate."""
     return isinstance(time_column, str) and time_column.strip().lower() == "none"
 
 
@@ -378,7 +380,7 @@ def time_column_of(columns, time_column, path: Path, notes: list[str]):
     notes : list of str
         Gets a note when a time column is ignored.
     """
-    if _no_clock(time_column):
+    if no_clock(time_column):
         found = _find_column(columns, None, TIME, path, "time_column")
         if found is not None:
             notes.append(f"time column {found!r} ignored (--time-column none): the samples "
@@ -568,7 +570,7 @@ def read_headerless(path: Path, source: str, text: TableText, rate, units, trial
     if trial_column is not None:
         raise InputError("a table without a header row has no trial column to name", path,
                          field="trial_column")
-    if time_column is not None and not _no_clock(time_column):
+    if time_column is not None and not no_clock(time_column):
         raise InputError(f"a table without a header row has no column {time_column!r}: its "
                          "samples are timed by `rate`", path, field="time_column")
     if rate is None:

@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from perception.errors import InputError
-from perception.io.mocap_tables import table_trials
+from perception.io.mocap_tables import no_clock, table_trials
 from perception.io.mocap_text import TableText, decimal_mark, delimiter
 from perception.io.mocap_trial import RATE_TOLERANCE, MocapTrial, check_rate, strip_subject
 from perception.limits import MAX_FRAMES
@@ -90,11 +90,8 @@ def read_trc(path: Path, source: str, text: TableText, rate, units, trial_column
     rate, units, trial_column, time_column
         As :func:`perception.io.mocap.read_mocap` takes them.
     """
-    if trial_column is not None:
-        raise InputError("a TRC file holds one trial: it has no trial column", path,
-                         field="trial_column")
-    no_clock = time_column is not None and str(time_column).strip().lower() == "none"
-    if time_column is not None and not no_clock:
+    clockless = no_clock(time_column)
+    if time_column is not None and not clockless:
         raise InputError("a TRC file's clock is its Time column: leave `time_column` out to "
                          "use it, or give `time_column` none", path, field="time_column")
     if not is_trc(text.first):
@@ -125,9 +122,9 @@ def read_trc(path: Path, source: str, text: TableText, rate, units, trial_column
     df = _rows(path, lines[start:], len(names), time_label, top)
     df = _cut_rows(df, time_label, meta, notes)
     groups = {name: tuple(f"c{2 + 3 * k + a}" for a in range(3)) for k, name in enumerate(used)}
-    own_rate = _data_rate(meta, path, notes, clock=not no_clock)
-    time_col = None if no_clock else time_label
-    if no_clock:
+    own_rate = _data_rate(meta, path, notes, clock=not clockless)
+    time_col = None if clockless else time_label
+    if clockless:
         notes.append(f"time column {time_label!r} ignored (--time-column none): the samples "
                      "are timed by the rate")
     elif own_rate is not None and not _clock_agrees(df, own_rate[0], time_label, notes):

@@ -26,7 +26,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from perception.errors import InputError
-from perception.io.mocap_tables import table_trials
+from perception.io.mocap_tables import no_clock, table_trials
 from perception.io.mocap_text import TableText, delimiter, is_number, load, split
 from perception.io.mocap_trial import MocapTrial, check_rate, strip_subject
 
@@ -68,9 +68,6 @@ def read_motive(path: Path, source: str, text: TableText, rate, units, trial_col
     rate, units, trial_column, time_column
         As :func:`perception.io.mocap.read_mocap` takes them.
     """
-    if trial_column is not None:
-        raise InputError("a Motive export holds one take: it has no trial column", path,
-                         field="trial_column")
     lines = text.lines
     sep = delimiter(text.first)
     cells = split(text.first, sep)
@@ -125,7 +122,7 @@ def read_motive(path: Path, source: str, text: TableText, rate, units, trial_col
         time_col = axes[1]
         df = df.rename(columns={"c1": time_col})
     if time_column is not None:
-        if str(time_column).strip().lower() != "none":
+        if not no_clock(time_column):
             raise InputError(f"a Motive export's clock is its {axes[1]!r} column: leave "
                              "`time_column` out to use it, or give `time_column` none",
                              path, field="time_column")

@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from perception.errors import InputError
+from perception.io.mocap_tables import no_clock
 from perception.io.mocap_text import TableText, decimal_mark, delimiter, is_number, load, split
 from perception.io.mocap_trial import MocapTrial, assemble, check_unit, header_rate, strip_subject
 
@@ -81,10 +82,7 @@ def read_vicon(path: Path, source: str, text: TableText, rate, units, trial_colu
     rate, units, trial_column, time_column
         As :func:`perception.io.mocap.read_mocap` takes them.
     """
-    if trial_column is not None:
-        raise InputError("a Vicon Nexus export holds one trial: it has no trial column", path,
-                         field="trial_column")
-    if time_column is not None and str(time_column).strip().lower() != "none":
+    if time_column is not None and not no_clock(time_column):
         raise InputError("a Vicon Nexus export has no time column: its frames are timed by "
                          "the Trajectories block's rate", path, field="time_column")
     lines = text.all_lines()
