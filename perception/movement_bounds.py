@@ -29,7 +29,7 @@ FIT_SPAN = 3.0
 
 
 def onset_time(filtered: np.ndarray, time: np.ndarray, noise: float, params: ObserveParams,
-               name: str, rest: np.ndarray | None = None) -> float:
+               name: str) -> float:
     """When the movement's command began, s: the wrist's crossing less the model's latency.
 
     The crossing is where the wrist's displacement from rest first exceeds
@@ -53,9 +53,6 @@ def onset_time(filtered: np.ndarray, time: np.ndarray, noise: float, params: Obs
         The onset rule's settings.
     name : str
         What an error names.
-    rest : (2,) array, optional
-        The wrist's rest position, m (default: the median of the first
-        ``rest_frames``): given, the rows may be the latest few of a stream.
 
     Raises
     ------
@@ -64,13 +61,11 @@ def onset_time(filtered: np.ndarray, time: np.ndarray, noise: float, params: Obs
     """
     # the onset found in rows this one begins with (a stream's last recognition): the
     # rows up to the crossing's hold decide it, and they are the same numbers
-    kept = _ONSET.longest((params, noise), (filtered, time)) if rest is None else None
+    kept = _ONSET.longest((params, noise), (filtered, time))
     if kept is not None:
         return kept[1]
     w = filtered[:, 0]
-    given = rest is not None
-    rest = np.median(w[: params.rest_frames], axis=0) if rest is None else rest
-    disp = np.linalg.norm(w - rest, axis=1)
+    disp = np.linalg.norm(w - np.median(w[: params.rest_frames], axis=0), axis=1)
     threshold = max(params.onset_displacement, params.onset_noise_factor * noise)
     i = _held_above(disp, threshold, params.onset_hold_frames)
     if i is None:
@@ -98,7 +93,7 @@ def onset_time(filtered: np.ndarray, time: np.ndarray, noise: float, params: Obs
         scale = float(np.clip(np.polyfit(t0, tc, 1)[0], lo, hi))
         onset = float(np.mean(tc - scale * t0))
     m = max(m, params.rest_frames)
-    if not given and m <= len(filtered) and len(t0) == len(levels) + 1:
+    if m <= len(filtered) and len(t0) == len(levels) + 1:
         # rows after the last crossing's hold never change it: more rows, the same onset
         _ONSET.keep((params, noise), (np.array(filtered[:m]), np.array(time[:m])), onset)
     return onset

@@ -149,8 +149,12 @@ def test_the_onset_of_a_prefix_fits_the_crossings_it_has_passed():
     n = int(np.argmax(disp > 0.003)) + 3
     assert onset_time(path[:n], t[:n], 0.0, ObserveParams(), "reach") == pytest.approx(
         onset_time(path[:n], t[:n], 0.0, ObserveParams(onset_scale_range=None), "reach"))
-    # past the profile's last displacement: what more rows bring changes nothing
+    # past the profile's last displacement: what more rows bring changes nothing (found
+    # afresh: the onset kept for the whole path would answer for its prefix)
+    from perception import movement_bounds
+
     n = int(np.argmax(disp > 0.012)) + 3
+    movement_bounds._ONSET.local.__dict__.clear()
     assert onset_time(path[:n], t[:n], 0.0, ObserveParams(), "reach") == whole
     # a noisy start raises the threshold: too little span left to fit, the profile as is
     assert onset_time(path, t, 0.002, ObserveParams(), "reach") == onset_time(
