@@ -6,8 +6,10 @@ from its stored gains, with command noise) varied the way one person's
 grasps vary (movement time, the grip's timing against the transport, the
 size of the opening, a bowed path), puts them through a camera with tracking
 noise, observes them like a clip (:func:`~perception.observation.observe`:
-smoothing, onset, end; the onset by the model's own latency, unscaled: a
-demonstration starts as the model does) and scores each against the model
+smoothing, onset, end; the onset by the onset profile unscaled, as before
+its time scale was fitted to a clip's start: fitted, a demonstration whose
+clock runs ahead early (``transport_skew``) moves its onset, and every
+calibration widened) and scores each against the model
 (:func:`~perception.recognition.engine.recognize`). The misfits are the
 model's :class:`~perception.recognition.verdict.Calibration`. It is done once
 per repertoire (``Repertoire.build``, or on loading a file that lacks it)
@@ -107,8 +109,9 @@ def _calibrate_one(model: MotorModel, params: CalibrationParams, seed: list[int]
     cv = params.execution_cv
     run = rollout([model], steps, trials=params.demonstrations, cv=cv, rng=rng)
     values = []
-    # a model's own demonstrations start as the model does: their onset is the crossing
-    # less the model's own latency, not a time scale fitted to their start (a person's)
+    # the onset profile unscaled: a time scale fitted to the demonstrations' start moved
+    # the onset of those whose clock runs ahead early, and widened every calibration
+    # (docs/recognition.md §1)
     own = ObserveParams(onset_scale_range=None)
     for j in range(params.demonstrations):
         obs = observe(own_demonstration(model, run, j, params, rng), own,
