@@ -85,10 +85,10 @@ def _one_hand(names: list[str], paths) -> str | None:
     if paths is None:
         return "r"
 
-    def travel(side):
-        ranges = [np.nanmax(np.ptp(np.asarray(paths[n], dtype=float), axis=0))
+    def travel(side):  # the largest range of a seen digit marker's coordinates (NaN: lost)
+        ranges = [float(np.max(np.nanmax(p, axis=0) - np.nanmin(p, axis=0)))
                   for n in names if _side(n) == side and any(w in n.lower() for w in _DIGITS)
-                  and ever_seen(paths[n])]
+                  and ever_seen(p := np.asarray(paths[n], dtype=float))]
         return max(ranges, default=0.0)
 
     return max(("r", "l"), key=travel)
