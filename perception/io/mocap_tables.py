@@ -108,13 +108,14 @@ def two_row_header(text: TableText, sep: str) -> tuple[list[str], int] | None:
     top, axes = split(lines[0], sep), split(lines[1], sep)
     labels = [a.strip().lower() for a in axes]
     at = [i for i, a in enumerate(labels) if a in ("x", "y", "z")]
-    if not at or any(labels[i] for i in range(len(labels)) if i not in at) \
+    axis = set(at)
+    if not at or any(a for i, a in enumerate(labels) if i not in axis) \
             or len(at) % 3 or any(labels[i:i + 3] != ["x", "y", "z"] for i in at[::3]):
         return None
     names, owner = [], ""
     for i in range(max(len(top), len(labels))):
         cell = top[i].strip() if i < len(top) else ""
-        if i in at:
+        if i in axis:
             if labels[i] == "x":
                 owner = cell
             if not owner or (cell and cell != owner):
@@ -126,7 +127,7 @@ def two_row_header(text: TableText, sep: str) -> tuple[list[str], int] | None:
     if not units or not all(_UNIT_CELL.fullmatch(c.strip()) for c in units):
         return names, 2
     # a units row: each coordinate's unit goes with its name, as a one-row header says it
-    return [f"{n} ({u.strip()})" if i in at and u.strip() else n
+    return [f"{n} ({u.strip()})" if i in axis and u.strip() else n
             for i, (n, u) in enumerate(zip(names, [*units, *[""] * len(names)]))], 3
 
 

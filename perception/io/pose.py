@@ -171,7 +171,10 @@ class PoseImport:
                 "cleaning": None if self.cleaning is None else self.cleaning.to_dict()}
 
     def keypoint(self, marker: str) -> str:
-        """The file's keypoint name for ``marker``.
+        """The keypoint asked for ``marker``: the mapping's, else the marker's own name
+        (a file without it has one taken by its name on reading:
+        :func:`~perception.io.pose_mapping.keypoint_mapping`; ``/tracker keypoints``
+        records what was read).
 
         Parameters
         ----------
