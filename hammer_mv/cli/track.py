@@ -98,22 +98,10 @@ def run(args: argparse.Namespace) -> int:
 
 def summary_line(out: Path) -> str:
     """``OUT: N frames; found thumb 100 %, ...``: the share of frames in which each marker
-    was placed, and its ambiguous frames.
+    was placed, and its ambiguous frames (:func:`perception.io.tracks.marker_counts`)."""
+    from perception.io.tracks import marker_counts
 
-    Read from the three datasets it needs (``docs/tracks-format.md``):
-    :meth:`~perception.io.tracks.Tracks.load` checks the whole file, 10 ms at
-    the end of every run, for the file this command has just written.
-    """
-    import h5py
-    import numpy as np
-
-    from perception.io.tracks import Status
-
-    with h5py.File(out, "r") as fh:
-        markers = [m.decode("utf-8") if isinstance(m, bytes) else str(m)
-                   for m in fh["tracks/markers"][()]]
-        placed = np.isfinite(fh["tracks/position"][()]).all(axis=-1)
-        ambiguous = (fh["tracks/status"][()] == Status.AMBIGUOUS).sum(axis=0)
+    markers, placed, ambiguous = marker_counts(out)
     found = ", ".join(
         f"{name} {100 * placed[:, j].mean():.0f} %"
         + (f" ({int(ambiguous[j])} frames ambiguous)" if ambiguous[j] else "")
