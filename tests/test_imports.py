@@ -97,6 +97,30 @@ def test_recognize_of_a_file_that_is_not_video_loads_no_opencv(tmp_path, kind):
     assert not _loads_opencv(rows), [r for r in rows if r[0].split(".")[0] == "cv2"]
 
 
+QUALISYS = Path(__file__).parent / "data" / "mocap" / "qualisys-recording.tsv"
+
+
+# pandas (with what it pulls in, ~0.25 s) was the whole start-up margin of these files:
+# a plain DeepLabCut csv and a Qualisys export are read (and the recording's trials.csv
+# written) without it (perception/io/plain_tables.py)
+@pytest.mark.parametrize("kind", ["pose", "qualisys"])
+def test_recognize_of_a_plain_pose_or_qualisys_file_loads_no_pandas(tmp_path, kind):
+    if kind == "pose":
+        res, rows = _recognize(dlc_csv(tmp_path)[0], tmp_path / "out", "--fps", "30",
+                               "--object-diameter-px", "80")
+    else:
+        res, rows = _recognize(QUALISYS, tmp_path / "out")
+    assert res.returncode == 0, _said(res)
+    assert list((tmp_path / "out").glob("*.recognition.json")), _said(res)
+    loaded = {name.split(".")[0] for name, _, _ in rows}
+    assert not loaded & {"pandas", "xarray", "movement"}, sorted(loaded)
+    if kind == "qualisys":  # the trials table written without pandas, as pandas would
+        import pandas as pd
+
+        table = next((tmp_path / "out").glob("*.trials.csv"))
+        assert pd.read_csv(table)["status"].tolist() == ["ok"]
+
+
 def test_recognize_of_a_video_loads_opencv(tmp_path):
     res, rows = _recognize(_mp4(tmp_path), tmp_path / "out")
     assert "Traceback" not in res.stderr and "clip.mp4" in _said(res), _said(res)

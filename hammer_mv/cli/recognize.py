@@ -234,16 +234,11 @@ def _run_mocap(args: argparse.Namespace, path: Path) -> int:
         missed.append((reach.name, why))
     # reports of this recording's trials that are not scored now (or no longer in it)
     remove_stale_reports(args.output, path, kept)
-    import pandas as pd
-
     # the trial's factors and numbers after its name, as summary.csv has them
     more = list(dict.fromkeys(c for r in rows for c in r if c not in TRIALS_COLUMNS))
     columns = [TRIALS_COLUMNS[0], *more, *TRIALS_COLUMNS[1:]]
-    trials = pd.DataFrame(rows, columns=columns)
-    if "reach_number" in trials:  # a whole trial without a reach has none: not 1.0
-        trials = trials.astype({"reach_number": "Int64"})
-    write_csv(table, trials)
-    write_units(table, trials.columns)
+    write_csv(table, _trials_table_cells(rows, columns))
+    write_units(table, columns)
     if not args.quiet:
         print(f"{trial_summary(len(recording.trials), len(kept), len(missed))} -> {table}")
         # one line per kind of warning for the recording; each reach's are in its report
@@ -252,6 +247,50 @@ def _run_mocap(args: argparse.Namespace, path: Path) -> int:
     for name, why in missed:  # always: nothing is dropped without a word
         print(f"{name}: not scored: {why}", file=sys.stderr)
     return 1 if missed else 0
+
+
+def _trials_table_cells(rows: list[dict], columns: list[str]):
+    """``<recording>.trials.csv``'s cells as :func:`~perception.io.atomic.write_csv` writes
+    them: each column's text as pandas writes its DataFrame of ``rows`` (``reach_number``
+    as integers: a whole trial without a reach has none, not 1.0), here without pandas
+    for the columns of text and numbers a recording gives (its import would be a third of
+    a ``recognize``'s start-up); otherwise that DataFrame."""
+    cells = {c: _column_cells([r.get(c) for r in rows], integers=c == "reach_number")
+             for c in columns}
+    if all(v is not None for v in cells.values()):
+        return cells
+    import pandas as pd
+
+    trials = pd.DataFrame(rows, columns=columns)
+    if "reach_number" in trials:
+        trials = trials.astype({"reach_number": "Int64"})
+    return trials
+
+
+def _column_cells(values: list, integers: bool = False) -> list[str] | None:
+    """A column's cells as pandas writes them to csv, or None where only pandas knows.
+
+    Missing (None, NaN) is empty; a column of text and missing cells is the text; of
+    integers, the integers; of numbers with a float or a missing cell, floats as numpy
+    writes them (pandas' float64); ``integers`` (pandas' Int64): integral numbers.
+    """
+    import numpy as np
+
+    missing = [v is None or (isinstance(v, float) and v != v) for v in values]
+    present = [v for v, m in zip(values, missing) if not m]
+    if all(isinstance(v, str) for v in present):
+        return ["" if m else v for v, m in zip(values, missing)]
+    if not all(isinstance(v, (int, float)) and not isinstance(v, bool) and abs(v) < 2 ** 53
+               for v in present):
+        return None
+    if integers:
+        if not all(float(v).is_integer() for v in present):
+            return None
+        return ["" if m else str(int(v)) for v, m in zip(values, missing)]
+    if all(type(v) is int for v in present) and not any(missing):
+        return [str(v) for v in values]
+    floats = np.array([np.nan if m else v for v, m in zip(values, missing)], dtype=np.float64)
+    return ["" if m else t for t, m in zip(floats.astype(str), missing)]
 
 
 def _row(name: str, status: str, reason: str, onset: float, end: float, path: Path, *,

@@ -15,6 +15,8 @@ from perception.errors import InputError
 from perception.io.mocap_tables import table_trials, time_column_of
 from perception.io.mocap_text import TableText, load
 from perception.io.mocap_trial import MocapTrial, check_rate
+from perception.io.plain_tables import numeric_table
+from perception.limits import MAX_FRAMES
 
 __all__ = ["is_qtm", "read_qtm"]
 
@@ -104,7 +106,10 @@ def read_qtm(path: Path, source: str, text: TableText, rate, units, trial_column
     groups = {m: tuple(f"{m} {a}" for a in "XYZ") for m in names}
     first = lines[skip].split("\t")[0].strip() if skip < len(lines) else ""
     titled = bool(first) and not re.fullmatch(r"[-+0-9.eE]+", first)
-    df = load(path, text.raw, "\t", skip, 0 if titled else None)
+    # the plain case without pandas (its import is most of a recognize's start-up)
+    df = numeric_table(text.raw, "\t", skip, MAX_FRAMES) if titled else None
+    if df is None:
+        df = load(path, text.raw, "\t", skip, 0 if titled else None)
     if not titled:  # older exports: X Y Z per marker, perhaps after Frame and Time
         columns = [c for cols in groups.values() for c in cols]
         if df.shape[1] not in (len(columns), len(columns) + 2):

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from perception.errors import InputError
+from perception.io.plain_tables import NumericColumn
 from perception.limits import MAX_FRAMES
 
 __all__ = ["TableText", "check_fields", "header_width", "load_chunks", "table_text"]
@@ -399,13 +400,15 @@ def numeric(column, path: Path, name: str) -> np.ndarray:
 
     Parameters
     ----------
-    column : pandas.Series
+    column : pandas.Series or NumericColumn
         The column.
     path : Path
         The file.
     name : str
         The column's name, for the message.
     """
+    if isinstance(column, NumericColumn):  # read as numbers (plain_tables): every cell is
+        return column.to_numpy(dtype=float)
     import pandas as pd
 
     values = pd.to_numeric(column, errors="coerce")

@@ -28,7 +28,8 @@ from pathlib import Path
 
 from perception.errors import InputError
 
-__all__ = ["POSE_EXTRA", "dlc_inputs", "import_movement", "movement_loaders", "require_movement"]
+__all__ = ["POSE_EXTRA", "VALIDATOR", "dlc_inputs", "import_movement", "movement_loaders",
+           "require_movement"]
 
 #: The message when the optional ``pose`` extra (``movement``, PyTables) is missing.
 POSE_EXTRA = ("reading and writing pose files needs the optional extra: "
@@ -139,7 +140,7 @@ def dlc_inputs(df, fps: float | None, source_software: str = "DeepLabCut"):
     InputError
         ``movement`` is not installed.
     """
-    require_movement(_VALIDATOR)
+    require_movement(VALIDATOR)
     from movement.validators.datasets import ValidPosesInputs
 
     if "individuals" in df.columns.names:
@@ -164,7 +165,7 @@ def dlc_inputs(df, fps: float | None, source_software: str = "DeepLabCut"):
 
 
 #: The module of movement a DeepLabCut table needs (:func:`dlc_inputs`).
-_VALIDATOR = "movement.validators.datasets"
+VALIDATOR = "movement.validators.datasets"
 
 
 def require_movement(module: str = "movement.io") -> None:

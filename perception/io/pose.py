@@ -17,18 +17,24 @@ a frame rate take that video's (:func:`video_beside`).
 ``movement`` pulls in many packages (xarray, netCDF4, PyTables, pynwb,
 sleap-io), so it is an optional extra: ``pip install 'hammer-mv[pose]'``.
 It is imported through :mod:`perception.io.movement_import`, which keeps its
-import from writing under HOME.
+import from writing under HOME. A DeepLabCut csv of plain numbers (as DeepLabCut
+writes it) is read without movement or pandas (:func:`_plain_dlc`,
+:mod:`perception.io.plain_tables`), exactly as they read it: their imports were
+most of a ``recognize``'s start-up.
 docs/pose-files.md describes the mapping, the scale and every format.
 """
 
 from __future__ import annotations
 
 import functools
+import importlib.util
+import itertools
 import json
 import logging
 import math
 import os
 import re
+import types
 import warnings
 from collections.abc import Mapping
 from dataclasses import field
@@ -43,9 +49,11 @@ from perception.errors import InputError
 from perception.io.atomic import write_bytes, write_text
 from perception.io.files import input_file
 from perception.io.movement_import import POSE_EXTRA as _EXTRA
+from perception.io.movement_import import VALIDATOR as _VALIDATOR
 from perception.io.movement_import import dlc_inputs, require_movement
 from perception.io.movement_import import movement_loaders as _movement
 from perception.io.names import POSE_SUFFIXES, TRACKS_SUFFIX, VIDEO_SUFFIXES
+from perception.io.plain_tables import dlc_table
 from perception.io.pose_arrays import (
     PoseTable,
     check_sizes,
@@ -363,16 +371,56 @@ def _check_hdf5_sizes(path: Path, source: str) -> None:
 _MAX_TABLE_BYTES = 24 * MAX_POSE_POINTS
 
 
+def _csv_levels(path: Path) -> list[str]:
+    """The header rows of a DeepLabCut csv: with ``individuals`` where it is multi-animal."""
+    with open(path, encoding="utf-8", errors="replace") as fh:
+        second = fh.readline() and fh.readline()
+    return (["scorer", "individuals", "bodyparts", "coords"]
+            if second.lower().startswith("individuals") else ["scorer", "bodyparts", "coords"])
+
+
+def _plain_dlc(path: Path, fps: float | None) -> tuple[PoseTable, np.ndarray] | None:
+    """A DeepLabCut csv of plain numbers as :func:`dlc_inputs` and :func:`_own_frames` read
+    it through pandas, read without pandas or movement (their imports are most of a
+    ``recognize``'s start-up: issue 45); None for any other table, read as before.
+
+    The common case only: DeepLabCut's header (``x``, ``y``, ``likelihood`` of each
+    keypoint, individuals and keypoints in order), integer frame numbers, numbers or empty
+    cells (:mod:`perception.io.plain_tables`); whatever movement's validator would refuse
+    (or pandas read otherwise) is left to them, so errors read the same.
+    """
+    levels = _csv_levels(path)
+    try:
+        text = path.read_bytes().decode("utf-8")
+    except UnicodeDecodeError:
+        return None  # pandas says why
+    read = dlc_table(text, len(levels))
+    if read is None:
+        return None
+    columns, frames, values = read
+    keyed = [c[1:] for c in columns]  # (individual,) bodypart, coord
+    names = [list(dict.fromkeys(c[k] for c in keyed)) for k in range(len(keyed[0]))]
+    individuals = names[0] if len(levels) == 4 else ["individual_0"]
+    keypoints, coords = names[-2], names[-1]
+    if coords != ["x", "y", "likelihood"] or keyed != list(itertools.product(*names)):
+        return None
+    _check_table_size(len(values), len(columns), path)
+    # movement's arrays: (time, coords, keypoints, individuals), as dlc_inputs makes them
+    tracks = values.reshape((-1, len(individuals), len(keypoints), 3)).transpose(0, 3, 2, 1)
+    fps = None if fps is None else float(fps)  # movement's converter: a rate <= 0 is none
+    valid = types.SimpleNamespace(
+        position_array=tracks[:, [0, 1], :, :], confidence_array=tracks[:, 2, :, :],
+        individual_names=individuals, keypoint_names=keypoints,
+        fps=None if fps is not None and fps <= 0 else fps, source_software="DeepLabCut")
+    return PoseTable(valid), _own_frames(frames, len(frames))
+
+
 def _dlc_table(path: Path):
     """A DeepLabCut table as DeepLabCut writes it: its own frame index, MultiIndex columns."""
     import pandas as pd
 
     if path.suffix.lower() == ".csv":
-        with open(path, encoding="utf-8", errors="replace") as fh:
-            second = fh.readline() and fh.readline()
-        levels = (["scorer", "individuals", "bodyparts", "coords"]
-                  if second.lower().startswith("individuals") else
-                  ["scorer", "bodyparts", "coords"])
+        levels = _csv_levels(path)
         df = pd.read_csv(path, header=list(range(len(levels))))
         df = df.set_index(df.columns[0])
         df.index.name = None
@@ -401,7 +449,8 @@ def _own_frames(index, n: int) -> np.ndarray | None:
 def _load_dataset(path: Path, source: str, fps: float | None):
     """The file as a ``movement`` poses dataset, and the file's own frame numbers (or None)."""
     if source == "dlc":  # a DeepLabCut table needs only movement's validator (dlc_inputs)
-        require_movement("movement.validators.datasets")
+        if importlib.util.find_spec("movement") is None:  # found, not imported (0.4 s)
+            require_movement(_VALIDATOR)  # the error naming the extra
     else:
         load_dataset, _ = _movement()
     suffix = path.suffix.lower()
@@ -428,6 +477,10 @@ def _load_dataset(path: Path, source: str, fps: float | None):
                     raise InputError("a netCDF file that is not a movement poses dataset", path)
                 return ds, None
             if source == "dlc":
+                plain = _plain_dlc(path, fps) if suffix == ".csv" else None
+                if plain is not None:
+                    return plain
+                require_movement(_VALIDATOR)
                 df = _dlc_table(path)
                 _check_sizes_table(df, path)
                 ds = PoseTable(dlc_inputs(df, fps))
@@ -448,11 +501,15 @@ def _check_sizes(ds, path: Path) -> None:
 
 
 def _check_sizes_table(df, path: Path) -> None:
-    if len(df) > MAX_FRAMES:
-        raise InputError(f"holds {len(df)} frames, more than the {MAX_FRAMES} a pose file may "
+    _check_table_size(len(df), len(df.columns), path)
+
+
+def _check_table_size(rows: int, columns: int, path: Path) -> None:
+    if rows > MAX_FRAMES:
+        raise InputError(f"holds {rows} frames, more than the {MAX_FRAMES} a pose file may "
                          "hold", path)
-    if len(df.columns) > 3 * MAX_KEYPOINTS * 16 or len(df) * len(df.columns) > 3 * MAX_POSE_POINTS:
-        raise InputError(f"holds {len(df.columns)} columns of {len(df)} frames, more than a pose "
+    if columns > 3 * MAX_KEYPOINTS * 16 or rows * columns > 3 * MAX_POSE_POINTS:
+        raise InputError(f"holds {columns} columns of {rows} frames, more than a pose "
                          "file may hold", path)
 
 
