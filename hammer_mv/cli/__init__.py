@@ -254,23 +254,36 @@ def _run(args: argparse.Namespace) -> int:
 
 def entry() -> int:
     """The ``hammer-mv`` command (console script and ``python -m hammer_mv``): :func:`main`,
-    then the objects made so far frozen out of the interpreter's last collection.
+    with no cyclic garbage collection while the command's modules import, and the
+    objects made so far frozen out of the interpreter's last collection.
 
-    That collection walks every object the imports made (numpy, scipy, pydantic, ...):
-    about 40 ms of a 0.4 s ``track`` of a short clip. Not in :func:`main`, which tests
-    and scripts call in their own processes.
+    The imports make hundreds of thousands of objects (numpy, scipy, pydantic, ...) and
+    no garbage worth collecting; each collection meanwhile walks them all: about 6 % of a
+    ``recognize``'s start-up. Collection resumes, those objects frozen out of it, before
+    the command runs (:func:`main`'s ``quiet_start``). The last collection walked them
+    too: about 40 ms of a 0.4 s ``track`` of a short clip. Not in :func:`main`, which
+    tests and scripts call in their own processes.
     """
-    status = main()
+    gc.disable()
+    status = main(quiet_start=True)
     gc.freeze()
     return status
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: list[str] | None = None, *, quiet_start: bool = False) -> int:
     """Run ``hammer-mv`` with ``argv`` (default ``sys.argv[1:]``); return the exit status.
 
     0 on success; 1 if some of the work failed (a batch's clips) or on a bug
     (its traceback shown); 2 for a user's mistake (one line on stderr); 130
     when interrupted.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments.
+    quiet_start : bool
+        Garbage collection is off while the command's modules import (:func:`entry`):
+        freeze what they made and turn it on before the command runs.
     """
     # FFmpeg and OpenCV print their own warnings about broken files on stderr;
     # we report those files in one line ourselves. Set before any video opens.
@@ -279,6 +292,9 @@ def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     parser = build_parser(_command(argv))
     args = parser.parse_args(argv)
+    if quiet_start:
+        gc.freeze()
+        gc.enable()
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
     if not getattr(args, "func", None):
