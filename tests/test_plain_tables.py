@@ -316,3 +316,14 @@ def test_a_trials_table_is_written_as_pandas_writes_it(tmp_path):
             rows
         compared += isinstance(cells, dict)
     assert compared > 100  # most written without pandas
+
+
+def test_a_dlc_csv_with_text_among_its_values_is_refused_in_one_line(tmp_path):
+    # pandas reads the column as text; its values reached numpy as objects, and
+    # float('one') was a bug's traceback (ValueError) rather than the user's error
+    from perception.errors import InputError
+
+    path = tmp_path / "grasp.csv"
+    path.write_bytes(LEFT["a text cell"].encode())
+    with pytest.raises(InputError, match=r"a value of keypoint 'thumb' is not a number"):
+        pose.read_pose(path, PoseImport(fps=30.0))

@@ -203,7 +203,27 @@ class PoseTable:
         index = [at(k) for k in marker_keys(self.keypoints, keys, path)]
         check_space(self.position.shape[1], path)
         who = self.individuals.index(individual)
-        xy = np.asarray(self.position[:, :, :, who].transpose(0, 2, 1)[:, index],
-                        dtype=np.float64)
-        conf = np.asarray(self.confidence[:, :, who][:, index], dtype=np.float64)
+        xy = self.position[:, :, :, who].transpose(0, 2, 1)[:, index]
+        conf = self.confidence[:, :, who][:, index]
+        try:
+            xy, conf = np.asarray(xy, dtype=np.float64), np.asarray(conf, dtype=np.float64)
+        except (TypeError, ValueError):  # a cell of text read into an object column
+            raise InputError(f"a value of keypoint {_not_numeric(xy, conf, keys)!r} is "
+                             "not a number", path) from None
         return xy, np.clip(np.nan_to_num(conf, nan=0.0), 0.0, 1.0)
+
+
+def _not_numeric(xy: np.ndarray, conf: np.ndarray, keys: Mapping[str, str]) -> str:
+    """The first keypoint of ``keys`` with a value that is not a number."""
+    def number(value) -> bool:
+        try:
+            float(value)
+        except (TypeError, ValueError):
+            return False
+        return True
+
+    for j, key in enumerate(keys.values()):
+        values = [*np.ravel(xy[:, j]), *np.ravel(conf[:, j])]
+        if not all(map(number, values)):
+            return key
+    return next(iter(keys.values()))
