@@ -96,8 +96,6 @@ def run(args: argparse.Namespace) -> int:
     from perception.report.tracking import write_tracking_report
     from perception.sources import check_command
 
-    if not args.no_figures:
-        _import_figures_meanwhile()
     kind = check_command(args.input, "recognize")  # a camera or a stream: watch's
     path = args.input = Path(args.input)
     output_folder(args.output)  # before any tracking
@@ -140,44 +138,6 @@ def run(args: argparse.Namespace) -> int:
         for warning in rec.warnings:
             print(f"{clip}: warning: {warning}", file=sys.stderr)
     return 0
-
-
-#: What drawing a clip's figures imports (matplotlib's Figure and Agg canvas, the
-#: report's figure modules): about 0.3 s of CPU, a quarter of a recognize with figures.
-FIGURE_MODULES = ("matplotlib.figure", "matplotlib.backends.backend_agg",
-                  "matplotlib.collections", "perception.report.figures",
-                  "perception.report.kinematics")
-
-
-#: The name of the thread that imports them.
-FIGURE_THREAD = "hammer-mv figure imports"
-
-
-def _import_figures_meanwhile() -> None:
-    """Import :data:`FIGURE_MODULES` in a thread of their own while the clip is tracked,
-    read, planned and scored.
-
-    Imports are Python (they hold the GIL), but tracking (FFmpeg's decoding, OpenCV) and
-    planning (the compiled passes, in their threads) mostly do not: on a second core the
-    imports then cost the command no wall time. Whatever fails here (matplotlib missing)
-    fails again, and is reported, where the figures are drawn. The thread is not a
-    daemon: the interpreter waits for it rather than stop it midway through an import.
-    """
-    import importlib
-    import threading
-
-    def run():
-        try:
-            for name in FIGURE_MODULES:
-                importlib.import_module(name)
-            from perception.report.canvas import _canvas_class
-
-            _canvas_class()
-        except Exception:  # noqa: BLE001, S110 - said again where the figures are drawn
-            pass
-
-    if not all(name in sys.modules for name in FIGURE_MODULES):
-        threading.Thread(target=run, name=FIGURE_THREAD).start()
 
 
 def verdict_line(rec, rule: bool = False) -> str:
