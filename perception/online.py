@@ -33,6 +33,7 @@ from perception.recognition.provisional import (
 )
 from perception.recognition.repertoire import PlanCache, Repertoire
 from perception.recognition.result import Recognition
+from perception.recognition.rules import judge
 
 __all__ = ["Decision", "OnlineRecognizer", "OnlineState", "SettleRule", "decision_summary"]
 
@@ -120,7 +121,7 @@ class OnlineRecognizer:
         self._rows = _Rows(len(self.markers))
         self._received = 0  # frames or rows given to update
         self._last_time: float | None = None
-        self._verdicts: list[tuple[float, str | None]] = []  # (since onset, verdict) on change
+        self._answer: tuple[float, tuple | None] | None = None  # (since onset, settling answer)
         self._decision: Decision | None = None
         self.prefix: Recognition | None = None
         self.state: OnlineState | None = None
@@ -211,13 +212,14 @@ class OnlineRecognizer:
     def _judge(self, index: int, t: float, rec: Recognition) -> OnlineState:
         d, rules = rec.decision, self.settings.rules
         since = t - rec.time_origin  # the onset on the stream's clock
-        if not self._verdicts or self._verdicts[-1][1] != d.verdict:
-            self._verdicts.append((since, d.verdict))
         grip = grip_course(rec)
-        sure = self.settle.sure(d, rec.evidence, grip, rules, grip.progress)
-        if (self._decision is None and sure and d.verdict is not None
-                and since - self._verdicts[-1][0] >= self.settle.hold):
-            self._decision = Decision(d.verdict, d.detail, t, since, index)
+        answer = self.settle.settles(judge(rec.evidence, rules, ongoing=True), rec.evidence,
+                                     grip, rules)
+        if self._answer is None or self._answer[1] != answer:
+            self._answer = (since, answer)
+        if (self._decision is None and answer is not None
+                and since - self._answer[0] >= self.settle.hold):
+            self._decision = Decision(*answer, t, since, index)
         self.state = OnlineState(
             index, t, "moving", list(rec.names), rec.confidence[:, -1].copy(),
             rec.log_likelihood[:, -1].copy(), since, grip.progress, rec.verdict_model,

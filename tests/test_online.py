@@ -195,10 +195,26 @@ def test_normal_and_reach_settle_while_the_stream_runs(rep, condition):
     d = rec.decision
     assert d is not None and d.verdict == final.verdict == condition
     assert d.frame < tracks.frame[-1]
-    # a normal grasp settles once the field's end of the movement is seen: when its grip
-    # started to open is a share of the movement (the landmark of the rows so far), known
-    # at the end (issue 42; before, a minimum-jerk stand-in settled it at ~0.77 of it)
     assert d.since_onset < final.observation.time[-1] + 0.25
+
+
+def test_a_normal_grasp_settles_before_its_hand_arrives(rep):
+    """Judged as a movement that ends as it goes (``judge(..., ongoing=True)``), a grasp
+    whose grip opened early and is still opening with the wrist 90 % of its way there,
+    past its peak speed, settles `normal`, while ``recognize`` of the rows so far still
+    calls them `incomplete` (the state's verdict)."""
+    tracks = _tracks("normal", seed=11)
+    rec, states = _feed(rep, tracks)
+    final, d = rec.finish(), rec.decision
+    assert d is not None and d.verdict == final.verdict == "normal"
+    at = states[next(i for i, s in enumerate(states) if s.decision is not None)]
+    assert (at.verdict, at.verdict_detail) == ("unfamiliar", "incomplete")
+    assert at.judged_on.slowed < VerdictRules().arrival
+    assert at.progress >= SettleRule().approached
+    assert d.since_onset < 0.8 * final.observation.time[-1]
+    # asked to wait for the hand at the object, the same rows settle later
+    later, _ = _feed(rep, tracks, settle=SettleRule(approached=1.0))
+    assert later.decision is not None and later.decision.frame > d.frame
 
 
 def test_a_stream_too_near_the_object_is_refused_as_offline(rep):

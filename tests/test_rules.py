@@ -15,6 +15,7 @@ from perception.errors import InputError
 from perception.landmarks import LandmarkParams, Landmarks
 from perception.pipeline import RecognitionSettings, recognize_tracks
 from perception.recognition.rules import (
+    AT_END,
     RULE_TABLE,
     VERDICT_RULES,
     Evidence,
@@ -52,6 +53,22 @@ def test_the_rules_are_tried_in_order_and_the_first_that_fires_names_itself():
     assert (d.verdict, d.rule) == ("abnormal", "familiarity")
     d = judge(_evidence(familiarity=np.array([np.nan, 0.9])))
     assert d.verdict is None and d.rule is None
+
+
+def test_a_movement_still_being_seen_is_not_cut_short():
+    """``ongoing=True`` (a stream's rows so far) leaves out the rules that read the
+    movement's end: the hand that has not arrived yet is judged as it goes; every other
+    rule fires as it does on a whole movement."""
+    under_way = _evidence(slowed=0.3)
+    d = judge(under_way)
+    assert (d.verdict, d.rule, d.detail) == ("unfamiliar", "incomplete", "incomplete")
+    d = judge(under_way, ongoing=True)
+    assert (d.verdict, d.rule) == ("normal", "familiarity")
+    assert AT_END == ("incomplete",) and set(AT_END) <= set(VERDICT_RULES)
+    for kw, rule in (({"transport_familiarity": 0.001}, "not-a-human-reach"),
+                     ({"aperture_gap": 0.5}, "insufficient-data"),
+                     ({"observed": Landmarks(aperture_peaks=2)}, "grip-departs")):
+        assert judge(_evidence(slowed=0.3, **kw), ongoing=True).rule == rule
 
 
 def test_peaks_the_landmarks_could_not_count_leave_the_digits_unseen():

@@ -288,13 +288,13 @@ def test_the_tracks_of_a_set_are_the_movements_its_video_shows():
 def test_online_settling_is_fed_the_held_out_clips_of_the_second_generator(capsys):
     online = _tool("evaluate_online_demos")
     ev = _tool("evaluate_verdict")
-    clips = list(online.heldout_clips("sigma-lognormal", counts={"normal": 1,
-                                                                  "open-close-open": 2}))
+    clips = list(online.set_clips("sigma-lognormal", counts={"normal": 1,
+                                                              "open-close-open": 2}))
     assert [c for c, _ in clips] == ["normal", "open-close-open", "open-close-open"]
     # clip k of the held-out set: seed 9000 + k, as tools/evaluate_verdict.py draws it
     third = ev.clip_tracks("sigma-lognormal", "heldout", "open-close-open", 9002)[0]
     np.testing.assert_array_equal(clips[2][1].position, third.position)
-    fast = next(online.heldout_clips("sigma-lognormal", fast=True, counts={"reach": 1}))[1]
+    fast = next(online.set_clips("sigma-lognormal", fast=True, counts={"reach": 1}))[1]
     assert fast.time[-1] < 0.65 + 2 * 0.5 + 0.05  # a fast grasp and its rests
     online.report({"reach": [("reach", True, 0.5, True), ("reach", False, 1.0, True)]})
     assert "settled before the end 1/2, decision_fraction median 0.75, settled = offline 2/2" \

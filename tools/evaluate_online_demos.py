@@ -23,6 +23,9 @@ rules are tuned on, its held-out seeds), for the gap between the two::
     python tools/evaluate_online_demos.py
     python tools/evaluate_online_demos.py --generator sigma-lognormal [--fast]
     python tools/evaluate_online_demos.py --generator independent [--fast]
+
+``--generator independent --set dev [--fast]`` gives its dev sets, the only
+ones a settle rule may be chosen on.
 """
 
 from __future__ import annotations
@@ -61,10 +64,11 @@ def minvar_clips(per_condition: int = 10, seed: int = 5):
                                     duration=duration)[0]
 
 
-def heldout_clips(generator: str, fast: bool = False, counts: dict[str, int] | None = None):
-    """(condition, tracks) of a generator's held-out set in memory: the clips of
-    ``tools/evaluate_verdict.py --generator GENERATOR --set [fast-]heldout --source tracks``."""
-    set_name = "fast-heldout" if fast else "heldout"
+def set_clips(generator: str, fast: bool = False, counts: dict[str, int] | None = None,
+              part: str = "heldout"):
+    """(condition, tracks) of a generator's set in memory: the clips of
+    ``tools/evaluate_verdict.py --generator GENERATOR --set [fast-]PART --source tracks``."""
+    set_name = f"fast-{part}" if fast else part
     counts = ev.DEFAULT_COUNTS if counts is None else counts
     seed = ev.SETS[set_name]
     for cond in CONDITIONS:
@@ -106,9 +110,14 @@ def main(argv: list[str] | None = None) -> dict[str, list[tuple]]:
                         "(sigma-lognormal: never tuned on)")
     p.add_argument("--fast", action="store_true",
                    help="with a generator: its fast held-out set (0.45-0.65 s movements)")
+    p.add_argument("--set", choices=("heldout", "dev"), default="heldout",
+                   help="with the independent generator: its dev set (seeds 1000 + k, or "
+                        "20000 + k with --fast), where the settle rule is chosen")
     args = p.parse_args(argv)
+    if args.set == "dev" and args.generator != "independent":
+        p.error("--set dev: the independent generator's only (the others are never tuned on)")
     clips = (minvar_clips() if args.generator == "minvar"
-             else heldout_clips(args.generator, args.fast))
+             else set_clips(args.generator, args.fast, part=args.set))
     out = settle(clips)
     report(out)
     return out

@@ -23,62 +23,66 @@ __all__ = ["Decision", "OnlineState", "SettleRule", "decision_summary", "grip_co
 
 @declared
 class SettleRule:
-    """When a provisional verdict is trusted: *settled* at the first frame where it has
-    stood for ``hold`` s and
+    """When the verdict of a movement still being seen is trusted: *settled* at the first
+    frame where one of these has held for ``hold`` s. Each reads the evidence of the rows
+    so far, judged as a movement that ends as it goes (``judge(..., ongoing=True)``: a
+    stream is not ``incomplete`` while it runs):
 
-    * a grip seen to depart from the transport (``grip-departs``): the wrist
-      has covered ``min_progress`` of its way to the models' goal, and the
-      grip has opened twice (two aperture peaks, and after opening as a
-      grasp's must it closed and opened again: :func:`grip_course`'s
-      ``twice``), or — the hand arrived (below) — started to open
-      after ``late_opening + late_margin`` of the movement (the landmark,
-      known once the movement's end is seen);
-    * ``normal`` or ``reach`` resting on familiarity: the hand has arrived — the transport
-      has slowed by ``slowed`` (at least the rules' ``arrival``) from its peak
-      speed: a stream cut after that is no longer ``incomplete`` —, the
-      leading model's familiarity and the transport's are each at least
-      ``margin`` natural-log units from their thresholds, and either the grip
-      has opened — once, starting before ``late_opening - late_margin`` of
-      the movement (before its end is seen: before the wrist had covered
-      ``early_opening`` of its way), and closed ``closing`` of its opening
-      since its maximum while the wrist has covered ``arrived`` of its way:
-      the hand is at the object, and a second opening comes on the way
-      there — or, the movement's end seen, it has not opened by even
-      ``reach_opening`` m while the wrist has covered ``reach_progress`` of
-      its way and slowed by ``reach_slowed`` (a late opener has opened by
-      then);
-    * ``abnormal`` by familiarity (a movement's familiarity rises as it
-      comes to rest) and the other rules (``unfamiliar``) settle at the end.
+    * a grip seen to depart (``grip-departs``), once the wrist has covered
+      ``min_progress`` of its way to the models' goal: it opened twice (two aperture
+      peaks, and after opening as a grasp's must it closed and opened again:
+      :func:`grip_course`'s ``twice``), or — the hand arrived (the transport slowed by
+      ``slowed``, at least the rules' ``arrival``) — it started to open after
+      ``late_opening + late_margin`` of the movement (the landmark, known once the
+      movement's end is seen);
+    * ``normal`` by familiarity: the leading model's familiarity and the transport's
+      each ``margin`` natural-log units from their thresholds; the grip opened once (no
+      second opening of the markers' aperture either),
+      starting early (``opening_time`` before ``late_opening - late_margin`` once the end
+      is seen, before it before the wrist had covered ``early_opening`` of its way); the
+      transport past its peak speed (slowed by ``past_peak``); and either the grip still
+      opening (closed less than ``closing`` of its opening since its maximum) with the
+      wrist at ``approached`` of its way, or closed by ``closing`` with the wrist at
+      ``arrived`` (a closing before then may be a re-opening's dip);
+    * ``reach`` by familiarity (the same margins): the grip has not opened by even
+      ``reach_opening`` m while the wrist has covered ``reach_progress`` of its way and
+      slowed by ``reach_slowed`` (a delayed opener has started to open by then);
+    * ``abnormal`` by familiarity (a movement's familiarity rises as it comes to rest) and
+      ``unfamiliar`` settle at the end.
 
-    The defaults were chosen on the dev population (seeds 1000 + k,
-    ``tools/evaluate_online.py --set dev``) and the shared Optotrak table's
-    even trials replayed by ``hammer-mv watch``, never on the held-out ones.
+    A stream cut before its hand arrives is ``incomplete`` offline; a verdict settled
+    before then stays its online decision. The defaults were chosen on the independent
+    generator's dev sets (seeds 1000 + k and 20000 + k, ``tools/evaluate_online_demos.py
+    --generator independent --set dev [--fast]``) and the shared Optotrak table's even
+    trials replayed by ``hammer-mv watch``, never on the held-out ones or the second
+    generator.
 
     Parameters
     ----------
-    min_progress, arrived, reach_progress : float
+    min_progress, approached, arrived, reach_progress : float
         Share of the wrist's way, 0..1.
     late_margin : float
         Share of the movement kept from ``late_opening`` (the landmark
         ``opening_time``, known once the movement's end is seen).
     early_opening : float
         Before the movement's end is seen: the grip must have started to open
-        before the wrist covered this share of its way
-        (:attr:`~perception.recognition.rules.Evidence.opening_progress`).
-    slowed, reach_slowed, closing : float
+        before the wrist covered this share of its way.
+    slowed, past_peak, reach_slowed, closing : float
         Share of the peak speed, of the opening, 0..1.
     reach_opening : float
         Most a grip may have opened and still count as not opening, m.
     margin : float
         Evidence margin, natural-log units of familiarity.
     hold : float
-        Time the verdict must have stood, s.
+        Time the settling answer must have stood, s.
     """
 
     min_progress: Share = 0.5
     late_margin: NonNegative = 0.12
     slowed: Share = 0.6
+    past_peak: Share = 0.2
     closing: Share = 0.05
+    approached: Share = 0.9
     arrived: Share = 0.95
     margin: NonNegative = 1.0
     reach_progress: Share = 0.7
@@ -95,58 +99,55 @@ class SettleRule:
             return math.inf
         return _log_margin(verdict.familiarity, rules.familiarity_threshold)
 
-    def sure(self, verdict: Verdict, evidence: Evidence, grip, rules: VerdictRules,
-             progress: float) -> bool:
-        """Whether ``verdict`` on ``evidence`` is settled (see the class docstring).
+    def settles(self, verdict: Verdict, evidence: Evidence, grip, rules: VerdictRules
+                ) -> tuple[str, str | None] | None:
+        """The verdict and its detail that ``evidence`` settles (see the class docstring),
+        or None while it is not conclusive.
 
         Parameters
         ----------
         verdict : Verdict
-            The provisional verdict.
+            ``judge(evidence, rules, ongoing=True)``.
         evidence : Evidence
-            What it was judged on.
+            The rows so far.
         grip : namespace
-            The movement's course so far: ``opened``, ``peaks``, ``opening``
-            (m), ``closing`` (share of the opening closed since its maximum),
-            ``slowed`` (share of the transport's peak speed lost since).
+            :func:`grip_course` of them.
         rules : VerdictRules
-        progress : float
-            The wrist's share of its way covered.
         """
         lm = evidence.observed
-        if verdict.verdict is None or lm is None:
-            return False
-        # the hand must have arrived for anything but a second opening: a stream cut
-        # before then is `incomplete` at its end
-        arrived = grip.slowed >= max(self.slowed, rules.arrival)
+        if verdict.verdict in (None, "unfamiliar") or lm is None:
+            return None
         if verdict.rule == "grip-departs":
             # two peaks count when the grip opened as a grasp's must before its dip: a
             # peak is a share of the opening so far, and a late opener's first
             # millimetres are no opening
-            return progress >= self.min_progress and ((grip.peaks or 0) >= 2 and grip.twice or (
-                arrived and lm.opening_time > rules.late_opening + self.late_margin))
-        if verdict.rule != "familiarity" or not arrived:
-            return False
-        if verdict.verdict == "abnormal":
-            # a movement's familiarity rises as it completes and comes to rest (a few
-            # still rows at the end raised 0.02 to 0.07 on the dev sets): a low one is
-            # not conclusive before the stream ends
-            return False
+            twice = (grip.peaks or 0) >= 2 and grip.twice
+            arrived = grip.slowed >= max(self.slowed, rules.arrival)
+            late = arrived and lm.opening_time > rules.late_opening + self.late_margin
+            sure = grip.progress >= self.min_progress and (twice or late)
+            return (verdict.verdict, verdict.detail) if sure else None
+        if verdict.rule != "familiarity" or verdict.verdict == "abnormal":
+            return None
         tf = evidence.transport_familiarity
         if self.evidence(verdict, evidence, rules) < self.margin or (
                 math.isfinite(tf) and _log_margin(tf, rules.unfamiliar_threshold) < self.margin):
-            return False
-        if grip.opened:  # the maximum is past, and with it the time for a second opening
-            # when the grip started to open: the landmark once the movement's end is seen,
-            # before it how far the wrist had come by then
-            early = (lm.opening_time <= rules.late_opening - self.late_margin
-                     if math.isfinite(lm.opening_time)
-                     else evidence.opening_progress <= self.early_opening)
-            return (grip.closing >= self.closing and grip.peaks == 1
-                    and progress >= self.arrived and early)
-        # a late opener opens by the end of its movement: a reach's end must be seen
-        return (progress >= self.reach_progress and grip.slowed >= self.reach_slowed
-                and grip.opening < self.reach_opening and math.isfinite(lm.end_time))
+            return None
+        if verdict.verdict == "reach":
+            # a late opener opens by the end of its movement: a reach's end must be seen
+            sure = (grip.progress >= self.reach_progress and grip.slowed >= self.reach_slowed
+                    and grip.opening < self.reach_opening and math.isfinite(lm.end_time))
+            return ("reach", None) if sure else None
+        early = (lm.opening_time <= rules.late_opening - self.late_margin
+                 if math.isfinite(lm.opening_time)
+                 else evidence.opening_progress <= self.early_opening)
+        # past the maximum, a closing is the hand at the object only near the end of its
+        # way: before, it may be the dip of a re-opening
+        near = self.arrived if grip.closing >= self.closing else self.approached
+        # the markers' own second opening comes a frame or two before the landmarks
+        # count its peak
+        sure = (grip.opened and grip.peaks in (0, 1) and not grip.twice and early
+                and grip.slowed >= self.past_peak and grip.progress >= near)
+        return ("normal", None) if sure else None
 
 
 def _log_margin(value: float, threshold: float) -> float:
@@ -163,7 +164,8 @@ class Decision:
     verdict : str
         ``normal``, ``abnormal`` or ``reach``.
     detail : str or None
-        ``re-opening`` for a grip seen to open twice, else None.
+        ``re-opening`` for a grip seen to open twice, ``delayed-opening`` for one that
+        started to open late, else None.
     time : float
         Stream time of the frame it settled at, s.
     since_onset : float

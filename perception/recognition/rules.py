@@ -27,8 +27,8 @@ from perception.landmarks import LandmarkParams, Landmarks
 from perception.observation import ObserveParams
 from perception.validation import Int, Share, declared
 
-__all__ = ["DETAILS", "HAND_SPAN", "REASONS", "RULE_TABLE", "VERDICT_RULES", "Evidence", "Verdict",
-           "VerdictRules", "grip_departs", "judge", "reason", "slowed", "verdict_detail"]
+__all__ = ["AT_END", "DETAILS", "HAND_SPAN", "REASONS", "RULE_TABLE", "VERDICT_RULES", "Evidence",
+           "Verdict", "VerdictRules", "grip_departs", "judge", "reason", "slowed", "verdict_detail"]
 
 #: Kinds of an abnormal verdict (:func:`verdict_detail`).
 DETAILS = ("delayed-opening", "re-opening", "no-opening", "other")
@@ -372,11 +372,15 @@ RULE_TABLE: tuple[tuple[str, str, Callable[[Evidence, VerdictRules, str | None],
 )
 #: The rules' names (:attr:`Verdict.rule`), in the order they are tried.
 VERDICT_RULES = tuple(name for name, _, _ in RULE_TABLE)
+#: The rules that read the movement's end: a movement still being seen (``judge(...,
+#: ongoing=True)``) has not ended short.
+AT_END = ("incomplete",)
 #: Why the data cannot carry a verdict (the ``verdict_detail`` of an ``unfamiliar`` one).
 REASONS = ("digits-unseen", "several-movements", "incomplete")
 
 
-def judge(evidence: Evidence, rules: VerdictRules | None = None) -> Verdict:
+def judge(evidence: Evidence, rules: VerdictRules | None = None, *,
+          ongoing: bool = False) -> Verdict:
     """The verdict: the best model by log-likelihood, then the first rule of
     :data:`RULE_TABLE` that fires.
 
@@ -384,6 +388,11 @@ def judge(evidence: Evidence, rules: VerdictRules | None = None) -> Verdict:
     ----------
     evidence : Evidence
     rules : VerdictRules, optional
+    ongoing : bool
+        The movement is still being seen (a stream's rows so far): the rules
+        of :data:`AT_END` do not fire, so the verdict is the one the
+        movement gets if it ends as it goes (what
+        :class:`~perception.online.SettleRule` settles).
     """
     if not isinstance(evidence, Evidence):  # not an AttributeError at its first use
         raise TypeError(f"expected Evidence, got {type(evidence).__name__}")
@@ -398,6 +407,8 @@ def judge(evidence: Evidence, rules: VerdictRules | None = None) -> Verdict:
     for name, verdict, fires in RULE_TABLE:
         if name not in ("not-a-precision-grip", "insufficient-data") and base is None:
             continue  # no calibration: only the rules about the data
+        if ongoing and name in AT_END:
+            continue
         why = fires(evidence, rules, base)
         if why:
             verdict = verdict or base
