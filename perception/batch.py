@@ -30,6 +30,7 @@ import numpy as np
 import perception.workers as workers
 from perception.batch_clip import (
     ClipResult,
+    ModelRows,
     RunTiming,
     _guarded,
     _numbers,
@@ -62,9 +63,9 @@ if TYPE_CHECKING:
 
     from perception.reach_data import Reach
 
-__all__ = ["REPORT_SET", "BatchItem", "ClipResult", "Discovery", "RunTiming", "count_trials",
-           "discover", "expand_recordings", "find_clips", "process_clip", "remove_stale_reports",
-           "run_batch", "summary_table"]
+__all__ = ["REPORT_SET", "BatchItem", "ClipResult", "ClipWarnings", "Discovery", "RunTiming",
+           "count_trials", "discover", "expand_recordings", "find_clips", "process_clip",
+           "remove_stale_reports", "run_batch", "summary_table"]
 
 log = logging.getLogger(__name__)
 
@@ -310,8 +311,10 @@ def run_batch(
     jobs : int
         Worker processes working on clips, one OpenCV, FFmpeg, planning and
         BLAS thread each (:mod:`perception.workers`; 1: in this process;
-        ignored with ``scheduler``). Scripts that use ``jobs > 1`` need the
-        usual ``if __name__ == "__main__":`` guard of multiprocessing.
+        ignored with ``scheduler``), and then on a large study's statistics
+        (:func:`~perception.report.statistics.landmark_statistics`). Scripts
+        that use ``jobs > 1`` need the usual ``if __name__ == "__main__":``
+        guard of multiprocessing.
     scheduler : str, optional
         Address of a dask.distributed scheduler (``tcp://host:8786``) to run on.
     repertoire_id : str
@@ -336,16 +339,16 @@ def run_batch(
         clips, reading recordings), ``clips`` (from the first clip handed out
         to the last result), ``report`` (the batch's report), s, and ``runs``,
         a row per summary row: the process that ran it, its start and end
-        (``time.perf_counter()``) and its CPU time (:class:`RunTiming`).
+        (``time.perf_counter()``) and its CPU time (:class:`RunTiming`);
+        ``attrs["warnings"]`` each scored clip's warnings (:class:`ClipWarnings`).
+        This process keeps a clip's every-model curves on disk while the
+        clips run (:class:`~perception.batch_clip.ModelRows`): what it holds a
+        clip does not grow with the repertoire.
         Reports of a recording's trials not scored in this run (no longer in
         the file, or no reach now) are removed from ``out``. The report files
         (:data:`REPORT_SET`) come from one run: the last run's are removed
         first, and this run's again if one of them cannot be written.
     """
-    from tqdm import tqdm
-
-    from perception.report.batch import write_batch_report
-
     if not isinstance(repertoire, Repertoire):  # not an AttributeError from a worker
         raise TypeError(f"expected a Repertoire (Repertoire.load or Repertoire.build), "
                         f"got {type(repertoire).__name__}")
@@ -396,25 +399,54 @@ def run_batch(
         results = workers.run_pool(work(), job, jobs, shared=repertoire)
     else:
         results = _run_local([_Work(*pair) for pair in pairs], repertoire, job, jobs)
+    with ModelRows(out) as rows:  # every model's curves on disk, not in this process
+        done = _collected(results, rows, streamed, len(items), quiet)
+        return _finish(done, rows, items, found if streamed else None, late, job, repertoire,
+                       settings, skipped, t0, t1, repertoire_id, jobs)
+
+
+def _collected(results: Iterable[ClipResult], rows: ModelRows, streamed: bool, n: int,
+               quiet: bool) -> list[ClipResult]:
+    """Every result as it comes (a progress bar on a terminal), its per-model curves
+    kept in ``rows``: what the batch holds a clip does not grow with the models."""
+    from tqdm import tqdm
+
     done: list[ClipResult] = []
-    with tqdm(total=None if streamed else len(items), unit="clip", file=sys.stderr,
+    with tqdm(total=None if streamed else n, unit="clip", file=sys.stderr,
               desc="batch", disable=quiet or not sys.stderr.isatty()) as bar:
         for result in results:
-            done.append(result)
+            done.append(rows.keep(result))
             bar.update()
+    return done
+
+
+def _finish(done: list[ClipResult], rows: ModelRows, items: list[BatchItem],
+            found: list[BatchItem] | None, late: list, job: _Job, repertoire: Repertoire,
+            settings: RecognitionSettings, skipped, t0: float, t1: float,
+            repertoire_id: str, jobs: int) -> pd.DataFrame:
+    """The batch's report from its results (:func:`run_batch`'s last steps)."""
+    from perception.report.batch import write_batch_report
+    from perception.report.conditions import reference_model
+
+    out, figure_format, dpi = job.out, job.figure_format, job.dpi
+    streamed = found is not None
     if streamed:
         items = _take_back(found, late, done, job, repertoire)
     done.sort(key=lambda r: r.clip)
     t2 = time.perf_counter()
     for path, clips in _recordings(items).items():  # reports of trials no longer in them
         remove_stale_reports(out, path, [r.clip for r in done if r.scored and r.clip in clips])
-    summary = summary_table(done)
+    scored = [r for r in done if r.summary is not None]
+    # the one model whose curves the report reads (summary_table would find the same)
+    reference = reference_model([r.summary for r in scored], [r.condition for r in scored])
+    summary = summary_table(done, reference)
     summary.attrs["trials"] = count_trials(items)
     bugs = [f"== {r.clip} ({r.error})\n{r.traceback}" for r in done if r.traceback]
     _remove_report(out)  # the last run's set: a kill or a full disk below leaves no mix
     try:
-        write_batch_report(summary, {r.clip: r.summary for r in done if r.summary is not None},
-                           out, models=repertoire.models, figure_format=figure_format, dpi=dpi)
+        write_batch_report(summary, {r.clip: rows.restored(r.summary, reference)
+                                     for r in scored}, out, models=repertoire.models,
+                           figure_format=figure_format, dpi=dpi, jobs=jobs)
         if bugs:
             write_text(out / ERRORS_LOG, "\n".join(bugs))
         write_json(out / "batch.json", {
@@ -432,7 +464,31 @@ def run_batch(
     # set last: pandas copies attrs deeply with every frame made from this one
     summary.attrs["timing"] = {"read": t1 - t0, "clips": t2 - t1,
                                "report": time.perf_counter() - t2, "runs": _runs(done)}
+    summary.attrs["warnings"] = ClipWarnings(tuple(
+        (r.clip, tuple(r.summary.warning_values)) for r in scored))
     return summary
+
+
+@dataclass(frozen=True)
+class ClipWarnings:
+    """Each scored clip's warnings (its report's ``warning_values``), in the summary's
+    order: ``attrs["warnings"]`` of :func:`run_batch`'s summary.
+
+    The command line said them by reading every clip's report back (6 ms a
+    clip: a minute of a 10,000-trial study, after the report). Read-only,
+    and shared rather than copied by the deep copy pandas makes of a frame's
+    ``attrs`` for every frame made from it.
+
+    Attributes
+    ----------
+    by_clip : tuple of (str, tuple of dict)
+        Each scored clip and its warnings (``{"kind", "value"}``).
+    """
+
+    by_clip: tuple[tuple[str, tuple[dict, ...]], ...]
+
+    def __deepcopy__(self, _memo) -> ClipWarnings:
+        return self
 
 
 def _runs(done: list[ClipResult]) -> np.ndarray:

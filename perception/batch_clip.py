@@ -8,12 +8,16 @@ input, settings, repertoire and code is reused.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import logging
+import tempfile
 import traceback
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, BinaryIO
+
+import numpy as np
 
 from perception.discovery import BatchItem
 from perception.errors import HammerMVError
@@ -35,7 +39,7 @@ from perception.report.tracking import write_tracking_report
 if TYPE_CHECKING:
     from perception.reach_data import Reach
 
-__all__ = ["ClipResult", "RunTiming", "process_clip"]
+__all__ = ["ClipResult", "ModelRows", "RunTiming", "process_clip"]
 
 log = logging.getLogger("perception.batch")
 
@@ -163,6 +167,116 @@ class ClipResult:
     def winner(self) -> str | None:
         """The winning model, if the clip was scored."""
         return None if self.summary is None else self.summary.winner
+
+
+class ModelRows:
+    """The batch's clips' every-model curves, kept on disk while the batch runs.
+
+    A clip's :class:`ClipSummary` holds its confidence and transport term
+    for every model of the repertoire (16 by default: 12 kB of a mocap
+    trial's 20 kB), but the batch report reads every model's final value
+    and the curves of one, the reference model, known only once every clip
+    is in. :meth:`keep` writes a result's curves to a temporary file beside
+    the report and keeps the final values; :meth:`restored` reads back the
+    reference model's. What the batch holds a clip is then its scalars, its
+    own curves (time, aperture, the kinematic traces) and two rows of
+    ``(1, N)``: the same at any number of models and the report's numbers the
+    same, bit for bit (float64 written and read as it was).
+
+    Use it as a context manager: the file goes when it closes (at once on
+    POSIX: it is never linked into the folder).
+
+    Parameters
+    ----------
+    folder : Path
+        Where the temporary file goes (the report folder: a disk, where
+        ``/tmp`` may be memory).
+    """
+
+    def __init__(self, folder: Path):
+        self._file: BinaryIO = tempfile.TemporaryFile(dir=folder, prefix=".batch-rows-")
+        #: clip: (offset of its confidence, its shape, its transport's shape)
+        self._where: dict[str, tuple[int, tuple[int, ...], tuple[int, ...]]] = {}
+
+    def __enter__(self) -> ModelRows:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self._file.close()
+
+    def keep(self, result: ClipResult) -> ClipResult:
+        """``result`` with its summary's per-model curves written here and dropped.
+
+        The kept summary's ``confidence`` is its final column, ``(M, 1)``,
+        its ``transport`` ``(M, 0)``, and its ``traces`` arrays (a reused
+        report's are lists of floats: 32 bytes a value, not 8); a result
+        without a summary is returned as it is.
+
+        Parameters
+        ----------
+        result : ClipResult
+            A clip's result, as a worker returned it.
+        """
+        s = result.summary
+        if s is None:
+            return result
+        confidence = np.ascontiguousarray(s.confidence, dtype=float)
+        transport = np.ascontiguousarray(s.transport, dtype=float)
+        if confidence.ndim != 2 or transport.ndim != 2:  # no models: nothing to keep apart
+            return result
+        self._file.seek(0, 2)
+        self._where[s.clip] = self._file.tell(), confidence.shape, transport.shape
+        self._file.write(confidence.tobytes())
+        self._file.write(transport.tobytes())
+        traces = ({k: np.asarray(v, dtype=float) for k, v in s.traces.items()}
+                  if isinstance(s.traces, dict) else s.traces)
+        return dataclasses.replace(result, summary=dataclasses.replace(
+            s, confidence=confidence[:, -1:].copy(),
+            transport=np.zeros((len(s.names), 0)), traces=traces))
+
+    def restored(self, summary: ClipSummary, model: str | None) -> ClipSummary:
+        """A kept summary with the curves of ``model`` alone, read back.
+
+        ``names``, ``kinds`` and the per-model arrays hold ``model`` only: what
+        the batch report reads of a clip once the reference model is known.
+        Without ``model``, or for a clip that has no such model, every
+        model's curves come back (the report then fails or reads as it would
+        have).
+
+        Parameters
+        ----------
+        summary : ClipSummary
+            A summary :meth:`keep` returned.
+        model : str or None
+            The reference model.
+        """
+        if summary.clip not in self._where:  # not kept here: as it is
+            return summary
+        offset, shape, transport_shape = self._where[summary.clip]
+        n = shape[0] * shape[1]
+        if model is None or model not in summary.names:
+            return dataclasses.replace(
+                summary, confidence=self._read(offset, shape),
+                transport=self._read(offset + 8 * n, transport_shape))
+        i = summary.names.index(model)
+        row = self._read(offset + 8 * i * shape[1], (1, shape[1]))
+        width = transport_shape[1]
+        transport = (self._read(offset + 8 * (n + i * width), (1, width))
+                     if transport_shape[0] > i else np.zeros((1, 0)))
+        pick = slice(i, i + 1)
+
+        def one(values: np.ndarray) -> np.ndarray:  # an array a model, if it is one
+            return values[pick] if len(values) == len(summary.names) else values
+
+        return dataclasses.replace(
+            summary, names=[model], kinds=summary.kinds[pick], confidence=row,
+            transport=transport, final_log_likelihood=one(summary.final_log_likelihood),
+            familiarities=one(summary.familiarities))
+
+    def _read(self, offset: int, shape: tuple[int, ...]) -> np.ndarray:
+        self._file.seek(offset)
+        count = int(np.prod(shape))
+        return np.frombuffer(self._file.read(8 * count), dtype=float).reshape(shape).copy()
 
 
 def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,

@@ -9,6 +9,17 @@ process. The same-run baselines are the one-process figures, and for each N
 the throughput of N independent one-process batches side by side: how far
 the machine itself lets N single-threaded processes scale, which no way of
 sharing the clips can beat.
+
+The ``study`` part (issue 45; ``--only study``) writes the shipped Optotrak
+trials as a lab's study, ``--participants`` x ``--study-trials`` (100 x 100 =
+10,000 trials by default), one file per participant with a ``participant``
+and a ``condition`` column, runs ``hammer-mv batch`` of it with its figures
+and report at ``--jobs``, and prints the wall time, trials/s, the peak
+resident memory of the whole process tree and of the batch's own process
+(psutil, sampled every 0.1 s), and what the batch's own process holds per
+trial: its peak over that of the same study with a tenth of the participants,
+per trial more, against the targets (10,000 trials in 2 minutes at ``--jobs
+16``; memory a trial small and the same at any size).
 """
 
 from __future__ import annotations
@@ -238,6 +249,151 @@ def phase_rows(cores: int, rounds: int = 1, trials: int = 600
     return [(f"phases of a batch of {n} motion-capture trials with figures", "", "", ""), *rows]
 
 
+#: The study part's targets: seconds for a 10,000-trial study at ``--jobs 16``, and
+#: bytes a trial the batch's own process may grow by (10,000 trials: 50 MB).
+STUDY_SECONDS, STUDY_TRIALS = 120.0, 10_000
+STUDY_BYTES_PER_TRIAL = 5_000
+
+
+def make_study(folder: Path, participants: int, trials: int, conditions: int = 2) -> int:
+    """Write the shipped Optotrak trials as a study: ``participants`` files
+    (``P001.tsv``, ...) of ``trials`` trials each, the shipped four in turn.
+
+    Each row gains a ``participant`` column (``P001``) and, with ``conditions``
+    above 0, a ``condition`` column (``normal``, ``delayed``, ``c3``, ...: trial
+    ``k`` of a participant is condition ``k % conditions``); trials are numbered
+    through the study, so that no two files share a trial's number.
+
+    Returns
+    -------
+    int
+        The trials written.
+    """
+    from bench_mocap import SOURCE
+
+    lines = SOURCE.read_text().splitlines()
+    header, rows = lines[0].split("\t"), [line.split("\t") for line in lines[1:]]
+    by_trial: dict[str, list[list[str]]] = {}
+    for r in rows:
+        by_trial.setdefault(r[0], []).append(r[1:])
+    shipped = list(by_trial.values())
+    names = ["normal", "delayed", *(f"c{k}" for k in range(3, conditions + 1))][:conditions]
+    folder.mkdir(parents=True, exist_ok=True)
+    head = ["participant", *(["condition"] if conditions else []), *header]
+    for p in range(participants):
+        who = f"P{p + 1:03d}"
+        out = ["\t".join(head)]
+        for k in range(trials):
+            number = str(p * trials + k)
+            cond = [names[k % conditions]] if conditions else []
+            prefix = "\t".join([who, *cond, number])
+            out += [f"{prefix}\t" + "\t".join(r) for r in shipped[k % len(shipped)]]
+        (folder / f"{who}.tsv").write_text("\n".join(out) + "\n")
+    return participants * trials
+
+
+def _watched(cmd: list[str]) -> tuple[float, float, int, int]:
+    """Run ``cmd``; its wall time (s), its own CPU time (s; its workers are the
+    forkserver's children, not its own), and the peak resident memory of its whole
+    process tree and of the process itself, bytes (psutil, every 0.1 s)."""
+    import subprocess
+
+    import psutil
+
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, cwd=ROOT)
+    watched = psutil.Process(proc.pid)
+    tree_peak = own_peak = 0
+    while proc.poll() is None:
+        try:
+            own = watched.memory_info().rss
+            tree = own + sum(_rss(c) for c in watched.children(recursive=True))
+            own = max(own, _high_water(proc.pid))
+        except psutil.Error:  # it ended between the poll and the look
+            break
+        own_peak, tree_peak = max(own_peak, own), max(tree_peak, tree)
+        time.sleep(0.1)
+    err = proc.stderr.read().decode(errors="replace")
+    if proc.wait() not in (0, 1):  # 1: a trial not scored, said in the report
+        raise RuntimeError(f"{' '.join(cmd)} failed:\n{err[-2000:]}")
+    wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return wall, cpu, tree_peak, own_peak
+
+
+def _high_water(pid: int) -> int:
+    """A process's peak resident memory so far, bytes (Linux's VmHWM: the peak between
+    two looks too; 0 elsewhere). Not ``ru_maxrss`` of the children: that is the
+    largest of every process waited for, a batch's workers among them."""
+    try:
+        with open(f"/proc/{pid}/status") as status:
+            for line in status:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    return 0
+
+
+def _rss(proc) -> int:
+    import psutil
+
+    try:
+        return proc.memory_info().rss
+    except psutil.Error:  # a worker that has just ended
+        return 0
+
+
+def study_rows(participants: int, trials: int, jobs: int, conditions: int = 2
+               ) -> list[tuple[str, str, str, str]]:
+    """A study of ``participants`` x ``trials`` Optotrak trials through ``hammer-mv
+    batch --jobs jobs`` (issue 45), and the same with a tenth of the participants (at
+    least one fewer): wall, trials/s, peak memory and memory a trial."""
+    from bench_mocap import RATE
+    from bench_speed import HAMMER
+
+    work = Path(tempfile.mkdtemp(prefix="hammer-bench-study-"))
+    try:
+        runs = {}
+        small = max(1, participants // 10) if participants > 1 else 0
+        for who in ([small] if small else []) + [participants]:
+            folder = work / f"study{who}"
+            n = make_study(folder, who, trials, conditions)
+            cmd = [*HAMMER, "batch", str(folder), "--rate", RATE, "-o", str(work / "out"),
+                   "--jobs", str(jobs), "--quiet"]
+            runs[n] = _watched(cmd)
+            shutil.rmtree(work / "out", ignore_errors=True)
+            shutil.rmtree(folder, ignore_errors=True)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    n = participants * trials
+    wall, cpu, tree, own = runs[n]
+    mb = 1 << 20
+    rows = [(f"study: {participants} participants x {trials} trials = {n} trials, "
+             f"batch --jobs {jobs}, figures and report", "", "", ""),
+            ("  wall, whole command", f"{wall:.1f} s ({n / wall:.1f} trials/s; the batch's "
+             f"own process CPU {cpu:.0f} s)",
+             f"target {STUDY_TRIALS} trials <= {STUDY_SECONDS:.0f} s at --jobs 16 "
+             f"({STUDY_TRIALS / STUDY_SECONDS:.0f} trials/s)",
+             ("ok" if wall <= STUDY_SECONDS else "MISSED") if n == STUDY_TRIALS and jobs >= 16
+             else "(another size)"),
+            ("  peak memory, every process", f"{tree / mb:.0f} MB",
+             f"{tree / n / 1e3:.1f} kB a trial", ""),
+            ("  peak memory, the batch's own process", f"{own / mb:.0f} MB",
+             f"{own / n / 1e3:.1f} kB a trial", "")]
+    if small:
+        m = small * trials
+        grown = (own - runs[m][3]) / (n - m)
+        rows.append((f"  its growth a trial, {m} -> {n} trials",
+                     f"{grown / 1e3:.1f} kB",
+                     f"target <= {STUDY_BYTES_PER_TRIAL / 1e3:.0f} kB ({m} trials: peak "
+                     f"{runs[m][3] / mb:.0f} MB, {runs[m][0]:.1f} s)",
+                     "ok" if grown <= STUDY_BYTES_PER_TRIAL else "MISSED"))
+    return rows
+
+
 def main(argv: list[str] | None = None) -> None:
     """Print the recognition and scaling figures."""
     import argparse
@@ -245,14 +401,29 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rounds", type=int, default=ROUNDS,
                         help=f"runs of each batch configuration, the best counts ({ROUNDS})")
-    parser.add_argument("--only", choices=("phases",),
-                        help="only the phase table of a motion-capture batch")
+    parser.add_argument("--only", choices=("phases", "study"),
+                        help="only the phase table of a motion-capture batch, or only the "
+                        "study")
     parser.add_argument("--trials", type=int, default=600,
                         help="trials of the phase table's table (600)")
+    parser.add_argument("--participants", type=int, default=100,
+                        help="the study's participants (100)")
+    parser.add_argument("--study-trials", type=int, default=100,
+                        help="the study's trials per participant (100)")
+    parser.add_argument("--jobs", type=int, default=None,
+                        help="the study's batch's worker processes (default: every core)")
+    parser.add_argument("--conditions", type=int, default=2,
+                        help="the study's conditions, taking turns trial by trial (2; 0: no "
+                        "condition column)")
     args = parser.parse_args(argv)
     rounds = args.rounds
     cores = (len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
              else os.cpu_count() or 1)
+    if args.only == "study":
+        jobs = args.jobs or cores
+        table(f"perception: a lab's study through batch ({cores} cores)",
+              study_rows(args.participants, args.study_trials, jobs, args.conditions))
+        return
     if args.only == "phases":
         table(f"perception: where a batch's time goes ({cores} cores)",
               phase_rows(cores, min(rounds, 2), args.trials))

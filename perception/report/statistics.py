@@ -38,8 +38,8 @@ import pandas as pd
 from perception.report.conditions import plain_tests
 
 __all__ = ["ABSURD_SE_FACTOR", "BOUNDARY_VARIANCE_RATIO", "MIN_PARTICIPANTS",
-           "PARTICIPANT_COLUMNS", "landmark_statistics", "measure_table", "mixed_fit_problems",
-           "participant_column", "participant_means"]
+           "PARALLEL_TRIALS", "PARTICIPANT_COLUMNS", "fitted_in_workers", "landmark_statistics",
+           "measure_table", "mixed_fit_problems", "participant_column", "participant_means"]
 
 #: Manifest columns that name the participant, first found wins.
 PARTICIPANT_COLUMNS = ("participant", "subject")
@@ -132,7 +132,14 @@ def participant_means(data: pd.DataFrame) -> pd.DataFrame:
     return cells.agg(n="count", mean="mean", sd="std").reset_index()
 
 
-def landmark_statistics(data: pd.DataFrame) -> pd.DataFrame:
+#: Trials of a measure from which :func:`landmark_statistics` fits the measures in
+#: worker processes when it is given more than one: a mixed model of 1,200 trials
+#: and 12 participants took 0.6-0.8 s a measure (17 measures), a second's start-up
+#: of a worker (statsmodels' imports) less than one measure.
+PARALLEL_TRIALS = 500
+
+
+def landmark_statistics(data: pd.DataFrame, jobs: int = 1) -> pd.DataFrame:
     """Each measure compared between conditions, one row per measure and term.
 
     A mixed model (``method`` ``mixedlm``) where :data:`MIN_PARTICIPANTS`
@@ -146,6 +153,12 @@ def landmark_statistics(data: pd.DataFrame) -> pd.DataFrame:
     ----------
     data : pandas.DataFrame
         :func:`measure_table`.
+    jobs : int
+        Worker processes that may fit the measures side by side
+        (:mod:`perception.workers`: one BLAS thread each, as the command's
+        own process has), where a measure has :data:`PARALLEL_TRIALS` trials
+        or more and a participant column (mixed models); the rows are the
+        same, in the same order.
 
     Returns
     -------
@@ -155,14 +168,53 @@ def landmark_statistics(data: pd.DataFrame) -> pd.DataFrame:
         ``df2``, ``p_value``, ``n`` (trials), ``n_participants``, ``note``.
     """
     who = participant_column(data.columns)
-    rows = []
+    measures = []
     for (measure, unit), d in data.groupby(["measure", "unit"], sort=False):
         d = d[d["condition"].notna() & np.isfinite(d["value"].to_numpy(float))]
         if who is not None:
             d = d[d[who].notna() & (d[who].astype(str) != "")]
-        rows += [{"measure": measure, "unit": unit, **r} for r in _measure_rows(d, who)]
+        measures.append((len(measures), measure, unit, d))
+    job = _MeasureJob(who)
+    if fitted_in_workers(data, jobs):
+        from perception.workers import run_pool
+
+        found = dict(run_pool(measures, job, min(jobs, len(measures)),
+                              size=lambda item: len(item[3])))
+    else:
+        found = dict(job.run(m, None) for m in measures)
+    rows = [r for k in range(len(measures)) for r in found[k]]
     table = pd.DataFrame(rows, columns=_STAT_COLUMNS)
     return table.astype({"n": "Int64", "n_participants": "Int64"})
+
+
+def fitted_in_workers(data: pd.DataFrame, jobs: int) -> bool:
+    """Whether :func:`landmark_statistics` fits ``data``'s measures in worker processes
+    with ``jobs``: more than one measure, one of :data:`PARALLEL_TRIALS` trials or more,
+    a participant column (mixed models: the plain tests cost too little).
+
+    Parameters
+    ----------
+    data : pandas.DataFrame
+        :func:`measure_table`.
+    jobs : int
+        Worker processes allowed.
+    """
+    if jobs <= 1 or participant_column(data.columns) is None or not len(data):
+        return False
+    trials = data.groupby(["measure", "unit"], sort=False).size()
+    return len(trials) > 1 and int(trials.max()) >= PARALLEL_TRIALS
+
+
+class _MeasureJob:
+    """One measure's rows, for :func:`~perception.workers.run_pool` (picklable)."""
+
+    def __init__(self, who: str | None):
+        self.who = who
+
+    def run(self, item: tuple[int, str, str, pd.DataFrame], shared) -> tuple[int, list[dict]]:
+        """``(its place, its rows)`` of the measure ``item`` (place, measure, unit, trials)."""
+        k, measure, unit, d = item
+        return k, [{"measure": measure, "unit": unit, **r} for r in _measure_rows(d, self.who)]
 
 
 def _measure_rows(d: pd.DataFrame, who: str | None) -> list[dict]:

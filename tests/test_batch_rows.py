@@ -1,0 +1,142 @@
+"""What a batch keeps of a clip while it runs: one value a model, the curves on disk.
+
+A batch's own process held every model's curves of every clip (about 50 kB a
+trial), though its report reads one model's: :class:`perception.batch_clip.ModelRows`
+keeps them on disk and gives back the reference model's, and the report
+written from them is the report written from the results in memory.
+"""
+
+import dataclasses
+import pickle
+import re
+
+import numpy as np
+
+from perception.batch import ClipResult, summary_table
+from perception.batch_clip import ModelRows
+from perception.report import ClipSummary, write_batch_report
+from perception.report.conditions import reference_model
+
+
+def _results(models: int) -> list[ClipResult]:
+    """Six scored clips of two conditions against ``models`` models (half of them grasp
+    models), each with its kinematic traces and landmarks."""
+    rng = np.random.default_rng(7)
+    names = [f"{'grasp' if m % 2 == 0 else 'reach'}-{m}" for m in range(models)]
+    kinds = [n.split("-")[0] for n in names]
+    out = []
+    for k, cond in enumerate(["normal", "delayed"] * 3):
+        time = np.linspace(0.0, 0.8 + 0.05 * k, 40)
+        confidence = np.cumsum(rng.uniform(0.0, 0.01, (models, time.size)), axis=1)
+        traces = {"time": np.linspace(-0.2, 1.0, 90),
+                  "wrist_speed": np.round(np.abs(np.sin(np.linspace(0, 3, 90))) + k / 10, 6),
+                  "aperture": np.round(0.05 + 0.03 * np.sin(np.linspace(0, 3.1, 90)), 6)}
+        observed = {"onset_time": 0.0, "end_time": 0.8, "movement_time": 0.8,
+                    "peak_speed": 1.0 + k / 10, "peak_speed_time": 0.4, "mga": 0.08,
+                    "mga_time": 0.6, "aperture_peaks": 1}
+        summary = ClipSummary(
+            f"P{k % 3}-trial{k}", time, names, kinds, confidence,
+            rng.normal(100.0, 10.0, models), names[0], "likelihood", verdict="normal",
+            familiarity=0.5, margin=1.0, familiarities=rng.uniform(0, 1, models),
+            transport=confidence * rng.uniform(0.2, 0.8, (models, 1)),
+            aperture=0.05 + 0.01 * rng.standard_normal(time.size),
+            extras={"condition": cond, "mocap": {"trial": str(k)}},
+            kinematics={"observed": observed}, traces=traces, time_origin=1.5)
+        out.append(ClipResult(summary.clip, cond, "ok", summary=summary,
+                              factors=(("participant", f"P{k % 3}"),)))
+    return out
+
+
+def _arrays(summary: ClipSummary) -> int:
+    """Bytes of a summary's arrays, its traces' among them."""
+    fields = [getattr(summary, f.name) for f in dataclasses.fields(summary)]
+    fields += list((summary.traces or {}).values())
+    return sum(v.nbytes for v in fields if isinstance(v, np.ndarray))
+
+
+def test_a_kept_clip_holds_one_value_a_model_however_many_models(tmp_path):
+    kept = {}
+    for models in (2, 32):
+        with ModelRows(tmp_path) as rows:
+            full = _results(models)[0]
+            kept[models] = rows.keep(full).summary
+            assert kept[models].confidence.shape == (models, 1)
+            assert kept[models].transport.size == 0
+            # the final values summary.csv reads are those of the results
+            assert np.array_equal(kept[models].confidence[:, 0], full.summary.confidence[:, -1])
+    # 30 more models: 30 final confidences, likelihoods and familiarities, no curve
+    assert _arrays(kept[32]) - _arrays(kept[2]) == 30 * 3 * 8
+    assert len(pickle.dumps(kept[32])) - len(pickle.dumps(kept[2])) < 30 * 40 * 8
+
+
+def test_the_reference_models_curves_come_back_bit_for_bit(tmp_path):
+    results = _results(8)
+    with ModelRows(tmp_path) as rows:
+        kept = [rows.keep(r).summary for r in results]
+        for full, short in zip(results, kept):
+            s = full.summary
+            one = rows.restored(short, "grasp-4")
+            assert one.names == ["grasp-4"] and one.kinds == ["grasp"]
+            assert one.confidence.tobytes() == s.confidence[4:5].tobytes()
+            assert one.transport.tobytes() == s.transport[4:5].tobytes()
+            assert one.final_log_likelihood.tobytes() == s.final_log_likelihood[4:5].tobytes()
+            every = rows.restored(short, None)  # no reference: every model's curves
+            assert every.names == s.names
+            assert every.confidence.tobytes() == s.confidence.tobytes()
+            assert every.transport.tobytes() == s.transport.tobytes()
+    assert not list(tmp_path.iterdir())  # the file is gone with the context
+
+
+def test_a_report_from_kept_rows_is_the_report_from_the_results(tmp_path,
+                                                                figure_format="svg"):
+    results = _results(6)
+    memory, kept_out = tmp_path / "memory", tmp_path / "kept"
+    write_batch_report(summary_table(results),
+                       {r.clip: r.summary for r in results}, memory,
+                       figure_format=figure_format)
+    with ModelRows(tmp_path) as rows:
+        kept = [rows.keep(r) for r in results]
+        scored = [r.summary for r in kept]
+        reference = reference_model(scored, [r.condition for r in kept])
+        write_batch_report(summary_table(kept, reference),
+                           {r.clip: rows.restored(r.summary, reference) for r in kept},
+                           kept_out, figure_format=figure_format)
+    files = sorted(p.name for p in memory.iterdir())
+    assert files == sorted(p.name for p in kept_out.iterdir())
+    assert f"confidence_all.{figure_format}" in files and "summary.csv" in files
+    for name in files:  # tables, page and figures, byte for byte (an SVG's date aside)
+        assert _undated(memory / name) == _undated(kept_out / name), name
+
+
+def _undated(path) -> bytes:
+    return re.sub(rb"<dc:date>[^<]*</dc:date>", b"", path.read_bytes())
+
+
+def test_a_batch_gives_its_clips_warnings_without_reading_its_reports_back(tmp_path,
+                                                                           monkeypatch):
+    import copy
+    import json
+    import shutil
+    from pathlib import Path
+
+    from hammer_mv.cli import batch as cli
+    from perception.batch import discover, run_batch
+    from perception.pipeline import RecognitionSettings
+    from perception.recognition.repertoire import Repertoire
+    from perception.recordings import MocapImport
+    from perception.report.clip import clip_outputs
+
+    (tmp_path / "in").mkdir()
+    shutil.copy(Path(__file__).parent / "data" / "mocap" / "optotrak-trials.tsv",
+                tmp_path / "in" / "P1.tsv")
+    out = tmp_path / "out"
+    summary = run_batch(discover(tmp_path / "in"), out, Repertoire.default(),
+                        RecognitionSettings(mocap=MocapImport(rate=85.0)), quiet=True)
+    scored = summary.loc[summary["status"] == "ok", "clip"].tolist()
+    assert scored
+    read_back = [(c, json.loads(clip_outputs(out, c)["json"].read_text())["warning_values"])
+                 for c in scored]
+    kept = summary.attrs["warnings"]
+    assert copy.deepcopy(summary.attrs)["warnings"] is kept  # shared, not copied
+    monkeypatch.setattr("perception.report.clip.clip_outputs", None)  # no report read
+    assert cli._warnings(summary, out) == read_back
