@@ -188,22 +188,35 @@ class Tracker:
 
     def attrs(self) -> dict[str, Any]:
         """The ``/tracker`` attributes: method, colour models, criteria, parameters."""
-        p = self.params
-        out: dict[str, Any] = {
-            "method": "camshift",
-            "colour_models": self.markers.to_json(),
-            "termination_criteria": json.dumps(
-                {"type": "eps+count", "eps_px": p.term_eps_px, "max_iter": p.term_max_iter}
-            ),
+        return {
+            **self._fixed_attrs(),
             "rois": json.dumps({k: list(v) for k, v in self.rois.items()}),
             "reference_mass_px": [float(t.ref) for t in self._tracks],
             "diameter_px": [float(t.diameter) for t in self._tracks],
             "ambiguous_rivals_px": json.dumps(
                 {k: [list(map(float, c)) for c in v] for k, v in self.ambiguities.items()}),
         }
-        for key, value in asdict(p).items():
-            out[key] = json.dumps(value) if isinstance(value, tuple) else value
-        return out
+
+    def _fixed_attrs(self) -> dict[str, Any]:
+        """The attributes of the markers and parameters, written once per pair: a stream
+        asks for the attributes at every frame (``asdict`` of the parameters cost a
+        twentieth of an online update)."""
+        # both frozen: the same objects give the same attributes (held here, so that an
+        # id is not reused by another)
+        fixed = getattr(self, "_fixed", None)
+        if fixed is None or fixed[0] is not self.markers or fixed[1] is not self.params:
+            p = self.params
+            out: dict[str, Any] = {
+                "method": "camshift",
+                "colour_models": self.markers.to_json(),
+                "termination_criteria": json.dumps(
+                    {"type": "eps+count", "eps_px": p.term_eps_px, "max_iter": p.term_max_iter}
+                ),
+            }
+            for name, value in asdict(p).items():
+                out[name] = json.dumps(value) if isinstance(value, tuple) else value
+            self._fixed = (self.markers, self.params, out)
+        return self._fixed[2]
 
     def feed(self, frame: np.ndarray, time_s: float, index: int) -> list[tuple]:
         """Take a stream's next frame; return the rows tracked meanwhile, in order.
