@@ -167,7 +167,8 @@ def _advance(leaves: Leaves, x: np.ndarray, y: np.ndarray, s0: int, s1: int,
     """One frame on: the prediction (L, 2) of step ``s1`` from the angles ``y`` (L, 2) seen
     at step ``s0``, and the filter's estimate (L, n) at ``s1``."""
     ok = np.isfinite(y).all(axis=1)
-    y = np.where(ok[:, None], _unwrap_to(np.nan_to_num(y), x[:, :2]), x[:, :2])
+    # unseen angles take the estimate's, which unwrap to themselves
+    y = _unwrap_to(np.where(ok[:, None], y, x[:, :2]), x[:, :2])
     # Two states per leaf step together: the prediction, which starts from
     # the observed joint angles (the filter's estimate supplies only what
     # is not observed: velocity, force), and the filter itself, which runs
@@ -177,7 +178,7 @@ def _advance(leaves: Leaves, x: np.ndarray, y: np.ndarray, s0: int, s1: int,
     both = np.stack([x, x], axis=1)
     both[:, 0, :2] = y
     both = leaves.step(both, s0)
-    both[:, 1] += gain * np.einsum("lip,lp->li", leaves.Kp[s0], innov)
+    both[:, 1] += gain * (leaves.Kp[s0] @ innov[:, :, None])[:, :, 0]
     for s in range(s0 + 1, s1):
         both = leaves.step(both, s)
     return both[:, 0, :2], both[:, 1]
