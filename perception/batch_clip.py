@@ -197,6 +197,8 @@ class ModelRows:
         self._file: BinaryIO = tempfile.TemporaryFile(dir=folder, prefix=".batch-rows-")
         #: clip: (offset of its confidence, its shape, its transport's shape)
         self._where: dict[str, tuple[int, tuple[int, ...], tuple[int, ...]]] = {}
+        #: the model lists seen, each kept once (every clip's are alike: 2 kB a clip)
+        self._lists: dict[tuple[str, ...], list[str]] = {}
 
     def __enter__(self) -> ModelRows:
         return self
@@ -232,7 +234,12 @@ class ModelRows:
                   if isinstance(s.traces, dict) else s.traces)
         return dataclasses.replace(result, summary=dataclasses.replace(
             s, confidence=confidence[:, -1:].copy(),
-            transport=np.zeros((len(s.names), 0)), traces=traces))
+            transport=np.zeros((len(s.names), 0)), traces=traces,
+            names=self._shared(s.names), kinds=self._shared(s.kinds)))
+
+    def _shared(self, values: list[str]) -> list[str]:
+        """``values``, as the first equal list kept (read, never changed, by the report)."""
+        return self._lists.setdefault(tuple(values), list(values))
 
     def restored(self, summary: ClipSummary, model: str | None) -> ClipSummary:
         """A kept summary with the curves of ``model`` alone, read back.

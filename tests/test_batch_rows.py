@@ -140,3 +140,35 @@ def test_a_batch_gives_its_clips_warnings_without_reading_its_reports_back(tmp_p
     assert copy.deepcopy(summary.attrs)["warnings"] is kept  # shared, not copied
     monkeypatch.setattr("perception.report.clip.clip_outputs", None)  # no report read
     assert cli._warnings(summary, out) == read_back
+
+
+def test_the_landmark_table_built_a_column_at_a_time_is_the_one_built_a_row_at_a_time():
+    import math
+
+    import pandas as pd
+
+    from perception.landmarks import Landmarks
+    from perception.report import tables
+    from perception.report.tables import MovementLandmarks, tidy_landmarks
+
+    observed = _results(2)[0].summary.kinematics["observed"]
+    movements = [
+        MovementLandmarks("a", "a", Landmarks.from_dict(observed), "complete",
+                          condition="normal", factors={"participant": "P1", "block": "2"},
+                          trial_number="1", reach_number="1"),
+        MovementLandmarks("b", "b", None, "no reach", reason="the hand never moved",
+                          factors={"participant": "P2"}),  # no block, no condition
+    ]
+    factors = ["participant", "block", "session"]  # session: no movement has one
+    rows = []  # the table as it was built: a dict a row
+    for m in movements:
+        cells = tables._cells(m, factors)
+        for name, value, unit, clock, flag in m.values():
+            rows.append({**cells, "landmark": name, "value": value, "unit": unit,
+                         "clock": clock, "flag": flag, "status": m.status, "reason": m.reason})
+    names = [*tables._HEAD, *factors, *tables._NUMBERS, *tables._LONG]
+    expected = pd.DataFrame(rows, columns=names).astype({"trial_number": str,
+                                                         "reach_number": str})
+    table = tidy_landmarks(movements, factors)
+    pd.testing.assert_frame_equal(table, expected, check_exact=True)
+    assert table["session"].isna().all() and not math.isnan(table["value"].iloc[0])
