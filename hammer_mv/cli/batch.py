@@ -111,7 +111,7 @@ def _warnings(summary, out: Path) -> list[tuple[str, list[dict]]]:
     the batch's: a report written before they were recorded counts as without.
 
     ``run_batch`` gives them in the summary's ``attrs``; only a summary without
-    them (made by other code) has its reports read back, 6 ms a clip."""
+    them (made by other code) has its reports read back, about 1 ms a clip."""
     import json
 
     from perception.report.clip import clip_outputs
