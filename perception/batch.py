@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
-import json
 import logging
 import os
 import sys
@@ -50,11 +49,14 @@ from perception.discovery import (
 )
 from perception.errors import InputError
 from perception.io.atomic import write_json, write_text
-from perception.io.names import output_folder, output_stem
+from perception.io.names import output_folder
 from perception.pipeline import RecognitionSettings
 from perception.provenance import code_digest
 from perception.recognition.repertoire import PlanCache, Repertoire
-from perception.report.clip import ClipSummary, clip_outputs, remove_output
+from perception.report.clip import (  # remove_stale_reports: also perception.batch's
+    ClipSummary,
+    remove_stale_reports,
+)
 from perception.report.figures import DPI, FIGURE_FORMATS
 from perception.report.tracking import tracking_columns
 
@@ -518,54 +520,6 @@ def _recordings(items: Iterable[BatchItem]) -> dict[Path, set[str]]:
         if i.kind == "mocap":
             out.setdefault(Path(i.path), set()).add(i.clip)
     return out
-
-
-def remove_stale_reports(out: str | os.PathLike, source: str | os.PathLike,
-                         keep: Iterable[str]) -> list[str]:
-    """Remove the reports in ``out`` of a recording's reaches that are not in ``keep``.
-
-    A rerun after a table lost a trial (or a trial that no longer gives a
-    reach) must not leave that trial's report and figures looking current.
-    Only reaches' reports (those with a ``mocap`` entry) made from ``source``
-    itself (the same file) are touched, and only in ``out``.
-
-    Parameters
-    ----------
-    out : str or os.PathLike
-        The report folder.
-    source : str or os.PathLike
-        The recording.
-    keep : iterable of str
-        The clips scored now.
-
-    Returns
-    -------
-    list of str
-        The stems of the reports removed.
-    """
-    out, source = Path(out), Path(source)
-    keep_stems = {output_stem(c) for c in keep}
-    removed = []
-    suffix = ".recognition.json"
-    for report in sorted(out.glob(f"*{suffix}")):
-        stem = report.name[:-len(suffix)]
-        if stem in keep_stems:
-            continue
-        try:
-            data = json.loads(report.read_text())
-            made_from = data.get("input") if isinstance(data, dict) and "mocap" in data else None
-            same = made_from is not None and os.path.samefile(made_from, source)
-        except (OSError, ValueError):
-            continue
-        if not same:
-            continue
-        log.info("%s: removed: its trial is not scored from %s now", report, source)
-        for path in dict.fromkeys(p for fmt in FIGURE_FORMATS
-                                  for p in clip_outputs(out, stem, fmt).values()):
-            with contextlib.suppress(OSError):
-                remove_output(path)
-        removed.append(stem)
-    return removed
 
 
 def _remove_report(out: Path) -> None:

@@ -178,7 +178,6 @@ def _run_mocap(args: argparse.Namespace, path: Path) -> int:
 
     from hammer_mv.cli.flags import flag_text
     from hammer_mv.cli.options import load_repertoire, mocap_import, recognition_settings
-    from perception.batch import remove_stale_reports
     from perception.errors import HammerMVError
     from perception.factors import entry_columns
     from perception.io.atomic import check_output, write_csv
@@ -186,7 +185,7 @@ def _run_mocap(args: argparse.Namespace, path: Path) -> int:
     from perception.reaches import Unscored
     from perception.recognition.result import warnings_summary
     from perception.recordings import read_recording, recognize_reach, trial_summary
-    from perception.report.clip import write_clip_report
+    from perception.report.clip import remove_stale_reports, write_clip_report
     from perception.report.tables import write_units
 
     settings = recognition_settings(args)

@@ -159,7 +159,6 @@ def _watch_recording(args: argparse.Namespace, signals: _Signals) -> int:
     from hammer_mv.cli.checks import writable_folder
     from hammer_mv.cli.flags import flag_text
     from hammer_mv.cli.options import load_repertoire, mocap_import, recognition_settings
-    from perception.batch import remove_stale_reports
     from perception.errors import InputError
     from perception.io.atomic import check_output
     from perception.io.capture import RowsSource
@@ -168,6 +167,7 @@ def _watch_recording(args: argparse.Namespace, signals: _Signals) -> int:
     from perception.reaches import Unscored
     from perception.recordings import prepare_reach, read_recording, trial_summary
     from perception.report import clip as report
+    from perception.report.clip import remove_stale_reports
 
     path = Path(args.source)
     if args.labelled_video is not None:

@@ -11,8 +11,11 @@ condition and input, or a tracking summary) come back in
 from __future__ import annotations
 
 import bisect
+import contextlib
+import json
+import logging
 import os
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -24,7 +27,9 @@ from perception.recognition.result import Recognition
 from perception.report.figures import DPI, FIGURE_FORMATS
 
 __all__ = ["KINEMATICS_COLUMNS", "ClipSummary", "clip_figures", "clip_outputs", "clip_traces",
-           "remove_output", "write_clip_report"]
+           "remove_output", "remove_stale_reports", "write_clip_report"]
+
+log = logging.getLogger(__name__)
 
 #: Keys of ``<clip>.recognition.json`` that :meth:`Recognition.to_dict` writes;
 #: any other key is an extra (see :attr:`ClipSummary.extras`).
@@ -358,6 +363,54 @@ def remove_output(path: Path) -> None:
         pass
     except OSError as exc:
         raise OSError(exc.errno, f"cannot remove {path}: {exc.strerror or exc}") from None
+
+
+def remove_stale_reports(out: str | os.PathLike, source: str | os.PathLike,
+                         keep: Iterable[str]) -> list[str]:
+    """Remove the reports in ``out`` of a recording's reaches that are not in ``keep``.
+
+    A rerun after a table lost a trial (or a trial that no longer gives a
+    reach) must not leave that trial's report and figures looking current.
+    Only reaches' reports (those with a ``mocap`` entry) made from ``source``
+    itself (the same file) are touched, and only in ``out``.
+
+    Parameters
+    ----------
+    out : str or os.PathLike
+        The report folder.
+    source : str or os.PathLike
+        The recording.
+    keep : iterable of str
+        The clips scored now.
+
+    Returns
+    -------
+    list of str
+        The stems of the reports removed.
+    """
+    out, source = Path(out), Path(source)
+    keep_stems = {output_stem(c) for c in keep}
+    removed = []
+    suffix = ".recognition.json"
+    for report in sorted(out.glob(f"*{suffix}")):
+        stem = report.name[:-len(suffix)]
+        if stem in keep_stems:
+            continue
+        try:
+            data = json.loads(report.read_text())
+            made_from = data.get("input") if isinstance(data, dict) and "mocap" in data else None
+            same = made_from is not None and os.path.samefile(made_from, source)
+        except (OSError, ValueError):
+            continue
+        if not same:
+            continue
+        log.info("%s: removed: its trial is not scored from %s now", report, source)
+        for path in dict.fromkeys(p for fmt in FIGURE_FORMATS
+                                  for p in clip_outputs(out, stem, fmt).values()):
+            with contextlib.suppress(OSError):
+                remove_output(path)
+        removed.append(stem)
+    return removed
 
 
 def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,
