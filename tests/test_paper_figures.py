@@ -173,6 +173,9 @@ def test_write_figure_writes_valid_files(trials, tmp_path, fmt):
             assert any(t.text and "mm" in t.text for t in root.iter(f"{ns}text"))  # text
         else:
             assert data.startswith(b"%PDF") and b"/Subtype /Image" not in data  # vector
+        # the same figure is the same file: no date stamped (matplotlib writes the time)
+        again = write_figure(fig, tmp_path / f"{name}.again", fmt, 150).read_bytes()
+        assert again == data and b"<dc:date>" not in data and b"/CreationDate" not in data
     with pytest.raises(ValueError, match="png, svg, pdf"):
         write_figure(kinematics_figure(recs[0]), tmp_path / "x", "jpg", 100)
     with pytest.raises(ValueError, match="dpi"):

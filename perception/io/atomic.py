@@ -358,14 +358,21 @@ def _cell(value):
     return "" if isinstance(value, float) and value != value else value
 
 
+#: Metadata matplotlib would stamp with the time of writing, left out so that the same
+#: figure is the same file (``None`` removes a key).
+_NO_DATES = {"svg": {"Date": None}, "pdf": {"CreationDate": None}}
+
+
 def save_figure(path: str | os.PathLike, fig, *, dpi: int = 120) -> Path:
     """Save a matplotlib figure ``fig`` to ``path`` atomically at ``dpi``.
 
-    The format follows the suffix of ``path``. A character the font lacks (a
+    The format follows the suffix of ``path``; an SVG or PDF carries no date,
+    so the same figure gives the same bytes. A character the font lacks (a
     clip name in another script) is drawn as a box without a warning on stderr.
     """
     final = Path(path)
+    fmt = final.suffix.lstrip(".") or "png"
     with atomic_path(final) as tmp, warnings.catch_warnings():
         warnings.filterwarnings("ignore", message="Glyph .* missing from", category=UserWarning)
-        fig.savefig(tmp, dpi=dpi, format=final.suffix.lstrip(".") or "png")
+        fig.savefig(tmp, dpi=dpi, format=fmt, metadata=_NO_DATES.get(fmt))
     return final
