@@ -1,4 +1,5 @@
 import json
+import signal
 from pathlib import Path
 
 import numpy as np
@@ -6,6 +7,21 @@ import pytest
 
 #: Copy of shared/reference/todorov_reach.json: Todorov's kalman_lqg.m run in Octave.
 REFERENCE = Path(__file__).resolve().parent / "data" / "todorov_reach.json"
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _signals_as_in_a_terminal():
+    """SIGINT and SIGHUP handled as in a terminal, whoever started the suite.
+
+    A suite started in the background by a shell without job control (``cmd &``,
+    ``nohup``) inherits them ignored, and a watch leaves an ignored signal ignored
+    (as under nohup, by design): its signal tests would then see no Ctrl-C, and the
+    watches they run as subprocesses would inherit the ignored signals.
+    """
+    for number, handler in ((signal.SIGINT, signal.default_int_handler),
+                            (signal.SIGHUP, signal.SIG_DFL)):
+        if signal.getsignal(number) is signal.SIG_IGN:
+            signal.signal(number, handler)
 
 
 @pytest.fixture(scope="session")
