@@ -253,7 +253,7 @@ class OnlineState:
 
 
 def grip_course(rec: Recognition) -> SimpleNamespace:
-    """The movement's course so far, as :meth:`SettleRule.sure` reads it, from its recognition.
+    """The movement's course so far, as :meth:`SettleRule.settles` reads it, from its recognition.
 
     ``opened`` (the grip opened as a grasp's must: the grasp models judged),
     ``peaks`` (its landmark ``aperture_peaks``), ``opening`` (m beyond its
