@@ -21,7 +21,8 @@ import pytest
 from _demos import demo_tracks
 
 from perception.cleaning import CleaningParams, clean_path, held, quantum
-from perception.io.pose import PoseImport, read_pose, write_dlc
+from perception.io.exports import write_dlc
+from perception.io.pose import PoseImport, read_pose
 from perception.io.tracks import Status
 from perception.landmarks import LandmarkParams, observed_landmarks
 from perception.observation import ObserveParams, observe

@@ -20,7 +20,8 @@ from _demos import default_repertoire
 from perception.batch import run_batch
 from perception.discovery import find_clips
 from perception.errors import InputError
-from perception.io.pose import PoseImport, pose_output, read_pose, video_beside, write_dlc
+from perception.io.exports import write_dlc
+from perception.io.pose import PoseImport, pose_output, read_pose, video_beside
 from perception.observation import ObserveParams, observe
 from perception.pipeline import RecognitionSettings, clip_name
 from perception.synthetic.demos import demo_tracks, render_demo_clip

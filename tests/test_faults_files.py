@@ -27,8 +27,8 @@ from _faults import error_within, refused
 
 from perception.errors import InputError
 from perception.io import atomic
-from perception.io.exports import export_tracks, status_path_for
-from perception.io.pose import PoseImport, _movement, read_pose, write_dlc
+from perception.io.exports import export_tracks, status_path_for, write_dlc
+from perception.io.pose import PoseImport, _movement, read_pose
 from perception.io.repertoire import read_repertoire
 from perception.io.tracks import Tracks
 from perception.io.video import FrameSource, sha256_file, write_video

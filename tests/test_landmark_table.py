@@ -345,7 +345,7 @@ def test_landmarks_takes_object_diameter_px_and_suggests_only_its_own_flags():
 
 
 def test_landmarks_on_a_deeplabcut_file_takes_the_flag_it_suggests(tmp_path):
-    from perception.io.pose import write_dlc
+    from perception.io.exports import write_dlc
     from perception.synthetic.demos import demo_tracks
 
     tracks, _ = demo_tracks("normal", 0, fps=25.0)

@@ -52,8 +52,9 @@ from evaluate_real import independent_landmarks  # noqa: E402
 
 from perception.errors import HammerMVError  # noqa: E402
 from perception.io.atomic import write_text  # noqa: E402
+from perception.io.exports import write_dlc  # noqa: E402
 from perception.io.mocap import read_mocap  # noqa: E402
-from perception.io.pose import PoseImport, write_dlc  # noqa: E402
+from perception.io.pose import PoseImport  # noqa: E402
 from perception.io.tracks import Status, Tracks  # noqa: E402
 from perception.observation import ObserveParams  # noqa: E402
 from perception.reaches import MarkerMap, ReachParams, fit_plane  # noqa: E402

@@ -23,12 +23,16 @@ import contextlib
 import os
 from pathlib import Path
 
-from perception.errors import InputError
-from perception.io.atomic import write_text
-from perception.io.pose import _check_markers, write_dlc, write_movement
-from perception.io.tracks import Tracks
+import numpy as np
 
-__all__ = ["EXPORT_FORMATS", "export_tracks", "status_path_for"]
+from perception.errors import InputError
+from perception.io.atomic import write_bytes, write_text
+from perception.io.movement_import import POSE_EXTRA, movement_loaders
+from perception.io.pose import DLC_KEY
+from perception.io.tracks import Tracks
+from perception.limits import MAX_MARKERS
+
+__all__ = ["EXPORT_FORMATS", "export_tracks", "status_path_for", "write_dlc", "write_movement"]
 
 #: Formats of :func:`export_tracks`.
 EXPORT_FORMATS = ("dlc", "trackpy", "csv", "movement")
@@ -93,3 +97,102 @@ def export_tracks(tracks: Tracks, path: str | os.PathLike, format: str) -> list[
         return [write_movement(tracks, path)]
     _write_csv(tracks.to_trackpy() if format == "trackpy" else tracks.to_pandas(), path)
     return [path]
+
+
+def write_dlc(tracks: Tracks, path: str | os.PathLike, *, scorer: str = "hammer-mv") -> Path:
+    """Write tracks as a DeepLabCut table: a real ``.h5`` (pandas HDF) or a ``.csv``.
+
+    The ``.h5`` holds the table under the key ``df_with_missing`` with the
+    ``scorer / bodyparts / coords`` column MultiIndex, as DeepLabCut writes
+    it; the ``.csv`` has DeepLabCut's three header rows.
+
+    Parameters
+    ----------
+    tracks : Tracks
+        What to write.
+    path : str or os.PathLike
+        Output file ending in ``.h5`` or ``.csv``.
+    scorer : str
+        The ``scorer`` level of the columns.
+    """
+    path = Path(path)
+    _check_markers(tracks, path)
+    suffix = path.suffix.lower()
+    if suffix not in (".csv", ".h5"):
+        raise InputError("a DeepLabCut file ends in .h5 or .csv", path)
+    table = tracks.to_dlc(scorer).rename_axis(None)
+    if suffix == ".csv":
+        write_text(path, table.to_csv(na_rep="NaN"))
+        return path
+    try:
+        import tables  # noqa: F401 - pandas' HDF writer needs PyTables
+    except ImportError:
+        raise InputError(POSE_EXTRA, path) from None
+    write_bytes(path, _hdf_image(table))
+    return path
+
+
+def _hdf_image(table) -> bytes:
+    """A DataFrame as the bytes of a pandas HDF file (key ``df_with_missing``), built in memory.
+
+    PyTables' own writes to a full disk fail late or not at all (leaving a
+    table of zeros); the image is written with :func:`write_bytes` instead,
+    whose failure is an :class:`OSError` and leaves nothing behind.
+    """
+    import pandas as pd
+
+    with pd.HDFStore(f"hammer-mv-{id(table)}.h5", mode="w", driver="H5FD_CORE",
+                     driver_core_backing_store=0) as store:
+        store.put(DLC_KEY, table, format="table", track_times=False)
+        store.flush()
+        return bytes(store._handle.get_file_image())
+
+
+def _check_markers(tracks: Tracks, path: Path) -> None:
+    if len(tracks.markers) > MAX_MARKERS:
+        raise InputError(f"the tracks hold {len(tracks.markers)} markers, more than the "
+                         f"{MAX_MARKERS} an export may hold", path, field="markers")
+
+
+def write_movement(tracks: Tracks, path: str | os.PathLike) -> Path:
+    """Write tracks as a ``movement`` poses dataset in netCDF (``.nc``).
+
+    One individual (``hammer-mv``), the markers as keypoints, the likelihood
+    as ``confidence``, times in seconds; ``status`` (per frame and marker)
+    rides along as an extra data variable.
+
+    Parameters
+    ----------
+    tracks : Tracks
+        What to write.
+    path : str or os.PathLike
+        Output file (``.nc``).
+    """
+    _, load_poses = movement_loaders()
+    path = Path(path)
+    _check_markers(tracks, path)
+    fps = _fps(tracks)
+    pos = np.transpose(tracks.position, (0, 2, 1))[..., None]  # (time, space, keypoints, ind)
+    ds = load_poses.from_numpy(pos, tracks.likelihood.astype(np.float64)[..., None],
+                               individual_names=["hammer-mv"],
+                               keypoint_names=list(tracks.markers), fps=fps,
+                               source_software="hammer-mv")
+    ds = ds.assign_coords(time=tracks.time)  # the real time stamps, not index / fps
+    ds["status"] = (("time", "keypoints", "individuals"), tracks.status[..., None])
+    ds.attrs["frame_offset"] = int(tracks.frame[0]) if tracks.n_frames else 0
+    # Built in memory and written whole: netCDF's own writes onto a full disk
+    # fail late (or crash the process) and leave a partial file.
+    try:
+        image = ds.to_netcdf(engine="h5netcdf")
+    except (ImportError, ValueError):
+        image = ds.to_netcdf()
+    write_bytes(path, bytes(image))
+    return path
+
+
+def _fps(tracks: Tracks) -> float:
+    nominal = float(tracks.video.get("fps_nominal", 0) or 0)
+    if nominal > 0:
+        return nominal
+    dt = np.diff(tracks.time)
+    return float(1.0 / np.median(dt)) if len(dt) else 30.0

@@ -10,7 +10,7 @@ points below the likelihood cutoff (DeepLabCut's ``pcutoff``, 0.6 by default)
 count as lost, and the tracks are cleaned as motion capture is (DeepLabCut's
 single-frame jumps are spikes: :mod:`perception.track_cleaning`, here where
 the file is read, so that every command reads the same tracks).
-:func:`write_dlc` and :func:`write_movement` go the other way.
+:mod:`perception.io.exports` goes the other way.
 Files DeepLabCut and SLEAP name after their video (:func:`pose_output`) without
 a frame rate take that video's (:func:`video_beside`).
 
@@ -46,7 +46,6 @@ import numpy as np
 from pydantic import Field, PlainValidator
 
 from perception.errors import InputError
-from perception.io.atomic import write_bytes, write_text
 from perception.io.files import input_file
 from perception.io.movement_import import POSE_EXTRA as _EXTRA
 from perception.io.movement_import import VALIDATOR as _VALIDATOR
@@ -64,7 +63,7 @@ from perception.io.pose_arrays import (
 )
 from perception.io.pose_mapping import keypoint_mapping, object_at_grip
 from perception.io.tracks import Status, Tracks, position_bounds
-from perception.limits import MAX_FPS, MAX_FRAMES, MAX_KEYPOINTS, MAX_MARKERS, MAX_POSE_POINTS
+from perception.limits import MAX_FPS, MAX_FRAMES, MAX_KEYPOINTS, MAX_POSE_POINTS
 from perception.track_cleaning import TrackCleaning, clean_tracks
 from perception.validation import Positive, Share, declared
 
@@ -78,8 +77,6 @@ __all__ = [
     "pose_output",
     "read_pose",
     "video_beside",
-    "write_dlc",
-    "write_movement",
 ]
 
 log = logging.getLogger(__name__)
@@ -629,102 +626,3 @@ def read_pose(path: str | os.PathLike, options: PoseImport | None = None) -> Tra
                     status=np.where(seen, Status.TRACKED, Status.LOST).astype(np.int8),
                     video=video, tracker=tracker, path=path)
     return tracks if options.cleaning is None else clean_tracks(tracks, options.cleaning)
-
-
-def write_dlc(tracks: Tracks, path: str | os.PathLike, *, scorer: str = "hammer-mv") -> Path:
-    """Write tracks as a DeepLabCut table: a real ``.h5`` (pandas HDF) or a ``.csv``.
-
-    The ``.h5`` holds the table under the key ``df_with_missing`` with the
-    ``scorer / bodyparts / coords`` column MultiIndex, as DeepLabCut writes
-    it; the ``.csv`` has DeepLabCut's three header rows.
-
-    Parameters
-    ----------
-    tracks : Tracks
-        What to write.
-    path : str or os.PathLike
-        Output file ending in ``.h5`` or ``.csv``.
-    scorer : str
-        The ``scorer`` level of the columns.
-    """
-    path = Path(path)
-    _check_markers(tracks, path)
-    suffix = path.suffix.lower()
-    if suffix not in (".csv", ".h5"):
-        raise InputError("a DeepLabCut file ends in .h5 or .csv", path)
-    table = tracks.to_dlc(scorer).rename_axis(None)
-    if suffix == ".csv":
-        write_text(path, table.to_csv(na_rep="NaN"))
-        return path
-    try:
-        import tables  # noqa: F401 - pandas' HDF writer needs PyTables
-    except ImportError:
-        raise InputError(_EXTRA, path) from None
-    write_bytes(path, _hdf_image(table))
-    return path
-
-
-def _hdf_image(table) -> bytes:
-    """A DataFrame as the bytes of a pandas HDF file (key ``df_with_missing``), built in memory.
-
-    PyTables' own writes to a full disk fail late or not at all (leaving a
-    table of zeros); the image is written with :func:`write_bytes` instead,
-    whose failure is an :class:`OSError` and leaves nothing behind.
-    """
-    import pandas as pd
-
-    with pd.HDFStore(f"hammer-mv-{id(table)}.h5", mode="w", driver="H5FD_CORE",
-                     driver_core_backing_store=0) as store:
-        store.put(DLC_KEY, table, format="table", track_times=False)
-        store.flush()
-        return bytes(store._handle.get_file_image())
-
-
-def _check_markers(tracks: Tracks, path: Path) -> None:
-    if len(tracks.markers) > MAX_MARKERS:
-        raise InputError(f"the tracks hold {len(tracks.markers)} markers, more than the "
-                         f"{MAX_MARKERS} an export may hold", path, field="markers")
-
-
-def write_movement(tracks: Tracks, path: str | os.PathLike) -> Path:
-    """Write tracks as a ``movement`` poses dataset in netCDF (``.nc``).
-
-    One individual (``hammer-mv``), the markers as keypoints, the likelihood
-    as ``confidence``, times in seconds; ``status`` (per frame and marker)
-    rides along as an extra data variable.
-
-    Parameters
-    ----------
-    tracks : Tracks
-        What to write.
-    path : str or os.PathLike
-        Output file (``.nc``).
-    """
-    _, load_poses = _movement()
-    path = Path(path)
-    _check_markers(tracks, path)
-    fps = _fps(tracks)
-    pos = np.transpose(tracks.position, (0, 2, 1))[..., None]  # (time, space, keypoints, ind)
-    ds = load_poses.from_numpy(pos, tracks.likelihood.astype(np.float64)[..., None],
-                               individual_names=["hammer-mv"],
-                               keypoint_names=list(tracks.markers), fps=fps,
-                               source_software="hammer-mv")
-    ds = ds.assign_coords(time=tracks.time)  # the real time stamps, not index / fps
-    ds["status"] = (("time", "keypoints", "individuals"), tracks.status[..., None])
-    ds.attrs["frame_offset"] = int(tracks.frame[0]) if tracks.n_frames else 0
-    # Built in memory and written whole: netCDF's own writes onto a full disk
-    # fail late (or crash the process) and leave a partial file.
-    try:
-        image = ds.to_netcdf(engine="h5netcdf")
-    except (ImportError, ValueError):
-        image = ds.to_netcdf()
-    write_bytes(path, bytes(image))
-    return path
-
-
-def _fps(tracks: Tracks) -> float:
-    nominal = float(tracks.video.get("fps_nominal", 0) or 0)
-    if nominal > 0:
-        return nominal
-    dt = np.diff(tracks.time)
-    return float(1.0 / np.median(dt)) if len(dt) else 30.0
