@@ -40,14 +40,20 @@ from perception.io.mocap_trial import UNITS, MocapTrial, TrialStream, check_rate
 from perception.io.motive import is_motive, read_motive
 from perception.io.vicon import is_vicon, read_vicon
 
-__all__ = ["LAYOUTS", "LAYOUTS_READ", "MOCAP_SUFFIXES", "UNITS", "MocapTrial", "is_mocap_file",
-           "read_mocap", "table_layout", "unknown_layout"]
+__all__ = ["LAYOUTS", "LAYOUTS_READ", "LAYOUT_READERS", "MOCAP_SUFFIXES", "UNITS", "MocapTrial",
+           "is_mocap_file", "read_mocap", "table_layout", "unknown_layout"]
 
 #: File endings read as motion-capture files (a table's first lines decide on reading; a
 #: ``.c3d`` and a ``.trc`` are of their layout by name).
 MOCAP_SUFFIXES = (".c3d", ".tsv", ".txt", ".csv", ".trc")
 #: The layouts that name their own markers and hold one trial (vendor exports).
-_VENDOR = ("qtm", "vicon-nexus", "motive", "trc", "dlc-3d")
+#: The reader of each layout a vendor's header names. Each is called as
+#: ``reader(path, source, text, rate, units, trial_column, time_column)``: the file, the
+#: file as the caller named it, its text (:class:`~perception.io.mocap_text.TableText`),
+#: and the rest as :func:`read_mocap` takes them (checked there); it returns the trials.
+LAYOUT_READERS = {"qtm": read_qtm, "vicon-nexus": read_vicon, "motive": read_motive,
+                  "trc": read_trc, "dlc-3d": read_dlc3d}
+_VENDOR = tuple(LAYOUT_READERS)
 #: Each layout :func:`table_layout` names, and what it is, in words.
 LAYOUTS = {
     "qtm": "a Qualisys TSV export (NO_OF_FRAMES, FREQUENCY, MARKER_NAMES, ...)",
@@ -263,16 +269,8 @@ def read_mocap(path: str | os.PathLike, *, rate: float | None = None, units: str
                          "columns to read factors from: `factors` names the columns of a "
                          "table whose header names X, Y and Z per marker (`factors_from_name` "
                          "reads them from file names)", p, field=FACTOR_FLAG)
-    if layout == "qtm":
-        return read_qtm(*args)
-    if layout == "vicon-nexus":
-        return read_vicon(*args)
-    if layout == "motive":
-        return read_motive(*args)
-    if layout == "trc":
-        return read_trc(*args)
-    if layout == "dlc-3d":
-        return read_dlc3d(*args)
+    if layout in LAYOUT_READERS:
+        return LAYOUT_READERS[layout](*args)
     if headerless:
         return read_headerless(*args, columns)
     return read_xyz_table(*args, columns, factors)

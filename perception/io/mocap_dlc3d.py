@@ -52,16 +52,7 @@ def read_dlc3d(path: Path, source: str, text: TableText, rate, units, trial_colu
                time_column) -> list[MocapTrial]:
     """A DeepLabCut 3-D table's keypoints as markers, timed by ``rate``.
 
-    Parameters
-    ----------
-    path : Path
-        The file.
-    source : str
-        The file as the caller named it.
-    text : TableText
-        Its text.
-    rate, units, trial_column, time_column
-        As :func:`perception.io.mocap.read_mocap` takes them.
+    One of :data:`perception.io.mocap.LAYOUT_READERS`, called as they all are.
     """
     import pandas as pd
 

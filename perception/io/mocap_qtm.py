@@ -63,16 +63,7 @@ def read_qtm(path: Path, source: str, text: TableText, rate, units, trial_column
              time_column) -> list[MocapTrial]:
     """A QTM 3D TSV export.
 
-    Parameters
-    ----------
-    path : Path
-        The file.
-    source : str
-        The file as the caller named it.
-    text : TableText
-        Its text.
-    rate, units, trial_column, time_column
-        As :func:`perception.io.mocap.read_mocap` takes them.
+    One of :data:`perception.io.mocap.LAYOUT_READERS`, called as they all are.
     """
     lines = text.lines
     header: dict[str, list[str]] = {}

@@ -79,16 +79,7 @@ def read_trc(path: Path, source: str, text: TableText, rate, units, trial_column
              time_column) -> list[MocapTrial]:
     """A TRC file's markers, timed by its Time column.
 
-    Parameters
-    ----------
-    path : Path
-        The file.
-    source : str
-        The file as the caller named it.
-    text : TableText
-        Its text.
-    rate, units, trial_column, time_column
-        As :func:`perception.io.mocap.read_mocap` takes them.
+    One of :data:`perception.io.mocap.LAYOUT_READERS`, called as they all are.
     """
     clockless = no_clock(time_column)
     if time_column is not None and not clockless:

@@ -57,16 +57,7 @@ def read_motive(path: Path, source: str, text: TableText, rate, units, trial_col
                 time_column) -> list[MocapTrial]:
     """A Motive CSV export's marker and rigid-body positions.
 
-    Parameters
-    ----------
-    path : Path
-        The file.
-    source : str
-        The file as the caller named it.
-    text : TableText
-        Its text.
-    rate, units, trial_column, time_column
-        As :func:`perception.io.mocap.read_mocap` takes them.
+    One of :data:`perception.io.mocap.LAYOUT_READERS`, called as they all are.
     """
     lines = text.lines
     sep = delimiter(text.first)

@@ -71,16 +71,7 @@ def read_vicon(path: Path, source: str, text: TableText, rate, units, trial_colu
                time_column) -> list[MocapTrial]:
     """The ``Trajectories`` block of a Nexus CSV export.
 
-    Parameters
-    ----------
-    path : Path
-        The file.
-    source : str
-        The file as the caller named it.
-    text : TableText
-        Its text (the whole file).
-    rate, units, trial_column, time_column
-        As :func:`perception.io.mocap.read_mocap` takes them.
+    One of :data:`perception.io.mocap.LAYOUT_READERS`, called as they all are.
     """
     if time_column is not None and not no_clock(time_column):
         raise InputError("a Vicon Nexus export has no time column: its frames are timed by "
