@@ -52,7 +52,8 @@ def read_dlc3d(path: Path, source: str, text: TableText, rate, units, trial_colu
                time_column) -> list[MocapTrial]:
     """A DeepLabCut 3-D table's keypoints as markers, timed by ``rate``.
 
-    One of :data:`perception.io.mocap.LAYOUT_READERS`, called as they all are.
+    One of :data:`perception.io.mocap.LAYOUT_READERS`, called as they all are:
+    ``(path, source, text, rate, units, trial_column, time_column)``.
     """
     import pandas as pd
 

@@ -63,7 +63,8 @@ def read_qtm(path: Path, source: str, text: TableText, rate, units, trial_column
              time_column) -> list[MocapTrial]:
     """A QTM 3D TSV export.
 
-    One of :data:`perception.io.mocap.LAYOUT_READERS`, called as they all are.
+    One of :data:`perception.io.mocap.LAYOUT_READERS`, called as they all are:
+    ``(path, source, text, rate, units, trial_column, time_column)``.
     """
     lines = text.lines
     header: dict[str, list[str]] = {}

@@ -79,7 +79,8 @@ def read_trc(path: Path, source: str, text: TableText, rate, units, trial_column
              time_column) -> list[MocapTrial]:
     """A TRC file's markers, timed by its Time column.
 
-    One of :data:`perception.io.mocap.LAYOUT_READERS`, called as they all are.
+    One of :data:`perception.io.mocap.LAYOUT_READERS`, called as they all are:
+    ``(path, source, text, rate, units, trial_column, time_column)``.
     """
     clockless = no_clock(time_column)
     if time_column is not None and not clockless:

@@ -57,7 +57,8 @@ def read_motive(path: Path, source: str, text: TableText, rate, units, trial_col
                 time_column) -> list[MocapTrial]:
     """A Motive CSV export's marker and rigid-body positions.
 
-    One of :data:`perception.io.mocap.LAYOUT_READERS`, called as they all are.
+    One of :data:`perception.io.mocap.LAYOUT_READERS`, called as they all are:
+    ``(path, source, text, rate, units, trial_column, time_column)``.
     """
     lines = text.lines
     sep = delimiter(text.first)

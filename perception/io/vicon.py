@@ -71,7 +71,8 @@ def read_vicon(path: Path, source: str, text: TableText, rate, units, trial_colu
                time_column) -> list[MocapTrial]:
     """The ``Trajectories`` block of a Nexus CSV export.
 
-    One of :data:`perception.io.mocap.LAYOUT_READERS`, called as they all are.
+    One of :data:`perception.io.mocap.LAYOUT_READERS`, called as they all are:
+    ``(path, source, text, rate, units, trial_column, time_column)``.
     """
     if time_column is not None and not no_clock(time_column):
         raise InputError("a Vicon Nexus export has no time column: its frames are timed by "
