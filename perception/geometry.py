@@ -33,12 +33,14 @@ DEFAULT_TIP_START = 0.06
 
 @dataclass(frozen=True)
 class SimilarityTransform:
-    """Pixels (x right, y down) <-> model frame (m).
+    """Pixels (x right, y down) <-> model frame (m); or a plane's metres (x right, y up).
 
     ``pixel = origin_px + px_per_m * flip(R(rotation) @ S @ model)`` where ``S``
     mirrors the model's x axis when ``mirror`` is set, ``R`` turns the model's
     axes into the image's "up" coordinates (x right, y up) and ``flip`` turns
-    y up into y down.
+    y up into y down. A motion-capture reach's tracks are metres in the
+    movement's plane, y up (``y_down`` false, ``px_per_m`` 1): the same
+    rotation, translation and mirror, no flip, no scale.
 
     Parameters
     ----------
@@ -52,12 +54,15 @@ class SimilarityTransform:
         up the image).
     mirror : bool
         Mirror the model's x axis (the finger on the model's -x side).
+    y_down : bool
+        The "pixels" run y down (an image's); false for metres, y up.
     """
 
     origin_px: np.ndarray
     px_per_m: float
     rotation: float = math.pi / 2
     mirror: bool = False
+    y_down: bool = True
 
     def __post_init__(self) -> None:
         origin = np.asarray(self.origin_px, dtype=np.float64).reshape(-1)
@@ -77,6 +82,7 @@ class SimilarityTransform:
         object.__setattr__(self, "px_per_m", float(self.px_per_m))
         object.__setattr__(self, "rotation", float(self.rotation))
         object.__setattr__(self, "mirror", bool(self.mirror))
+        object.__setattr__(self, "y_down", bool(self.y_down))
 
     @property
     def basis(self) -> np.ndarray:
@@ -92,16 +98,19 @@ class SimilarityTransform:
     def matrix(self) -> np.ndarray:
         """(2, 3) affine matrix: ``pixel = M[:, :2] @ model + M[:, 2]``."""
         linear = self.basis * self.px_per_m
-        linear[1] *= -1.0  # image y points down
+        if self.y_down:
+            linear[1] *= -1.0  # image y points down
         return np.column_stack([linear, self.origin_px])
 
     def to_model(self, px: np.ndarray) -> np.ndarray:
         """Pixels ``(..., 2)`` -> model frame ``(..., 2)``, m (NaN stays NaN)."""
         rel = np.asarray(px, dtype=np.float64) - self.origin_px
-        up = np.stack([rel[..., 0], -rel[..., 1]], axis=-1) / self.px_per_m
+        up = (np.stack([rel[..., 0], -rel[..., 1]], axis=-1) if self.y_down else rel
+              ) / self.px_per_m
         return up @ self.basis
 
     def to_pixels(self, xy: np.ndarray) -> np.ndarray:
         """Model frame ``(..., 2)``, m -> pixels ``(..., 2)`` (NaN stays NaN)."""
         up = np.asarray(xy, dtype=np.float64) @ self.basis.T * self.px_per_m
-        return np.stack([up[..., 0], -up[..., 1]], axis=-1) + self.origin_px
+        return (np.stack([up[..., 0], -up[..., 1]], axis=-1) if self.y_down else up
+                ) + self.origin_px

@@ -5,7 +5,9 @@ the demonstrator's start toward the object, metres. Pixels map to metres by
 the similarity transform of :mod:`perception.geometry`, fixed from the first
 frames of the clip (the scene): the object's position, its known diameter
 (or a given pixel scale), and the direction from the wrist's rest position
-to the object.
+to the object. A motion-capture reach's tracks are metres in its plane
+already (:attr:`Tracks.units`): only the object's position and the
+approach are fixed.
 
 The movement is scored over its :class:`MovementSpan`: from its onset (the
 wrist's displacement from rest, less the model's own latency) to the end of
@@ -335,8 +337,8 @@ class RestScene(NamedTuple):
     dt : float
         The median frame period, s.
     transform : SimilarityTransform
-        Pixels -> model frame: the object at the origin, the wrist's rest
-        position on the -y axis, metres.
+        Pixels (or a reach's metres in its plane) -> model frame: the object
+        at the origin, the wrist's rest position on the -y axis, metres.
     raw : (T, 3, 2) float
         Wrist, finger and thumb markers in the model frame, m, unfiltered.
     rest : (3, 2) float
@@ -376,7 +378,8 @@ def _source(tracks, name: str) -> str:
 
 
 def _marker_pixels(tracks, params: ObserveParams, name: str) -> dict[str, np.ndarray]:
-    """(T, 2) px of every needed marker; refuses tracks that cannot be scored."""
+    """(T, 2) positions of every needed marker (px, or m: :attr:`Tracks.units`); refuses
+    tracks that cannot be scored."""
     markers = list(tracks.markers)
     pos = np.asarray(tracks.position, dtype=float)
     px = {}
@@ -414,7 +417,7 @@ def _frame_times(tracks, params: ObserveParams, name: str) -> tuple[np.ndarray, 
 
 def _scene_transform(px: dict[str, np.ndarray], tracks, params: ObserveParams,
                      name: str) -> SimilarityTransform:
-    """The pixel -> model transform from the first frames: object, scale, approach."""
+    """The tracks -> model transform from the first frames: object, scale, approach."""
     rest = slice(0, params.rest_frames)
     for m in NEEDED_MARKERS:
         if not np.isfinite(px[m][rest]).all():
@@ -431,7 +434,8 @@ def _scene_transform(px: dict[str, np.ndarray], tracks, params: ObserveParams,
         raise InputError("the object is never seen in the first "
                          f"{2 * params.rest_frames} frames", name, field="object")
     origin = np.median(seen, axis=0)
-    scale = params.px_per_m
+    metric = tracks.units == "m"  # a reach in its plane: metres, y up (no scale to find)
+    scale = 1.0 if metric else params.px_per_m
     if scale is None:
         dpx = tracks.object_diameter_px()
         if dpx is None:
@@ -440,11 +444,12 @@ def _scene_transform(px: dict[str, np.ndarray], tracks, params: ObserveParams,
                              f"{pose}`px_per_m`", name)
         scale = dpx / params.object_diameter
     d = np.median(px["wrist"][rest], axis=0) - origin
-    approach = np.array([-d[0], d[1]])  # from wrist toward object, in y-up image coordinates
+    # from the wrist toward the object, y up
+    approach = -d if metric else np.array([-d[0], d[1]])
     if np.linalg.norm(approach) < 1e-6:
         raise InputError("impossible geometry: the wrist starts on the object", name)
     return SimilarityTransform(origin, float(scale), float(np.arctan2(approach[1], approach[0])),
-                               params.mirror)
+                               params.mirror, y_down=not metric)
 
 
 def _rest_noise(raw: np.ndarray, params: ObserveParams, name: str) -> tuple[float, np.ndarray]:
@@ -492,7 +497,7 @@ def rest_scene(tracks, params: ObserveParams | None = None, *,
     params = ObserveParams() if params is None else params
     where = _source(tracks, _clip_name(tracks, clip))  # the tracks file where there is one
     # the pipeline settles a clip's start, then observes it: one scene for both
-    key = (where, params, tuple(tracks.markers),
+    key = (where, params, tuple(tracks.markers), tracks.units,
            tracks.object_diameter_px() if params.px_per_m is None else None)
     kept = _SCENES.longest(key, (tracks.time, tracks.position))
     scene = None

@@ -81,7 +81,8 @@ class OnlineRecognizer:
         the tracker's, ``thumb, finger, wrist, object``).
     tracker_attrs : dict, optional
         ``/tracker`` attributes of rows given as positions: the object's
-        apparent size (``diameter_px``) sets the scale unless ``px_per_m`` does.
+        apparent size (``diameter_px``) sets the scale unless ``px_per_m`` does;
+        ``units`` ``"m"`` makes them metres in a plane (:attr:`Tracks.units`).
     settle : SettleRule, optional
         When a verdict settles.
     plan_cache : PlanCache, optional
@@ -130,13 +131,14 @@ class OnlineRecognizer:
     def update(self, frame_or_points: np.ndarray, t: float, index: int | None = None, *,
                likelihood: np.ndarray | None = None, status: np.ndarray | None = None
                ) -> OnlineState:
-        """Take the next frame (H, W, 3) uint8 BGR, or marker positions (M, 2) px; the state.
+        """Take the next frame (H, W, 3) uint8 BGR, or marker positions (M, 2); the state.
 
         Parameters
         ----------
         frame_or_points : array
             A video frame (tracked here), or one row of positions in the order
-            of :attr:`markers` (NaN where lost).
+            of :attr:`markers` (NaN where lost): px, or m where ``tracker_attrs``
+            say ``units`` m (a motion-capture reach's rows).
         t : float
             Its time, s (increasing).
         index : int, optional
@@ -241,7 +243,7 @@ class OnlineRecognizer:
 
     @property
     def last_row(self) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-        """The last row: positions (M, 2) px, likelihood (M,), status (M,); None before one."""
+        """The last row: positions (M, 2), likelihood (M,), status (M,); None before one."""
         rows = self._rows.arrays(last=True)
         return None if rows is None else (rows["position"], rows["likelihood"], rows["status"])
 

@@ -25,11 +25,9 @@ from perception.errors import InputError
 from perception.landmarks import LandmarkParams
 from perception.validation import NonNegative, Positive, Tuple, declared
 
-__all__ = ["MIN_SAMPLES", "OBJECT_WORDS", "PX_PER_M",
+__all__ = ["MIN_SAMPLES", "OBJECT_WORDS",
            "MarkerMap", "Movement", "Reach", "ReachParams", "Unscored", "ever_seen"]
 
-#: The scale of the tracks a reach becomes: one "pixel" per millimetre.
-PX_PER_M = 1000.0
 #: Fewest samples a trial needs to be searched for reaches (the low-pass filter's own
 #: need is 3 x its order + 1 per seen stretch), and a reach to be scored.
 MIN_SAMPLES = 10
@@ -37,7 +35,6 @@ MIN_SAMPLES = 10
 #: :data:`_STILL_WINDOW`: its speed then is the recording's noise floor.
 _STILL_RANGE = 0.002
 _STILL_WINDOW = 0.2
-_ORIGIN_PX = np.array([2000.0, 2000.0])
 
 
 #: Words in a marker's (or keypoint's) name that make it the object (:meth:`MarkerMap.guess`).

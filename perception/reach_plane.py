@@ -1,7 +1,7 @@
 """A reach brought into the movement's own plane as the tracks the recognition reads.
 
 :func:`fit_plane` fits the transport path's plane (SVD); :func:`reach_tracks`
-writes the reach as tracks in it, one "pixel" per millimetre (y down), with
+writes the reach as tracks in it, in metres (y up: :attr:`Tracks.units` ``"m"``), with
 the grip placed across the approach at its 3D aperture, the models' wrist
 behind it, the object where it is (or where the grip closes) and rest before
 the onset where the recording has too little. :mod:`perception.reaches`
@@ -19,7 +19,7 @@ import numpy as np
 from perception.boundary import expect
 from perception.errors import InputError
 from perception.io.tracks import Status, Tracks
-from perception.reach_data import _ORIGIN_PX, PX_PER_M, Reach, ReachParams
+from perception.reach_data import Reach, ReachParams
 
 __all__ = ["PlaneFit", "ReachTracks", "fit_plane", "reach_tracks"]
 
@@ -83,8 +83,8 @@ class ReachTracks(NamedTuple):
     Attributes
     ----------
     tracks : Tracks
-        Markers thumb, finger, wrist and object in the movement's plane, 1 px
-        = 1 mm, y down; the object's apparent diameter in the tracker attributes.
+        Markers thumb, finger, wrist and object in the movement's plane, m,
+        y along the approach (:attr:`Tracks.units` ``"m"``).
     info : dict
         What the report says of it: ``plane`` (normal, out-of-plane RMS and
         largest, m), ``object_size`` (m), ``rest_aperture`` (m), ``notes``,
@@ -102,7 +102,7 @@ class ReachTracks(NamedTuple):
 
 
 def reach_tracks(reach: Reach, params: ReachParams | None = None) -> ReachTracks:
-    """A reach as tracks in its plane (1 px = 1 mm), and what the report says of it.
+    """A reach as tracks in its plane (metres), and what the report says of it.
 
     Parameters
     ----------
@@ -188,16 +188,13 @@ def reach_tracks(reach: Reach, params: ReachParams | None = None) -> ReachTracks
         time = np.r_[time[:last + 1], time[last] + dt * np.arange(1, k + 1)]
         pos = np.concatenate([pos[:last + 1], np.repeat(pos[last:last + 1], k, axis=0)])
         solid = np.concatenate([solid[:last + 1], np.repeat(solid[last:last + 1], k, axis=0)])
-    px = _ORIGIN_PX + PX_PER_M * pos * np.array([1.0, -1.0])
-    lost = ~np.isfinite(px).all(axis=-1)
+    lost = ~np.isfinite(pos).all(axis=-1)
     status = np.where(lost, Status.LOST, Status.TRACKED).astype(np.int8)
-    diameter = [math.nan, math.nan, math.nan, size * PX_PER_M]
     tracks = Tracks(frame=np.arange(len(time)), time=time - time[0],
-                    markers=("thumb", "finger", "wrist", "object"), position=px,
+                    markers=("thumb", "finger", "wrist", "object"), position=pos,
                     likelihood=np.where(lost, 0.0, 1.0).astype(np.float32), status=status,
                     video={"path": reach.source, "fps_nominal": 1 / dt},
-                    tracker={"diameter_px": diameter, "source": "mocap"},
-                    attrs={"clip": reach.name})
+                    tracker={"units": "m", "source": "mocap"}, attrs={"clip": reach.name})
     info = {"plane": plane.to_dict(), "object_size": size, "notes": notes,
             "rest_aperture": rest_g,
             "bounds": {"onset": max(0, reach.onset + shift), "end": reach.end + shift,

@@ -50,8 +50,9 @@ describes the rules; in short:
   ends where the hand goes on (the object's first motion, the speed minimum
   before a transport or a lift) ends there, its last sample held as long.
 
-Positions are written as "pixels" of one millimetre (:data:`PX_PER_M`),
-y down, so every later stage reads them as it reads a clip's.
+Positions are written in metres in the plane, y along the approach
+(:attr:`~perception.io.tracks.Tracks.units` ``"m"``): every later stage
+reads them as a clip's, with no image scale to find.
 
 The data are :mod:`perception.reach_data`'s, the movement rules
 :mod:`perception.movements`' and the plane :mod:`perception.reach_plane`'s;
@@ -70,7 +71,6 @@ from perception.errors import InputError
 from perception.movements import classify_movements, find_movements, find_reaches
 from perception.reach_data import (
     MIN_SAMPLES,
-    PX_PER_M,
     MarkerMap,
     Movement,
     Reach,
@@ -80,7 +80,7 @@ from perception.reach_data import (
 )
 from perception.reach_plane import PlaneFit, ReachTracks, fit_plane, reach_tracks
 
-__all__ = ["MIN_SAMPLES", "PX_PER_M", "MarkerMap", "Movement", "PlaneFit", "Reach", "ReachParams",
+__all__ = ["MIN_SAMPLES", "MarkerMap", "Movement", "PlaneFit", "Reach", "ReachParams",
            "ReachTracks", "Unscored", "classify_movements", "find_movements", "find_reaches",
            "fit_plane", "reach_tracks", "recording_reaches", "trial_reaches"]
 

@@ -39,7 +39,6 @@ from perception.factors import merge_factors, name_factors
 from perception.landmarks import MeasuredPaths
 from perception.limits import MAX_FPS
 from perception.reaches import (
-    PX_PER_M,
     MarkerMap,
     Reach,
     ReachParams,
@@ -571,7 +570,7 @@ def prepare_reach(reach: Reach, settings=None, options: MocapImport | None = Non
     at_rest = aperture[:2 * settings.observe.rest_frames]
     widest = float(np.max(at_rest, initial=0.0, where=np.isfinite(at_rest)))
     observe = dataclasses.replace(
-        settings.observe, px_per_m=PX_PER_M, object_diameter=info["object_size"],
+        settings.observe, object_diameter=info["object_size"],
         # a whole-hand grasp may rest with the digits apart: the rest
         # aperture is taken off like the markers' separation at rest
         max_rest_aperture=max(settings.observe.max_rest_aperture, widest + 0.01))

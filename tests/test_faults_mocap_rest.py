@@ -202,7 +202,8 @@ def test_a_synthesised_wrist_is_placed_wrist_behind_the_grip():
         tracks = reach_tracks(reach, ReachParams(wrist_behind=behind)).tracks
         pos = {m: tracks.position[:, i] for i, m in enumerate(tracks.markers)}
         mid = 0.5 * (pos["thumb"] + pos["finger"])
-        gap = np.linalg.norm(mid - pos["wrist"], axis=1) / 1000  # 1 px = 1 mm
+        assert tracks.units == "m"
+        gap = np.linalg.norm(mid - pos["wrist"], axis=1)
         assert np.nanmedian(gap) == pytest.approx(behind, abs=1e-9)
 
 

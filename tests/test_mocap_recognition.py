@@ -131,7 +131,8 @@ def test_tracks_of_a_reach_hold_its_3d_aperture(optotrak_reaches):
     r = optotrak_reaches[0]
     tracks, info, _, aperture = reach_tracks(r)
     finger, thumb = tracks.marker("finger"), tracks.marker("thumb")
-    g2d = np.linalg.norm(finger - thumb, axis=1) / 1000
+    assert tracks.units == "m"  # metres in the plane, not pixels
+    g2d = np.linalg.norm(finger - thumb, axis=1)
     # the 2D digits stand at the 3D distance, sample for sample (rest held at the start)
     g3d = r.aperture[np.isfinite(r.aperture)]
     assert np.nanmax(g2d) == pytest.approx(np.nanmax(g3d), abs=1e-9)

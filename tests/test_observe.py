@@ -29,6 +29,40 @@ def test_pixel_transform_round_trip():
     assert d_px == pytest.approx(750.0 * d_m)
 
 
+def test_a_planes_metres_map_without_flip_or_scale():
+    """y up: a point up the plane is up the model's axis the rotation names, lengths kept."""
+    tr = SimilarityTransform(np.array([0.3, -0.2]), 1.0, 0.4, mirror=True, y_down=False)
+    pts = np.random.default_rng(1).uniform(-0.3, 0.3, (20, 2))
+    np.testing.assert_allclose(tr.to_model(tr.to_pixels(pts)), pts, atol=1e-15)
+    m = tr.matrix
+    np.testing.assert_allclose(tr.to_pixels(pts), pts @ m[:, :2].T + m[:, 2], atol=1e-15)
+    up = SimilarityTransform(np.zeros(2), 1.0, np.pi / 2, y_down=False)
+    np.testing.assert_allclose(up.to_model(np.array([0.0, 0.1])), [0.0, 0.1], atol=1e-15)
+    assert np.linalg.norm(tr.to_model(pts[1]) - tr.to_model(pts[0])) == pytest.approx(
+        np.linalg.norm(pts[1] - pts[0]), rel=1e-12)
+
+
+@pytest.mark.parametrize("angle", [0.0, -120.0])
+def test_tracks_in_metres_observe_as_their_pixels_do(angle):
+    """A reach's tracks (metres in its plane, y up) and the same movement filmed give one
+    observation: the scale is not looked for, the approach is read with y up."""
+    tracks, truth = demo_tracks("normal", 1, angle_deg=angle, noise_px=0.0)
+    world = np.stack([truth["world"][m] for m in tracks.markers], axis=1)
+    turn = np.deg2rad(30.0)  # the plane's own axes: turned and shifted from the model's
+    rot = np.array([[np.cos(turn), -np.sin(turn)], [np.sin(turn), np.cos(turn)]])
+    metric = tracks.replace(position=world @ rot.T + [0.4, 1.2],
+                            tracker={"units": "m", "source": "mocap"})
+    assert metric.units == "m" and tracks.units == "px"
+    a, b = observe(tracks), observe(metric)
+    assert (a.onset_frame, a.end_frame) == (b.onset_frame, b.end_frame)
+    for name in ("wrist", "finger", "thumb"):
+        np.testing.assert_allclose(b.raw[name], truth["world"][name][b.frame], atol=1e-12)
+        np.testing.assert_allclose(getattr(b, name), getattr(a, name), atol=1e-9)
+    assert not b.scene.y_down and b.scene.px_per_m == 1.0
+    with pytest.raises(ValueError, match="units"):
+        tracks.replace(tracker={"units": "mm"})
+
+
 @pytest.mark.parametrize("field, value", [
     ("rest_frames", 0), ("rest_frames", 1), ("min_frames", 2), ("onset_hold_frames", 0),
     ("object_diameter", -0.1), ("hand_size_range", (0.3, 0.1)), ("alpha", 0.0),

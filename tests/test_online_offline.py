@@ -33,7 +33,7 @@ from perception.geometry import DEFAULT_OBJECT_DIAMETER
 from perception.observation import ObserveParams
 from perception.online import OnlineRecognizer
 from perception.pipeline import RecognitionSettings, recognize_tracks
-from perception.reaches import PX_PER_M, reach_tracks
+from perception.reaches import reach_tracks
 from perception.recognition.engine import HammerParams, StepScorer, recognize
 from perception.recognition.models import SceneSpec
 from perception.recordings import MocapImport, prepare_reach, read_reaches, recognize_reach
@@ -401,12 +401,12 @@ def test_real_reaches_fed_row_by_row_end_as_recognize(rep, optotrak, k, row):
     reach = optotrak[k]
     tracks, info, _, aperture = reach_tracks(reach, options.reaches)
     base = _settings(OPTIONS[row])
-    # the settings recognize_reach scores a reach with: a millimetre per "pixel", the
-    # grip's object size, a whole hand's rest aperture (perception.recordings)
+    # the settings recognize_reach scores a reach with: the grip's object size, a whole
+    # hand's rest aperture (perception.recordings); the rows are metres in its plane
     rest = aperture[:2 * base.observe.rest_frames]
     widest = float(np.max(rest, initial=0.0, where=np.isfinite(rest)))
     settings = dataclasses.replace(base, observe=dataclasses.replace(
-        base.observe, px_per_m=PX_PER_M, object_diameter=info["object_size"],
+        base.observe, object_diameter=info["object_size"],
         max_rest_aperture=max(base.observe.max_rest_aperture, widest + 0.01)))
     rec, states = _feed(rep, tracks, settings, clip=reach.name)
     final = rec.finish()

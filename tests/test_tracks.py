@@ -162,6 +162,20 @@ def test_interpolation_fills_short_gaps_only():
         tr.interpolate(-1)
 
 
+def test_units_are_pixels_unless_the_tracks_say_metres(tmp_path):
+    """A reach's tracks in metres keep their units through a file, a pickle and a view."""
+    import pickle
+
+    tr = _tracks()
+    assert tr.units == "px"
+    metric = tr.replace(tracker={**tr.tracker, "units": "m"})
+    back = Tracks.load(metric.save(tmp_path / "m.tracks.h5"))
+    assert (back.units, pickle.loads(pickle.dumps(metric)).units, metric.rows(2, 9).units) == (
+        "m", "m", "m")
+    with pytest.raises(ValueError, match=r"units.*'px', 'm'|units.*px, m"):
+        tr.replace(tracker={"units": "cm"})
+
+
 def test_rows_are_a_view():
     tr = _tracks()
     part = tr.rows(10, 40)

@@ -64,6 +64,8 @@ SCHEMA_VERSION = 1
 INTERPOLATED_LIKELIHOOD = 0.5
 
 #: The per-frame datasets of ``/tracks`` and their dtypes, in the order they are written.
+#: What a position is in (:attr:`Tracks.units`): image pixels, or metres in a plane.
+UNITS = ("px", "m")
 _DTYPES = {"frame": np.int64, "time": np.float64, "position": np.float64,
            "likelihood": np.float32, "status": np.int8}
 
@@ -116,7 +118,9 @@ class Tracks:
     markers : tuple of str
         Marker names, M of them, in column order.
     position : (T, M, 2) float64
-        Image position (x right, y down), px; NaN where lost.
+        Image position (x right, y down), px; NaN where lost. Metres, x right
+        and y up, where :attr:`units` is ``"m"`` (a motion-capture reach in
+        its movement's plane).
     likelihood : (T, M) float32
         0..1; 0 where lost.
     status : (T, M) int8
@@ -156,6 +160,9 @@ class Tracks:
             object.__setattr__(self, name, value)
         for name in ("video", "tracker", "attrs"):
             object.__setattr__(self, name, MappingProxyType(dict(getattr(self, name))))
+        if self.units not in UNITS:
+            raise ValueError(f"Tracks.tracker['units']: expected one of {', '.join(UNITS)}, "
+                             f"got {self.units!r}")
 
     def __reduce__(self):
         # MappingProxyType does not pickle: batch workers send tracks between processes
@@ -178,6 +185,12 @@ class Tracks:
             return self.markers.index(name)
         except ValueError:
             raise KeyError(f"no marker {name!r} (markers: {', '.join(self.markers)})") from None
+
+    @property
+    def units(self) -> str:
+        """``"px"`` (image pixels, y down) or ``"m"`` (metres in a plane, y up): the
+        ``/tracker`` attribute ``units``, pixels where it is absent."""
+        return str(self.tracker.get("units", "px"))
 
     def object_diameter_px(self, name: str = "object") -> float | None:
         """Apparent diameter of the round object in pixels, if the tracks can tell.
