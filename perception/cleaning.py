@@ -48,6 +48,7 @@ from scipy.interpolate import PchipInterpolator
 from scipy.ndimage import median_filter
 
 from perception.resume import Kept
+from perception.rowwise import finite_rows
 from perception.validation import Int, NonNegative, declared
 
 __all__ = ["CleaningParams", "Repairs", "clean_path", "held", "quantum", "spikes"]
@@ -213,7 +214,7 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
 
 
 def spikes(time: np.ndarray, path: np.ndarray, ok: np.ndarray | None = None,
-           params: CleaningParams | None = None) -> np.ndarray:
+           params: CleaningParams | None = None, *, step: float | None = None) -> np.ndarray:
     """(N,) samples off the running median of the seen samples around them: spikes.
 
     A path that begins with one tested before in this thread (the same seen
@@ -232,10 +233,13 @@ def spikes(time: np.ndarray, path: np.ndarray, ok: np.ndarray | None = None,
         The samples to read (default: the finite ones).
     params : CleaningParams, optional
         Its ``spike_distance`` and ``spike_window``.
+    step : float, optional
+        The median of ``time``'s steps, s, where the caller has it (the
+        landmarks test three paths on one clock); default: found here.
     """
     params = CleaningParams() if params is None else params
-    ok = np.isfinite(path).all(axis=1) if ok is None else ok
-    dt = float(np.median(np.diff(time))) if len(time) > 1 else 1.0
+    ok = finite_rows(path) if ok is None else ok
+    dt = step if step is not None else float(np.median(np.diff(time))) if len(time) > 1 else 1.0
     half = max(1, int(round(params.spike_window / dt)))
     idx = np.flatnonzero(ok)
     if len(idx) < 2 * half + 1:

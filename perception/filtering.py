@@ -60,7 +60,7 @@ def alpha_beta(z: np.ndarray, dt: np.ndarray | float, alpha: float, beta: float)
         step = copy.copy(kept[1][1])  # its state is replaced at every frame, never changed
     for i in range(start, z.shape[0]):
         out[i] = step(z[i], dt[i])
-    _KEPT.keep((alpha, beta), (z.copy(), dt.copy()), (out.copy(), copy.copy(step)), kept)
+    _KEPT.keep((alpha, beta), (z, dt), (out.copy(), copy.copy(step)), kept)
     return out
 
 

@@ -60,12 +60,12 @@ def gap_near(time: np.ndarray, lost: np.ndarray, at: float, reach: float) -> flo
     if not len(near):
         return None
     edges = np.diff(np.r_[0, lost.astype(np.int8), 0])
-    longest = 0.0
-    for a, b in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)):
-        if a <= near[-1] and b > near[0]:  # this stretch reaches within ``reach``
-            lo, hi = max(a - 1, 0), min(b, len(time) - 1)
-            longest = max(longest, float(time[hi] - time[lo]))
-    return longest
+    a, b = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+    # the stretches that reach within ``reach``, as arrays (a stream's many short losses
+    # were a Python loop at every row)
+    close = (a <= near[-1]) & (b > near[0])
+    lo, hi = np.maximum(a[close] - 1, 0), np.minimum(b[close], len(time) - 1)
+    return max(0.0, float((time[hi] - time[lo]).max()))
 
 
 def why_not_open(time: np.ndarray, g: np.ndarray, level: float) -> str:

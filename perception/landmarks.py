@@ -35,6 +35,7 @@ from perception.landmark_flags import (
     why_not_open,
 )
 from perception.landmark_values import _NAMES, OK, Landmarks
+from perception.rowwise import finite_rows, row_norm
 from perception.validation import Int, Share, declared
 
 if TYPE_CHECKING:
@@ -47,12 +48,36 @@ __all__ = ["OK", "LandmarkParams", "Landmarks", "MeasuredPaths",
 
 
 @functools.lru_cache(maxsize=64)
-def _butter(order: int, wn: float) -> tuple[np.ndarray, np.ndarray]:
-    """The Butterworth low-pass's coefficients: designed once per order and cutoff, not
-    once per movement (a 2,000-trial table's 4,000 designs took 1.6 s)."""
-    from scipy.signal import butter  # noqa: PLC0415 (only when filtering)
+def _butter(order: int, wn: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The Butterworth low-pass's coefficients and its step response's steady state
+    (:func:`scipy.signal.lfilter_zi`): designed once per order and cutoff, not once per
+    movement (a 2,000-trial table's 4,000 designs took 1.6 s; the steady state took
+    30 us at each of a stream's rows, twice)."""
+    from scipy.signal import butter, lfilter_zi  # noqa: PLC0415 (only when filtering)
 
-    return butter(order, wn)
+    b, a = butter(order, wn)
+    return b, a, lfilter_zi(b, a)
+
+
+def _filtfilt(b: np.ndarray, a: np.ndarray, zi: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """:func:`scipy.signal.filtfilt` of ``x`` (N, K) along its rows, its default padding
+    (odd, ``3 x max(len(a), len(b))`` rows), with ``zi`` its ``lfilter_zi(b, a)``: the same
+    operations on the same numbers, without designing the steady state again at every call.
+    """
+    from scipy.signal import lfilter  # noqa: PLC0415 (only when filtering)
+
+    edge = 3 * max(len(a), len(b))
+    ext = np.concatenate((2 * x[0:1] - x[edge:0:-1], x,
+                          2 * x[-1:] - x[-2:-(edge + 2):-1]), axis=0)
+    zi = zi.reshape(-1, 1)
+    y, _ = lfilter(b, a, ext, axis=0, zi=zi * ext[0:1])
+    y, _ = lfilter(b, a, y[::-1], axis=0, zi=zi * y[-1:])
+    return y[::-1][edge:-edge]
+
+
+def _step(time: np.ndarray) -> float:
+    """The median time step, s (NaN with fewer than two samples)."""
+    return float(np.median(np.diff(time))) if len(time) > 1 else math.nan
 
 
 @declared
@@ -158,27 +183,33 @@ class LandmarkParams:
         values : (N, ...) array
             Values, NaN where missing.
         """
+        return self._lowpass(time, values, _step(time))
+
+    def _lowpass(self, time: np.ndarray, values: np.ndarray, step: float) -> np.ndarray:
+        """:meth:`lowpass` with the median time ``step`` found (s): a movement's landmarks
+        filter two series on one clock."""
         x = np.array(values, dtype=float)
         if self.cutoff is None or len(time) < 2:
             return x
-        from scipy.signal import filtfilt  # noqa: PLC0415 (only when filtering)
-
-        rate = 1.0 / float(np.median(np.diff(time)))
-        b, a = _butter(self.order, min(self.cutoff / (0.5 * rate), 0.95))
+        b, a, zi = _butter(self.order, min(self.cutoff / (0.5 * (1.0 / step)), 0.95))
         flat = x.reshape(len(x), -1)
-        ok = np.isfinite(flat).all(axis=1)
+        ok = finite_rows(flat)
         edges = np.diff(np.r_[0, ok.astype(np.int8), 0])
         for lo, hi in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)):
             if hi - lo > 3 * max(len(a), len(b)):
-                flat[lo:hi] = filtfilt(b, a, flat[lo:hi], axis=0)
+                flat[lo:hi] = _filtfilt(b, a, zi, flat[lo:hi])
         return flat.reshape(x.shape)
 
     def speed_of(self, time: np.ndarray, path: np.ndarray) -> np.ndarray:
         """(N,) speed of a path (N, D) after :meth:`lowpass`, m/s (NaN where lost)."""
-        p = self.lowpass(time, path)
+        return self._speed_of(time, path, _step(time))
+
+    def _speed_of(self, time: np.ndarray, path: np.ndarray, step: float) -> np.ndarray:
+        """:meth:`speed_of` with the median time ``step`` found, s."""
+        p = self._lowpass(time, path, step)
         if len(time) < 3:
             return np.full(len(time), np.nan)
-        return np.linalg.norm(np.gradient(p, np.asarray(time, dtype=float), axis=0), axis=1)
+        return row_norm(np.gradient(p, np.asarray(time, dtype=float), axis=0))
 
 
 def movement_bounds(time: np.ndarray, speed: np.ndarray, peak: int,
@@ -201,14 +232,21 @@ def movement_bounds(time: np.ndarray, speed: np.ndarray, peak: int,
     params : LandmarkParams, optional
     """
     params = LandmarkParams() if params is None else params
-    bound = speed_bound(speed, peak, params)
+    return _bounds_at(time, speed, peak, speed_bound(speed, peak, params), params.hold)
+
+
+def _bounds_at(time: np.ndarray, speed: np.ndarray, peak: int, bound: float, hold: float
+               ) -> tuple[int | None, int | None]:
+    """:func:`movement_bounds` with its speed ``bound`` found (m/s)."""
     below = np.isfinite(speed) & (speed < bound)
     edges = np.diff(np.r_[0, below.astype(np.int8), 0])
-    runs = [(a, b) for a, b in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1))
-            if time[b - 1] - time[a] >= params.hold - 1e-9]
-    before = [b for a, b in runs if b <= peak]
-    after = [a for a, b in runs if a > peak]
-    return (int(before[-1]) if before else None, int(after[0]) - 1 if after else None)
+    # the runs below it, as arrays: a stream at rest crosses a noise-raised bound at many
+    # rows, and a Python loop over its runs grew with the stream at every row
+    a, b = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+    held = (time[b - 1] - time[a]) >= hold - 1e-9
+    a, b = a[held], b[held]
+    before, after = b[b <= peak], a[a > peak]
+    return (int(before[-1]) if len(before) else None, int(after[0]) - 1 if len(after) else None)
 
 
 def speed_bound(speed: np.ndarray, peak: int, params: LandmarkParams) -> float:
@@ -415,18 +453,26 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
     """
     params = LandmarkParams() if params is None else params
     time = np.asarray(time, dtype=float)
+    return _landmarks(time, transport, aperture, params, bounds, _step(time))
+
+
+def _landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.ndarray,
+               params: LandmarkParams, bounds: tuple[int | None, int | None] | None,
+               step: float) -> Landmarks:
+    """:func:`movement_landmarks` with the median time ``step`` found (s): every pass
+    below reads it (a median of every row's step each time: seven times a row in a
+    stream)."""
     g_raw = np.asarray(aperture, dtype=float)
     if len(time) < 3:
         return Landmarks(flags=all_flags(_NAMES, f"not seen: {len(time)} samples"))
     path = np.asarray(transport, dtype=float)
-    speed = params.speed_of(time, path)
+    speed = params._speed_of(time, path, step)
     if not np.isfinite(speed).any():
         return Landmarks(flags=all_flags(_NAMES, "not seen: the transport point is lost "
                                                  "throughout"))
     raised = []  # (side, share of peak) where a bound was raised above the asked one
     if bounds is None:
         peak = int(np.nanargmax(speed))
-        onset, end = movement_bounds(time, speed, peak, params)
     else:
         lo, hi = bounds
         a, b = (0 if lo is None else lo), (len(time) - 1 if hi is None else hi)
@@ -434,7 +480,9 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
             return Landmarks(flags=all_flags(_NAMES, "not seen: the transport point is lost "
                                               "throughout the movement"))
         peak = a + int(np.nanargmax(speed[a:b + 1]))
-        onset, end = movement_bounds(time, speed, peak, params)
+    bound = speed_bound(speed, peak, params)  # once: a percentile of every row's speed
+    onset, end = _bounds_at(time, speed, peak, bound, params.hold)
+    if bounds is not None:
         # the user's rule, within the rows the movement was parted at
         if lo is not None and (onset is None or onset < lo):
             onset = lo
@@ -442,7 +490,6 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
         if hi is not None and (end is None or end > hi):
             end = hi
             raised.append(("end", float(speed[hi] / speed[peak])))
-    bound = speed_bound(speed, peak, params)
     if params.speed is None and bound > params.threshold * float(speed[peak]) * (1 + 1e-9):
         # the noise floor raised the share-of-peak bound: both sides are placed by it
         raised += [(side, bound / float(speed[peak])) for side in ("onset", "end")
@@ -457,7 +504,7 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
     fast = np.nan_to_num(speed) > params.second_movement * speed[peak]
     fast[lo:hi + 1] = False
     edges = np.diff(np.r_[0, fast.astype(np.int8), 0])
-    step = float(np.median(np.diff(time)))  # a sample stands for a frame period of time
+    # a sample stands for a frame period of time (``step``)
     others = sum((b - a) * step >= params.second_movement_time - 1e-9
                  for a, b in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)))
     base = {"onset_time": t_on, "end_time": t_end, "movement_time": T, "movements": 1 + others,
@@ -467,13 +514,13 @@ def movement_landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.nda
     # the filter and the derivative reach this far either side of a sample: a value taken
     # this near a lost stretch was shaped by what the tracker did not see
     reach = max(0.5 / params.cutoff if params.cutoff else 0.0,
-                1.5 * float(np.median(np.diff(time))))
-    lost_transport = ~np.isfinite(path.reshape(len(time), -1)).all(axis=1)
+                1.5 * step)
+    lost_transport = ~finite_rows(path)
     if (gap := gap_near(time, lost_transport, float(time[peak]), reach)) is not None:
         said = f"inside a gap: the transport point was lost for {gap * 1000:.0f} ms at the peak"
         for name in ("peak_speed", "peak_speed_time", "deceleration_time"):
             flags.setdefault(name, said)
-    g = params.lowpass(time, g_raw)
+    g = params._lowpass(time, g_raw, step)
     rows = np.arange(lo, hi + 1)
     seen = rows[np.isfinite(g[rows])]
     if len(seen) < 3:
@@ -552,11 +599,14 @@ def observed_landmarks(obs: Observation, params: LandmarkParams | None = None) -
         raw = np.stack([r[k] for k in ("wrist", "finger", "thumb")], axis=1)
     from perception.cleaning import spikes  # noqa: PLC0415 (scipy.ndimage)
 
+    params = LandmarkParams() if params is None else params
+    time = np.asarray(time, dtype=float)
+    step = _step(time)
     raw = np.array(raw, dtype=float)  # a one-frame glitch is lost, not a movement's peak
     for k in range(raw.shape[1]):
-        raw[spikes(time, raw[:, k]), k] = np.nan
-    return movement_landmarks(time, raw[:, 0], np.linalg.norm(raw[:, 1] - raw[:, 2], axis=1),
-                              params)
+        raw[spikes(time, raw[:, k], step=step if len(time) > 1 else None), k] = np.nan
+    return _landmarks(time, raw[:, 0], row_norm(raw[:, 1] - raw[:, 2]),
+                      params, None, step)
 
 
 def model_landmarks(time: np.ndarray, wrist: np.ndarray, finger: np.ndarray,

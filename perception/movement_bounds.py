@@ -95,7 +95,7 @@ def onset_time(filtered: np.ndarray, time: np.ndarray, noise: float, params: Obs
     m = max(m, params.rest_frames)
     if m <= len(filtered) and len(t0) == len(levels) + 1:
         # rows after the last crossing's hold never change it: more rows, the same onset
-        _ONSET.keep((params, noise), (np.array(filtered[:m]), np.array(time[:m])), onset)
+        _ONSET.keep((params, noise), (filtered[:m], time[:m]), onset)
     return onset
 
 
@@ -160,6 +160,6 @@ def end_row(filtered: np.ndarray, time: np.ndarray, noise: float, dt: float,
     speed = np.linalg.norm(f[k:] - f[:-k], axis=-1) / (t[k:] - t[:-k])[:, None]
     moving = np.flatnonzero(np.nanmax(np.where(np.isfinite(speed), speed, 0), axis=1) > floor)
     active = int(moving[-1]) + start if len(moving) else active
-    _END.keep((params, k, floor), (np.array(filtered), np.array(time)), active)
+    _END.keep((params, k, floor), (filtered, time), active)  # copied there
     last = len(time) - 1
     return int(min(last, active + k * params.end_pad_frames)) if active >= 0 else last

@@ -469,7 +469,7 @@ def score_clip(observation: Observation, models: Sequence[MotorModel],
         rule=scorer.params.rule)
     for a in (*scores[2:9], *scores.predicted.values()):
         a.flags.writeable = False  # shared by every result made from the same scores
-    _SCORED.keep(key, tuple(np.array(a) for a in arrays), (models, scores))
+    _SCORED.keep(key, arrays, (models, scores))  # copied there
     return scores
 
 
@@ -517,7 +517,7 @@ def _scored(models: list, key: tuple, obs: Observation, arrays: tuple
         scorer.log_likelihood = terms.log_likelihood.sum(axis=1)
         scorer.mahalanobis = terms.mahalanobis.sum(axis=1)
         scorer.scored = terms.valid.sum(axis=1)
-    _RESUMABLE.keep(key, tuple(np.array(a) for a in arrays), (models, scorer, terms), best)
+    _RESUMABLE.keep(key, arrays, (models, scorer, terms), best)
     return scorer, terms
 
 

@@ -1,0 +1,104 @@
+"""The landmarks' passes over every row of a stream cost what they must (issue 45, item
+6), and give what the library functions they stand for give, bit for bit.
+
+* the zero-lag filter is :func:`scipy.signal.filtfilt` with its steady state
+  designed once per filter, not at every call;
+* the median time step is taken once per clip, not by every pass;
+* per-row tests and norms are taken a column at a time
+  (:mod:`perception.rowwise`), equal to NumPy's reductions.
+"""
+
+from __future__ import annotations
+
+import importlib
+
+import numpy as np
+import pytest
+import scipy.signal
+
+from perception.rowwise import finite_rows, row_norm
+
+landmarks = importlib.import_module("perception.landmarks")
+cleaning = importlib.import_module("perception.cleaning")
+
+
+@pytest.mark.parametrize("order", [1, 2, 4, 8])
+@pytest.mark.parametrize("wn", [0.1, 0.667, 0.95])
+def test_the_zero_lag_filter_is_filtfilt_bit_for_bit(order, wn):
+    b, a, zi = landmarks._butter(order, wn)
+    rng = np.random.default_rng(order)
+    for n in (3 * max(len(a), len(b)) + 1, 40, 301):
+        for k in (1, 2, 3):
+            x = np.cumsum(rng.normal(size=(n, k)), axis=0)
+            want = scipy.signal.filtfilt(b, a, x, axis=0)
+            assert np.asarray(landmarks._filtfilt(b, a, zi, x)).tobytes() == want.tobytes()
+
+
+def _clip(n=400, fps=30.0, seed=0):
+    """A reach then rest, with gaps: time, wrist (N, 2), aperture (N,)."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) / fps
+    s = np.clip((t - 0.5) / 1.2, 0, 1)
+    x = 0.3 * (10 * s**3 - 15 * s**4 + 6 * s**5)
+    wrist = np.c_[x, 0.02 * x] + rng.normal(0, 3e-4, (n, 2))
+    g = 0.02 + 0.06 * np.sin(np.pi * s) ** 2 + rng.normal(0, 3e-4, n)
+    wrist[[50, 51, 200], 0] = np.nan
+    g[[60, 300, 301, 302]] = np.nan
+    return t, wrist, g
+
+
+def test_a_movements_landmarks_design_the_filter_once(monkeypatch):
+    """The steady state of the filter's step response is designed once per filter: a
+    stream's landmarks designed it twice at every row (30 us each)."""
+    designed = []
+    zi = scipy.signal.lfilter_zi
+
+    def counted(b, a):
+        designed.append(1)
+        return zi(b, a)
+
+    monkeypatch.setattr(scipy.signal, "lfilter_zi", counted)
+    monkeypatch.setattr(scipy.signal._signaltools, "lfilter_zi", counted)
+    landmarks._butter.cache_clear()
+    t, wrist, g = _clip()
+    params = landmarks.LandmarkParams(cutoff=9.5)  # a filter no other test designed
+    first = landmarks.movement_landmarks(t, wrist, g, params)
+    for n in range(380, 400):
+        landmarks.movement_landmarks(t[:n], wrist[:n], g[:n], params)
+    assert len(designed) == 1
+    assert repr(first) == repr(landmarks.movement_landmarks(t, wrist, g, params))
+
+
+def test_the_step_is_found_once_for_the_landmarks_of_a_clip(monkeypatch):
+    """observed_landmarks reads every row's time step once, not in each of its passes
+    (the three markers' spike tests, two filters, the bounds: seven medians a row)."""
+    calls = []
+    median = np.median
+
+    def counted(a, *args, **kw):
+        calls.append(len(a))
+        return median(a, *args, **kw)
+
+    t, wrist, g = _clip()
+    raw = np.stack([wrist, wrist + [0.05, g[0]], wrist + [0.05, 0.0]], axis=1)
+    obs = type("Obs", (), {"clip_time": t, "clip_raw": raw})()
+    want = landmarks.observed_landmarks(obs)
+    monkeypatch.setattr(np, "median", counted)
+    cleaning._SPIKES.local.__dict__.clear()
+    got = landmarks.observed_landmarks(obs)
+    assert repr(got) == repr(want)
+    assert calls.count(len(t) - 1) == 1, calls  # the steps' median, once
+
+
+def test_rows_tested_and_measured_a_column_at_a_time_are_numpys():
+    rng = np.random.default_rng(5)
+    for k in (1, 2, 3, 4, 6, 9):
+        x = rng.normal(size=(5000, k)) * rng.choice([1e-3, 1.0, 1e200], (5000, 1))
+        x[rng.random(x.shape) < 0.02] = np.nan
+        x[rng.random(x.shape) < 0.005] = np.inf
+        for y in (x, x[:, ::-1], x[::3]):
+            with np.errstate(over="ignore"):  # 1e200 squared: inf either way
+                assert row_norm(y).tobytes() == np.linalg.norm(y, axis=1).tobytes()
+            assert np.array_equal(finite_rows(y), np.isfinite(y).all(axis=1))
+        assert np.array_equal(finite_rows(x.reshape(-1, 1, k)), np.isfinite(x).all(axis=1))
+    assert finite_rows(np.zeros((0, 2))).shape == (0,)
