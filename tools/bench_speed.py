@@ -21,6 +21,11 @@ start-up is measured here, at the command line, not forbidden imports in tests.
   compiled to bytecode (as installed; the targets are for this case) and from
   source (as under PYTHONDONTWRITEBYTECODE=1); and which of OpenCV, matplotlib
   and pandas each loaded.
+
+``--phases N`` instead prints where ``recognize`` of the 2 s video with its figures
+spends its wall and CPU time, step by step (imports, settings, repertoire, tracking,
+scoring, the contact sheet, matplotlib's import, the figures, the exit), median of N
+fresh processes beside the floor of the same rounds.
 """
 
 from __future__ import annotations
@@ -305,8 +310,124 @@ def file_startup_rows(repeat: int = 3) -> list[tuple[str, str, str, str]]:
     return rows
 
 
-def main() -> None:
-    """Print the start-up, planning and per-clip table."""
+#: ``--phases``' child: ``hammer-mv recognize`` (as ``python -m hammer_mv`` runs it) with
+#: the wall and CPU time taken where each step returns; prints them as JSON. matplotlib
+#: and scipy.stats are imported just before the steps that would import them, to count
+#: them apart (scipy.stats is in the floor: scipy.signal loads it).
+_PHASES = """
+import gc, json, resource, sys, time
+gc.disable()  # as hammer_mv/__main__.py
+marks = [("interpreter, site", time.perf_counter(), time.process_time())]
+def mark(name):
+    marks.append((name, time.perf_counter(), time.process_time()))
+def after(owner, attr, name):
+    fn = getattr(owner, attr)
+    def call(*args, **kwargs):
+        if attr == "write_clip_report":
+            import matplotlib.figure, matplotlib.backends.backend_agg
+            mark("import matplotlib (the figures')")
+        elif attr == "recognize_tracks":
+            import scipy.stats
+            mark("import scipy.stats (the verdict's; in the floor)")
+        out = fn(*args, **kwargs)
+        mark(name)
+        return out
+    setattr(owner, attr, call)
+import hammer_mv.cli as cli
+mark("import hammer_mv.cli")
+run_command = cli._run
+def wrapped(args):
+    mark("imports of the command, parser")
+    from hammer_mv.cli import options
+    from perception import pipeline
+    from perception.report import clip, tracking
+    mark("imports of recognize.run")
+    after(options, "recognition_settings", "settings")
+    after(options, "load_repertoire", "repertoire")
+    after(pipeline, "load_clip", "tracking the video (load_clip)")
+    after(pipeline, "recognize_tracks", "scoring: planning, engine (recognize_tracks)")
+    after(tracking, "write_tracking_report", "tracking report, contact sheet")
+    after(clip, "write_clip_report", "three figures, CSV, JSON (write_clip_report)")
+    return run_command(args)
+cli._run = wrapped
+sys.argv = ["hammer-mv", *sys.argv[1:]]
+status = cli.entry()
+mark("after the command")
+print(json.dumps(marks))
+"""
+
+
+def phase_rows(repeat: int = 5) -> list[tuple[str, str, str, str]]:
+    """Where ``recognize`` of a 2 s video with its figures spends its time (issue 45 item 4).
+
+    Fresh processes (our packages compiled to bytecode, as installed), each step's wall
+    and CPU time (all threads: planning and decoding run in threads) taken where it
+    returns, beside the floor (``python -c 'import numpy, scipy.signal'``) in the same
+    rounds; the median of ``repeat`` rounds each. The last row, the interpreter's exit,
+    is the process's CPU time (``ru_utime + ru_stime``) after the last mark.
+    """
+    import json
+
+    work = Path(tempfile.mkdtemp(prefix="hammer-bench-phases-"))
+    try:
+        clip = _start_files(work)["2 s video, with figures"]
+        root = _project_copy(work, bytecode=True)
+        env = {**os.environ, "PYTHONPATH": str(root), "PYTHONDONTWRITEBYTECODE": "1"}
+        env.pop("PYTHONPYCACHEPREFIX", None)
+        out = work / "out"
+        steps: dict[str, list[tuple[float, float]]] = {}
+        floors, wholes = [], []
+        for _ in range(repeat):
+            floors.append(_timed(_FLOOR, 1, env, cwd=root))
+            shutil.rmtree(out, ignore_errors=True)  # tracked and planned afresh
+            before = resource.getrusage(resource.RUSAGE_CHILDREN)
+            t0 = time.perf_counter()
+            proc = subprocess.run([sys.executable, "-c", _PHASES, "recognize", *clip, "-o",
+                                   str(out), "--quiet"], check=True, capture_output=True,
+                                  text=True, cwd=root, env=env, preexec_fn=_on_two_cores)
+            wall = time.perf_counter() - t0
+            after = resource.getrusage(resource.RUSAGE_CHILDREN)
+            cpu = after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime
+            wholes.append((wall, cpu))
+            marks = json.loads(proc.stdout.splitlines()[-1])
+            last_cpu = 0.0
+            steps.setdefault(marks[0][0], []).append((0.0, marks[0][2]))  # its CPU only
+            for (_, w_prev, c_prev), (name, w, c) in zip(marks, marks[1:]):
+                steps.setdefault(name, []).append((w - w_prev, c - c_prev))
+                last_cpu = c
+            steps.setdefault("exit (modules torn down)", []).append((0.0, cpu - last_cpu))
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    med = statistics.median
+    floor_wall, floor_cpu = med(f[0] for f in floors), med(f[1] for f in floors)
+    whole_wall, whole_cpu = med(w[0] for w in wholes), med(w[1] for w in wholes)
+    rows = [(f"  {name}", f"{1e3 * med(v[0] for v in values):.0f} ms" if name not in (
+                 "interpreter, site", "exit (modules torn down)") else "-",
+             f"CPU {1e3 * med(v[1] for v in values):.0f} ms", "")
+            for name, values in steps.items()]
+    return [("floor: python -c 'import numpy, scipy.signal' (bytecode)", f"{floor_wall:.2f} s",
+             f"CPU {floor_cpu:.2f} s; same rounds", ""),
+            ("recognize, 2 s video, with figures (bytecode), whole process",
+             f"{whole_wall:.2f} s ({whole_wall - floor_wall:+.2f})",
+             f"CPU {whole_cpu:.2f} s ({whole_cpu - floor_cpu:+.2f}); its steps below", ""),
+            *rows]
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Print the start-up, planning and per-clip table (``--phases N``: only the steps of
+    ``recognize`` of a 2 s video with its figures, median of N fresh processes)."""
+    import argparse
+
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--phases", type=int, metavar="N", default=0,
+                    help="only the steps of recognize of a 2 s video, N fresh processes")
+    # called from tools/bench.py with that script's own arguments in sys.argv
+    args = ap.parse_args([] if argv is None and __name__ != "__main__" else argv)
+    if args.phases:
+        table("hammer-mv recognize of a 2 s video with its figures, step by step (fresh "
+              f"processes, median of {args.phases}; wall and CPU of each step)",
+              phase_rows(args.phases))
+        return
     table("hammer-mv: start-up, planning, one clip (whole processes, median)",
           startup_rows() + planning_rows() + clip_rows())
     table("hammer-mv recognize of each input kind against the floor (whole processes, "
