@@ -51,6 +51,18 @@ def test_the_rules_are_tried_in_order_and_the_first_that_fires_names_itself():
     assert (d.verdict, d.rule) == ("unfamiliar", "insufficient-data")
     d = judge(_evidence(familiarity=np.array([0.01, 0.9])))
     assert (d.verdict, d.rule) == ("abnormal", "familiarity")
+    # unlike the models, and the transport alone as unlike them: the misfit is the
+    # transport's, so the movement is out of the verdict's depth, not an abnormal grasp
+    d = judge(_evidence(familiarity=np.array([0.01, 0.9]), transport_familiarity=0.03))
+    assert (d.verdict, d.rule, d.detail) == ("unfamiliar", "transport-departs", None)
+    d = judge(_evidence(familiarity=np.array([0.01, 0.9]), transport_familiarity=0.06))
+    assert (d.verdict, d.rule) == ("abnormal", "familiarity")
+    # a familiar grasp stays normal, and a grip that departs stays abnormal, however
+    # unlike a reach its transport
+    assert judge(_evidence(transport_familiarity=0.03)).verdict == "normal"
+    d = judge(_evidence(familiarity=np.array([0.01, 0.9]), transport_familiarity=0.03,
+                        observed=Landmarks(aperture_peaks=2)))
+    assert (d.verdict, d.rule, d.detail) == ("abnormal", "grip-departs", "re-opening")
     d = judge(_evidence(familiarity=np.array([np.nan, 0.9])))
     assert d.verdict is None and d.rule is None
 
@@ -98,7 +110,10 @@ def test_every_threshold_is_a_field_that_moves_the_verdict():
     assert judge(gap).verdict == "normal"
     strict = VerdictRules(landmarks=LandmarkParams(max_gap=0.05, max_gap_share=0.1))
     assert judge(gap, strict).rule == "insufficient-data"
-    assert judge(_evidence(), VerdictRules(familiarity_threshold=0.6)).verdict == "abnormal"
+    assert judge(_evidence(transport_familiarity=0.9),
+                 VerdictRules(familiarity_threshold=0.6)).verdict == "abnormal"
+    # the transport is held to the same threshold
+    assert judge(_evidence(), VerdictRules(familiarity_threshold=0.6)).rule == "transport-departs"
     assert judge(_evidence(rest_aperture=0.03), VerdictRules(precision_grip_aperture=0.02)) \
         .rule == "not-a-precision-grip"
 

@@ -97,6 +97,10 @@ def test_an_unfamiliar_grasp_names_the_familiarity_its_threshold_and_the_nearest
      "slowed by 30 % of its peak speed, under the 60 %", "30 %"),
     (_evidence(transport_familiarity=0.004), "not a human reach: its transport's familiarity "
      "to the best reach model 0.004 < 0.01 threshold (unfamiliar_threshold)", "0.004"),
+    (_evidence(familiarity=np.array([0.02, 0.04, 0.01]), transport_familiarity=0.03),
+     "the transport departs, not the grip: the transport's familiarity to the best reach "
+     "model 0.03 < 0.05 threshold (familiarity_threshold), as the movement's (best model "
+     "grasp-1.0s at 0.02)", "0.03"),
     (_evidence(), "best model grasp-1.0s familiarity 0.50 >= 0.05 threshold", "0.50"),
     (_evidence(log_likelihood=np.array([1.0, 0.0, 5.0])), "best model reach-1.0s familiarity "
      "0.20 >= 0.05 threshold", "0.20"),
@@ -113,7 +117,8 @@ def test_every_rule_of_the_table_has_a_reason():
     fired = set()
     for e in (_evidence(rest_aperture=0.09), _evidence(observed=_landmarks(opening_time=0.7)),
               _evidence(aperture_gap=0.5), _evidence(slowed=0.3),
-              _evidence(transport_familiarity=0.004), _evidence()):
+              _evidence(transport_familiarity=0.004), _evidence(),
+              _evidence(familiarity=np.array([0.02, 0.04, 0.01]), transport_familiarity=0.03)):
         v = judge(e)
         fired.add(v.rule)
         why = reason(v, e)

@@ -368,6 +368,13 @@ RULE_TABLE: tuple[tuple[str, str, Callable[[Evidence, VerdictRules, str | None],
     # even the transport is like no reach model's own
     ("not-a-human-reach", "unfamiliar",
      lambda e, r, base: e.transport_familiarity < r.unfamiliar_threshold),
+    # unfamiliar where the grip shows no departure of its own and the transport alone
+    # fails the test the movement failed: the misfit is the transport's, and the
+    # abnormal grasps the verdict knows (a late or a second opening, thesis ch. 5) keep a
+    # reach's transport
+    ("transport-departs", "unfamiliar",
+     lambda e, r, base: base == "abnormal"
+     and e.transport_familiarity < r.familiarity_threshold),
     ("familiarity", "", lambda e, r, base: base is not None),
 )
 #: The rules' names (:attr:`Verdict.rule`), in the order they are tried.
@@ -559,6 +566,13 @@ def reason(verdict: Verdict, evidence: Evidence, rules: VerdictRules | None = No
         return (f"not a human reach: its transport's familiarity to the best reach model "
                 f"{_fam(e.transport_familiarity)} < {_fam(rules.unfamiliar_threshold)} "
                 "threshold (unfamiliar_threshold)")
+    if rule == "transport-departs":
+        return (f"the transport departs, not the grip: the transport's familiarity to the "
+                f"best reach model {_fam(e.transport_familiarity)} < "
+                f"{_fam(rules.familiarity_threshold)} threshold (familiarity_threshold), as "
+                f"the movement's (best model {names[v.best]} at {_fam(v.familiarity)}), "
+                "and no landmark of the grip departs (an abnormal grasp keeps a reach's "
+                "transport)")
     if rule is None:
         return (f"no verdict: the best model {names[v.best]} has no calibration (no "
                 "familiarity to judge by)")
