@@ -48,7 +48,7 @@ from scipy.interpolate import PchipInterpolator
 from scipy.ndimage import median_filter
 
 from perception.resume import Kept
-from perception.rowwise import finite_rows
+from perception.rowwise import finite_rows, row_norm
 from perception.validation import Int, NonNegative, declared
 
 __all__ = ["CleaningParams", "Repairs", "clean_path", "held", "quantum", "spikes"]
@@ -217,11 +217,13 @@ def spikes(time: np.ndarray, path: np.ndarray, ok: np.ndarray | None = None,
            params: CleaningParams | None = None, *, step: float | None = None) -> np.ndarray:
     """(N,) samples off the running median of the seen samples around them: spikes.
 
-    A path that begins with one tested before in this thread (the same seen
-    samples and times, bitwise, the same window) is tested again only from
-    ``3 x window`` samples before that one's end: a sample's flag reads the
-    samples within three windows of it, so those before are as they were
-    (a stream's landmarks test a path one row longer at every row).
+    A path that begins with one tested before in this thread (the same
+    times, positions and samples to read, bitwise, the same window) is
+    tested again only from ``3 x window`` seen samples before that one's end:
+    a sample's flag reads the samples within three windows of it, so those
+    before are as they were (a stream's landmarks test a path one row longer
+    at every row). Only those samples are gathered again, not the whole
+    path's.
 
     Parameters
     ----------
@@ -238,29 +240,35 @@ def spikes(time: np.ndarray, path: np.ndarray, ok: np.ndarray | None = None,
         landmarks test three paths on one clock); default: found here.
     """
     params = CleaningParams() if params is None else params
-    ok = finite_rows(path) if ok is None else ok
+    time, path = np.asarray(time, dtype=float), np.asarray(path)
+    ok = finite_rows(path) if ok is None else np.asarray(ok, dtype=bool)
     dt = step if step is not None else float(np.median(np.diff(time))) if len(time) > 1 else 1.0
     half = max(1, int(round(params.spike_window / dt)))
-    idx = np.flatnonzero(ok)
+    kept = _SPIKES.longest((half, params), (time, path, ok),
+                           first=lambda series: _last_alike(series, path))
+    # the seen samples: those of the kept rows as they were, then the new rows'
+    rows = 0 if kept is None else len(kept[0][0])
+    idx = np.flatnonzero(ok[rows:]) + rows
+    if kept is not None:
+        idx = np.concatenate([kept[1][0], idx])
     if len(idx) < 2 * half + 1:
         return np.zeros(len(path), dtype=bool)
-    seen = path[idx]
-    ts = np.asarray(time, dtype=float)[idx]
-    kept = _SPIKES.longest((half, params), (ts, seen), first=lambda series: _last_alike(
-        series, seen))
     # A sample's first flag reads the ``half`` samples either side (the median; mirrored
     # at the path's end), and its final flag the first flags within ``2 x half`` of it
     # and the final flags before it: those ``3 x half`` or more before the kept path's
     # end never read past it, and their flags are that path's
-    start = 0 if kept is None else max(0, len(kept[0][0]) - 3 * half - 1)
-    before = np.zeros(0, dtype=bool) if kept is None else kept[1][:start]
+    start = 0 if kept is None else max(0, len(kept[1][0]) - 3 * half - 1)
+    before = np.zeros(0, dtype=bool) if kept is None else kept[1][1][:start]
+    # the seen samples read from here on: within twice the window before ``start``
+    r0 = max(0, start - 2 * half)
+    seen, ts = path[idx[r0:]], time[idx[r0:]]
     # mirrored at the ends, so that a first sample off the path meets the
     # samples after it, not copies of itself; a sample's median reads ``half``
     # either side, so from ``start - half`` on the medians from ``start`` are
     # those of the whole path
     lo = max(0, start - half)
-    med = median_filter(seen[lo:], size=(2 * half + 1, 1), mode="mirror")[start - lo:]
-    off = np.r_[before, np.linalg.norm(seen[start:] - med, axis=1) > params.spike_distance]
+    med = median_filter(seen[lo - r0:], size=(2 * half + 1, 1), mode="mirror")[start - lo:]
+    off = np.concatenate([before, row_norm(seen[start - r0:] - med) > params.spike_distance])
     # A spike in the window shifts its neighbours' median by one sample's motion,
     # which at video rates (33 ms a frame) is a centimetre of a fast reach: a
     # sample found off is judged again against the samples around it that are
@@ -269,28 +277,30 @@ def spikes(time: np.ndarray, path: np.ndarray, ok: np.ndarray | None = None,
     # kept if it lies on their path.
     for i in np.flatnonzero(off[start:]) + start:
         # the nearest samples not found off, within twice the window either side
-        near = np.arange(max(0, i - 2 * half), min(len(seen), i + 2 * half + 1))
+        near = np.arange(max(0, i - 2 * half), min(len(idx), i + 2 * half + 1))
         near = near[~off[near]]
-        lo, hi = near[near < i], near[near > i]
+        lo, hi = near[near < i] - r0, near[near > i] - r0
+        j = i - r0
         if len(lo) and len(hi):
             a, b = lo[-1], hi[0]
-            ref = seen[a] + (ts[i] - ts[a]) / (ts[b] - ts[a]) * (seen[b] - seen[a])
+            ref = seen[a] + (ts[j] - ts[a]) / (ts[b] - ts[a]) * (seen[b] - seen[a])
         else:  # at an end of the path: the median of those within the window
-            close = near[np.abs(near - i) <= half]
+            close = near[np.abs(near - i) <= half] - r0
             ref = np.median(seen[close], axis=0) if len(close) else None
-        if ref is not None and np.linalg.norm(seen[i] - ref) <= params.spike_distance:
+        if ref is not None and np.linalg.norm(seen[j] - ref) <= params.spike_distance:
             off[i] = False
-    _SPIKES.keep((half, params), (ts, seen), off, kept)  # the path it resumed superseded
+    # the path it resumed superseded
+    _SPIKES.keep((half, params), (time, path, ok), (idx, off), kept)
     out = np.zeros(len(path), dtype=bool)
     out[idx[off]] = True
     return out
 
 
-def _last_alike(series: tuple, seen: np.ndarray) -> bool:
-    """Whether a kept path's last sample is ``seen``'s at that row: another marker's path
+def _last_alike(series: tuple, path: np.ndarray) -> bool:
+    """Whether a kept path's last row is ``path``'s at that row: another marker's path
     differs there, told apart before comparing all."""
     n = len(series[0])
-    return 0 < n <= len(seen) and np.array_equal(series[1][-1], seen[n - 1], equal_nan=True)
+    return 0 < n <= len(path) and np.array_equal(series[1][-1], path[n - 1], equal_nan=True)
 
 
 #: Paths kept per thread: a recognition's landmarks test three markers' paths.

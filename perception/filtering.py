@@ -47,7 +47,7 @@ def alpha_beta(z: np.ndarray, dt: np.ndarray | float, alpha: float, beta: float)
     """
     z = np.asarray(z, dtype=float)
     dt = np.broadcast_to(np.asarray(dt, dtype=float), (z.shape[0],))
-    out = np.full_like(z, np.nan)
+    out = np.empty_like(z)  # every row is written below: the kept ones, then each new one
     # the online recogniser observes the rows so far after every row: each call is the
     # last one's series and a row more; the filter is causal, so the rows it filtered
     # are filtered alike (the same operations on the same numbers)

@@ -75,6 +75,30 @@ def _filtfilt(b: np.ndarray, a: np.ndarray, zi: np.ndarray, x: np.ndarray) -> np
     return y[::-1][edge:-edge]
 
 
+def _gradient_rows(f: np.ndarray, x: np.ndarray, lo: int, hi: int) -> np.ndarray:
+    """``np.gradient(f, x)[lo:hi]`` for (N,) ``f`` and ``x`` (N >= 2), bit for bit: its
+    formulas (uniform steps where every step is the first, else the second-order
+    non-uniform one; one-sided at the ends) on those rows alone, not every row of a
+    stream's clip."""
+    dx = np.diff(x)
+    out = np.empty(hi - lo)
+    a, b = max(lo, 1), min(hi, len(f) - 1)  # the interior rows asked for
+    if b > a:
+        if (dx == dx[0]).all():
+            out[a - lo:b - lo] = (f[a + 1:b + 1] - f[a - 1:b - 1]) / (2. * dx[0])
+        else:
+            dx1, dx2 = dx[a - 1:b - 1], dx[a:b]
+            ca = -(dx2) / (dx1 * (dx1 + dx2))
+            cb = (dx2 - dx1) / (dx1 * dx2)
+            cc = dx1 / (dx2 * (dx1 + dx2))
+            out[a - lo:b - lo] = ca * f[a - 1:b - 1] + cb * f[a:b] + cc * f[a + 1:b + 1]
+    if lo == 0 < hi:
+        out[0] = (f[1] - f[0]) / dx[0]
+    if lo < len(f) == hi:
+        out[-1] = (f[-1] - f[-2]) / dx[-1]
+    return out
+
+
 def _step(time: np.ndarray) -> float:
     """The median time step, s (NaN with fewer than two samples)."""
     return float(np.median(np.diff(time))) if len(time) > 1 else math.nan
@@ -559,8 +583,8 @@ def _landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.ndarray,
     elif (gap := gap_near(time, lost_grip, t_open, reach)) is not None:
         flags["opening_time"] = (f"inside a gap: a digit was lost for {gap * 1000:.0f} ms "
                                  "where the grip opened")
-    rate = np.gradient(g, time)
-    widening = rate[lo:j + 1][np.isfinite(rate[lo:j + 1])]
+    rate = _gradient_rows(g, time, lo, j + 1)
+    widening = rate[np.isfinite(rate)]
     if not len(widening):
         flags["peak_opening_speed"] = "not seen: the aperture is lost before the MGA"
     return Landmarks(

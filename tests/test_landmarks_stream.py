@@ -102,3 +102,17 @@ def test_rows_tested_and_measured_a_column_at_a_time_are_numpys():
             assert np.array_equal(finite_rows(y), np.isfinite(y).all(axis=1))
         assert np.array_equal(finite_rows(x.reshape(-1, 1, k)), np.isfinite(x).all(axis=1))
     assert finite_rows(np.zeros((0, 2))).shape == (0,)
+
+
+def test_the_opening_speed_reads_the_gradient_of_its_rows_alone_bit_for_bit():
+    rng = np.random.default_rng(7)
+    for n in (2, 3, 11, 40):
+        steps = (np.full(n, 0.25), rng.random(n) + 0.5, np.full(n, 1 / 30.0))
+        for x in (np.cumsum(s) for s in steps):
+            f = rng.normal(size=n)
+            f[rng.random(n) < 0.1] = np.nan
+            want = np.gradient(f, x)
+            for lo in range(n):
+                for hi in range(lo, n + 1):
+                    got = landmarks._gradient_rows(f, x, lo, hi)
+                    assert got.tobytes() == want[lo:hi].tobytes(), (n, lo, hi)
