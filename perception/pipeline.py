@@ -173,9 +173,20 @@ def file_sha256(path: str | os.PathLike) -> str:
     path : str or os.PathLike
         The file.
     """
+    key = _file_key(path)
+    return _KNOWN.get(key) or _sha256(key)
+
+
+def _file_key(path: str | os.PathLike) -> tuple[Path, int, int]:
     p = Path(path).resolve()
     st = p.stat()
-    return _sha256((p, st.st_size, st.st_mtime_ns))
+    return p, st.st_size, st.st_mtime_ns
+
+
+#: SHA-256s of files hashed elsewhere in this process, by :func:`_file_key`: a video's,
+#: read while it was decoded (the tracker hashes what it decodes), not read again for its
+#: fingerprint.
+_KNOWN: dict[tuple[Path, int, int], str] = {}
 
 
 @functools.lru_cache(maxsize=256)
@@ -251,9 +262,13 @@ def load_clip(source: str | os.PathLike | Tracks, *, tracks_out: str | os.PathLi
     from perception.tracking.video_tracks import track_video  # OpenCV only when there is video
 
     kw = {} if setup is None else {"markers": setup.markers, "params": setup.params}
-    return Tracks.load(track_video(path, out, progress=progress, keep_truncated=keep_truncated,
-                                   fps=fps, frames=frames, decoder_threads=decoder_threads,
-                                   **kw))
+    key = _file_key(path)  # before decoding: a file changed meanwhile is hashed again
+    tracks = Tracks.load(track_video(path, out, progress=progress,
+                                     keep_truncated=keep_truncated, fps=fps, frames=frames,
+                                     decoder_threads=decoder_threads, **kw))
+    if tracks.video.get("sha256") and _file_key(path) == key:
+        _KNOWN[key] = tracks.video["sha256"]
+    return tracks
 
 
 #: ``/tracker`` attributes that describe what a tracker learned from the clip

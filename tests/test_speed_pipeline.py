@@ -118,6 +118,26 @@ def test_current_tracks_file_is_reused_and_a_stale_one_is_not(tmp_path, monkeypa
     assert current_tracks(clip.video, [roi]) is None  # other tracker settings
 
 
+def test_a_tracked_video_is_hashed_once_for_its_fingerprint(tmp_path):
+    """The tracker hashes what it decodes; the fingerprint takes that hash, and a file
+    changed since is hashed again."""
+    import hashlib
+
+    from perception import pipeline
+    from perception.synthetic.demos import render_demo_clip
+
+    clip, _ = render_demo_clip(tmp_path, "h.mp4", n=12)
+    pipeline.load_clip(clip.video, tracks_out=tmp_path / "h.tracks.h5")
+    read = pipeline._sha256.cache_info().misses
+    want = hashlib.sha256(clip.video.read_bytes()).hexdigest()
+    assert pipeline.file_sha256(clip.video) == want
+    assert pipeline._sha256.cache_info().misses == read  # not read again
+    with open(clip.video, "ab") as fh:  # changed: its own hash
+        fh.write(b"\0")
+    assert pipeline.file_sha256(clip.video) == hashlib.sha256(
+        clip.video.read_bytes()).hexdigest() != want
+
+
 def test_a_report_without_figures_removes_stale_ones(tmp_path):
     from perception.pipeline import recognize_clip
     from perception.report.clip import clip_outputs, write_clip_report
