@@ -35,6 +35,7 @@ from perception.landmark_flags import (
     why_not_open,
 )
 from perception.landmark_values import _NAMES, OK, Landmarks
+from perception.resume import Kept
 from perception.rowwise import finite_rows, row_norm
 from perception.validation import Int, Share, declared
 
@@ -97,6 +98,18 @@ def _gradient_rows(f: np.ndarray, x: np.ndarray, lo: int, hi: int) -> np.ndarray
     if lo < len(f) == hi:
         out[-1] = (f[-1] - f[-2]) / dx[-1]
     return out
+
+
+def _last_alike(series: tuple, flat: np.ndarray) -> bool:
+    """Whether a kept series' last row is ``flat``'s at that row, bitwise: another
+    series is told apart before comparing all."""
+    n = len(series[0])
+    return 0 < n <= len(flat) and series[0][-1].tobytes() == flat[n - 1].tobytes()
+
+
+#: Series low-passed in this thread whose runs a lost row closed, with those runs
+#: filtered (:meth:`LandmarkParams.lowpass`): a movement's transport and aperture.
+_LOWPASSED = Kept(4)
 
 
 def _step(time: np.ndarray) -> float:
@@ -215,13 +228,30 @@ class LandmarkParams:
         x = np.array(values, dtype=float)
         if self.cutoff is None or len(time) < 2:
             return x
-        b, a, zi = _butter(self.order, min(self.cutoff / (0.5 * (1.0 / step)), 0.95))
+        wn = min(self.cutoff / (0.5 * (1.0 / step)), 0.95)
+        b, a, zi = _butter(self.order, wn)
         flat = x.reshape(len(x), -1)
         ok = finite_rows(flat)
         edges = np.diff(np.r_[0, ok.astype(np.int8), 0])
-        for lo, hi in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)):
-            if hi - lo > 3 * max(len(a), len(b)):
+        starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+        # A run a lost row has closed is filtered on its own values alone: a series that
+        # begins with it and that row (a stream's next rows) filters it alike, so the
+        # runs closed in the longest such series filtered before are taken as they came
+        # out (a stream that loses a marker now and then filtered every run at every row)
+        key = (self.order, wn)
+        kept = _LOWPASSED.longest(key, (flat,), first=lambda series: _last_alike(series, flat))
+        done = 0 if kept is None else kept[1][0]
+        closed = stops[stops < len(flat)]
+        closed = int(closed[-1]) if len(closed) else 0  # the last closed run's end
+        raw = flat[:closed + 1].copy() if closed > done else None
+        if done:
+            flat[:done] = kept[1][1]
+        width = 3 * max(len(a), len(b))
+        for lo, hi in zip(starts, stops):
+            if lo >= done and hi - lo > width:
                 flat[lo:hi] = _filtfilt(b, a, zi, flat[lo:hi])
+        if raw is not None:  # these rows, the row that closed the last run among them
+            _LOWPASSED.keep(key, (raw,), (closed, flat[:closed].copy()), kept)
         return flat.reshape(x.shape)
 
     def speed_of(self, time: np.ndarray, path: np.ndarray) -> np.ndarray:

@@ -116,3 +116,39 @@ def test_the_opening_speed_reads_the_gradient_of_its_rows_alone_bit_for_bit():
                 for hi in range(lo, n + 1):
                     got = landmarks._gradient_rows(f, x, lo, hi)
                     assert got.tobytes() == want[lo:hi].tobytes(), (n, lo, hi)
+
+
+def test_runs_a_gap_closed_are_filtered_once_and_alike():
+    """A stream that loses a marker now and then: after every row, the low-passed path
+    resumed from the row before is the fresh one, bitwise, and only the run still open
+    at the end is filtered again (was every run at every row)."""
+    rng = np.random.default_rng(3)
+    n = 300
+    t = np.arange(n) / 30.0
+    x = np.cumsum(rng.normal(size=(n, 2)), axis=0)
+    x[rng.choice(n, 25, replace=False)] = np.nan
+    x[100:103] = np.nan
+    params = landmarks.LandmarkParams()
+    filtered = []
+    zero_lag = landmarks._filtfilt
+
+    def counted(*args):
+        filtered.append(len(args[3]))
+        return zero_lag(*args)
+
+    landmarks._LOWPASSED.local.__dict__.clear()
+    for m in range(2, n + 1):
+        resumed = params.lowpass(t[:m], x[:m])
+        saved = dict(landmarks._LOWPASSED.local.__dict__)
+        landmarks._LOWPASSED.local.__dict__.clear()
+        assert resumed.tobytes() == params.lowpass(t[:m], x[:m]).tobytes(), m
+        landmarks._LOWPASSED.local.__dict__.update(saved)
+    landmarks._LOWPASSED.local.__dict__.clear()
+    params.lowpass(t[:199], x[:199])
+    landmarks._filtfilt = counted
+    try:
+        for m in range(200, 300):
+            params.lowpass(t[:m], x[:m])
+    finally:
+        landmarks._filtfilt = zero_lag
+    assert len(filtered) <= 100  # one open run a row at most, not the 20-odd closed ones
