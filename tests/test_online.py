@@ -150,7 +150,9 @@ def test_an_abnormal_familiarity_waits_for_the_stream_s_end(rep):
     not conclusive early: an `abnormal` resting on familiarity settles only at the end
     (as offline), while a normal grasp under the usual threshold settles before it."""
     tracks = _tracks("normal")
-    strict = RecognitionSettings(rules=VerdictRules(familiarity_threshold=0.999))
+    # above the grasp's familiarity (0.45), under its transport's (0.81): `abnormal`, not
+    # a transport that departs
+    strict = RecognitionSettings(rules=VerdictRules(familiarity_threshold=0.6))
     rec, states = _feed(rep, tracks, settings=strict, settle=SettleRule(margin=0.0))
     final = rec.finish()
     assert (final.verdict, final.verdict_rule) == ("abnormal", "familiarity")
