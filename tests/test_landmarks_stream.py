@@ -152,3 +152,19 @@ def test_runs_a_gap_closed_are_filtered_once_and_alike():
     finally:
         landmarks._filtfilt = zero_lag
     assert len(filtered) <= 100  # one open run a row at most, not the 20-odd closed ones
+
+
+def test_the_markers_paths_are_copied_apart_bit_for_bit():
+    raw = np.random.default_rng(4).normal(size=(50, 3, 2))
+    raw[3, 1, 0] = np.nan
+    raw[4, 2, 1] = -0.0
+    raw.view(np.int64)[7, 0, 0] = 0x7FF8000000000123  # a NaN with a payload
+    before = raw.copy()
+    paths = landmarks._by_marker(raw)
+    assert paths.shape == (3, 50, 2) and paths.flags.c_contiguous
+    assert all(paths[k].tobytes() == raw[:, k].tobytes() for k in range(3))
+    paths[:] = 0.0  # a copy: the observation's positions stay
+    assert raw.tobytes() == before.tobytes()
+    one = np.ones((4, 1, 2))
+    landmarks._by_marker(one)[:] = 0.0
+    assert (one == 1.0).all()
