@@ -514,7 +514,7 @@ def rest_scene(tracks, params: ObserveParams | None = None, *,
         scene = RestScene(where, time, dts, float(np.median(dts)), transform, raw, rest, noise)
     for a in (scene.dts, scene.raw, scene.rest):
         a.flags.writeable = False  # shared by the observations made from the same rows
-    _SCENES.keep(key, (np.array(tracks.time), np.array(tracks.position)), scene)
+    _SCENES.keep(key, (tracks.time, tracks.position), scene)  # Kept copies them
     return scene
 
 

@@ -32,8 +32,10 @@ import perception.filtering as filtering
 import perception.movement_bounds as movement_bounds
 import perception.observation as observation
 import perception.recognition.engine as engine
+import perception.recognition.evidence as evidence
 import perception.recognition.leaves as leaves
 from perception.errors import InputError
+from perception.landmarks import _LOWPASSED
 from perception.observation import ObserveParams
 from perception.online import OnlineRecognizer
 from perception.pipeline import recognize_tracks
@@ -43,7 +45,7 @@ from perception.synthetic.independent import draw_independent, independent_track
 #: what the passes keep between calls, per thread
 KEPT = (observation._SCENES.local, movement_bounds._ONSET.local, movement_bounds._END.local,
         cleaning._SPIKES.local, engine._SCORED.local, engine._RESUMABLE.local,
-        filtering._KEPT.local)
+        filtering._KEPT.local, evidence._ARRIVAL.local, _LOWPASSED.local)
 
 
 def _forget():
