@@ -105,9 +105,13 @@ class SimilarityTransform:
     def to_model(self, px: np.ndarray) -> np.ndarray:
         """Pixels ``(..., 2)`` -> model frame ``(..., 2)``, m (NaN stays NaN)."""
         rel = np.asarray(px, dtype=np.float64) - self.origin_px
-        up = (np.stack([rel[..., 0], -rel[..., 1]], axis=-1) if self.y_down else rel
-              ) / self.px_per_m
-        return up @ self.basis
+        u = rel[..., 0] / self.px_per_m
+        w = (-rel[..., 1] if self.y_down else rel[..., 1]) / self.px_per_m
+        b = self.basis
+        # element by element, not a matrix product (whose kernels may round a row
+        # differently with other rows beside it): a row maps alike in any array, so a
+        # stream maps only its new rows (perception.observation)
+        return np.stack([u * b[0, 0] + w * b[1, 0], u * b[0, 1] + w * b[1, 1]], axis=-1)
 
     def to_pixels(self, xy: np.ndarray) -> np.ndarray:
         """Model frame ``(..., 2)``, m -> pixels ``(..., 2)`` (NaN stays NaN)."""

@@ -526,11 +526,10 @@ def _extended(scene: RestScene, n: int, tracks, params: ObserveParams) -> RestSc
     """The scene fixed from the first ``n`` rows of ``tracks``, with the rows after them.
 
     What the first rows fix (the transform, the rest posture and its noise,
-    the checks on them) stands; the new rows are checked and the frame
-    periods' median taken again; the model-frame positions are mapped again
-    whole (a mapping of the new rows alone is not promised to round alike).
-    None where a new row would be refused: :func:`rest_scene` then refuses
-    the rows as a fresh pass does.
+    the checks on them) stands; the new rows are checked, mapped to the model
+    frame (a row maps alike in any array: :meth:`SimilarityTransform.to_model`)
+    and the frame periods' median taken again. None where a new row would be
+    refused: :func:`rest_scene` then refuses the rows as a fresh pass does.
     """
     pos = np.asarray(tracks.position, dtype=float)
     time = np.asarray(tracks.time, dtype=float)
@@ -545,11 +544,9 @@ def _extended(scene: RestScene, n: int, tracks, params: ObserveParams) -> RestSc
     lo, hi = params.frame_period_range
     if not lo * (1 - 1e-6) <= dt <= hi * (1 + 1e-6):
         return None
-    raw = np.stack([scene.transform.to_model(pos[:, markers.index(m)])
+    new = np.stack([scene.transform.to_model(pos[n:, markers.index(m)])
                     for m in DIGIT_MARKERS], axis=1)
-    if not np.array_equal(raw[: params.rest_frames], scene.raw[: params.rest_frames]):
-        return None  # the rest fixed from other numbers: fixed again
-    return scene._replace(time=time, dts=dts, dt=dt, raw=raw)
+    return scene._replace(time=time, dts=dts, dt=dt, raw=np.concatenate([scene.raw, new]))
 
 
 def _prepare(tracks, params: ObserveParams, name: str) -> _Prepared:

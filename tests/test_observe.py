@@ -29,6 +29,19 @@ def test_pixel_transform_round_trip():
     assert d_px == pytest.approx(750.0 * d_m)
 
 
+def test_a_row_maps_alike_whatever_rows_come_with_it():
+    """A stream maps only its new rows: each row's model-frame position is the same bits
+    in a part as in the whole (a matrix product need not round so)."""
+    tr = SimilarityTransform(np.array([312.4, 201.7]), 812.3, 1.234, mirror=True)
+    px = np.random.default_rng(2).uniform(0, 640, (1001, 2))
+    whole = tr.to_model(px)
+    for k in (1, 7, 500, 1000):
+        np.testing.assert_array_equal(np.concatenate([tr.to_model(px[:k]), tr.to_model(px[k:])]),
+                                      whole)
+    np.testing.assert_allclose(whole, (np.stack([px[:, 0] - 312.4, 201.7 - px[:, 1]], axis=-1)
+                                       / 812.3) @ tr.basis, rtol=0, atol=1e-15)
+
+
 def test_a_planes_metres_map_without_flip_or_scale():
     """y up: a point up the plane is up the model's axis the rotation names, lengths kept."""
     tr = SimilarityTransform(np.array([0.3, -0.2]), 1.0, 0.4, mirror=True, y_down=False)
