@@ -8,7 +8,7 @@ of every trial or movement that gives none (:class:`~perception.reaches.Unscored
 a :class:`Recording`. One trial's failure never stops the trials after it.
 :func:`read_reaches` is its reaches alone. :func:`recognize_reach` scores one
 reach, in the movement's own plane, with the settings the reach's own
-geometry asks for (its scale is a millimetre per "pixel", its object's size
+geometry asks for (its tracks are metres in that plane, its object's size
 is the grip's or the one given, and the digits need not touch at rest), and
 measures its landmarks by the verdict rules' ``[verdict.landmarks]``, as a
 video's are: :func:`prepare_reach`, then the recognition with the reach's 3D
@@ -533,8 +533,8 @@ class PreparedReach(NamedTuple):
         reach finder's own bounds only choose the reach's window), and the
         recording's clock.
     settings : RecognitionSettings
-        The settings its geometry asks for: a millimetre per "pixel", the
-        grip's object size, a whole hand's rest aperture.
+        The settings its geometry asks for: the grip's object size, a whole
+        hand's rest aperture.
     """
 
     tracks: object
