@@ -33,7 +33,7 @@ from perception.recognition.provisional import (
 )
 from perception.recognition.repertoire import PlanCache, Repertoire
 from perception.recognition.result import Recognition
-from perception.recognition.rules import judge
+from perception.recognition.rules import AT_END, judge
 
 __all__ = ["Decision", "OnlineRecognizer", "OnlineState", "SettleRule", "decision_summary"]
 
@@ -215,8 +215,10 @@ class OnlineRecognizer:
         d, rules = rec.decision, self.settings.rules
         since = t - rec.time_origin  # the onset on the stream's clock
         grip = grip_course(rec)
-        answer = self.settle.settles(judge(rec.evidence, rules, ongoing=True), rec.evidence,
-                                     grip, rules)
+        # the verdict if the movement ends as it goes: the offline one unless a rule about
+        # the movement's end gave it (only then judged again)
+        ongoing = d if d.rule not in AT_END else judge(rec.evidence, rules, ongoing=True)
+        answer = self.settle.settles(ongoing, rec.evidence, grip, rules)
         if self._answer is None or self._answer[1] != answer:
             self._answer = (since, answer)
         if (self._decision is None and answer is not None

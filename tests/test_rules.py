@@ -81,6 +81,13 @@ def test_a_movement_still_being_seen_is_not_cut_short():
                      ({"aperture_gap": 0.5}, "insufficient-data"),
                      ({"observed": Landmarks(aperture_peaks=2)}, "grip-departs")):
         assert judge(_evidence(slowed=0.3, **kw), ongoing=True).rule == rule
+    # a verdict no rule of AT_END gave is the ongoing one too (the online path judges again
+    # only after such a rule)
+    for kw in ({}, {"transport_familiarity": 0.001}, {"aperture_gap": 0.5},
+               {"familiarity": np.array([0.01, 0.9]), "transport_familiarity": 0.03},
+               {"observed": Landmarks(aperture_peaks=2)}):
+        d = judge(_evidence(**kw))
+        assert d.rule not in AT_END and judge(_evidence(**kw), ongoing=True) == d
 
 
 def test_peaks_the_landmarks_could_not_count_leave_the_digits_unseen():
