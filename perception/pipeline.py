@@ -25,10 +25,10 @@ calls step 2-5 on the rows received so far (docs/architecture.md):
 from __future__ import annotations
 
 import dataclasses
-import functools
 import hashlib
 import json
 import os
+import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -174,27 +174,35 @@ def file_sha256(path: str | os.PathLike) -> str:
         The file.
     """
     key = _file_key(path)
-    return _KNOWN.get(key) or _sha256(key)
+    known = _HASHES.get(key)
+    if known is None:
+        from perception.io.files import sha256_file
+
+        known = sha256_file(key[0])
+        _hashed(key, known)
+    return known
 
 
 def _file_key(path: str | os.PathLike) -> tuple[Path, int, int]:
+    """A file as its hash is kept: its path, size and time (a changed file is a new key)."""
     p = Path(path).resolve()
     st = p.stat()
     return p, st.st_size, st.st_mtime_ns
 
 
-#: SHA-256s of files hashed elsewhere in this process, by :func:`_file_key`: a video's,
-#: read while it was decoded (the tracker hashes what it decodes), not read again for its
-#: fingerprint.
-_KNOWN: dict[tuple[Path, int, int], str] = {}
+#: SHA-256s by :func:`_file_key`, the newest last: the files this process hashed, and the
+#: videos the tracker hashed while it decoded them (:func:`load_clip`).
+_HASHES: dict[tuple[Path, int, int], str] = {}
+_HASHES_LOCK = threading.Lock()
 
 
-@functools.lru_cache(maxsize=256)
-def _sha256(key: tuple[Path, int, int]) -> str:
-    """SHA-256 of ``key[0]``; its size and time in the key make a changed file a new entry."""
-    from perception.io.files import sha256_file
-
-    return sha256_file(key[0])
+def _hashed(key: tuple[Path, int, int], sha256: str) -> None:
+    """Keep a file's hash, the 256 newest at most (a batch worker hashes many files)."""
+    with _HASHES_LOCK:
+        _HASHES.pop(key, None)
+        _HASHES[key] = sha256
+        while len(_HASHES) > 256:
+            del _HASHES[next(iter(_HASHES))]
 
 
 def load_clip(source: str | os.PathLike | Tracks, *, tracks_out: str | os.PathLike | None = None,
@@ -267,7 +275,7 @@ def load_clip(source: str | os.PathLike | Tracks, *, tracks_out: str | os.PathLi
                                      keep_truncated=keep_truncated, fps=fps, frames=frames,
                                      decoder_threads=decoder_threads, **kw))
     if tracks.video.get("sha256") and _file_key(path) == key:
-        _KNOWN[key] = tracks.video["sha256"]
+        _hashed(key, tracks.video["sha256"])
     return tracks
 
 

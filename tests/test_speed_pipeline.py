@@ -118,24 +118,34 @@ def test_current_tracks_file_is_reused_and_a_stale_one_is_not(tmp_path, monkeypa
     assert current_tracks(clip.video, [roi]) is None  # other tracker settings
 
 
-def test_a_tracked_video_is_hashed_once_for_its_fingerprint(tmp_path):
+def test_a_tracked_video_is_hashed_once_for_its_fingerprint(tmp_path, monkeypatch):
     """The tracker hashes what it decodes; the fingerprint takes that hash, and a file
     changed since is hashed again."""
     import hashlib
 
     from perception import pipeline
+    from perception.io import files
     from perception.synthetic.demos import render_demo_clip
 
     clip, _ = render_demo_clip(tmp_path, "h.mp4", n=12)
     pipeline.load_clip(clip.video, tracks_out=tmp_path / "h.tracks.h5")
-    read = pipeline._sha256.cache_info().misses
+    read = []
+    monkeypatch.setattr(files, "sha256_file", _counted(files.sha256_file, read))
     want = hashlib.sha256(clip.video.read_bytes()).hexdigest()
     assert pipeline.file_sha256(clip.video) == want
-    assert pipeline._sha256.cache_info().misses == read  # not read again
+    assert pipeline.file_sha256(clip.video) == want and read == []  # not read again
     with open(clip.video, "ab") as fh:  # changed: its own hash
         fh.write(b"\0")
     assert pipeline.file_sha256(clip.video) == hashlib.sha256(
         clip.video.read_bytes()).hexdigest() != want
+    assert len(read) == 1
+
+
+def _counted(fn, calls):
+    def counted(path):
+        calls.append(path)
+        return fn(path)
+    return counted
 
 
 def test_a_report_without_figures_removes_stale_ones(tmp_path):
