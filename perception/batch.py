@@ -403,8 +403,9 @@ def run_batch(
         results = _run_local([_Work(*pair) for pair in pairs], repertoire, job, jobs)
     with ModelRows(out) as rows:  # every model's curves on disk, not in this process
         done = _collected(results, rows, streamed, len(items), quiet)
+        # with a scheduler `jobs` is the cluster's: the report's statistics fit here, alone
         return _finish(done, rows, items, found if streamed else None, late, job, repertoire,
-                       settings, skipped, t0, t1, repertoire_id, jobs)
+                       settings, skipped, t0=t0, t1=t1, jobs=1 if scheduler else jobs)
 
 
 def _collected(results: Iterable[ClipResult], rows: ModelRows, streamed: bool, n: int,
@@ -424,8 +425,8 @@ def _collected(results: Iterable[ClipResult], rows: ModelRows, streamed: bool, n
 
 def _finish(done: list[ClipResult], rows: ModelRows, items: list[BatchItem],
             found: list[BatchItem] | None, late: list, job: _Job, repertoire: Repertoire,
-            settings: RecognitionSettings, skipped, t0: float, t1: float,
-            repertoire_id: str, jobs: int) -> pd.DataFrame:
+            settings: RecognitionSettings, skipped, *, t0: float, t1: float,
+            jobs: int) -> pd.DataFrame:
     """The batch's report from its results (:func:`run_batch`'s last steps)."""
     from perception.report.batch import write_batch_report
     from perception.report.conditions import reference_model
@@ -458,7 +459,7 @@ def _finish(done: list[ClipResult], rows: ModelRows, items: list[BatchItem],
             "not_scored": [{"clip": r.clip, "status": r.status, "reason": r.reason}
                            for r in done if not r.scored],
             "skipped": [{"file": n, "reason": why} for n, why in skipped],
-            "settings": settings.fingerprint(), "repertoire": repertoire_id,
+            "settings": settings.fingerprint(), "repertoire": job.repertoire_id,
             "code": code_digest()})
     except BaseException:  # none of the set rather than part of it
         _remove_report(out)

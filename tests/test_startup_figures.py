@@ -26,6 +26,7 @@ def test_the_canvas_measures_a_string_as_agg_measures_it():
     from matplotlib.backends.backend_agg import RendererAgg
     from matplotlib.font_manager import FontProperties
 
+    canvas._EXTENTS.clear()  # the first call measures, whatever ran before in this process
     fig = _figure([])
     ours = fig.canvas.get_renderer()
     agg = RendererAgg(300, 200, 100)

@@ -297,12 +297,16 @@ def _watched(cmd: list[str]) -> tuple[float, float, int, int]:
     forkserver's children, not its own), and the peak resident memory of its whole
     process tree and of the process itself, bytes (psutil, every 0.1 s)."""
     import subprocess
+    import tempfile
 
     import psutil
 
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
-    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, cwd=ROOT)
+    # stderr to a file: a pipe read only at the end fills (64 kB of "not scored" lines)
+    # and blocks the command while this loop waits for it
+    err_file = tempfile.TemporaryFile()
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=err_file, cwd=ROOT)
     watched = psutil.Process(proc.pid)
     tree_peak = own_peak = 0
     while proc.poll() is None:
@@ -314,8 +318,11 @@ def _watched(cmd: list[str]) -> tuple[float, float, int, int]:
             break
         own_peak, tree_peak = max(own_peak, own), max(tree_peak, tree)
         time.sleep(0.1)
-    err = proc.stderr.read().decode(errors="replace")
-    if proc.wait() not in (0, 1):  # 1: a trial not scored, said in the report
+    status = proc.wait()
+    err_file.seek(0)
+    err = err_file.read().decode(errors="replace")
+    err_file.close()
+    if status not in (0, 1):  # 1: a trial not scored, said in the report
         raise RuntimeError(f"{' '.join(cmd)} failed:\n{err[-2000:]}")
     wall = time.perf_counter() - t0
     after = resource.getrusage(resource.RUSAGE_CHILDREN)

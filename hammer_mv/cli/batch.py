@@ -95,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
               f"{len(unscored)} not scored -> {args.output / 'report.html'}")
         print(trial_summary(summary.attrs.get("trials", len(summary)), scored,
                             len(summary) - scored))
-        for line in warnings_summary(_warnings(summary, args.output), "clips"):
+        for line in warnings_summary(_warnings(summary), "clips"):
             print(f"hammer-mv batch: warning: {line}", file=sys.stderr)
     why = unscored["reason"] if "reason" in unscored else unscored["error"]
     for clip, reason in zip(unscored["clip"], why):  # always: nothing dropped without a word
@@ -106,30 +106,10 @@ def run(args: argparse.Namespace) -> int:
     return 1 if failed or len(unscored) else 0
 
 
-def _warnings(summary, out: Path) -> list[tuple[str, list[dict]]]:
-    """Each scored clip's warnings (its report's ``warning_values``), for one summary of
-    the batch's: a report written before they were recorded counts as without.
-
-    ``run_batch`` gives them in the summary's ``attrs``; only a summary without
-    them (made by other code) has its reports read back, about 1 ms a clip."""
-    import json
-
-    from perception.report.clip import clip_outputs
-
-    kept = summary.attrs.get("warnings")
-    if kept is not None:
-        return [(clip, list(values)) for clip, values in kept.by_clip]
-    found = []
-    for clip, status in zip(summary["clip"], summary["status"]):
-        if status != "ok":
-            continue
-        try:
-            report = json.loads(clip_outputs(out, clip)["json"].read_text())
-        except (OSError, ValueError):
-            report = {}
-        values = report.get("warning_values") if isinstance(report, dict) else None
-        found.append((clip, values if isinstance(values, list) else []))
-    return found
+def _warnings(summary) -> list[tuple[str, list[dict]]]:
+    """Each scored clip's warnings (its report's ``warning_values``), as ``run_batch``
+    gives them in the summary's ``attrs``."""
+    return [(clip, list(values)) for clip, values in summary.attrs["warnings"].by_clip]
 
 
 def _not_over_inputs(source: Path, out: Path) -> None:

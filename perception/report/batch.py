@@ -377,13 +377,21 @@ def _statistics_soon(measures: pd.DataFrame, jobs: int) -> Callable[[], pd.DataF
     if not fitted_in_workers(measures, jobs):
         table = landmark_statistics(measures)
         return lambda: table
-    from concurrent.futures import ThreadPoolExecutor
+    import threading
+    from concurrent.futures import Future
 
-    pool = ThreadPoolExecutor(1, thread_name_prefix="statistics")  # it waits on the workers
-    try:
-        return pool.submit(landmark_statistics, measures, jobs).result
-    finally:
-        pool.shutdown(wait=False)
+    done: Future = Future()
+
+    def fit() -> None:
+        try:
+            done.set_result(landmark_statistics(measures, jobs))
+        except BaseException as exc:  # noqa: BLE001 - raised where it is asked for
+            done.set_exception(exc)
+
+    # a daemon thread (an executor's is joined at exit): a report that fails meanwhile
+    # exits after the fits under way, not after every fit
+    threading.Thread(target=fit, name="statistics", daemon=True).start()
+    return done.result
 
 
 def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummary],

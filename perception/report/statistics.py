@@ -211,6 +211,11 @@ class _MeasureJob:
     def __init__(self, who: str | None):
         self.who = who
 
+    def lost(self, item, message: str) -> tuple[int, list[dict]]:
+        """A measure whose worker died (killed, out of memory), fitted here: the same rows,
+        not a batch without its report."""
+        return self.run(item, None)
+
     def run(self, item: tuple[int, str, str, pd.DataFrame], shared) -> tuple[int, list[dict]]:
         """``(its place, its rows)`` of the measure ``item`` (place, measure, unit, trials)."""
         k, measure, unit, d = item
