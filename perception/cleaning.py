@@ -244,8 +244,7 @@ def spikes(time: np.ndarray, path: np.ndarray, ok: np.ndarray | None = None,
     ok = finite_rows(path) if ok is None else np.asarray(ok, dtype=bool)
     dt = step if step is not None else float(np.median(np.diff(time))) if len(time) > 1 else 1.0
     half = max(1, int(round(params.spike_window / dt)))
-    kept = _SPIKES.longest((half, params), (time, path, ok),
-                           first=lambda series: _last_alike(series, path))
+    kept = _SPIKES.longest((half, params), (time, path, ok))
     # the seen samples: those of the kept rows as they were, then the new rows'
     rows = 0 if kept is None else len(kept[0][0])
     idx = np.flatnonzero(ok[rows:]) + rows
@@ -294,13 +293,6 @@ def spikes(time: np.ndarray, path: np.ndarray, ok: np.ndarray | None = None,
     out = np.zeros(len(path), dtype=bool)
     out[idx[off]] = True
     return out
-
-
-def _last_alike(series: tuple, path: np.ndarray) -> bool:
-    """Whether a kept path's last row is ``path``'s at that row: another marker's path
-    differs there, told apart before comparing all."""
-    n = len(series[0])
-    return 0 < n <= len(path) and np.array_equal(series[1][-1], path[n - 1], equal_nan=True)
 
 
 #: Paths kept per thread: a recognition's landmarks test three markers' paths.

@@ -60,6 +60,11 @@ def _butter(order: int, wn: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return b, a, lfilter_zi(b, a)
 
 
+def _padlen(b: np.ndarray, a: np.ndarray) -> int:
+    """Rows :func:`scipy.signal.filtfilt` pads each end with by default (odd padding)."""
+    return 3 * max(len(a), len(b))
+
+
 def _filtfilt(b: np.ndarray, a: np.ndarray, zi: np.ndarray, x: np.ndarray) -> np.ndarray:
     """:func:`scipy.signal.filtfilt` of ``x`` (N, K) along its rows, its default padding
     (odd, ``3 x max(len(a), len(b))`` rows), with ``zi`` its ``lfilter_zi(b, a)``: the same
@@ -67,7 +72,7 @@ def _filtfilt(b: np.ndarray, a: np.ndarray, zi: np.ndarray, x: np.ndarray) -> np
     """
     from scipy.signal import lfilter  # noqa: PLC0415 (only when filtering)
 
-    edge = 3 * max(len(a), len(b))
+    edge = _padlen(b, a)
     ext = np.concatenate((2 * x[0:1] - x[edge:0:-1], x,
                           2 * x[-1:] - x[-2:-(edge + 2):-1]), axis=0)
     zi = zi.reshape(-1, 1)
@@ -98,13 +103,6 @@ def _gradient_rows(f: np.ndarray, x: np.ndarray, lo: int, hi: int) -> np.ndarray
     if lo < len(f) == hi:
         out[-1] = (f[-1] - f[-2]) / dx[-1]
     return out
-
-
-def _last_alike(series: tuple, flat: np.ndarray) -> bool:
-    """Whether a kept series' last row is ``flat``'s at that row, bitwise: another
-    series is told apart before comparing all."""
-    n = len(series[0])
-    return 0 < n <= len(flat) and series[0][-1].tobytes() == flat[n - 1].tobytes()
 
 
 #: Series low-passed in this thread whose runs a lost row closed, with those runs
@@ -239,14 +237,14 @@ class LandmarkParams:
         # runs closed in the longest such series filtered before are taken as they came
         # out (a stream that loses a marker now and then filtered every run at every row)
         key = (self.order, wn)
-        kept = _LOWPASSED.longest(key, (flat,), first=lambda series: _last_alike(series, flat))
+        kept = _LOWPASSED.longest(key, (flat,))
         done = 0 if kept is None else kept[1][0]
         closed = stops[stops < len(flat)]
         closed = int(closed[-1]) if len(closed) else 0  # the last closed run's end
         raw = flat[:closed + 1].copy() if closed > done else None
         if done:
             flat[:done] = kept[1][1]
-        width = 3 * max(len(a), len(b))
+        width = _padlen(b, a)
         for lo, hi in zip(starts, stops):
             if lo >= done and hi - lo > width:
                 flat[lo:hi] = _filtfilt(b, a, zi, flat[lo:hi])

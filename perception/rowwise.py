@@ -47,7 +47,7 @@ def row_norm(x: np.ndarray) -> np.ndarray:
         Rows of coordinates (NaN stays NaN).
     """
     x = np.asarray(x, dtype=float)
-    if x.ndim != 2 or not 1 <= x.shape[1] <= 4:  # from 8 on NumPy adds in another order
+    if x.ndim != 2 or not 1 <= x.shape[1] <= 4:  # as tested; from 8 NumPy adds in another order
         return np.linalg.norm(x, axis=1)
     total = x[:, 0] * x[:, 0]
     for k in range(1, x.shape[1]):

@@ -27,8 +27,7 @@ import numpy as np
 
 from perception.errors import InputError
 from perception.io.atomic import write_bytes, write_text
-from perception.io.movement_import import POSE_EXTRA, movement_loaders
-from perception.io.pose import DLC_KEY
+from perception.io.movement_import import DLC_KEY, POSE_EXTRA, movement_loaders
 from perception.io.tracks import Tracks
 from perception.limits import MAX_MARKERS
 

@@ -28,10 +28,13 @@ from pathlib import Path
 
 from perception.errors import InputError
 
-__all__ = ["POSE_EXTRA", "VALIDATOR", "dlc_inputs", "import_movement", "movement_loaders",
-           "require_movement"]
+__all__ = ["DLC_KEY", "POSE_EXTRA", "VALIDATOR", "dlc_inputs", "import_movement",
+           "movement_loaders", "require_movement"]
 
 #: The message when the optional ``pose`` extra (``movement``, PyTables) is missing.
+#: The pandas HDF key of a DeepLabCut ``.h5`` table (as DeepLabCut writes it): here, where
+#: the pose reader and the exports both take it without loading each other.
+DLC_KEY = "df_with_missing"
 POSE_EXTRA = ("reading and writing pose files needs the optional extra: "
               "pip install 'hammer-mv[pose]'")
 

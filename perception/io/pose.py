@@ -47,9 +47,9 @@ from pydantic import Field, PlainValidator
 
 from perception.errors import InputError
 from perception.io.files import input_file
+from perception.io.movement_import import DLC_KEY, dlc_inputs, require_movement
 from perception.io.movement_import import POSE_EXTRA as _EXTRA
 from perception.io.movement_import import VALIDATOR as _VALIDATOR
-from perception.io.movement_import import dlc_inputs, require_movement
 from perception.io.movement_import import movement_loaders as _movement
 from perception.io.names import POSE_SUFFIXES, TRACKS_SUFFIX, VIDEO_SUFFIXES
 from perception.io.plain_tables import dlc_table
@@ -83,8 +83,6 @@ log = logging.getLogger(__name__)
 
 #: The markers recognition needs, in the tracks' column order.
 MARKERS = ("thumb", "finger", "wrist", "object")
-#: The pandas HDF key of a DeepLabCut ``.h5`` table (as DeepLabCut writes it).
-DLC_KEY = "df_with_missing"
 #: ``movement``'s name for each source, by how the file is recognised.
 _SOURCES = {"dlc": "DeepLabCut", "sleap": "SLEAP", "lp": "LightningPose", "nwb": "NWB"}
 _VIDEO = r"\.(?:mp4|avi|mkv|mov|m4v)"

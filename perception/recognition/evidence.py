@@ -18,9 +18,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from perception.landmarks import Landmarks, longest_gap, model_landmarks, observed_landmarks
-from perception.recognition.rules import Evidence, VerdictRules, slowed
+from perception.recognition.rules import Evidence, VerdictRules, peak_and_least, slowed, speeds
 from perception.resume import Kept
-from perception.rowwise import row_norm
 
 if TYPE_CHECKING:
     from perception.observation import Observation
@@ -234,37 +233,19 @@ def _arrival(obs) -> float:
     time, wrist, movement = obs.clip_time[start:], obs.clip_wrist[start:], len(obs.time)
     kept = _ARRIVAL.longest(movement, (time, wrist))
     if kept is None:
-        peak_least = _peak_and_least(time, wrist, movement)
+        peak_least = peak_and_least(time, wrist, movement)
         if peak_least is None:
-            return slowed(time, wrist, movement=movement)
+            return 0.0  # slowed's: no peak to slow from
         peak, least = peak_least
     else:
         (peak, least), n = kept[1], len(kept[0][0])
-        new = _speeds(time[n - 1:], wrist[n - 1:])
+        new = speeds(time[n - 1:], wrist[n - 1:])
         new = new[np.isfinite(new)]
         if len(new):
             least = min(least, new.min())
     if movement <= len(time):  # its peak among these rows: a longer series resumes it
         _ARRIVAL.keep(movement, (time, wrist), (peak, least), kept)
     return float(1.0 - least / peak)
-
-
-def _speeds(time: np.ndarray, wrist: np.ndarray) -> np.ndarray:
-    """The speed between consecutive samples, as :func:`slowed` reads it, m/s."""
-    return row_norm(np.diff(wrist, axis=0)) / np.maximum(np.diff(time), 1e-9)
-
-
-def _peak_and_least(time: np.ndarray, wrist: np.ndarray, movement: int):
-    """:func:`slowed`'s peak speed in the movement and the slowest finite speed from it on
-    (None where it finds no peak: it gives 0)."""
-    speed = _speeds(time, wrist)
-    within = np.isfinite(speed)
-    within[max(movement - 1, 0):] = False
-    if not within.any() or speed[within].max() <= 0:
-        return None
-    peak = int(np.flatnonzero(within)[np.argmax(speed[within])])
-    after = speed[peak:]
-    return speed[peak], after[np.isfinite(after)].min()
 
 
 #: The last arrival measured in this thread: the movement's length, its rows, and their

@@ -25,10 +25,12 @@ from pydantic import Field
 
 from perception.landmarks import LandmarkParams, Landmarks
 from perception.observation import ObserveParams
+from perception.rowwise import row_norm
 from perception.validation import Int, Share, declared
 
 __all__ = ["AT_END", "DETAILS", "HAND_SPAN", "REASONS", "RULE_TABLE", "VERDICT_RULES", "Evidence",
-           "Verdict", "VerdictRules", "grip_departs", "judge", "reason", "slowed", "verdict_detail"]
+           "Verdict", "VerdictRules", "grip_departs", "judge", "peak_and_least", "reason", "slowed",
+           "speeds", "verdict_detail"]
 
 #: Kinds of an abnormal verdict (:func:`verdict_detail`).
 DETAILS = ("delayed-opening", "re-opening", "no-opening", "other")
@@ -249,15 +251,43 @@ def slowed(time: np.ndarray, wrist: np.ndarray, movement: int | None = None) -> 
         the samples after it count for how far the speed fell (default:
         every sample is the movement's).
     """
-    speed = np.linalg.norm(np.diff(wrist, axis=0), axis=1) / np.maximum(np.diff(time), 1e-9)
+    found = peak_and_least(time, wrist, movement)
+    return 0.0 if found is None else float(1.0 - found[1] / found[0])
+
+
+def speeds(time: np.ndarray, wrist: np.ndarray) -> np.ndarray:
+    """The wrist's speed between consecutive samples, m/s (NaN where one is lost): what
+    :func:`slowed` reads.
+
+    Parameters
+    ----------
+    time : (N,) array
+        Times, s.
+    wrist : (N, 2) array
+        Positions, m.
+    """
+    return row_norm(np.diff(wrist, axis=0)) / np.maximum(np.diff(time), 1e-9)
+
+
+def peak_and_least(time: np.ndarray, wrist: np.ndarray, movement: int | None = None
+                   ) -> tuple[float, float] | None:
+    """:func:`slowed`'s peak speed within the movement and the slowest finite speed from
+    it on, m/s; None where the movement has no speed above 0.
+
+    Parameters
+    ----------
+    time, wrist, movement
+        As :func:`slowed`'s.
+    """
+    speed = speeds(time, wrist)
     within = np.isfinite(speed)
     if movement is not None:
         within[max(movement - 1, 0):] = False
     if not within.any() or speed[within].max() <= 0:
-        return 0.0
+        return None
     peak = int(np.flatnonzero(within)[np.argmax(speed[within])])
     after = speed[peak:]
-    return float(1.0 - after[np.isfinite(after)].min() / speed[peak])
+    return float(speed[peak]), float(after[np.isfinite(after)].min())
 
 
 def grip_departs(observed: Landmarks, rules: VerdictRules | None = None) -> bool:
