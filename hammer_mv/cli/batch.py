@@ -108,8 +108,9 @@ def run(args: argparse.Namespace) -> int:
 
 def _warnings(summary) -> list[tuple[str, list[dict]]]:
     """Each scored clip's warnings (its report's ``warning_values``), as ``run_batch``
-    gives them in the summary's ``attrs``."""
-    return [(clip, list(values)) for clip, values in summary.attrs["warnings"].by_clip]
+    gives them in the summary's ``attrs`` (none for a summary made otherwise)."""
+    kept = summary.attrs.get("warnings")
+    return [] if kept is None else [(clip, list(values)) for clip, values in kept.by_clip]
 
 
 def _not_over_inputs(source: Path, out: Path) -> None:
