@@ -75,7 +75,8 @@ class Kept:
             n = len(series[0])
             if (k == key and (best is None or n > len(best[0][0]))
                     and (not shorter or n < len(arrays[0]))
-                    and (first is None or first(series)) and _begins(arrays, series, blobs)):
+                    and (first is None or first(series))
+                    and _begins(arrays, series, blobs, self.size > 1)):
                 best = (series, value)
         return best
 
@@ -91,14 +92,15 @@ class Kept:
 
 
 def _begins(arrays: Sequence[np.ndarray], kept: Sequence[np.ndarray],
-            blobs: Sequence[bytes]) -> bool:
+            blobs: Sequence[bytes], several: bool = False) -> bool:
     """:func:`begins_with`, the kept series' bytes at hand."""
     for a, k in zip(arrays, kept, strict=True):  # shapes first: nothing compared
         if len(k) > len(a) or a.shape[1:] != k.shape[1:] or a.dtype != k.dtype:
             return False
-    # each kept series' last row first: another series (another marker's path) differs
-    # there, told apart before the whole is copied
-    if any(len(k) and k[-1].tobytes() != a[len(k) - 1].tobytes() for a, k in zip(arrays, kept)):
+    # where several series are kept (several markers' paths), each one's last row first:
+    # another series differs there, told apart before the whole is copied
+    if several and any(len(k) and k[-1:].tobytes() != a[len(k) - 1:len(k)].tobytes()
+                       for a, k in zip(arrays, kept)):
         return False
     # bit for bit: the bytes compared whole (memcmp), a few microseconds for a 60 s
     # stream's rows where np.array_equal(equal_nan=True) took tens, at every resumed
