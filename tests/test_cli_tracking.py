@@ -352,6 +352,10 @@ def test_contact_sheet_from_frames_kept_while_tracking_matches_a_decoded_one(tmp
     kept = contact_sheet(tracks, None, tmp_path / "kept.png", frames=every)
     decoded = contact_sheet(tracks, None, tmp_path / "decoded.png")
     np.testing.assert_array_equal(cv2.imread(str(kept)), cv2.imread(str(decoded)))
+    # deflated, not stored as OpenCV's defaults store it: the same pixels, a smaller file
+    pixels = cv2.imread(str(kept))
+    ok, default = cv2.imencode(".png", pixels)
+    assert ok and kept.stat().st_size < 0.7 * len(default)
 
     few = FrameSample(max_frames=8)  # every 6th frame: the nearest stand in
     track_video(clip.video, tmp_path / "d.tracks.h5", frames=few)
