@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from perception.rowwise import run_edges
+
 __all__ = ["APERTURE_LANDMARKS", "NEEDS", "all_flags", "bound_flags", "gap_near", "why_not_open"]
 
 
@@ -59,8 +61,7 @@ def gap_near(time: np.ndarray, lost: np.ndarray, at: float, reach: float) -> flo
     near = np.flatnonzero(lost & (np.abs(time - at) <= reach + 1e-9))
     if not len(near):
         return None
-    edges = np.diff(np.r_[0, lost.astype(np.int8), 0])
-    a, b = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+    a, b = run_edges(lost)
     # the stretches that reach within ``reach``, as arrays (a stream's many short losses
     # were a Python loop at every row)
     close = (a <= near[-1]) & (b > near[0])

@@ -36,7 +36,7 @@ from perception.landmark_flags import (
 )
 from perception.landmark_values import _NAMES, OK, Landmarks
 from perception.resume import Kept
-from perception.rowwise import finite_rows, row_norm
+from perception.rowwise import finite_rows, row_norm, run_edges
 from perception.validation import Int, Share, declared
 
 if TYPE_CHECKING:
@@ -230,8 +230,7 @@ class LandmarkParams:
         b, a, zi = _butter(self.order, wn)
         flat = x.reshape(len(x), -1)
         ok = finite_rows(flat)
-        edges = np.diff(np.r_[0, ok.astype(np.int8), 0])
-        starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+        starts, stops = run_edges(ok)
         # A run a lost row has closed is filtered on its own values alone: a series that
         # begins with it and that row (a stream's next rows) filters it alike, so the
         # runs closed in the longest such series filtered before are taken as they came
@@ -291,10 +290,9 @@ def _bounds_at(time: np.ndarray, speed: np.ndarray, peak: int, bound: float, hol
                ) -> tuple[int | None, int | None]:
     """:func:`movement_bounds` with its speed ``bound`` found (m/s)."""
     below = np.isfinite(speed) & (speed < bound)
-    edges = np.diff(np.r_[0, below.astype(np.int8), 0])
     # the runs below it, as arrays: a stream at rest crosses a noise-raised bound at many
     # rows, and a Python loop over its runs grew with the stream at every row
-    a, b = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+    a, b = run_edges(below)
     held = (time[b - 1] - time[a]) >= hold - 1e-9
     a, b = a[held], b[held]
     before, after = b[b <= peak], a[a > peak]
@@ -351,7 +349,7 @@ def count_peaks(values: np.ndarray, min_prominence: float) -> int:
     if not x.size:
         return 0
     low = x.min()
-    return len(find_peaks(np.r_[low, x, low], prominence=min_prominence)[0])
+    return len(find_peaks(np.concatenate(([low], x, [low])), prominence=min_prominence)[0])
 
 
 def _crossing(time: np.ndarray, values: np.ndarray, level: float,
@@ -444,7 +442,7 @@ def longest_gap(time: np.ndarray, values: np.ndarray) -> float:
     ts = time[np.isfinite(np.asarray(values, dtype=float))]
     if not len(ts):
         return float(time[-1] - time[0])
-    return float(np.diff(np.r_[time[0], ts, time[-1]]).max())
+    return float(np.diff(np.concatenate(([time[0]], ts, [time[-1]]))).max())
 
 
 class MeasuredPaths(NamedTuple):
@@ -555,10 +553,9 @@ def _landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.ndarray,
     # another movement: a stretch outside this one going faster than a share of its peak
     fast = np.nan_to_num(speed) > params.second_movement * speed[peak]
     fast[lo:hi + 1] = False
-    edges = np.diff(np.r_[0, fast.astype(np.int8), 0])
     # a sample stands for a frame period of time (``step``)
     others = sum((b - a) * step >= params.second_movement_time - 1e-9
-                 for a, b in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)))
+                 for a, b in zip(*run_edges(fast)))
     base = {"onset_time": t_on, "end_time": t_end, "movement_time": T, "movements": 1 + others,
             "peak_speed": float(speed[peak]), "peak_speed_time": share(time[peak]),
             "deceleration_time": t_end - float(time[peak])}
@@ -584,7 +581,7 @@ def _landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.ndarray,
     mga, rest = float(g[j]), float(g[seen[0]])
     opening = mga - rest
     ts = time[seen]
-    gaps = np.r_[ts[0] - time[lo], np.diff(ts), time[hi] - ts[-1]]
+    gaps = np.concatenate(([ts[0] - time[lo]], np.diff(ts), [time[hi] - ts[-1]]))
     peaks: int | None = count_peaks(g[seen], max(params.peak_prominence * opening,
                                                  params.peak_min_prominence))
     # a closing and re-opening seen stands; one lost digit long enough can hide one

@@ -28,6 +28,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from perception.rowwise import last_norm
+
 __all__ = ["RULES", "THESIS_SIGNS", "thesis_rule", "likelihood_rule"]
 
 #: Rules that can pick the winner.
@@ -91,14 +93,16 @@ def thesis_rule(r_obs: np.ndarray, g_obs: np.ndarray, r_pred: np.ndarray, g_pred
     return np.where(ok, dC_r, 0.0), np.where(ok, dC_g, 0.0)
 
 
-def _unit(v: np.ndarray) -> np.ndarray:
-    norm = np.linalg.norm(v, axis=-1, keepdims=True)
+def _unit(v: np.ndarray, norm: np.ndarray | None = None) -> np.ndarray:
+    """``v`` (..., 2) over its ``norm`` (...), where the caller has it; (1, 0) where ~0."""
+    norm = last_norm(v)[..., None] if norm is None else norm[..., None]
     return np.where(norm > 1e-9, v / np.where(norm > 1e-9, norm, 1), np.array([1.0, 0.0]))
 
 
 def likelihood_rule(r_obs: np.ndarray, g_obs: np.ndarray, midpoint: np.ndarray,
                     opening: np.ndarray, cov_tips: np.ndarray, valid: np.ndarray,
-                    obs_sd: float) -> tuple[np.ndarray, np.ndarray]:
+                    obs_sd: float, norms: tuple[np.ndarray, np.ndarray] | None = None
+                    ) -> tuple[np.ndarray, np.ndarray]:
     """Per-step log-likelihood of the observed ``(r, g)`` under each model's prediction.
 
     The predicted wrist, finger and thumb positions have Cartesian covariances
@@ -118,6 +122,9 @@ def likelihood_rule(r_obs: np.ndarray, g_obs: np.ndarray, midpoint: np.ndarray,
         Steps that count; others score 0.
     obs_sd : float
         SD of a tracked position after filtering, m.
+    norms : ((M, N), (M, N)) arrays, optional
+        The predicted r and g (the norms of ``midpoint`` and ``opening``), where the
+        caller has them.
 
     Returns
     -------
@@ -137,13 +144,14 @@ def likelihood_rule(r_obs: np.ndarray, g_obs: np.ndarray, midpoint: np.ndarray,
     cov_m = Sw + 0.25 * (Sf + St) + 0.5 * var * eye
     cov_d = Sf + St + 2 * var * eye
     cov_md = 0.5 * (Sf - St)
-    um, ud = _unit(midpoint), _unit(opening)
+    r_pred, g_pred = (last_norm(midpoint), last_norm(opening)) if norms is None else norms
+    um, ud = _unit(midpoint, r_pred), _unit(opening, g_pred)
     var_r = np.einsum("mni,mnij,mnj->mn", um, cov_m, um)
     var_g = np.einsum("mni,mnij,mnj->mn", ud, cov_d, ud)
     cov_rg = np.einsum("mni,mnij,mnj->mn", um, cov_md, ud)
     det = var_r * var_g - cov_rg**2
-    er = r_obs[None] - np.linalg.norm(midpoint, axis=-1)
-    eg = g_obs[None] - np.linalg.norm(opening, axis=-1)
+    er = r_obs[None] - r_pred
+    eg = g_obs[None] - g_pred
     maha = (var_g * er**2 - 2 * cov_rg * er * eg + var_r * eg**2) / det
     dll = -0.5 * (np.log(det) + maha) - np.log(2 * np.pi)
     ok = valid & np.isfinite(dll)

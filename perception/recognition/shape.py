@@ -42,6 +42,7 @@ from perception.landmarks import movement_time
 from perception.observation import Observation
 from perception.recognition.models import SceneSpec
 from perception.recognition.rules import VerdictRules
+from perception.rowwise import finite_rows
 
 __all__ = ["WRIST_GOAL_OFFSET", "Normalisation", "canonical", "closed_hand", "is_mirrored",
            "opens", "rest_and_opening"]
@@ -83,9 +84,10 @@ class Normalisation:
 def _resample(t_new: np.ndarray, t: np.ndarray, xy: np.ndarray) -> np.ndarray:
     """``xy`` (N, 2) at ``t_new``, linearly; NaN where either neighbour is lost."""
     out = np.empty((len(t_new), 2))
+    filled = np.nan_to_num(xy)  # both columns at once: 8 us a call, six calls a row
     for k in range(2):
-        out[:, k] = np.interp(t_new, t, np.nan_to_num(xy[:, k]))
-    lost = ~np.isfinite(xy).all(axis=1)
+        out[:, k] = np.interp(t_new, t, filled[:, k])
+    lost = ~finite_rows(xy)
     i = np.clip(np.searchsorted(t, t_new), 1, len(t) - 1)
     gone = lost[i] | lost[i - 1]
     out[gone] = np.nan

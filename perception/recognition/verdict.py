@@ -159,7 +159,7 @@ class Calibration:
             The clip's frame period, s; its misfit is rescaled to the
             calibration's by the squared ratio of the two.
         """
-        if not np.isfinite(misfit):
+        if not math.isfinite(misfit):
             return float("nan")
         if frame_period:
             misfit = misfit * (self.frame_period / frame_period) ** 2
