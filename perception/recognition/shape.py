@@ -42,6 +42,7 @@ from perception.landmarks import movement_time
 from perception.observation import Observation
 from perception.recognition.models import SceneSpec
 from perception.recognition.rules import VerdictRules
+from perception.resume import Kept
 from perception.rowwise import finite_rows
 
 __all__ = ["WRIST_GOAL_OFFSET", "Normalisation", "canonical", "closed_hand", "is_mirrored",
@@ -127,6 +128,32 @@ def canonical(obs: Observation, scene: SceneSpec, durations: tuple[float, float]
         travels less than ``rules.min_transport``.
     """
     rules = VerdictRules() if rules is None else rules
+    # a stream at rest brings the same movement again at every row (only the rows after it
+    # grow): what it became is kept (the observation's other fields are the new one's)
+    key = (scene, durations, rules.span_fraction, rules.min_transport)
+    inputs = (obs.time, obs.wrist, obs.finger, obs.thumb, obs.frame,
+              np.array([*np.asarray(obs.hand_offset, dtype=float), obs.start_distance,
+                        obs.noise, wrist_offset]))
+    kept = _CANONICAL.longest(key, inputs, first=lambda s: len(s[0]) == len(obs.time))
+    if kept is None:
+        arrays, norm = _canonical(obs, scene, durations, rules, wrist_offset)
+        _CANONICAL.keep(key, inputs, (arrays, norm))
+    else:
+        arrays, norm = kept[1]
+    # copies: each result's arrays its own, as they were when made afresh
+    return dataclasses.replace(obs, **{k: np.copy(v) for k, v in arrays.items()}, raw={},
+                               dt=scene.frame_period, start_distance=scene.distance,
+                               noise=obs.noise * norm.distance_scale), norm
+
+
+#: Movements brought to the reference scale in this thread (:func:`canonical`): the
+#: verdict's, kept for the rows of a stream at rest.
+_CANONICAL = Kept(2)
+
+
+def _canonical(obs: Observation, scene: SceneSpec, durations: tuple[float, float],
+               rules: VerdictRules, wrist_offset: float) -> tuple[dict, Normalisation]:
+    """:func:`canonical`'s new arrays (time, frames, paths, hand offset) and what was done."""
     mt = movement_time(obs, rules.span_fraction)
     if not (np.isfinite(mt) and mt > 0):
         raise InputError("the wrist is seen too little to measure the movement time",
@@ -146,14 +173,11 @@ def canonical(obs: Observation, scene: SceneSpec, durations: tuple[float, float]
     step = scene.frame_period
     t_new = np.arange(np.ceil(t_scaled[0] / step), np.floor(t_scaled[-1] / step) + 1) * step
     frames = np.interp(t_new, t_scaled, obs.frame.astype(float)).round().astype(int)
-    out = dataclasses.replace(
-        obs, time=t_new, frame=frames,
-        wrist=_resample(t_new, t_scaled, wrist), finger=_resample(t_new, t_scaled, finger),
-        thumb=_resample(t_new, t_scaled, thumb), raw={}, dt=step,
-        start_distance=scene.distance,
-        hand_offset=np.asarray(obs.hand_offset, dtype=float) + tip,
-        noise=obs.noise * s)
-    return out, Normalisation(float(mt), float(alpha), float(s), float(wrist_offset))
+    arrays = {"time": t_new, "frame": frames, "wrist": _resample(t_new, t_scaled, wrist),
+              "finger": _resample(t_new, t_scaled, finger),
+              "thumb": _resample(t_new, t_scaled, thumb),
+              "hand_offset": np.asarray(obs.hand_offset, dtype=float) + tip}
+    return arrays, Normalisation(float(mt), float(alpha), float(s), float(wrist_offset))
 
 
 def closed_hand(obs: Observation) -> Observation:
