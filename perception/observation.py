@@ -544,8 +544,8 @@ def _extended(scene: RestScene, n: int, tracks, params: ObserveParams) -> RestSc
     lo, hi = params.frame_period_range
     if not lo * (1 - 1e-6) <= dt <= hi * (1 + 1e-6):
         return None
-    new = np.stack([scene.transform.to_model(pos[n:, markers.index(m)])
-                    for m in DIGIT_MARKERS], axis=1)
+    # the three markers' new rows mapped in one call (a row maps alike in any array)
+    new = scene.transform.to_model(pos[n:, [markers.index(m) for m in DIGIT_MARKERS]])
     return scene._replace(time=time, dts=dts, dt=dt, raw=np.concatenate([scene.raw, new]))
 
 
