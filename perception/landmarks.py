@@ -348,8 +348,18 @@ def count_peaks(values: np.ndarray, min_prominence: float) -> int:
     x = np.asarray(values, dtype=float)
     if not x.size:
         return 0
+    # a stream at rest counts the same movement's peaks at every row: the last counts kept
+    kept = _PEAKS.longest(min_prominence, (x,), first=lambda series: len(series[0]) == len(x))
+    if kept is not None:
+        return kept[1]
     low = x.min()
-    return len(find_peaks(np.concatenate(([low], x, [low])), prominence=min_prominence)[0])
+    peaks = len(find_peaks(np.concatenate(([low], x, [low])), prominence=min_prominence)[0])
+    _PEAKS.keep(min_prominence, (x,), peaks)
+    return peaks
+
+
+#: Sequences whose peaks were counted in this thread, with their counts (:func:`count_peaks`).
+_PEAKS = Kept(2)
 
 
 def _crossing(time: np.ndarray, values: np.ndarray, level: float,
