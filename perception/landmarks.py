@@ -381,17 +381,22 @@ def _crossing(time: np.ndarray, values: np.ndarray, level: float,
     return float(t[i - 1] + (level - v[i - 1]) / (v[i] - v[i - 1]) * (t[i] - t[i - 1]))
 
 
-def _progress_time(time: np.ndarray, w: np.ndarray, fraction: float) -> float:
-    """When the wrist first covers ``fraction`` of its start-to-end displacement, s."""
-    ok = np.isfinite(w).all(axis=1)
-    if ok.sum() < 3:
-        return float("nan")
-    start, end = w[ok][0], w[ok][-1]
+def _progress(time: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """The times the wrist was seen and its share of its start-to-end displacement then
+    (None where it is seen too little, or ends where it started)."""
+    ok = finite_rows(w)
+    seen = w[ok]
+    if len(seen) < 3:
+        return None
+    start, end = seen[0], seen[-1]
     total = float(np.linalg.norm(end - start))
     if total <= 0:
-        return float("nan")
-    progress = np.linalg.norm(w[ok] - start, axis=1) / total
-    t = time[ok]
+        return None
+    return time[ok], row_norm(seen - start) / total
+
+
+def _progress_time(t: np.ndarray, progress: np.ndarray, fraction: float) -> float:
+    """When the wrist first covers ``fraction`` of its displacement (:func:`_progress`), s."""
     i = int(np.argmax(progress >= fraction))
     if i == 0:
         return float(t[0])
@@ -431,8 +436,10 @@ def wrist_movement_time(time: np.ndarray, wrist: np.ndarray, span_fraction: floa
         As :func:`movement_time`'s.
     """
     time, wrist = np.asarray(time, dtype=float), np.asarray(wrist, dtype=float)
-    return ((_progress_time(time, wrist, 0.9) - _progress_time(time, wrist, 0.1))
-            / span_fraction)
+    seen = _progress(time, wrist)  # once for both crossings
+    if seen is None:
+        return float("nan")
+    return (_progress_time(*seen, 0.9) - _progress_time(*seen, 0.1)) / span_fraction
 
 
 def longest_gap(time: np.ndarray, values: np.ndarray) -> float:
