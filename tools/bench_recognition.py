@@ -1,14 +1,16 @@
 """Recognition benchmarks: one clip against a repertoire, and how batches scale.
 
-Targets (issues: HAMMER-MV recognition; 11, speed): recognising one 1 s
-clip's tracks against a built repertoire of >= 10 models <= 50 ms; batch
-parallel efficiency (throughput with N processes / N x throughput with 1)
->= 85 % for N = 2 and for every core; a dask cluster of N single-threaded
-workers within 10 % of N local processes; ``synth --jobs N`` against one
-process. The same-run baselines are the one-process figures, and for each N
-the throughput of N independent one-process batches side by side: how far
-the machine itself lets N single-threaded processes scale, which no way of
-sharing the clips can beat.
+Targets (issues: HAMMER-MV recognition; 11, speed; 45, sixteen cores):
+recognising one 1 s clip's tracks against a built repertoire of >= 10
+models <= 50 ms; batch parallel efficiency (throughput with N processes / N
+x throughput with 1) >= 90 % (issue 45: at 16 processes); a dask cluster of
+N single-threaded workers >= 95 % of N local processes; ``synth --jobs N``
+against one process. The same-run baselines are the one-process figures,
+and for each N the throughput of N independent one-process batches side by
+side: how far the machine itself lets N single-threaded processes scale,
+which no way of sharing the clips can beat. ``--clips`` and ``--counts``
+size the scaling run (``tools/device/run.sh`` measures 1 and 16 processes
+in one call).
 
 The ``study`` part (issue 45; ``--only study``) writes the shipped Optotrak
 trials as a lab's study, ``--participants`` x ``--study-trials`` (100 x 100 =
@@ -25,12 +27,14 @@ per trial more, against the targets (10,000 trials in 2 minutes at ``--jobs
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 import resource
 import shutil
 import sys
 import tempfile
 import time
+import traceback
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -47,15 +51,18 @@ CLIPS_PER_CORE = 8
 ROUNDS = 5
 
 
-def _counts(cores: int) -> dict[str, int]:
-    """Clips of each condition for a machine of ``cores`` cores."""
-    total = max(40, CLIPS_PER_CORE * cores)
+def _counts(cores: int, total: int | None = None) -> dict[str, int]:
+    """Clips of each condition for a machine of ``cores`` cores (``total`` in all if given)."""
+    total = total or max(40, CLIPS_PER_CORE * cores)
     names = ("normal", "delayed", "open-close-open")
     return {c: total // 3 + (i < total % 3) for i, c in enumerate(names)}
 
 
-def _worker_counts(cores: int) -> list[int]:
-    """1, 2, 4, ... and every core: the process counts a batch is timed with."""
+def _worker_counts(cores: int, asked: str | None = None) -> list[int]:
+    """1, 2, 4, ... and every core: the process counts a batch is timed with; ``asked``
+    (``"8,16"``) names them instead (1, the baseline, always among them)."""
+    if asked:
+        return sorted({1, *(min(int(c), cores) for c in asked.split(","))})
     counts, n = {1, cores}, 2
     while n < cores:
         counts.add(n)
@@ -207,11 +214,14 @@ def _phases(summary, jobs: int, wall: float) -> tuple[str, str, str, str]:
             f"ms/clip, idle at the end {float(np.mean(tail)):.1f} s", "")
 
 
-def phase_rows(cores: int, rounds: int = 1, trials: int = 600
-               ) -> list[tuple[str, str, str, str]]:
-    """Where a batch's time goes at 1, 2, 4, ... processes (issue 45 item 1): a
-    ``trials``-trial motion-capture table (the shipped Optotrak trials repeated) with
-    its figures and report. The best of ``rounds`` runs of each."""
+def phase_rows(cores: int, rounds: int = 1, trials: int = 600, counts: str | None = None,
+               base_trials: int | None = None) -> list[tuple[str, str, str, str]]:
+    """Where a batch's time goes at 1, 2, 4, ... processes (issue 45 item 1; ``counts``,
+    e.g. ``"8,16"``, names them): a ``trials``-trial motion-capture table (the shipped
+    Optotrak trials repeated) with its figures and report. The best of ``rounds`` runs
+    of each. The efficiency is against one process on the same table, or on a
+    ``base_trials``-trial table (the issue's own baseline, "the 60-trial rate": a 600-trial
+    table at one process alone takes minutes)."""
     from bench_mocap import RATE, make_table
 
     from perception.batch import discover, run_batch
@@ -222,13 +232,20 @@ def phase_rows(cores: int, rounds: int = 1, trials: int = 600
     work = Path(tempfile.mkdtemp(prefix="hammer-bench-phases-"))
     rows = []
     try:
-        (work / "session").mkdir()
-        n = make_table(work / "session" / "trials.tsv", copies=max(1, trials // 4))
-        items = discover(work / "session")
         rep = Repertoire.default()
         settings = RecognitionSettings(mocap=MocapImport(rate=float(RATE)))
+        tables = {}
+
+        def table_of(size: int):
+            if size not in tables:
+                (work / f"session{size}").mkdir()
+                n = make_table(work / f"session{size}" / "trials.tsv", copies=max(1, size // 4))
+                tables[size] = n, discover(work / f"session{size}")
+            return tables[size]
+
         base = None
-        for jobs in _worker_counts(cores):
+        for jobs in _worker_counts(cores, counts):
+            n, items = table_of(base_trials if jobs == 1 and base_trials else trials)
             best = None
             for _ in range(rounds):
                 shutil.rmtree(work / "out", ignore_errors=True)
@@ -239,14 +256,20 @@ def phase_rows(cores: int, rounds: int = 1, trials: int = 600
                 if best is None or wall < best[0]:
                     best = wall, summary
             wall, summary = best
-            base = base or wall
-            rows.append(_phases(summary, jobs, wall))
-            if jobs > 1:
-                rows.append(("", f"efficiency {base / (jobs * wall):.0%}", "target >= 90 % at 16",
-                             ""))
+            what, *rest = _phases(summary, jobs, wall)
+            rows.append((f"{what} ({n} trials)", *rest))
+            print(*rows[-1], sep="  ", flush=True)  # a run cut short still says the last
+            if base is None:
+                base = n / wall
+                continue
+            eff = n / wall / (jobs * base)
+            rows.append(("", f"efficiency {eff:.0%}", "of as many times one process's rate; "
+                         "target >= 90 % at 16", ("ok" if eff >= 0.9 else "MISSED")
+                         if jobs >= 16 else ""))
     finally:
         shutil.rmtree(work, ignore_errors=True)
-    return [(f"phases of a batch of {n} motion-capture trials with figures", "", "", ""), *rows]
+    return [("phases of motion-capture batches with figures (the shipped Optotrak trials "
+             "repeated)", "", "", ""), *rows]
 
 
 #: The study part's targets: seconds for a 10,000-trial study at ``--jobs 16``, and
@@ -373,6 +396,9 @@ def study_rows(participants: int, trials: int, jobs: int, conditions: int = 2
             cmd = [*HAMMER, "batch", str(folder), "--rate", RATE, "-o", str(work / "out"),
                    "--jobs", str(jobs), "--quiet"]
             runs[n] = _watched(cmd)
+            # said as it ends: a study stopped at a time limit still leaves the smaller run's
+            print(f"study of {n} trials: {runs[n][0]:.1f} s, peak memory {runs[n][2] / 2**20:.0f}"
+                  f" MB every process, {runs[n][3] / 2**20:.0f} MB its own", flush=True)
             shutil.rmtree(work / "out", ignore_errors=True)
             shutil.rmtree(folder, ignore_errors=True)
     finally:
@@ -421,6 +447,14 @@ def main(argv: list[str] | None = None) -> None:
                         help="the study's trials per participant (100)")
     parser.add_argument("--jobs", type=int, default=None,
                         help="the study's batch's worker processes (default: every core)")
+    parser.add_argument("--clips", type=int, default=None,
+                        help="the scaling run's clips (default: 8 a core, 40 at least)")
+    parser.add_argument("--counts", default=None, metavar="N,N",
+                        help="process counts of the scaling run and the phase table, e.g. "
+                        "8,16 (default: 1, 2, 4, ... and every core; 1, the baseline, always)")
+    parser.add_argument("--base-trials", type=int, default=None,
+                        help="the phase table's one-process baseline on a table of this many "
+                        "trials (default: the same table as the others)")
     parser.add_argument("--conditions", type=int, default=2,
                         help="the study's conditions, taking turns trial by trial (2; 0: no "
                         "condition column)")
@@ -435,7 +469,7 @@ def main(argv: list[str] | None = None) -> None:
         return
     if args.only == "phases":
         table(f"perception: where a batch's time goes ({cores} cores)",
-              phase_rows(cores, min(rounds, 2), args.trials))
+              phase_rows(cores, min(rounds, 2), args.trials, args.counts, args.base_trials))
         return
     from _demos import demo_tracks
 
@@ -463,7 +497,7 @@ def main(argv: list[str] | None = None) -> None:
     work = Path(tempfile.mkdtemp(prefix="hammer-bench-"))
     try:
         recipe = dataclasses.replace(load_recipe(ROOT / "datasets" / "smoke.toml"),
-                                     counts=_counts(cores))
+                                     counts=_counts(cores, args.clips))
         t0 = time.perf_counter()
         synthesize(recipe, work / "clips1", seed=0)
         synth1 = time.perf_counter() - t0
@@ -474,7 +508,8 @@ def main(argv: list[str] | None = None) -> None:
                      f"--jobs 1 {synth1:.1f} s", f"{synth1 / synthn:.2f}x"))
         items = discover(work / "clips")
         n = len(items)
-        workers = cores  # dask's, against as many local processes
+        counts = _worker_counts(cores, args.counts)
+        workers = counts[-1]  # dask's, against as many local processes
         times, summaries = {}, {}
         # Best of ROUNDS, the configurations taking turns: on a shared machine
         # a run's speed drifts by 20 % within seconds, and the best time is
@@ -482,7 +517,7 @@ def main(argv: list[str] | None = None) -> None:
         cores_used = []  # by the one process: it decodes on other threads
         ceiling = {}  # process count: wall time of as many one-process batches side by side
         for _ in range(rounds):
-            for jobs in _worker_counts(cores):
+            for jobs in counts:
                 elapsed, summaries[jobs], cpu = _batch(items, work / f"out{jobs}", rep,
                                                        jobs=jobs)
                 times[jobs] = min(times.get(jobs, elapsed), elapsed)
@@ -491,7 +526,12 @@ def main(argv: list[str] | None = None) -> None:
                     ceiling[jobs] = min(ceiling.get(jobs, alone), alone)
                 if jobs == 1:
                     cores_used.append(cpu / elapsed)
-            first, again, dask_summary = _dask(items, work / "dask", rep, workers)
+            try:
+                first, again, dask_summary = _dask(items, work / "dask", rep, workers)
+            except Exception:  # noqa: BLE001 (no cluster: the local rows still count)
+                traceback.print_exc()
+                first = again = math.inf
+                dask_summary = None
             times["dask"] = min(times.get("dask", again), again)
             times["dask, new"] = min(times.get("dask, new", first), first)
         base = n / times[1]
@@ -505,8 +545,8 @@ def main(argv: list[str] | None = None) -> None:
             eff = n / times[jobs] / (jobs * base)
             bound = n / ceiling[jobs] / (jobs * base)
             rows.append((f"  {jobs} processes", f"{n / times[jobs]:.1f} clips/s",
-                         f"efficiency {eff:.0%} (target >= 85 %)",
-                         "ok" if eff >= 0.85 else "MISSED"))
+                         f"efficiency {eff:.0%} (target >= 90 %)",
+                         "ok" if eff >= 0.9 else "MISSED"))
             rows.append((f"    {jobs} one-process batches side by side",
                          f"{n / ceiling[jobs]:.1f} clips/s",
                          f"{bound:.0%}: the machine's own limit (nothing shared)",
@@ -521,8 +561,12 @@ def main(argv: list[str] | None = None) -> None:
         rows.append(("    its first batch (workers import and warm up)",
                      f"{n / times['dask, new']:.1f} clips/s",
                      f"{cold:.0%} of {workers} local processes", ""))
-        same = all(s.equals(summaries[1]) for s in (*summaries.values(), dask_summary))
-        rows.append(("  summaries of every run identical", "yes" if same else "NO", "", ""))
+        if dask_summary is None:
+            rows.append(("  dask", "FAILED", "the cluster did not start (above)", "MISSED"))
+        same = all(s.equals(summaries[1]) for s in summaries.values()) and (
+            dask_summary is None or dask_summary.equals(summaries[1]))
+        rows.append(("  summaries of every run identical", "yes" if same else "NO",
+                     "" if dask_summary is not None else "local runs only", ""))
     finally:
         shutil.rmtree(work, ignore_errors=True)
     table(f"perception: HAMMER-MV recognition and scaling ({cores} cores)", rows)

@@ -3,9 +3,7 @@
 ``run.sh`` runs each part in its own process under ``timeout``, so that a part that
 overruns or fails costs only itself. Each part is the benchmark tool's own code
 (``tools/bench_recognition.py``, ``tools/bench_online.py``, ``tools/bench_mocap.py``)
-at the sizes given here; where a tool has no flag for a size (the scaling run's clips
-and process counts, the phase table's process counts) its module-level helper is
-replaced for this process alone, so that the figures stay those the tool computes.
+at the sizes given here, through their own flags.
 
 Run: ``python3 tools/device/parts.py PART [options]`` from anywhere; ``--help`` lists
 the parts. ``--markdown FILE`` appends the part's tables to FILE.
@@ -14,11 +12,9 @@ the parts. ``--markdown FILE`` appends the part's tables to FILE.
 from __future__ import annotations
 
 import argparse
-import math
 import os
 import sys
 import time
-import traceback
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -33,12 +29,6 @@ def _cores() -> int:
             else os.cpu_count() or 1)
 
 
-def _split(total: int) -> dict[str, int]:
-    """``total`` clips over the smoke recipe's three conditions, as the bench deals them."""
-    names = ("normal", "delayed", "open-close-open")
-    return {c: total // 3 + (i < total % 3) for i, c in enumerate(names)}
-
-
 def scaling(args) -> None:
     """``bench_recognition.py``'s scaling run: ``--clips`` clips at 1 process and at
     every core, the N one-process batches side by side, a dask cluster of N
@@ -46,78 +36,19 @@ def scaling(args) -> None:
     dask >= 95 % of N local, every summary identical)."""
     import bench_recognition
 
-    cores = _cores()
-    bench_recognition._counts = lambda _cores: _split(args.clips)
-    bench_recognition._worker_counts = lambda _cores: sorted({1, cores})
-    cluster = bench_recognition._dask
-
-    def dask_or_say(items, out, rep, workers):
-        # a cluster that cannot start (no loopback, a port refused) costs its own rows,
-        # not the local figures of the same table (printed only at the end)
-        try:
-            return cluster(items, out, rep, workers)
-        except Exception:
-            import pandas as pd
-
-            traceback.print_exc()
-            print("dask: FAILED (above); its rows read 0 clips/s and NO", flush=True)
-            return math.inf, math.inf, pd.DataFrame()
-
-    bench_recognition._dask = dask_or_say
-    bench_recognition.main(["--rounds", "1"])
+    bench_recognition.main(["--rounds", "1", "--clips", str(args.clips),
+                            "--counts", str(_cores())])
 
 
 def phases(args) -> None:
-    """Where a motion-capture batch with figures and report spends its time (issue 45
-    item 1), and the efficiency of a ``--trials`` table at each of ``--counts``
-    processes against one process on a ``--base-trials`` table (the issue's own
-    baseline: "the 60-trial rate"; target >= 90 % at 16). Each is one run of
-    ``run_batch``, profiled by ``bench_recognition._phases``, the table read afresh as
-    by a new command (as ``bench_recognition.phase_rows`` does, whose one-table loop
-    would cost 600 trials at one process: minutes)."""
-    import shutil
-    import tempfile
+    """``bench_recognition.py --only phases``: where a motion-capture batch with figures
+    and report spends its time (issue 45 item 1), a ``--trials`` table at each of
+    ``--counts`` processes against one process on a ``--base-trials`` table (the issue's
+    own baseline, "the 60-trial rate"; target >= 90 % at 16)."""
+    import bench_recognition
 
-    from bench_mocap import RATE, make_table
-    from bench_recognition import _phases
-
-    from perception.batch import discover, run_batch
-    from perception.pipeline import RecognitionSettings
-    from perception.recognition.repertoire import Repertoire
-    from perception.recordings import MocapImport, _cached
-
-    counts = sorted({min(int(c), _cores()) for c in args.counts.split(",")})
-    rep = Repertoire.default()
-    settings = RecognitionSettings(mocap=MocapImport(rate=float(RATE)))
-    work = Path(tempfile.mkdtemp(prefix="hammer-kit-phases-"))
-    rows, base = [], None
-    try:
-        for trials, jobs in [(args.base_trials, 1), *((args.trials, c) for c in counts)]:
-            folder = work / f"session{trials}"
-            if not folder.is_dir():
-                folder.mkdir()
-                make_table(folder / "trials.tsv", copies=max(1, trials // 4))
-            items = discover(folder)
-            shutil.rmtree(work / "out", ignore_errors=True)
-            _cached.cache_clear()  # the table read in each run, as by a new command
-            t0 = time.perf_counter()
-            summary = run_batch(items, work / "out", rep, settings, jobs=jobs, quiet=True)
-            wall = time.perf_counter() - t0
-            n = len(summary)
-            what, *rest = _phases(summary, jobs, wall)
-            rows.append((f"  {n} trials, {what.strip()}", *rest))
-            if base is None:
-                base = n / wall
-                continue
-            eff = n / wall / (jobs * base)
-            rows.append(("", f"efficiency {eff:.0%}", f"of {jobs} x the {args.base_trials}-"
-                         "trial rate at 1 process; target >= 90 % at 16",
-                         ("ok" if eff >= 0.9 else "MISSED") if jobs >= 16 else ""))
-    finally:
-        shutil.rmtree(work, ignore_errors=True)
-    bench.table(f"perception: where a batch's time goes ({_cores()} cores)",
-                [("phases of motion-capture batches with figures (the shipped Optotrak "
-                  "trials repeated)", "", "", ""), *rows])
+    bench_recognition.main(["--only", "phases", "--rounds", "1", "--trials", str(args.trials),
+                            "--base-trials", str(args.base_trials), "--counts", args.counts])
 
 
 def study(args) -> None:
@@ -126,20 +57,6 @@ def study(args) -> None:
     participants for the memory a trial (target: 10,000 trials <= 120 s at 16)."""
     import bench_recognition
 
-    watched = bench_recognition._watched
-
-    def watched_and_said(cmd):
-        # each run said as it ends: the smaller study's figures stay in the log when the
-        # whole study is stopped at the part's limit (its table is printed at the end)
-        t0 = time.perf_counter()
-        print(f"running: {' '.join(cmd[3:])}", flush=True)
-        wall, cpu, tree, own = result = watched(cmd)
-        print(f"  {time.perf_counter() - t0:.1f} s (its wall {wall:.1f} s), peak memory "
-              f"{tree / 2**20:.0f} MB every process, {own / 2**20:.0f} MB its own",
-              flush=True)
-        return result
-
-    bench_recognition._watched = watched_and_said
     bench_recognition.main(["--only", "study", "--participants", str(args.participants),
                             "--study-trials", str(args.study_trials)])
 
