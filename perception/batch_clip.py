@@ -333,7 +333,8 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
         status, reason = item.unscored
         return ClipResult(**base, status=status, reason=reason)
     try:
-        input_file(item.path, "clip")  # before hashing: a FIFO or device would never end
+        # before hashing: a FIFO or device would never end
+        input_file(item.path, "clip", empty=False)
         fp = clip_fingerprint(item.path, settings, repertoire_id + (
             f"#reach{item.reach}" if item.reach is not None else ""))
         done = _current_report(item, out, fp, figure_format)

@@ -243,7 +243,8 @@ def find_clips(source: str | os.PathLike) -> Discovery:
         elif is_regular_file(path) and (why := unknown_layout(path)) is not None:
             skipped.append((path.name, why))
         elif kind == "unknown":
-            skipped.append((path.name, "not a video, tracks or pose file"))
+            skipped.append((path.name, "empty file (0 bytes)" if is_regular_file(path)
+                            and path.stat().st_size == 0 else "not a video, tracks or pose file"))
         elif not is_regular_file(path):
             skipped.append((path.name, "not a regular file (a FIFO, device, socket or a "
                                        "broken link)"))

@@ -341,3 +341,30 @@ def test_recognize_tracks_names_the_clip_of_a_planning_error(monkeypatch, error)
         assert "out of the arm's reach" in str(info.value) and "`px_per_m`" in str(info.value)
     else:
         assert not isinstance(info.value, InputError | PlanningError)
+
+
+@pytest.mark.parametrize("name", ["trial.tsv", "trial.c3d", "poses.csv", "poses.h5",
+                                  "clip.tracks.h5", "clip.mp4"])
+def test_an_empty_recording_is_refused_as_empty_naming_the_file(tmp_path, capsys, name):
+    """A 0-byte input says it is empty, whatever its reader would have made of it (the
+    pose reader said its header rows did not match DeepLabCut's)."""
+    from hammer_mv.cli import main
+
+    (tmp_path / name).write_bytes(b"")
+    status = main(["recognize", str(tmp_path / name), "-o", str(tmp_path / "out"),
+                   "--rate", "100", "--fps", "30"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(err) == 1
+    assert name in err[0] and "empty file (0 bytes)" in err[0]
+    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())
+
+
+def test_a_batch_lists_an_empty_table_as_empty(tmp_path):
+    """An empty table of no kind is skipped as empty; an empty video fails as one."""
+    from perception.discovery import find_clips
+
+    (tmp_path / "trial.tsv").write_bytes(b"")
+    (tmp_path / "notes.tsv").write_text("a\tb\n1\t2\n")
+    found = find_clips(tmp_path)
+    assert dict(found.skipped)["trial.tsv"] == "empty file (0 bytes)"
+    assert "empty" not in dict(found.skipped)["notes.tsv"]

@@ -82,6 +82,7 @@ def run(args: argparse.Namespace) -> int:
     from hammer_mv.cli.checks import output_folder
     from hammer_mv.cli.options import load_repertoire, recognition_settings
     from perception.errors import InputError
+    from perception.io.files import input_file
     from perception.io.frame_sample import FrameSample
     from perception.io.names import output_folder as subfolder
     from perception.io.names import output_stem
@@ -112,7 +113,9 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(why, path)
     clip, kind = clip_name(path)
     if kind == "unknown":
-        raise InputError("not a video, tracks file, pose file or motion-capture recording", path)
+        what = "video, tracks file, pose file or motion-capture recording"
+        input_file(path, what, empty=False)  # an empty file is of no kind: it says so
+        raise InputError(f"not a {what}", path)
     clip = _own_clip(args.output, clip, path)
     settings = recognition_settings(args)
     rep, rep_id = load_repertoire(args)

@@ -27,7 +27,7 @@ def is_regular_file(path: str | os.PathLike) -> bool:
         return False
 
 
-def input_file(path: str | os.PathLike, what: str = "file") -> Path:
+def input_file(path: str | os.PathLike, what: str = "file", *, empty: bool = True) -> Path:
     """``path`` as a Path if it is a regular file that can be read.
 
     Parameters
@@ -36,12 +36,15 @@ def input_file(path: str | os.PathLike, what: str = "file") -> Path:
         The file the user named.
     what : str
         What the file is meant to be, for the message (``"video"``, ``"setup file"``).
+    empty : bool
+        Whether an empty file can be one (a setup file of defaults can; a
+        recording cannot, and its reader's own complaint would not say why).
 
     Raises
     ------
     InputError
-        Missing, a folder, or not a regular file (a FIFO, device or socket,
-        or a symbolic link to one).
+        Missing, a folder, not a regular file (a FIFO, device or socket, or
+        a symbolic link to one), or empty where ``empty`` is false.
     """
     p = Path(path)
     try:
@@ -56,6 +59,8 @@ def input_file(path: str | os.PathLike, what: str = "file") -> Path:
     if not stat.S_ISREG(mode):
         raise InputError(f"is not a regular file (a FIFO, device or socket); expected a {what}",
                          p)
+    if not empty and os.stat(p).st_size == 0:
+        raise InputError(f"empty file (0 bytes); expected a {what}", p)
     return p
 
 

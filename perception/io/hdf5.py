@@ -48,7 +48,7 @@ def open_hdf5(path: str | os.PathLike, what: str):
     p = Path(path)
     if not os.path.lexists(p) or not p.exists():
         raise InputError("no such file", p)
-    input_file(p, what)  # a FIFO or device would block or never end
+    input_file(p, what, empty=False)  # a FIFO or device would block or never end
     try:
         return h5py.File(p, "r")
     except OSError:

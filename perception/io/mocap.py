@@ -228,7 +228,7 @@ def read_mocap(path: str | os.PathLike, *, rate: float | None = None, units: str
         lacks or that varies within a trial, or (for C3D) the ``mocap``
         extra not installed.
     """
-    p = input_file(path, "motion-capture file")
+    p = input_file(path, "motion-capture file", empty=False)
     if p.suffix.lower() not in MOCAP_SUFFIXES:
         raise InputError("expected a .c3d, .trc, .tsv, .txt or .csv motion-capture file", p)
     if units is not None:

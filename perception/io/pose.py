@@ -602,7 +602,7 @@ def read_pose(path: str | os.PathLike, options: PoseImport | None = None) -> Tra
     path = Path(path)
     if not os.path.exists(path):
         raise InputError("no such file", path)
-    input_file(path, "pose file")  # a FIFO or device would block or never end
+    input_file(path, "pose file", empty=False)  # a FIFO or device would block or never end
     source = _source(path)
     ds, own = _load_dataset(path, source, options.fps)
     frames, time, fps, xy, conf, mapping, notes = _markers(ds, options, path, own)

@@ -226,9 +226,7 @@ class FrameSource(capture.Source):
         self.fps_override = fps
         if not self.path.exists():
             raise InputError("no such file", self.path)
-        input_file(self.path, "video")  # a FIFO or device would block or never end
-        if self.path.stat().st_size == 0:
-            raise InputError("empty file (0 bytes)", self.path)
+        input_file(self.path, "video", empty=False)  # a FIFO or device would block or never end
         with opencv_name(self.path) as name:
             cap = (cv2.VideoCapture(name, cv2.CAP_FFMPEG, [cv2.CAP_PROP_N_THREADS, int(threads)])
                    if threads > 0 else cv2.VideoCapture(name, cv2.CAP_FFMPEG))
