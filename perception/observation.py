@@ -608,7 +608,8 @@ def check_hand(scene: RestScene, params: ObserveParams | None = None) -> None:
                          + ("wrist (keypoints on the wrong markers? check `keypoints`, and "
                             "`object_diameter_px` or `px_per_m`)" if is_pose_file(scene.source)
                             else "wrist (a same-coloured object taken for a marker? give --roi "
-                            "when tracking, or check `px_per_m`)"), scene.source)
+                            "when tracking; or a wrong scale: check `object_diameter`, the "
+                            "object's real size, or `px_per_m`)"), scene.source)
 
 
 def observe(tracks, params: ObserveParams | None = None, *, clip: str | None = None) -> Observation:

@@ -37,6 +37,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from perception.errors import InputError, PlanningError
+from perception.io.files import input_file
 from perception.io.tracks import Tracks, tracks_path_for
 from perception.landmarks import MeasuredPaths, movement_landmarks
 from perception.observation import ObserveParams, observe
@@ -252,6 +253,7 @@ def load_clip(source: str | os.PathLike | Tracks, *, tracks_out: str | os.PathLi
     path = Path(source)
     kind = clip_name(path)[1]
     if kind == "unknown":
+        input_file(path, "video, tracks or pose file", empty=False)  # an empty one says so
         raise InputError("not a video, tracks or pose file", path)
     if kind == "tracks":
         return Tracks.load(path)

@@ -368,3 +368,12 @@ def test_a_batch_lists_an_empty_table_as_empty(tmp_path):
     found = find_clips(tmp_path)
     assert dict(found.skipped)["trial.tsv"] == "empty file (0 bytes)"
     assert "empty" not in dict(found.skipped)["notes.tsv"]
+
+
+def test_landmarks_of_an_empty_table_says_it_is_empty(tmp_path, capsys):
+    from hammer_mv.cli import main
+
+    (tmp_path / "trial.tsv").write_bytes(b"")
+    assert main(["landmarks", str(tmp_path / "trial.tsv"), "-o", str(tmp_path / "l.csv")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "trial.tsv" in err[0] and "empty file (0 bytes)" in err[0]

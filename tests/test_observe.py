@@ -280,3 +280,11 @@ def test_rest_scene_from_the_first_rows_is_the_whole_clips(angle):
     check_hand(whole, params)  # a hand: no error
     with pytest.raises(InputError, match="does not look like a hand"):
         check_hand(whole._replace(rest=whole.rest * 10), params)
+
+
+def test_a_hand_that_is_the_wrong_size_names_the_scale_to_check():
+    """Tracks scaled by a wrong object size: the message points at `object_diameter`."""
+    tracks, _ = demo_tracks("normal", 0)
+    with pytest.raises(InputError, match="does not look like a hand") as err:
+        observe(tracks, ObserveParams(object_diameter=0.4))
+    assert "object_diameter" in str(err.value) and "px_per_m" in str(err.value)
