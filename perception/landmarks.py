@@ -20,13 +20,13 @@ the verdict's shape pass scales a clip by (:mod:`perception.recognition.shape`).
 
 from __future__ import annotations
 
-import functools
 import math
 from typing import TYPE_CHECKING, Annotated, NamedTuple
 
 import numpy as np
 from pydantic import Field
 
+from perception import zero_lag
 from perception.landmark_flags import (
     APERTURE_LANDMARKS,
     all_flags,
@@ -46,63 +46,6 @@ __all__ = ["OK", "LandmarkParams", "Landmarks", "MeasuredPaths",
            "count_peaks", "longest_gap", "model_landmarks", "movement_bounds",
            "movement_landmarks", "movement_time", "observed_landmarks", "speed_bound",
            "wrist_movement_time"]
-
-
-@functools.lru_cache(maxsize=64)
-def _butter(order: int, wn: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The Butterworth low-pass's coefficients and its step response's steady state
-    (:func:`scipy.signal.lfilter_zi`): designed once per order and cutoff, not once per
-    movement (a 2,000-trial table's 4,000 designs took 1.6 s; the steady state took
-    30 us at each of a stream's rows, twice)."""
-    from scipy.signal import butter, lfilter_zi  # noqa: PLC0415 (only when filtering)
-
-    b, a = butter(order, wn)
-    return b, a, lfilter_zi(b, a)
-
-
-def _padlen(b: np.ndarray, a: np.ndarray) -> int:
-    """Rows :func:`scipy.signal.filtfilt` pads each end with by default (odd padding)."""
-    return 3 * max(len(a), len(b))
-
-
-def _filtfilt(b: np.ndarray, a: np.ndarray, zi: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """:func:`scipy.signal.filtfilt` of ``x`` (N, K) along its rows, its default padding
-    (odd, ``3 x max(len(a), len(b))`` rows), with ``zi`` its ``lfilter_zi(b, a)``: the same
-    operations on the same numbers, without designing the steady state again at every call.
-    """
-    from scipy.signal import lfilter  # noqa: PLC0415 (only when filtering)
-
-    edge = _padlen(b, a)
-    ext = np.concatenate((2 * x[0:1] - x[edge:0:-1], x,
-                          2 * x[-1:] - x[-2:-(edge + 2):-1]), axis=0)
-    zi = zi.reshape(-1, 1)
-    y, _ = lfilter(b, a, ext, axis=0, zi=zi * ext[0:1])
-    y, _ = lfilter(b, a, y[::-1], axis=0, zi=zi * y[-1:])
-    return y[::-1][edge:-edge]
-
-
-def _gradient_rows(f: np.ndarray, x: np.ndarray, lo: int, hi: int) -> np.ndarray:
-    """``np.gradient(f, x)[lo:hi]`` for (N,) ``f`` and ``x`` (N >= 2), bit for bit: its
-    formulas (uniform steps where every step is the first, else the second-order
-    non-uniform one; one-sided at the ends) on those rows alone, not every row of a
-    stream's clip."""
-    dx = np.diff(x)
-    out = np.empty(hi - lo)
-    a, b = max(lo, 1), min(hi, len(f) - 1)  # the interior rows asked for
-    if b > a:
-        if (dx == dx[0]).all():
-            out[a - lo:b - lo] = (f[a + 1:b + 1] - f[a - 1:b - 1]) / (2. * dx[0])
-        else:
-            dx1, dx2 = dx[a - 1:b - 1], dx[a:b]
-            ca = -(dx2) / (dx1 * (dx1 + dx2))
-            cb = (dx2 - dx1) / (dx1 * dx2)
-            cc = dx1 / (dx2 * (dx1 + dx2))
-            out[a - lo:b - lo] = ca * f[a - 1:b - 1] + cb * f[a:b] + cc * f[a + 1:b + 1]
-    if lo == 0 < hi:
-        out[0] = (f[1] - f[0]) / dx[0]
-    if lo < len(f) == hi:
-        out[-1] = (f[-1] - f[-2]) / dx[-1]
-    return out
 
 
 #: Series low-passed in this thread whose runs a lost row closed, with those runs
@@ -227,7 +170,7 @@ class LandmarkParams:
         if self.cutoff is None or len(time) < 2:
             return x
         wn = min(self.cutoff / (0.5 * (1.0 / step)), 0.95)
-        b, a, zi = _butter(self.order, wn)
+        b, a, zi = zero_lag.design(self.order, wn)
         flat = x.reshape(len(x), -1)
         ok = finite_rows(flat)
         starts, stops = run_edges(ok)
@@ -243,10 +186,10 @@ class LandmarkParams:
         raw = flat[:closed + 1].copy() if closed > done else None
         if done:
             flat[:done] = kept[1][1]
-        width = _padlen(b, a)
+        width = zero_lag.padlen(b, a)
         for lo, hi in zip(starts, stops):
             if lo >= done and hi - lo > width:
-                flat[lo:hi] = _filtfilt(b, a, zi, flat[lo:hi])
+                flat[lo:hi] = zero_lag.filtfilt(b, a, zi, flat[lo:hi])
         if raw is not None:  # these rows, the row that closed the last run among them
             _LOWPASSED.keep(key, (raw,), (closed, flat[:closed].copy()), kept)
         return flat.reshape(x.shape)
@@ -625,7 +568,7 @@ def _landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.ndarray,
     elif (gap := gap_near(time, lost_grip, t_open, reach)) is not None:
         flags["opening_time"] = (f"inside a gap: a digit was lost for {gap * 1000:.0f} ms "
                                  "where the grip opened")
-    rate = _gradient_rows(g, time, lo, j + 1)
+    rate = zero_lag.gradient_rows(g, time, lo, j + 1)
     widening = rate[np.isfinite(rate)]
     if not len(widening):
         flags["peak_opening_speed"] = "not seen: the aperture is lost before the MGA"

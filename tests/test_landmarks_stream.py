@@ -20,18 +20,19 @@ from perception.rowwise import finite_rows, row_norm
 
 landmarks = importlib.import_module("perception.landmarks")
 cleaning = importlib.import_module("perception.cleaning")
+zero_lag = importlib.import_module("perception.zero_lag")
 
 
 @pytest.mark.parametrize("order", [1, 2, 4, 8])
 @pytest.mark.parametrize("wn", [0.1, 0.667, 0.95])
 def test_the_zero_lag_filter_is_filtfilt_bit_for_bit(order, wn):
-    b, a, zi = landmarks._butter(order, wn)
+    b, a, zi = zero_lag.design(order, wn)
     rng = np.random.default_rng(order)
     for n in (3 * max(len(a), len(b)) + 1, 40, 301):
         for k in (1, 2, 3):
             x = np.cumsum(rng.normal(size=(n, k)), axis=0)
             want = scipy.signal.filtfilt(b, a, x, axis=0)
-            assert np.asarray(landmarks._filtfilt(b, a, zi, x)).tobytes() == want.tobytes()
+            assert np.asarray(zero_lag.filtfilt(b, a, zi, x)).tobytes() == want.tobytes()
 
 
 def _clip(n=400, fps=30.0, seed=0):
@@ -59,7 +60,7 @@ def test_a_movements_landmarks_design_the_filter_once(monkeypatch):
 
     monkeypatch.setattr(scipy.signal, "lfilter_zi", counted)
     monkeypatch.setattr(scipy.signal._signaltools, "lfilter_zi", counted)
-    landmarks._butter.cache_clear()
+    zero_lag.design.cache_clear()
     t, wrist, g = _clip()
     params = landmarks.LandmarkParams(cutoff=9.5)  # a filter no other test designed
     first = landmarks.movement_landmarks(t, wrist, g, params)
@@ -114,7 +115,7 @@ def test_the_opening_speed_reads_the_gradient_of_its_rows_alone_bit_for_bit():
             want = np.gradient(f, x)
             for lo in range(n):
                 for hi in range(lo, n + 1):
-                    got = landmarks._gradient_rows(f, x, lo, hi)
+                    got = zero_lag.gradient_rows(f, x, lo, hi)
                     assert got.tobytes() == want[lo:hi].tobytes(), (n, lo, hi)
 
 
@@ -130,11 +131,11 @@ def test_runs_a_gap_closed_are_filtered_once_and_alike():
     x[100:103] = np.nan
     params = landmarks.LandmarkParams()
     filtered = []
-    zero_lag = landmarks._filtfilt
+    filtfilt = zero_lag.filtfilt
 
     def counted(*args):
         filtered.append(len(args[3]))
-        return zero_lag(*args)
+        return filtfilt(*args)
 
     landmarks._LOWPASSED.local.__dict__.clear()
     for m in range(2, n + 1):
@@ -145,12 +146,12 @@ def test_runs_a_gap_closed_are_filtered_once_and_alike():
         landmarks._LOWPASSED.local.__dict__.update(saved)
     landmarks._LOWPASSED.local.__dict__.clear()
     params.lowpass(t[:199], x[:199])
-    landmarks._filtfilt = counted
+    zero_lag.filtfilt = counted
     try:
         for m in range(200, 300):
             params.lowpass(t[:m], x[:m])
     finally:
-        landmarks._filtfilt = zero_lag
+        zero_lag.filtfilt = filtfilt
     assert len(filtered) <= 100  # one open run a row at most, not the 20-odd closed ones
 
 
