@@ -1,4 +1,4 @@
-"""Per-row tests and norms of (N, K) arrays, column by column.
+"""Per-row tests and norms of (N, K) arrays, column by column; the runs of a mask.
 
 NumPy reduces a row of two or three values (``np.isfinite(x).all(axis=1)``,
 ``np.linalg.norm(x, axis=1)``) through its general reduction machinery,

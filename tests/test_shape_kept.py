@@ -62,3 +62,9 @@ def test_a_changed_movement_or_setting_is_made_afresh():
         assert out.noise == changed.noise * norm.distance_scale
     out, norm = canonical(obs, scene, durations, rules, 0.07)
     _same(out, norm, _fresh(obs, scene, durations, rules, 0.07))
+    # other rules: made afresh under them (the movement time's span read at 0.7, not 0.8)
+    canonical(obs, scene, durations, rules, 0.06)
+    other = dataclasses.replace(rules, span_fraction=0.7)
+    out, norm = canonical(obs, scene, durations, other, 0.06)
+    _same(out, norm, _fresh(obs, scene, durations, other))
+    assert norm.movement_time != canonical(obs, scene, durations, rules, 0.06)[1].movement_time

@@ -130,7 +130,7 @@ def canonical(obs: Observation, scene: SceneSpec, durations: tuple[float, float]
     rules = VerdictRules() if rules is None else rules
     # a stream at rest brings the same movement again at every row (only the rows after it
     # grow): what it became is kept (the observation's other fields are the new one's)
-    key = (scene, durations, rules.span_fraction, rules.min_transport)
+    key = (scene, durations, rules)  # the whole rules: a field read later is keyed too
     inputs = (obs.time, obs.wrist, obs.finger, obs.thumb, obs.frame,
               np.array([*np.asarray(obs.hand_offset, dtype=float), obs.start_distance,
                         obs.noise, wrist_offset]))
