@@ -32,7 +32,13 @@ def design(order: int, wn: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def padlen(b: np.ndarray, a: np.ndarray) -> int:
-    """Rows :func:`scipy.signal.filtfilt` pads each end with by default (odd padding)."""
+    """Rows :func:`scipy.signal.filtfilt` pads each end with by default (odd padding).
+
+    Parameters
+    ----------
+    b, a : arrays
+        The filter's numerator and denominator (:func:`design`).
+    """
     return 3 * max(len(a), len(b))
 
 
