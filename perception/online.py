@@ -29,7 +29,6 @@ from perception.recognition.provisional import (
     OnlineState,
     SettleRule,
     decision_summary,
-    grip_course,
 )
 from perception.recognition.repertoire import PlanCache, Repertoire
 from perception.recognition.result import Recognition
@@ -214,11 +213,10 @@ class OnlineRecognizer:
     def _judge(self, index: int, t: float, rec: Recognition) -> OnlineState:
         d, rules = rec.decision, self.settings.rules
         since = t - rec.time_origin  # the onset on the stream's clock
-        grip = grip_course(rec)
         # the verdict if the movement ends as it goes: the offline one unless a rule about
         # the movement's end gave it (only then judged again)
         ongoing = d if d.rule not in AT_END else judge(rec.evidence, rules, ongoing=True)
-        answer = self.settle.settles(ongoing, rec.evidence, grip, rules)
+        answer = self.settle.settles(ongoing, rec.evidence, rules)
         if self._answer is None or self._answer[1] != answer:
             self._answer = (since, answer)
         if (self._decision is None and answer is not None
@@ -226,7 +224,7 @@ class OnlineRecognizer:
             self._decision = Decision(*answer, t, since, index)
         self.state = OnlineState(
             index, t, "moving", list(rec.names), rec.confidence[:, -1].copy(),
-            rec.log_likelihood[:, -1].copy(), since, grip.progress, rec.verdict_model,
+            rec.log_likelihood[:, -1].copy(), since, rec.evidence.progress, rec.verdict_model,
             d.verdict, d.detail, d.familiarity, self.settle.evidence(d, rec.evidence, rules),
             self._decision, judged_on=rec.evidence)
         return self.state

@@ -45,9 +45,9 @@ from perception.provenance import code_digest
 from perception.recognition.engine import HammerParams, score_clip
 from perception.recognition.evidence import (
     clip_landmarks,
+    grip_course,
     judged_models,
     movement_evidence,
-    opening_progress,
 )
 from perception.recognition.models import SceneSpec
 from perception.recognition.repertoire import PlanCache, Repertoire
@@ -430,7 +430,7 @@ def recognize_tracks(tracks: Tracks, repertoire: Repertoire,
     evidence = movement_evidence(
         obs, [scores.kinds[i] for i in judged], scores.log_likelihood[judged, -1],
         familiarity[list(judged)], landmarks, transport, float(share),
-        opening_progress(obs, rules, norm.wrist_offset))
+        grip_course(obs, rules, norm.wrist_offset))
     return Recognition(
         clip=obs.clip, time=scored_obs.time / norm.time_scale, frame=scored_obs.frame,
         **{**scores._asdict(), "familiarity": familiarity}, observation=obs, models=models,

@@ -197,3 +197,49 @@ def test_online_nothing_settles_that_the_final_result_overturns(case):
     assert rec.decision is None
     summary = decision_summary(final, rec.decision)
     assert summary["agrees"] and 0 <= summary["decision_fraction"] <= 1
+
+
+def _course(aperture, wrist_x, start_distance=0.35, wrist_offset=0.05, diameter=0.06):
+    """grip_course of a movement given as its digits' aperture (NaN: lost) and its wrist's
+    way along x (the goal ``start_distance - wrist_offset`` away)."""
+    from types import SimpleNamespace
+
+    from perception.recognition.evidence import grip_course
+    from perception.recognition.rules import VerdictRules
+
+    wrist = np.c_[np.asarray(wrist_x, float), np.zeros(len(wrist_x))]
+    obs = SimpleNamespace(raw=None, g=np.asarray(aperture, float), wrist=wrist,
+                          start_distance=start_distance, object_diameter=diameter)
+    return grip_course(obs, VerdictRules(), wrist_offset)
+
+
+def test_the_grips_course_is_read_from_the_markers_aperture_and_the_wrists_way():
+    """Analytic cases of the online settle rule's evidence (one place for both paths):
+    rest 2 cm for 5 samples, opening to 10 cm (8 cm beyond rest, > 0.5 x 6 cm), then
+    closing to 8 cm: a quarter of the opening closed; the wrist at 0.15 of a 0.30 m way."""
+    g = [0.02] * 5 + [0.03, 0.06, 0.10, 0.09, 0.08]
+    x = np.linspace(0.0, 0.15, len(g))
+    c = _course(g, x)
+    assert c["opening"] == pytest.approx(0.08)
+    assert c["closing"] == pytest.approx(0.25)
+    assert c["progress"] == pytest.approx(0.5)
+    assert not c["reopened"]
+    # opening starts where the aperture first exceeds rest + 10 % of the opening: sample 5
+    assert c["opening_progress"] == pytest.approx(x[5] / 0.30)
+    # lost samples are left out, and the wrist's way is clipped at its goal
+    c = _course([np.nan, *g, np.nan], np.linspace(0.0, 0.45, len(g) + 2))
+    assert c["opening"] == pytest.approx(0.08) and c["progress"] == 1.0
+
+
+def test_a_grip_that_closes_and_opens_again_is_reopened_a_wobble_is_not():
+    """reopened: opened as a grasp's must, then closed and opened again, each by 15 % of
+    the opening so far (LandmarkParams.peak_prominence); a 1 mm wobble is no re-opening,
+    and a grip that never opened as a grasp's must gives no opening_progress."""
+    x = np.linspace(0.0, 0.2, 12)
+    twice = [0.02] * 5 + [0.06, 0.09, 0.06, 0.05, 0.07, 0.10, 0.10]
+    assert _course(twice, x)["reopened"]
+    wobble = [0.02] * 5 + [0.06, 0.09, 0.089, 0.09, 0.095, 0.10, 0.10]
+    assert not _course(wobble, x)["reopened"]
+    closed = _course([0.02] * 6 + [0.03] * 6, x)  # 1 cm beyond rest < 0.5 x 6 cm
+    assert np.isnan(closed["opening_progress"]) and not closed["reopened"]
+    assert _course([0.02, np.nan], x[:2])["opening"] == 0.0

@@ -306,9 +306,10 @@ def _assert_same_evidence(a, b):
     for x, y in ((a.log_likelihood, b.log_likelihood), (a.familiarity, b.familiarity)):
         np.testing.assert_allclose(x, y, rtol=1e-9, atol=1e-9)
     for name in ("transport_familiarity", "rest_aperture", "aperture_gap", "slowed",
-                 "scored_share", "opening_progress"):
+                 "scored_share", "opening_progress", "opening", "closing", "progress"):
         np.testing.assert_allclose(getattr(a, name), getattr(b, name), rtol=1e-9, atol=1e-12,
                                    err_msg=name)
+    assert a.reopened == b.reopened
     assert _landmark_text(a.observed) == _landmark_text(b.observed)
     assert _landmark_text(a.reference) == _landmark_text(b.reference)
 

@@ -25,8 +25,8 @@ if TYPE_CHECKING:
     from perception.observation import Observation
     from perception.recognition.models import MotorModel
 
-__all__ = ["clip_landmarks", "judged_models", "marker_aperture", "model_own_landmarks",
-           "movement_evidence", "opening_progress", "reference_model", "wrist_progress"]
+__all__ = ["clip_landmarks", "grip_course", "judged_models", "marker_aperture",
+           "model_own_landmarks", "movement_evidence", "reference_model", "wrist_progress"]
 
 
 def judged_models(kinds: Sequence[str], kind: str) -> tuple[int, ...]:
@@ -144,16 +144,27 @@ def wrist_progress(obs: Observation, wrist_offset: float) -> np.ndarray:
     return np.linalg.norm(obs.wrist - obs.wrist[0], axis=1) / (obs.start_distance - wrist_offset)
 
 
-def opening_progress(observation: Observation, rules: VerdictRules,
-                     wrist_offset: float) -> float:
-    """How far the wrist had come on its way to the models' goal when the grip started to
-    open (:func:`wrist_progress` there), 0..1.
+def grip_course(observation: Observation, rules: VerdictRules,
+                wrist_offset: float) -> dict[str, float | bool]:
+    """The grip's course in the movement so far, read from the digit markers' own aperture
+    (:func:`marker_aperture`, seen samples) and the wrist's way to the models' goal
+    (:func:`wrist_progress`): what :class:`~perception.recognition.rules.Evidence` holds
+    as ``opening_progress``, ``opening``, ``closing``, ``progress`` and ``reopened``.
 
-    The grip starts to open where its aperture first exceeds its rest by
-    ``opening_level`` of its opening
-    (:func:`~perception.recognition.shape.rest_and_opening`), as the landmark
-    ``opening_time`` reads it; NaN where it has not opened by
-    ``rules.grasp_opening`` × the object's diameter.
+    Each is known while the movement is under way, before the end that the landmarks
+    need (the online settle rule reads them; the verdict does not). The grip *opened as
+    a grasp's must* where its aperture exceeded its rest
+    (:func:`~perception.recognition.shape.rest_and_opening`) by ``rules.grasp_opening``
+    × the object's diameter.
+
+    * ``opening_progress``: the wrist's progress where the aperture first exceeded its
+      rest by ``rules.landmarks.opening_level`` of its opening, as the landmark
+      ``opening_time`` reads it (NaN where it has not opened as a grasp's must);
+    * ``opening``: how far it opened beyond its rest, m;
+    * ``closing``: share of that opening closed since its maximum;
+    * ``progress``: the largest share of the wrist's way covered, 0..1;
+    * ``reopened``: it opened as a grasp's must, then closed and opened again, each by
+      ``rules.landmarks.peak_prominence`` of its opening so far.
 
     Parameters
     ----------
@@ -168,13 +179,26 @@ def opening_progress(observation: Observation, rules: VerdictRules,
     obs = observation
     g = marker_aperture(obs)
     rows = np.flatnonzero(np.isfinite(g))
-    if len(rows) < 3:
-        return float("nan")
-    rest, opening = rest_and_opening(g[rows], rules)
-    if opening < rules.grasp_opening * obs.object_diameter:
-        return float("nan")
-    k = rows[int(np.argmax(g[rows] > rest + rules.landmarks.opening_level * opening))]
-    return float(np.clip(wrist_progress(obs, wrist_offset)[k], 0.0, 1.0))
+    g = g[rows]
+    moved = wrist_progress(obs, wrist_offset)
+    rest, opening = rest_and_opening(g, rules)
+    course = {"opening_progress": float("nan"), "opening": opening,
+              "closing": float(g.max() - g[-1]) / opening if opening > 0 and g.size else 0.0,
+              "progress": float(np.clip(np.nanmax(moved, initial=0.0), 0.0, 1.0)),
+              "reopened": False}
+    if len(g) < 3:
+        return course
+    if opening >= rules.grasp_opening * obs.object_diameter:
+        k = rows[int(np.argmax(g > rest + rules.landmarks.opening_level * opening))]
+        course["opening_progress"] = float(np.clip(moved[k], 0.0, 1.0))
+    above = np.flatnonzero(g > rest + rules.grasp_opening * obs.object_diameter)
+    if above.size:
+        after = g[above[0]:]
+        dip = np.maximum.accumulate(after) - after
+        k = int(np.argmax(dip))
+        need = rules.landmarks.peak_prominence * (float(after.max()) - rest)
+        course["reopened"] = bool(dip[k] >= need and float(after[k:].max() - after[k]) >= need)
+    return course
 
 
 def movement_evidence(observation: Observation, kinds: Sequence[str],
@@ -182,7 +206,7 @@ def movement_evidence(observation: Observation, kinds: Sequence[str],
                       landmarks: tuple[Landmarks, Landmarks | None] | None = None,
                       transport_familiarity: float = float("nan"),
                       scored_share: float = 1.0,
-                      opening_progress: float = float("nan")) -> Evidence:
+                      grip: dict | None = None) -> Evidence:
     """The :class:`~perception.recognition.rules.Evidence` of a movement.
 
     Parameters
@@ -201,8 +225,8 @@ def movement_evidence(observation: Observation, kinds: Sequence[str],
         The transport's alone to the best reach model (NaN: not measured).
     scored_share : float
         Share of the movement's steps scored.
-    opening_progress : float
-        :func:`opening_progress`'s (NaN: not measured).
+    grip : dict, optional
+        :func:`grip_course`'s (None: not measured).
     """
     if landmarks is None:
         return Evidence(list(kinds), np.asarray(log_likelihood), np.asarray(familiarity))
@@ -212,8 +236,7 @@ def movement_evidence(observation: Observation, kinds: Sequence[str],
                     rest_aperture=obs.marker_separation, observed=landmarks[0],
                     reference=landmarks[1],
                     aperture_gap=longest_gap(obs.time, marker_aperture(obs)),
-                    slowed=_arrival(obs), scored_share=float(scored_share),
-                    opening_progress=float(opening_progress))
+                    slowed=_arrival(obs), scored_share=float(scored_share), **(grip or {}))
 
 
 def _arrival(obs) -> float:

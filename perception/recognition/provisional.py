@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from types import SimpleNamespace
 
 import numpy as np
 
@@ -18,7 +17,7 @@ from perception.recognition.result import Recognition
 from perception.recognition.rules import Evidence, Verdict, VerdictRules
 from perception.validation import NonNegative, Share, declared
 
-__all__ = ["Decision", "OnlineState", "SettleRule", "decision_summary", "grip_course"]
+__all__ = ["Decision", "OnlineState", "SettleRule", "decision_summary"]
 
 
 @declared
@@ -31,7 +30,7 @@ class SettleRule:
     * a grip seen to depart (``grip-departs``), once the wrist has covered
       ``min_progress`` of its way to the models' goal: it opened twice (two aperture
       peaks, and after opening as a grasp's must it closed and opened again:
-      :func:`grip_course`'s ``twice``), or — the hand arrived (the transport slowed by
+      the evidence's ``reopened``), or — the hand arrived (the transport slowed by
       ``slowed``, at least the rules' ``arrival``) — it started to open after
       ``late_opening + late_margin`` of the movement (the landmark, known once the
       movement's end is seen);
@@ -99,7 +98,7 @@ class SettleRule:
             return math.inf
         return _log_margin(verdict.familiarity, rules.familiarity_threshold)
 
-    def settles(self, verdict: Verdict, evidence: Evidence, grip, rules: VerdictRules
+    def settles(self, verdict: Verdict, evidence: Evidence, rules: VerdictRules
                 ) -> tuple[str, str | None] | None:
         """The verdict and its detail that ``evidence`` settles (see the class docstring),
         or None while it is not conclusive.
@@ -109,9 +108,7 @@ class SettleRule:
         verdict : Verdict
             ``judge(evidence, rules, ongoing=True)``.
         evidence : Evidence
-            The rows so far.
-        grip : namespace
-            :func:`grip_course` of them.
+            The rows so far (the grip's course among it).
         rules : VerdictRules
         """
         lm = evidence.observed
@@ -121,10 +118,10 @@ class SettleRule:
             # two peaks count when the grip opened as a grasp's must before its dip: a
             # peak is a share of the opening so far, and a late opener's first
             # millimetres are no opening
-            twice = (grip.peaks or 0) >= 2 and grip.twice
-            arrived = grip.slowed >= max(self.slowed, rules.arrival)
+            twice = (lm.aperture_peaks or 0) >= 2 and evidence.reopened
+            arrived = evidence.slowed >= max(self.slowed, rules.arrival)
             late = arrived and lm.opening_time > rules.late_opening + self.late_margin
-            sure = grip.progress >= self.min_progress and (twice or late)
+            sure = evidence.progress >= self.min_progress and (twice or late)
             return (verdict.verdict, verdict.detail) if sure else None
         if verdict.rule != "familiarity" or verdict.verdict == "abnormal":
             return None
@@ -134,19 +131,21 @@ class SettleRule:
             return None
         if verdict.verdict == "reach":
             # a late opener opens by the end of its movement: a reach's end must be seen
-            sure = (grip.progress >= self.reach_progress and grip.slowed >= self.reach_slowed
-                    and grip.opening < self.reach_opening and math.isfinite(lm.end_time))
+            sure = (evidence.progress >= self.reach_progress
+                    and evidence.slowed >= self.reach_slowed
+                    and evidence.opening < self.reach_opening and math.isfinite(lm.end_time))
             return ("reach", None) if sure else None
         early = (lm.opening_time <= rules.late_opening - self.late_margin
                  if math.isfinite(lm.opening_time)
                  else evidence.opening_progress <= self.early_opening)
         # past the maximum, a closing is the hand at the object only near the end of its
         # way: before, it may be the dip of a re-opening
-        near = self.arrived if grip.closing >= self.closing else self.approached
+        near = self.arrived if evidence.closing >= self.closing else self.approached
         # the markers' own second opening comes a frame or two before the landmarks
         # count its peak
-        sure = (grip.opened and grip.peaks in (0, 1) and not grip.twice and early
-                and grip.slowed >= self.past_peak and grip.progress >= near)
+        opened = evidence.kinds[:1] == ["grasp"]  # the grasp models were judged
+        sure = (opened and lm.aperture_peaks in (0, 1) and not evidence.reopened and early
+                and evidence.slowed >= self.past_peak and evidence.progress >= near)
         return ("normal", None) if sure else None
 
 
@@ -250,59 +249,6 @@ class OnlineState:
     def settled(self) -> bool:
         """Whether a verdict has settled."""
         return self.decision is not None
-
-
-def grip_course(rec: Recognition) -> SimpleNamespace:
-    """The movement's course so far, as :meth:`SettleRule.settles` reads it, from its recognition.
-
-    ``opened`` (the grip opened as a grasp's must: the grasp models judged),
-    ``peaks`` (its landmark ``aperture_peaks``), ``opening`` (m beyond its
-    rest: :func:`~perception.recognition.shape.rest_and_opening` of the
-    markers' own aperture), ``closing`` (share of the opening closed since its
-    maximum), ``slowed`` (the evidence's), ``progress`` (the largest share of
-    the wrist's way to the models' goal covered so far, 0..1), ``twice`` (the
-    grip opened as a grasp's must — by ``grasp_opening`` of the object's
-    diameter —, then closed and opened again, each by ``peak_prominence`` of
-    its opening so far).
-
-    Parameters
-    ----------
-    rec : Recognition
-        The recognition of the rows so far.
-    """
-    from perception.recognition.evidence import marker_aperture, wrist_progress
-    from perception.recognition.shape import rest_and_opening
-
-    obs, ev = rec.observation, rec.evidence
-    g = marker_aperture(obs)
-    g = g[np.isfinite(g)]
-    _, opening = rest_and_opening(g, rec.rules)
-    closing = float(g.max() - g[-1]) / opening if opening > 0 and g.size else 0.0
-    moved = wrist_progress(obs, rec.normalisation.wrist_offset)
-    progress = float(np.clip(np.nanmax(moved, initial=0.0), 0.0, 1.0))
-    opened = rec.judged is not None and rec.kinds[rec.judged[0]] == "grasp"
-    peaks = ev.observed.aperture_peaks if ev.observed is not None else None
-    return SimpleNamespace(opened=opened, peaks=peaks, opening=opening, closing=closing,
-                           slowed=ev.slowed, progress=progress,
-                           twice=_opened_twice(g, rec.rules, obs.object_diameter))
-
-
-def _opened_twice(g: np.ndarray, rules, diameter: float) -> bool:
-    """Whether the aperture ``g`` (seen samples) opened as a grasp's, then closed and opened
-    again by ``peak_prominence`` of its opening so far (see :func:`grip_course`)."""
-    from perception.recognition.shape import rest_and_opening
-
-    if g.size < 3:
-        return False
-    rest, _ = rest_and_opening(g, rules)
-    above = np.flatnonzero(g > rest + rules.grasp_opening * diameter)
-    if not above.size:
-        return False
-    after = g[above[0]:]
-    dip = np.maximum.accumulate(after) - after
-    k = int(np.argmax(dip))
-    need = rules.landmarks.peak_prominence * (float(after.max()) - rest)
-    return bool(dip[k] >= need and float(after[k:].max() - after[k]) >= need)
 
 
 def decision_summary(rec: Recognition, decision: Decision | None) -> dict:

@@ -212,12 +212,14 @@ class Evidence:
         (:func:`slowed`; 1: the hand came to rest).
     scored_share : float
         Share of the movement's steps scored.
-    opening_progress : float
-        How far the wrist had come on its way to the models' goal when the
-        grip started to open, 0..1 (NaN: it has not opened as a grasp's must):
-        known as soon as the opening starts, before the movement's end that
-        the landmark ``opening_time`` needs (what the online settle rule reads
-        while the movement is under way; the verdict does not).
+    opening_progress, opening, closing, progress, reopened
+        The grip's course (:func:`~perception.recognition.evidence.grip_course`):
+        the wrist's progress when the grip started to open, 0..1 (NaN: it has not
+        opened as a grasp's must); how far it opened beyond its rest, m; the share
+        of that opening closed since its maximum; the largest share of the wrist's
+        way covered, 0..1; whether it opened, closed and opened again. Known before
+        the movement's end that the landmarks need: what the online settle rule
+        reads while the movement is under way (the verdict does not).
     """
 
     kinds: list[str]
@@ -231,6 +233,10 @@ class Evidence:
     slowed: float = 1.0
     scored_share: float = 1.0
     opening_progress: float = math.nan
+    opening: float = 0.0
+    closing: float = 0.0
+    progress: float = 0.0
+    reopened: bool = False
 
 
 def slowed(time: np.ndarray, wrist: np.ndarray, movement: int | None = None) -> float:
