@@ -293,7 +293,7 @@ def test_the_shipped_qualisys_file_is_read_without_pandas():
 
 
 def test_a_trials_table_is_written_as_pandas_writes_it(tmp_path):
-    from hammer_mv.cli.recognize import _trials_table_cells
+    from hammer_mv.cli.recording import _trials_table_cells
     from perception.io.atomic import write_csv
 
     pool = [None, float("nan"), 1, 2, 0, -3, 1.5, 0.1, 1e-7, 123456.789, 1e16, -0.0, 2.0,

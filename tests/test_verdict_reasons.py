@@ -15,7 +15,8 @@ import pytest
 from _demos import default_repertoire, demo_tracks
 
 from hammer_mv.cli import main
-from hammer_mv.cli.recognize import TRIALS_COLUMNS, verdict_line
+from hammer_mv.cli.recognize import verdict_line
+from hammer_mv.cli.recording import TRIALS_COLUMNS
 from perception.batch import ClipResult, summary_table
 from perception.landmarks import Landmarks
 from perception.pipeline import recognize_tracks

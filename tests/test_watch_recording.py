@@ -49,6 +49,10 @@ def test_watch_of_a_recording_replays_each_reach_and_accounts_for_every_trial(
     line = next(x for x in said.out.splitlines() if x.startswith("P01-trial1: ") and
                 "winner" in x)
     assert " rows) -> " in line and line.endswith("P01-trial1.recognition.json")
+    # every trial accounted for in the recording's table, as recognize writes it
+    trials = pd.read_csv(tmp_path / "watch" / "P01.trials.csv")
+    assert trials["trial"].tolist() == ["P01-trial1", "P01-trial2"]
+    assert trials["status"].tolist()[0] == "ok" and trials["reason"].notna().tolist()[1]
     watched = json.loads((tmp_path / "watch" / "P01-trial1.recognition.json").read_text())
     assert watched["online"]["source"] == "recording"
     assert watched["online"]["frames"] > 100 and not watched["online"]["interrupted"]
@@ -56,6 +60,8 @@ def test_watch_of_a_recording_replays_each_reach_and_accounts_for_every_trial(
     assert main(["recognize", str(recording), "-o", str(tmp_path / "rec"),
                  "--no-figures"]) == 1
     offline = json.loads((tmp_path / "rec" / "P01-trial1.recognition.json").read_text())
+    assert (tmp_path / "rec" / "P01.trials.csv").read_bytes() == (
+        tmp_path / "watch" / "P01.trials.csv").read_bytes()
     assert watched["mocap"]["trial"] == "P01-trial1"
     assert {k: v for k, v in watched.items() if k != "online"} == offline
 

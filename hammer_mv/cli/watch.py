@@ -147,82 +147,42 @@ def _watch(args: argparse.Namespace, signals: _Signals) -> int:
 
 def _watch_recording(args: argparse.Namespace, signals: _Signals) -> int:
     """``watch`` of a motion-capture recording: each reach's rows streamed as a pose file's,
-    as ``recognize`` would score it offline (docs/online.md).
-
-    Each reach prints what a watched file prints and leaves the report watch
-    writes; the trials that give none are listed, as ``recognize`` lists them,
-    with the accounting line. Exit status 1 when a trial or reach is not
-    scored; a signal ends the replay after the reach under way is reported.
-    """
-    import dataclasses
-
-    from hammer_mv.cli.checks import writable_folder
-    from hammer_mv.cli.flags import flag_text
-    from hammer_mv.cli.options import load_repertoire, mocap_import, recognition_settings
+    then scored as ``recognize`` scores it, every trial accounted for as it does
+    (docs/online.md). A signal ends the replay after the reach under way is reported."""
+    from hammer_mv.cli.recording import score_recording
     from perception.errors import InputError
-    from perception.io.atomic import check_output
     from perception.io.capture import RowsSource
     from perception.online import OnlineRecognizer
-    from perception.pipeline import clip_fingerprint
-    from perception.reaches import Unscored
-    from perception.recordings import prepare_reach, read_recording, trial_summary
-    from perception.report import clip as report
-    from perception.report.clip import remove_stale_reports
+    from perception.recordings import prepare_reach
 
-    path = Path(args.source)
     if args.labelled_video is not None:
         raise InputError("a motion-capture recording has no frames to label (leave out "
                          "--labelled-video)", args.labelled_video, field="--labelled-video")
-    settings = recognition_settings(args)
-    options = settings.mocap or mocap_import(args)
-    out = writable_folder(args.output)
-    recording = read_recording(path, options)
-    stem = path.stem
+    path = Path(args.source)
 
     def named(entry):  # --clip names the recording: its trials and reaches keep their tails
         if args.clip is None:
             return entry.name
-        return args.clip + (entry.name[len(stem):] if entry.name.startswith(stem) else
-                            f"-{entry.name}")
+        return args.clip + (entry.name[len(path.stem):] if entry.name.startswith(path.stem)
+                            else f"-{entry.name}")
 
-    reaches = [dataclasses.replace(e, name=named(e)) for e in recording.reaches]
-    inputs = [f for f in (args.repertoire, path) if f is not None]
-    for reach in reaches:  # every output refused before the first reach is replayed
-        for target in report.clip_outputs(out, reach.name).values():
-            check_output(target, inputs)
-    rep, rep_id = load_repertoire(args)
-    missed = [(named(u), u.reason) for u in recording.entries if isinstance(u, Unscored)]
-    kept = []
-    for k, reach in enumerate(reaches):
-        if signals.received:
-            missed.append((reach.name, f"not replayed: watch interrupted ({signals.name})"))
-            continue
+    def score(reach, settings, options, rep):
         prepared = prepare_reach(reach, settings, options)
         rows = prepared.tracks
         rec = OnlineRecognizer(rep, prepared.settings, clip=reach.name, markers=rows.markers,
                                tracker_attrs=dict(rows.tracker))
         with RowsSource(rows, str(path)) as src:
             online = _stream(src, rec, args, signals, _Drawer(None), pace=True)
-        try:
-            result = rec.finish(dict(rows.video), source=reach.source, paths=prepared.paths)
-        except HammerMVError as exc:  # this reach's (too few rows when interrupted, ...)
-            missed.append((reach.name, f"failed: {flag_text(exc.problem)}"))
-            continue
-        extra = {"fingerprint": clip_fingerprint(path, settings, f"{rep_id}#reach{k}"),
-                 "condition": None, "input": str(path), "mocap": prepared.info,
-                 "online": {**online(result), "source": "recording"}}
-        paths = report.write_clip_report(result, out, extra=extra, figures=not args.no_figures)
-        kept.append(reach.name)
-        _say_result(args, reach.name, result, online, paths, rows=True)
-    if not signals.received:  # reports of trials no longer scored (a rerun after one was lost)
-        remove_stale_reports(out, path, kept)
-    if not args.quiet:
-        print(trial_summary(len(recording.trials), len(kept), len(missed)), flush=True)
-    for name, why in missed:  # always: nothing is dropped without a word
-        print(f"{name}: not scored: {why}", file=sys.stderr)
-    if signals.received:
-        return 128 + signals.received
-    return 1 if missed else 0
+        result = rec.finish(dict(rows.video), source=reach.source, paths=prepared.paths)
+        return result, {"mocap": prepared.info, "online": {**online(result),
+                                                           "source": "recording"}}, \
+            lambda rec, paths: _say_result(args, reach.name, rec, online, paths, rows=True)
+
+    def stopped():
+        return f"not replayed: watch interrupted ({signals.name})" if signals.received else None
+
+    status = score_recording(args, path, score, name=named, stopped=stopped)
+    return 128 + signals.received if signals.received else status
 
 
 def _stream(src, rec, args: argparse.Namespace, signals: _Signals, draw: _Drawer, *,
