@@ -110,8 +110,7 @@ def name_factors(pattern, name: str | os.PathLike) -> dict[str, str] | None:
     stem = Path(name).stem
     found = compiled.search(stem)
     if found is None:
-        # a warning, not an error: no field to name, so in the command line's words
-        log.warning("%s: --factors-from-name %r does not match the file name %r: no factors "
+        log.warning("%s: `factors_from_name` %r does not match the file name %r: no factors "
                     "from its name", name, compiled.pattern, stem)
         return None
     return {k: v for k, v in found.groupdict().items() if v is not None}

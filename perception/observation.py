@@ -607,7 +607,7 @@ def check_hand(scene: RestScene, params: ObserveParams | None = None) -> None:
                          f"markers {apart * 100:.1f} cm apart, {size * 100:.1f} cm from the "
                          + ("wrist (keypoints on the wrong markers? check `keypoints`, and "
                             "`object_diameter_px` or `px_per_m`)" if is_pose_file(scene.source)
-                            else "wrist (a same-coloured object taken for a marker? give --roi "
+                            else "wrist (a same-coloured object taken for a marker? give `rois` "
                             "when tracking; or a wrong scale: check `object_diameter`, the "
                             "object's real size, or `px_per_m`)"), scene.source)
 

@@ -212,3 +212,31 @@ def test_the_error_line_names_the_flag_where_the_library_names_the_field(error, 
 
     _parser("recognize")
     assert error_line("recognize", error) == f"hammer-mv recognize: error: {line}"
+
+
+def test_a_library_log_line_names_fields_and_the_command_line_gives_their_flags():
+    """The library's warnings name its fields (```factors_from_name```, ```rois```), as
+    its errors do; the command line's log handler gives them as the flags that set them,
+    and leaves a handler it did not make alone."""
+    import logging
+
+    from hammer_mv.cli import _flag_words
+
+    _parser("landmarks")
+    record = logging.LogRecord("perception.factors", logging.WARNING, __file__, 1,
+                               "%s: `factors_from_name` %r does not match", ("a.tsv", "P"),
+                               None)
+    assert _flag_words(record)
+    assert record.getMessage() == "a.tsv: --factors-from-name 'P' does not match"
+    record = logging.LogRecord("perception.tracking", logging.WARNING, __file__, 1,
+                               "give `rois` thumb X Y W H; `no_such_field` stays", (), None)
+    _flag_words(record)
+    assert record.getMessage() == "give --roi thumb X Y W H; `no_such_field` stays"
+    root = logging.getLogger()
+    theirs = logging.NullHandler()
+    root.addHandler(theirs)
+    try:
+        assert main([]) == 2  # no command: the help, after logging is set up
+    finally:
+        root.removeHandler(theirs)
+    assert _flag_words not in theirs.filters

@@ -295,8 +295,11 @@ def main(argv: list[str] | None = None, *, quiet_start: bool = False) -> int:
     if quiet_start:
         gc.freeze()
         gc.enable()
+    ours = set(logging.getLogger().handlers)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
+    for handler in set(logging.getLogger().handlers) - ours:  # the handler made here only
+        handler.addFilter(_flag_words)
     if not getattr(args, "func", None):
         parser.print_help(sys.stderr)
         return 2
@@ -313,6 +316,17 @@ def main(argv: list[str] | None = None, *, quiet_start: bool = False) -> int:
         print(f"hammer-mv {args.command}: this is a bug in hammer-mv (not in your input); "
               "please report it with the traceback above", file=sys.stderr)
         return 1
+
+
+def _flag_words(record: logging.LogRecord) -> bool:
+    """A library's log line with the fields it names given as their flags (as an error's)."""
+    from hammer_mv.cli.flags import flag_text
+
+    text = record.getMessage()
+    flagged = flag_text(text)
+    if flagged != text:
+        record.msg, record.args = flagged, None
+    return True
 
 
 if __name__ == "__main__":  # python -m hammer_mv.cli

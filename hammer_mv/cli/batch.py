@@ -96,7 +96,7 @@ def run(args: argparse.Namespace) -> int:
         print(trial_summary(summary.attrs.get("trials", len(summary)), scored,
                             len(summary) - scored))
         for line in warnings_summary(_warnings(summary), "clips"):
-            print(f"hammer-mv batch: warning: {line}", file=sys.stderr)
+            print(f"hammer-mv batch: warning: {flag_text(line)}", file=sys.stderr)
     why = unscored["reason"] if "reason" in unscored else unscored["error"]
     for clip, reason in zip(unscored["clip"], why):  # always: nothing dropped without a word
         print(f"{clip}: not scored: {flag_text(str(reason))}", file=sys.stderr)

@@ -34,7 +34,9 @@ FPS_HELP = ("true frame rate, frames/s (default: the file's own): for videos who
             "wrong")
 
 #: The flag of each field a command's flags set, by the field's name (``"px_per_m"``).
-FIELD_FLAGS: dict[str, str] = {}
+#: The tracker's ``rois`` are named by tracking's messages wherever a video is tracked
+#: (``recognize``, ``batch``): their flag is ``hammer-mv track``'s.
+FIELD_FLAGS: dict[str, str] = {"rois": "--roi"}
 #: The same by ``(class name, field)`` (``("ObserveParams", "px_per_m")``): read off a
 #: declared class's error, whose ``location`` is that pair.
 OWNER_FLAGS: dict[tuple[str, str], str] = {}

@@ -80,6 +80,7 @@ def run(args: argparse.Namespace) -> int:
         Parsed arguments.
     """
     from hammer_mv.cli.checks import output_folder
+    from hammer_mv.cli.flags import flag_text
     from hammer_mv.cli.options import load_repertoire, recognition_settings
     from perception.errors import InputError
     from perception.io.files import input_file
@@ -139,7 +140,7 @@ def run(args: argparse.Namespace) -> int:
                       else "; the scene is mirrored: scored as with --mirror")
         print(f"{verdict_line(rec, rule=True)}{mirror} -> {paths['json']}")
         for warning in rec.warnings:
-            print(f"{clip}: warning: {warning}", file=sys.stderr)
+            print(f"{clip}: warning: {flag_text(warning)}", file=sys.stderr)
     return 0
 
 

@@ -122,7 +122,7 @@ def score_recording(args: argparse.Namespace, path: Path, score: Callable, *,
               flush=True)
         # one line per kind of warning for the recording; each reach's are in its report
         for line in warnings_summary(warned, "reaches"):
-            print(f"{path.name}: warning: {line}", file=sys.stderr)
+            print(f"{path.name}: warning: {flag_text(line)}", file=sys.stderr)
     for entry_name, why in missed:  # always: nothing is dropped without a word
         print(f"{entry_name}: not scored: {why}", file=sys.stderr)
     return 1 if missed else 0

@@ -341,7 +341,7 @@ class FrameSource(capture.Source):
                     "frames its header claims (`keep_truncated` uses the decoded frames)",
                     self.path)
             logger.warning("%s: decoded %d of the %d frames the header claims; keeping them "
-                           "(--keep-truncated)", self.path, self.n_decoded, claimed)
+                           "(`keep_truncated`)", self.path, self.n_decoded, claimed)
         if self._times.n_fallback and self.fps_override is None:
             logger.warning("%s: %d of %d frames had no usable container timestamp; used "
                            "previous + 1/fps", self.path, self._times.n_fallback, self.n_decoded)

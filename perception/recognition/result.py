@@ -125,7 +125,7 @@ _WARNING_RANGES = {"movement_time": ("movement time", VALIDATED_MOVEMENT_TIME, "
                    "peak_speed": ("peak speed", VALIDATED_PEAK_SPEED, " m/s"),
                    "distance": ("reach distance", VALIDATED_DISTANCE, " m")}
 #: What a warning's likely cause may be, where one is known.
-_WARNING_HINTS = {"peak_speed": " (a motion-capture file's --units?)"}
+_WARNING_HINTS = {"peak_speed": " (a motion-capture file's `units`?)"}
 
 @dataclass(frozen=True, eq=False)
 class Recognition:

@@ -277,7 +277,8 @@ class FirstDetection:
         if tr.name not in self.ambiguities:
             self.ambiguities[tr.name] = tr.rivals
             logger.warning("%s: %s; reported ambiguous (status %d) until it can be told "
-                           "from them; give --roi %s X Y W H or a setup file (--setup)",
+                           "from them; give `rois` %s X Y W H or a setup file "
+                           "(hammer-mv calibrate)",
                            tr.name, tr.why_not_found(), Status.AMBIGUOUS, tr.name)
 
     def _start(self, tr: MarkerTrack, frame: np.ndarray, blob: Blob) -> Located | None:

@@ -276,7 +276,7 @@ def calibrate(frames: Sequence[np.ndarray], *, rois: Mapping[str, tuple[int, int
                if not np.isfinite(position[j]).all()]
     if missing:
         why = "; ".join(f"{m}: {tracker.why_not_found(m)}" for m in missing)
-        raise InputError(f"cannot calibrate: {why}; give --roi "
+        raise InputError(f"cannot calibrate: {why}; give `rois` "
                          f"{missing[0]} X Y W H around it on the first frame")
     hsv = cv2.cvtColor(frames[0], cv2.COLOR_BGR2HSV)
     learned, masks = [], {}

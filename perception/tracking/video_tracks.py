@@ -217,7 +217,7 @@ def track_video(
             raise InputError(
                 f"marker{'s' if len(missing) > 1 else ''} {', '.join(missing)} never found "
                 f"in {src.n_decoded} frames ({why}); check the colour models and marker "
-                "sizes (hammer-mv calibrate, --setup), or give --roi MARKER X Y W H",
+                "sizes (a setup file: hammer-mv calibrate), or give `rois` MARKER X Y W H",
                 video,
             )
         w.update(video=src.attrs(), tracker=tracker.attrs())
