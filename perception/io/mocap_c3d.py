@@ -39,6 +39,16 @@ def _c3d_values(group: Mapping, name: str) -> list:
     return list(value) if isinstance(value, list | tuple) else list(np.atleast_1d(value))
 
 
+def _labels(point: Mapping) -> list[str]:
+    """POINT:LABELS, then LABELS2, LABELS3, ...: a parameter holds at most 255 labels."""
+    labels = _c3d_values(point, "LABELS")
+    more = 2
+    while f"LABELS{more}" in point:
+        labels += _c3d_values(point, f"LABELS{more}")
+        more += 1
+    return [str(x).strip() for x in labels]
+
+
 def _stated_frames(path: Path) -> tuple[int, int] | None:
     """``(frames the header states, frames whose bytes the file holds)``, or None if unknown.
 
@@ -93,6 +103,10 @@ def read_c3d(path: Path, source: str, rate, units) -> list[MocapTrial]:
     points = np.asarray(c3d["data"]["points"], dtype=float)[:3]  # (3, n_points, n_frames)
     residuals = np.asarray(c3d["data"]["meta_points"]["residuals"], dtype=float)
     notes: list[str] = []
+    if not points.shape[1]:  # before the rate: a forces-only file states POINT:RATE 0
+        raise InputError("no marker points: POINT:USED is 0 (the file holds other data only: "
+                         "analog channels, forces or rotations)",
+                         path, field="POINT:USED")
     counts = _stated_frames(path)
     if counts is not None and min(counts[1], points.shape[2]) < counts[0]:
         held = min(counts[1], points.shape[2])
@@ -102,7 +116,7 @@ def read_c3d(path: Path, source: str, rate, units) -> list[MocapTrial]:
         notes.append(f"the file is cut short: its header states {counts[0]} frames, it holds "
                      f"{held}: those {held} are read")
         points, residuals = points[:, :, :held], residuals[..., :held]
-    labels = [str(x).strip() for x in _c3d_values(point, "LABELS")]
+    labels = _labels(point)
     labels = [labels[i] if i < len(labels) and labels[i] else f"point{i + 1}"
               for i in range(points.shape[1])]
     modelled = {str(x).strip() for g in _C3D_MODELLED for x in _c3d_values(point, g)}

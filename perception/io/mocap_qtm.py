@@ -13,7 +13,7 @@ from pathlib import Path
 
 from perception.errors import InputError
 from perception.io.mocap_tables import table_trials, time_column_of
-from perception.io.mocap_text import TableText, load
+from perception.io.mocap_text import TableText, decimal_mark, load
 from perception.io.mocap_trial import MocapTrial, check_rate
 from perception.io.plain_tables import numeric_table
 from perception.limits import MAX_FRAMES
@@ -59,6 +59,30 @@ def _name_notes(names: list[str], named: list[str], header: dict) -> list[str]:
     return notes
 
 
+def _unread_notes(columns: list[str], groups: dict[str, tuple]) -> list[str]:
+    """What the columns besides the markers' X, Y, Z and the clock are, said as not read:
+    QTM writes a timecode (``SMPTE``) and, when asked, a ``name Type`` column per
+    marker (Measured, Gap-filled, ...) beside those of the markers it lists."""
+    listed = {c for cols in groups.values() for c in cols} | {"Frame", "Time"}
+    other = [c for c in columns if c not in listed and not c.startswith("Unnamed: ")]
+    own = [c for c in other if c.rsplit(" ", 1)[0] in groups]
+    xyz = [c for c in other if c not in own and c.rsplit(" ", 1)[-1] in ("X", "Y", "Z")]
+    rest = [c for c in other if c not in own and c not in xyz]
+    notes = []
+    if xyz:
+        unlisted = sorted({c.rsplit(" ", 1)[0] for c in xyz})
+        notes.append(f"columns of markers MARKER_NAMES does not list, not read: "
+                     f"{', '.join(map(repr, unlisted[:5]))}")
+    if own:
+        kinds = sorted({c.rsplit(" ", 1)[1] for c in own})
+        notes.append(f"the markers' {', '.join(map(repr, kinds))} columns not read "
+                     f"({len(own)} columns)")
+    if rest:
+        notes.append(f"column{'s' if len(rest) > 1 else ''} {', '.join(map(repr, rest[:5]))} "
+                     "not read (not a marker's X, Y, Z)")
+    return notes
+
+
 def read_qtm(path: Path, source: str, text: TableText, rate, units, trial_column,
              time_column) -> list[MocapTrial]:
     """A QTM 3D TSV export.
@@ -97,11 +121,13 @@ def read_qtm(path: Path, source: str, text: TableText, rate, units, trial_column
         raise InputError("no sampling rate: give it with `rate`", path, field="FREQUENCY")
     groups = {m: tuple(f"{m} {a}" for a in "XYZ") for m in names}
     first = lines[skip].split("\t")[0].strip() if skip < len(lines) else ""
-    titled = bool(first) and not re.fullmatch(r"[-+0-9.eE]+", first)
+    titled = bool(first) and not re.fullmatch(r"[-+0-9.,eE]+", first)
+    # a QTM export opened and saved again by a European spreadsheet writes decimal commas
+    decimal = decimal_mark(lines[skip + titled:], "\t")
     # the plain case without pandas (its import is most of a recognize's start-up)
-    df = numeric_table(text.raw, "\t", skip, MAX_FRAMES) if titled else None
+    df = numeric_table(text.raw, "\t", skip, MAX_FRAMES) if titled and decimal == "." else None
     if df is None:
-        df = load(path, text.raw, "\t", skip, 0 if titled else None)
+        df = load(path, text.raw, "\t", skip, 0 if titled else None, decimal)
     if not titled:  # older exports: X Y Z per marker, perhaps after Frame and Time
         columns = [c for cols in groups.values() for c in cols]
         if df.shape[1] not in (len(columns), len(columns) + 2):
@@ -113,12 +139,7 @@ def read_qtm(path: Path, source: str, text: TableText, rate, units, trial_column
     if missing:
         raise InputError(f"no column {missing!r} for a marker it lists", path,
                          field="MARKER_NAMES")
-    listed = {c for cols in groups.values() for c in cols} | {"Frame", "Time"}
-    unlisted = sorted({c.rsplit(" ", 1)[0] for c in df.columns
-                       if c not in listed and not c.startswith("Unnamed: ")})
-    if unlisted:
-        notes.append(f"columns of markers MARKER_NAMES does not list, not read: "
-                     f"{', '.join(map(repr, unlisted[:5]))}")
+    notes += _unread_notes(list(df.columns), groups)
     stated = (header.get("NO_OF_FRAMES") or [""])[0]
     if stated and stated != str(len(df)):
         notes.append(f"NO_OF_FRAMES says {stated}; the file holds {len(df)} frames")

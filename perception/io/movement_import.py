@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
+import itertools
 import sys
 from pathlib import Path
 
@@ -153,9 +154,27 @@ def dlc_inputs(df, fps: float | None, source_software: str = "DeepLabCut"):
     keypoint_names = df.columns.get_level_values("bodyparts").unique().to_list()
     coord_names = df.columns.get_level_values("coords").unique().to_list()
     n_coords = len(coord_names)
-    tracks = (df.to_numpy()
-              .reshape((-1, len(individual_names), len(keypoint_names), n_coords))
-              .transpose(0, 3, 2, 1))
+    values = df.to_numpy()
+    shape = (len(df), len(individual_names), len(keypoint_names), n_coords)
+    where = [tuple(df.columns.get_level_values(level)) if level in df.columns.names
+             else ("individual_0",) * df.shape[1]
+             for level in ("individuals", "bodyparts", "coords")]
+    held = list(zip(*where))
+    if held == list(itertools.product(individual_names, keypoint_names, coord_names)):
+        tracks = values.reshape(shape)
+    else:
+        import numpy as np
+
+        # A multi-animal project's unique body parts (individual "single": the object, often)
+        # are not kept for every animal, nor the animals' for it: each column is put in its
+        # place and the keypoints an individual lacks are NaN (movement 0.15 reshapes the
+        # table as if every individual had every keypoint, and reads it as garbage)
+        tracks = np.full(shape, np.nan, dtype=values.dtype if values.dtype == object else float)
+        at = [{name: i for i, name in enumerate(names)}
+              for names in (individual_names, keypoint_names, coord_names)]
+        for j, (who, part, coord) in enumerate(held):
+            tracks[:, at[0][who], at[1][part], at[2][coord]] = values[:, j]
+    tracks = tracks.transpose(0, 3, 2, 1)
     if "likelihood" in coord_names:  # x, y, likelihood
         likelihood_index = coord_names.index("likelihood")
         confidence_array = tracks[:, likelihood_index, :, :]

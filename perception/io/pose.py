@@ -60,6 +60,7 @@ from perception.io.pose_arrays import (
     frame_times,
     marker_keys,
     pick_individual,
+    unique_fill,
 )
 from perception.io.pose_mapping import keypoint_mapping, object_at_grip
 from perception.io.tracks import Status, Tracks, position_bounds
@@ -508,12 +509,16 @@ def _check_table_size(rows: int, columns: int, path: Path) -> None:
                          "file may hold", path)
 
 
-def _pick_individual(ds, options: PoseImport, path: Path):
-    names = [str(n) for n in ds["individuals"].values] if "individuals" in ds.dims else []
-    name = pick_individual(names, options.individual, path)
-    if options.individual is not None:
-        return ds.sel(individuals=name)
-    return ds.isel(individuals=0) if names else ds
+def _seen(position, table: bool) -> list[str] | None:
+    """The individuals with a position in some frame (None: the file has no individuals)."""
+    if table:
+        finite = np.isfinite(np.asarray(position.position, dtype=np.float64))
+        return [n for n, f in zip(position.individuals, finite.any(axis=(0, 1, 2))) if f]
+    if "individuals" not in position.dims:
+        return None
+    finite = position["position"].notnull().any([d for d in position["position"].dims
+                                                 if d != "individuals"])
+    return [str(n) for n, f in zip(position["individuals"].values, finite.values) if f]
 
 
 def _marker_arrays(ds, keys: Mapping[str, str], path: Path) -> tuple[np.ndarray, np.ndarray]:
@@ -541,16 +546,32 @@ def _markers(ds, options: PoseImport, path: Path, own: np.ndarray | None):
     names = ds.keypoints if table else [str(k) for k in ds["keypoints"].values]
     mapping, notes = keypoint_mapping(names, options.keypoints, MARKERS)
     keys = {m: k for m, k in mapping.items() if k is not None}
+    individuals = ds.individuals if table else (
+        [str(n) for n in ds["individuals"].values] if "individuals" in ds.dims else [])
+    try:
+        seen = _seen(ds, table)
+    except (TypeError, ValueError):  # text in a column: said where the arrays are read
+        seen = None
+    who, more = pick_individual(individuals, options.individual, path, seen)
+    notes += more
     if table:
-        who = pick_individual(ds.individuals, options.individual, path)
         frames, time, fps = frame_times(ds.sizes["time"], ds.time, ds.attrs, options.fps, own,
                                         rate, path)
-        xy, conf = ds.markers(who, keys, path)
+
+        def arrays(name):
+            return ds.markers(name, keys, path)
     else:
-        ds = _pick_individual(ds, options, path)
         frames, time, fps = frame_times(ds.sizes["time"], ds["time"].values, ds.attrs,
                                         options.fps, own, rate, path)
-        xy, conf = _marker_arrays(ds, keys, path)
+
+        def arrays(name):
+            return _marker_arrays(ds if name is None else ds.sel(individuals=name), keys, path)
+    filled = unique_fill(individuals, who, keys, arrays)
+    if filled is None:
+        xy, conf = arrays(who if individuals else None)
+    else:
+        xy, conf, more = filled
+        notes += more
     if mapping["object"] is None:
         hand = np.where((conf >= options.pcutoff)[..., None], xy, np.nan)
         place = object_at_grip(hand)

@@ -21,7 +21,8 @@ import numpy as np
 from perception.errors import InputError
 from perception.limits import MAX_FPS, MAX_FRAMES, MAX_KEYPOINTS, MAX_POSE_POINTS
 
-__all__ = ["PoseTable", "check_sizes", "frame_times", "marker_keys", "pick_individual"]
+__all__ = ["UNIQUE_BODYPARTS", "PoseTable", "check_sizes", "frame_times", "marker_keys",
+           "pick_individual", "unique_fill"]
 
 
 def check_sizes(sizes: Mapping[str, int], path: Path) -> None:
@@ -48,8 +49,18 @@ def check_sizes(sizes: Mapping[str, int], path: Path) -> None:
                          field="position")
 
 
-def pick_individual(names: Sequence[str], individual: str | None, path: Path) -> str | None:
-    """The individual scored: ``individual`` (in the file), else the file's only one.
+#: The individual DeepLabCut's multi-animal tables file their unique body parts under
+#: (``uniquebodyparts`` of the project: often the object), not an animal.
+UNIQUE_BODYPARTS = "single"
+
+
+def pick_individual(names: Sequence[str], individual: str | None, path: Path,
+                    seen: Sequence[str] | None = None) -> tuple[str | None, list[str]]:
+    """The individual scored: ``individual`` (in the file), else the file's only one seen.
+
+    An individual never seen (a SLEAP track defined but given no instance) and
+    DeepLabCut's ``single`` (its unique body parts, read with any individual:
+    :func:`unique_fill`) are no choice to make.
 
     Parameters
     ----------
@@ -59,21 +70,68 @@ def pick_individual(names: Sequence[str], individual: str | None, path: Path) ->
         The one asked for.
     path : Path
         The file.
+    seen : sequence of str, optional
+        The individuals with a position in some frame (default: all of them).
 
     Returns
     -------
-    str or None
-        Its name; None where the file names none.
+    tuple
+        Its name (None where the file names none) and notes on what was left aside.
     """
     if individual is not None:
         if individual not in names:
             raise InputError(f"`individual` {individual!r}: not in the file "
                              f"(individuals: {', '.join(names) or 'none'})", path)
-        return individual
-    if len(names) > 1:
-        raise InputError(f"the file holds {len(names)} individuals ({', '.join(names)}): "
+        return individual, []
+    seen = list(names) if seen is None else [n for n in names if n in set(seen)]
+    animals = [n for n in seen if n != UNIQUE_BODYPARTS] or seen
+    if len(animals) > 1:
+        raise InputError(f"the file holds {len(animals)} individuals ({', '.join(animals)}): "
                          "choose one with `individual`", path)
-    return names[0] if names else None
+    if not animals:  # nothing seen anywhere: as the file's only one, if it is
+        if len(names) > 1:
+            raise InputError(f"the file holds {len(names)} individuals ({', '.join(names)}): "
+                             "choose one with `individual`", path)
+        return (names[0] if names else None), []
+    aside = [n for n in names if n not in seen]
+    notes = [f"individual{'s' if len(aside) > 1 else ''} {', '.join(map(repr, aside))} never "
+             f"seen: {animals[0]!r} read"] if aside else []
+    return animals[0], notes
+
+
+def unique_fill(names: Sequence[str], who: str | None, keys: Mapping[str, str],
+                arrays: Callable[[str], tuple[np.ndarray, np.ndarray]]
+                ) -> tuple[np.ndarray, np.ndarray, list[str]] | None:
+    """The individual's ``(T, M, 2)`` positions and ``(T, M)`` likelihoods with the
+    keypoints it never has taken from DeepLabCut's unique body parts, or None
+    where the file has none or ``who`` is that individual.
+
+    Parameters
+    ----------
+    names : sequence of str
+        The file's individuals.
+    who : str
+        The one read.
+    keys : mapping
+        The file's keypoint of each marker, in the arrays' order.
+    arrays : callable
+        ``arrays(individual)``: its positions and likelihoods of ``keys``.
+    """
+    if who is None or who == UNIQUE_BODYPARTS or UNIQUE_BODYPARTS not in names:
+        return None
+    xy, conf = arrays(who)
+    shared, shared_conf = arrays(UNIQUE_BODYPARTS)
+    own = np.isfinite(xy).all(axis=-1).any(axis=0)
+    unique = np.isfinite(shared).all(axis=-1).any(axis=0)
+    take = ~own & unique
+    if not take.any():
+        return xy, conf, []
+    xy, conf = xy.copy(), conf.copy()
+    xy[:, take], conf[:, take] = shared[:, take], shared_conf[:, take]
+    taken = [k for k, t in zip(keys.values(), take) if t]
+    return xy, conf, [f"keypoint{'s' if len(taken) > 1 else ''} {', '.join(map(repr, taken))} "
+                      f"read from DeepLabCut's unique body parts (individual "
+                      f"{UNIQUE_BODYPARTS!r}) with {who!r}"]
 
 
 def frame_times(n: int, coords: Any, attrs: Mapping[str, Any], fps_given: float | None,

@@ -1,0 +1,99 @@
+"""Pose files in the layouts DeepLabCut and SLEAP write for multi-animal projects.
+
+- DeepLabCut multi-animal tables (``analyze_videos`` of a project with
+  ``uniquebodyparts``): the header rows scorer, individuals, bodyparts,
+  coords, each animal's keypoints, then the unique body parts under the
+  individual ``single`` (DeepLabCut's name for them; the object of a reach,
+  often). Written here with pandas as DeepLabCut writes them (``to_hdf`` key
+  ``df_with_missing``, ``to_csv``).
+- SLEAP labels (``.slp``) whose project defines a track no instance is given
+  (a track deleted from every frame stays in the file): written with
+  sleap-io, the library SLEAP itself reads and writes ``.slp`` through.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from perception.errors import InputError
+from perception.io.pose import PoseImport, read_pose
+
+pytest.importorskip("movement", reason="the 'pose' extra (make test installs it)")
+
+N = 40
+SCORER = "DLC_resnet50_reachOct30shuffle1_200000"
+PARTS = ("thumb", "index", "wrist")
+
+
+def _animal(shift: float) -> dict[str, np.ndarray]:
+    t = np.arange(N, dtype=float)
+    return {"thumb": np.c_[100 + 3 * t + shift, 200 - t], "index": np.c_[100 + 3 * t + shift,
+            220 + t], "wrist": np.c_[40 + 3 * t + shift, 210 + 0 * t]}
+
+
+def _dlc_ma() -> pd.DataFrame:
+    columns, data = [], []
+    for who, shift in (("mouse1", 0.0), ("mouse2", 300.0)):
+        for part, xy in _animal(shift).items():
+            for k, coord in enumerate(("x", "y", "likelihood")):
+                columns.append((SCORER, who, part, coord))
+                data.append(xy[:, k] if k < 2 else np.full(N, 0.97))
+    for k, coord in enumerate(("x", "y", "likelihood")):  # the unique body part: the cup
+        columns.append((SCORER, "single", "cup", coord))
+        data.append(np.full(N, (520.0, 215.0, 0.99)[k]))
+    names = ["scorer", "individuals", "bodyparts", "coords"]
+    return pd.DataFrame(np.array(data).T,
+                        columns=pd.MultiIndex.from_tuples(columns, names=names))
+
+
+@pytest.fixture(params=["h5", "csv"])
+def dlc_ma(request, tmp_path):
+    df = _dlc_ma()
+    path = tmp_path / f"reach01DLC_resnet50_reachOct30shuffle1_200000_el.{request.param}"
+    if request.param == "h5":
+        pytest.importorskip("tables")
+        df.to_hdf(path, key="df_with_missing", format="table", mode="w")
+    else:
+        df.to_csv(path)
+    return path
+
+
+def test_dlc_unique_bodyparts_are_read_with_each_animal(dlc_ma):
+    with pytest.raises(InputError, match=r"2 individuals \(mouse1, mouse2\)"):
+        read_pose(dlc_ma, PoseImport(fps=30))  # 'single' is no animal to choose
+    for who, shift in (("mouse1", 0.0), ("mouse2", 300.0)):
+        tracks = read_pose(dlc_ma, PoseImport(fps=30, individual=who, cleaning=None,
+                                              keypoints={"object": "cup"}))
+        assert tracks.n_frames == N  # not the table's values reshaped to other frames
+        at = {m: tracks.markers.index(m) for m in ("thumb", "finger", "wrist", "object")}
+        np.testing.assert_allclose(tracks.position[:, at["thumb"]], _animal(shift)["thumb"])
+        np.testing.assert_allclose(tracks.position[:, at["finger"]], _animal(shift)["index"])
+        np.testing.assert_allclose(tracks.position[:, at["object"]],
+                                   np.tile([520.0, 215.0], (N, 1)))
+        notes = tracks.tracker["reading_notes"]
+        assert "keypoint 'cup' read from DeepLabCut's unique body parts" in notes
+
+
+def test_sleap_track_without_instances_is_no_choice(tmp_path):
+    sio = pytest.importorskip("sleap_io")
+    skeleton = sio.Skeleton(["thumb", "index", "wrist", "ball"])
+    video = sio.Video(filename="reach01.mp4", open_backend=False)
+    used, unused = sio.Track("hand"), sio.Track("hand_old")
+    frames = []
+    for i in range(N):
+        points = np.array([[100 + 3 * i, 200], [100 + 3 * i, 230], [40 + 3 * i, 215],
+                           [400, 215]], dtype=float)
+        frames.append(sio.LabeledFrame(video=video, frame_idx=i, instances=[
+            sio.PredictedInstance.from_numpy(points, skeleton=skeleton, score=0.9,
+                                             point_scores=np.full(4, 0.9), track=used)]))
+    path = tmp_path / "reach01.slp"
+    sio.save_slp(sio.Labels(labeled_frames=frames, videos=[video], skeletons=[skeleton],
+                            tracks=[used, unused]), str(path))
+    tracks = read_pose(path, PoseImport(fps=30, cleaning=None))
+    np.testing.assert_allclose(tracks.position[:, tracks.markers.index("wrist"), 0],
+                               40 + 3 * np.arange(N))
+    assert "individual 'hand_old' never seen: 'hand' read" in tracks.tracker["reading_notes"]
+    with pytest.raises(InputError, match="not in the file"):
+        read_pose(path, PoseImport(fps=30, individual="other"))
