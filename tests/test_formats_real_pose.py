@@ -97,3 +97,44 @@ def test_sleap_track_without_instances_is_no_choice(tmp_path):
     assert "individual 'hand_old' never seen: 'hand' read" in tracks.tracker["reading_notes"]
     with pytest.raises(InputError, match="not in the file"):
         read_pose(path, PoseImport(fps=30, individual="other"))
+
+
+def _collected(index) -> pd.DataFrame:
+    """DeepLabCut's labelled frames as it writes them: x, y per keypoint (no likelihood),
+    a row per labelled image (the layout of talmolab/sleap-io's
+    tests/data/dlc/dlc_test_project/labeled-data/*/CollectedData_JohnDoe.csv)."""
+    columns = [("JohnDoe", part, coord) for part in PARTS for coord in "xy"]
+    values = np.random.default_rng(1).uniform(100, 900, (len(index), len(columns)))
+    return pd.DataFrame(values, index=index, columns=pd.MultiIndex.from_tuples(
+        columns, names=["scorer", "bodyparts", "coords"]))
+
+
+@pytest.mark.parametrize("layout", ["three-column index", "path index", "h5"])
+def test_dlc_labelled_frames_are_refused_saying_what_they_are(tmp_path, layout):
+    images = [f"img{i:05d}.png" for i in (144, 838, 2172)]
+    if layout == "three-column index":  # DeepLabCut 2.2 and later
+        df = _collected(pd.MultiIndex.from_tuples([("labeled-data", "reach01", i)
+                                                   for i in images]))
+    else:  # DeepLabCut 2.1: one column of paths
+        df = _collected([f"labeled-data/reach01/{i}" for i in images])
+    path = tmp_path / f"CollectedData_JohnDoe.{'h5' if layout == 'h5' else 'csv'}"
+    if layout == "h5":
+        pytest.importorskip("tables")
+        df.to_hdf(path, key="keypoints", mode="w")
+    else:
+        df.to_csv(path)
+    with pytest.raises(InputError, match="DeepLabCut's labelled frames .* analyze_videos"):
+        read_pose(path, PoseImport(fps=30))
+
+
+def test_a_dlc_table_without_likelihoods_counts_its_points_as_seen(tmp_path):
+    df = _collected(range(N))
+    df[:] = np.tile(np.r_[_animal(0.0)["thumb"][0], _animal(0.0)["index"][0],
+                          _animal(0.0)["wrist"][0]], (N, 1))
+    df.iloc[5, 0:2] = np.nan  # the thumb lost in one frame
+    path = tmp_path / "reach01.csv"
+    df.to_csv(path)
+    tracks = read_pose(path, PoseImport(fps=30, cleaning=None, object_diameter_px=80))
+    thumb = tracks.markers.index("thumb")
+    assert np.isfinite(tracks.position[:, thumb, 0]).sum() == N - 1
+    assert tracks.likelihood[4, thumb] == 1.0 and tracks.likelihood[5, thumb] == 0.0

@@ -302,6 +302,11 @@ def _video_rate(path: Path) -> float:
     return source.header.fps_nominal
 
 
+#: DeepLabCut's labelled frames (``labeled-data/<video>/CollectedData_<scorer>.csv``/``.h5``).
+_LABELLED = ("DeepLabCut's labelled frames (CollectedData: a row per labelled image), not a "
+             "video's keypoints: give the .h5 or .csv DeepLabCut's analyze_videos wrote")
+
+
 def _source(path: Path) -> str:
     """Which tool wrote a pose file: ``dlc``, ``sleap``, ``lp``, ``nwb`` or ``movement``."""
     suffix = path.suffix.lower()
@@ -311,6 +316,8 @@ def _source(path: Path) -> str:
     if suffix == ".csv":
         with open(path, encoding="utf-8", errors="replace") as fh:
             first = fh.readline().strip().lower()
+        if first.startswith("scorer,,"):  # the index is folder, video and image: 3 columns
+            raise InputError(_LABELLED, path)
         # DeepLabCut's first header row names the scorer; Lightning Pose writes the same table
         return "dlc" if first.startswith("scorer") else "lp"
     import h5py
@@ -324,6 +331,8 @@ def _source(path: Path) -> str:
                 return "dlc"
             if "tracks" in fh and "node_names" in fh:
                 return "sleap"
+            if "keypoints" in fh:
+                raise InputError(_LABELLED, path)
     except OSError:
         raise InputError("not an HDF5 file (or unreadable)", path) from None
     raise InputError("an HDF5 file that is neither a DeepLabCut table "
@@ -478,6 +487,8 @@ def _load_dataset(path: Path, source: str, fps: float | None):
                     return plain
                 require_movement(_VALIDATOR)
                 df = _dlc_table(path)
+                if len(df) and str(df.index[0]).lower().endswith((".png", ".jpg", ".jpeg")):
+                    raise InputError(_LABELLED, path)  # DeepLabCut 2.1's one-column index
                 _check_sizes_table(df, path)
                 ds = PoseTable(dlc_inputs(df, fps))
                 return ds, _own_frames(df.index, len(df))
@@ -527,7 +538,7 @@ def _marker_arrays(ds, keys: Mapping[str, str], path: Path) -> tuple[np.ndarray,
     pos = ds["position"].transpose("time", "keypoints", "space")
     check_space(pos.sizes["space"], path)
     xy = np.asarray(pos.sel(keypoints=keys).values, dtype=np.float64)
-    if "confidence" in ds:
+    if "confidence" in ds and bool(ds["confidence"].notnull().any()):  # NaN: no scores
         conf = ds["confidence"].transpose("time", "keypoints").sel(keypoints=keys).values
         conf = np.nan_to_num(np.asarray(conf, dtype=np.float64), nan=0.0)
     else:  # a file without scores: every seen point is as good as the file says

@@ -225,6 +225,11 @@ class PoseTable:
     def __init__(self, valid: Any):
         self.position = valid.position_array
         self.confidence = valid.confidence_array
+        if not np.any(np.isfinite(np.asarray(self.confidence, dtype=np.float64))):
+            # a table without likelihoods (x, y only; movement fills NaN): as a file without
+            # scores, every point it has is seen
+            self.confidence = np.isfinite(np.asarray(self.position, dtype=np.float64)).all(
+                axis=1).astype(np.float64)
         self.individuals = [str(n) for n in valid.individual_names]
         self.keypoints = [str(k) for k in valid.keypoint_names]
         n = self.position.shape[0]
