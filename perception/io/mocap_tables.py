@@ -34,6 +34,7 @@ from perception.io.mocap_trial import (
     check_rate,
     clock_rate,
     header_rate,
+    strip_subject,
     unique_name,
 )
 
@@ -430,6 +431,9 @@ def read_xyz_table(path: Path, source: str, text: TableText, rate, units, trial_
     if not groups:
         raise InputError("no marker columns: expected X, Y and Z columns for each marker "
                          "(such as thumb_x, thumb_y, thumb_z)", path, field="header")
+    if any(":" in name for name in groups):  # Vicon's Subject:Marker, kept by a lab's export
+        short, more = strip_subject(list(groups))
+        groups, notes = dict(zip(short, groups.values())), notes + more
     # a unit given wins over the columns' own (and settles columns that disagree)
     own = _stated_unit(groups, path) if units is None else None
     return table_trials(path, source, df, groups, time_col, trial_col, rate, units, own, notes,
