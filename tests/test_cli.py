@@ -54,8 +54,7 @@ FLAGS = {
                   ("--threshold", "threshold", 0.05), ("--speed", "speed", None),
                   ("--hold", "hold", 0.0), ("--cutoff", "cutoff", 10.0),
                   ("--px-per-m", "px_per_m", None), ("--object-diameter", "object_diameter", None),
-                  ("--object-diameter-px", "object_diameter_px", None), ("--fps", "fps", None),
-                  *_MOCAP],
+                  *_RECOGNITION[-6:], *_MOCAP],  # the pose options, as recognize's
     # the simulation commands (issue 42 item 6: written down before they were generated)
     "reach": [("--start", "start", (0.2, 0.2)), ("--goal", "goal", (0.4, 0.5)),
               ("--duration", "duration", 0.5), ("--via", "via", []),

@@ -164,7 +164,8 @@ def _commands():
     yield "recognize", ["x.tracks.h5", "-o", "out"], recognition, options.recognition_settings
     yield "batch", ["clips", "-o", "out"], recognition, options.recognition_settings
     yield ("landmarks", ["x.csv", "-o", "out.csv"],
-           (*landmarks.DEFINITIONS, *landmarks.SCALE, *options.MOCAP, *options.FACTORS),
+           (*landmarks.DEFINITIONS, *landmarks.SCALE, *options.POSE, *options.MOCAP,
+            *options.FACTORS),
            landmarks.landmark_settings)
     yield "reach", ["-o", "out"], (*reach.TASK, *reach.PLANT), reach.reach_settings
     yield "grasp simulate", ["-o", "out"], grasp.SIMULATE, grasp.grasp_task

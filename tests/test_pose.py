@@ -190,3 +190,32 @@ def test_pose_options_override_the_config(tmp_path):
                                       str(path), "--fps", "30", "--keypoints", "wrist=Wr"])
     got = pose_import(args)
     assert got.fps == 30 and got.keypoints == {"thumb": "T", "wrist": "Wr"}
+
+
+def test_landmarks_reads_a_pose_file_with_the_pose_options(tracks, tmp_path):
+    """``hammer-mv landmarks`` takes recognize's pose options: a two-animal file whose
+    keypoints have a lab's own names is measured for the animal and keypoints named, as the
+    tracks it came from (without them it is refused, naming the choice to make)."""
+    from hammer_mv.cli import main
+
+    pos = np.transpose(tracks.position, (0, 2, 1))[..., None]
+    ds = load_poses.from_numpy(np.concatenate([pos, pos + 5], axis=-1),
+                               np.ones((tracks.n_frames, 4, 2)),
+                               individual_names=["left", "right"],
+                               keypoint_names=["T", "I", "W", "ball"], fps=30,
+                               source_software="SLEAP")
+    path = tmp_path / "two.nc"
+    ds.to_netcdf(path)
+    from perception.synthetic.demos import DEMO_CAMERA
+
+    own = tracks.save(tmp_path / "clip.tracks.h5")
+    scale = ["--px-per-m", str(DEMO_CAMERA.px_per_m)]
+    assert main(["landmarks", str(own), "-o", str(tmp_path / "a.csv"), "--quiet", *scale]) == 0
+    assert main(["landmarks", str(path), "-o", str(tmp_path / "no.csv"), "--quiet",
+                 *scale]) == 2
+    assert main(["landmarks", str(path), "-o", str(tmp_path / "b.csv"), "--quiet", *scale,
+                 "--individual", "left", "--keypoints", "thumb=T", "finger=I", "wrist=W",
+                 "object=ball"]) == 0
+    a, b = (pd.read_csv(tmp_path / f"{x}.csv") for x in "ab")
+    assert len(a) == len(b) and len(a) > 5
+    np.testing.assert_allclose(b["value"], a["value"], rtol=1e-6, equal_nan=True)

@@ -6,9 +6,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from hammer_mv.cli.flags import FPS_HELP, Setting, add_settings, flag_text
-from hammer_mv.cli.options import add_mocap_options, mocap_import
-from perception.io.pose import PoseImport
+from hammer_mv.cli.flags import Setting, add_settings, flag_text
+from hammer_mv.cli.options import add_mocap_options, add_pose_options, mocap_import, pose_import
 from perception.landmarks import LandmarkParams
 from perception.observation import ObserveParams
 
@@ -29,10 +28,6 @@ SCALE = (
             metavar="X"),
     Setting(ObserveParams, "object_diameter", "the object's real diameter, m, to scale tracks "
             "by its apparent one", default=None, metavar="M"),
-    # the flag recognize's pose options declare (hammer_mv/cli/options.py), here for tracks too
-    Setting(PoseImport, "object_diameter_px", "the object's apparent diameter in pixels, where "
-            "the tracks or pose file do not give it (with --object-diameter)", metavar="D"),
-    Setting(PoseImport, "fps", FPS_HELP, metavar="F"),
 )
 
 
@@ -66,6 +61,9 @@ def register(sub) -> None:
                         "(their units and clocks in TABLE.units.json beside it)")
     add_settings(p.add_argument_group("definitions"), DEFINITIONS)
     add_settings(p.add_argument_group("scale of pixel tracks"), SCALE)
+    # a pose file's keypoints, individual, rate and object size (--object-diameter-px scales
+    # a tracks file without its object's size too), as recognize reads them
+    add_pose_options(p)
     add_mocap_options(p)
     p.set_defaults(func=run)
 
@@ -85,16 +83,15 @@ def landmark_settings(args: argparse.Namespace):
     mocap : MocapImport
         Bounded by ``params`` too: one rule bounds and measures.
     pose : PoseImport or None
-        None without ``--fps``.
+        None without a pose option (``--keypoints``, ``--fps``, ``--pose-config``, ...).
     """
     params = LandmarkParams(threshold=args.threshold, speed=args.speed, hold=args.hold,
                             cutoff=args.cutoff or None)
     # the scale is measure_inputs' arguments: checked by the classes that declare it
     ObserveParams(**{k: v for k, v in (("object_diameter", args.object_diameter),
                                        ("px_per_m", args.px_per_m)) if v is not None})
-    pose = PoseImport(fps=args.fps, object_diameter_px=args.object_diameter_px)
     mocap = mocap_import(args).with_landmarks(params)
-    return params, mocap, pose if args.fps is not None else None
+    return params, mocap, pose_import(args)
 
 
 def run(args: argparse.Namespace) -> int:
