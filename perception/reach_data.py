@@ -228,7 +228,8 @@ class MarkerMap:
                                      "exactly", source, field="markers")
                 if m not in names:
                     raise InputError(f"no marker {m!r} for the {role} (the recording has "
-                                     f"{', '.join(sorted(names))})", source, field="markers")
+                                     f"{', '.join(sorted(names))}): say which is which with "
+                                     f"`markers` ({role}=NAME)", source, field="markers")
 
 
 @declared

@@ -411,3 +411,19 @@ def test_trial_pickles_and_its_mappings_are_read_only(qtm):
     np.testing.assert_array_equal(again.markers["thumb_tip"], qtm.markers["thumb_tip"])
     with pytest.raises(TypeError):
         qtm.markers["new"] = np.zeros((350, 3))
+
+
+def test_a_marker_the_recording_lacks_is_refused_saying_how_to_map_it():
+    """A mapping (given, or the default names where none could be guessed) that names a
+    marker the recording lacks lists the recording's markers and says how to name it: the
+    library its field, the command line its flag."""
+    from hammer_mv.cli import build_parser, error_line
+    from perception.reaches import MarkerMap
+
+    with pytest.raises(InputError) as err:
+        MarkerMap().check(["RTHUMB", "RIDX", "RWRA"], "gait.c3d")
+    assert "no marker 'thumb' for the thumb (the recording has RIDX, RTHUMB, RWRA)" in str(
+        err.value) and "`markers` (thumb=NAME)" in str(err.value)
+    build_parser("recognize")  # its flags name the fields
+    line = error_line("recognize", err.value)
+    assert line.endswith("say which is which with --markers (thumb=NAME)"), line

@@ -55,7 +55,7 @@ def _name_notes(names: list[str], named: list[str], header: dict) -> list[str]:
     alike = [", ".join(map(repr, v)) for v in folded.values() if len(v) > 1]
     if alike:
         notes.append(f"marker names apart only in case ({'; '.join(alike)}): read as "
-                     "written, each its own marker (--markers names them exactly)")
+                     "written, each its own marker (`markers` names them exactly)")
     return notes
 
 

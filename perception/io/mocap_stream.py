@@ -180,7 +180,7 @@ def _checked_stream(path: Path, source: str, text: TableText, sep: str, rate, un
         if True in kinds[c]:
             others.append(c)
         elif c not in taken:
-            notes.append(f"column {c!r} is not numeric: not read (--factors {c} reads it as "
+            notes.append(f"column {c!r} is not numeric: not read (`factors` {c} reads it as "
                          "a factor)")
     if time_col is None:
         if rate is None:

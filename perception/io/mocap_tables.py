@@ -348,7 +348,7 @@ def table_trials(path: Path, source: str, df, groups, time_col, trial_col, rate,
         if df[c].dtype.kind in "biuf":
             others[c] = df[c].to_numpy(dtype=float)
         elif c not in taken:
-            notes.append(f"column {c!r} is not numeric: not read (--factors {c} reads it as "
+            notes.append(f"column {c!r} is not numeric: not read (`factors` {c} reads it as "
                          "a factor)")
     if time_col is None:
         if own_rate is not None:
@@ -385,7 +385,7 @@ def time_column_of(columns, time_column, path: Path, notes: list[str]):
     if no_clock(time_column):
         found = _find_column(columns, None, TIME, path, "time_column")
         if found is not None:
-            notes.append(f"time column {found!r} ignored (--time-column none): the samples "
+            notes.append(f"time column {found!r} ignored (`time_column` none): the samples "
                          "are timed by the rate")
         return None
     return _find_column(columns, time_column, TIME, path, "time_column")
@@ -592,7 +592,7 @@ def read_headerless(path: Path, source: str, text: TableText, rate, units, trial
     df.columns = [f"{n} {a}" for n in names for a in "XYZ"]
     groups = {n: tuple(f"{n} {a}" for a in "XYZ") for n in names}
     notes = list(text.notes) + [f"no header row: columns read as X, Y, Z of "
-                                f"{', '.join(names)} (--columns)"]
+                                f"{', '.join(names)} (`columns`)"]
     if decimal == ",":
         notes.append("decimal commas read")
     return table_trials(path, source, df, groups, None, None, rate, units, None, notes,

@@ -117,7 +117,7 @@ def read_trc(path: Path, source: str, text: TableText, rate, units, trial_column
     own_rate = _data_rate(meta, path, notes, clock=not clockless)
     time_col = None if clockless else time_label
     if clockless:
-        notes.append(f"time column {time_label!r} ignored (--time-column none): the samples "
+        notes.append(f"time column {time_label!r} ignored (`time_column` none): the samples "
                      "are timed by the rate")
     elif own_rate is not None and not _clock_agrees(df, own_rate[0], time_label, notes):
         own_rate = None  # the clock's own steps give the rate (and its frame-count check)

@@ -340,7 +340,7 @@ def infer_units(spans: list[float]) -> tuple[str, str]:
     units = "mm" if span > _MM_ABOVE else "m"
     markers = f"{len(spans)} marker{'s' if len(spans) != 1 else ''}"
     return units, (f"units inferred: {units} (the positions span {span:.4g}: the median over "
-                   f"{markers} of each one's range, without its extreme 1 %; give --units to "
+                   f"{markers} of each one's range, without its extreme 1 %; give `units` to "
                    "say)")
 
 

@@ -119,7 +119,7 @@ def read_motive(path: Path, source: str, text: TableText, rate, units, trial_col
                              "`time_column` out to use it, or give `time_column` none",
                              path, field="time_column")
         if time_col is not None:
-            notes.append(f"time column {time_col!r} ignored (--time-column none): the samples "
+            notes.append(f"time column {time_col!r} ignored (`time_column` none): the samples "
                          "are timed by the rate")
         time_col = None
     own_rate = None

@@ -204,7 +204,7 @@ def check_space(n_space: int, path: Path) -> None:
     if n_space == 3:  # DeepLabCut's triangulate writes its 3-D table as .h5 and .csv
         raise InputError("expected 2-D poses (x, y), got 3 coordinates: a 3-D table is "
                          "motion capture, read from its .csv (DeepLabCut's triangulate "
-                         "writes one with save_as_csv=True) with --rate", path)
+                         "writes one with save_as_csv=True) with its `rate`", path)
     if n_space != 2:
         raise InputError(f"expected 2-D poses (x, y), got {n_space} coordinates", path)
 
