@@ -138,3 +138,43 @@ def test_a_dlc_table_without_likelihoods_counts_its_points_as_seen(tmp_path):
     thumb = tracks.markers.index("thumb")
     assert np.isfinite(tracks.position[:, thumb, 0]).sum() == N - 1
     assert tracks.likelihood[4, thumb] == 1.0 and tracks.likelihood[5, thumb] == 0.0
+
+
+def _slp(path, instances_per_frame: int, tracks=None, user=False):
+    """A SLEAP labels file of N frames, ``instances_per_frame`` predicted hands each (with
+    ``tracks``, one track each), and with ``user`` a user's instance beside the first."""
+    sio = pytest.importorskip("sleap_io")
+    skeleton = sio.Skeleton(["thumb", "index", "wrist", "ball"])
+    video = sio.Video(filename="reach01.mp4", open_backend=False)
+    frames = []
+    for i in range(N):
+        made = []
+        for k in range(instances_per_frame):
+            points = np.array([[100 + 3 * i + 200 * k, 200], [100 + 3 * i + 200 * k, 230],
+                               [40 + 3 * i + 200 * k, 215], [400, 215]], dtype=float)
+            made.append(sio.PredictedInstance.from_numpy(
+                points, skeleton=skeleton, score=0.9, point_scores=np.full(4, 0.9),
+                track=None if tracks is None else tracks[k]))
+        if user:
+            made.append(sio.Instance.from_numpy(made[0].numpy(), skeleton=skeleton))
+        frames.append(sio.LabeledFrame(video=video, frame_idx=i, instances=made))
+    sio.save_slp(sio.Labels(labeled_frames=frames, videos=[video], skeletons=[skeleton],
+                            tracks=list(tracks or [])), str(path))
+    return path
+
+
+def test_sleap_frames_of_several_untracked_instances_are_refused_not_mixed(tmp_path):
+    """movement keeps one of a frame's instances when none has a track, silently: two hands
+    would be read as one jumping between them. Refused, saying what to do; one untracked
+    hand a frame (with a user's correction beside it) and tracked hands read as before."""
+    sio = pytest.importorskip("sleap_io")
+    with pytest.raises(InputError, match="up to 2 instances without a track.*`individual`"):
+        read_pose(_slp(tmp_path / "two.slp", 2), PoseImport(fps=30, cleaning=None))
+    one = read_pose(_slp(tmp_path / "one.slp", 1, user=True), PoseImport(fps=30, cleaning=None))
+    np.testing.assert_allclose(one.position[:, one.markers.index("wrist"), 0],
+                               40 + 3 * np.arange(N))
+    hands = [sio.Track("left"), sio.Track("right")]
+    right = read_pose(_slp(tmp_path / "tracked.slp", 2, hands),
+                      PoseImport(fps=30, cleaning=None, individual="right"))
+    np.testing.assert_allclose(right.position[:, right.markers.index("wrist"), 0],
+                               240 + 3 * np.arange(N))

@@ -465,6 +465,8 @@ def _load_dataset(path: Path, source: str, fps: float | None):
         except InputError:
             if suffix != ".nc":  # a netCDF3 file is not HDF5: xarray checks it lazily below
                 raise
+        if suffix == ".slp":
+            _check_untracked(path)
     elif path.stat().st_size > _MAX_TABLE_BYTES:
         raise InputError(f"a table of {path.stat().st_size / 1e9:.3g} GB holds more than the "
                          f"{MAX_POSE_POINTS:.3g} points a pose file may hold", path)
@@ -501,6 +503,33 @@ def _load_dataset(path: Path, source: str, fps: float | None):
         first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         raise InputError(f"not a readable {_SOURCES.get(source, source)} pose file: {first}",
                          path) from None
+
+
+def _check_untracked(path: Path) -> None:
+    """Refuse a SLEAP labels file whose frames hold several instances of no track: which is
+    which from frame to frame is not known (movement keeps one of each frame's, silently:
+    two hands would be read as one hand jumping between them)."""
+    import h5py
+
+    try:
+        with h5py.File(path, "r") as fh:
+            if "instances" not in fh:
+                return
+            inst = fh["instances"].fields(["frame_id", "instance_type", "track"])[:]
+    except (OSError, KeyError, ValueError):
+        return  # movement says what is wrong with the file
+    free = inst[inst["track"] < 0]
+    if not len(free):
+        return
+    # a user's instance beside the prediction it corrects is one animal: count each kind
+    _, counts = np.unique(np.stack([free["frame_id"].astype(np.int64),
+                                    free["instance_type"].astype(np.int64)]), axis=1,
+                          return_counts=True)
+    if counts.max() > 1:
+        raise InputError(f"frames hold up to {int(counts.max())} instances without a track: "
+                         "which is which from frame to frame is not known; track them in "
+                         "SLEAP (a track per animal or hand, then choose one with "
+                         "`individual`) or keep one instance a frame", path)
 
 
 def _check_sizes(ds, path: Path) -> None:
