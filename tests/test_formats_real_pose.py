@@ -178,3 +178,15 @@ def test_sleap_frames_of_several_untracked_instances_are_refused_not_mixed(tmp_p
                       PoseImport(fps=30, cleaning=None, individual="right"))
     np.testing.assert_allclose(right.position[:, right.markers.index("wrist"), 0],
                                240 + 3 * np.arange(N))
+
+
+def test_sleaps_untracked_slots_are_named_as_such_when_a_choice_is_asked():
+    """SLEAP's analysis export of untracked instances names their slots track_0, track_1:
+    the refusal says a slot is then no one animal (a choice between them would mix hands)."""
+    from perception.io.pose_arrays import pick_individual
+
+    with pytest.raises(InputError, match=r"track_0, track_1\): choose one.*not tracked"):
+        pick_individual(["track_0", "track_1"], None, "x.analysis.h5")
+    with pytest.raises(InputError) as err:
+        pick_individual(["left", "right"], None, "x.analysis.h5")
+    assert "not tracked" not in str(err.value)

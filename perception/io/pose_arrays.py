@@ -12,6 +12,7 @@ the same whichever way it was read.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -86,8 +87,13 @@ def pick_individual(names: Sequence[str], individual: str | None, path: Path,
     seen = list(names) if seen is None else [n for n in names if n in set(seen)]
     animals = [n for n in seen if n != UNIQUE_BODYPARTS] or seen
     if len(animals) > 1:
+        # SLEAP's analysis export names the slots of untracked instances so
+        untracked = all(re.fullmatch(r"track_\d+", n) for n in animals)
         raise InputError(f"the file holds {len(animals)} individuals ({', '.join(animals)}): "
-                         "choose one with `individual`", path)
+                         "choose one with `individual`" + (
+                             " (SLEAP names its instances' slots so when they were not "
+                             "tracked: a slot is then no one animal from frame to frame; "
+                             "track them in SLEAP first)" if untracked else ""), path)
     if not animals:  # nothing seen anywhere: as the file's only one, if it is
         if len(names) > 1:
             raise InputError(f"the file holds {len(names)} individuals ({', '.join(names)}): "
