@@ -91,8 +91,8 @@ def pick_individual(names: Sequence[str], individual: str | None, path: Path,
         untracked = all(re.fullmatch(r"track_\d+", n) for n in animals)
         raise InputError(f"the file holds {len(animals)} individuals ({', '.join(animals)}): "
                          "choose one with `individual`" + (
-                             " (SLEAP names its instances' slots so when they were not "
-                             "tracked: a slot is then no one animal from frame to frame; "
+                             " (if SLEAP's tracker did not run, these are its slots for "
+                             "untracked instances, no one animal from frame to frame: "
                              "track them in SLEAP first)" if untracked else ""), path)
     if not animals:  # nothing seen anywhere: as the file's only one, if it is
         if len(names) > 1:
