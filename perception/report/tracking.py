@@ -148,6 +148,13 @@ def tracking_columns(tracking: dict | None) -> dict:
 SHEET_PNG_LEVEL = 1
 
 
+def _sheet_filter(cv2) -> list[int]:
+    """OpenCV's flags for the sheet's PNG filter, ``Sub`` on every row (an OpenCV
+    without the flag keeps libpng's own choice)."""
+    flag = getattr(cv2, "IMWRITE_PNG_FILTER", None)
+    return [] if flag is None else [flag, cv2.IMWRITE_PNG_FILTER_SUB]
+
+
 def _pick_frames(tracks: Tracks, n: int) -> list[int]:
     """The first frame, then ``n - 1`` frames spread over the movement (or the clip)."""
     from perception.errors import InputError
@@ -225,8 +232,10 @@ def contact_sheet(tracks: Tracks, video: str | os.PathLike | None, out: str | os
     # encoded here and written by us: OpenCV is never handed a path (a name that
     # is not UTF-8 crashes its writer). OpenCV 5's default PNG settings store a
     # 1200 x 600 sheet in about 1 MB; zlib level 1 in 0.4 MB, as fast (a batch of
-    # videos writes one a clip)
-    ok, png = cv2.imencode(".png", sheet, [cv2.IMWRITE_PNG_COMPRESSION, SHEET_PNG_LEVEL])
+    # videos writes one a clip); one filter for every row (Sub) rather than libpng's
+    # choice among five per row: half the encoding's time (64 -> 30 ms), 3 % larger
+    ok, png = cv2.imencode(".png", sheet, [cv2.IMWRITE_PNG_COMPRESSION, SHEET_PNG_LEVEL,
+                                           *_sheet_filter(cv2)])
     if not ok:
         raise OSError(f"{out}: cannot encode the contact sheet")
     return write_bytes(out, png.tobytes())
