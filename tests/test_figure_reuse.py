@@ -262,3 +262,61 @@ def test_texts_are_measured_and_placed_as_on_matplotlibs_own_canvas(clips):
                 *ax.get_xticklabels(), *ax.get_yticklabels()))]
             boxes.append([_values(t.get_window_extent(renderer).bounds) for t in texts])
         assert boxes[0] == boxes[1], kind
+
+
+def _ticked(keep: str | None):
+    """Two panels with curves, on a kept figure (``keep``: its key) or a new one, drawn."""
+    from perception.report.figures import _figure
+
+    def build():
+        return _figure((8, 4), 2, titled=True)
+
+    fig, axes = kept_figure(("test ticks", keep), build) if keep else build()
+    t = np.linspace(0.0, 2.3, 60)
+    axes[0].plot(t, 1e3 * np.sin(t))
+    axes[1].plot(t, 0.01 * np.cos(3 * t))
+    axes[1].tick_params(axis="y", labelsize=7, colors="C3")  # after the first tick
+    fig.canvas.draw()
+    return fig, axes
+
+
+def test_ticks_copied_from_the_first_draw_as_matplotlibs_own():
+    from perception.report.canvas import png_bytes
+
+    kept, kept_axes = _ticked(keep="copied")
+    new, new_axes = _ticked(keep=None)
+    for a, b in zip(kept_axes, new_axes):
+        for axis_a, axis_b in ((a.xaxis, b.xaxis), (a.yaxis, b.yaxis)):
+            assert "get_major_ticks" in vars(axis_a) and "get_major_ticks" not in vars(axis_b)
+            ticks_a, ticks_b = axis_a.get_major_ticks(), axis_b.get_major_ticks()
+            assert len(ticks_a) == len(ticks_b) > 3
+            for ta, tb in zip(ticks_a, ticks_b):
+                assert ta.get_loc() == tb.get_loc()
+                for part_a, part_b in zip(ta.get_children(), tb.get_children()):
+                    assert part_a is not part_b
+                    assert type(part_a) is type(part_b)
+                    assert part_a.get_visible() == part_b.get_visible()
+                for text_a, text_b in ((ta.label1, tb.label1), (ta.label2, tb.label2)):
+                    assert text_a.get_text() == text_b.get_text()
+                    assert text_a.get_fontsize() == text_b.get_fontsize()
+                    assert text_a.get_color() == text_b.get_color()
+    assert png_bytes(kept, 100) == png_bytes(new, 100)  # every pixel
+
+
+def test_a_copied_tick_is_a_tick_of_its_own():
+    fig, (ax, _) = _ticked(keep="own")
+    first, second, third = ax.yaxis.get_major_ticks()[:3]
+    for a, b in ((first, second), (second, third)):
+        for part_a, part_b in zip(a.get_children(), b.get_children()):
+            assert part_a is not part_b
+            assert part_a._callbacks is not part_b._callbacks
+        assert a.label1.get_fontproperties() is not b.label1.get_fontproperties()
+    second.label1.set_fontsize(20)
+    second.tick1line.set_markersize(9)
+    second.tick1line.set_xdata([0.5])
+    assert first.label1.get_fontsize() == third.label1.get_fontsize() != 20
+    assert first.tick1line.get_markersize() == third.tick1line.get_markersize() != 9
+    ax.tick_params(axis="y", length=6, labelcolor="C2")  # reaches every tick, copied or not
+    for tick in ax.yaxis.get_major_ticks():
+        assert tick.tick1line.get_markersize() == 6
+        assert tick.label1.get_color() == "C2"

@@ -151,6 +151,57 @@ def test_writing_a_clip_report_draws_its_two_figures(rec, tmp_path):
     assert not list((tmp_path / "none").glob("*.png"))
 
 
+def test_figure_files_are_the_files_write_figure_writes(rec, tmp_path):
+    from perception.report.figures import (
+        FigureFiles,
+        confidence_figure,
+        paths_figure,
+        write_figure,
+    )
+
+    figs = {"conf": confidence_figure(rec), "paths": paths_figure(rec)}
+    see_through = paths_figure(rec)
+    see_through.patch.set_alpha(0.0)  # encoded at once, through matplotlib (RGBA)
+    figs["clear"] = see_through
+    with FigureFiles("png", 90) as files:
+        written = [files.write(fig, tmp_path / f"{name}.x") for name, fig in figs.items()]
+        # a PNG is written once the next figure is drawn; the last when the block ends
+        assert [p.name for p in written] == ["conf.x.png", "paths.x.png", "clear.x.png"]
+        assert (tmp_path / "conf.x.png").exists()
+    for name, fig in figs.items():
+        want = write_figure(fig, tmp_path / f"{name}.want", "png", 90).read_bytes()
+        assert (tmp_path / f"{name}.x.png").read_bytes() == want, name
+    with Image.open(tmp_path / "clear.x.png") as png:
+        assert png.mode == "RGBA"
+    with FigureFiles("svg", 90) as files:
+        svg = files.write(figs["conf"], tmp_path / "conf")
+    assert svg.read_bytes().lstrip().startswith(b"<?xml")
+    with pytest.raises(ValueError, match="figure format"):
+        FigureFiles("jpg", 90)
+    with pytest.raises(ValueError, match="dpi"):
+        FigureFiles("png", 0)
+
+
+def test_figure_files_raise_an_encoding_error_and_write_nothing_after_one(rec, tmp_path,
+                                                                        monkeypatch):
+    from perception.report import canvas
+    from perception.report.figures import FigureFiles, confidence_figure
+
+    def broken(*args):
+        raise MemoryError("no room to encode")
+
+    monkeypatch.setattr(canvas, "_png_of", broken)
+    files = FigureFiles("png", 50)
+    files.write(confidence_figure(rec), tmp_path / "a")
+    with pytest.raises(MemoryError, match="no room"):
+        files.close()  # raised in the caller's thread
+    assert not list(tmp_path.iterdir())
+    with pytest.raises(RuntimeError, match="drawing failed"), FigureFiles("png", 50) as files:
+        files.write(confidence_figure(rec), tmp_path / "b")
+        raise RuntimeError("drawing failed")
+    assert not list(tmp_path.iterdir())  # the pending figure is not written after an error
+
+
 # -- a batch ----------------------------------------------------------------------
 def _summaries():
     """Five scored clips of three conditions (two of them spare), in memory."""

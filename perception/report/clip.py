@@ -446,19 +446,26 @@ def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,
 
     expect(rec, Recognition, "write_clip_report(rec=)", hint="recognize_clip's result")
     paths = clip_outputs(Path(out), rec.clip, figure_format)
-    if figures:
-        from perception.report.figures import confidence_figure, paths_figure, write_figure
-        from perception.report.kinematics import kinematics_figure
+    with contextlib.ExitStack() as stack:
+        if figures:
+            from perception.report.figures import (
+                FigureFiles,
+                confidence_figure,
+                paths_figure,
+            )
+            from perception.report.kinematics import kinematics_figure
 
-        # each on this process's kept figure of its kind, saved before the next clip's
-        for key, draw in (("confidence_png", confidence_figure), ("paths_png", paths_figure),
-                          ("kinematics_png", kinematics_figure)):
-            write_figure(draw(rec, reuse=True), paths[key].with_suffix(""), figure_format, dpi)
-    for fmt in FIGURE_FORMATS:
-        if not figures or fmt != figure_format:
-            for key in FIGURE_KEYS:
-                remove_output(clip_outputs(Path(out), rec.clip, fmt)[key])
-    write_csv(paths["csv"], rec.columns())
+            # each on this process's kept figure of its kind, drawn before the next clip's;
+            # a PNG encoded while the next figure is drawn, the last while the CSV is written
+            files = stack.enter_context(FigureFiles(figure_format, dpi))
+            for key, draw in (("confidence_png", confidence_figure), ("paths_png", paths_figure),
+                              ("kinematics_png", kinematics_figure)):
+                files.write(draw(rec, reuse=True), paths[key].with_suffix(""))
+        for fmt in FIGURE_FORMATS:
+            if not figures or fmt != figure_format:
+                for key in FIGURE_KEYS:
+                    remove_output(clip_outputs(Path(out), rec.clip, fmt)[key])
+        write_csv(paths["csv"], rec.columns())
     # the JSON last: its presence marks the clip's report complete
     write_json(paths["json"], {**rec.to_dict(), "traces": clip_traces(rec), **(extra or {})})
     return paths

@@ -24,8 +24,9 @@ Confidence is drawn in cm (weighted), ×100 of its value in the files.
 
 from __future__ import annotations
 
+import threading
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -33,7 +34,7 @@ import numpy as np
 
 from perception.io.atomic import save_figure, write_bytes
 from perception.io.names import printable
-from perception.report.canvas import kept_figure, png_bytes
+from perception.report.canvas import kept_figure, png_encoder
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -44,9 +45,9 @@ if TYPE_CHECKING:
     from perception.recognition.result import Recognition
     from perception.report.clip import ClipSummary
 
-__all__ = ["DPI", "FIGURE_FORMATS", "aperture_figure", "condition_colour", "condition_figure",
-           "confidence_all_figure", "confidence_figure", "confidence_single_figure",
-           "paths_figure", "write_figure"]
+__all__ = ["DPI", "FIGURE_FORMATS", "FigureFiles", "aperture_figure", "condition_colour",
+           "condition_figure", "confidence_all_figure", "confidence_figure",
+           "confidence_single_figure", "paths_figure", "write_figure"]
 
 #: The formats :func:`write_figure` writes, the first the default; and its default resolution.
 FIGURE_FORMATS = ("png", "svg", "pdf")
@@ -454,6 +455,22 @@ def confidence_all_figure(clips: Sequence[ClipSummary], conditions: Sequence[str
     return fig
 
 
+def _checked(fmt: str, dpi: int) -> None:
+    if fmt not in FIGURE_FORMATS:
+        raise ValueError(f"figure format must be one of {', '.join(FIGURE_FORMATS)}, not {fmt!r}")
+    if not (isinstance(dpi, int | np.integer) and dpi > 0):
+        raise ValueError(f"dpi must be a positive whole number, not {dpi!r}")
+
+
+def _drawn_png(fig: Figure, dpi: int) -> bytes | Callable[[], bytes]:
+    """``fig`` drawn now; its PNG's bytes, or what encodes them
+    (:func:`~perception.report.canvas.png_encoder`)."""
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message="Glyph .* missing from",
+                                category=UserWarning)  # drawn as a box, as save_figure
+        return png_encoder(fig, int(dpi))
+
+
 def write_figure(fig: Figure, path_stem: str | Path, fmt: str = "png", dpi: int = DPI) -> Path:
     """Save ``fig`` as ``<path_stem>.<fmt>``, atomically: PNG at ``dpi``, or vector SVG or PDF.
 
@@ -479,16 +496,102 @@ def write_figure(fig: Figure, path_stem: str | Path, fmt: str = "png", dpi: int 
     """
     from matplotlib import rc_context
 
-    if fmt not in FIGURE_FORMATS:
-        raise ValueError(f"figure format must be one of {', '.join(FIGURE_FORMATS)}, not {fmt!r}")
-    if not (isinstance(dpi, int | np.integer) and dpi > 0):
-        raise ValueError(f"dpi must be a positive whole number, not {dpi!r}")
+    _checked(fmt, dpi)
     path = Path(f"{path_stem}.{fmt}")
     if fmt == "png":  # encoded here: half Pillow's time (perception.report.canvas)
-        with warnings.catch_warnings():
-            warnings.filterwarnings("ignore", message="Glyph .* missing from",
-                                    category=UserWarning)  # drawn as a box, as save_figure
-            data = png_bytes(fig, int(dpi))
-        return write_bytes(path, data)
+        data = _drawn_png(fig, dpi)
+        return write_bytes(path, data() if callable(data) else data)
     with rc_context(_VECTOR_TEXT):
         return save_figure(path, fig, dpi=int(dpi))
+
+
+class FigureFiles:
+    """Figures written one after another as :func:`write_figure` writes them, each PNG
+    encoded while the caller draws the next.
+
+    A PNG's encoding (NumPy and zlib, which let other threads run: about a
+    tenth of a report figure's time) runs in a thread of its own from the
+    moment its figure is drawn; the file is written by the caller's thread
+    when the next figure is given, or at :meth:`close`. Drawing stays in the
+    caller's thread (matplotlib's figures are not shared between threads);
+    the encoding thread imports nothing (two threads importing at once can
+    fail) and writes no file (writing reads the process's umask by setting
+    it: two threads at once could leave it 0). SVG and PDF are written at
+    once. A context manager: leaving it writes what is pending (not after an
+    error).
+
+    Parameters
+    ----------
+    fmt : str
+        ``png``, ``svg`` or ``pdf`` (:data:`FIGURE_FORMATS`).
+    dpi : int
+        Dots per inch, positive.
+    """
+
+    def __init__(self, fmt: str = "png", dpi: int = DPI):
+        _checked(fmt, dpi)
+        self.fmt, self.dpi = fmt, int(dpi)
+        self._pending: tuple[Path, threading.Thread, list] | None = None
+
+    def write(self, fig: Figure, path_stem: str | Path) -> Path:
+        """Draw ``fig`` now and write it as ``<path_stem>.<fmt>`` (a PNG: by the next
+        :meth:`write` or :meth:`close`).
+
+        Parameters
+        ----------
+        fig : matplotlib.figure.Figure
+            The figure; drawn before this returns, so that it may be emptied and
+            drawn again (a kept figure: :func:`~perception.report.canvas.kept_figure`).
+        path_stem : str or Path
+            The file's path without its format's suffix.
+
+        Returns
+        -------
+        Path
+            The file's path (a PNG's written later).
+        """
+        if self.fmt != "png":
+            self._finish()
+            return write_figure(fig, path_stem, self.fmt, self.dpi)
+        path = Path(f"{path_stem}.{self.fmt}")
+        data = _drawn_png(fig, self.dpi)  # while the last figure is encoded
+        self._finish()
+        if not callable(data):
+            return write_bytes(path, data)
+        out: list = []
+
+        def encode() -> None:
+            try:
+                out.append(data())
+            except BaseException as exc:  # raised again in the caller's thread
+                out.append(exc)
+
+        thread = threading.Thread(target=encode, name="hammer-mv figure encoding", daemon=True)
+        thread.start()
+        self._pending = path, thread, out
+        return path
+
+    def _finish(self) -> None:
+        """Wait for the pending PNG and write it."""
+        if self._pending is None:
+            return
+        path, thread, out = self._pending
+        self._pending = None
+        thread.join()
+        if isinstance(out[0], BaseException):
+            raise out[0]
+        write_bytes(path, out[0])
+
+    def close(self) -> None:
+        """Write the PNG still pending (waiting for its encoding)."""
+        self._finish()
+
+    def __enter__(self) -> FigureFiles:
+        return self
+
+    def __exit__(self, kind, value, traceback) -> None:
+        if kind is None:
+            self.close()
+        elif self._pending is not None:  # not written after an error
+            self._pending[1].join()
+            self._pending = None
