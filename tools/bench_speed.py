@@ -210,15 +210,16 @@ finally:
 """
 
 
-def _project_copy(work: Path, bytecode: bool) -> Path:
-    """The project's packages copied under ``work``: compiled (as a user's installed
-    copy is, its ``.pyc`` files written) or without any ``.pyc`` (compiled from source at
-    every start, as here, where PYTHONDONTWRITEBYTECODE=1 keeps our edits uncompiled)."""
+def _project_copy(work: Path, bytecode: bool, source: Path = ROOT, name: str = "") -> Path:
+    """The project's packages (of ``source``, a checkout) copied under ``work``: compiled
+    (as a user's installed copy is, its ``.pyc`` files written) or without any ``.pyc``
+    (compiled from source at every start, as here, where PYTHONDONTWRITEBYTECODE=1 keeps
+    our edits uncompiled)."""
     import compileall
 
-    root = work / ("bytecode" if bytecode else "source")
+    root = work / (("bytecode" if bytecode else "source") + name)
     for package in ("hammer_mv", "perception", "minvar"):
-        shutil.copytree(ROOT / package, root / package,
+        shutil.copytree(source / package, root / package,
                         ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
     if bytecode:
         assert compileall.compile_dir(root, quiet=1, workers=1)
@@ -258,53 +259,74 @@ def _start_files(work: Path) -> dict[str, list[str]]:
 _MARGINS = {"2 s video, with figures": 0.8}
 
 
-def file_startup_rows(repeat: int = 3) -> list[tuple[str, str, str, str]]:
+#: ``--kinds``' names of the input kinds (``_start_files``' keys).
+KINDS = {"tracks": "tracks file", "pose": "pose file (DeepLabCut csv)",
+         "mocap": "motion-capture file (Qualisys tsv)", "video": "2 s video, with figures"}
+
+
+def file_startup_rows(repeat: int = 3, *, baseline: Path | None = None,
+                      kinds: list[str] | None = None,
+                      modes: tuple[bool, ...] = (True, False)) -> list[tuple[str, str, str, str]]:
     """``recognize`` of each input kind, whole processes, beside the floor of the same run.
 
     Rounds interleave the floor and every command (so a busy spell costs each alike);
-    the median of ``repeat`` rounds each. Twice: with our packages compiled to bytecode
-    (a user's installation; the targets are for this case) and compiled from source
-    at every start (this machine's PYTHONDONTWRITEBYTECODE=1).
+    the median of ``repeat`` rounds each. Twice (``modes``): with our packages compiled
+    to bytecode (a user's installation; the targets are for this case) and compiled from
+    source at every start (this machine's PYTHONDONTWRITEBYTECODE=1). ``baseline``,
+    another checkout (a worktree of the commit before a change), is timed in the same
+    rounds, each of its commands right after ours; ``kinds`` (keys of :data:`KINDS`)
+    limits the input kinds.
     """
     work = Path(tempfile.mkdtemp(prefix="hammer-bench-start-"))
     rows = []
     try:
         files = _start_files(work)
-        for bytecode in (True, False):
-            root = _project_copy(work, bytecode)
-            env = {**os.environ, "PYTHONPATH": str(root), "PYTHONDONTWRITEBYTECODE": "1"}
+        if kinds:
+            files = {KINDS[k]: files[KINDS[k]] for k in kinds}
+        for bytecode in modes:
+            roots = {"": _project_copy(work, bytecode)}
+            if baseline is not None:
+                roots[" baseline"] = _project_copy(work, bytecode, baseline, "-baseline")
+            env = {**os.environ, "PYTHONDONTWRITEBYTECODE": "1"}
             env.pop("PYTHONPYCACHEPREFIX", None)
+            envs = {tag: {**env, "PYTHONPATH": str(root)} for tag, root in roots.items()}
             out = work / "out"
 
-
-            def run(args, out=out, env=env, root=root):
+            def run(args, tag, out=out, envs=envs, roots=roots):
                 shutil.rmtree(out, ignore_errors=True)  # nothing reused: tracked, planned
                 cmd = [sys.executable, "-m", "hammer_mv", "recognize", *args, "-o", str(out),
                        "--quiet"]
-                return _timed(cmd, 1, env, cwd=root)
+                return _timed(cmd, 1, envs[tag], cwd=roots[tag])
 
-            times: dict[str, list[tuple[float, float]]] = {"floor": []}
-            run(files["tracks file"])  # warm the disk cache
+            times: dict[tuple[str, str], list[tuple[float, float]]] = {("floor", ""): []}
+            for tag in roots:
+                run(next(iter(files.values())), tag)  # warm the disk cache
             for _ in range(repeat):
-                times["floor"].append(_timed(_FLOOR, 1, env, cwd=root))
+                times["floor", ""].append(_timed(_FLOOR, 1, envs[""], cwd=roots[""]))
                 for what, args in files.items():
-                    times.setdefault(what, []).append(run(args))
-            floor, floor_cpu = (statistics.median(t[i] for t in times["floor"]) for i in (0, 1))
+                    for tag in roots:
+                        times.setdefault((what, tag), []).append(run(args, tag))
+            floor, floor_cpu = (statistics.median(t[i] for t in times["floor", ""])
+                                for i in (0, 1))
             how = "bytecode" if bytecode else "from source"
             rows.append((f"floor: python -c 'import numpy, scipy.signal' ({how})",
                          f"{floor:.2f} s", f"CPU {floor_cpu:.2f} s; same rounds", ""))
             for what, args in files.items():
-                shutil.rmtree(out, ignore_errors=True)
-                loaded = subprocess.run(
-                    [sys.executable, "-c", _WHICH, "recognize", *args, "-o", str(out),
-                     "--quiet"], capture_output=True, text=True, cwd=root, env=env,
-                    check=True).stdout.split()[-1]
-                wall, cpu = (statistics.median(t[i] for t in times[what]) for i in (0, 1))
-                margin = _MARGINS.get(what, 0.25)
-                target = (f"floor + {margin:.2f} s (target for bytecode); CPU {cpu:.2f} s "
-                          f"({cpu - floor_cpu:+.2f}); loaded of cv2,matplotlib,pandas: {loaded}")
-                rows.append((f"  recognize, {what} ({how})", f"{wall:.2f} s ({wall - floor:+.2f})",
-                             target, _verdict(wall - floor, margin) if bytecode else ""))
+                for tag, root in roots.items():
+                    shutil.rmtree(out, ignore_errors=True)
+                    loaded = subprocess.run(
+                        [sys.executable, "-c", _WHICH, "recognize", *args, "-o", str(out),
+                         "--quiet"], capture_output=True, text=True, cwd=root, env=envs[tag],
+                        check=True).stdout.split()[-1]
+                    wall, cpu = (statistics.median(t[i] for t in times[what, tag])
+                                 for i in (0, 1))
+                    margin = _MARGINS.get(what, 0.25)
+                    target = (f"floor + {margin:.2f} s (target for bytecode); CPU {cpu:.2f} s "
+                              f"({cpu - floor_cpu:+.2f}); loaded of cv2,matplotlib,pandas: "
+                              f"{loaded}")
+                    rows.append((f"  recognize, {what} ({how}){tag}",
+                                 f"{wall:.2f} s ({wall - floor:+.2f})", target,
+                                 _verdict(wall - floor, margin) if bytecode else ""))
     finally:
         shutil.rmtree(work, ignore_errors=True)
     return rows
@@ -415,23 +437,44 @@ def phase_rows(repeat: int = 5) -> list[tuple[str, str, str, str]]:
 
 def main(argv: list[str] | None = None) -> None:
     """Print the start-up, planning and per-clip table (``--phases N``: only the steps of
-    ``recognize`` of a 2 s video with its figures, median of N fresh processes)."""
+    ``recognize`` of a 2 s video with its figures, median of N fresh processes;
+    ``--baseline DIR`` or ``--kinds``: only the input kinds against the floor)."""
     import argparse
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--phases", type=int, metavar="N", default=0,
                     help="only the steps of recognize of a 2 s video, N fresh processes")
+    ap.add_argument("--baseline", type=Path, metavar="DIR",
+                    help="only the input kinds against the floor, and another checkout of "
+                         "the project (e.g. a git worktree of HEAD) timed in the same rounds")
+    ap.add_argument("--kinds", metavar="K,...",
+                    help=f"only these input kinds against the floor: {','.join(KINDS)}")
+    ap.add_argument("--rounds", type=int, default=3, metavar="N",
+                    help="rounds of the input kinds against the floor (default 3)")
+    ap.add_argument("--bytecode-only", action="store_true",
+                    help="the input kinds only as installed (compiled to bytecode)")
     # called from tools/bench.py with that script's own arguments in sys.argv
     args = ap.parse_args([] if argv is None and __name__ != "__main__" else argv)
+    kinds = args.kinds.split(",") if args.kinds else None
+    if kinds and set(kinds) - set(KINDS):
+        ap.error(f"--kinds: one or more of {','.join(KINDS)}")
+    if args.baseline is not None and not (args.baseline / "perception").is_dir():
+        ap.error(f"--baseline: {args.baseline} holds no checkout of the project")
     if args.phases:
         table("hammer-mv recognize of a 2 s video with its figures, step by step (fresh "
               f"processes, median of {args.phases}; wall and CPU of each step)",
               phase_rows(args.phases))
         return
+    kinds_rows = ("hammer-mv recognize of each input kind against the floor (whole processes, "
+                  f"median of {args.rounds})")
+    modes = (True,) if args.bytecode_only else (True, False)
+    if args.baseline is not None or kinds or args.bytecode_only:
+        table(kinds_rows, file_startup_rows(args.rounds, baseline=args.baseline, kinds=kinds,
+                                            modes=modes))
+        return
     table("hammer-mv: start-up, planning, one clip (whole processes, median)",
           startup_rows() + planning_rows() + clip_rows())
-    table("hammer-mv recognize of each input kind against the floor (whole processes, "
-          "median of 3)", file_startup_rows())
+    table(kinds_rows, file_startup_rows(args.rounds))
 
 
 if __name__ == "__main__":
