@@ -456,7 +456,7 @@ def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,
             from perception.report.kinematics import kinematics_figure
 
             # each on this process's kept figure of its kind, drawn before the next clip's;
-            # a PNG encoded while the next figure is drawn, the last while the CSV is written
+            # a PNG encoded while the next figure is drawn, the last while the CSV and JSON are made
             files = stack.enter_context(FigureFiles(figure_format, dpi))
             for key, draw in (("confidence_png", confidence_figure), ("paths_png", paths_figure),
                               ("kinematics_png", kinematics_figure)):
@@ -466,6 +466,7 @@ def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,
                 for key in FIGURE_KEYS:
                     remove_output(clip_outputs(Path(out), rec.clip, fmt)[key])
         write_csv(paths["csv"], rec.columns())
-    # the JSON last: its presence marks the clip's report complete
-    write_json(paths["json"], {**rec.to_dict(), "traces": clip_traces(rec), **(extra or {})})
+        report = {**rec.to_dict(), "traces": clip_traces(rec), **(extra or {})}
+    # the JSON last, once every figure is written: its presence marks the report complete
+    write_json(paths["json"], report)
     return paths
