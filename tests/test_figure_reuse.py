@@ -320,3 +320,20 @@ def test_a_copied_tick_is_a_tick_of_its_own():
     for tick in ax.yaxis.get_major_ticks():
         assert tick.tick1line.get_markersize() == 6
         assert tick.label1.get_color() == "C2"
+
+
+def test_a_kept_axis_updates_its_ticks_afresh_at_each_draw_and_outside_one():
+    from perception.report.canvas import png_bytes
+
+    kept, kept_axes = _ticked(keep="afresh")
+    new, new_axes = _ticked(keep=None)
+    for axes in (kept_axes, new_axes):  # after a draw: other limits, the ticks asked for
+        axes[0].set_xlim(-5.0, 17.0)
+        axes[1].set_ylim(-0.5, 0.25)
+    assert ([t.get_text() for t in kept_axes[0].get_xticklabels()]
+            == [t.get_text() for t in new_axes[0].get_xticklabels()])
+    assert "−5" in [t.get_text() for t in kept_axes[0].get_xticklabels()]  # a minus sign
+    assert png_bytes(kept, 100) == png_bytes(new, 100)  # and drawn again, every pixel
+    labels = [t.get_text() for t in kept_axes[1].get_yticklabels()]
+    assert labels == [t.get_text() for t in new_axes[1].get_yticklabels()]
+    assert "−0.4" in labels  # the new limits' ticks (matplotlib's minus sign)
