@@ -376,15 +376,56 @@ def _rss(proc) -> int:
         return 0
 
 
-def study_rows(participants: int, trials: int, jobs: int, conditions: int = 2
-               ) -> list[tuple[str, str, str, str]]:
+#: ``python -c`` running ``hammer-mv`` under tracemalloc (the batch's own process; its
+#: workers are not traced): argv[1] is where it writes, as JSON, what the process held
+#: when the clips were all in (``held``), its peak until then (``clips_peak``), the
+#: report's peak (``report_peak``) and the whole run's (``peak``), bytes of Python and
+#: numpy allocations.
+TRACED = """
+import json, sys, tracemalloc
+tracemalloc.start()
+import perception.batch as batch
+marks = {}
+finish = batch._finish
+def traced(*args, **kwargs):
+    marks["held"], marks["clips_peak"] = tracemalloc.get_traced_memory()
+    tracemalloc.reset_peak()
+    try:
+        return finish(*args, **kwargs)
+    finally:
+        marks["report_peak"] = tracemalloc.get_traced_memory()[1]
+batch._finish = traced
+from hammer_mv.cli import entry
+where = sys.argv.pop(1)
+sys.argv[0] = "hammer-mv"
+try:
+    status = entry()
+finally:
+    marks["peak"] = max(marks.get("clips_peak", 0), marks.get("report_peak", 0))
+    with open(where, "w") as f:
+        json.dump(marks, f)
+sys.exit(status)
+"""
+
+
+def _traced_marks(path: Path) -> dict[str, int]:
+    import json
+
+    return json.loads(path.read_text()) if path.exists() else {}
+
+
+def study_rows(participants: int, trials: int, jobs: int, conditions: int = 2,
+               traced: bool = False) -> list[tuple[str, str, str, str]]:
     """A study of ``participants`` x ``trials`` Optotrak trials through ``hammer-mv
     batch --jobs jobs`` (issue 45), and the same with a tenth of the participants (5 at
-    least, where there are 6): wall, trials/s, peak memory and memory a trial."""
+    least, where there are 6): wall, trials/s, peak memory and memory a trial; with
+    ``traced``, the batch's own process under tracemalloc (slower), and what it held
+    (:data:`TRACED`) a trial more."""
     from bench_mocap import RATE
     from bench_speed import HAMMER
 
     work = Path(tempfile.mkdtemp(prefix="hammer-bench-study-"))
+    marks: dict[int, dict[str, int]] = {}
     try:
         runs = {}
         # a tenth, but 5 participants at least (where there are 6): the statistics'
@@ -393,9 +434,14 @@ def study_rows(participants: int, trials: int, jobs: int, conditions: int = 2
         for who in ([small] if small else []) + [participants]:
             folder = work / f"study{who}"
             n = make_study(folder, who, trials, conditions)
-            cmd = [*HAMMER, "batch", str(folder), "--rate", RATE, "-o", str(work / "out"),
-                   "--jobs", str(jobs), "--quiet"]
+            args = ["batch", str(folder), "--rate", RATE, "-o", str(work / "out"),
+                    "--jobs", str(jobs), "--quiet"]
+            cmd = ([sys.executable, "-c", TRACED, str(work / "marks.json"), *args] if traced
+                   else [*HAMMER, *args])
             runs[n] = _watched(cmd)
+            if traced:
+                marks[n] = _traced_marks(work / "marks.json")
+                print(f"  traced: {marks[n]}", flush=True)
             # said as it ends: a study stopped at a time limit still leaves the smaller run's
             print(f"study of {n} trials: {runs[n][0]:.1f} s, peak memory {runs[n][2] / 2**20:.0f}"
                   f" MB every process, {runs[n][3] / 2**20:.0f} MB its own", flush=True)
@@ -426,6 +472,16 @@ def study_rows(participants: int, trials: int, jobs: int, conditions: int = 2
                      f"target <= {STUDY_BYTES_PER_TRIAL / 1e3:.0f} kB ({m} trials: peak "
                      f"{runs[m][3] / mb:.0f} MB, {runs[m][0]:.1f} s)",
                      "ok" if grown <= STUDY_BYTES_PER_TRIAL else "MISSED"))
+        if marks.get(n) and marks.get(m):
+            for key, what in (("held", "held when the clips were in"),
+                              ("clips_peak", "traced peak while the clips ran"),
+                              ("report_peak", "traced peak of the report"),
+                              ("peak", "traced peak, whole run")):
+                a, b = marks[m].get(key, 0), marks[n].get(key, 0)
+                rows.append((f"  tracemalloc: {what}", f"{(b - a) / (n - m) / 1e3:.1f} kB a "
+                             "trial", f"{m} trials {a / mb:.1f} MB, {n} trials {b / mb:.1f} MB",
+                             "" if key != "peak" else
+                             "ok" if (b - a) / (n - m) <= STUDY_BYTES_PER_TRIAL else "MISSED"))
     return rows
 
 
@@ -458,6 +514,9 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--conditions", type=int, default=2,
                         help="the study's conditions, taking turns trial by trial (2; 0: no "
                         "condition column)")
+    parser.add_argument("--traced", action="store_true",
+                        help="the study's batch process under tracemalloc (slower): what it "
+                        "holds and its peaks, a trial more")
     args = parser.parse_args(argv)
     rounds = args.rounds
     cores = (len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
@@ -465,7 +524,8 @@ def main(argv: list[str] | None = None) -> None:
     if args.only == "study":
         jobs = args.jobs or cores
         table(f"perception: a lab's study through batch ({cores} cores)",
-              study_rows(args.participants, args.study_trials, jobs, args.conditions))
+              study_rows(args.participants, args.study_trials, jobs, args.conditions,
+                         args.traced))
         return
     if args.only == "phases":
         table(f"perception: where a batch's time goes ({cores} cores)",
