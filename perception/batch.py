@@ -250,8 +250,10 @@ def summary_table(results: list[ClipResult], reference: str | None = None) -> pd
     factors = list(dict.fromkeys(f for r in results for f, _ in r.factors))
     numbered = any(getattr(r, "trial_number", None) is not None for r in results)
     own = ("clip", "condition", *(("trial_number", "reach_number") if numbered else ()))
-    table = []
-    for r in results:
+    # a list a column, not a dict a row (3 kB a row: a study's largest peak while its
+    # report began); a column a row first names comes after those seen, as from rows
+    columns: dict[str, list] = {}
+    for k, r in enumerate(results):
         entry = {"winner": r.winner, "rule": r.rule}
         s = r.summary
         for column, value in CLIP_COLUMNS:
@@ -274,10 +276,17 @@ def summary_table(results: list[ClipResult], reference: str | None = None) -> pd
         given = dict(r.factors)
         numbers = ({"trial_number": r.trial_number, "reach_number": r.reach_number}
                    if numbered else {})
-        table.append({"clip": r.clip, "condition": r.condition, **{
+        row = {"clip": r.clip, "condition": r.condition, **{
             f"manifest_{f}" if f in entry or f in own else f: given.get(f)
-            for f in factors}, **numbers, **entry})
-    table = pd.DataFrame(table)
+            for f in factors}, **numbers, **entry}
+        for column, value in row.items():
+            if column not in columns:  # missing in the rows before: NaN, as from rows
+                columns[column] = [np.nan] * k
+            columns[column].append(value)
+        for values in columns.values():
+            if len(values) == k:
+                values.append(np.nan)
+    table = pd.DataFrame(columns) if results else pd.DataFrame([])
     for count in ("aperture_peaks", "reach_number"):  # 1, not 1.0 (empty where unknown)
         if count in table:
             table[count] = table[count].astype("Int64")
@@ -401,11 +410,12 @@ def run_batch(
         results = workers.run_pool(work(), job, jobs, shared=repertoire)
     else:
         results = _run_local([_Work(*pair) for pair in pairs], repertoire, job, jobs)
-    with ModelRows(out) as rows:  # every model's curves on disk, not in this process
-        done = _collected(results, rows, streamed, len(items), quiet)
-        # with a scheduler `jobs` is the cluster's: the report's statistics fit here, alone
-        return _finish(done, rows, items, found if streamed else None, late, job, repertoire,
-                       settings, skipped, t0=t0, t1=t1, jobs=1 if scheduler else jobs)
+    with ModelRows(out) as rows:  # each clip's summary on disk, a compact one here
+        # with a scheduler `jobs` is the cluster's: the report's statistics fit here, alone;
+        # the results' list is _finish's alone (it lets go of them before the report)
+        return _finish(_collected(results, rows, streamed, len(items), quiet), rows, items,
+                       found if streamed else None, late, job, repertoire, settings, skipped,
+                       t0=t0, t1=t1, jobs=1 if scheduler else jobs)
 
 
 def _collected(results: Iterable[ClipResult], rows: ModelRows, streamed: bool, n: int,
@@ -445,19 +455,26 @@ def _finish(done: list[ClipResult], rows: ModelRows, items: list[BatchItem],
     summary = summary_table(done, reference)
     summary.attrs["trials"] = count_trials(items)
     bugs = [f"== {r.clip} ({r.error})\n{r.traceback}" for r in done if r.traceback]
+    clips, runs = len(done), _runs(done)
+    not_scored = [{"clip": r.clip, "status": r.status, "reason": r.reason}
+                  for r in done if not r.scored]
+    warnings = ClipWarnings(tuple((r.clip, tuple(r.summary.warning_values)) for r in scored))
+    kept = rows.summaries((r.summary for r in scored), reference)
+    # the results, read: the report reads each clip back from disk, the summary's rows
+    # hold the rest (the caller keeps no reference to the list)
+    del scored
+    done.clear()
     _remove_report(out)  # the last run's set: a kill or a full disk below leaves no mix
     try:
-        write_batch_report(summary, {r.clip: rows.restored(r.summary, reference)
-                                     for r in scored}, out, models=repertoire.models,
+        write_batch_report(summary, kept, out, models=repertoire.models,
                            figure_format=figure_format, dpi=dpi, jobs=jobs)
         if bugs:
             write_text(out / ERRORS_LOG, "\n".join(bugs))
         write_json(out / "batch.json", {
-            "clips": len(done), "trials": summary.attrs["trials"],
+            "clips": clips, "trials": summary.attrs["trials"],
             "ok": int((summary["status"] == "ok").sum()),
             "failed": int((summary["status"] == "failed").sum()),
-            "not_scored": [{"clip": r.clip, "status": r.status, "reason": r.reason}
-                           for r in done if not r.scored],
+            "not_scored": not_scored,
             "skipped": [{"file": n, "reason": why} for n, why in skipped],
             "settings": settings.fingerprint(), "repertoire": job.repertoire_id,
             "code": code_digest()})
@@ -466,9 +483,8 @@ def _finish(done: list[ClipResult], rows: ModelRows, items: list[BatchItem],
         raise
     # set last: pandas copies attrs deeply with every frame made from this one
     summary.attrs["timing"] = {"read": t1 - t0, "clips": t2 - t1,
-                               "report": time.perf_counter() - t2, "runs": _runs(done)}
-    summary.attrs["warnings"] = ClipWarnings(tuple(
-        (r.clip, tuple(r.summary.warning_values)) for r in scored))
+                               "report": time.perf_counter() - t2, "runs": runs}
+    summary.attrs["warnings"] = warnings
     return summary
 
 

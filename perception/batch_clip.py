@@ -8,11 +8,15 @@ input, settings, repertoire and code is reused.
 
 from __future__ import annotations
 
+import array
 import dataclasses
 import json
 import logging
+import math
+import pickle
 import tempfile
 import traceback
+from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, BinaryIO
@@ -32,14 +36,20 @@ from perception.pipeline import (
     recognize_tracks,
 )
 from perception.recognition.repertoire import PlanCache, Repertoire
-from perception.report.clip import ClipSummary, clip_outputs, remove_output, write_clip_report
+from perception.report.clip import (
+    KINEMATICS_COLUMNS,
+    ClipSummary,
+    clip_outputs,
+    remove_output,
+    write_clip_report,
+)
 from perception.report.figures import DPI, FIGURE_FORMATS
 from perception.report.tracking import write_tracking_report
 
 if TYPE_CHECKING:
     from perception.reach_data import Reach
 
-__all__ = ["ClipResult", "ModelRows", "RunTiming", "process_clip"]
+__all__ = ["ClipResult", "KeptSummaries", "ModelRows", "RunTiming", "process_clip"]
 
 log = logging.getLogger("perception.batch")
 
@@ -170,18 +180,21 @@ class ClipResult:
 
 
 class ModelRows:
-    """The batch's clips' every-model curves, kept on disk while the batch runs.
+    """The batch's clips' summaries, kept on disk while the batch runs and its report
+    is written.
 
     A clip's :class:`ClipSummary` holds its confidence and transport term
-    for every model of the repertoire (16 by default: 12 kB of a mocap
-    trial's 20 kB), but the batch report reads every model's final value
-    and the curves of one, the reference model, known only once every clip
-    is in. :meth:`keep` writes a result's curves to a temporary file beside
-    the report and keeps the final values; :meth:`restored` reads back the
-    reference model's. What the batch holds a clip is then its scalars, its
-    own curves (time, aperture, the kinematic traces) and two rows of
-    ``(1, N)``: the same at any number of models and the report's numbers the
-    same, bit for bit (float64 written and read as it was).
+    for every model of the repertoire (16 by default), its kinematic traces,
+    landmarks, notes and sentences: 21 kB of Python objects a motion-capture
+    trial, which a study of 10,000 trials cannot hold. :meth:`keep` writes a
+    result's summary to a temporary file beside the report (the per-model
+    curves as float64 rows, the rest pickled) and keeps a compact summary:
+    the scalars and landmarks ``summary.csv`` reads, one final value a model
+    (its confidence and log-likelihood) and the warnings. :meth:`restored`
+    reads a clip back, with the curves of one model (the reference model,
+    known only once every clip is in), and :meth:`summaries` gives the
+    report every scored clip that way, one at a time. The report's numbers
+    are the same, bit for bit (float64 written and read as it was).
 
     Use it as a context manager: the file goes when it closes (at once on
     POSIX: it is never linked into the folder).
@@ -195,10 +208,21 @@ class ModelRows:
 
     def __init__(self, folder: Path):
         self._file: BinaryIO = tempfile.TemporaryFile(dir=folder, prefix=".batch-rows-")
-        #: clip: (offset of its confidence, its shape, its transport's shape)
-        self._where: dict[str, tuple[int, tuple[int, ...], tuple[int, ...]]] = {}
+        #: clip: its row of :attr:`_places`
+        self._where: dict[str, int] = {}
+        #: a clip's place in the file, :data:`_PLACE` numbers a clip (56 bytes, where a
+        #: tuple of them was 300)
+        self._places = array.array("q")
+        #: a model count's empty transport, shared by the compact summaries
+        self._no_transport: dict[int, np.ndarray] = {}
+        #: the (names, kinds) pairs of the clips kept, each once
+        self._models: dict[tuple[int, int], int] = {}
+        self._model_lists: list[tuple[list[str], list[str]]] = []
         #: the model lists seen, each kept once (every clip's are alike: 2 kB a clip)
         self._lists: dict[tuple[str, ...], list[str]] = {}
+        #: short texts every clip repeats (condition, verdict, factors, ...), each kept
+        #: once: a result unpickled from a worker brings its own copy of each
+        self._texts: dict = {}
 
     def __enter__(self) -> ModelRows:
         return self
@@ -207,12 +231,15 @@ class ModelRows:
         self._file.close()
 
     def keep(self, result: ClipResult) -> ClipResult:
-        """``result`` with its summary's per-model curves written here and dropped.
+        """``result`` with its summary written here and a compact one in its place.
 
-        The kept summary's ``confidence`` is its final column, ``(M, 1)``,
-        its ``transport`` ``(M, 0)``, and its ``traces`` arrays (a reused
-        report's are lists of floats: 32 bytes a value, not 8); a result
-        without a summary is returned as it is.
+        The compact summary holds what ``summary.csv`` and the choice of the
+        reference model read: the scalars, ``confidence`` as its final column
+        ``(M, 1)`` (``transport`` ``(M, 0)``), ``final_log_likelihood``, the
+        landmarks of :data:`~perception.report.clip.KINEMATICS_COLUMNS`, the
+        tracking quality and the warnings' values; no curve, trace, note or
+        sentence (:meth:`restored` gives them back). A result without a
+        summary is returned as it is, its repeated texts shared.
 
         Parameters
         ----------
@@ -220,29 +247,70 @@ class ModelRows:
             A clip's result, as a worker returned it.
         """
         s = result.summary
+        shared = dataclasses.replace(
+            result, condition=self._text(result.condition), rule=self._text(result.rule),
+            status=self._text(result.status), factors=self._text(result.factors))
         if s is None:
-            return result
+            return shared
         confidence = np.ascontiguousarray(s.confidence, dtype=float)
         transport = np.ascontiguousarray(s.transport, dtype=float)
         if confidence.ndim != 2 or transport.ndim != 2:  # no models: nothing to keep apart
-            return result
-        self._file.seek(0, 2)
-        self._where[s.clip] = self._file.tell(), confidence.shape, transport.shape
-        self._file.write(confidence.tobytes())
-        self._file.write(transport.tobytes())
+            return shared
+        names, kinds = self._shared(s.names), self._shared(s.kinds)
         traces = ({k: np.asarray(v, dtype=float) for k, v in s.traces.items()}
                   if isinstance(s.traces, dict) else s.traces)
-        return dataclasses.replace(result, summary=dataclasses.replace(
-            s, confidence=confidence[:, -1:].copy(),
-            transport=np.zeros((len(s.names), 0)), traces=traces,
-            names=self._shared(s.names), kinds=self._shared(s.kinds)))
+        self._file.seek(0, 2)
+        offset = self._file.tell()
+        self._file.write(confidence.tobytes())
+        self._file.write(transport.tobytes())
+        rest = pickle.dumps(dataclasses.replace(
+            s, confidence=_NO_CURVES, transport=_NO_CURVES, traces=traces, names=[],
+            kinds=[]), protocol=pickle.HIGHEST_PROTOCOL)
+        self._where[s.clip] = len(self._places) // len(_PLACE)
+        pair = self._models.setdefault((id(names), id(kinds)), len(self._model_lists))
+        if pair == len(self._model_lists):
+            self._model_lists.append((names, kinds))
+        self._places.extend((offset, *confidence.shape, *transport.shape, self._file.tell(),
+                             len(rest), pair))
+        self._file.write(rest)
+        observed = (s.kinematics or {}).get("observed") or {}
+        m = len(names)
+        if m not in self._no_transport:
+            self._no_transport[m] = _read_only(np.zeros((m, 0)))
+        compact = ClipSummary(
+            result.clip if s.clip == result.clip else s.clip, _NO_VALUES, names, kinds,
+            confidence[:, -1:].copy(), np.asarray(s.final_log_likelihood, dtype=float),
+            self._text(s.winner),
+            self._text(s.rule), verdict=self._text(s.verdict), familiarity=s.familiarity,
+            margin=s.margin, familiarities=_NO_VALUES,
+            reference_model=self._text(s.reference_model),
+            transport=self._no_transport[m], aperture=_NO_VALUES,
+            extras={"tracking": s.tracking} if s.tracking is not None else {},
+            verdict_detail=self._text(s.verdict_detail),
+            kinematics={"observed": {k: observed[k] for k in KINEMATICS_COLUMNS
+                                     if k in observed}},
+            verdict_rule=self._text(s.verdict_rule),
+            warning_values=[{k: self._text(v) if isinstance(v, str) else v
+                             for k, v in w.items()} for w in s.warning_values],
+            transport_point=self._text(s.transport_point), time_origin=s.time_origin)
+        return dataclasses.replace(shared, summary=compact)
 
     def _shared(self, values: list[str]) -> list[str]:
         """``values``, as the first equal list kept (read, never changed, by the report)."""
         return self._lists.setdefault(tuple(values), list(values))
 
+    def _text(self, value):
+        """``value`` (a text or a tuple of texts), as the first equal one kept; anything
+        else as it is."""
+        if not isinstance(value, str | tuple):
+            return value
+        try:
+            return self._texts.setdefault(value, value)
+        except TypeError:  # a tuple of something not hashable
+            return value
+
     def restored(self, summary: ClipSummary, model: str | None) -> ClipSummary:
-        """A kept summary with the curves of ``model`` alone, read back.
+        """A kept summary as it was, with the curves of ``model`` alone, read back.
 
         ``names``, ``kinds`` and the per-model arrays hold ``model`` only: what
         the batch report reads of a clip once the reference model is known.
@@ -259,31 +327,106 @@ class ModelRows:
         """
         if summary.clip not in self._where:  # not kept here: as it is
             return summary
-        offset, shape, transport_shape = self._where[summary.clip]
+        return self._restored(summary.clip, model)
+
+    def _restored(self, clip: str, model: str | None) -> ClipSummary:
+        k = self._where[clip] * len(_PLACE)
+        offset, rows, width, transport_rows, transport_width, at, length, pair = (
+            self._places[k:k + len(_PLACE)])
+        shape, transport_shape = (rows, width), (transport_rows, transport_width)
+        names, kinds = self._model_lists[pair]
+        self._file.seek(at)
+        whole = pickle.loads(self._file.read(length))  # one dataclasses.replace below: 25 µs
         n = shape[0] * shape[1]
-        if model is None or model not in summary.names:
+        if model is None or model not in names:
             return dataclasses.replace(
-                summary, confidence=self._read(offset, shape),
+                whole, names=names, kinds=kinds, confidence=self._read(offset, shape),
                 transport=self._read(offset + 8 * n, transport_shape))
-        i = summary.names.index(model)
+        i = names.index(model)
         row = self._read(offset + 8 * i * shape[1], (1, shape[1]))
-        width = transport_shape[1]
-        transport = (self._read(offset + 8 * (n + i * width), (1, width))
-                     if transport_shape[0] > i else np.zeros((1, 0)))
+        transport = (self._read(offset + 8 * (n + i * transport_width), (1, transport_width))
+                     if transport_rows > i else np.zeros((1, 0)))
         pick = slice(i, i + 1)
 
         def one(values: np.ndarray) -> np.ndarray:  # an array a model, if it is one
-            return values[pick] if len(values) == len(summary.names) else values
+            return values[pick] if len(values) == len(names) else values
 
         return dataclasses.replace(
-            summary, names=[model], kinds=summary.kinds[pick], confidence=row,
-            transport=transport, final_log_likelihood=one(summary.final_log_likelihood),
-            familiarities=one(summary.familiarities))
+            whole, names=[model], kinds=kinds[pick], confidence=row,
+            transport=transport, final_log_likelihood=one(whole.final_log_likelihood),
+            familiarities=one(whole.familiarities))
+
+    def summaries(self, summaries: Iterable[ClipSummary], model: str | None) -> KeptSummaries:
+        """Every one of ``summaries`` by clip, each read back (:meth:`restored`) when
+        it is asked for and not kept: what the batch report reads.
+
+        Parameters
+        ----------
+        summaries : iterable of ClipSummary
+            Summaries :meth:`keep` returned.
+        model : str or None
+            The reference model.
+        """
+        # a summary not kept here (a recording's that failed at its end) is held as it is
+        return KeptSummaries(self, {s.clip: None if s.clip in self._where else s
+                                    for s in summaries}, model)
 
     def _read(self, offset: int, shape: tuple[int, ...]) -> np.ndarray:
         self._file.seek(offset)
-        count = int(np.prod(shape))
+        count = math.prod(shape)
         return np.frombuffer(self._file.read(8 * count), dtype=float).reshape(shape).copy()
+
+
+def _read_only(values: np.ndarray) -> np.ndarray:
+    values.flags.writeable = False
+    return values
+
+
+#: What a summary written to disk holds in place of its per-model curves, and a compact
+#: one in place of its time, aperture and familiarities: shared, never written to.
+_NO_CURVES = _read_only(np.zeros((0, 0)))
+_NO_VALUES = _read_only(np.zeros(0))
+#: The numbers of a clip's place in :class:`ModelRows`' file: its confidence's offset and
+#: shape, its transport's shape, the offset and length of the rest, pickled, and which of
+#: the model lists is its.
+_PLACE = ("offset", "rows", "width", "transport_rows", "transport_width", "rest", "length",
+          "models")
+
+
+class KeptSummaries(Mapping):
+    """Scored clips by name, each read back from a :class:`ModelRows` when asked for:
+    a mapping of :class:`ClipSummary` that holds none of them (:meth:`ModelRows.summaries`).
+
+    Each look-up reads the clip's summary from disk (about 30 µs): a report
+    reads each clip a few times rather than holding every one.
+
+    Parameters
+    ----------
+    rows : ModelRows
+        Where the clips were kept.
+    clips : dict of str to ClipSummary or None
+        The clips, in order: None for one kept in ``rows``, else its summary
+        (one not kept there, held as it is).
+    model : str or None
+        The reference model (:meth:`ModelRows.restored`).
+    """
+
+    def __init__(self, rows: ModelRows, clips: dict[str, ClipSummary | None],
+                 model: str | None):
+        self._rows, self._clips, self._model = rows, clips, model
+
+    def __getitem__(self, clip: str) -> ClipSummary:
+        held = self._clips[clip]
+        return self._rows._restored(clip, self._model) if held is None else held
+
+    def __contains__(self, clip) -> bool:
+        return clip in self._clips
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._clips)
+
+    def __len__(self) -> int:
+        return len(self._clips)
 
 
 def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,

@@ -63,8 +63,8 @@ def test_a_kept_clip_holds_one_value_a_model_however_many_models(tmp_path):
             assert kept[models].transport.size == 0
             # the final values summary.csv reads are those of the results
             assert np.array_equal(kept[models].confidence[:, 0], full.summary.confidence[:, -1])
-    # 30 more models: 30 final confidences, likelihoods and familiarities, no curve
-    assert _arrays(kept[32]) - _arrays(kept[2]) == 30 * 3 * 8
+    # a final confidence and likelihood a model, and nothing else: no curve, no trace
+    assert _arrays(kept[32]) == 32 * 2 * 8 and _arrays(kept[2]) == 2 * 2 * 8
     assert len(pickle.dumps(kept[32])) - len(pickle.dumps(kept[2])) < 30 * 40 * 8
 
 
@@ -97,14 +97,70 @@ def test_a_report_from_kept_rows_is_the_report_from_the_results(tmp_path,
         kept = [rows.keep(r) for r in results]
         scored = [r.summary for r in kept]
         reference = reference_model(scored, [r.condition for r in kept])
-        write_batch_report(summary_table(kept, reference),
-                           {r.clip: rows.restored(r.summary, reference) for r in kept},
+        # each clip read back from disk as the report reads it, as run_batch gives them
+        write_batch_report(summary_table(kept, reference), rows.summaries(scored, reference),
                            kept_out, figure_format=figure_format)
     files = sorted(p.name for p in memory.iterdir())
     assert files == sorted(p.name for p in kept_out.iterdir())
     assert f"confidence_all.{figure_format}" in files and "summary.csv" in files
     for name in files:  # tables, page and figures, byte for byte (figures carry no date)
         assert (memory / name).read_bytes() == (kept_out / name).read_bytes(), name
+
+
+def test_a_kept_clip_holds_no_curve_and_no_sentence_however_long_the_clip(tmp_path):
+    long = _results(4)[0]
+    s = long.summary
+    n = 20_000  # a long clip: every curve and trace 20,000 samples
+    long = dataclasses.replace(long, summary=dataclasses.replace(
+        s, time=np.linspace(0, 1, n), confidence=np.ones((4, n)), transport=np.ones((4, n)),
+        aperture=np.ones(n), traces={k: np.ones(n) for k in s.traces},
+        verdict_reason="x" * 10_000, extras={**s.extras, "notes": ["y" * 10_000]}))
+    with ModelRows(tmp_path) as rows:
+        short = rows.keep(_results(4)[0]).summary
+        kept = rows.keep(long).summary
+        assert len(pickle.dumps(kept)) == len(pickle.dumps(short)) < 2_500
+        back = rows.restored(kept, None)  # and all of it comes back
+        assert back.traces["time"].size == n and back.verdict_reason == "x" * 10_000
+        assert back.extras["notes"] == ["y" * 10_000] and back.confidence.shape == (4, n)
+        assert back.landmark("mga") == kept.landmark("mga") == 0.08
+
+
+def test_the_report_reads_the_kept_clips_one_at_a_time(tmp_path):
+    """write_batch_report given a mapping that reads each clip back holds a few at once,
+    not every one (a study's are 21 kB a trial)."""
+    import gc
+    import weakref
+    from collections.abc import Mapping
+
+    results = [dataclasses.replace(r, clip=f"{r.clip}-{k}", summary=dataclasses.replace(
+        r.summary, clip=f"{r.clip}-{k}")) for k in range(3) for r in _results(4)]
+    alive: weakref.WeakSet = weakref.WeakSet()
+    most = []
+
+    class Counted(Mapping):  # each look-up a new summary, as one read back from disk
+        def __init__(self, kept):
+            self.kept = kept
+
+        def __getitem__(self, clip):
+            gc.collect()
+            most.append(len(alive))
+            one = pickle.loads(pickle.dumps(self.kept[clip]))
+            alive.add(one)
+            return one
+
+        def __iter__(self):
+            return iter(self.kept)
+
+        def __len__(self):
+            return len(self.kept)
+
+    write_batch_report(summary_table(results), Counted({r.clip: r.summary for r in results}),
+                       tmp_path, figure_format="svg")
+    assert len(results) == 18 and len(most) >= 4 * 18  # every clip read, several times
+    # the clip being read, the previous one, and the two typical clips of Fig. 5.8(a)
+    assert max(most) <= 4
+    page = (tmp_path / "report.html").read_text()
+    assert all(f">{r.clip}</h3>" in page for r in results)
 
 
 def test_a_batch_gives_its_clips_warnings_without_reading_its_reports_back(tmp_path):
@@ -165,3 +221,81 @@ def test_the_landmark_table_built_a_column_at_a_time_is_the_one_built_a_row_at_a
     table = tidy_landmarks(movements, factors)
     pd.testing.assert_frame_equal(table, expected, check_exact=True)
     assert table["session"].isna().all() and not math.isnan(table["value"].iloc[0])
+
+
+def _with_unscored(results: list[ClipResult]) -> list[ClipResult]:
+    """``results`` and two rows without a result: a failed clip with a factor of its own
+    (``block``) and a trial that gives no reach."""
+    return [ClipResult("a-failed", "normal", "failed", "boom", reason="boom",
+                       factors=(("participant", "P9"), ("block", "2"))),
+            *results,
+            ClipResult("z-none", None, "no reach", reason="the hand never moved",
+                       factors=(("participant", "P0"),))]
+
+
+def test_landmarks_csv_written_a_chunk_at_a_time_is_the_whole_tables(tmp_path):
+    import pandas as pd
+
+    from perception.report.tables import landmark_table, write_landmark_table
+
+    results = _with_unscored(_results(3))
+    summary = summary_table(results)
+    recognitions = {r.clip: r.summary for r in results if r.summary is not None}
+    whole = landmark_table(summary, recognitions)
+    whole.to_csv(tmp_path / "whole.csv", index=False)
+    for chunk in (1, 2, 3, 100):  # the first chunk without a block, the last one too
+        columns, kept = write_landmark_table(summary, recognitions, tmp_path / "chunks.csv",
+                                             keep=("clip", "value", "block", "nothing"),
+                                             chunk=chunk)
+        assert (tmp_path / "chunks.csv").read_bytes() == (tmp_path / "whole.csv").read_bytes()
+        assert columns == list(whole.columns) and set(kept) == {"clip", "value", "block"}
+        assert kept["clip"] == whole["clip"].tolist()
+        assert np.array_equal(np.frombuffer(kept["value"]), whole["value"].to_numpy(),
+                              equal_nan=True)
+        pd.testing.assert_series_equal(pd.Series(kept["block"], name="block"),
+                                       whole["block"])
+
+
+def test_the_statistics_read_the_measure_tables_columns_bit_for_bit(tmp_path):
+    import pandas as pd
+
+    from perception.report import batch as report
+    from perception.report.statistics import measure_table
+    from perception.report.tables import landmark_table, write_landmark_table
+
+    results = _with_unscored(_results(4))
+    summary = summary_table(results)
+    recognitions = {r.clip: r.summary for r in results if r.summary is not None}
+    columns, kept = write_landmark_table(summary, recognitions, tmp_path / "l.csv",
+                                         keep=("clip", "condition", "participant", "landmark",
+                                               "value", "unit"))
+    expected = measure_table(landmark_table(summary, recognitions), summary)[
+        ["measure", "unit", "participant", "condition", "value"]]
+    pd.testing.assert_frame_equal(report._measures(columns, kept, summary), expected,
+                                  check_exact=True)
+    assert expected["measure"].iloc[-1] == "reference_confidence"
+    assert np.isnan(expected["value"].iloc[-1])  # the trial without a result
+
+
+def test_profiles_of_curves_one_at_a_time_are_those_of_every_curve_at_once():
+    import pandas as pd
+
+    from perception.report.conditions import PROFILE_POINTS, _phase, condition_profiles
+
+    results = _results(4)
+    recs = [r.summary for r in results]
+    conds = [r.condition for r in results]
+    table = condition_profiles(recs, conds, "grasp-2")
+    phase = np.linspace(0, 1, PROFILE_POINTS)
+    for cond, rows in table.groupby("condition", sort=False):
+        mine = [r for r, c in zip(recs, conds) if c == cond]
+        total = np.array([np.interp(phase, _phase(r), r.confidence[2]) for r in mine])
+        transport = np.array([np.interp(phase, _phase(r), r.transport[2]) for r in mine])
+        for column, curves in (("", total), ("transport_", transport),
+                               ("grip_", total - transport)):
+            assert rows[f"{column}mean"].to_numpy().tobytes() == np.nanmean(
+                curves, axis=0).tobytes()
+            assert rows[f"{column}sd"].to_numpy().tobytes() == np.nanstd(
+                curves, axis=0, ddof=1).tobytes()
+        assert (rows["n"] == len(mine)).all()
+    assert list(pd.unique(table["condition"])) == ["normal", "delayed"]

@@ -13,9 +13,10 @@ the page and in ``summary.csv``, with them escaped
 
 from __future__ import annotations
 
+import gc
 import html
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from urllib.parse import quote
@@ -23,7 +24,7 @@ from urllib.parse import quote
 import numpy as np
 import pandas as pd
 
-from perception.io.atomic import write_csv, write_text
+from perception.io.atomic import atomic_path, write_csv
 from perception.io.names import printable
 from perception.report.clip import ClipSummary, clip_figures, clip_outputs
 from perception.report.conditions import (
@@ -43,22 +44,25 @@ from perception.report.figures import (
     write_figure,
 )
 from perception.report.paper import (
+    LANDMARKS,
     condition_kinematics_figure,
     kinematic_profiles,
     landmark_strip_figure,
     transport_name,
 )
 from perception.report.statistics import (
+    PARTICIPANT_COLUMNS,
     fitted_in_workers,
     landmark_statistics,
-    measure_table,
+    participant_column,
     participant_means,
 )
 from perception.report.tables import (
     TABLES,
     in_lab_units,
-    landmark_table,
     r_aliases,
+    records,
+    write_landmark_table,
     write_units,
 )
 
@@ -119,6 +123,25 @@ class BatchReport:
     html: Path
 
 
+class _Clips(Sequence):
+    """The scored clips' summaries in table order, each looked up in ``recognitions``
+    when it is read (a batch's are read back from disk, one at a time: none is kept)."""
+
+    def __init__(self, recognitions: Mapping[str, ClipSummary], names: list[str]):
+        self._recognitions, self.names = recognitions, names
+
+    def __getitem__(self, i):
+        if isinstance(i, slice):
+            return _Clips(self._recognitions, self.names[i])
+        return self._recognitions[self.names[i]]
+
+    def __iter__(self) -> Iterator[ClipSummary]:
+        return (self._recognitions[name] for name in self.names)
+
+    def __len__(self) -> int:
+        return len(self.names)
+
+
 def _e(value) -> str:
     """A cell's text, escaped; empty for None and NaN."""
     if value is None or (isinstance(value, float) and not np.isfinite(value)):
@@ -139,15 +162,23 @@ def _image(name: str, alt: str, cls: str = "", lazy: bool = False) -> str:
     return f'<a href="{src}"><img{attrs} alt="{_e(alt)}"></a>'
 
 
-def _table(headers: Sequence[str], rows: Sequence[Sequence[str]], numeric: set[int] = frozenset(),
+def _table(headers: Sequence[str], rows: Iterable[Sequence[str]], numeric: set[int] = frozenset(),
            cls: str = "t") -> str:
     """An HTML table from escaped cell strings; ``numeric`` columns are right-aligned."""
+    return "".join(_table_parts(headers, rows, numeric, cls))
+
+
+def _table_parts(headers: Sequence[str], rows: Iterable[Sequence[str]],
+                 numeric: set[int] = frozenset(), cls: str = "t") -> Iterator[str]:
+    """:func:`_table`'s text, a row at a time (a page written as it is made)."""
     def row(cells, tag):
         return "<tr>" + "".join(
             f'<{tag}{" class=n" if i in numeric else ""}>{c}</{tag}>'
             for i, c in enumerate(cells)) + "</tr>"
-    return (f'<table class="{cls}"><thead>{row([html.escape(h) for h in headers], "th")}'
-            f'</thead><tbody>{"".join(row(r, "td") for r in rows)}</tbody></table>')
+    yield (f'<table class="{cls}"><thead>{row([html.escape(h) for h in headers], "th")}'
+           "</thead><tbody>")
+    yield from (row(r, "td") for r in rows)
+    yield "</tbody></table>"
 
 
 def _printable_table(table: pd.DataFrame) -> pd.DataFrame:
@@ -192,15 +223,19 @@ def with_verdict_reasons(summary: pd.DataFrame, recognitions: dict[str, ClipSumm
     recognitions : dict of ClipSummary
         Scored clips by name.
     """
-    summary = summary.copy()
     where = (list(summary.columns).index("verdict_rule") + 1 if "verdict_rule" in summary
              else len(summary.columns))
-    for column in ("verdict_reason", "winner_note"):
-        if column in summary:
-            continue
-        values = [getattr(recognitions[c], column) if c in recognitions and ok == "ok"
-                  else None for c, ok in zip(summary["clip"], summary["status"])]
-        summary.insert(where, column, values)
+    wanted = [c for c in ("verdict_reason", "winner_note") if c not in summary]
+    values: dict[str, list] = {c: [] for c in wanted}
+    if wanted:
+        for c, ok in zip(summary["clip"], summary["status"]):
+            # one read a clip: a batch's summaries are read back from disk one at a time
+            rec = recognitions[c] if ok == "ok" and c in recognitions else None
+            for column in wanted:
+                values[column].append(getattr(rec, column) if rec is not None else None)
+    summary = summary.copy(deep=False)  # copied on write: the columns are shared
+    for column in wanted:
+        summary.insert(where, column, values[column])
         where += 1
     return summary
 
@@ -215,39 +250,46 @@ def _verdict_cell(verdict, status: str, detail=None) -> str:
     return f'<span class="v-{v}">{v}</span>{kind}' if verdict else v
 
 
-def _main_table(summary: pd.DataFrame, anchors: dict[str, str], reference: str | None) -> str:
+def _main_table(summary: pd.DataFrame, anchors: dict[str, str], reference: str | None
+                ) -> Iterator[str]:
     headers = ["clip", "condition", "verdict", "familiarity (0–1)", "margin (log-lik.)",
                "winner", "winner log-lik.", f"C of {reference or 'reference'} (cm)", "status"]
-    rows = []
-    for r in summary.itertuples(index=False):
-        def get(name, r=r):  # a summary written by other code may lack columns
-            return getattr(r, name, None)
+    def rows():
+        for r in summary.itertuples(index=False):
+            yield _main_row(r, anchors)
 
-        clip = _e(r.clip)
-        if r.clip in anchors:
-            clip = f'<a href="#{anchors[r.clip]}">{clip}</a>'
-        ref = get("reference_confidence")
-        rows.append([clip, _e(r.condition),
-                     _verdict_cell(get("verdict"), r.status, get("verdict_detail")),
-                     _num(get("familiarity"), ".2f"), _num(get("margin"), ".1f"), _e(r.winner),
-                     _num(get("winner_log_likelihood"), ".1f"),
-                     _num(ref * 100 if ref is not None else None, ".2f"), _e(r.status)])
-    return _table(headers, rows, numeric={3, 4, 6, 7}, cls="t main")
+    return _table_parts(headers, rows(), numeric={3, 4, 6, 7}, cls="t main")
 
 
-def _models_table(summary: pd.DataFrame) -> str:
+def _main_row(r, anchors: dict[str, str]) -> list[str]:
+    """One clip's row of the main table."""
+    def get(name):  # a summary written by other code may lack columns
+        return getattr(r, name, None)
+
+    clip = _e(r.clip)
+    if r.clip in anchors:
+        clip = f'<a href="#{anchors[r.clip]}">{clip}</a>'
+    ref = get("reference_confidence")
+    return [clip, _e(r.condition), _verdict_cell(get("verdict"), r.status, get("verdict_detail")),
+            _num(get("familiarity"), ".2f"), _num(get("margin"), ".1f"), _e(r.winner),
+            _num(get("winner_log_likelihood"), ".1f"),
+            _num(ref * 100 if ref is not None else None, ".2f"), _e(r.status)]
+
+
+def _models_table(summary: pd.DataFrame) -> Iterator[str]:
     aliases = r_aliases(summary.columns)
     cols = [c for c in summary.columns if c.startswith("conf_") and c not in aliases]
     if not cols:
-        return ""
-    rows = [[_e(r["clip"])] + [_num(r[c] * 100, ".2f") for c in cols]
+        return
+    rows = ([_e(r["clip"])] + [_num(r[c] * 100, ".2f") for c in cols]
             # dicts, not iterrows' Series a row: 1 s of a 6,000-clip report a table
-            for r in summary[summary["status"] == "ok"].to_dict("records")]
-    table = _table(["clip"] + [c[len("conf_"):] for c in cols], rows,
-                   numeric=set(range(1, len(cols) + 1)))
-    return ("<details><summary>Final thesis-rule confidence C of every model (cm, "
-            f'weighted; <code>conf_&lt;model&gt;</code> in summary.csv, m)</summary>'
-            f'<div class="scroll">{table}</div></details>')
+            for r in records(summary[summary["status"] == "ok"]))
+    yield ("<details><summary>Final thesis-rule confidence C of every model (cm, "
+           'weighted; <code>conf_&lt;model&gt;</code> in summary.csv, m)</summary>'
+           '<div class="scroll">')
+    yield from _table_parts(["clip"] + [c[len("conf_"):] for c in cols], rows,
+                            numeric=set(range(1, len(cols) + 1)))
+    yield "</div></details>"
 
 
 #: summary.csv columns the main table or the per-model table shows.
@@ -256,18 +298,19 @@ _SHOWN = {"clip", "condition", "winner", "rule", "verdict", "verdict_detail", "f
           "reused", "error", "reason", "verdict_reason", "winner_note"}
 
 
-def _other_columns_table(summary: pd.DataFrame) -> str:
+def _other_columns_table(summary: pd.DataFrame) -> Iterator[str]:
     """summary.csv's other columns (the tracking quality, …), folded away."""
     cols = [c for c in summary.columns if c not in _SHOWN | r_aliases(summary.columns)
             and not c.startswith("conf_")]
     if not cols:
-        return ""
-    rows = [[_e(r["clip"])] + [_num(r[c], ".3g") if isinstance(r[c], int | float | np.number)
+        return
+    rows = ([_e(r["clip"])] + [_num(r[c], ".3g") if isinstance(r[c], int | float | np.number)
                                and not isinstance(r[c], bool) else _e(r[c]) for c in cols]
-            for r in summary[summary["status"] == "ok"].to_dict("records")]
-    table = _table(["clip", *cols], rows, numeric=set(range(1, len(cols) + 1)))
-    return ("<details><summary>Tracking quality and other columns of summary.csv</summary>"
-            f'<div class="scroll">{table}</div></details>')
+            for r in records(summary[summary["status"] == "ok"]))
+    yield ("<details><summary>Tracking quality and other columns of summary.csv</summary>"
+           '<div class="scroll">')
+    yield from _table_parts(["clip", *cols], rows, numeric=set(range(1, len(cols) + 1)))
+    yield "</div></details>"
 
 
 def _verdict_counts(ok: pd.DataFrame) -> str:
@@ -305,6 +348,20 @@ def _clip_section(rec: ClipSummary, out: Path, anchor: str, condition,
     return f'<div class="clip"><h3 id="{anchor}">{_e(rec.clip)}</h3><p>{line}</p>{figs}</div>'
 
 
+def _written(fig, stem: Path, fmt: str, dpi: int) -> None:
+    """:func:`~perception.report.figures.write_figure`, then the figure's memory freed.
+
+    A figure is a cycle of objects (figure, canvas, axes, artists) that only
+    the garbage collector frees, and its full collection comes seldom: a
+    study's figure of every clip's curve (1 kB a trial) and the tables made
+    before it stayed on: the report's peak grew 10.6 kB a trial without
+    these collections, 2.7 kB with them (tracemalloc, 100 and 400 trials).
+    """
+    write_figure(fig, stem, fmt, dpi)
+    del fig
+    gc.collect()
+
+
 def _chapter5(recs: list[ClipSummary], conds: list[str], reference: str, models, out: Path,
               fmt: str, dpi: int) -> None:
     """The four chapter 5 figures (matplotlib) and their tables."""
@@ -316,14 +373,14 @@ def _chapter5(recs: list[ClipSummary], conds: list[str], reference: str, models,
                        ignore_index=True)[["condition", "phase", "mean", "sd", "n"]]
     write_csv(out / "aperture_profiles.csv", ap)
     observed = ap[~ap["condition"].astype(str).str.startswith("model:")]
-    write_figure(aperture_figure(observed, own, reference), out / "aperture_profiles", fmt, dpi)
+    _written(aperture_figure(observed, own, reference), out / "aperture_profiles", fmt, dpi)
     single, single_conds = typical_clips(recs, conds, reference)
-    write_figure(confidence_single_figure(single, single_conds, reference),
+    _written(confidence_single_figure(single, single_conds, reference),
                  out / "confidence_single", fmt, dpi)
-    write_figure(confidence_all_figure(recs, conds, reference), out / "confidence_all", fmt, dpi)
+    _written(confidence_all_figure(recs, conds, reference), out / "confidence_all", fmt, dpi)
     prof = condition_profiles(recs, conds, reference)
     write_csv(out / "condition_profiles.csv", prof)
-    write_figure(condition_figure(prof, reference), out / "condition_profiles", fmt, dpi)
+    _written(condition_figure(prof, reference), out / "condition_profiles", fmt, dpi)
 
 
 def _grid(figures: Sequence[tuple[str, str]], fmt: str) -> str:
@@ -343,11 +400,14 @@ def _figures_html(reference: str, fmt: str) -> str:
 def _kinematics(recs: list[ClipSummary], conds: list[str], landmarks: pd.DataFrame, out: Path,
                 fmt: str, dpi: int) -> str:
     """The kinematics per condition: its table, its two figures and their HTML."""
-    write_csv(out / "kinematic_profiles.csv", kinematic_profiles(recs, conds))
-    write_figure(condition_kinematics_figure(recs, conds), out / "kinematic_profiles", fmt, dpi)
-    write_figure(landmark_strip_figure(landmarks), out / "landmark_strips", fmt, dpi)
+    # each a pass over the clips, read back from disk: made once, the table and its figure
+    profiles, point = kinematic_profiles(recs, conds), transport_name(recs)
+    write_csv(out / "kinematic_profiles.csv", profiles)
+    _written(condition_kinematics_figure(recs, conds, profiles=profiles, point=point),
+             out / "kinematic_profiles", fmt, dpi)
+    _written(landmark_strip_figure(landmarks), out / "landmark_strips", fmt, dpi)
     return "<h2>Kinematics per condition</h2>" + _grid([
-        ("kinematic_profiles", f"{transport_name(recs)} speed (mm/s) and grip aperture (mm) "
+        ("kinematic_profiles", f"{point} speed (mm/s) and grip aperture (mm) "
          "per condition, mean ± SD, from each trial's onset to its end "
          "(kinematic_profiles.csv)"),
         ("landmark_strips", "each landmark of every trial, per condition (coloured by "
@@ -367,6 +427,43 @@ def _statistics_html(stats_df: pd.DataFrame) -> str:
              _num(r.effect_size, ".2f")] for r in stats_df.itertuples(index=False)]
     return _table(["test", "groups", "n", "statistic", "value", "df", "p", "mean difference (cm)",
                    "effect size", "value"], rows, numeric={2, 4, 6, 7, 9})
+
+
+#: The columns of ``landmarks.csv`` :func:`~perception.report.paper.landmark_strip_figure`
+#: reads, with the participant's and the condition.
+STRIP_COLUMNS = ("landmark", "value", "status")
+
+
+def _measures(columns: list[str], kept: dict[str, list], summary: pd.DataFrame
+              ) -> pd.DataFrame:
+    """What :func:`~perception.report.statistics.landmark_statistics` and
+    :func:`~perception.report.statistics.participant_means` read of
+    :func:`~perception.report.statistics.measure_table` (``measure, unit``, the
+    participant, ``condition, value``), the same table, from ``landmarks.csv``'s
+    ``kept`` columns: its other columns were 2 kB a trial."""
+    who = participant_column(columns)
+    first: dict[str, int] = {}
+    for i, clip in enumerate(kept["clip"]):
+        first.setdefault(clip, i)
+    rows = list(first.values())
+    ok = summary[summary["status"] == "ok"].set_index("clip")["reference_confidence"]
+    table = {"measure": kept["landmark"] + ["reference_confidence"] * len(rows),
+             "unit": kept["unit"] + ["mm"] * len(rows)}
+    for c in ([who] if who else []) + ["condition"]:
+        table[c] = kept[c] + [kept[c][i] for i in rows]
+    table["value"] = np.concatenate([np.frombuffer(kept["value"], dtype=float),
+                                     ok.reindex(list(first)).to_numpy(float) * 1e3])
+    return pd.DataFrame(table)
+
+
+def _strip_rows(kept: dict[str, list]) -> pd.DataFrame:
+    """The rows of ``landmarks.csv``'s ``kept`` columns that the strips figure draws
+    (:data:`~perception.report.paper.LANDMARKS`)."""
+    drawn = {name for name, *_ in LANDMARKS}
+    rows = [i for i, name in enumerate(kept["landmark"]) if name in drawn]
+    values = np.frombuffer(kept["value"], dtype=float)
+    return pd.DataFrame({c: values[rows] if c == "value" else [kept[c][i] for i in rows]
+                         for c in kept if c != "unit"})
 
 
 def _statistics_soon(measures: pd.DataFrame, jobs: int) -> Callable[[], pd.DataFrame]:
@@ -436,23 +533,30 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
     # the landmark columns in the landmark tables' units (ms, mm, mm/s, %), said beside it
     write_csv(out / "summary.csv", _printable_table(in_lab_units(summary)))
     write_units(out / "summary.csv", summary.columns)
-    landmarks = landmark_table(summary, recognitions)
-    measures = measure_table(landmarks, summary)
+    # landmarks.csv written a chunk of movements at a time; kept of it, what the
+    # statistics and the strips figure read (the whole table was 2 kB a trial)
+    columns, kept = write_landmark_table(
+        summary, recognitions, out / TABLES[0], shown=_printable_table,
+        keep=("clip", "condition", *PARTICIPANT_COLUMNS, *STRIP_COLUMNS, "unit"))
+    measures = _measures(columns, kept, summary)
     statistics = _statistics_soon(measures, jobs)
-    for name, table in zip(TABLES, (landmarks, participant_means(measures))):
-        write_csv(out / name, _printable_table(table))
+    write_csv(out / TABLES[1], _printable_table(participant_means(measures)))
+    landmarks = _strip_rows(kept)
+    del kept
     ok = summary[summary["status"] == "ok"]
-    recs = [recognitions[c] for c in ok["clip"] if c in recognitions]
+    recs = _Clips(recognitions, [c for c in ok["clip"] if c in recognitions])
     condition_of = ok.set_index("clip")["condition"]
-    conds = [c if isinstance(c, str) else "unlabelled" for c in condition_of.loc[
-        [r.clip for r in recs]]]
+    conds = [c if isinstance(c, str) else "unlabelled" for c in condition_of.loc[recs.names]]
     if profile_model is None and "reference_model" in ok and ok["reference_model"].notna().any():
         profile_model = str(ok["reference_model"].dropna().iloc[0])
     if recs and profile_model is None:
-        profile_model = reference_model(recs, [condition_of.get(r.clip) for r in recs])
+        profile_model = reference_model(recs, [condition_of.get(c) for c in recs.names])
+    scored, counts = len(ok), _verdict_counts(ok)
+    del ok  # a copy of the summary's scored rows: 1 kB a trial
     sections, stats_df = [], pd.DataFrame()
     if recs:
         sections.append(_kinematics(recs, conds, landmarks, out, figure_format, dpi))
+    del landmarks  # written and drawn
     if recs and profile_model:
         _chapter5(recs, conds, profile_model, models, out, figure_format, dpi)
         stats_df = condition_statistics(summary, profile_model)
@@ -461,7 +565,7 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
         if len(stats_df):
             sections.append("<h2>Statistics of the reference model's final confidence</h2>"
                             + _statistics_html(stats_df))
-    anchors = {rec.clip: f"clip-{i}" for i, rec in enumerate(recs)}
+    anchors = {clip: f"clip-{i}" for i, clip in enumerate(recs.names)}
     failed = summary[summary["status"] != "ok"]
     if len(failed):  # failures and trials that give no reach, each with why
         why = failed["reason"] if "reason" in failed else failed["error"]
@@ -470,25 +574,35 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
             ["clip", "status", "reason"],
             [[_e(c), _e(st), _e(w)] for c, st, w in zip(failed["clip"], failed["status"], why)]))
     names = sorted(os.listdir(out))  # once, not once per clip
-    clips = [_clip_section(rec, out, anchors[rec.clip], condition_of.get(rec.clip), names)
-             for rec in recs]
+    clips = (_clip_section(rec, out, anchors[rec.clip], condition_of.get(rec.clip), names)
+             for rec in recs)
     tables = [_link(n, n) for n in ("summary.csv", *(["statistics.csv"] if len(stats_df)
                                                       else []), *TABLES)]
-    body = "\n".join([
+    body = [
         f"<h1>{_e(title)}</h1>",
-        f"<p>{len(summary)} clips: {len(ok)} scored, {len(failed)} not scored. Tables: "
+        f"<p>{len(summary)} clips: {scored} scored, {len(failed)} not scored. Tables: "
         + ", ".join(tables) + '. <span class="note">' + _HOW_TO_READ + "</span></p>",
-        _verdict_counts(ok),
+        counts,
         "<h2>Summary</h2>", _main_table(summary, anchors, profile_model), _models_table(summary),
         _other_columns_table(summary),
         *sections, "<h2>Clips</h2>", *clips,
-    ])
-    page = ("<!doctype html><html><head><meta charset='utf-8'>"
-            "<meta name='viewport' content='width=device-width, initial-scale=1'>"
-            f"<title>{_e(title)}</title><style>{_CSS}</style></head><body>"
-            f"{body}</body></html>\n")
-    write_csv(out / TABLES[2], _printable_table(statistics()))
-    write_text(out / "report.html", page)
+    ]
+    # the page written as it is made, a table row and a clip at a time (the whole of it
+    # was 35 kB a trial at its peak), and renamed into place once complete
+    with atomic_path(out / "report.html") as tmp, open(
+            tmp, "w", encoding="utf-8", errors="backslashreplace", newline="") as page:
+        page.write("<!doctype html><html><head><meta charset='utf-8'>"
+                   "<meta name='viewport' content='width=device-width, initial-scale=1'>"
+                   f"<title>{_e(title)}</title><style>{_CSS}</style></head><body>")
+        for k, part in enumerate(body):
+            if k:
+                page.write("\n")
+            if isinstance(part, str):
+                page.write(part)
+            else:  # a table or a clip's section, a row at a time
+                page.writelines(part)
+        page.write("</body></html>\n")
+        write_csv(out / TABLES[2], _printable_table(statistics()))
     return BatchReport(folder=out, summary=out / "summary.csv", html=out / "report.html")
 
 

@@ -8,7 +8,7 @@ grasp model" that chapter 5 reads every stimulus on.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Iterable, Sequence
 
 import numpy as np
 import pandas as pd
@@ -17,7 +17,7 @@ from perception.report.clip import ClipSummary
 
 __all__ = ["PROFILE_POINTS", "aperture_profiles", "condition_profiles", "condition_statistics",
            "default_profile_model", "model_aperture", "plain_tests", "reference_model",
-           "typical_clips"]
+           "stacked_curves", "typical_clips"]
 
 #: Samples of normalised movement time for per-condition mean profiles.
 PROFILE_POINTS = 101
@@ -27,20 +27,66 @@ def _phase(rec: ClipSummary) -> np.ndarray:
     return rec.time / rec.time[-1] if rec.time[-1] > 0 else rec.time
 
 
-def _mean_sd(curves: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-    arr = np.array(curves)
+def _mean_sd(curves: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    arr = np.asarray(curves)
     sd = np.nanstd(arr, axis=0, ddof=1) if len(arr) > 1 else np.zeros(arr.shape[1])
     return np.nanmean(arr, axis=0), sd
 
 
-def condition_profiles(recognitions: list[ClipSummary], conditions: list[str],
+def stacked_curves(recognitions: Iterable, conditions: Sequence[str],
+                   curve: Callable[[object], np.ndarray | None], points: int = PROFILE_POINTS
+                   ) -> tuple[dict[str, np.ndarray], list[str]]:
+    """Each condition's curves, one pass over ``recognitions``, in one array a condition.
+
+    What a profile's mean ± SD reads, built without a list of arrays (and
+    its copy): a batch's clips are read back one at a time, and a curve a
+    clip held at once was 0.9 kB a trial and curve.
+
+    Parameters
+    ----------
+    recognitions : iterable
+        The clips, in order (read once).
+    conditions : sequence of str
+        Their conditions.
+    curve : callable
+        A clip's curve, ``(points,)``, or None to leave the clip out.
+    points : int
+        Samples of a curve.
+
+    Returns
+    -------
+    curves : dict of str to array
+        ``(k, points)`` for each condition, in the order the conditions come (``k``
+        0 where every clip of it was left out), rows in the clips' order.
+    order : list of str
+        The conditions in the order their first curve came.
+    """
+    conditions = list(conditions)
+    counts = dict.fromkeys(conditions, 0)
+    for cond in conditions:
+        counts[cond] += 1
+    arrays = {cond: np.empty((n, points)) for cond, n in counts.items()}
+    filled = dict.fromkeys(counts, 0)
+    order: list[str] = []
+    for rec, cond in zip(recognitions, conditions):
+        values = curve(rec)
+        if values is None:
+            continue
+        if not filled[cond]:
+            order.append(cond)
+        arrays[cond][filled[cond]] = values
+        filled[cond] += 1
+    return {cond: a[:filled[cond]] for cond, a in arrays.items()}, order
+
+
+def condition_profiles(recognitions: Sequence[ClipSummary], conditions: list[str],
                        model: str) -> pd.DataFrame:
     """Mean ± SD confidence of one model per condition over normalised movement time.
 
     Parameters
     ----------
-    recognitions : list of ClipSummary
-        Scored clips.
+    recognitions : sequence of ClipSummary
+        Scored clips (read once a curve: total, transport, grip).
     conditions : list of str
         Condition of each clip (e.g. normal, delayed, open-close-open).
     model : str
@@ -53,34 +99,41 @@ def condition_profiles(recognitions: list[ClipSummary], conditions: list[str],
         m), and transport_mean, transport_sd, grip_mean, grip_sd (its two terms).
     """
     phase = np.linspace(0, 1, PROFILE_POINTS)
-    curves: dict[str, dict[str, list[np.ndarray]]] = {}
-    for rec, cond in zip(recognitions, conditions):
-        i = rec.index(model)
-        c = curves.setdefault(cond, {"": [], "transport_": [], "grip_": []})
-        t = _phase(rec)
-        c[""].append(np.interp(phase, t, rec.confidence[i]))
-        c["transport_"].append(np.interp(phase, t, rec.transport[i]) if rec.transport.size
-                               else np.full(len(phase), np.nan))
-        c["grip_"].append(c[""][-1] - c["transport_"][-1])
-    rows = []
-    for cond, parts in curves.items():
-        table = {"condition": cond, "phase": phase}
-        for prefix, cs in parts.items():
+
+    def total(rec: ClipSummary) -> np.ndarray:
+        return np.interp(phase, _phase(rec), rec.confidence[rec.index(model)])
+
+    def transport(rec: ClipSummary) -> np.ndarray:
+        return (np.interp(phase, _phase(rec), rec.transport[rec.index(model)])
+                if rec.transport.size else np.full(len(phase), np.nan))
+
+    def grip(rec: ClipSummary) -> np.ndarray:
+        return total(rec) - transport(rec)
+
+    # a curve at a time over every clip: one curve a clip held, not three
+    conditions = list(conditions)[:len(recognitions)]
+    tables: dict[str, dict] = {}
+    for prefix, curve in (("", total), ("transport_", transport), ("grip_", grip)):
+        curves, _ = stacked_curves(recognitions, conditions, curve)
+        for cond, cs in curves.items():
+            table = tables.setdefault(cond, {"condition": cond, "phase": phase})
             table[f"{prefix}mean"], table[f"{prefix}sd"] = _mean_sd(cs)
-        table["n"] = len(parts[""])
-        rows.append(pd.DataFrame(table))
+            table.setdefault("n", len(cs))
+        del curves
+    rows = [pd.DataFrame(table) for table in tables.values()]
     return pd.concat(rows, ignore_index=True)[
         ["condition", "phase", "mean", "sd", "n", "transport_mean", "transport_sd", "grip_mean",
          "grip_sd"]]
 
 
-def aperture_profiles(recognitions: list[ClipSummary], conditions: list[str]) -> pd.DataFrame:
+def aperture_profiles(recognitions: Sequence[ClipSummary], conditions: list[str]
+                      ) -> pd.DataFrame:
     """Mean ± SD observed grip aperture per condition over normalised movement time.
 
     Parameters
     ----------
-    recognitions : list of ClipSummary
-        Scored clips.
+    recognitions : sequence of ClipSummary
+        Scored clips (read once).
     conditions : list of str
         Condition of each clip.
 
@@ -90,14 +143,18 @@ def aperture_profiles(recognitions: list[ClipSummary], conditions: list[str]) ->
         Columns: condition, phase (0..1), mean, sd (m), n.
     """
     phase = np.linspace(0, 1, PROFILE_POINTS)
-    curves: dict[str, list[np.ndarray]] = {}
-    for rec, cond in zip(recognitions, conditions):
+
+    def curve(rec: ClipSummary) -> np.ndarray | None:
         g = rec.aperture
         ok = np.isfinite(g)
-        if ok.sum() >= 2:
-            curves.setdefault(cond, []).append(np.interp(phase, _phase(rec)[ok], g[ok]))
-    rows = [pd.DataFrame({"condition": cond, "phase": phase, "mean": _mean_sd(cs)[0],
-                          "sd": _mean_sd(cs)[1], "n": len(cs)}) for cond, cs in curves.items()]
+        return np.interp(phase, _phase(rec)[ok], g[ok]) if ok.sum() >= 2 else None
+
+    curves, order = stacked_curves(recognitions, conditions, curve)
+    rows = []
+    for cond in order:
+        mean, sd = _mean_sd(curves[cond])
+        rows.append(pd.DataFrame({"condition": cond, "phase": phase, "mean": mean, "sd": sd,
+                                  "n": len(curves[cond])}))
     return (pd.concat(rows, ignore_index=True) if rows
             else pd.DataFrame(columns=["condition", "phase", "mean", "sd", "n"]))
 
@@ -245,24 +302,27 @@ def reference_model(recs: list[ClipSummary], conditions: Sequence[str | None]) -
     return default_profile_model(normal or list(recs))
 
 
-def typical_clips(recs: list[ClipSummary], conditions: Sequence[str], model: str
+def typical_clips(recs: Sequence[ClipSummary], conditions: Sequence[str], model: str
                   ) -> tuple[list[ClipSummary], list[str]]:
     """One clip per condition: the one whose final confidence is the condition's median.
 
     Parameters
     ----------
-    recs : list of ClipSummary
-        Scored clips.
+    recs : sequence of ClipSummary
+        Scored clips (each read once, the chosen ones again).
     conditions : sequence of str
         Their conditions.
     model : str
         The model whose final confidence ranks them.
     """
+    # each clip's final value read once, the chosen clips looked up again: a batch's
+    # summaries are read back from disk, and a condition's group of them was every clip
+    finals = [float(r.confidence[r.index(model), -1]) for r in recs]
     chosen, conds = [], []
     for cond in dict.fromkeys(conditions):
-        group = [r for r, c in zip(recs, conditions) if c == cond]
-        final = np.array([r.confidence[r.index(model), -1] for r in group])
-        chosen.append(group[int(np.argsort(final)[(len(final) - 1) // 2])])
+        group = [i for i, c in enumerate(conditions) if c == cond and i < len(finals)]
+        final = np.array([finals[i] for i in group])
+        chosen.append(recs[group[int(np.argsort(final)[(len(final) - 1) // 2])]])
         conds.append(cond)
     return chosen, conds
 

@@ -35,6 +35,7 @@ import numpy as np
 import pandas as pd
 
 from perception.report.clip import ClipSummary
+from perception.report.conditions import stacked_curves
 from perception.report.figures import (
     LEFT,
     LEGEND_PT,
@@ -136,35 +137,40 @@ def kinematic_profiles(recognitions: Sequence[Recognition | ClipSummary],
         (mm), ``aperture_n`` (the trials with a curve; SD 0 for one).
     """
     share = np.linspace(0.0, 1.0, POINTS)
-    curves: dict[str, dict[str, list[np.ndarray]]] = {}
-    for rec, cond in zip(recognitions, conditions):
-        time, speed, aperture, onset, end = _trial(rec)
-        mine = curves.setdefault(cond if isinstance(cond, str) else "unlabelled",
-                                 {"speed": [], "aperture": []})
-        for key, values in (("speed", speed), ("aperture", aperture)):
-            curve = _resampled(time, values, onset, end, share)
-            if curve is not None and np.isfinite(curve).any():
-                mine[key].append(curve * MM)
-    tables = []
-    for cond, measures in curves.items():
-        table = {"condition": cond, "movement": share * 100}
-        for key, cs in measures.items():
-            arr = np.array(cs).reshape(len(cs), POINTS)
+    conds = [cond if isinstance(cond, str) else "unlabelled" for cond in conditions]
+    conds = conds[:len(recognitions)]
+    tables: dict[str, dict] = {cond: {"condition": cond, "movement": share * 100}
+                               for cond in conds}
+    # a curve at a time over every trial (a batch's are read back from disk one by one):
+    # one resampled curve a trial held, not two
+    for key, which in (("speed", 1), ("aperture", 2)):
+        def curve(rec, which=which) -> np.ndarray | None:
+            values = _trial(rec)
+            c = _resampled(values[0], values[which], values[3], values[4], share)
+            return c * MM if c is not None and np.isfinite(c).any() else None
+
+        curves, _ = stacked_curves(recognitions, conds, curve, POINTS)
+        for cond, arr in curves.items():
+            table = tables[cond]
             with warnings.catch_warnings():  # a point no trial reaches: NaN, not a warning
                 warnings.simplefilter("ignore", RuntimeWarning)
-                table[f"{key}_mean"] = np.nanmean(arr, axis=0) if cs else np.full(POINTS, np.nan)
-                table[f"{key}_sd"] = (np.nanstd(arr, axis=0, ddof=1) if len(cs) > 1
-                                      else np.zeros(POINTS) if cs else np.full(POINTS, np.nan))
-            table[f"{key}_n"] = len(cs)
-        tables.append(pd.DataFrame(table))
+                table[f"{key}_mean"] = (np.nanmean(arr, axis=0) if len(arr)
+                                        else np.full(POINTS, np.nan))
+                table[f"{key}_sd"] = (np.nanstd(arr, axis=0, ddof=1) if len(arr) > 1
+                                      else np.zeros(POINTS) if len(arr)
+                                      else np.full(POINTS, np.nan))
+            table[f"{key}_n"] = len(arr)
+        del curves
     columns = ["condition", "movement", "speed_mean", "speed_sd", "speed_n", "aperture_mean",
                "aperture_sd", "aperture_n"]
-    return pd.concat(tables, ignore_index=True)[columns] if tables else pd.DataFrame(
-        columns=columns)
+    return (pd.concat([pd.DataFrame(t) for t in tables.values()], ignore_index=True)[columns]
+            if tables else pd.DataFrame(columns=columns))
 
 
 def condition_kinematics_figure(recognitions: Sequence[Recognition | ClipSummary],
-                                conditions: Sequence[str | None]) -> Figure:
+                                conditions: Sequence[str | None], *,
+                                profiles: pd.DataFrame | None = None,
+                                point: str | None = None) -> Figure:
     """Transport speed (mm/s) and grip aperture (mm) per condition, mean ± SD, onset to end.
 
     Left the speed (named for its point, :func:`transport_name`), right the
@@ -178,11 +184,17 @@ def condition_kinematics_figure(recognitions: Sequence[Recognition | ClipSummary
         The trials.
     conditions : sequence of str or None
         Their conditions (None: ``unlabelled``).
+    profiles : pandas.DataFrame, optional
+        Their :func:`kinematic_profiles`, if made already (each is a pass over
+        the trials: a batch reads its trials back from disk).
+    point : str, optional
+        Their :func:`transport_name`, if known already.
     """
-    profiles = kinematic_profiles(recognitions, conditions)
+    if profiles is None:
+        profiles = kinematic_profiles(recognitions, conditions)
     conds = list(dict.fromkeys(profiles["condition"]))
     fig, axes = _figure((11.0, 4.8), 2, titled=True)
-    speed = f"{transport_name(recognitions)} speed"
+    speed = f"{point or transport_name(recognitions)} speed"
     for ax, key, title, unit in zip(axes, ("speed", "aperture"), (speed, "grip aperture"),
                                     ("mm/s", "mm")):
         lines = []

@@ -15,9 +15,11 @@ R's ``read.csv`` take them as they are.
 
 from __future__ import annotations
 
+import array
+import itertools
 import math
 import re
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -30,6 +32,7 @@ if TYPE_CHECKING:  # pandas only where a table is written
 
 __all__ = ["LANDMARK_CLOCKS", "LANDMARK_COLUMNS", "LANDMARK_UNITS", "NOT_SCORED", "TABLES",
            "MovementLandmarks", "factor_columns", "in_lab_units", "landmark_table", "r_name",
+           "records", "write_landmark_table",
            "tidy_landmarks",
            "units_of", "units_path", "wide_landmarks", "with_r_aliases", "write_units"]
 
@@ -247,14 +250,24 @@ def tidy_landmarks(movements: Iterable[MovementLandmarks],
     """
     import pandas as pd
 
-    movements = list(movements)
-    factors = _factor_names(movements) if factors is None else list(factors)
+    if factors is None:  # else taken one at a time (a batch's are read from disk)
+        movements = list(movements)
+        factors = _factor_names(movements)
     names = [*_HEAD, *factors, *_NUMBERS, *_LONG]
-    if not movements:
+    columns = _long_columns(movements, names)
+    if not columns["clip"]:
         return pd.DataFrame([], columns=names).astype({"trial_number": str,
                                                        "reach_number": str})
+    table = pd.DataFrame(columns, columns=names)
+    return table.astype({"trial_number": str, "reach_number": str})
+
+
+def _long_columns(movements: Iterable[MovementLandmarks], names: list[str]
+                  ) -> dict[str, list]:
+    """:func:`tidy_landmarks`' columns (``names``: the factors among them) as lists."""
     # a list a column, not a dict a row: a 10,000-trial study's 70,000 dicts were
     # the batch report's largest peak of memory (12 kB a trial)
+    factors = names[len(_HEAD):-len(_NUMBERS) - len(_LONG)]
     columns: dict[str, list] = {c: [] for c in names}
     for m in movements:
         cells = _cells(m, factors)
@@ -263,8 +276,7 @@ def tidy_landmarks(movements: Iterable[MovementLandmarks],
                    "clock": clock, "flag": flag, "status": m.status, "reason": m.reason}
             for c in names:
                 columns[c].append(row.get(c, math.nan))  # missing: NaN, as from rows
-    table = pd.DataFrame(columns, columns=names)
-    return table.astype({"trial_number": str, "reach_number": str})
+    return columns
 
 
 def wide_landmarks(movements: Iterable[MovementLandmarks],
@@ -368,7 +380,7 @@ def write_units(table: str | Path, columns: Iterable[str],
                       else units_of(columns))
 
 
-def landmark_table(summary: pd.DataFrame, recognitions: dict[str, ClipSummary]
+def landmark_table(summary: pd.DataFrame, recognitions: Mapping[str, ClipSummary]
                    ) -> pd.DataFrame:
     """``landmarks.csv``: :func:`tidy_landmarks` of a batch's clips.
 
@@ -380,8 +392,9 @@ def landmark_table(summary: pd.DataFrame, recognitions: dict[str, ClipSummary]
     ----------
     summary : pandas.DataFrame
         :func:`perception.batch.summary_table` (clips, conditions, factors).
-    recognitions : dict of ClipSummary
-        The scored clips by name: their ``kinematics.observed`` landmarks.
+    recognitions : mapping of str to ClipSummary
+        The scored clips by name: their ``kinematics.observed`` landmarks (each
+        read once, when its rows are made).
 
     Returns
     -------
@@ -390,11 +403,89 @@ def landmark_table(summary: pd.DataFrame, recognitions: dict[str, ClipSummary]
         :func:`factor_columns` (one named like a column here gets
         ``manifest_`` before it).
     """
-    from perception.landmarks import Landmarks
+    factors = [f for f in factor_columns(summary) if f not in _NUMBERS]
+    own = {*_HEAD, *_NUMBERS, *_LONG}
+    # a movement at a time, each clip's summary read when its rows are made
+    return tidy_landmarks(_movements(summary, recognitions, factors),
+                          [f"manifest_{f}" if f in own else f for f in factors])
+
+
+#: Movements a chunk of :func:`write_landmark_table`.
+LANDMARKS_CHUNK = 500
+
+
+def write_landmark_table(summary: pd.DataFrame, recognitions: Mapping[str, ClipSummary],
+                         path: str | Path, keep: Iterable[str] = (),
+                         shown: Callable[[pd.DataFrame], pd.DataFrame] | None = None,
+                         chunk: int = LANDMARKS_CHUNK) -> tuple[list[str], dict[str, list]]:
+    """Write :func:`landmark_table` to ``path`` as CSV, a chunk of movements at a time.
+
+    The same file as ``landmark_table(summary, recognitions).to_csv(path,
+    index=False)``, atomically, without the whole table at once (a
+    10,000-trial study's is 180,000 rows, 2 kB a trial, and twice that while
+    it is built); what the report reads of it after are the columns ``keep``.
+
+    Parameters
+    ----------
+    summary : pandas.DataFrame
+        :func:`perception.batch.summary_table`.
+    recognitions : mapping of str to ClipSummary
+        The scored clips by name (each read once).
+    path : str or Path
+        The CSV file.
+    keep : iterable of str
+        Columns to give back, whole (those the table lacks are left out).
+    shown : callable, optional
+        What each chunk becomes before it is written (the report's escaping of
+        text that is not UTF-8).
+    chunk : int
+        Movements a chunk.
+
+    Returns
+    -------
+    columns : list of str
+        The table's columns.
+    kept : dict of str to list
+        The values of each of ``keep``'s columns the table has, every row.
+    """
+    import pandas as pd
+
+    from perception.io.atomic import atomic_path
 
     factors = [f for f in factor_columns(summary) if f not in _NUMBERS]
-    movements = []
-    for r in summary.to_dict("records"):
+    own = {*_HEAD, *_NUMBERS, *_LONG}
+    named = [f"manifest_{f}" if f in own else f for f in factors]
+    columns = [*_HEAD, *named, *_NUMBERS, *_LONG]
+    # the values a float64 array (a float object each was 32 bytes), the rest lists
+    kept: dict[str, list] = {c: array.array("d") if c == "value" else []
+                             for c in keep if c in columns}
+    movements = _movements(summary, recognitions, factors)
+    with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8", errors="backslashreplace",
+                                        newline="") as f:
+        first = True
+        while True:
+            some = list(itertools.islice(movements, chunk))
+            if some or first:
+                raw = _long_columns(some, columns)
+                for c, values in kept.items():
+                    values.extend(raw[c])
+                table = (pd.DataFrame(raw, columns=columns) if raw["clip"]
+                         else pd.DataFrame([], columns=columns)).astype(
+                    {"trial_number": str, "reach_number": str})
+                del raw
+                (shown(table) if shown else table).to_csv(f, index=False, header=first)
+            first = False
+            if len(some) < chunk:
+                break
+    return columns, kept
+
+
+def _movements(summary: pd.DataFrame, recognitions: Mapping[str, ClipSummary],
+               factors: list[str]) -> Iterator[MovementLandmarks]:
+    """:func:`landmark_table`'s movements, one at a time."""
+    from perception.landmarks import Landmarks
+
+    for r in records(summary):
         s = recognitions.get(r["clip"]) if r["status"] == "ok" else None
         common = dict(clip=r["clip"], condition=_text(r.get("condition")),
                       factors={f: _text(r.get(f)) for f in factors},
@@ -403,19 +494,37 @@ def landmark_table(summary: pd.DataFrame, recognitions: dict[str, ClipSummary]
         if s is None:
             why = _text(r.get("reason")) or _text(r.get("error")) or "not scored"
             status = r["status"] if r["status"] != "ok" else "failed"
-            movements.append(MovementLandmarks(trial=r["clip"], landmarks=None, status=status,
-                                               reason=why, **common))
+            yield MovementLandmarks(trial=r["clip"], landmarks=None, status=status,
+                                    reason=why, **common)
             continue
         lm = Landmarks.from_dict((s.kinematics or {}).get("observed"))
         mocap = s.extras.get("mocap") or {}
         # the report's times are on the observation's clock; its origin puts them on the
         # recording's (unknown in reports written before it was recorded)
         origin = float(getattr(s, "time_origin", math.nan))
-        movements.append(MovementLandmarks(
+        yield MovementLandmarks(
             trial=str(mocap.get("trial") or r["clip"]), landmarks=lm, status=lm.status,
-            clock_offset=origin if math.isfinite(origin) else None, **common))
-    own = {*_HEAD, *_NUMBERS, *_LONG}
-    return tidy_landmarks(movements, [f"manifest_{f}" if f in own else f for f in factors])
+            clock_offset=origin if math.isfinite(origin) else None, **common)
+
+
+#: Rows a chunk of :func:`records`.
+RECORDS_CHUNK = 1000
+
+
+def records(table: pd.DataFrame, chunk: int = RECORDS_CHUNK) -> Iterator[dict]:
+    """``table.to_dict("records")``, the same dicts, made a chunk of rows at a time.
+
+    ``to_dict`` makes every row's dict at once: a 10,000-trial summary's
+    60 columns, 3 kB a row, for a loop that reads one.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+    chunk : int
+        Rows made at once.
+    """
+    for start in range(0, len(table), chunk):
+        yield from table.iloc[start:start + chunk].to_dict("records")
 
 
 def _text(value) -> str | None:
