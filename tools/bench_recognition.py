@@ -21,7 +21,11 @@ resident memory of the whole process tree and of the batch's own process
 (psutil, sampled every 0.1 s), and what the batch's own process holds per
 trial: its peak over that of the same study with a tenth of the participants,
 per trial more, against the targets (10,000 trials in 2 minutes at ``--jobs
-16``; memory a trial small and the same at any size).
+16``; memory a trial small and the same at any size). With ``--traced`` the
+batch's own process runs under tracemalloc (slower: for small studies) and
+the table adds what it held when the clips were in and its peaks, while the
+clips ran, in the report and over the run, a trial more: Python's and
+numpy's allocations, without the allocator's noise.
 """
 
 from __future__ import annotations
