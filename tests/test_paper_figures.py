@@ -141,7 +141,10 @@ def test_the_strip_plot_has_a_point_per_trial_and_landmark(trials):
                             ("peak_speed_time", 100), ("mga_time", 100), ("opening_time", 100),
                             ("rest_aperture", 1e3)):
             rows.append({"clip": r.clip, "condition": cond, "participant": who,
-                         "landmark": name, "value": getattr(lm, name) * scale, "unit": ""})
+                         "landmark": name, "value": getattr(lm, name) * scale, "unit": "",
+                         "status": "complete"})  # the movement's, as landmarks.csv has it
+    rows.append({"clip": "lost", "condition": conds[0], "participant": "p1",  # no reach in it
+                 "landmark": "mga", "value": np.nan, "unit": "mm", "status": "no reach"})
     import pandas as pd
 
     fig = landmark_strip_figure(pd.DataFrame(rows))

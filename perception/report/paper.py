@@ -221,10 +221,12 @@ def condition_kinematics_figure(recognitions: Sequence[Recognition | ClipSummary
 
 def _long(table: pd.DataFrame) -> pd.DataFrame:
     """``table`` as one row per trial and landmark: condition, landmark, value (its unit)."""
-    if "status" in table:
-        table = table[table["status"] == "ok"]
-    if {"landmark", "value"} <= set(table.columns):  # landmarks.csv: already in its units
+    if {"landmark", "value"} <= set(table.columns):
+        # landmarks.csv: already in its units; its status is the movement's (complete,
+        # starts in motion, ...), and a movement not measured has no value to draw
         return table[table["landmark"].isin([name for name, *_ in LANDMARKS])]
+    if "status" in table:  # summary.csv: the clips scored
+        table = table[table["status"] == "ok"]
     keep = [c for c in table.columns if c not in {name for name, *_ in LANDMARKS}]
     parts = [table[keep].assign(landmark=name, value=pd.to_numeric(table[name]) * scale)
              for name, _, _, scale in LANDMARKS if name in table]
