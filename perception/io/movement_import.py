@@ -160,8 +160,14 @@ def dlc_inputs(df, fps: float | None, source_software: str = "DeepLabCut"):
              else ("individual_0",) * df.shape[1]
              for level in ("individuals", "bodyparts", "coords")]
     held = list(zip(*where))
-    if held == list(itertools.product(individual_names, keypoint_names, coord_names)):
-        tracks = values.reshape(shape)
+    coords_of: dict[tuple, set] = {}
+    for who, part, coord in held:
+        coords_of.setdefault((who, part), set()).add(coord)
+    if held == list(itertools.product(individual_names, keypoint_names, coord_names)) or any(
+            got != set(coord_names) for got in coords_of.values()):
+        # every keypoint of every individual in order; or a keypoint short of a coordinate:
+        # a damaged table, refused as movement refuses it (the values do not fill the shape)
+        tracks = values.reshape((-1, *shape[1:]))
     else:
         import numpy as np
 
