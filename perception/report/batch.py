@@ -24,7 +24,8 @@ from urllib.parse import quote
 import numpy as np
 import pandas as pd
 
-from perception.io.atomic import atomic_path, write_csv
+from perception.io import atomic
+from perception.io.atomic import write_csv
 from perception.io.names import printable
 from perception.report.clip import ClipSummary, clip_figures, clip_outputs
 from perception.report.conditions import (
@@ -588,8 +589,9 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
         *sections, "<h2>Clips</h2>", *clips,
     ]
     # the page written as it is made, a table row and a clip at a time (the whole of it
-    # was 35 kB a trial at its peak), and renamed into place once complete
-    with atomic_path(out / "report.html") as tmp, open(
+    # was 35 kB a trial at its peak), and renamed into place once complete (through the
+    # module, as write_csv and write_text call it: the one place a write can fail)
+    with atomic.atomic_path(out / "report.html") as tmp, open(
             tmp, "w", encoding="utf-8", errors="backslashreplace", newline="") as page:
         page.write("<!doctype html><html><head><meta charset='utf-8'>"
                    "<meta name='viewport' content='width=device-width, initial-scale=1'>"
