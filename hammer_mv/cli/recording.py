@@ -70,8 +70,8 @@ def score_recording(args: argparse.Namespace, path: Path, score: Callable, *,
     table = check_output(_trials_table(out, path), [path])
     inputs = [f for f in (getattr(args, "repertoire", None), path) if f is not None]
     for entry in entries:  # every output refused before the first reach is scored
-        for target in clip_outputs(out, entry.name).values():
-            if not isinstance(entry, Unscored):
+        if not isinstance(entry, Unscored):
+            for target in clip_outputs(out, entry.name).values():
                 check_output(target, inputs)
     rep, rep_id = load_repertoire(args)
     figures = {"figures": not args.no_figures,

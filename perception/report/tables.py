@@ -198,11 +198,17 @@ class MovementLandmarks:
 
 
 def _factor_names(movements: list[MovementLandmarks]) -> list[str]:
-    """The factors of ``movements`` as R-safe columns (:func:`r_name`), in first-seen order;
-    one named like a column of the table gets ``manifest_`` before it."""
-    own = {*_HEAD, *_NUMBERS, *_LONG, "flags", "bound"}
+    """The factors of ``movements`` as R-safe columns (:func:`r_name`), in first-seen order
+    (:func:`_renamed`)."""
     names = dict.fromkeys(r_name(f) for m in movements for f in _own_factors(m))
-    return [f"manifest_{f}" if f in own else f for f in names]
+    return _renamed(names, ("flags", "bound"))
+
+
+def _renamed(factors: Iterable[str], more: Iterable[str] = ()) -> list[str]:
+    """``factors`` as the table's columns: one named like a column of the table (or one of
+    ``more``) gets ``manifest_`` before it."""
+    own = {*_HEAD, *_NUMBERS, *_LONG, *more}
+    return [f"manifest_{f}" if f in own else f for f in factors]
 
 
 def _own_factors(m: MovementLandmarks) -> dict[str, str]:
@@ -404,10 +410,8 @@ def landmark_table(summary: pd.DataFrame, recognitions: Mapping[str, ClipSummary
         ``manifest_`` before it).
     """
     factors = [f for f in factor_columns(summary) if f not in _NUMBERS]
-    own = {*_HEAD, *_NUMBERS, *_LONG}
     # a movement at a time, each clip's summary read when its rows are made
-    return tidy_landmarks(_movements(summary, recognitions, factors),
-                          [f"manifest_{f}" if f in own else f for f in factors])
+    return tidy_landmarks(_movements(summary, recognitions, factors), _renamed(factors))
 
 
 #: Movements a chunk of :func:`write_landmark_table`.
@@ -453,9 +457,7 @@ def write_landmark_table(summary: pd.DataFrame, recognitions: Mapping[str, ClipS
     from perception.io.atomic import atomic_path
 
     factors = [f for f in factor_columns(summary) if f not in _NUMBERS]
-    own = {*_HEAD, *_NUMBERS, *_LONG}
-    named = [f"manifest_{f}" if f in own else f for f in factors]
-    columns = [*_HEAD, *named, *_NUMBERS, *_LONG]
+    columns = [*_HEAD, *_renamed(factors), *_NUMBERS, *_LONG]
     # the values a float64 array (a float object each was 32 bytes), the rest lists
     kept: dict[str, list] = {c: array.array("d") if c == "value" else []
                              for c in keep if c in columns}
