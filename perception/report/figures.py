@@ -24,9 +24,9 @@ Confidence is drawn in cm (weighted), ×100 of its value in the files.
 
 from __future__ import annotations
 
-import threading
 import warnings
 from collections.abc import Callable, Sequence
+from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -531,7 +531,10 @@ class FigureFiles:
     def __init__(self, fmt: str = "png", dpi: int = DPI):
         _checked(fmt, dpi)
         self.fmt, self.dpi = fmt, int(dpi)
-        self._pending: tuple[Path, threading.Thread, list] | None = None
+        # one encoding thread: its future carries the PNG's bytes or the error, raised
+        # again in the caller's thread
+        self._pool = ThreadPoolExecutor(1, thread_name_prefix="hammer-mv figure encoding")
+        self._pending: tuple[Path, Future] | None = None
 
     def write(self, fig: Figure, path_stem: str | Path) -> Path:
         """Draw ``fig`` now and write it as ``<path_stem>.<fmt>`` (a PNG: by the next
@@ -558,33 +561,23 @@ class FigureFiles:
         self._finish()
         if not callable(data):
             return write_bytes(path, data)
-        out: list = []
-
-        def encode() -> None:
-            try:
-                out.append(data())
-            except BaseException as exc:  # raised again in the caller's thread
-                out.append(exc)
-
-        thread = threading.Thread(target=encode, name="hammer-mv figure encoding", daemon=True)
-        thread.start()
-        self._pending = path, thread, out
+        self._pending = path, self._pool.submit(data)
         return path
 
     def _finish(self) -> None:
         """Wait for the pending PNG and write it."""
         if self._pending is None:
             return
-        path, thread, out = self._pending
+        path, encoded = self._pending
         self._pending = None
-        thread.join()
-        if isinstance(out[0], BaseException):
-            raise out[0]
-        write_bytes(path, out[0])
+        write_bytes(path, encoded.result())
 
     def close(self) -> None:
         """Write the PNG still pending (waiting for its encoding)."""
-        self._finish()
+        try:
+            self._finish()
+        finally:
+            self._pool.shutdown()
 
     def __enter__(self) -> FigureFiles:
         return self
@@ -592,6 +585,6 @@ class FigureFiles:
     def __exit__(self, kind, value, traceback) -> None:
         if kind is None:
             self.close()
-        elif self._pending is not None:  # not written after an error
-            self._pending[1].join()
+        else:  # not written after an error
             self._pending = None
+            self._pool.shutdown()
