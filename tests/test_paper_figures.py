@@ -154,6 +154,17 @@ def test_the_strip_plot_has_a_point_per_trial_and_landmark(trials):
     assert len({tuple(c) for c in colours}) == 3  # one per participant
     assert [t.get_text() for t in fig.legends[0].get_texts()] == ["p1", "p2", "p3"]
 
+    # a study where only some trials name their participant: the others drawn grey, not
+    # a report that fails (list.index of a NaN participant raised)
+    some = pd.DataFrame(rows).assign(participant=lambda t: t["participant"].where(
+        t["clip"] != recs[0].clip))
+    fig = landmark_strip_figure(some)
+    assert [_points(ax) for ax in fig.axes] == [6] * 6
+    colours = {tuple(c) for c in np.concatenate([c.get_facecolors() for c in fig.axes[3].collections
+                                                 if c.get_gid() == "trials"])}
+    assert (0.6, 0.6, 0.6, 1.0) in colours and len(colours) == 4
+    assert sorted(t.get_text() for t in fig.legends[0].get_texts()) == ["p1", "p2", "p3"]
+
 
 @pytest.mark.parametrize("fmt", ["png", "svg", "pdf"])
 def test_write_figure_writes_valid_files(trials, tmp_path, fmt):
