@@ -193,7 +193,7 @@ def _printable_table(table: pd.DataFrame) -> pd.DataFrame:
             # printable() escapes character by character: a column whose text, run
             # together, needs none needs none cell by cell (2.3 million cells, 3 s, at
             # 10,000 trials)
-            text = "".join(v for v in table[c] if isinstance(v, str))
+            text = "".join(v for v in table[c].tolist() if isinstance(v, str))
             if printable(text) != text:
                 shown[c] = table[c].map(cell)
     return shown
