@@ -275,13 +275,17 @@ def _long_columns(movements: Iterable[MovementLandmarks], names: list[str]
     # the batch report's largest peak of memory (12 kB a trial)
     factors = names[len(_HEAD):-len(_NUMBERS) - len(_LONG)]
     columns: dict[str, list] = {c: [] for c in names}
+    own = [c for c in names if c not in _LONG]
     for m in movements:
         cells = _cells(m, factors)
-        for name, value, unit, clock, flag in m.values():
-            row = {**cells, "landmark": name, "value": value, "unit": unit,
-                   "clock": clock, "flag": flag, "status": m.status, "reason": m.reason}
-            for c in names:
-                columns[c].append(row.get(c, math.nan))  # missing: NaN, as from rows
+        rows = list(m.values())  # (landmark, value, unit, clock, flag) a landmark
+        k = len(rows)
+        for c in own:  # a movement's cells on each of its rows; missing: NaN, as from rows
+            columns[c].extend([cells.get(c, math.nan)] * k)
+        for j, c in enumerate(_LONG[:5]):
+            columns[c].extend(row[j] for row in rows)
+        columns["status"].extend([m.status] * k)
+        columns["reason"].extend([m.reason] * k)
     return columns
 
 
