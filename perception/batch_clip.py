@@ -263,9 +263,11 @@ class ModelRows:
         offset = self._file.tell()
         self._file.write(confidence.tobytes())
         self._file.write(transport.tobytes())
+        # the curves and model names are set again on every read (None: no array to
+        # rebuild for them, a dozen reads a clip)
         rest = pickle.dumps(dataclasses.replace(
-            s, confidence=_NO_CURVES, transport=_NO_CURVES, traces=traces, names=[],
-            kinds=[]), protocol=pickle.HIGHEST_PROTOCOL)
+            s, confidence=None, transport=None, traces=traces, names=None, kinds=None),
+            protocol=pickle.HIGHEST_PROTOCOL)
         self._where[s.clip] = len(self._places) // len(_PLACE)
         pair = self._models.setdefault((id(names), id(kinds)), len(self._model_lists))
         if pair == len(self._model_lists):
@@ -389,9 +391,8 @@ def _read_only(values: np.ndarray) -> np.ndarray:
     return values
 
 
-#: What a summary written to disk holds in place of its per-model curves, and a compact
-#: one in place of its time, aperture and familiarities: shared, never written to.
-_NO_CURVES = _read_only(np.zeros((0, 0)))
+#: What a compact summary holds in place of its time, aperture and familiarities: shared,
+#: never written to.
 _NO_VALUES = _read_only(np.zeros(0))
 #: The numbers of a clip's place in :class:`ModelRows`' file: its confidence's offset and
 #: shape, its transport's shape, the offset and length of the rest, pickled, and which of
