@@ -56,6 +56,7 @@ from perception.recognition.repertoire import PlanCache, Repertoire
 from perception.report.clip import (  # remove_stale_reports: also perception.batch's
     ClipSummary,
     remove_stale_reports,
+    remove_stale_trials,
 )
 from perception.report.figures import DPI, FIGURE_FORMATS
 from perception.report.tracking import tracking_columns
@@ -447,8 +448,9 @@ def _finish(done: list[ClipResult], rows: ModelRows, items: list[BatchItem],
         items = _take_back(found, late, done, job, repertoire)
     done.sort(key=lambda r: r.clip)
     t2 = time.perf_counter()
-    for path, clips in _recordings(items).items():  # reports of trials no longer in them
-        remove_stale_reports(out, path, [r.clip for r in done if r.scored and r.clip in clips])
+    scored_now = {r.clip for r in done if r.scored}
+    remove_stale_trials(out, {path: clips & scored_now  # reports of trials no longer in them
+                              for path, clips in _recordings(items).items()})
     scored = [r for r in done if r.summary is not None]
     # the one model whose curves the report reads (summary_table would find the same)
     reference = reference_model([r.summary for r in scored], [r.condition for r in scored])

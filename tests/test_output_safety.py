@@ -144,6 +144,40 @@ def test_a_rerun_after_a_trial_left_the_table_removes_its_report(tmp_path):
     assert list(pd.read_csv(report / "summary.csv")["clip"]) == ["t-trial0"]
 
 
+def test_stale_trials_of_several_recordings_go_in_one_pass(tmp_path, monkeypatch):
+    from perception.report import clip
+
+    a, b = (tmp_path / "a.tsv", tmp_path / "b.tsv")
+    for f in (a, b):
+        f.write_text("x")
+    out = tmp_path / "out"
+    out.mkdir()
+
+    def report(stem, source, mocap=True):
+        (out / f"{stem}.recognition.json").write_text(
+            json.dumps({"input": str(source), **({"mocap": {}} if mocap else {})}))
+        (out / f"{stem}.confidence.png").write_bytes(b"png")
+
+    for stem, source in (("a-trial0", a), ("a-trial1", a), ("b-trial0", b), ("b-trial1", b),
+                         ("c-trial0", tmp_path / "c.tsv")):
+        report(stem, source)
+    report("a-video", a, mocap=False)  # not a reach's report: never touched
+    reads = []
+    loads = json.loads
+    monkeypatch.setattr(clip, "json", type("J", (), {"loads": staticmethod(
+        lambda text: reads.append(text) or loads(text))}))
+    removed = clip.remove_stale_trials(out, {a: ["a-trial0"], b: ["b-trial0", "b-trial1"]})
+    assert removed == ["a-trial1"]
+    assert not list(out.glob("a-trial1.*"))
+    assert {p.name.split(".")[0] for p in out.iterdir()} == {
+        "a-trial0", "b-trial0", "b-trial1", "c-trial0", "a-video"}
+    # the clips scored now are not read: only the three others, once each
+    assert len(reads) == 3
+    # the one-recording form removes only that recording's
+    assert clip.remove_stale_reports(out, b, ["b-trial0"]) == ["b-trial1"]
+    assert (out / "a-trial0.recognition.json").is_file()
+
+
 def test_a_batch_will_not_write_its_report_over_a_recording_in_its_folder(tmp_path):
     folder = tmp_path / "in"
     folder.mkdir()

@@ -15,7 +15,7 @@ import contextlib
 import json
 import logging
 import os
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -27,7 +27,8 @@ from perception.recognition.result import Recognition
 from perception.report.figures import DPI, FIGURE_FORMATS
 
 __all__ = ["KINEMATICS_COLUMNS", "ClipSummary", "clip_figures", "clip_outputs", "clip_traces",
-           "remove_output", "remove_stale_reports", "write_clip_report"]
+           "remove_output", "remove_stale_reports", "remove_stale_trials",
+           "write_clip_report"]
 
 log = logging.getLogger(__name__)
 
@@ -373,6 +374,7 @@ def remove_stale_reports(out: str | os.PathLike, source: str | os.PathLike,
     reach) must not leave that trial's report and figures looking current.
     Only reaches' reports (those with a ``mocap`` entry) made from ``source``
     itself (the same file) are touched, and only in ``out``.
+    :func:`remove_stale_trials` does it for several recordings at once.
 
     Parameters
     ----------
@@ -388,21 +390,52 @@ def remove_stale_reports(out: str | os.PathLike, source: str | os.PathLike,
     list of str
         The stems of the reports removed.
     """
-    out, source = Path(out), Path(source)
-    keep_stems = {output_stem(c) for c in keep}
+    return remove_stale_trials(out, {source: keep})
+
+
+def remove_stale_trials(out: str | os.PathLike,
+                        scored: Mapping[str | os.PathLike, Iterable[str]]) -> list[str]:
+    """:func:`remove_stale_reports` for every recording of ``scored`` in one pass over ``out``.
+
+    A report whose clip is scored now is current whichever recording it came
+    from (clip names are unique in a batch); every other one is read once,
+    and removed if it was made from one of the recordings. One pass for a
+    batch: a pass a recording read every other recording's reports, and a
+    study of P files of T trials made P x P x T reads.
+
+    Parameters
+    ----------
+    out : str or os.PathLike
+        The report folder.
+    scored : mapping of recording to iterable of str
+        Each recording, with the clips scored from it now.
+
+    Returns
+    -------
+    list of str
+        The stems of the reports removed.
+    """
+    out = Path(out)
+    keep_stems = {output_stem(c) for clips in scored.values() for c in clips}
+    recordings = {}  # the recordings' files by identity: samefile without a stat a pair
+    for source in scored:
+        with contextlib.suppress(OSError):
+            st = os.stat(source)
+            recordings[(st.st_dev, st.st_ino)] = Path(source)
     removed = []
     suffix = ".recognition.json"
-    for report in sorted(out.glob(f"*{suffix}")):
+    for report in sorted(out.glob(f"*{suffix}")) if recordings else ():
         stem = report.name[:-len(suffix)]
         if stem in keep_stems:
             continue
         try:
             data = json.loads(report.read_text())
             made_from = data.get("input") if isinstance(data, dict) and "mocap" in data else None
-            same = made_from is not None and os.path.samefile(made_from, source)
+            st = os.stat(made_from) if isinstance(made_from, str) else None
         except (OSError, ValueError):
             continue
-        if not same:
+        source = recordings.get((st.st_dev, st.st_ino)) if st is not None else None
+        if source is None:
             continue
         log.info("%s: removed: its trial is not scored from %s now", report, source)
         for path in dict.fromkeys(p for fmt in FIGURE_FORMATS
