@@ -23,7 +23,7 @@ from perception.reach_data import (
     ReachParams,
 )
 
-__all__ = ["classify_movements", "find_movements", "find_reaches"]
+__all__ = ["classify_movements", "find_movements", "find_reaches", "movements_of"]
 
 
 def _field_bound(lp: LandmarkParams) -> str:
@@ -102,7 +102,8 @@ def _bounds(time: np.ndarray, speed: np.ndarray, peak: int,
 
 
 def find_movements(time: np.ndarray, transport: np.ndarray, params: ReachParams | None = None,
-                   aperture: np.ndarray | None = None) -> list[Movement]:
+                   aperture: np.ndarray | None = None, *,
+                   speed: np.ndarray | None = None) -> list[Movement]:
     """Every movement of the transport point, in time order (not yet told apart).
 
     Each local peak of the (low-passed) speed of at least ``min_speed`` is
@@ -125,6 +126,9 @@ def find_movements(time: np.ndarray, transport: np.ndarray, params: ReachParams 
     aperture : (N,) array, optional
         Thumb-index distance, m (NaN where lost); without it a turn alone parts
         two movements.
+    speed : (N,) array, optional
+        ``params.landmarks.speed_of(time, transport)``, where the caller has it
+        (:func:`classify_movements` reads it too).
     """
     from scipy.signal import find_peaks  # noqa: PLC0415 (as the landmarks take it)
 
@@ -135,7 +139,7 @@ def find_movements(time: np.ndarray, transport: np.ndarray, params: ReachParams 
     n = len(time)
     if n < 3:
         return []
-    speed = lp.speed_of(time, transport)
+    speed = lp.speed_of(time, transport) if speed is None else speed
     if not np.isfinite(speed).any():
         return []
     # a lost stretch is neither a stop nor a peak: the speed across it is interpolated
@@ -277,7 +281,8 @@ def _object_first_motion(obj: _Seen, ospeed: np.ndarray, hand_speed: np.ndarray,
 def classify_movements(time: np.ndarray, transport: np.ndarray, movements: list[Movement],
                        params: ReachParams | None = None,
                        object_path: np.ndarray | None = None,
-                       aperture: np.ndarray | None = None) -> list[Movement]:
+                       aperture: np.ndarray | None = None, *,
+                       speed: np.ndarray | None = None) -> list[Movement]:
     """Each movement told apart: a reach to grasp, what follows one, or another movement.
 
     Reach-ness is read from the transport, never from the grip. With an
@@ -305,6 +310,8 @@ def classify_movements(time: np.ndarray, transport: np.ndarray, movements: list[
         The object's centre, m.
     aperture : (N,) array, optional
         Thumb-index distance, m (NaN where lost).
+    speed : (N,) array, optional
+        As :func:`find_movements`'.
 
     Returns
     -------
@@ -320,7 +327,7 @@ def classify_movements(time: np.ndarray, transport: np.ndarray, movements: list[
     if object_path is not None and not np.isfinite(object_path).all(axis=1).any():
         object_path = None
     lp = params.landmarks
-    speed = np.nan_to_num(lp.speed_of(time, transport), nan=0.0)
+    speed = np.nan_to_num(lp.speed_of(time, transport) if speed is None else speed, nan=0.0)
     hand = _Seen(transport)
     if object_path is not None:
         obj = _Seen(object_path)
@@ -392,6 +399,19 @@ def classify_movements(time: np.ndarray, transport: np.ndarray, movements: list[
     return out
 
 
+def movements_of(time: np.ndarray, transport: np.ndarray, params: ReachParams,
+                 aperture: np.ndarray | None = None,
+                 object_path: np.ndarray | None = None) -> list[Movement]:
+    """:func:`find_movements` then :func:`classify_movements`, the transport's speed
+    computed once for both (its low-pass filter was a tenth of reading a trial)."""
+    time = np.asarray(time, dtype=float)
+    transport = np.asarray(transport, dtype=float)
+    speed = params.landmarks.speed_of(time, transport) if len(time) >= 3 else None
+    return classify_movements(time, transport,
+                              find_movements(time, transport, params, aperture, speed=speed),
+                              params, object_path, aperture, speed=speed)
+
+
 def find_reaches(time: np.ndarray, transport: np.ndarray, aperture: np.ndarray | None = None,
                  params: ReachParams | None = None,
                  object_path: np.ndarray | None = None) -> list[tuple[int, int]]:
@@ -414,9 +434,7 @@ def find_reaches(time: np.ndarray, transport: np.ndarray, aperture: np.ndarray |
         The object's centre: a reach ends nearer it than it starts.
     """
     params = ReachParams() if params is None else params
-    moves = classify_movements(time, transport,
-                               find_movements(time, transport, params, aperture), params,
-                               object_path, aperture)
+    moves = movements_of(time, transport, params, aperture, object_path)
     return [(m.onset, m.end) for m in moves
             if m.kind == "reach" and m.onset is not None and m.end is not None]
 

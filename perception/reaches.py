@@ -68,7 +68,12 @@ import numpy as np
 from perception.boundary import expect
 from perception.cleaning import clean_path
 from perception.errors import InputError
-from perception.movements import classify_movements, find_movements, find_reaches
+from perception.movements import (
+    classify_movements,
+    find_movements,
+    find_reaches,
+    movements_of,
+)
 from perception.reach_data import (
     MIN_SAMPLES,
     MarkerMap,
@@ -187,9 +192,7 @@ def trial_reaches(trial, markers: MarkerMap | None = None,
             f"{markers.thumb} and {markers.finger} together"
         return [], [unscored("marker lost", f"marker lost throughout: {what}")]
     aperture = np.linalg.norm(finger - thumb, axis=1)
-    moves = classify_movements(time, transport,
-                               find_movements(time, transport, params, aperture), params, obj,
-                               aperture)
+    moves = movements_of(time, transport, params, aperture, obj)
     candidates = [m for m in moves if m.kind == "reach"]
     if not candidates:
         if not moves:
