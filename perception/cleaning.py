@@ -343,11 +343,13 @@ def clean_path(time: np.ndarray, path: np.ndarray, params: CleaningParams | None
     longest = 0.0
     ok = ~lost
     if ok.sum() >= 2:
-        fill = PchipInterpolator(time[ok], path[ok], axis=0, extrapolate=False)
+        fill = None  # built at the first gap it bridges: most trials have none
         for a, b in _runs(lost):
             inside = a > 0 and b < len(time)
             span = (time[b] - time[a - 1]) if inside else math.inf
             if inside and span <= params.max_bridge + 1e-9:
+                if fill is None:
+                    fill = PchipInterpolator(time[ok], path[ok], axis=0, extrapolate=False)
                 path[a:b] = fill(time[a:b])
                 bridged += b - a
             else:
