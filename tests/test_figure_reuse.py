@@ -337,3 +337,77 @@ def test_a_kept_axis_updates_its_ticks_afresh_at_each_draw_and_outside_one():
     labels = [t.get_text() for t in kept_axes[1].get_yticklabels()]
     assert labels == [t.get_text() for t in new_axes[1].get_yticklabels()]
     assert "−0.4" in labels  # the new limits' ticks (matplotlib's minus sign)
+
+
+def _legends(fig_keep: str | None, labels: list[str]):
+    """A figure with a legend placed at its best (in a panel) and a titled two-column one
+    below the panels, on a kept figure (``fig_keep``: its key) or a new one."""
+    from perception.report.figures import _figure, _legend
+
+    def build():
+        fig, axes = _figure((8, 4), 2, titled=True, legend_rows=3)
+        return fig, axes
+
+    fig, axes = kept_figure(("test legends", fig_keep), build) if fig_keep else build()
+    t = np.linspace(0.0, 1.0, 40)
+    # colours given, as the report's figures give them (a kept axes' colour cycle goes on)
+    lines = [axes[0].plot(t, (k + 1) * t ** (k + 1), color=f"C{k}", label=label)[0]
+             for k, label in enumerate(labels)]
+    axes[1].plot(t, np.cos(6 * t), color="k")
+    _legend(axes[0], lines)  # loc="best": found from the curves
+    _legend(fig, lines, "lower center", ncols=2, title="the models", frameon=False)
+    return fig, axes
+
+
+def test_a_legend_laid_out_once_a_draw_is_matplotlibs_own():
+    from perception.report.canvas import png_bytes, quicker_legend
+
+    labels = ["grasp-0.5s", "grasp-1.0s", "reach-0.8s"]
+    kept, axes = _legends("once", labels)
+    for legend in (*kept.legends, axes[0].get_legend()):
+        quicker_legend(legend)
+        assert "draw" in vars(legend) and "get_bbox" in vars(legend._legend_box)
+    new, _ = _legends(None, labels)
+    assert png_bytes(kept, 100) == png_bytes(new, 100)  # every pixel
+    # outside a draw a legend measures afresh: a longer entry, a wider box
+    (legend,) = kept.legends
+    renderer = kept.canvas.get_renderer()
+    before = legend.get_window_extent(renderer).width
+    legend.get_texts()[0].set_text("a much longer model name than before")
+    assert legend.get_window_extent(renderer).width > before
+    # and a kept figure drawn again with other entries shows them, as a new one does
+    kept, _ = _legends("once", ["one", "two (a longer name)", "three", "four"])
+    new, _ = _legends(None, ["one", "two (a longer name)", "three", "four"])
+    assert png_bytes(kept, 100) == png_bytes(new, 100)
+
+
+def test_a_kept_layout_follows_everything_a_texts_layout_depends_on():
+    from matplotlib.figure import Figure
+    from matplotlib.text import Text
+
+    from perception.report.canvas import keep_layouts
+
+    fig = Figure(figsize=(3, 2))
+    new_canvas(fig)
+    kept, plain = fig.text(0.5, 0.5, "grasp-1.0s"), fig.text(0.5, 0.5, "grasp-1.0s")
+    keep_layouts([kept])
+    assert "_get_layout" in vars(kept) and "_get_layout" not in vars(plain)
+    renderer = fig.canvas.get_renderer()
+    changes = [("text", "two\nlines"), ("fontsize", 14), ("rotation", 30),
+               ("ha", "right"), ("va", "top"), ("linespacing", 2.0),
+               ("multialignment", "center"), ("rotation_mode", "anchor"),
+               ("fontweight", "bold"), ("fontfamily", "monospace"), ("text", "pay $5")]
+    seen = set()
+    for name, value in changes:
+        for text in (kept, plain):
+            text.set(**{name: value})
+        box, lines, corner = kept._get_layout(renderer)
+        want_box, want_lines, want_corner = Text._get_layout(plain, renderer)
+        assert (box.bounds, lines, corner) == (want_box.bounds, want_lines, want_corner), name
+        seen.add(repr((box.bounds, lines, corner)))
+        box.x0 = -1e6  # the caller's own box: the next layout is not moved
+        assert kept._get_layout(renderer)[0].bounds == want_box.bounds
+    assert len(seen) == len(changes)  # each change moved the layout: each was followed
+    # on another renderer (a vector format), matplotlib's own layout
+    for fmt in ("svg", "pdf"):
+        fig.savefig(io.BytesIO(), format=fmt)

@@ -44,7 +44,8 @@ import numpy as np
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-__all__ = ["kept_figure", "new_canvas", "png_bytes", "png_encoder"]
+__all__ = ["keep_layouts", "kept_figure", "new_canvas", "png_bytes", "png_encoder",
+           "quicker_legend"]
 
 #: Rendered strings kept per process (a few kB each; a batch uses a few hundred).
 TEXT_CACHE_SIZE = 4096
@@ -57,6 +58,8 @@ _EXTENTS: OrderedDict[tuple, tuple[float, float, float]] = OrderedDict()
 _MASKS_LOCK = threading.Lock()
 #: Ascent, descent and line gap of each font and size, px (a few entries).
 _HEIGHTS: dict[tuple, tuple] = {}
+#: Each string's layout on the report's canvas (``Text._get_layout``), by what it depends on.
+_LAYOUTS: OrderedDict[tuple, tuple] = OrderedDict()
 _KEPT = threading.local()
 
 
@@ -84,6 +87,9 @@ def _canvas_class() -> type:
         return FigureCanvasAgg
 
     class _Renderer(RendererAgg):
+        #: its strings' measures are the kept ones (:func:`_kept_layout` may keep layouts)
+        keeps_layouts = True
+
         def _get_font_height_metrics(self, prop) -> tuple:
             """A font's ascent, descent and line gap at this size, px, as ``Text`` finds them
             (its ``OS/2`` or ``hhea`` table), once per font and size rather than at
@@ -257,9 +263,20 @@ def kept_figure(key: Hashable, build: Callable[[], tuple[Figure, object]], *,
     for ax in fig.axes:
         for axis in (ax.xaxis, ax.yaxis):
             _quicker_axis(axis)
+    for legend in (*fig.legends, *(ax.legend_ for ax in fig.axes if ax.legend_ is not None)):
+        quicker_legend(legend)  # a legend kept with its figure (clear=False)
+    keep_layouts(_texts(fig))
     while len(kept) > KEPT_FIGURES:
         kept.popitem(last=False)
     return fig, axes
+
+
+def _texts(fig) -> list:
+    """The texts of ``fig``: its own, its axes' (titles, axis labels, the ticks made),
+    its legends'."""
+    from matplotlib.text import Text
+
+    return fig.findobj(lambda a: isinstance(a, Text))
 
 
 def _quicker_axis(axis) -> None:
@@ -324,6 +341,131 @@ def _quicker_axis(axis) -> None:
         setattr(axis, fn.__name__, fn)
 
 
+def quicker_legend(legend) -> None:
+    """Let ``legend`` lay out its boxes once a draw, and find its best place once.
+
+    A legend's draw measures its box (every entry's text and handle, packed
+    in columns), then draws each box of the tree, and each box lays out its
+    own subtree again to place its children: a 16-entry legend lays out each
+    entry five times, a fifth of a clip's figures. Within one draw nothing
+    moves a box's size, so each box's layout (``get_bbox``,
+    ``_get_bbox_and_child_offsets``) is kept for the rest of that draw, and so
+    is the best location (``loc="best"``, asked for by the measure and by the
+    draw). Outside a draw the legend measures afresh. Only for a legend whose
+    class draws and places as ``Legend`` does, on this legend's boxes only
+    (attributes of the instances).
+
+    Parameters
+    ----------
+    legend : matplotlib.legend.Legend
+        A legend of a figure drawn on the report's canvas.
+    """
+    from matplotlib.legend import Legend
+    from matplotlib.offsetbox import OffsetBox
+
+    cls = type(legend)
+    if any(getattr(cls, name, None) is not getattr(Legend, name, None) or not hasattr(Legend, name)
+           for name in ("draw", "_find_best_position", "_findoffset")):
+        return
+    drawing: dict = {}  # while the legend draws: (method, box, arguments) -> result
+
+    def kept(box, name: str):
+        method = getattr(type(box), name)
+
+        def during_draw(*args, **kwargs):
+            if not drawing or kwargs:
+                return method(box, *args, **kwargs)
+            key = (name, id(box), *args)  # a renderer by identity, sizes by value
+            if key not in drawing:
+                drawing[key] = method(box, *args)
+            return drawing[key]
+
+        during_draw.__doc__ = method.__doc__
+        return during_draw
+
+    boxes, seen = [legend._legend_box], set()
+    while boxes:
+        box = boxes.pop()
+        if id(box) in seen or not isinstance(box, OffsetBox):
+            continue
+        seen.add(id(box))
+        for name in ("get_bbox", "_get_bbox_and_child_offsets"):
+            setattr(box, name, kept(box, name))
+        boxes.extend(box.get_children())
+
+    def draw(renderer):
+        drawing.clear()
+        drawing["on"] = True  # never a key of a result
+        try:
+            return cls.draw(legend, renderer)
+        finally:
+            drawing.clear()
+
+    draw.__doc__ = Legend.draw.__doc__
+    legend.draw = draw
+    keep_layouts((*legend.get_texts(), legend.get_title()))
+    legend._find_best_position = kept(legend, "_find_best_position")
+
+
+def keep_layouts(texts) -> None:
+    """Let each of ``texts`` take its layout from the process's kept ones when drawn on
+    the report's canvas.
+
+    A string's layout (``Text._get_layout``: its lines' extents, the box
+    rotated and aligned) is about a tenth of a millisecond of Python, asked
+    for when the text is measured and again when it is drawn; a clip's three
+    figures lay out some 250 strings, most of them the same in every clip
+    (tick labels, axis labels, legend entries). The layout depends only on
+    the string, its font and size, the dpi, the hinting and kerning
+    settings, the line spacing, alignments and rotation: on the report's
+    renderer (whose measures are kept by the same things) it is kept by
+    them. A text that may be mathtext or TeX, or wraps, on any other renderer
+    (SVG, PDF), is laid out by matplotlib as always.
+
+    Parameters
+    ----------
+    texts : iterable of matplotlib.text.Text
+        Texts of a figure on the report's canvas.
+    """
+    from matplotlib.text import Text
+
+    if not callable(getattr(Text, "_get_layout", None)):
+        return
+    for text in texts:
+        if type(text)._get_layout is Text._get_layout and "_get_layout" not in vars(text):
+            text._get_layout = _kept_layout(text)
+
+
+def _kept_layout(text):
+    """``text._get_layout``, kept per process for what it depends on (:func:`keep_layouts`)."""
+    from matplotlib import rcParams
+
+    def _get_layout(renderer):
+        s = text._text
+        if (not getattr(renderer, "keeps_layouts", False) or "$" in s or text._usetex
+                or text._wrap):
+            return type(text)._get_layout(text, renderer)
+        key = (s, *_font_key(text._fontproperties), text.get_figure(root=True).dpi,
+               renderer.dpi, rcParams["text.hinting"], rcParams["text.hinting_factor"],
+               rcParams["text.kerning_factor"], text._linespacing, text._multialignment,
+               text._horizontalalignment, text._verticalalignment, text.get_rotation(),
+               text._rotation_mode)
+        with _MASKS_LOCK:
+            hit = _LAYOUTS.get(key)
+        if hit is None:
+            hit = type(text)._get_layout(text, renderer)
+            with _MASKS_LOCK:
+                _LAYOUTS[key] = hit
+                while len(_LAYOUTS) > TEXT_CACHE_SIZE:
+                    _LAYOUTS.popitem(last=False)
+        box, lines, corner = hit
+        return box.frozen(), list(lines), corner  # the caller's own box and list
+
+    _get_layout.kept_layout = True  # a copy of the text (a copied tick) gets its own
+    _get_layout.__doc__ = "The text's layout (Text._get_layout), kept (canvas.keep_layouts)."
+    return _get_layout
+
+
 #: The parts of a ``Tick`` (``Tick.get_children``).
 _TICK_PARTS = ("tick1line", "tick2line", "gridline", "label1", "label2")
 
@@ -346,6 +488,8 @@ def _copied(artist, copiers: dict):
     for name, value in vars(artist).items():
         copier = copiers.get(type(value))
         state[name] = value if copier is None else copier(value)
+    if getattr(state.get("_get_layout"), "kept_layout", False):  # bound to the copy
+        state["_get_layout"] = _kept_layout(new)
     return new
 
 

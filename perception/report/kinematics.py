@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from perception.landmarks import LandmarkParams, Landmarks
-from perception.report.canvas import kept_figure, new_canvas
+from perception.report.canvas import kept_figure, new_canvas, quicker_legend
 from perception.report.figures import LEGEND_PT, _legend, _title
 
 if TYPE_CHECKING:
@@ -270,6 +270,8 @@ def kinematics_figure(rec: Recognition, *, reuse: bool = False) -> Figure:
     if len(time):
         grip.set_xlim(float(np.nanmin(time)), float(np.nanmax(time)))
     grip.set_xlabel(xlabel)
-    _legend(fig, handles, "lower center", ncols=4, frameon=False)
+    legend = _legend(fig, handles, "lower center", ncols=4, frameon=False)
+    if reuse:  # a new legend on the kept figure, its boxes laid out once a draw
+        quicker_legend(legend)
     _title(fig, kinematics_title(rec))
     return fig
