@@ -95,9 +95,11 @@ def _spans_its_data(fig) -> None:
     # a wrist not recorded, then one tracked: a figure of its own (one line fewer)
     ("paths", "mocap", "normal", False),
     ("paths", "normal", "mocap", False),
-    ("kinematics", "normal", "unmeasured", True),  # every landmark, then some not measured
-    ("kinematics", "unmeasured", "delayed", True),
-    ("kinematics", "mocap", "normal", True),
+    # kept per the marks drawn (which landmarks were measured) and the transport's point
+    ("kinematics", "normal", "normal1", True),
+    ("kinematics", "normal", "unmeasured", False),  # every landmark, then some not measured
+    ("kinematics", "unmeasured", "delayed", False),
+    ("kinematics", "mocap", "normal", False),  # the grip midpoint's speed, then the wrist's
 ])
 def test_a_kept_figure_shows_the_second_clip_and_nothing_of_the_first(clips, kind, first,
                                                                       second, same):
@@ -411,3 +413,21 @@ def test_a_kept_layout_follows_everything_a_texts_layout_depends_on():
     # on another renderer (a vector format), matplotlib's own layout
     for fmt in ("svg", "pdf"):
         fig.savefig(io.BytesIO(), format=fmt)
+
+
+def test_a_kinematics_figure_moved_to_another_trial_is_drawn_as_a_new_one(clips):
+    from perception.report.canvas import png_bytes
+
+    mocap = [recognize_reach(r, default_repertoire())[0]
+             for r in read_reaches(OPTOTRAK, MocapImport(rate=85))[1:3]]
+    trials = [clips[n] for n in ("normal", "normal1", "delayed", "unmeasured", "mocap",
+                                 "normal")] + mocap
+    figures = []
+    for rec in trials:
+        kept = kinematics_figure(rec, reuse=True)
+        figures.append(kept)
+        assert png_bytes(kept, 80) == png_bytes(kinematics_figure(rec), 80), rec.clip
+        assert rec.clip in kept.get_suptitle()
+    # the same marks measured: the same figure, its artists moved (not drawn afresh)
+    assert figures[1] is figures[0] and figures[5] is figures[0]
+    assert figures[3] is not figures[0]  # onset, MGA and opening not measured: its own

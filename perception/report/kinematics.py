@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from perception.io.names import printable
 from perception.landmarks import LandmarkParams, Landmarks
 from perception.report.canvas import kept_figure, new_canvas, quicker_legend
 from perception.report.figures import LEGEND_PT, _legend, _title
@@ -156,9 +157,9 @@ def _finite(*values: float) -> bool:
     return all(v is not None and math.isfinite(v) for v in values)
 
 
-def _note(ax: Axes, x: float, y: float, text: str, colour: str, dy: float = 8.0) -> None:
-    """A value beside a mark, a little above it."""
-    ax.annotate(text, (x, y), xytext=(6, dy), textcoords="offset points", fontsize=LEGEND_PT,
+def _note(ax: Axes, x: float, y: float, text: str, colour: str, dy: float = 8.0):
+    """A value beside a mark, a little above it (the annotation)."""
+    return ax.annotate(text, (x, y), xytext=(6, dy), textcoords="offset points", fontsize=LEGEND_PT,
                 color=colour, parse_math=False)
 
 
@@ -199,9 +200,56 @@ def kinematics_figure(rec: Recognition, *, reuse: bool = False) -> Figure:
         such call (the reports: :mod:`perception.report.canvas`); default a
         new figure.
     """
-    from matplotlib.lines import Line2D
-    from matplotlib.patches import Patch
+    m = _marks(rec)
+    if not reuse:
+        fig, axes = _layout()
+        _draw(fig, axes, m)
+        return fig
+    if not len(m.time):  # limits found from the marks: drawn afresh on the emptied figure
+        fig, axes = kept_figure("kinematics", _layout)
+        legend = _draw(fig, axes, m)["legend"]
+        quicker_legend(legend)  # a new legend on the kept figure, laid out once a draw
+        return fig
+    # the figure of this trial's marks kept with them: moved to this trial's values (a
+    # trial's marks were a fifth of its figures' building)
+    fig, drawn = kept_figure(("kinematics marks", *m.shape), lambda: _kept_layout(m),
+                             clear=False)
+    if drawn["marks"] is not m:
+        _update(fig, drawn, m)
+    return fig
 
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class _Marks:
+    """What a trial's kinematics figure shows: its curves (on the figure's clock, mm/s and
+    mm), its landmarks' marks (None: not measured) and texts, its limits."""
+
+    time: np.ndarray
+    speed: np.ndarray
+    aperture: np.ndarray
+    point: str
+    xlabel: str
+    title: str
+    span: tuple[float, float] | None
+    bounds: tuple[tuple[float, str], ...]
+    #: the bound's speed (a share of the peak), mm/s, and its legend entry
+    bound: tuple[float, str] | None
+    peak: tuple[float, float] | None
+    #: where the grip starts to open, mm, and its legend entry
+    opening: tuple[float, float, str] | None
+    mga: tuple[float, float] | None
+    ylims: tuple[tuple[float, float], tuple[float, float]]
+
+    @property
+    def shape(self) -> tuple:
+        """What the figure's artists and their order depend on: which marks, the axis label."""
+        return (self.point, self.span is not None, tuple(n for _, n in self.bounds),
+                self.bound is not None, self.peak is not None, self.opening is not None,
+                self.mga is not None)
+
+
+def _marks(rec: Recognition) -> _Marks:
+    """The trial's curves and landmarks, as :func:`kinematics_figure` draws them."""
     lm = rec.landmarks[0]
     params = rec.rules.landmarks  # the definitions its landmarks were measured by
     time, speed, aperture = kinematic_traces(rec.observation, params)
@@ -209,69 +257,150 @@ def kinematics_figure(rec: Recognition, *, reuse: bool = False) -> Figure:
     time = time + origin
     lm = dataclasses.replace(lm, onset_time=lm.onset_time + origin,
                              end_time=lm.end_time + origin)
-    point = transport_label(rec)
-
-    fig, (top, grip) = kept_figure("kinematics", _layout) if reuse else _layout()
-    handles = [top.plot(time, speed * MM, color=SPEED_COLOUR, lw=1.8,
-                        label=f"{point} speed")[0],
-               grip.plot(time, aperture * MM, color=GRIP_COLOUR, lw=1.8,
-                         label="grip aperture")[0]]
-
     on, end = lm.onset_time, lm.end_time
-    if _finite(on, end) and end > on:
-        for ax in (top, grip):
-            ax.axvspan(on, end, color=SHADE_COLOUR, alpha=0.12, lw=0, zorder=0)
+    bound = None
+    if _finite(lm.peak_speed):
+        bound = (params.threshold * lm.peak_speed * MM, f"{params.threshold:.0%} of the peak speed")
+    t_peak, t_open, t_mga = (_at(lm, lm.peak_speed_time), _at(lm, lm.opening_time),
+                             _at(lm, lm.mga_time))
+    seen = np.isfinite(aperture)
+    opening = None
+    if _finite(t_open) and seen.any():
+        opening = (t_open, float(np.interp(t_open, time[seen], aperture[seen])) * MM,
+                   f"opening starts ({lm.opening_time:.0%} of the movement)")
+    ylims = []
+    for curve, least in ((speed, MIN_TOP[0]), (aperture, MIN_TOP[1])):
+        # from 0, with room above the curve for the values; a still, closed hand looks it
+        top = float(np.nanmax(curve)) * MM if np.isfinite(curve).any() else 0.0
+        ylims.append((0.0, max(1.2 * top, least)))
+    return _Marks(
+        time, speed * MM, aperture * MM, transport_label(rec), xlabel, kinematics_title(rec),
+        (on, end) if _finite(on, end) and end > on else None,
+        tuple((t, name) for t, name in ((on, "onset"), (end, "end")) if _finite(t)), bound,
+        (t_peak, lm.peak_speed * MM) if _finite(t_peak, lm.peak_speed) else None, opening,
+        (t_mga, lm.mga * MM) if _finite(t_mga, lm.mga) else None, (ylims[0], ylims[1]))
+
+
+def _kept_layout(m: _Marks) -> tuple[Figure, dict]:
+    """A kept figure of ``m``'s marks: the empty figure, drawn with them."""
+    fig, axes = _layout()
+    return fig, _draw(fig, axes, m)
+
+
+def _draw(fig: Figure, axes, m: _Marks) -> dict:
+    """Draw ``m`` on the empty figure ``fig`` (its two panels ``axes``); return its artists,
+    for :func:`_update`."""
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    top, grip = axes
+    drawn: dict = {"marks": m}
+    handles = [top.plot(m.time, m.speed, color=SPEED_COLOUR, lw=1.8,
+                        label=f"{m.point} speed")[0],
+               grip.plot(m.time, m.aperture, color=GRIP_COLOUR, lw=1.8,
+                         label="grip aperture")[0]]
+    drawn["curves"] = handles[:2]
+    if m.span is not None:
+        drawn["spans"] = [ax.axvspan(*m.span, color=SHADE_COLOUR, alpha=0.12, lw=0, zorder=0)
+                          for ax in (top, grip)]
         handles.append(Patch(color=SHADE_COLOUR, alpha=0.25, label="movement"))
-    bounds = [(t, name) for t, name in ((on, "onset"), (end, "end")) if _finite(t)]
-    for t, name in bounds:
-        for ax in (top, grip):
-            ax.axvline(t, color=BOUND_COLOUR, ls="--", lw=1.0, zorder=1.5, gid=name)
+    drawn["bounds"] = []
+    for t, name in m.bounds:
+        lines = [ax.axvline(t, color=BOUND_COLOUR, ls="--", lw=1.0, zorder=1.5, gid=name)
+                 for ax in (top, grip)]
         # outside the movement, so that the two never overlap however short it is
-        top.annotate(f"{name} {t:.2f} s", (t, 1.0), xycoords=("data", "axes fraction"),
-                     xytext=(-2 if name == "onset" else 2, 3), textcoords="offset points",
-                     ha="right" if name == "onset" else "left", va="bottom",
-                     fontsize=LEGEND_PT, color=BOUND_COLOUR)
-    if bounds:
+        note = top.annotate(_bound_text(t, name), (t, 1.0), xycoords=("data", "axes fraction"),
+                            xytext=(-2 if name == "onset" else 2, 3),
+                            textcoords="offset points",
+                            ha="right" if name == "onset" else "left", va="bottom",
+                            fontsize=LEGEND_PT, color=BOUND_COLOUR)
+        drawn["bounds"].append((lines, note))
+    if m.bounds:
         handles.append(Line2D([], [], color=BOUND_COLOUR, ls="--", lw=1.0,
                               label="onset / end"))
-    if _finite(lm.peak_speed):
-        top.axhline(params.threshold * lm.peak_speed * MM, color=BOUND_COLOUR, ls=":", lw=0.9,
-                    zorder=1.5, gid="bound")
-        handles.append(Line2D([], [], color=BOUND_COLOUR, ls=":", lw=0.9,
-                              label=f"{params.threshold:.0%} of the peak speed"))
-
-    t_peak = _at(lm, lm.peak_speed_time)
-    if _finite(t_peak, lm.peak_speed):
-        y = lm.peak_speed * MM
-        handles += top.plot([t_peak], [y], "o", color=SPEED_COLOUR, ms=7, mec="k", mew=0.8,
+    if m.bound is not None:
+        drawn["bound"] = top.axhline(m.bound[0], color=BOUND_COLOUR, ls=":", lw=0.9,
+                                     zorder=1.5, gid="bound")
+        drawn["bound entry"] = len(handles)
+        handles.append(Line2D([], [], color=BOUND_COLOUR, ls=":", lw=0.9, label=m.bound[1]))
+    if m.peak is not None:
+        t, y = m.peak
+        handles += top.plot([t], [y], "o", color=SPEED_COLOUR, ms=7, mec="k", mew=0.8,
                             zorder=3, gid="peak_speed", label="peak speed")
-        _note(top, t_peak, y, f"peak {y:.0f} mm/s", SPEED_COLOUR, dy=-4.0)
-    t_open = _at(lm, lm.opening_time)
-    seen = np.isfinite(aperture)
-    if _finite(t_open) and seen.any():
-        y = float(np.interp(t_open, time[seen], aperture[seen])) * MM
-        handles += grip.plot([t_open], [y], "^", color=GRIP_COLOUR, ms=8, mfc="w", mew=1.5,
-                             zorder=3, gid="opening",
-                             label=f"opening starts ({lm.opening_time:.0%} of the movement)")
-    t_mga = _at(lm, lm.mga_time)
-    if _finite(t_mga, lm.mga):
-        y = lm.mga * MM
-        handles += grip.plot([t_mga], [y], "o", color=GRIP_COLOUR, ms=7, mec="k", mew=0.8,
+        drawn["peak"] = handles[-1], _note(top, t, y, _peak_text(y), SPEED_COLOUR, dy=-4.0)
+    if m.opening is not None:
+        t, y, label = m.opening
+        handles += grip.plot([t], [y], "^", color=GRIP_COLOUR, ms=8, mfc="w", mew=1.5,
+                             zorder=3, gid="opening", label=label)
+        drawn["opening"], drawn["opening entry"] = handles[-1], len(handles) - 1
+    if m.mga is not None:
+        t, y = m.mga
+        handles += grip.plot([t], [y], "o", color=GRIP_COLOUR, ms=7, mec="k", mew=0.8,
                              zorder=3, gid="mga", label="MGA (maximum grip aperture)")
-        _note(grip, t_mga, y, f"MGA {y:.0f} mm", GRIP_COLOUR)
+        drawn["mga"] = handles[-1], _note(grip, t, y, _mga_text(y), GRIP_COLOUR)
 
-    for ax, label, curve, least in ((top, f"{point} speed (mm/s)", speed, MIN_TOP[0]),
-                                    (grip, "grip aperture (mm)", aperture, MIN_TOP[1])):
+    for ax, label, ylim in ((top, f"{m.point} speed (mm/s)", m.ylims[0]),
+                            (grip, "grip aperture (mm)", m.ylims[1])):
         ax.set_ylabel(label)
         ax.grid(True, color="0.92", lw=0.6, zorder=0)
-        # from 0, with room above the curve for the values; a still, closed hand looks it
-        peak = float(np.nanmax(curve)) * MM if np.isfinite(curve).any() else 0.0
-        ax.set_ylim(0.0, max(1.2 * peak, least))
-    if len(time):
-        grip.set_xlim(float(np.nanmin(time)), float(np.nanmax(time)))
-    grip.set_xlabel(xlabel)
-    legend = _legend(fig, handles, "lower center", ncols=4, frameon=False)
-    if reuse:  # a new legend on the kept figure, its boxes laid out once a draw
-        quicker_legend(legend)
-    _title(fig, kinematics_title(rec))
-    return fig
+        ax.set_ylim(*ylim)
+    if len(m.time):
+        grip.set_xlim(float(np.nanmin(m.time)), float(np.nanmax(m.time)))
+    grip.set_xlabel(m.xlabel)
+    drawn["legend"] = _legend(fig, handles, "lower center", ncols=4, frameon=False)
+    _title(fig, m.title)
+    return drawn
+
+
+def _update(fig: Figure, drawn: dict, m: _Marks) -> None:
+    """Move a kept figure's artists (:func:`_draw` of marks of the same shape) to ``m``."""
+    drawn["marks"] = m
+    top, grip = fig.axes
+    for line, y in zip(drawn["curves"], (m.speed, m.aperture)):
+        line.set_data(m.time, y)
+    if m.span is not None:
+        on, end = m.span
+        for span in drawn["spans"]:  # as axvspan makes it: from (on, 0), end - on wide
+            span.set_xy((on, 0))
+            span.set_width(end - on)
+    for (t, name), (lines, note) in zip(m.bounds, drawn["bounds"]):
+        for line in lines:
+            line.set_xdata([t, t])
+        note.xy = (t, 1.0)
+        note.set_text(_bound_text(t, name))
+    texts = drawn["legend"].get_texts()
+    if m.bound is not None:
+        drawn["bound"].set_ydata([m.bound[0], m.bound[0]])
+        texts[drawn["bound entry"]].set_text(printable(m.bound[1]))
+    if m.peak is not None:
+        (marker, note), (t, y) = drawn["peak"], m.peak
+        marker.set_data([t], [y])
+        note.xy = (t, y)
+        note.set_text(_peak_text(y))
+    if m.opening is not None:
+        t, y, label = m.opening
+        drawn["opening"].set_data([t], [y])
+        drawn["opening"].set_label(label)
+        texts[drawn["opening entry"]].set_text(printable(label))
+    if m.mga is not None:
+        (marker, note), (t, y) = drawn["mga"], m.mga
+        marker.set_data([t], [y])
+        note.xy = (t, y)
+        note.set_text(_mga_text(y))
+    for ax, ylim in ((top, m.ylims[0]), (grip, m.ylims[1])):
+        ax.set_ylim(*ylim)
+    grip.set_xlim(float(np.nanmin(m.time)), float(np.nanmax(m.time)))
+    grip.set_xlabel(m.xlabel)
+    _title(fig, m.title)
+
+
+def _bound_text(t: float, name: str) -> str:
+    return f"{name} {t:.2f} s"
+
+
+def _peak_text(y: float) -> str:
+    return f"peak {y:.0f} mm/s"
+
+
+def _mga_text(y: float) -> str:
+    return f"MGA {y:.0f} mm"
