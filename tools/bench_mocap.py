@@ -21,6 +21,14 @@ so it needs nothing outside the repository.
 * baseline: one trial of the same table, ``recognize --no-figures``, whole
   process (60 times it is what scoring trial by trial would cost).
 
+The ``trial`` part (issue 45's 10,000-trial study: what one trial costs a batch)
+runs the table's trials through the batch's own per-trial path in one warm
+process (``--jobs 1``), each also without its figures in turn: CPU a trial,
+every thread and the batch's thread alone. ``trial-instructions`` counts the
+instructions a trial (``valgrind --tool=callgrind``, instrumentation on only
+while the trials run; not in the default run: it needs valgrind and takes
+minutes).
+
 The ``size`` part (issue 46; ``python tools/bench_mocap.py --only size``)
 builds a 1,000,000-row table of the same trials (1,984 trials, 95 MB) and
 runs ``hammer-mv landmarks`` of it in a subprocess: wall time and peak
@@ -187,14 +195,139 @@ def size() -> None:
         shutil.rmtree(work, ignore_errors=True)
 
 
-PARTS = {"scoring": scoring, "size": size}
+def trial_runs(trials: int = 24, warm: int = 4, work: Path | None = None,
+               figures_off: bool = True, toggle=None) -> dict[str, list[float]]:
+    """CPU time of each motion-capture trial as a batch runs it in one process, warm.
+
+    The 60-trial table's reaches go through the batch's own per-trial path
+    (``_Job.run``: recognition, the clip report, its figures), one process,
+    after ``warm`` trials (imports, fonts, the kept figures). With
+    ``figures_off`` each trial is also recognised and reported without its
+    figures, in turn with the other (the same-run baseline). ``toggle(on)``
+    (callgrind's instrumentation) is called around the measured trials.
+
+    Returns
+    -------
+    dict
+        ``process``: the process's CPU a trial (every thread: the PNG
+        encoding's too), s; ``caller``: this thread's; ``no figures``: the
+        process's without figures (empty without ``figures_off``).
+    """
+    from perception import Repertoire
+    from perception.batch import _Job, _Work
+    from perception.discovery import BatchItem
+    from perception.pipeline import RecognitionSettings
+    from perception.recordings import MocapImport, read_reaches, recognize_reach
+    from perception.report.clip import write_clip_report
+
+    work = Path(tempfile.mkdtemp(prefix="bench-mocap-trial-")) if work is None else work
+    try:
+        table_path = work / "trials.tsv"
+        make_table(table_path)
+        settings = RecognitionSettings(mocap=MocapImport(rate=float(RATE)))
+        repertoire = Repertoire.default()
+        reaches = read_reaches(table_path, settings.mocap)
+        job = _Job(work / "report", settings, "bench")
+        job.out.mkdir()
+        items = [_Work(BatchItem(r.name, table_path, "mocap", reach=k), r)
+                 for k, r in enumerate(reaches)]
+        items = (items * (1 + (warm + trials) // len(items)))[:warm + trials]
+
+        def bare(w: _Work) -> None:  # recognised and reported, no figures
+            rec, info = recognize_reach(w.reach, repertoire, settings, settings.mocap,
+                                        plan_cache=job.plan_cache)
+            write_clip_report(rec, work / "bare", extra={"mocap": info}, figures=False)
+
+        for w in items[:warm]:
+            job.run(w, repertoire)
+            if figures_off:
+                bare(w)
+        spent: dict[str, list[float]] = {"process": [], "caller": [], "no figures": []}
+        if toggle is not None:
+            toggle(True)
+        for w in items[warm:]:
+            t0, c0 = time.process_time(), time.thread_time()
+            result = job.run(w, repertoire)
+            spent["process"].append(time.process_time() - t0)
+            spent["caller"].append(time.thread_time() - c0)
+            if result.status != "ok":
+                raise RuntimeError(f"{w.item.clip}: {result.status} {result.error}")
+            if figures_off:
+                t0 = time.process_time()
+                bare(w)
+                spent["no figures"].append(time.process_time() - t0)
+        if toggle is not None:
+            toggle(False)
+        return spent
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+
+def trial(trials: int = 24) -> None:
+    """A motion-capture trial's CPU in a batch (``--jobs 1``, warm), with and without its
+    figures in the same run."""
+    spent = trial_runs(trials)
+    per = {k: 1000 * statistics.mean(v) for k, v in spent.items()}
+    mid = {k: 1000 * statistics.median(v) for k, v in spent.items()}
+    table(f"motion capture: a trial in a batch, CPU (one warm process, {trials} trials)", [
+        ("a trial: recognised, reported, figures", f"{per['process']:.0f} ms "
+         f"(median {mid['process']:.0f})", "every thread (PNG encoding too); issue 45: "
+         "10,000 trials in 2 min on 16 cores needs about 0.17 s", ""),
+        ("the same, the batch's thread alone", f"{per['caller']:.0f} ms "
+         f"(median {mid['caller']:.0f})", "drawing, files; the rest is PNG encoding "
+         "in its own thread", ""),
+        ("the same trial without figures", f"{per['no figures']:.0f} ms "
+         f"(median {mid['no figures']:.0f})", "same run, in turn: recognition, CSV, JSON",
+         ""),
+    ])
+
+
+def trial_instructions(trials: int = 6) -> None:
+    """Instructions a trial (callgrind, every thread): the trials of :func:`trial_runs`
+    in a process under valgrind, counted only while they run."""
+    if shutil.which("valgrind") is None:
+        print("trial-instructions: needs valgrind (callgrind)")
+        return
+    with tempfile.TemporaryDirectory(prefix="bench-mocap-cg-") as folder:
+        out = Path(folder) / "callgrind.out"
+        done = subprocess.run(
+            ["valgrind", "--tool=callgrind", "--instr-atstart=no",
+             f"--callgrind-out-file={out}", sys.executable, __file__, "--counted",
+             str(trials)], capture_output=True, text=True, cwd=ROOT)
+        counted = [int(line.split()[-1].replace(",", "")) for line in done.stderr.splitlines()
+                   if "Collected :" in line]
+        if done.returncode or not counted:
+            print(done.stderr[-2000:])
+            raise RuntimeError("callgrind run failed")
+    table(f"motion capture: a trial in a batch, instructions (callgrind, {trials} trials)", [
+        ("a trial: recognised, reported, figures", f"{counted[0] / trials / 1e6:.0f} million",
+         "every thread, warm process (valgrind --tool=callgrind)", ""),
+    ])
+
+
+def _counted(trials: int) -> None:
+    """Inside valgrind: run the trials, instrumentation on only while they run."""
+    def toggle(on: bool) -> None:
+        subprocess.run(["callgrind_control", "-i", "on" if on else "off", str(os.getpid())],
+                       check=True, stdout=subprocess.DEVNULL)
+
+    trial_runs(trials, warm=3, figures_off=False, toggle=toggle)
+
+
+PARTS = {"scoring": scoring, "size": size, "trial": trial,
+         "trial-instructions": trial_instructions}
 
 
 def main(argv: list[str] | None = None) -> None:
     """Run the parts named (default: all)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--only", nargs="+", choices=sorted(PARTS), help="parts to run")
-    for name in parser.parse_args(argv).only or list(PARTS):
+    parser.add_argument("--only", nargs="+", choices=sorted(PARTS), help="parts to run "
+                        "(default: all but trial-instructions, which needs valgrind)")
+    parser.add_argument("--counted", type=int, metavar="N", help=argparse.SUPPRESS)
+    args = parser.parse_args(argv)
+    if args.counted:  # trial-instructions' own process, under valgrind
+        return _counted(args.counted)
+    for name in args.only or [p for p in PARTS if p != "trial-instructions"]:
         PARTS[name]()
 
 

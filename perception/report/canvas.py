@@ -515,12 +515,6 @@ def _chunk(kind: bytes, data: bytes) -> bytes:
             + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF))
 
 
-@cache
-def _rgb_index(width: int) -> np.ndarray:
-    """Where a row of ``width`` RGBA pixels holds its R, G and B bytes, in order."""
-    return np.arange(width * 4).reshape(width, 4)[:, :3].ravel()
-
-
 def png_bytes(fig: Figure, dpi: int) -> bytes:
     """``fig`` drawn at ``dpi``, as the bytes of a PNG file.
 
@@ -567,18 +561,21 @@ def png_encoder(fig: Figure, dpi: int) -> bytes | Callable[[], bytes]:
         out = io.BytesIO()
         fig.savefig(out, format="png", dpi=dpi, pil_kwargs={"compress_level": 1})
         return out.getvalue()
+    from PIL import Image  # matplotlib's own dependency, loaded with it
+
     software = f"Matplotlib version{matplotlib.__version__}, https://matplotlib.org/"
-    index = _rgb_index(width)
-    return lambda: _png_of(rgba, dpi, software, index)
+    return lambda: _png_of(rgba, dpi, software, Image.frombuffer)
 
 
-def _png_of(rgba: np.ndarray, dpi: int, software: str, index: np.ndarray) -> bytes:
+def _png_of(rgba: np.ndarray, dpi: int, software: str, image: Callable) -> bytes:
     """The PNG file of opaque (H, W, 4) pixels: RGB, ``Sub`` filter, zlib level 1, with
-    ``software`` (its ``Software``); ``index``: :func:`_rgb_index` of W. Imports nothing
-    (called in a thread while another may import)."""
+    ``software`` (its ``Software``); ``image``: Pillow's ``Image.frombuffer``. Imports
+    nothing (called in a thread while another may import)."""
     height, width = rgba.shape[:2]
-    # the RGB bytes gathered by index: a third of the time of copying the strided view
-    rgb = np.take(rgba.reshape(height, width * 4), index, axis=1)
+    # the RGB bytes packed by Pillow (a C loop over the pixels): 2.5 times as fast as
+    # gathering them by index with NumPy, itself a third of copying the strided view
+    rgb = np.frombuffer(image("RGBA", (width, height), rgba, "raw", "RGBA", 0, 1).tobytes(
+        "raw", "RGB"), dtype=np.uint8).reshape(height, width * 3)
     rows = np.empty((height, width * 3 + 1), dtype=np.uint8)
     rows[:, 0] = 1  # Sub: each byte less the one a pixel before it (mod 256)
     rows[:, 1:4] = rgb[:, :3]
