@@ -274,6 +274,15 @@ def test_a_table_written_by_write_csv_reads_back_the_same(tmp_path):
     assert (tmp_path / "columns.csv").read_bytes() == (tmp_path / "ours.csv").read_bytes()
 
 
+def test_the_clip_csv_is_its_columns_as_pandas_writes_them(scored, tmp_path):
+    # written from Python's numbers (not NumPy's): the same text as the columns themselves
+    out, recs = scored
+    for name, (rec, _) in recs.items():
+        pd.DataFrame(rec.columns()).to_csv(tmp_path / "pandas.csv", index=False)
+        assert ((out / f"{name}.confidence.csv").read_bytes()
+                == (tmp_path / "pandas.csv").read_bytes()), name
+
+
 def _old_f_oneway(groups):
     """The batch's ANOVA before it called scipy.stats (on scipy.special)."""
     from scipy.special import fdtrc

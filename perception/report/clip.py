@@ -498,7 +498,10 @@ def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,
             if not figures or fmt != figure_format:
                 for key in FIGURE_KEYS:
                     remove_output(clip_outputs(Path(out), rec.clip, fmt)[key])
-        write_csv(paths["csv"], rec.columns())
+        # Python's numbers, not NumPy's: the same text (str of a float64 is repr of the
+        # float), without formatting each cell through NumPy's own (a fifth of the CSV's time)
+        write_csv(paths["csv"], {k: v.tolist() if isinstance(v, np.ndarray) else v
+                                 for k, v in rec.columns().items()})
         report = {**rec.to_dict(), "traces": clip_traces(rec), **(extra or {})}
     # the JSON last, once every figure is written: its presence marks the report complete
     write_json(paths["json"], report)
