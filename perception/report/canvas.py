@@ -452,6 +452,8 @@ def _kept_layout(text):
                text._rotation_mode)
         with _MASKS_LOCK:
             hit = _LAYOUTS.get(key)
+            if hit is not None:  # a tick label outlives the clips' titles
+                _LAYOUTS.move_to_end(key)
         if hit is None:
             hit = type(text)._get_layout(text, renderer)
             with _MASKS_LOCK:
