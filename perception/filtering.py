@@ -17,7 +17,7 @@ import copy
 
 import numpy as np
 
-from perception.resume import Kept
+from perception.resume import Kept, extended
 
 __all__ = ["AlphaBeta", "alpha_beta"]
 
@@ -42,25 +42,28 @@ def alpha_beta(z: np.ndarray, dt: np.ndarray | float, alpha: float, beta: float)
     Returns
     -------
     (N, ..., 2) array
-        Filtered positions; NaN where the input is missing (a gap is not filled;
-        the filter restarts from the first measurement after it).
+        Filtered positions, read-only; NaN where the input is missing (a gap is not
+        filled; the filter restarts from the first measurement after it).
     """
     z = np.asarray(z, dtype=float)
     dt = np.broadcast_to(np.asarray(dt, dtype=float), (z.shape[0],))
-    out = np.empty_like(z)  # every row is written below: the kept ones, then each new one
     # the online recogniser observes the rows so far after every row: each call is the
     # last one's series and a row more; the filter is causal, so the rows it filtered
-    # are filtered alike (the same operations on the same numbers)
+    # are filtered alike (the same operations on the same numbers), and the new rows'
+    # output is appended to theirs (resume.extended: no copy of the rows before, and a
+    # read-only series the next passes know begins with this one's)
     kept = _KEPT.longest((alpha, beta), (z, dt))
     if kept is None:
         start, step = 0, AlphaBeta(z.shape[1:], alpha, beta)
+        done = np.empty((0, *z.shape[1:]))
     else:
-        start = len(kept[0][0])
-        out[:start] = kept[1][0]
+        start, done = len(kept[0][0]), kept[1][0]
         step = copy.copy(kept[1][1])  # its state is replaced at every frame, never changed
+    new = np.empty((z.shape[0] - start, *z.shape[1:]))
     for i in range(start, z.shape[0]):
-        out[i] = step(z[i], dt[i])
-    _KEPT.keep((alpha, beta), (z, dt), (out.copy(), copy.copy(step)), kept)
+        new[i - start] = step(z[i], dt[i])
+    out = extended(done, new)
+    _KEPT.keep((alpha, beta), (z, dt), (out, copy.copy(step)), kept)
     return out
 
 

@@ -34,8 +34,9 @@ from perception.landmark_flags import (
     gap_near,
     why_not_open,
 )
+from perception.landmark_stream import filtfilt_run, median_step, speed_and_floor
 from perception.landmark_values import _NAMES, OK, Landmarks
-from perception.resume import Kept
+from perception.resume import Kept, grown_of, rowwise
 from perception.rowwise import finite_rows, row_norm, run_edges
 from perception.validation import Int, Share, declared
 
@@ -54,8 +55,9 @@ _LOWPASSED = Kept(4)
 
 
 def _step(time: np.ndarray) -> float:
-    """The median time step, s (NaN with fewer than two samples)."""
-    return float(np.median(np.diff(time))) if len(time) > 1 else math.nan
+    """The median time step, s (NaN with fewer than two samples): of a stream's rows,
+    the last row's steps in order with the new one put in (landmark_stream)."""
+    return median_step(time)
 
 
 @declared
@@ -189,7 +191,10 @@ class LandmarkParams:
         width = zero_lag.padlen(b, a)
         for lo, hi in zip(starts, stops):
             if lo >= done and hi - lo > width:
-                flat[lo:hi] = zero_lag.filtfilt(b, a, zi, flat[lo:hi])
+                # the run still open (a stream's next row extends it) resumes the last
+                # pass over it, its output the same bits (landmark_stream.filtfilt_run)
+                flat[lo:hi] = (filtfilt_run(b, a, zi, flat[lo:hi], key) if hi == len(flat)
+                               else zero_lag.filtfilt(b, a, zi, flat[lo:hi]))
         if raw is not None:  # these rows, the row that closed the last run among them
             _LOWPASSED.keep(key, (raw,), (closed, flat[:closed].copy()), kept)
         return flat.reshape(x.shape)
@@ -242,7 +247,8 @@ def _bounds_at(time: np.ndarray, speed: np.ndarray, peak: int, bound: float, hol
     return (int(before[-1]) if len(before) else None, int(after[0]) - 1 if len(after) else None)
 
 
-def speed_bound(speed: np.ndarray, peak: int, params: LandmarkParams) -> float:
+def speed_bound(speed: np.ndarray, peak: int, params: LandmarkParams, *,
+                floor: float | None = None) -> float:
     """The speed that bounds a movement, m/s (see :class:`LandmarkParams`).
 
     Parameters
@@ -252,12 +258,20 @@ def speed_bound(speed: np.ndarray, peak: int, params: LandmarkParams) -> float:
     peak : int
         Row of the movement's peak speed.
     params : LandmarkParams
+    floor : float, optional
+        The speed's noise floor, its :data:`FLOOR_PERCENTILE` th percentile (0 where
+        none is seen), where the caller has it; default: found here.
     """
     if params.speed is not None:
         return float(params.speed)
-    seen = speed[np.isfinite(speed)]
-    floor = float(np.percentile(seen, 10)) if len(seen) else 0.0
+    if floor is None:
+        seen = speed[np.isfinite(speed)]
+        floor = float(np.percentile(seen, FLOOR_PERCENTILE)) if len(seen) else 0.0
     return max(params.threshold * float(speed[peak]), params.noise_factor * floor)
+
+
+#: The percentile of a movement's speed that is its noise floor (:func:`speed_bound`).
+FLOOR_PERCENTILE = 10
 
 
 def _cross_time(time, speed, row, bound, rising) -> float:
@@ -476,7 +490,9 @@ def _landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.ndarray,
     if len(time) < 3:
         return Landmarks(flags=all_flags(_NAMES, f"not seen: {len(time)} samples"))
     path = np.asarray(transport, dtype=float)
-    speed = params._speed_of(time, path, step)
+    # the speed and its noise floor, resumed where a stream's last row measured them
+    # (landmark_stream: the rows whose filtered positions changed, measured again)
+    speed, floor = speed_and_floor(time, params._lowpass(time, path, step), FLOOR_PERCENTILE)
     if not np.isfinite(speed).any():
         return Landmarks(flags=all_flags(_NAMES, "not seen: the transport point is lost "
                                                  "throughout"))
@@ -490,7 +506,7 @@ def _landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.ndarray,
             return Landmarks(flags=all_flags(_NAMES, "not seen: the transport point is lost "
                                               "throughout the movement"))
         peak = a + int(np.nanargmax(speed[a:b + 1]))
-    bound = speed_bound(speed, peak, params)  # once: a percentile of every row's speed
+    bound = speed_bound(speed, peak, params, floor=floor)
     onset, end = _bounds_at(time, speed, peak, bound, params.hold)
     if bounds is not None:
         # the user's rule, within the rows the movement was parted at
@@ -612,9 +628,18 @@ def observed_landmarks(obs: Observation, params: LandmarkParams | None = None) -
     time = np.asarray(time, dtype=float)
     step = _step(time)
     paths = _by_marker(raw)  # a copy: a one-frame glitch is lost, not a movement's peak
-    for path in paths:
-        path[spikes(time, path, step=step if len(time) > 1 else None)] = np.nan
+    stream = grown_of(raw) is not None
+    for k, path in enumerate(paths):
+        # a stream's paths as rows of their own that grow with it (resume.rowwise): the
+        # spike test's kept path is proven their first rows, not compared with them
+        tested = rowwise(_PATHS, k, raw, lambda r, k=k: np.ascontiguousarray(r[:, k])
+                         ) if stream else path
+        path[spikes(time, tested, step=step if len(time) > 1 else None)] = np.nan
     return _landmarks(time, paths[0], row_norm(paths[1] - paths[2]), params, None, step)
+
+
+#: A stream's markers' paths taken apart in this thread (:func:`observed_landmarks`).
+_PATHS = Kept(6)
 
 
 def _by_marker(raw: np.ndarray) -> np.ndarray:

@@ -33,7 +33,7 @@ from perception.filtering import alpha_beta
 from perception.geometry import DEFAULT_OBJECT_DIAMETER, SimilarityTransform
 from perception.io.pose import is_pose_file
 from perception.movement_bounds import end_row, onset_time
-from perception.resume import Kept
+from perception.resume import Grown, Kept, Ordered, extended, rowwise
 from perception.track_cleaning import cleaning_notes
 from perception.validation import Int, Positive, Tuple, declared
 
@@ -423,11 +423,10 @@ def _scene_transform(px: dict[str, np.ndarray], tracks, params: ObserveParams,
         if not np.isfinite(px[m][rest]).all():
             what = "object" if m == "object" else f"marker '{m}'"
             raise InputError(f"the clip must start with the hand at rest and visible: the "
-                             f"{what} is lost in its first {params.rest_frames} frames", name,
-                             field=m)
-    # The object stays put while the hand is away: twice the rest frames
-    # average its centre better and are still long before the hand arrives;
-    # the median is over the frames in which it is seen (the hand may hide it).
+                             f"{what} is lost in its first {params.rest_frames} frames",
+                             name, field=m)
+    # The object stays put while the hand is away: twice the rest frames average its centre
+    # better, long before the hand arrives; over the frames it is seen (the hand may hide it)
     early = px["object"][: 2 * params.rest_frames]
     seen = early[np.isfinite(early).all(axis=1)]
     if not len(seen):
@@ -459,9 +458,8 @@ def _rest_noise(raw: np.ndarray, params: ObserveParams, name: str) -> tuple[floa
     """
     rest = raw[: params.rest_frames]
     steps = np.diff(rest, axis=0).reshape(-1, 2)
-    # A frame-to-frame change carries the noise of two frames: divide by sqrt 2. Each
-    # axis about its own median: the estimate must not change with the x axis's sign
-    # (a mirrored scene's onset would move).
+    # A frame-to-frame change carries the noise of two frames: divide by sqrt 2. Each axis
+    # about its own median: the estimate must not change with the x axis's sign (mirrored)
     noise = MAD_TO_SD * np.median(np.abs(steps - np.median(steps, axis=0))) / np.sqrt(2)
     mean = rest.mean(axis=0)
     drift = np.linalg.norm(rest - mean, axis=-1).max()
@@ -480,8 +478,7 @@ def rest_scene(tracks, params: ObserveParams | None = None, *,
     Parameters
     ----------
     tracks : Tracks
-        See :func:`observe`; only the first ``2 x params.rest_frames`` rows
-        are needed (the online recogniser passes no more).
+        See :func:`observe`.
     params : ObserveParams, optional
         Scale and rest settings.
     clip : str, optional
@@ -500,36 +497,41 @@ def rest_scene(tracks, params: ObserveParams | None = None, *,
     key = (where, params, tuple(tracks.markers), tracks.units,
            tracks.object_diameter_px() if params.px_per_m is None else None)
     kept = _SCENES.longest(key, (tracks.time, tracks.position))
-    scene = None
+    longer = None
     if kept is not None:
         if len(kept[0][0]) == len(tracks.time):
-            return kept[1]
-        scene = _extended(kept[1], len(kept[0][0]), tracks, params)
-    if scene is None:
+            return kept[1][0]
+        longer = _extended(*kept[1], len(kept[0][0]), tracks, params)
+    if longer is not None:
+        scene, order = longer
+    else:
         px = _marker_pixels(tracks, params, where)
         time, dts = _frame_times(tracks, params, where)
         transform = _scene_transform(px, tracks, params, where)
         raw = np.stack([transform.to_model(px[m]) for m in DIGIT_MARKERS], axis=1)
         noise, rest = _rest_noise(raw, params, where)
-        scene = RestScene(where, time, dts, float(np.median(dts)), transform, raw, rest, noise)
-    for a in (scene.dts, scene.raw, scene.rest):
-        a.flags.writeable = False  # shared by the observations made from the same rows
-    _SCENES.keep(key, (tracks.time, tracks.position), scene)  # Kept copies them
+        # rows a longer prefix appends to (resume.Grown); the periods' median kept in order
+        order = Ordered(dts)  # finite: _frame_times checked them
+        scene = RestScene(where, time, Grown(dts).rows(), order.median(), transform,
+                          Grown(raw).rows(), rest, noise)
+    scene.rest.flags.writeable = False  # shared by the observations made from the same rows
+    _SCENES.keep(key, (tracks.time, tracks.position), (scene, order))
     return scene
 
 
-#: The last scene fixed in this thread, and the rows it was fixed from (:func:`rest_scene`).
-_SCENES = Kept(1)
+#: The last scene fixed in this thread, and the rows it was fixed from (:func:`rest_scene`);
+_SCENES, _CLOCKS = Kept(1), Kept(4)  # rows on an observation's clock, digits (observe)
 
 
-def _extended(scene: RestScene, n: int, tracks, params: ObserveParams) -> RestScene | None:
-    """The scene fixed from the first ``n`` rows of ``tracks``, with the rows after them.
+def _extended(scene: RestScene, order: Ordered, n: int, tracks, params: ObserveParams):
+    """The scene fixed from the first ``n`` rows of ``tracks`` (its frame periods in
+    ``order``) with the rows after them, and their periods in order; or None.
 
-    What the first rows fix (the transform, the rest posture and its noise,
-    the checks on them) stands; the new rows are checked, mapped to the model
-    frame (a row maps alike in any array: :meth:`SimilarityTransform.to_model`)
-    and the frame periods' median taken again. None where a new row would be
-    refused: :func:`rest_scene` then refuses the rows as a fresh pass does.
+    What the first rows fix (the transform, the rest posture and its noise, the
+    checks on them) stands; the new rows are checked, mapped to the model frame (a
+    row maps alike in any array: :meth:`SimilarityTransform.to_model`) and appended
+    (:func:`~perception.resume.extended`), their periods put in ``order``. None where
+    a new row would be refused (:func:`rest_scene` then refuses them as afresh).
     """
     pos = np.asarray(tracks.position, dtype=float)
     time = np.asarray(tracks.time, dtype=float)
@@ -537,16 +539,16 @@ def _extended(scene: RestScene, n: int, tracks, params: ObserveParams) -> RestSc
     if not np.isfinite(time[n:]).all() or np.isinf(
             pos[n:, [markers.index(m) for m in NEEDED_MARKERS]]).any():
         return None
-    dts = np.concatenate([scene.dts, np.diff(time[n - 1:])])
-    if np.any(dts[n - 1:] <= 0):
+    if np.any((periods := np.diff(time[n - 1:])) <= 0):
         return None
-    dt = float(np.median(dts))
+    dts = extended(scene.dts, periods)
+    dt = (order := order.extended(periods, dts)).median()
     lo, hi = params.frame_period_range
     if not lo * (1 - 1e-6) <= dt <= hi * (1 + 1e-6):
         return None
     # the three markers' new rows mapped in one call (a row maps alike in any array)
     new = scene.transform.to_model(pos[n:, [markers.index(m) for m in DIGIT_MARKERS]])
-    return scene._replace(time=time, dts=dts, dt=dt, raw=np.concatenate([scene.raw, new]))
+    return scene._replace(time=time, dts=dts, dt=dt, raw=extended(scene.raw, new)), order
 
 
 def _prepare(tracks, params: ObserveParams, name: str) -> _Prepared:
@@ -652,9 +654,8 @@ def observe(tracks, params: ObserveParams | None = None, *, clip: str | None = N
     # The digits touch at rest (as in the model), so the markers' separation
     # then is where they sit on the digits, outside the tips: take it off.
     half = 0.5 * (finger0 - thumb0)
-    filt = p.filtered.copy()
-    filt[:, 1] -= half
-    filt[:, 2] += half
+    filt = rowwise(_CLOCKS, half.tobytes(), p.filtered, lambda f: np.stack(  # resumed
+        [f[:, 0], f[:, 1] - half, f[:, 2] + half], axis=1))  # a stream's: a row more
     sl = p.span.rows
     moved = float(np.nanmax(np.linalg.norm(filt[sl, 0] - start, axis=-1), initial=0.0))
     if moved < params.min_movement:
@@ -680,7 +681,7 @@ def observe(tracks, params: ObserveParams | None = None, *, clip: str | None = N
         hand_offset=0.5 * (finger0 + thumb0) - start,
         object_diameter=params.object_diameter,
         marker_separation=float(np.linalg.norm(2 * half)),
-        clip_time=sc.time - p.span.onset_time,
+        clip_time=rowwise(_CLOCKS, p.span.onset_time, sc.time, lambda t: t - p.span.onset_time),
         clip_raw=sc.raw,
         clip_wrist=filt[:, 0],
         notes=(*_reading_notes(tracks), *cleaning_notes(tracks)),

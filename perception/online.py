@@ -33,6 +33,7 @@ from perception.recognition.provisional import (
 from perception.recognition.repertoire import PlanCache, Repertoire
 from perception.recognition.result import Recognition
 from perception.recognition.rules import AT_END, judge
+from perception.resume import Grown
 
 __all__ = ["Decision", "OnlineRecognizer", "OnlineState", "SettleRule", "decision_summary"]
 
@@ -40,28 +41,38 @@ _FIELDS = ("frame", "time", "position", "likelihood", "status")
 
 
 class _Rows:
-    """The rows received, in arrays that grow by doubling: a prefix is a copy of their
-    first rows, not a conversion of growing lists at every row."""
+    """The rows received, each field a :class:`~perception.resume.Grown`: rows appended,
+    never changed, so that a prefix handed to the recognition is a view, not a copy,
+    and its resumed passes know it begins with the last one's rows without comparing
+    them (a pass over every row at every row)."""
 
     def __init__(self, markers: int):
         self.n = 0
-        self._a = {"frame": np.empty(64, np.int64), "time": np.empty(64),
-                   "position": np.empty((64, markers, 2)),
-                   "likelihood": np.empty((64, markers)),
-                   "status": np.empty((64, markers), np.int64)}
+        self._markers = markers
+        self._a: dict[str, Grown] = {}
 
     def append(self, *row) -> None:
-        if self.n == len(self._a["time"]):
-            self._a = {k: np.concatenate([a, np.empty_like(a)]) for k, a in self._a.items()}
+        if not self._a:  # the first row sets the buffers (doubling as they fill)
+            shapes = {"frame": ((), np.int64), "time": ((), float),
+                      "position": ((self._markers, 2), float),
+                      "likelihood": ((self._markers,), float),
+                      "status": ((self._markers,), np.int64)}
+            self._a = {k: Grown(np.empty((0, *shape), dtype)) for k, (shape, dtype)
+                       in shapes.items()}
         for key, value in zip(_FIELDS, row):
-            self._a[key][self.n] = value
+            self._a[key].append(np.asarray(value)[None])
         self.n += 1
 
-    def arrays(self, last: bool = False) -> dict | None:
-        """Every row (copies), or the last row alone (None before one)."""
+    def arrays(self, last: bool = False, views: bool = False) -> dict | None:
+        """Every row (copies; with ``views``, read-only views of the rows, which never
+        change), or the last row alone (None before one)."""
         if last:
-            return None if not self.n else {k: a[self.n - 1] for k, a in self._a.items()}
-        return {k: a[:self.n].copy() for k, a in self._a.items()}
+            return None if not self.n else {k: a.rows()[-1] for k, a in self._a.items()}
+        if not self.n:
+            return {k: np.empty((0, *shape)) for k, shape in
+                    (("frame", ()), ("time", ()), ("position", (self._markers, 2)),
+                     ("likelihood", (self._markers,)), ("status", (self._markers,)))}
+        return {k: a.rows() if views else a.rows().copy() for k, a in self._a.items()}
 
 
 class OnlineRecognizer:
@@ -195,7 +206,8 @@ class OnlineRecognizer:
         if self._rows.n < 2 * self.settings.observe.rest_frames:
             return self._waiting(index, t, "start")
         try:
-            self.prefix = recognize_tracks(self.tracks(), self.repertoire, self.settings,
+            self.prefix = recognize_tracks(self._tracks(views=True), self.repertoire,
+                                           self.settings,
                                            clip=self.clip, plan_cache=self.plan_cache)
         except InputError as exc:  # offline, this prefix is not (yet) a movement to judge
             self.prefix = None
@@ -237,9 +249,14 @@ class OnlineRecognizer:
         video : dict, optional
             ``/video`` attributes to carry.
         """
+        return self._tracks(video)
+
+    def _tracks(self, video: dict | None = None, *, views: bool = False) -> Tracks:
+        """:meth:`tracks`; with ``views`` on the rows themselves (read-only, never
+        changed), as the recognition of every row reads them."""
         tracker = self._tracker.attrs() if self._tracker is not None else self._tracker_attrs
         return Tracks(markers=self.markers, video=video or {}, tracker=tracker,
-                      **self._rows.arrays())
+                      **self._rows.arrays(views=views))
 
     @property
     def last_row(self) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
