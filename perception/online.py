@@ -59,8 +59,15 @@ class _Rows:
                       "status": ((self._markers,), np.int64)}
             self._a = {k: Grown(np.empty((0, *shape), dtype)) for k, (shape, dtype)
                        in shapes.items()}
+        # each value as its row first (cast and broadcast as an assignment does): one
+        # that cannot be leaves no field a row longer than the others
+        rows = []
         for key, value in zip(_FIELDS, row):
-            self._a[key].append(np.asarray(value)[None])
+            one = self._a[key].empty(1)
+            one[0] = value
+            rows.append((self._a[key], one))
+        for g, one in rows:
+            g.append(one)
         self.n += 1
 
     def arrays(self, last: bool = False, views: bool = False) -> dict | None:

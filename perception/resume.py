@@ -6,6 +6,16 @@ keep their last result per thread (the scene, the onset and end scans, the
 spike test, the causal filter, the scores) resume only from a series the new
 one begins with bit for bit: :func:`begins_with` is that one test, and
 :class:`Kept` the one store each of them keeps its results in.
+
+Comparing the rows costs a pass over every row at every row. A series that
+is the rows of a :class:`Grown` (rows appended, never changed: the online
+recogniser's rows, and what is made from them row by row with
+:func:`extended` and :func:`rowwise`) needs none: a kept one of the same
+:class:`Grown` is the new one's first rows by construction, so :class:`Kept`
+keeps it as it is (no copy) and proves it by its identity and length. Any
+other series is compared by its bytes. :class:`Ordered` keeps a series'
+values in order for its median and percentiles (``np.median``'s and
+``np.percentile``'s values, bit for bit).
 """
 
 from __future__ import annotations
@@ -45,9 +55,10 @@ class Grown:
     :meth:`rows` hands out read-only views of the rows so far (of a read-only
     buffer: they cannot be made writeable), on memory that only :meth:`append`
     writes, and only past them (it grows by doubling into new memory, the old
-    left as it was). Two views of one :class:`Grown`
-    therefore agree on the rows both hold: :class:`Kept` resumes from one
-    without comparing them.
+    left as it was). Two views of one :class:`Grown` therefore agree on the
+    rows both hold: :class:`Kept` resumes from one without comparing them.
+    One thread appends to a :class:`Grown` (a stream's passes keep theirs per
+    thread).
 
     Parameters
     ----------
@@ -81,6 +92,10 @@ class Grown:
             self._write = buf = write
         buf[n:n + k] = rows
         self.n = n + k
+
+    def empty(self, k: int) -> np.ndarray:
+        """A new writeable (k, ...) array of this series' dtype and row shape."""
+        return np.empty((k, *self._write.shape[1:]), self._write.dtype)
 
     def rows(self) -> np.ndarray:
         """The rows so far, a read-only view (plain ``ndarray``)."""

@@ -139,3 +139,17 @@ def test_the_median_step_resumed_is_numpys():
         assert _bits(landmark_stream.median_step(t[:m])) == _bits(np.median(np.diff(t[:m])))
     t[100] = np.nan
     assert np.isnan(landmark_stream.median_step(t))
+
+
+def test_a_row_that_cannot_be_taken_leaves_the_rows_as_they_were():
+    from perception.online import _Rows
+
+    rows = _Rows(4)
+    rows.append(0, 0.0, np.zeros((4, 2)), 1.0, 0)
+    with pytest.raises(ValueError):
+        rows.append(1, 1 / 30, np.zeros((4, 2)), np.ones(3), 0)  # a likelihood short
+    rows.append(1, 1 / 30, np.ones((4, 2)), np.ones(4), np.zeros(4))
+    got = rows.arrays(views=True)
+    assert {k: len(v) for k, v in got.items()} == dict.fromkeys(got, 2)
+    assert not got["position"].flags.writeable and rows.arrays()["position"].flags.writeable
+    assert np.array_equal(got["position"][1], np.ones((4, 2)))
