@@ -403,7 +403,20 @@ def movements_of(time: np.ndarray, transport: np.ndarray, params: ReachParams,
                  aperture: np.ndarray | None = None,
                  object_path: np.ndarray | None = None) -> list[Movement]:
     """:func:`find_movements` then :func:`classify_movements`, the transport's speed
-    computed once for both (its low-pass filter was a tenth of reading a trial)."""
+    computed once for both (its low-pass filter was a tenth of reading a trial).
+
+    Parameters
+    ----------
+    time : (N,) array
+        Sample times, s.
+    transport : (N, 3) array
+        The transport point, m (NaN where lost).
+    params : ReachParams
+    aperture : (N,) array, optional
+        Thumb-index distance, m (NaN where lost).
+    object_path : (N, 3) array, optional
+        The object's centre, m.
+    """
     time = np.asarray(time, dtype=float)
     transport = np.asarray(transport, dtype=float)
     speed = params.landmarks.speed_of(time, transport) if len(time) >= 3 else None
