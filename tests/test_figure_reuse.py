@@ -377,8 +377,12 @@ def test_a_legend_laid_out_once_a_draw_is_matplotlibs_own():
     before = legend.get_window_extent(renderer).width
     legend.get_texts()[0].set_text("a much longer model name than before")
     assert legend.get_window_extent(renderer).width > before
-    # and a kept figure drawn again with other entries shows them, as a new one does
-    kept, _ = _legends("once", ["one", "two (a longer name)", "three", "four"])
+    # and a kept figure drawn again with other entries, its new legends laid out once a
+    # draw too, shows them as a new one does
+    kept, axes = _legends("once", ["one", "two (a longer name)", "three", "four"])
+    for legend in (*kept.legends, axes[0].get_legend()):
+        quicker_legend(legend)
+        assert "draw" in vars(legend)
     new, _ = _legends(None, ["one", "two (a longer name)", "three", "four"])
     assert png_bytes(kept, 100) == png_bytes(new, 100)
 
@@ -387,6 +391,7 @@ def test_a_kept_layout_follows_everything_a_texts_layout_depends_on():
     from matplotlib.figure import Figure
     from matplotlib.text import Text
 
+    from perception.report import canvas
     from perception.report.canvas import keep_layouts
 
     fig = Figure(figsize=(3, 2))
@@ -395,6 +400,14 @@ def test_a_kept_layout_follows_everything_a_texts_layout_depends_on():
     keep_layouts([kept])
     assert "_get_layout" in vars(kept) and "_get_layout" not in vars(plain)
     renderer = fig.canvas.get_renderer()
+    assert renderer.keeps_layouts  # the report's renderer: layouts are kept
+    canvas._LAYOUTS.clear()
+    kept._get_layout(renderer)
+    assert len(canvas._LAYOUTS) == 1  # laid out once, kept
+    (key,) = canvas._LAYOUTS
+    canvas._LAYOUTS[key] = (canvas._LAYOUTS[key][0], ["marker"], canvas._LAYOUTS[key][2])
+    assert kept._get_layout(renderer)[1] == ["marker"]  # and taken from there
+    canvas._LAYOUTS.clear()
     changes = [("text", "two\nlines"), ("fontsize", 14), ("rotation", 30),
                ("ha", "right"), ("va", "top"), ("linespacing", 2.0),
                ("multialignment", "center"), ("rotation_mode", "anchor"),

@@ -445,7 +445,7 @@ def _kept_layout(text):
         if (not getattr(renderer, "keeps_layouts", False) or "$" in s or text._usetex
                 or text._wrap):
             return type(text)._get_layout(text, renderer)
-        key = (s, *_font_key(text._fontproperties), text.get_figure(root=True).dpi,
+        key = (s, *_font_key(text._fontproperties), text.figure.dpi,
                renderer.dpi, rcParams["text.hinting"], rcParams["text.hinting_factor"],
                rcParams["text.kerning_factor"], text._linespacing, text._multialignment,
                text._horizontalalignment, text._verticalalignment, text.get_rotation(),
