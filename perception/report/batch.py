@@ -255,11 +255,8 @@ def _main_table(summary: pd.DataFrame, anchors: dict[str, str], reference: str |
                 ) -> Iterator[str]:
     headers = ["clip", "condition", "verdict", "familiarity (0–1)", "margin (log-lik.)",
                "winner", "winner log-lik.", f"C of {reference or 'reference'} (cm)", "status"]
-    def rows():
-        for r in summary.itertuples(index=False):
-            yield _main_row(r, anchors)
-
-    return _table_parts(headers, rows(), numeric={3, 4, 6, 7}, cls="t main")
+    rows = (_main_row(r, anchors) for r in summary.itertuples(index=False))
+    return _table_parts(headers, rows, numeric={3, 4, 6, 7}, cls="t main")
 
 
 def _main_row(r, anchors: dict[str, str]) -> list[str]:
