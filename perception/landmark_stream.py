@@ -60,7 +60,7 @@ def median_step(time: np.ndarray) -> float:
     elif m == len(time):
         return kept[1].median()
     else:
-        order = kept[1].extended(np.diff(time[m - 1:]), np.diff(time))
+        order = kept[1].extended(np.diff(time[m - 1:]), lambda: np.diff(time))
     _STEPS.keep(None, (time,), order, kept)
     return order.median()
 
@@ -84,6 +84,7 @@ def filtfilt_run(b: np.ndarray, a: np.ndarray, zi: np.ndarray, x: np.ndarray,
     if kept is not None and len(kept[0][0]) == len(x):
         return kept[1].y
     done = zero_lag.filtfilt_resumed(b, a, zi, x, None if kept is None else kept[1])
+    done.y.flags.writeable = False  # kept, and read by the next pass: never written to
     _OPEN.keep(key, (x,), done, kept)
     return done.y
 
@@ -133,6 +134,7 @@ def speed_and_floor(time: np.ndarray, p: np.ndarray, q: float) -> tuple[np.ndarr
     else:
         head = speed[:r0]
         settled = (head, np.sort(head[np.isfinite(head)]))
+    speed.flags.writeable = False  # kept, and the next pass's first rows
     _SPEEDS.keep(None, (time,), (p, speed, settled, uniform), kept)
     tail = np.sort(new[np.isfinite(new)])
     return speed, _percentile(settled[1], tail, q)

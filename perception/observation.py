@@ -542,7 +542,7 @@ def _extended(scene: RestScene, order: Ordered, n: int, tracks, params: ObserveP
     if np.any((periods := np.diff(time[n - 1:])) <= 0):
         return None
     dts = extended(scene.dts, periods)
-    dt = (order := order.extended(periods, dts)).median()
+    dt = (order := order.extended(periods, lambda: dts)).median()
     lo, hi = params.frame_period_range
     if not lo * (1 - 1e-6) <= dt <= hi * (1 + 1e-6):
         return None

@@ -57,8 +57,8 @@ class _Rows:
                       "position": ((self._markers, 2), float),
                       "likelihood": ((self._markers,), float),
                       "status": ((self._markers,), np.int64)}
-            self._a = {k: Grown(np.empty((0, *shape), dtype)) for k, (shape, dtype)
-                       in shapes.items()}
+            self._a = {k: Grown(np.empty((0, *shape), dtype), extendable=False)
+                       for k, (shape, dtype) in shapes.items()}
         # each value as its row first (cast and broadcast as an assignment does): one
         # that cannot be leaves no field a row longer than the others
         rows = []

@@ -64,11 +64,16 @@ class Grown:
     ----------
     rows : (N, ...) array
         The first rows (copied).
+    extendable : bool
+        Whether :func:`extended` may append to it in place (a series made row by row
+        from others); False for one its owner alone appends to (the online
+        recogniser's rows: another's append would put a row out of step with them).
     """
 
-    def __init__(self, rows: np.ndarray):
+    def __init__(self, rows: np.ndarray, *, extendable: bool = True):
         rows = np.asarray(rows)
         self.n = 0
+        self.extendable = extendable
         self._write, self._read = self._memory(max(64, 2 * len(rows)), rows.shape[1:],
                                                rows.dtype)
         self.append(rows)
@@ -86,10 +91,10 @@ class Grown:
         """Write ``rows`` (k, ...) after the rows so far (cast to this series' dtype)."""
         k, n, buf = len(rows), self.n, self._write
         if n + k > len(buf):
-            write, self._read = self._memory(max(2 * len(buf), n + k), buf.shape[1:],
-                                             buf.dtype)
-            write[:n] = buf[:n]
-            self._write = buf = write
+            write, read = self._memory(max(2 * len(buf), n + k), buf.shape[1:], buf.dtype)
+            write[:n] = buf[:n]  # copied before any view of the new memory is handed out
+            self._write, self._read = write, read
+            buf = write
         buf[n:n + k] = rows
         self.n = n + k
 
@@ -137,7 +142,7 @@ def extended(first: np.ndarray, rows: np.ndarray) -> np.ndarray:
     """
     g = grown_of(first)
     rows = np.asarray(rows)
-    if (g is None or len(first) != g.n or rows.dtype != first.dtype
+    if (g is None or not g.extendable or len(first) != g.n or rows.dtype != first.dtype
             or rows.shape[1:] != first.shape[1:]):
         g = Grown(np.concatenate([first, rows]))
     else:
@@ -192,12 +197,14 @@ class Ordered:
         self._shared = [sorted(values[np.isfinite(values)].tolist()), 0]  # list, version
         self._version = 0
 
-    def replaced(self, old: np.ndarray, new: np.ndarray, whole: np.ndarray) -> Ordered:
+    def replaced(self, old: np.ndarray, new: np.ndarray,
+                 whole: Callable[[], np.ndarray]) -> Ordered:
         """The series with the values ``old`` (among its own) taken out and ``new`` put in;
-        ``whole``: every value of the series then, ordered afresh where this one was
-        changed already (by another series that began with it)."""
+        ``whole()``: every value of the series then, ordered afresh where this one was
+        changed already (by another series that began with it; called only then: making
+        it is a pass over every row)."""
         if self._shared[1] != self._version:
-            return Ordered(whole)
+            return Ordered(whole())
         values = self._shared[0]
         for v in np.asarray(old, dtype=float).tolist():
             if math.isfinite(v):
@@ -210,18 +217,26 @@ class Ordered:
         out._shared, out._version = self._shared, self._shared[1]
         return out
 
-    def extended(self, new: np.ndarray, whole: np.ndarray) -> Ordered:
+    def extended(self, new: np.ndarray, whole: Callable[[], np.ndarray]) -> Ordered:
         """:meth:`replaced` with nothing taken out: ``new`` values after the series."""
         return self.replaced((), new, whole)
+
+    def _values(self) -> list:
+        """The values in order; refused for an :class:`Ordered` that handed its list on (it
+        would give the other series' values)."""
+        if self._shared[1] != self._version:
+            raise RuntimeError("an Ordered read after it was replaced (read the one "
+                               "replaced() returned)")
+        return self._shared[0]
 
     @property
     def n(self) -> int:
         """How many finite values."""
-        return len(self._shared[0])
+        return len(self._values())
 
     def median(self) -> float:
         """``float(np.median(values))`` of the finite values (NaN with none)."""
-        v = self._shared[0]
+        v = self._values()
         n = len(v)
         if not n:
             return math.nan
@@ -230,7 +245,7 @@ class Ordered:
     def percentile(self, q: float) -> float:
         """``float(np.percentile(values, q))`` of the finite values (linear interpolation;
         NaN with none)."""
-        v = self._shared[0]
+        v = self._values()
         return percentile_at(v.__getitem__, len(v), q)
 
 

@@ -73,10 +73,10 @@ def test_ordered_statistics_are_numpys_bit_for_bit():
             assert _bits(o.percentile(q)) == _bits(np.percentile(seen, q)), (n, q)
         k = int(rng.integers(0, n))
         y = np.r_[x[:k], rng.normal(size=n - k + 2)]
-        moved = o.replaced(x[k:], y[k:], y)
+        moved = o.replaced(x[k:], y[k:], lambda y=y: y)
         assert _bits(moved.percentile(10)) == _bits(np.percentile(y[np.isfinite(y)], 10))
         # the first one was changed into the second: asked again, it orders afresh
-        again = o.extended([0.5], np.r_[x, 0.5])
+        again = o.extended([0.5], lambda x=x: np.r_[x, 0.5])
         assert _bits(again.median()) == _bits(np.median(np.r_[seen, 0.5]))
 
 
@@ -153,3 +153,25 @@ def test_a_row_that_cannot_be_taken_leaves_the_rows_as_they_were():
     assert {k: len(v) for k, v in got.items()} == dict.fromkeys(got, 2)
     assert not got["position"].flags.writeable and rows.arrays()["position"].flags.writeable
     assert np.array_equal(got["position"][1], np.ones((4, 2)))
+
+
+def test_a_grown_its_owner_alone_appends_to_is_not_extended_by_others():
+
+
+    g = Grown(np.arange(3.0), extendable=False)
+    out = extended(g.rows(), np.array([9.0]))
+    assert g.n == 3 and list(g.rows()) == [0.0, 1.0, 2.0]  # its own rows unchanged
+    assert list(out) == [0.0, 1.0, 2.0, 9.0]
+    free = Grown(np.arange(3.0))
+    assert list(extended(free.rows(), np.array([9.0]))) == [0.0, 1.0, 2.0, 9.0]
+    assert free.n == 4  # appended in place
+
+
+def test_an_ordered_read_after_it_was_replaced_is_refused():
+
+
+    old = Ordered(np.array([1.0, 2.0, 3.0]))
+    new = old.extended(np.array([4.0, 5.0]), lambda: np.arange(1.0, 6.0))
+    assert new.median() == 3.0
+    with pytest.raises(RuntimeError):
+        old.median()
