@@ -15,6 +15,7 @@ from .api import MarkerSet as MarkerSet
 from .api import MocapImport as MocapImport
 from .api import ModelSpec as ModelSpec
 from .api import MotorModel as MotorModel
+from .api import MovementRecord as MovementRecord
 from .api import MovementSpan as MovementSpan
 from .api import Observation as Observation
 from .api import ObserveParams as ObserveParams
@@ -42,7 +43,9 @@ from .api import discover as discover
 from .api import judge as judge
 from .api import landmarks as landmarks
 from .api import load_clip as load_clip
+from .api import load_movements as load_movements
 from .api import load_recipe as load_recipe
+from .api import movement_record as movement_record
 from .api import movement_span as movement_span
 from .api import observe as observe
 from .api import open_source as open_source

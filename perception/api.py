@@ -9,6 +9,7 @@
     obs = pc.observe(tracks)                                # model frame, movement span
     rep = pc.Repertoire.build()                             # or pc.Repertoire.load("rep.h5")
     rec = pc.recognize_clip("clip.mp4", rep)                # the whole chain in one call
+    moves = pc.load_movements("trials.tsv").records       # any input, in metres
     rec.winner, rec.to_pandas()
     pc.run_batch(pc.discover("clips/"), "report/", rep)    # many clips -> report.html
 
@@ -23,6 +24,7 @@ from perception.io.tracks import Status, Tracks, TracksWriter
 from perception.io.video import FrameSource, open_source, open_video, write_video
 from perception.landmarks import LandmarkParams, Landmarks
 from perception.measure import landmarks
+from perception.movement_record import MovementRecord, movement_record
 from perception.observation import MovementSpan, Observation, ObserveParams, movement_span, observe
 from perception.online import OnlineRecognizer, SettleRule
 from perception.pipeline import RecognitionSettings, load_clip, recognize_clip
@@ -40,6 +42,7 @@ from perception.recognition.engine import StepScorer
 from perception.recognition.rules import VerdictRules, judge
 from perception.recordings import MocapImport, read_reaches, recognize_reach
 from perception.report import write_batch_report, write_clip_report
+from perception.sources import load_movements
 from perception.synthetic.demos import demo_tracks
 from perception.synthetic.recipes import load_recipe, synthesize
 from perception.synthetic.render import render_clip
@@ -65,6 +68,7 @@ __all__ = [
     "MarkerSet",
     "ModelSpec",
     "MotorModel",
+    "MovementRecord",
     "MovementSpan",
     "Observation",
     "ObserveParams",
@@ -90,6 +94,8 @@ __all__ = [
     "demo_tracks",
     "discover",
     "load_clip",
+    "load_movements",
+    "movement_record",
     "recognize_reach",
     "read_reaches",
     "landmarks",

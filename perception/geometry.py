@@ -103,10 +103,22 @@ class SimilarityTransform:
         return np.column_stack([linear, self.origin_px])
 
     def to_model(self, px: np.ndarray) -> np.ndarray:
-        """Pixels ``(..., 2)`` -> model frame ``(..., 2)``, m (NaN stays NaN)."""
+        """Pixels ``(..., 2)`` -> model frame ``(..., 2)``, m (NaN stays NaN):
+        :meth:`rotated` of :meth:`to_plane`, bit for bit."""
+        return self.rotated(self.to_plane(px))
+
+    def to_plane(self, px: np.ndarray) -> np.ndarray:
+        """Pixels ``(..., 2)`` -> metres ``(..., 2)`` about the origin, x right and y up: the
+        scale and the flip, not the rotation (a :class:`~perception.movement_record.
+        MovementRecord`'s frame). NaN stays NaN."""
         rel = np.asarray(px, dtype=np.float64) - self.origin_px
-        u = rel[..., 0] / self.px_per_m
-        w = (-rel[..., 1] if self.y_down else rel[..., 1]) / self.px_per_m
+        return np.stack([rel[..., 0] / self.px_per_m,
+                         (-rel[..., 1] if self.y_down else rel[..., 1]) / self.px_per_m], axis=-1)
+
+    def rotated(self, plane: np.ndarray) -> np.ndarray:
+        """Metres about the origin, x right and y up ``(..., 2)`` (:meth:`to_plane`) ->
+        model frame ``(..., 2)``: the rotation (and mirror) alone."""
+        u, w = plane[..., 0], plane[..., 1]
         b = self.basis
         # element by element, not a matrix product (whose kernels may round a row
         # differently with other rows beside it): a row maps alike in any array, so a

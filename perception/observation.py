@@ -1,13 +1,14 @@
 """Tracks -> observations in the model frame.
 
 The model frame (docs/coordinates.md): origin at the object centre, +y from
-the demonstrator's start toward the object, metres. Pixels map to metres by
-the similarity transform of :mod:`perception.geometry`, fixed from the first
-frames of the clip (the scene): the object's position, its known diameter
-(or a given pixel scale), and the direction from the wrist's rest position
-to the object. A motion-capture reach's tracks are metres in its plane
-already (:attr:`Tracks.units`): only the object's position and the
-approach are fixed.
+the demonstrator's start toward the object, metres. Any input comes here as
+one :class:`~perception.movement_record.MovementRecord`: metres, x right and
+y up, about the object's position in the first frames, at the scale its
+object's known diameter (or a given pixel scale) gives; a motion-capture
+reach's tracks are metres in its plane already (:attr:`Tracks.units`). The
+scene turns the record into the model frame by the direction from the
+wrist's rest position to the object: the similarity transform of
+:mod:`perception.geometry`, fixed from the first frames.
 
 The movement is scored over its :class:`MovementSpan`: from its onset (the
 wrist's displacement from rest, less the model's own latency) to the end of
@@ -21,6 +22,7 @@ the sign of the small per-frame changes the thesis's confidence rule counts
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 from dataclasses import dataclass, field
 from typing import Annotated, NamedTuple
@@ -33,8 +35,8 @@ from perception.filtering import alpha_beta
 from perception.geometry import DEFAULT_OBJECT_DIAMETER, SimilarityTransform
 from perception.io.pose import is_pose_file
 from perception.movement_bounds import end_row, onset_time
+from perception.movement_record import MARKERS, MovementRecord, movement_record, reading_notes
 from perception.resume import Grown, Kept, Ordered, extended, rowwise
-from perception.track_cleaning import cleaning_notes
 from perception.validation import Int, Positive, Tuple, declared
 
 __all__ = [
@@ -53,8 +55,8 @@ log = logging.getLogger(__name__)
 
 #: Markers the recognition needs, in the order of the model's effectors.
 DIGIT_MARKERS = ("wrist", "finger", "thumb")
-#: Every marker an observation needs.
-NEEDED_MARKERS = (*DIGIT_MARKERS, "object")
+#: Every marker an observation needs: a movement record's.
+NEEDED_MARKERS = MARKERS
 #: Median absolute deviation -> standard deviation, for normally distributed noise.
 MAD_TO_SD = 1.4826
 
@@ -377,78 +379,19 @@ def _source(tracks, name: str) -> str:
     return str(path) if path is not None else name
 
 
-def _marker_pixels(tracks, params: ObserveParams, name: str) -> dict[str, np.ndarray]:
-    """(T, 2) positions of every needed marker (px, or m: :attr:`Tracks.units`); refuses
-    tracks that cannot be scored."""
-    markers = list(tracks.markers)
-    pos = np.asarray(tracks.position, dtype=float)
-    px = {}
-    for m in NEEDED_MARKERS:
-        what = "object" if m == "object" else f"marker '{m}'"
-        if m not in markers:
-            raise InputError(f"marker '{m}' is not in the tracks (have {', '.join(markers)})",
-                             name, field=m)
-        px[m] = pos[:, markers.index(m)]
-        if not np.isfinite(px[m]).all(axis=1).any():
-            raise InputError(f"{what} is never seen in the clip", name, field=m)
-        if np.isinf(px[m]).any():
-            raise InputError(f"marker '{m}' has infinite positions", name, field=m)
-    if len(pos) < params.min_frames:
-        raise InputError(f"clip too short to score: {len(pos)} frames "
-                         f"(need at least {params.min_frames})", name)
-    return px
-
-
-def _frame_times(tracks, params: ObserveParams, name: str) -> tuple[np.ndarray, np.ndarray]:
-    """Time stamps (T,) s and frame periods (T-1,) s, checked."""
-    time = np.asarray(tracks.time, dtype=float)
-    if not np.isfinite(time).all():
-        raise InputError(f"{int((~np.isfinite(time)).sum())} time stamps are not finite", name)
-    dts = np.diff(time)
-    if np.any(dts <= 0):
-        raise InputError("time stamps do not increase", name)
-    lo, hi = params.frame_period_range
-    dt = float(np.median(dts))
-    if not lo * (1 - 1e-6) <= dt <= hi * (1 + 1e-6):  # 1000 frames/s in float steps
-        raise InputError(f"implausible frame period {dt:g} s (time stamps must be in "
-                         f"seconds, {1 / hi:g}-{1 / lo:g} frames/s)", name)
-    return time, dts
-
-
-def _scene_transform(px: dict[str, np.ndarray], tracks, params: ObserveParams,
-                     name: str) -> SimilarityTransform:
-    """The tracks -> model transform from the first frames: object, scale, approach."""
-    rest = slice(0, params.rest_frames)
-    for m in NEEDED_MARKERS:
-        if not np.isfinite(px[m][rest]).all():
-            what = "object" if m == "object" else f"marker '{m}'"
-            raise InputError(f"the clip must start with the hand at rest and visible: the "
-                             f"{what} is lost in its first {params.rest_frames} frames",
-                             name, field=m)
-    # The object stays put while the hand is away: twice the rest frames average its centre
-    # better, long before the hand arrives; over the frames it is seen (the hand may hide it)
-    early = px["object"][: 2 * params.rest_frames]
-    seen = early[np.isfinite(early).all(axis=1)]
-    if not len(seen):
-        raise InputError("the object is never seen in the first "
-                         f"{2 * params.rest_frames} frames", name, field="object")
-    origin = np.median(seen, axis=0)
-    metric = tracks.units == "m"  # a reach in its plane: metres, y up (no scale to find)
-    scale = 1.0 if metric else params.px_per_m
-    if scale is None:
-        dpx = tracks.object_diameter_px()
-        if dpx is None:
-            pose = "`object_diameter_px` (the object in pixels) or " if is_pose_file(name) else ""
-            raise InputError(f"image scale unknown: the tracks carry no object size; give "
-                             f"{pose}`px_per_m`", name)
-        scale = dpx / params.object_diameter
-    d = np.median(px["wrist"][rest], axis=0) - origin
+def _scene_transform(record: MovementRecord, tracks, params: ObserveParams
+                     ) -> SimilarityTransform:
+    """The tracks -> model transform: the record's plane turned by the approach, the
+    direction from the wrist at rest toward the object (taken in the input's units: the
+    same angle as in the record's metres, and the bits it had before the record)."""
+    d = (np.median(np.asarray(tracks.marker("wrist"), dtype=float)[: params.rest_frames],
+                   axis=0) - record.plane.origin_px)
     # from the wrist toward the object, y up
-    approach = -d if metric else np.array([-d[0], d[1]])
+    approach = np.array([-d[0], d[1]]) if record.plane.y_down else -d
     if np.linalg.norm(approach) < 1e-6:
-        raise InputError("impossible geometry: the wrist starts on the object", name)
-    return SimilarityTransform(origin, float(scale), float(np.arctan2(approach[1], approach[0])),
-                               params.mirror, y_down=not metric)
+        raise InputError("impossible geometry: the wrist starts on the object", record.source)
+    return dataclasses.replace(record.plane, rotation=float(np.arctan2(approach[1], approach[0])),
+                               mirror=params.mirror)
 
 
 def _rest_noise(raw: np.ndarray, params: ObserveParams, name: str) -> tuple[float, np.ndarray]:
@@ -505,13 +448,13 @@ def rest_scene(tracks, params: ObserveParams | None = None, *,
     if longer is not None:
         scene, order = longer
     else:
-        px = _marker_pixels(tracks, params, where)
-        time, dts = _frame_times(tracks, params, where)
-        transform = _scene_transform(px, tracks, params, where)
-        raw = np.stack([transform.to_model(px[m]) for m in DIGIT_MARKERS], axis=1)
+        record = movement_record(tracks, params, clip=clip)
+        time, dts = record.time, np.diff(record.time)
+        transform = _scene_transform(record, tracks, params)
+        raw = np.stack([transform.rotated(getattr(record, m)) for m in DIGIT_MARKERS], axis=1)
         noise, rest = _rest_noise(raw, params, where)
         # rows a longer prefix appends to (resume.Grown); the periods' median kept in order
-        order = Ordered(dts)  # finite: _frame_times checked them
+        order = Ordered(dts)  # finite: the record checked them
         scene = RestScene(where, time, Grown(dts).rows(), order.median(), transform,
                           Grown(raw).rows(), rest, noise)
     scene.rest.flags.writeable = False  # shared by the observations made from the same rows
@@ -684,14 +627,5 @@ def observe(tracks, params: ObserveParams | None = None, *, clip: str | None = N
         clip_time=rowwise(_CLOCKS, p.span.onset_time, sc.time, lambda t: t - p.span.onset_time),
         clip_raw=sc.raw,
         clip_wrist=filt[:, 0],
-        notes=(*_reading_notes(tracks), *cleaning_notes(tracks)),
+        notes=reading_notes(tracks),
     )
-
-
-def _reading_notes(tracks) -> tuple[str, ...]:
-    """What reading the tracks took on trust (a pose file's keypoints guessed from their
-    names, an object placed where the grip ends): ``/tracker`` ``reading_notes``."""
-    import json
-
-    raw = getattr(tracks, "tracker", {}).get("reading_notes")
-    return tuple(str(n) for n in json.loads(raw)) if isinstance(raw, str) and raw else ()
