@@ -40,6 +40,7 @@ from perception.report.clip import (
     KINEMATICS_COLUMNS,
     ClipSummary,
     clip_outputs,
+    measured_traces,
     remove_output,
     write_clip_report,
 )
@@ -493,8 +494,11 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
             return ClipResult(**base, status="reused", summary=ClipSummary.from_dict(done))
         rec, extra = _recognized(item, out, repertoire, settings, fp, progress, plan_cache,
                                  reach)
-        write_clip_report(rec, out, extra=extra, figure_format=figure_format, dpi=dpi)
-        return ClipResult(**base, status="ok", summary=ClipSummary.from_recognition(rec, extra))
+        traces = measured_traces(rec)  # once, for the figure, the JSON and the summary
+        write_clip_report(rec, out, extra=extra, figure_format=figure_format, dpi=dpi,
+                          traces=traces)
+        return ClipResult(**base, status="ok",
+                          summary=ClipSummary.from_recognition(rec, extra, traces=traces))
     except (HammerMVError, OSError) as exc:  # the clip's fault; anything else is a bug
         msg = _first_line(exc)
         if isinstance(exc, OSError) and item.path.name not in msg:

@@ -532,18 +532,17 @@ def png_bytes(fig: Figure, dpi: int) -> bytes:
     dpi : int
         Dots per inch.
     """
-    encode = png_encoder(fig, dpi)
-    return encode() if callable(encode) else encode
+    return png_encoder(fig, dpi)()
 
 
-def png_encoder(fig: Figure, dpi: int) -> bytes | Callable[[], bytes]:
+def png_encoder(fig: Figure, dpi: int) -> Callable[[], bytes]:
     """``fig`` drawn at ``dpi`` now, and what encodes it as :func:`png_bytes` does.
 
     The drawing is matplotlib's (this thread only); the encoding of an
     opaque figure is NumPy's and zlib's on the pixels drawn, which any thread
     may call while this one draws the next figure (both let other threads
-    run). A figure with transparency is encoded at once: its bytes are
-    returned rather than a callable.
+    run). A figure with transparency is encoded at once (through
+    matplotlib), and what is returned gives its bytes.
 
     Parameters
     ----------
@@ -562,7 +561,7 @@ def png_encoder(fig: Figure, dpi: int) -> bytes | Callable[[], bytes]:
     if not (rgba.view("<u4") >= 0xFF000000).all():  # transparency: kept, as RGBA
         out = io.BytesIO()
         fig.savefig(out, format="png", dpi=dpi, pil_kwargs={"compress_level": 1})
-        return out.getvalue()
+        return out.getvalue
     from PIL import Image  # matplotlib's own dependency, loaded with it
 
     software = f"Matplotlib version{matplotlib.__version__}, https://matplotlib.org/"

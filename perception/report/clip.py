@@ -17,6 +17,7 @@ import logging
 import os
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -27,7 +28,7 @@ from perception.recognition.result import Recognition
 from perception.report.figures import DPI, FIGURE_FORMATS
 
 __all__ = ["KINEMATICS_COLUMNS", "ClipSummary", "clip_figures", "clip_outputs", "clip_traces",
-           "remove_output", "remove_stale_reports", "remove_stale_trials",
+           "measured_traces", "remove_output", "remove_stale_reports", "remove_stale_trials",
            "write_clip_report"]
 
 log = logging.getLogger(__name__)
@@ -50,13 +51,32 @@ KINEMATICS_COLUMNS = ("movement_time", "peak_speed", "peak_speed_time", "mga", "
 #: format), in the order a report shows them.
 FIGURE_KEYS = ("confidence_png", "paths_png", "kinematics_png")
 
+#: A clip's (time, transport speed, grip aperture) over the whole clip (:func:`measured_traces`).
+Traces = tuple[np.ndarray, np.ndarray, np.ndarray]
 
-def clip_traces(rec: Recognition) -> dict[str, np.ndarray]:
+
+def clip_traces(rec: Recognition, traces: Traces | None = None) -> dict[str, np.ndarray]:
     """The curves the clip's landmarks are measured on: the report's ``traces``.
 
     ``time`` (s, on the landmarks' clock), ``wrist_speed`` (m/s) and
     ``aperture`` (m, marker to marker) over the whole clip
-    (:func:`~perception.report.kinematics.kinematic_traces`), to the µm.
+    (:func:`measured_traces`), to the µm.
+
+    Parameters
+    ----------
+    rec : Recognition
+        A scored clip.
+    traces : tuple of array, optional
+        Its :func:`measured_traces`, if already made.
+    """
+    traces = measured_traces(rec) if traces is None else traces
+    return dict(zip(("time", "wrist_speed", "aperture"), (np.round(x, 6) for x in traces)))
+
+
+def measured_traces(rec: Recognition) -> Traces:
+    """The clip's time, transport speed and grip aperture as its landmarks were measured
+    (:func:`~perception.report.kinematics.kinematic_traces` by its rules' landmark
+    filter): what the kinematics figure draws and, rounded, the report's ``traces``.
 
     Parameters
     ----------
@@ -65,9 +85,7 @@ def clip_traces(rec: Recognition) -> dict[str, np.ndarray]:
     """
     from perception.report.kinematics import kinematic_traces
 
-    return dict(zip(("time", "wrist_speed", "aperture"),
-                    (np.round(x, 6) for x in kinematic_traces(rec.observation,
-                                                              rec.rules.landmarks))))
+    return kinematic_traces(rec.observation, rec.rules.landmarks)
 
 
 def _floats(values, n: int | None = None) -> np.ndarray:
@@ -245,7 +263,8 @@ class ClipSummary:
         )
 
     @classmethod
-    def from_recognition(cls, rec: Recognition, extras: dict | None = None) -> ClipSummary:
+    def from_recognition(cls, rec: Recognition, extras: dict | None = None, *,
+                         traces: Traces | None = None) -> ClipSummary:
         """From a :class:`~perception.recognition.result.Recognition`.
 
         Parameters
@@ -254,6 +273,8 @@ class ClipSummary:
             A scored clip.
         extras : dict, optional
             Keys added to its JSON (see :func:`write_clip_report`).
+        traces : tuple of array, optional
+            Its :func:`measured_traces`, if already made (its report's).
         """
         d = rec.decision
         return cls(clip=rec.clip, time=rec.time, names=list(rec.names), kinds=list(rec.kinds),
@@ -264,7 +285,7 @@ class ClipSummary:
                    transport=np.cumsum(rec.dC_r, axis=1), aperture=rec.scored_movement.g,
                    extras=dict(extras or {}), verdict_detail=rec.verdict_detail,
                    kinematics=rec.kinematics, verdict_rule=rec.verdict_rule,
-                   traces=clip_traces(rec), verdict_reason=rec.verdict_reason,
+                   traces=clip_traces(rec, traces), verdict_reason=rec.verdict_reason,
                    winner_note=rec.winner_note, warnings=rec.warnings,
                    warning_values=[w.to_dict() for w in rec.validation_warnings],
                    transport_point=rec.transport_point, time_origin=rec.time_origin)
@@ -448,7 +469,7 @@ def remove_stale_trials(out: str | os.PathLike,
 
 def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,
                       figures: bool = True, figure_format: str = "png",
-                      dpi: int = DPI) -> dict[str, Path]:
+                      dpi: int = DPI, traces: Traces | None = None) -> dict[str, Path]:
     """Write ``<clip>.recognition.json``, the per-step CSV and the three figures.
 
     Parameters
@@ -469,6 +490,9 @@ def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,
         ``png``, ``svg`` or ``pdf`` (:func:`~perception.report.figures.write_figure`).
     dpi : int
         The figures' resolution, dots per inch.
+    traces : tuple of array, optional
+        The clip's :func:`measured_traces`, if already made (a batch makes them once
+        for the report and the clip's :class:`ClipSummary`).
 
     Returns
     -------
@@ -479,6 +503,7 @@ def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,
 
     expect(rec, Recognition, "write_clip_report(rec=)", hint="recognize_clip's result")
     paths = clip_outputs(Path(out), rec.clip, figure_format)
+    traces = measured_traces(rec) if traces is None else traces  # the figure's, the JSON's
     with contextlib.ExitStack() as stack:
         if figures:
             from perception.report.figures import (
@@ -492,7 +517,7 @@ def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,
             # a PNG encoded while the next figure is drawn, the last while the CSV and JSON are made
             files = stack.enter_context(FigureFiles(figure_format, dpi))
             for key, draw in (("confidence_png", confidence_figure), ("paths_png", paths_figure),
-                              ("kinematics_png", kinematics_figure)):
+                              ("kinematics_png", partial(kinematics_figure, traces=traces))):
                 files.write(draw(rec, reuse=True), paths[key].with_suffix(""))
         for fmt in FIGURE_FORMATS:
             if not figures or fmt != figure_format:
@@ -502,7 +527,7 @@ def write_clip_report(rec: Recognition, out: Path, *, extra: dict | None = None,
         # float), without formatting each cell through NumPy's own (a fifth of the CSV's time)
         write_csv(paths["csv"], {k: v.tolist() if isinstance(v, np.ndarray) else v
                                  for k, v in rec.columns().items()})
-        report = {**rec.to_dict(), "traces": clip_traces(rec), **(extra or {})}
+        report = {**rec.to_dict(), "traces": clip_traces(rec, traces), **(extra or {})}
     # the JSON last, once every figure is written: its presence marks the report complete
     write_json(paths["json"], report)
     return paths

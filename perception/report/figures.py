@@ -462,8 +462,8 @@ def _checked(fmt: str, dpi: int) -> None:
         raise ValueError(f"dpi must be a positive whole number, not {dpi!r}")
 
 
-def _drawn_png(fig: Figure, dpi: int) -> bytes | Callable[[], bytes]:
-    """``fig`` drawn now; its PNG's bytes, or what encodes them
+def _drawn_png(fig: Figure, dpi: int) -> Callable[[], bytes]:
+    """``fig`` drawn now, and what encodes its PNG
     (:func:`~perception.report.canvas.png_encoder`)."""
     with warnings.catch_warnings():
         warnings.filterwarnings("ignore", message="Glyph .* missing from",
@@ -499,8 +499,7 @@ def write_figure(fig: Figure, path_stem: str | Path, fmt: str = "png", dpi: int 
     _checked(fmt, dpi)
     path = Path(f"{path_stem}.{fmt}")
     if fmt == "png":  # encoded here: half Pillow's time (perception.report.canvas)
-        data = _drawn_png(fig, dpi)
-        return write_bytes(path, data() if callable(data) else data)
+        return write_bytes(path, _drawn_png(fig, dpi)())
     with rc_context(_VECTOR_TEXT):
         return save_figure(path, fig, dpi=int(dpi))
 
@@ -557,11 +556,9 @@ class FigureFiles:
             self._finish()
             return write_figure(fig, path_stem, self.fmt, self.dpi)
         path = Path(f"{path_stem}.{self.fmt}")
-        data = _drawn_png(fig, self.dpi)  # while the last figure is encoded
+        encode = _drawn_png(fig, self.dpi)  # while the last figure is encoded
         self._finish()
-        if not callable(data):
-            return write_bytes(path, data)
-        self._pending = path, self._pool.submit(data)
+        self._pending = path, self._pool.submit(encode)
         return path
 
     def _finish(self) -> None:

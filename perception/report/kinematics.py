@@ -175,7 +175,8 @@ def _layout() -> tuple[Figure, np.ndarray]:
         top=1 - TOP / height, hspace=GAP / ((height - BOTTOM - TOP - GAP) / 2)))
 
 
-def kinematics_figure(rec: Recognition, *, reuse: bool = False) -> Figure:
+def kinematics_figure(rec: Recognition, *, reuse: bool = False,
+                      traces: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None) -> Figure:
     """The trial's transport speed and grip aperture with their landmarks.
 
     Above, the transport's speed (mm/s; labelled for what it is: the
@@ -199,8 +200,11 @@ def kinematics_figure(rec: Recognition, *, reuse: bool = False) -> Figure:
         Draw on this thread's kept figure of this kind, valid until the next
         such call (the reports: :mod:`perception.report.canvas`); default a
         new figure.
+    traces : tuple of array, optional
+        The clip's :func:`kinematic_traces` by its rules' landmark filter, if
+        already made (the clip report's, for its JSON too).
     """
-    m = _marks(rec)
+    m = _marks(rec, traces)
     if not reuse:
         fig, axes = _layout()
         _draw(fig, axes, m)
@@ -248,11 +252,13 @@ class _Marks:
                 self.mga is not None)
 
 
-def _marks(rec: Recognition) -> _Marks:
-    """The trial's curves and landmarks, as :func:`kinematics_figure` draws them."""
+def _marks(rec: Recognition, traces: tuple | None = None) -> _Marks:
+    """The trial's curves and landmarks, as :func:`kinematics_figure` draws them (its
+    :func:`kinematic_traces`, if made)."""
     lm = rec.landmarks[0]
     params = rec.rules.landmarks  # the definitions its landmarks were measured by
-    time, speed, aperture = kinematic_traces(rec.observation, params)
+    time, speed, aperture = (kinematic_traces(rec.observation, params) if traces is None
+                             else traces)
     origin, xlabel = time_axis(rec)
     time = time + origin
     lm = dataclasses.replace(lm, onset_time=lm.onset_time + origin,
@@ -288,18 +294,23 @@ def _kept_layout(m: _Marks) -> tuple[Figure, dict]:
 
 
 def _draw(fig: Figure, axes, m: _Marks) -> dict:
-    """Draw ``m`` on the empty figure ``fig`` (its two panels ``axes``); return its artists,
-    for :func:`_update`."""
+    """Build ``m``'s artists on the empty figure ``fig`` (its two panels ``axes``) and set
+    their values (:func:`_update`, which sets every one: a new figure and a kept one
+    moved to another trial are drawn by the one function); return them.
+
+    The curves are built empty, the marks where ``m`` puts them (a figure with no
+    samples finds its time axis from its marks as they are added), their texts empty.
+    """
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
     top, grip = axes
-    drawn: dict = {"marks": m}
-    handles = [top.plot(m.time, m.speed, color=SPEED_COLOUR, lw=1.8,
-                        label=f"{m.point} speed")[0],
-               grip.plot(m.time, m.aperture, color=GRIP_COLOUR, lw=1.8,
-                         label="grip aperture")[0]]
-    drawn["curves"] = handles[:2]
+    # the entries whose texts vary are labelled here too (matplotlib leaves out of a
+    # legend a line that has none), and again by _update
+    curves = [top.plot([], [], color=SPEED_COLOUR, lw=1.8, label=f"{m.point} speed")[0],
+              grip.plot([], [], color=GRIP_COLOUR, lw=1.8, label="grip aperture")[0]]
+    drawn: dict = {"curves": curves}
+    handles = list(curves)
     if m.span is not None:
         drawn["spans"] = [ax.axvspan(*m.span, color=SHADE_COLOUR, alpha=0.12, lw=0, zorder=0)
                           for ax in (top, grip)]
@@ -309,7 +320,7 @@ def _draw(fig: Figure, axes, m: _Marks) -> dict:
         lines = [ax.axvline(t, color=BOUND_COLOUR, ls="--", lw=1.0, zorder=1.5, gid=name)
                  for ax in (top, grip)]
         # outside the movement, so that the two never overlap however short it is
-        note = top.annotate(_bound_text(t, name), (t, 1.0), xycoords=("data", "axes fraction"),
+        note = top.annotate("", (t, 1.0), xycoords=("data", "axes fraction"),
                             xytext=(-2 if name == "onset" else 2, 3),
                             textcoords="offset points",
                             ha="right" if name == "onset" else "left", va="bottom",
@@ -319,15 +330,15 @@ def _draw(fig: Figure, axes, m: _Marks) -> dict:
         handles.append(Line2D([], [], color=BOUND_COLOUR, ls="--", lw=1.0,
                               label="onset / end"))
     if m.bound is not None:
-        drawn["bound"] = top.axhline(m.bound[0], color=BOUND_COLOUR, ls=":", lw=0.9,
-                                     zorder=1.5, gid="bound")
+        drawn["bound"] = top.axhline(m.bound[0], color=BOUND_COLOUR, ls=":", lw=0.9, zorder=1.5,
+                                     gid="bound")
         drawn["bound entry"] = len(handles)
         handles.append(Line2D([], [], color=BOUND_COLOUR, ls=":", lw=0.9, label=m.bound[1]))
     if m.peak is not None:
         t, y = m.peak
         handles += top.plot([t], [y], "o", color=SPEED_COLOUR, ms=7, mec="k", mew=0.8,
                             zorder=3, gid="peak_speed", label="peak speed")
-        drawn["peak"] = handles[-1], _note(top, t, y, _peak_text(y), SPEED_COLOUR, dy=-4.0)
+        drawn["peak"] = handles[-1], _note(top, t, y, "", SPEED_COLOUR, dy=-4.0)
     if m.opening is not None:
         t, y, label = m.opening
         handles += grip.plot([t], [y], "^", color=GRIP_COLOUR, ms=8, mfc="w", mew=1.5,
@@ -337,27 +348,25 @@ def _draw(fig: Figure, axes, m: _Marks) -> dict:
         t, y = m.mga
         handles += grip.plot([t], [y], "o", color=GRIP_COLOUR, ms=7, mec="k", mew=0.8,
                              zorder=3, gid="mga", label="MGA (maximum grip aperture)")
-        drawn["mga"] = handles[-1], _note(grip, t, y, _mga_text(y), GRIP_COLOUR)
-
-    for ax, label, ylim in ((top, f"{m.point} speed (mm/s)", m.ylims[0]),
-                            (grip, "grip aperture (mm)", m.ylims[1])):
-        ax.set_ylabel(label)
+        drawn["mga"] = handles[-1], _note(grip, t, y, "", GRIP_COLOUR)
+    for ax in (top, grip):
         ax.grid(True, color="0.92", lw=0.6, zorder=0)
-        ax.set_ylim(*ylim)
-    if len(m.time):
-        grip.set_xlim(float(np.nanmin(m.time)), float(np.nanmax(m.time)))
-    grip.set_xlabel(m.xlabel)
     drawn["legend"] = _legend(fig, handles, "lower center", ncols=4, frameon=False)
-    _title(fig, m.title)
+    _update(fig, drawn, m)
     return drawn
 
 
 def _update(fig: Figure, drawn: dict, m: _Marks) -> None:
-    """Move a kept figure's artists (:func:`_draw` of marks of the same shape) to ``m``."""
+    """Move the artists of :func:`_draw` (marks of the same shape) to ``m``: every value
+    the figure shows (curves, marks, notes, legend texts, labels, limits, title)."""
     drawn["marks"] = m
     top, grip = fig.axes
+    texts = drawn["legend"].get_texts()
     for line, y in zip(drawn["curves"], (m.speed, m.aperture)):
         line.set_data(m.time, y)
+    speed = f"{m.point} speed"
+    drawn["curves"][0].set_label(speed)
+    texts[0].set_text(printable(speed))
     if m.span is not None:
         on, end = m.span
         for span in drawn["spans"]:  # as axvspan makes it: from (on, 0), end - on wide
@@ -368,7 +377,6 @@ def _update(fig: Figure, drawn: dict, m: _Marks) -> None:
             line.set_xdata([t, t])
         note.xy = (t, 1.0)
         note.set_text(_bound_text(t, name))
-    texts = drawn["legend"].get_texts()
     if m.bound is not None:
         drawn["bound"].set_ydata([m.bound[0], m.bound[0]])
         texts[drawn["bound entry"]].set_text(printable(m.bound[1]))
@@ -387,9 +395,12 @@ def _update(fig: Figure, drawn: dict, m: _Marks) -> None:
         marker.set_data([t], [y])
         note.xy = (t, y)
         note.set_text(_mga_text(y))
-    for ax, ylim in ((top, m.ylims[0]), (grip, m.ylims[1])):
+    for ax, label, ylim in ((top, f"{m.point} speed (mm/s)", m.ylims[0]),
+                            (grip, "grip aperture (mm)", m.ylims[1])):
+        ax.set_ylabel(label)
         ax.set_ylim(*ylim)
-    grip.set_xlim(float(np.nanmin(m.time)), float(np.nanmax(m.time)))
+    if len(m.time):
+        grip.set_xlim(float(np.nanmin(m.time)), float(np.nanmax(m.time)))
     grip.set_xlabel(m.xlabel)
     _title(fig, m.title)
 
