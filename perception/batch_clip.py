@@ -19,7 +19,7 @@ import traceback
 from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, BinaryIO
+from typing import TYPE_CHECKING, BinaryIO, NamedTuple
 
 import numpy as np
 
@@ -50,7 +50,8 @@ from perception.report.tracking import write_tracking_report
 if TYPE_CHECKING:
     from perception.reach_data import Reach
 
-__all__ = ["ClipResult", "KeptSummaries", "ModelRows", "RunTiming", "process_clip"]
+__all__ = ["ClipCurves", "ClipResult", "KeptSummaries", "ModelRows", "RunTiming",
+           "process_clip"]
 
 log = logging.getLogger("perception.batch")
 
@@ -189,13 +190,15 @@ class ModelRows:
     landmarks, notes and sentences: 21 kB of Python objects a motion-capture
     trial, which a study of 10,000 trials cannot hold. :meth:`keep` writes a
     result's summary to a temporary file beside the report (the per-model
-    curves as float64 rows, the rest pickled) and keeps a compact summary:
-    the scalars and landmarks ``summary.csv`` reads, one final value a model
-    (its confidence and log-likelihood) and the warnings. :meth:`restored`
-    reads a clip back, with the curves of one model (the reference model,
-    known only once every clip is in), and :meth:`summaries` gives the
-    report every scored clip that way, one at a time. The report's numbers
-    are the same, bit for bit (float64 written and read as it was).
+    curves, time and aperture as float64 rows, the rest pickled) and keeps a
+    compact summary: the scalars and landmarks ``summary.csv`` reads, one
+    final value a model (its confidence and log-likelihood) and the warnings.
+    :meth:`restored` reads a clip back, with the curves of one model (the
+    reference model, known only once every clip is in), and :meth:`summaries`
+    gives the report every scored clip that way, one at a time
+    (:meth:`KeptSummaries.curves`: its time, aperture and that model's curves
+    alone, without unpickling the rest). The report's numbers are the same,
+    bit for bit (float64 written and read as it was).
 
     Use it as a context manager: the file goes when it closes (at once on
     POSIX: it is never linked into the folder).
@@ -211,7 +214,7 @@ class ModelRows:
         self._file: BinaryIO = tempfile.TemporaryFile(dir=folder, prefix=".batch-rows-")
         #: clip: its row of :attr:`_places`
         self._where: dict[str, int] = {}
-        #: a clip's place in the file, :data:`_PLACE` numbers a clip (56 bytes, where a
+        #: a clip's place in the file, :data:`_PLACE` numbers a clip (80 bytes, where a
         #: tuple of them was 300)
         self._places = array.array("q")
         #: a model count's empty transport, shared by the compact summaries
@@ -255,26 +258,28 @@ class ModelRows:
             return shared
         confidence = np.ascontiguousarray(s.confidence, dtype=float)
         transport = np.ascontiguousarray(s.transport, dtype=float)
-        if confidence.ndim != 2 or transport.ndim != 2:  # no models: nothing to keep apart
-            return shared
+        time = np.ascontiguousarray(s.time, dtype=float)
+        aperture = np.ascontiguousarray(s.aperture, dtype=float)
+        if confidence.ndim != 2 or transport.ndim != 2 or time.ndim != 1 or aperture.ndim != 1:
+            return shared  # no models (or no time): nothing to keep apart
         names, kinds = self._shared(s.names), self._shared(s.kinds)
         traces = ({k: np.asarray(v, dtype=float) for k, v in s.traces.items()}
                   if isinstance(s.traces, dict) else s.traces)
         self._file.seek(0, 2)
         offset = self._file.tell()
-        self._file.write(confidence.tobytes())
-        self._file.write(transport.tobytes())
+        for values in (confidence, transport, time, aperture):
+            self._file.write(values.tobytes())
         # the curves and model names are set again on every read (None: no array to
         # rebuild for them, a dozen reads a clip)
         rest = pickle.dumps(dataclasses.replace(
-            s, confidence=None, transport=None, traces=traces, names=None, kinds=None),
-            protocol=pickle.HIGHEST_PROTOCOL)
+            s, confidence=None, transport=None, time=None, aperture=None, traces=traces,
+            names=None, kinds=None), protocol=pickle.HIGHEST_PROTOCOL)
         self._where[s.clip] = len(self._places) // len(_PLACE)
         pair = self._models.setdefault((id(names), id(kinds)), len(self._model_lists))
         if pair == len(self._model_lists):
             self._model_lists.append((names, kinds))
-        self._places.extend((offset, *confidence.shape, *transport.shape, self._file.tell(),
-                             len(rest), pair))
+        self._places.extend((offset, *confidence.shape, *transport.shape, len(time),
+                             len(aperture), self._file.tell(), len(rest), pair))
         self._file.write(rest)
         observed = (s.kinematics or {}).get("observed") or {}
         m = len(names)
@@ -333,29 +338,53 @@ class ModelRows:
         return self._restored(summary.clip, model)
 
     def _restored(self, clip: str, model: str | None) -> ClipSummary:
-        k = self._where[clip] * len(_PLACE)
-        offset, rows, width, transport_rows, transport_width, at, length, pair = (
-            self._places[k:k + len(_PLACE)])
-        shape, transport_shape = (rows, width), (transport_rows, transport_width)
-        names, kinds = self._model_lists[pair]
-        self._file.seek(at)
-        whole = pickle.loads(self._file.read(length))
-        n = shape[0] * shape[1]
+        place = self._place(clip)
+        names, kinds = self._model_lists[place.models]
+        # the clip's arrays and its pickle lie end to end: one read
+        block = self._block(place, place.rest + place.length)
+        whole = pickle.loads(memoryview(block)[place.rest - place.offset:])
+        time, aperture = _array(block, place, place.time, place.steps), _array(
+            block, place, place.aperture, place.samples)
         if model is None or model not in names:
-            return _filled(whole, names=names, kinds=kinds, confidence=self._read(offset, shape),
-                           transport=self._read(offset + 8 * n, transport_shape))
+            return _filled(whole, names=names, kinds=kinds, time=time, aperture=aperture,
+                           confidence=_array(block, place, place.offset, place.rows,
+                                             place.width),
+                           transport=_array(block, place, place.transport, place.transport_rows,
+                                            place.transport_width))
         i = names.index(model)
-        row = self._read(offset + 8 * i * shape[1], (1, shape[1]))
-        transport = (self._read(offset + 8 * (n + i * transport_width), (1, transport_width))
-                     if transport_rows > i else np.zeros((1, 0)))
         pick = slice(i, i + 1)
 
         def one(values: np.ndarray) -> np.ndarray:  # an array a model, if it is one
             return values[pick] if len(values) == len(names) else values
 
-        return _filled(whole, names=[model], kinds=kinds[pick], confidence=row,
-                       transport=transport, final_log_likelihood=one(whole.final_log_likelihood),
+        return _filled(whole, names=[model], kinds=kinds[pick], time=time, aperture=aperture,
+                       confidence=_row(block, place, i), transport=_transport_row(block, place, i),
+                       final_log_likelihood=one(whole.final_log_likelihood),
                        familiarities=one(whole.familiarities))
+
+    def _curves(self, clip: str, model: str | None) -> ClipCurves | None:
+        """``clip``'s time, aperture and ``model``'s curves alone, read back without the
+        rest of its summary (None: no such model, or a clip not kept here)."""
+        if clip not in self._where:
+            return None
+        place = self._place(clip)
+        names = self._model_lists[place.models][0]
+        if model is None or model not in names:
+            return None
+        i = names.index(model)
+        block = self._block(place, place.rest)  # its arrays, not its pickle
+        return ClipCurves(clip, _array(block, place, place.time, place.steps), [model],
+                          _row(block, place, i), _transport_row(block, place, i),
+                          _array(block, place, place.aperture, place.samples))
+
+    def _place(self, clip: str) -> _Place:
+        k = self._where[clip] * len(_PLACE)
+        return _Place(*self._places[k:k + len(_PLACE)])
+
+    def _block(self, place: _Place, end: int) -> bytes:
+        """The file's bytes from ``place``'s first array up to ``end``."""
+        self._file.seek(place.offset)
+        return self._file.read(end - place.offset)
 
     def summaries(self, summaries: Iterable[ClipSummary], model: str | None) -> KeptSummaries:
         """Every one of ``summaries`` by clip, each read back (:meth:`restored`) when
@@ -372,10 +401,26 @@ class ModelRows:
         return KeptSummaries(self, {s.clip: None if s.clip in self._where else s
                                     for s in summaries}, model)
 
-    def _read(self, offset: int, shape: tuple[int, ...]) -> np.ndarray:
-        self._file.seek(offset)
-        count = math.prod(shape)
-        return np.frombuffer(self._file.read(8 * count), dtype=float).reshape(shape).copy()
+
+
+def _array(block: bytes, place: _Place, offset: int, *shape: int) -> np.ndarray:
+    """The float64 array of ``shape`` at ``offset`` in the file, from ``block`` (the bytes
+    from ``place``'s first array on), a copy of its own."""
+    return np.frombuffer(block, dtype=float, count=math.prod(shape),
+                         offset=offset - place.offset).reshape(shape).copy()
+
+
+def _row(block: bytes, place: _Place, i: int) -> np.ndarray:
+    """Model ``i``'s confidence, ``(1, N)``, from ``block`` (:func:`_array`)."""
+    return _array(block, place, place.offset + 8 * i * place.width, 1, place.width)
+
+
+def _transport_row(block: bytes, place: _Place, i: int) -> np.ndarray:
+    """Model ``i``'s transport term, ``(1, N)`` (``(1, 0)`` where it has none)."""
+    if place.transport_rows <= i:
+        return np.zeros((1, 0))
+    return _array(block, place, place.transport + 8 * i * place.transport_width, 1,
+                  place.transport_width)
 
 
 def _filled(summary: ClipSummary, **fields) -> ClipSummary:
@@ -395,11 +440,80 @@ def _read_only(values: np.ndarray) -> np.ndarray:
 #: What a compact summary holds in place of its time, aperture and familiarities: shared,
 #: never written to.
 _NO_VALUES = _read_only(np.zeros(0))
-#: The numbers of a clip's place in :class:`ModelRows`' file: its confidence's offset and
-#: shape, its transport's shape, the offset and length of the rest, pickled, and which of
-#: the model lists is its.
-_PLACE = ("offset", "rows", "width", "transport_rows", "transport_width", "rest", "length",
-          "models")
+class _Place(NamedTuple):
+    """A clip's place in :class:`ModelRows`' file: its confidence's offset and shape, its
+    transport's shape (after it), its time's and aperture's lengths (after that), the
+    offset and length of the rest, pickled, and which of the model lists is its."""
+
+    offset: int
+    rows: int
+    width: int
+    transport_rows: int
+    transport_width: int
+    steps: int
+    samples: int
+    rest: int
+    length: int
+    models: int
+
+    @property
+    def transport(self) -> int:
+        """Where its transport term starts."""
+        return self.offset + 8 * self.rows * self.width
+
+    @property
+    def time(self) -> int:
+        """Where its time starts."""
+        return self.transport + 8 * self.transport_rows * self.transport_width
+
+    @property
+    def aperture(self) -> int:
+        """Where its aperture starts."""
+        return self.time + 8 * self.steps
+
+
+#: The numbers of a :class:`_Place`, as :class:`ModelRows` keeps them (one array of them).
+_PLACE = _Place._fields
+
+
+@dataclass(frozen=True, eq=False)
+class ClipCurves:
+    """A clip's time, grip aperture and one model's curves: what the batch report's
+    profiles and confidence figures read of a clip (:meth:`KeptSummaries.curves`), read
+    back without the rest of its :class:`ClipSummary`.
+
+    Attributes
+    ----------
+    clip : str
+        Clip name.
+    time : (N,) array
+        Time since onset, s.
+    names : list of str
+        The one model.
+    confidence : (1, N) array
+        Its thesis-rule confidence, m (weighted).
+    transport : (1, N) array
+        Its transport term's share (``(1, 0)`` where the clip has none), m.
+    aperture : (N,) array
+        Observed grip aperture, m.
+    """
+
+    clip: str
+    time: np.ndarray
+    names: list[str]
+    confidence: np.ndarray
+    transport: np.ndarray
+    aperture: np.ndarray
+
+    def index(self, model: str) -> int:
+        """Row of ``model`` in the per-model arrays (:meth:`ClipSummary.index`).
+
+        Parameters
+        ----------
+        model : str
+            Model name.
+        """
+        return self.names.index(model)
 
 
 class KeptSummaries(Mapping):
@@ -421,12 +535,28 @@ class KeptSummaries(Mapping):
     """
 
     def __init__(self, rows: ModelRows, clips: dict[str, ClipSummary | None],
-                 model: str | None):
-        self._rows, self._clips, self._model = rows, clips, model
+                 model: str | None, *, curves: bool = False):
+        self._rows, self._clips, self._model, self._curves = rows, clips, model, curves
 
-    def __getitem__(self, clip: str) -> ClipSummary:
+    def __getitem__(self, clip: str) -> ClipSummary | ClipCurves:
         held = self._clips[clip]
-        return self._rows._restored(clip, self._model) if held is None else held
+        if held is not None:
+            return held
+        curves = self._rows._curves(clip, self._model) if self._curves else None
+        return self._rows._restored(clip, self._model) if curves is None else curves
+
+    def curves(self, model: str | None) -> KeptSummaries:
+        """The same clips, each read as its time, aperture and ``model``'s curves alone
+        (:class:`ClipCurves`, about a fifth of a whole read's time) where ``model`` is
+        the one they were kept for; else as here.
+
+        Parameters
+        ----------
+        model : str or None
+            The model whose curves are read (the report's reference model).
+        """
+        return KeptSummaries(self._rows, self._clips, self._model,
+                             curves=model is not None and model == self._model)
 
     def __contains__(self, clip) -> bool:
         return clip in self._clips

@@ -299,3 +299,58 @@ def test_profiles_of_curves_one_at_a_time_are_those_of_every_curve_at_once():
                 curves, axis=0, ddof=1).tobytes()
         assert (rows["n"] == len(mine)).all()
     assert list(pd.unique(table["condition"])) == ["normal", "delayed"]
+
+
+def test_a_clips_curves_come_back_without_the_rest_bit_for_bit(tmp_path):
+    """What the profiles and confidence figures read of a clip (its time, aperture and the
+    reference model's curves) is read back without unpickling the rest of its summary."""
+    from perception.batch_clip import ClipCurves
+
+    results = _results(8)
+    with ModelRows(tmp_path) as rows:
+        scored = [rows.keep(r).summary for r in results]
+        kept = rows.summaries(scored, "grasp-4")
+        curves = kept.curves("grasp-4")
+        assert list(curves) == list(kept) and len(curves) == len(kept)
+        for full in results:
+            s, one = full.summary, curves[full.clip]
+            assert isinstance(one, ClipCurves) and one.names == ["grasp-4"]
+            assert one.clip == s.clip and one.index("grasp-4") == 0
+            for name, values in (("time", s.time), ("aperture", s.aperture),
+                                 ("confidence", s.confidence[4:5]),
+                                 ("transport", s.transport[4:5])):
+                assert getattr(one, name).tobytes() == values.tobytes(), name
+                assert getattr(one, name).shape == values.shape, name
+            # the whole summary read as before, its time and aperture among its arrays
+            whole = kept[full.clip]
+            assert isinstance(whole, ClipSummary)
+            assert whole.time.tobytes() == s.time.tobytes()
+            assert whole.aperture.tobytes() == s.aperture.tobytes()
+            assert whole.traces["time"].tobytes() == s.traces["time"].tobytes()
+        # curves of another model than the one kept for: the whole summary, as before
+        assert isinstance(kept.curves("grasp-2")[results[0].clip], ClipSummary)
+
+
+def test_the_report_reads_its_profiles_and_confidence_figures_from_the_curves(tmp_path):
+    """Six of the report's twelve passes over the clips read their curves alone."""
+    results = _results(6)
+    with ModelRows(tmp_path) as rows:
+        kept = [rows.keep(r) for r in results]
+        scored = [r.summary for r in kept]
+        reference = reference_model(scored, [r.condition for r in kept])
+        calls = {"whole": 0, "curves": 0}
+        restored, curves = rows._restored, rows._curves
+
+        def counted(kind, read):
+            def read_counted(*args):
+                calls[kind] += 1
+                return read(*args)
+            return read_counted
+
+        rows._restored, rows._curves = counted("whole", restored), counted("curves", curves)
+        write_batch_report(summary_table(kept, reference), rows.summaries(scored, reference),
+                           tmp_path / "out", figure_format="svg")
+    n = len(results)
+    # aperture profiles, typical clips, every clip's confidence, three condition profiles
+    assert calls["curves"] >= 6 * n
+    assert calls["whole"] <= 6 * n

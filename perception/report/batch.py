@@ -142,6 +142,13 @@ class _Clips(Sequence):
     def __len__(self) -> int:
         return len(self.names)
 
+    def curves(self, model: str) -> _Clips:
+        """The same clips, each read as its time, aperture and ``model``'s curves alone
+        where the mapping can (a batch's: :meth:`~perception.batch_clip.KeptSummaries.curves`,
+        without unpickling the rest); else as here."""
+        curves = getattr(self._recognitions, "curves", None)
+        return self if curves is None else _Clips(curves(model), self.names)
+
 
 def _e(value) -> str:
     """A cell's text, escaped; empty for None and NaN."""
@@ -360,11 +367,14 @@ def _written(fig, stem: Path, fmt: str, dpi: int) -> None:
     gc.collect()
 
 
-def _chapter5(recs: list[ClipSummary], conds: list[str], reference: str, models, out: Path,
+def _chapter5(recs: _Clips, conds: list[str], reference: str, models, out: Path,
               fmt: str, dpi: int) -> None:
     """The four chapter 5 figures (matplotlib) and their tables."""
     model = next((m for m in models or () if m.name == reference), None)
     own = model_aperture(model) if model is not None else None
+    # six passes over the clips, each reading a clip's time, aperture and the reference
+    # model's curves alone: a whole clip read back is mostly unpickling the rest
+    recs = recs.curves(reference)
     ap = aperture_profiles(recs, conds)
     if own is not None:
         ap = pd.concat([ap, own.assign(condition=f"model:{reference}", n=1)],
