@@ -38,7 +38,7 @@ def test_write_json_writes_the_text_of_encoding_twice(tmp_path):
         "scalars": [np.float64("nan"), np.float32(0.1), np.int64(7), np.bool_(True),
                     Float(1.5), True, None, "é \u2028"],
         # keys json writes as text, a later equal one replacing the first's value
-        "keys": {1: "a", "1": "b", 2.5: "c", True: "d", None: "e"},
+        "keys": {2: "a", "2": "b", 2.5: "c", False: "d", None: "e"},
         "other": {"set": {3, 1, 2}, "path": Path("/a/b"), "tuple": (1, (2, [np.nan]))},
         "empty": [{}, [], ()],
     }
