@@ -402,7 +402,6 @@ class ModelRows:
                                     for s in summaries}, model)
 
 
-
 def _array(block: bytes, place: _Place, offset: int, *shape: int) -> np.ndarray:
     """The float64 array of ``shape`` at ``offset`` in the file, from ``block`` (the bytes
     from ``place``'s first array on), a copy of its own."""
@@ -440,6 +439,8 @@ def _read_only(values: np.ndarray) -> np.ndarray:
 #: What a compact summary holds in place of its time, aperture and familiarities: shared,
 #: never written to.
 _NO_VALUES = _read_only(np.zeros(0))
+
+
 class _Place(NamedTuple):
     """A clip's place in :class:`ModelRows`' file: its confidence's offset and shape, its
     transport's shape (after it), its time's and aperture's lengths (after that), the
@@ -532,6 +533,9 @@ class KeptSummaries(Mapping):
         (one not kept there, held as it is).
     model : str or None
         The reference model (:meth:`ModelRows.restored`).
+    curves : bool
+        Read each clip kept in ``rows`` as its time, aperture and ``model``'s
+        curves alone (:class:`ClipCurves`; :meth:`curves`).
     """
 
     def __init__(self, rows: ModelRows, clips: dict[str, ClipSummary | None],
