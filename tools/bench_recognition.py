@@ -26,6 +26,10 @@ batch's own process runs under tracemalloc (slower: for small studies) and
 the table adds what it held when the clips were in and its peaks, while the
 clips ran, in the report and over the run, a trial more: Python's and
 numpy's allocations, without the allocator's noise.
+
+``--only report-reads`` times the batch report's reads of a kept clip: a whole
+summary (unpickled) and its curves alone (``KeptSummaries.curves``), µs of thread
+CPU a clip and pass (``--trials``: the clips kept, 600 by default).
 """
 
 from __future__ import annotations
@@ -489,6 +493,46 @@ def study_rows(participants: int, trials: int, jobs: int, conditions: int = 2,
     return rows
 
 
+def report_reads_rows(trials: int = 400, rounds: int = 15) -> list[tuple[str, str, str, str]]:
+    """The batch report's reads of a kept clip (:class:`~perception.batch_clip.ModelRows`):
+    a whole summary, and its time, aperture and the reference model's curves alone
+    (:meth:`~perception.batch_clip.KeptSummaries.curves`); thread CPU a clip and pass,
+    fastest and median of ``rounds`` passes over ``trials`` real Optotrak trials' summaries
+    (the shipped four, recognised, kept under new names in turn)."""
+    import statistics
+
+    from bench_mocap import SOURCE
+
+    from perception.batch_clip import ClipResult, ModelRows
+    from perception.recognition.repertoire import Repertoire
+    from perception.recordings import MocapImport, read_reaches, recognize_reach
+    from perception.report.clip import ClipSummary
+
+    rep = Repertoire.default()
+    shipped = [ClipSummary.from_recognition(recognize_reach(r, rep)[0])
+               for r in read_reaches(SOURCE, MocapImport(rate=85))]
+    model = shipped[0].reference_model
+    spent: dict[str, list[float]] = {"whole": [], "curves": []}
+    with tempfile.TemporaryDirectory() as folder, ModelRows(Path(folder)) as rows:
+        kept = [rows.keep(ClipResult(f"t{k}", None, "ok", summary=dataclasses.replace(
+            shipped[k % len(shipped)], clip=f"t{k}"))).summary for k in range(trials)]
+        whole = rows.summaries(kept, model)
+        reads = {"whole": whole, "curves": whole.curves(model)}
+        for _ in range(rounds):
+            for kind, clips in reads.items():
+                t0 = time.thread_time()
+                for clip in clips:
+                    clips[clip]
+                spent[kind].append((time.thread_time() - t0) / trials * 1e6)
+    return [(f"report: a kept clip read back, {what}", f"{min(spent[kind]):.0f} µs",
+             f"median {statistics.median(spent[kind]):.0f} µs a clip and pass ({trials} "
+             f"trials, {rounds} passes); {note}", "")
+            for kind, what, note in (
+                ("whole", "whole", "six of the report's twelve passes"),
+                ("curves", "its curves alone", "the other six: profiles, typical clips, "
+                 "every clip's confidence"))]
+
+
 def main(argv: list[str] | None = None) -> None:
     """Print the recognition and scaling figures."""
     import argparse
@@ -496,9 +540,9 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rounds", type=int, default=ROUNDS,
                         help=f"runs of each batch configuration, the best counts ({ROUNDS})")
-    parser.add_argument("--only", choices=("phases", "study"),
-                        help="only the phase table of a motion-capture batch, or only the "
-                        "study")
+    parser.add_argument("--only", choices=("phases", "study", "report-reads"),
+                        help="only the phase table of a motion-capture batch, only the "
+                        "study, or only the report's reads of a kept clip")
     parser.add_argument("--trials", type=int, default=600,
                         help="trials of the phase table's table (600)")
     parser.add_argument("--participants", type=int, default=100,
@@ -530,6 +574,10 @@ def main(argv: list[str] | None = None) -> None:
         table(f"perception: a lab's study through batch ({cores} cores)",
               study_rows(args.participants, args.study_trials, jobs, args.conditions,
                          args.traced))
+        return
+    if args.only == "report-reads":
+        table("perception: the batch report's reads of a clip (thread CPU)",
+              report_reads_rows(args.trials))
         return
     if args.only == "phases":
         table(f"perception: where a batch's time goes ({cores} cores)",
