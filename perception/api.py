@@ -23,9 +23,17 @@ from perception.geometry import DEFAULT_OBJECT_DIAMETER, SimilarityTransform
 from perception.io.tracks import Status, Tracks, TracksWriter
 from perception.io.video import FrameSource, open_source, open_video, write_video
 from perception.landmarks import LandmarkParams, Landmarks
+from perception.loading import load_movements
 from perception.measure import landmarks
-from perception.movement_record import MovementRecord, movement_record
-from perception.observation import MovementSpan, Observation, ObserveParams, movement_span, observe
+from perception.movement_record import MovementRecord
+from perception.observation import (
+    MovementSpan,
+    Observation,
+    ObserveParams,
+    movement_record,
+    movement_span,
+    observe,
+)
 from perception.online import OnlineRecognizer, SettleRule
 from perception.pipeline import RecognitionSettings, load_clip, recognize_clip
 from perception.reaches import MarkerMap
@@ -42,7 +50,6 @@ from perception.recognition.engine import StepScorer
 from perception.recognition.rules import VerdictRules, judge
 from perception.recordings import MocapImport, read_reaches, recognize_reach
 from perception.report import write_batch_report, write_clip_report
-from perception.sources import load_movements
 from perception.synthetic.demos import demo_tracks
 from perception.synthetic.recipes import load_recipe, synthesize
 from perception.synthetic.render import render_clip

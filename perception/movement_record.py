@@ -2,12 +2,13 @@
 
 A video's tracks and a pose file's are pixels, y down, at a scale the object
 tells; a motion-capture reach's are metres in its movement's plane, y up.
-:func:`movement_record` brings any of them to one :class:`MovementRecord`: the
+:func:`~perception.observation.movement_record` brings any of them to one
+:class:`MovementRecord`: the
 wrist (the transport point), finger, thumb and object in metres, x right and y
 up, about the object's centre as the first frames show it, with the clock,
 which samples each marker was seen in, the scale taken and where from, and the
 notes of how the input was read. Every source's loader ends here
-(:func:`perception.sources.load_movements`), and so does the observation
+(:func:`perception.loading.load_movements`), and so does the observation
 (:func:`perception.observation.observe`), which turns the record into the
 model frame by a rotation alone (the approach): recognition, landmarks and
 the online recogniser see one record, online and offline alike.
@@ -31,7 +32,7 @@ if TYPE_CHECKING:
 
     from perception.observation import ObserveParams
 
-__all__ = ["MARKERS", "MovementRecord", "movement_record", "reading_notes"]
+__all__ = ["MARKERS", "MovementRecord", "make_record", "reading_notes"]
 
 #: The record's markers: the transport point, the digits and the object.
 MARKERS = ("wrist", "finger", "thumb", "object")
@@ -185,36 +186,9 @@ def reading_notes(tracks) -> tuple[str, ...]:
     return (*read, *cleaning_notes(tracks))
 
 
-def movement_record(tracks, params: ObserveParams | None = None, *,
-                    clip: str | None = None) -> MovementRecord:
-    """The movement of some tracks in metres, x right and y up, about the object at rest.
-
-    Parameters
-    ----------
-    tracks : Tracks
-        A video's or pose file's (pixels, y down; the scale from ``params.px_per_m``
-        or the object's apparent size over ``params.object_diameter``), or a
-        motion-capture reach's in its plane (:attr:`~perception.io.tracks.Tracks.units`
-        ``"m"``). The markers ``wrist``, ``finger``, ``thumb`` and ``object`` are needed.
-    params : ObserveParams, optional
-        The scale, the object's size, the rest frames and the clock's checks.
-    clip : str, optional
-        Clip name for messages and the record (default: the tracks').
-
-    Raises
-    ------
-    InputError
-        Naming the tracks file (else the clip): a needed marker is missing or
-        never seen, the time stamps are not increasing finite seconds, the clip
-        does not start with every marker seen, or the scale is unknown.
-    """
-    from perception.boundary import expect
-    from perception.io.tracks import Tracks
-    from perception.observation import ObserveParams
-
-    expect(tracks, Tracks, "movement_record(tracks=)", hint="perception.load_tracks")
-    expect(params, ObserveParams, "movement_record(params=)", optional=True)
-    params = ObserveParams() if params is None else params
+def make_record(tracks, params: ObserveParams, clip: str | None = None) -> MovementRecord:
+    """:func:`perception.observation.movement_record` of checked arguments: the record of
+    ``tracks`` at ``params``' scale and rest, named ``clip`` (default: the tracks')."""
     name = clip or getattr(tracks, "name", None) or "clip"
     path = getattr(tracks, "path", None)
     source = str(path) if path is not None else name

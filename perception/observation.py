@@ -35,7 +35,7 @@ from perception.filtering import alpha_beta
 from perception.geometry import DEFAULT_OBJECT_DIAMETER, SimilarityTransform
 from perception.io.pose import is_pose_file
 from perception.movement_bounds import end_row, onset_time
-from perception.movement_record import MARKERS, MovementRecord, movement_record, reading_notes
+from perception.movement_record import MARKERS, MovementRecord, make_record, reading_notes
 from perception.resume import Grown, Kept, Ordered, extended, rowwise
 from perception.validation import Int, Positive, Tuple, declared
 
@@ -46,6 +46,7 @@ __all__ = [
     "Observation",
     "RestScene",
     "check_hand",
+    "movement_record",
     "movement_span",
     "observe",
     "rest_scene",
@@ -379,6 +380,38 @@ def _source(tracks, name: str) -> str:
     return str(path) if path is not None else name
 
 
+def movement_record(tracks, params: ObserveParams | None = None, *,
+                    clip: str | None = None) -> MovementRecord:
+    """The movement of some tracks in metres, x right and y up, about the object at rest:
+    the record :func:`observe` turns into the model frame (docs/coordinates.md).
+
+    Parameters
+    ----------
+    tracks : Tracks
+        A video's or pose file's (pixels, y down; the scale from ``params.px_per_m``
+        or the object's apparent size over ``params.object_diameter``), or a
+        motion-capture reach's in its plane (:attr:`~perception.io.tracks.Tracks.units`
+        ``"m"``). The markers ``wrist``, ``finger``, ``thumb`` and ``object`` are needed.
+    params : ObserveParams, optional
+        The scale, the object's size, the rest frames and the clock's checks.
+    clip : str, optional
+        Clip name for messages and the record (default: the tracks').
+
+    Raises
+    ------
+    InputError
+        Naming the tracks file (else the clip): a needed marker is missing or
+        never seen, the time stamps are not increasing finite seconds, the clip
+        does not start with every marker seen, or the scale is unknown.
+    """
+    from perception.boundary import expect
+    from perception.io.tracks import Tracks
+
+    expect(tracks, Tracks, "movement_record(tracks=)", hint="perception.load_tracks")
+    expect(params, ObserveParams, "movement_record(params=)", optional=True)
+    return make_record(tracks, ObserveParams() if params is None else params, clip)
+
+
 def _scene_transform(record: MovementRecord, tracks, params: ObserveParams
                      ) -> SimilarityTransform:
     """The tracks -> model transform: the record's plane turned by the approach, the
@@ -448,7 +481,7 @@ def rest_scene(tracks, params: ObserveParams | None = None, *,
     if longer is not None:
         scene, order = longer
     else:
-        record = movement_record(tracks, params, clip=clip)
+        record = make_record(tracks, params, clip)
         time, dts = record.time, np.diff(record.time)
         transform = _scene_transform(record, tracks, params)
         raw = np.stack([transform.rotated(getattr(record, m)) for m in DIGIT_MARKERS], axis=1)

@@ -17,11 +17,11 @@ from _demos import dlc_csv
 
 from perception.errors import InputError
 from perception.io.pose import PoseImport
-from perception.movement_record import MARKERS, MovementRecord, movement_record
-from perception.observation import ObserveParams, observe
+from perception.loading import load_movements
+from perception.movement_record import MARKERS, MovementRecord
+from perception.observation import ObserveParams, movement_record, observe
 from perception.pipeline import RecognitionSettings
 from perception.recordings import MocapImport, read_recording
-from perception.sources import load_movements
 from perception.synthetic.independent import draw_independent, independent_paths, tracked_paths
 from perception.synthetic.scene import Camera
 
