@@ -28,24 +28,29 @@ class Movements(NamedTuple):
     ----------
     records : list of MovementRecord
         One per clip, or per reach of a motion-capture recording.
-    not_read : list of (str, str)
+    no_reach : list of (str, str)
         ``(name, why)`` of each trial or movement of a recording that gives no
-        reach (:attr:`perception.recordings.Recording.unscored`).
+        reach (:attr:`perception.recordings.Recording.unscored`), or whose reach
+        could not be observed.
     """
 
     records: list
-    not_read: list
+    no_reach: list
 
 
-def _record(tracks, observe, clip: str, **also):
-    """The record recognition observes: from the first rows at rest, as it settles them."""
+def _record(tracks, observe, clip: str, source: str, **also):
+    """The record recognition observes: from the first rows at rest, as it settles them;
+    a refusal names ``source``, the file the user gave, as ``recognize``'s does."""
     from perception.observation import movement_record
     from perception.settling import settle_start
 
-    tracks, settled = settle_start(tracks, observe, clip=clip)
-    rec = movement_record(tracks, observe, clip=clip)
+    try:
+        tracks, settled = settle_start(tracks, observe, clip=clip)
+        rec = movement_record(tracks, observe, clip=clip)
+    except InputError as exc:
+        raise type(exc)(exc.problem, source, field=exc.field) from None
     notes = (*also.pop("notes", ()), *rec.notes, *((settled,) if settled else ()))
-    return dataclasses.replace(rec, notes=notes, **also)
+    return dataclasses.replace(rec, source=source, notes=notes, **also)
 
 
 def _load_clip(source, settings, tracks_out) -> Movements:
@@ -54,7 +59,8 @@ def _load_clip(source, settings, tracks_out) -> Movements:
 
     tracks = load_clip(source, tracks_out=tracks_out, setup=settings.tracking,
                        pose=settings.pose, **settings.video_options())
-    return Movements([_record(tracks, settings.observe, clip_name(source)[0])], [])
+    return Movements([_record(tracks, settings.observe, clip_name(source)[0],
+                              os.fspath(source))], [])
 
 
 def _load_recording(source, settings, tracks_out) -> Movements:
@@ -65,13 +71,16 @@ def _load_recording(source, settings, tracks_out) -> Movements:
     recording = read_recording(source, options)
     wrist = (f"wrist: the models' own, {options.reaches.wrist_behind * 100:g} cm behind the "
              "grip (no marker's)")
-    records = []
+    records, none = [], [(u.name, u.reason) for u in recording.unscored]
     for reach in recording.reaches:
-        p = prepare_reach(reach, settings, options)
-        records.append(_record(p.tracks, p.settings.observe, reach.name, source=reach.source,
-                               clock_offset=p.paths.clock_offset,
-                               notes=(*p.info["notes"], wrist)))
-    return Movements(records, [(u.name, u.reason) for u in recording.unscored])
+        try:  # one reach that cannot be observed costs that reach, not the recording
+            p = prepare_reach(reach, settings, options)
+            records.append(_record(p.tracks, p.settings.observe, reach.name, reach.source,
+                                   clock_offset=p.paths.clock_offset,
+                                   notes=(*p.info["notes"], wrist)))
+        except InputError as exc:
+            none.append((reach.name, exc.problem))
+    return Movements(records, none)
 
 
 #: Each file kind's loader: ``load(source, settings, tracks_out) -> Movements`` (a live
@@ -87,9 +96,10 @@ def load_movements(source: str | os.PathLike, settings=None, *,
 
     A video is tracked (its tracks file written as ``recognize`` writes it, or a current
     one read), a tracks or pose file read, a motion-capture recording's reaches found and
-    each brought into its movement's plane; a start that is not yet at rest is left out
-    as recognition leaves it out (:func:`~perception.settling.settle_start`, its note among
-    the record's).
+    each brought into its movement's plane. A start that is not yet at rest is settled as
+    recognition settles it (:func:`~perception.settling.settle_start`): its first frames
+    left out, or, where the hand moves from the first frame, that frame held still before
+    it; its note is among the record's.
 
     Parameters
     ----------
@@ -107,8 +117,10 @@ def load_movements(source: str | os.PathLike, settings=None, *,
         An input of no kind, a camera or a stream (``hammer-mv watch`` reads those), or
         one that cannot be read, naming the file and the field.
     """
+    from perception.boundary import expect
     from perception.pipeline import RecognitionSettings
 
+    expect(settings, RecognitionSettings, "load_movements(settings=)", optional=True)
     settings = RecognitionSettings() if settings is None else settings
     kind = input_kind(source)
     load = LOADERS.get(kind.name) if kind is not None else None

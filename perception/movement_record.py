@@ -52,15 +52,17 @@ class MovementRecord:
         Time stamps, s, on the input's clock (a motion-capture reach's from its first
         sample: add ``clock_offset`` for the recording's).
     frame : (T,) int array
-        The input's frame (row) of each sample.
+        The input's frame of each sample (a motion-capture reach's sample, counted from
+        its first; a start held still, as recognition holds one, repeats its first frame:
+        see the notes).
     wrist, finger, thumb, object : (T, 2) arrays
         Positions, m; NaN where the marker was not seen.
-    plane : SimilarityTransform
+    input_transform : SimilarityTransform
         Input units -> these metres (:meth:`~perception.geometry.SimilarityTransform.
         to_plane`): the object's centre in the input's units (``origin_px``),
         the scale (``px_per_m``: 1 for an input in metres) and whether the
-        input's y runs down. Its ``to_pixels`` of the model frame draws on the
-        input once the observation has set the rotation.
+        input's y runs down. With the approach's rotation set, it is the
+        observation's scene (:attr:`~perception.observation.Observation.scene`).
     scale_from : str
         Where the scale came from: ``metres`` (the input is in metres),
         ``px_per_m`` (given) or ``object`` (its apparent diameter over
@@ -82,7 +84,7 @@ class MovementRecord:
     finger: np.ndarray = field(repr=False)
     thumb: np.ndarray = field(repr=False)
     object: np.ndarray = field(repr=False)
-    plane: SimilarityTransform = field(repr=False)
+    input_transform: SimilarityTransform = field(repr=False)
     scale_from: str = "metres"
     object_diameter: float = 0.0
     notes: tuple[str, ...] = ()
@@ -91,7 +93,7 @@ class MovementRecord:
     @property
     def px_per_m(self) -> float:
         """Input units per metre (1 for an input in metres)."""
-        return self.plane.px_per_m
+        return self.input_transform.px_per_m
 
     @property
     def seen(self) -> dict[str, np.ndarray]:
@@ -186,17 +188,19 @@ def reading_notes(tracks) -> tuple[str, ...]:
     return (*read, *cleaning_notes(tracks))
 
 
-def make_record(tracks, params: ObserveParams, clip: str | None = None) -> MovementRecord:
+def make_record(tracks, params: ObserveParams, clip: str | None = None, *,
+                notes: bool = True) -> MovementRecord:
     """:func:`perception.observation.movement_record` of checked arguments: the record of
-    ``tracks`` at ``params``' scale and rest, named ``clip`` (default: the tracks')."""
+    ``tracks`` at ``params``' scale and rest, named ``clip`` (default: the tracks'); without
+    its ``notes`` where the caller gives them (a scene fixed while a start is settled)."""
     name = clip or getattr(tracks, "name", None) or "clip"
     path = getattr(tracks, "path", None)
     source = str(path) if path is not None else name
     pos = _positions(tracks, params, source)
     time, _ = _frame_times(tracks, params, source)
-    plane, scale_from = _plane(pos, tracks, params, source)
-    xy = {m: plane.to_plane(pos[m]) for m in MARKERS}
+    to_metres, scale_from = _plane(pos, tracks, params, source)
+    xy = {m: to_metres.to_plane(pos[m]) for m in MARKERS}
     frame = np.asarray(getattr(tracks, "frame", np.arange(len(time))))
-    return MovementRecord(name, source, time, frame, plane=plane, scale_from=scale_from,
-                          object_diameter=float(params.object_diameter),
-                          notes=reading_notes(tracks), **xy)
+    return MovementRecord(name, source, time, frame, input_transform=to_metres,
+                          scale_from=scale_from, object_diameter=float(params.object_diameter),
+                          notes=reading_notes(tracks) if notes else (), **xy)

@@ -414,17 +414,17 @@ def movement_record(tracks, params: ObserveParams | None = None, *,
 
 def _scene_transform(record: MovementRecord, tracks, params: ObserveParams
                      ) -> SimilarityTransform:
-    """The tracks -> model transform: the record's plane turned by the approach, the
+    """The tracks -> model transform: the record's turned by the approach, the
     direction from the wrist at rest toward the object (taken in the input's units: the
     same angle as in the record's metres, and the bits it had before the record)."""
     d = (np.median(np.asarray(tracks.marker("wrist"), dtype=float)[: params.rest_frames],
-                   axis=0) - record.plane.origin_px)
+                   axis=0) - record.input_transform.origin_px)
     # from the wrist toward the object, y up
-    approach = np.array([-d[0], d[1]]) if record.plane.y_down else -d
+    approach = np.array([-d[0], d[1]]) if record.input_transform.y_down else -d
     if np.linalg.norm(approach) < 1e-6:
         raise InputError("impossible geometry: the wrist starts on the object", record.source)
-    return dataclasses.replace(record.plane, rotation=float(np.arctan2(approach[1], approach[0])),
-                               mirror=params.mirror)
+    return dataclasses.replace(record.input_transform, mirror=params.mirror,
+                               rotation=float(np.arctan2(approach[1], approach[0])))
 
 
 def _rest_noise(raw: np.ndarray, params: ObserveParams, name: str) -> tuple[float, np.ndarray]:
@@ -481,7 +481,7 @@ def rest_scene(tracks, params: ObserveParams | None = None, *,
     if longer is not None:
         scene, order = longer
     else:
-        record = make_record(tracks, params, clip)
+        record = make_record(tracks, params, clip, notes=False)  # observe gives them
         time, dts = record.time, np.diff(record.time)
         transform = _scene_transform(record, tracks, params)
         raw = np.stack([transform.rotated(getattr(record, m)) for m in DIGIT_MARKERS], axis=1)

@@ -67,7 +67,7 @@ def test_a_given_scale_wins_and_the_plane_maps_back_to_pixels():
     tracks, _, params = _rendered()
     rec = movement_record(tracks, ObserveParams(px_per_m=350.0))
     assert rec.scale_from == "px_per_m" and rec.px_per_m == 350.0
-    back = rec.plane.origin_px + rec.wrist * [350.0, -350.0]
+    back = rec.input_transform.origin_px + rec.wrist * [350.0, -350.0]
     np.testing.assert_allclose(back, tracks.marker("wrist"), atol=1e-9)
 
 
@@ -78,8 +78,8 @@ def test_the_observation_is_the_record_turned():
     p = ObserveParams(object_diameter=params.object_size)
     rec = movement_record(tracks, p)
     obs = observe(tracks, p)
-    assert np.array_equal(obs.scene.origin_px, rec.plane.origin_px)
-    assert obs.scene.px_per_m == rec.plane.px_per_m
+    assert np.array_equal(obs.scene.origin_px, rec.input_transform.origin_px)
+    assert obs.scene.px_per_m == rec.input_transform.px_per_m
     raw = np.stack([obs.scene.rotated(getattr(rec, m)) for m in ("wrist", "finger", "thumb")],
                    axis=1)
     assert np.array_equal(raw, obs.clip_raw, equal_nan=True)
@@ -102,11 +102,32 @@ def test_a_record_says_where_each_marker_was_seen_and_reads_as_a_table():
     assert len(table) == tracks.n_frames
 
 
-def test_the_scale_unknown_is_refused_naming_the_field():
+def test_the_scale_unknown_is_refused_naming_the_setting():
     tracks, _, _ = _rendered()
     bare = tracks.replace(tracker={})
     with pytest.raises(InputError, match="image scale unknown.*`px_per_m`"):
         movement_record(bare)
+
+
+def test_a_start_not_at_rest_is_settled_as_recognition_settles_it(tmp_path):
+    """The record load_movements gives is the one recognition observed, where the start
+    had to be settled: rotated, it is the observation's raw markers, bit for bit."""
+    from _demos import default_repertoire
+
+    from perception.pipeline import recognize_tracks
+
+    tracks, _, params = _rendered(seed=8)
+    pos = tracks.position.copy()
+    pos[0, tracks.markers.index("wrist")] += 40.0  # a one-frame spike at the start
+    spiky = tracks.replace(position=pos)
+    path = spiky.save(tmp_path / "spike.tracks.h5")
+    settings = RecognitionSettings(observe=ObserveParams(object_diameter=params.object_size))
+    rec = load_movements(path, settings).records[0]
+    assert any("left out" in n for n in rec.notes) and len(rec.time) < spiky.n_frames
+    obs = recognize_tracks(spiky, default_repertoire(), settings).observation
+    raw = np.stack([obs.scene.rotated(getattr(rec, m)) for m in ("wrist", "finger", "thumb")],
+                   axis=1)
+    assert np.array_equal(raw, obs.clip_raw, equal_nan=True)
 
 
 def test_a_tracks_file_loads_as_recognition_observes_it(tmp_path):
@@ -114,7 +135,7 @@ def test_a_tracks_file_loads_as_recognition_observes_it(tmp_path):
     path = tracks.save(tmp_path / "grasp.tracks.h5")
     settings = RecognitionSettings(observe=ObserveParams(object_diameter=params.object_size))
     loaded = load_movements(path, settings)
-    assert loaded.not_read == [] and len(loaded.records) == 1
+    assert loaded.no_reach == [] and len(loaded.records) == 1
     rec = loaded.records[0]
     assert isinstance(rec, MovementRecord) and rec.clip == "grasp" and rec.source == str(path)
     same = movement_record(tracks, settings.observe)
@@ -127,7 +148,7 @@ def test_a_pose_file_loads_in_metres(tmp_path):
     settings = RecognitionSettings(pose=PoseImport(fps=30.0, object_diameter_px=80.0))
     rec = load_movements(path, settings).records[0]
     assert rec.scale_from == "object" and rec.px_per_m == pytest.approx(80.0 / 0.10)
-    rel = tracks.marker("wrist") - rec.plane.origin_px
+    rel = tracks.marker("wrist") - rec.input_transform.origin_px
     np.testing.assert_allclose(rec.wrist[:, 0], rel[:, 0] / rec.px_per_m, atol=1e-9)
     np.testing.assert_allclose(rec.wrist[:, 1], -rel[:, 1] / rec.px_per_m, atol=1e-9)
 
@@ -138,7 +159,7 @@ def test_a_recording_gives_one_record_per_reach_and_says_what_gave_none():
     loaded = load_movements(path, RecognitionSettings(mocap=OPTOTRAK))
     # nothing lost: every reach a record, every other entry a line saying why
     assert len(loaded.records) == len(recording.reaches) > 0
-    assert len(loaded.not_read) == len(recording.unscored)
+    assert len(loaded.no_reach) == len(recording.unscored)
     assert {r.clip for r in loaded.records} == {r.name for r in recording.reaches}
     for rec, reach in zip(loaded.records, recording.reaches):
         assert rec.scale_from == "metres" and rec.px_per_m == 1.0
@@ -147,9 +168,20 @@ def test_a_recording_gives_one_record_per_reach_and_says_what_gave_none():
         # the recording's clock: the reach's onset is where the file has it
         onset = reach.time[reach.onset]
         assert np.min(np.abs(rec.time + rec.clock_offset - onset)) < 1e-9
-        assert not rec.plane.y_down
+        assert not rec.input_transform.y_down
         # a hand-span apart at rest, at most: metres, not millimetres
         assert np.linalg.norm(rec.wrist[0]) < 1.0
+
+
+@pytest.mark.parametrize("name", ["vicon-nexus-trajectories.csv", "motive-export.csv"])
+def test_a_recording_without_reaches_says_why_for_every_trial(name):
+    """Nothing lost: a recording none of whose trials holds a reach gives no record and a
+    line per trial saying why."""
+    recording = read_recording(DATA / name)
+    loaded = load_movements(DATA / name)
+    assert loaded.records == [] and len(recording.unscored) >= 1
+    assert [n for n, _ in loaded.no_reach] == [u.name for u in recording.unscored]
+    assert all(why for _, why in loaded.no_reach)
 
 
 def test_a_recordings_object_size_reaches_its_records():
@@ -188,3 +220,11 @@ def test_a_video_is_tracked_to_the_metres_of_its_ground_truth(tmp_path):
         err = np.linalg.norm(getattr(rec, m)[seen] - getattr(truth, m)[seen], axis=1)
         # about a third of a pixel at 800 px/m (measured 0.4-0.5 mm, at most 1 mm)
         assert np.median(err) < 0.0015 and err.max() < 0.003, m
+    # a refusal names the video the user gave, not the tracks file made from it
+    with pytest.raises(InputError, match=r"grasp\.mp4: clip too short"):
+        load_movements(clip.video, RecognitionSettings(observe=ObserveParams(min_frames=500)))
+
+
+def test_load_movements_checks_its_settings():
+    with pytest.raises(TypeError, match="load_movements"):
+        load_movements(DATA / "optotrak-trials.tsv", "fast")
