@@ -39,6 +39,7 @@ from perception.recognition.repertoire import PlanCache, Repertoire
 from perception.report.clip import (
     KINEMATICS_COLUMNS,
     ClipSummary,
+    PerModel,
     clip_outputs,
     measured_traces,
     remove_output,
@@ -478,7 +479,7 @@ _PLACE = _Place._fields
 
 
 @dataclass(frozen=True, eq=False)
-class ClipCurves:
+class ClipCurves(PerModel):
     """A clip's time, grip aperture and one model's curves: what the batch report's
     profiles and confidence figures read of a clip (:meth:`KeptSummaries.curves`), read
     back without the rest of its :class:`ClipSummary`.
@@ -505,16 +506,6 @@ class ClipCurves:
     confidence: np.ndarray
     transport: np.ndarray
     aperture: np.ndarray
-
-    def index(self, model: str) -> int:
-        """Row of ``model`` in the per-model arrays (:meth:`ClipSummary.index`).
-
-        Parameters
-        ----------
-        model : str
-            Model name.
-        """
-        return self.names.index(model)
 
 
 class KeptSummaries(Mapping):

@@ -201,11 +201,7 @@ class LandmarkParams:
 
     def speed_of(self, time: np.ndarray, path: np.ndarray) -> np.ndarray:
         """(N,) speed of a path (N, D) after :meth:`lowpass`, m/s (NaN where lost)."""
-        return self._speed_of(time, path, _step(time))
-
-    def _speed_of(self, time: np.ndarray, path: np.ndarray, step: float) -> np.ndarray:
-        """:meth:`speed_of` with the median time ``step`` found, s."""
-        p = self._lowpass(time, path, step)
+        p = self._lowpass(time, path, _step(time))
         if len(time) < 3:
             return np.full(len(time), np.nan)
         return row_norm(np.gradient(p, np.asarray(time, dtype=float), axis=0))

@@ -47,18 +47,23 @@ class _Rows:
     them (a pass over every row at every row)."""
 
     def __init__(self, markers: int):
-        self.n = 0
         self._markers = markers
         self._a: dict[str, Grown] = {}
 
+    def _shapes(self) -> dict[str, tuple[tuple, type]]:
+        m = self._markers
+        return {"frame": ((), np.int64), "time": ((), float), "position": ((m, 2), float),
+                "likelihood": ((m,), float), "status": ((m,), np.int64)}
+
+    @property
+    def n(self) -> int:
+        """Rows received."""
+        return len(self._a["time"].rows()) if self._a else 0
+
     def append(self, *row) -> None:
         if not self._a:  # the first row sets the buffers (doubling as they fill)
-            shapes = {"frame": ((), np.int64), "time": ((), float),
-                      "position": ((self._markers, 2), float),
-                      "likelihood": ((self._markers,), float),
-                      "status": ((self._markers,), np.int64)}
             self._a = {k: Grown(np.empty((0, *shape), dtype), extendable=False)
-                       for k, (shape, dtype) in shapes.items()}
+                       for k, (shape, dtype) in self._shapes().items()}
         # each value as its row first (cast and broadcast as an assignment does): one
         # that cannot be leaves no field a row longer than the others
         rows = []
@@ -68,7 +73,6 @@ class _Rows:
             rows.append((self._a[key], one))
         for g, one in rows:
             g.append(one)
-        self.n += 1
 
     def arrays(self, last: bool = False, views: bool = False) -> dict | None:
         """Every row (copies; with ``views``, read-only views of the rows, which never
@@ -76,9 +80,8 @@ class _Rows:
         if last:
             return None if not self.n else {k: a.rows()[-1] for k, a in self._a.items()}
         if not self.n:
-            return {k: np.empty((0, *shape)) for k, shape in
-                    (("frame", ()), ("time", ()), ("position", (self._markers, 2)),
-                     ("likelihood", (self._markers,)), ("status", (self._markers,)))}
+            return {k: np.empty((0, *shape), dtype) for k, (shape, dtype) in
+                    self._shapes().items()}
         return {k: a.rows() if views else a.rows().copy() for k, a in self._a.items()}
 
 

@@ -27,9 +27,9 @@ from perception.io.names import output_stem, printable
 from perception.recognition.result import Recognition
 from perception.report.figures import DPI, FIGURE_FORMATS
 
-__all__ = ["KINEMATICS_COLUMNS", "ClipSummary", "clip_figures", "clip_outputs", "clip_traces",
-           "measured_traces", "remove_output", "remove_stale_reports", "remove_stale_trials",
-           "write_clip_report"]
+__all__ = ["KINEMATICS_COLUMNS", "ClipSummary", "PerModel", "clip_figures", "clip_outputs",
+           "clip_traces", "measured_traces", "remove_output", "remove_stale_reports",
+           "remove_stale_trials", "write_clip_report"]
 
 log = logging.getLogger(__name__)
 
@@ -95,8 +95,25 @@ def _floats(values, n: int | None = None) -> np.ndarray:
     return np.array([np.nan if v is None else v for v in values], dtype=float)
 
 
+class PerModel:
+    """A clip's per-model arrays, a row per model of ``names``: what the batch report reads
+    of a :class:`ClipSummary` and of a :class:`~perception.batch_clip.ClipCurves` alike."""
+
+    names: list[str]
+
+    def index(self, model: str) -> int:
+        """Row of ``model`` in the per-model arrays.
+
+        Parameters
+        ----------
+        model : str
+            Model name.
+        """
+        return self.names.index(model)
+
+
 @dataclass(frozen=True, eq=False)
-class ClipSummary:
+class ClipSummary(PerModel):
     """What a batch keeps of one scored clip (rebuilt from its JSON on resume).
 
     Attributes
@@ -290,15 +307,6 @@ class ClipSummary:
                    warning_values=[w.to_dict() for w in rec.validation_warnings],
                    transport_point=rec.transport_point, time_origin=rec.time_origin)
 
-    def index(self, model: str) -> int:
-        """Row of ``model`` in the per-model arrays.
-
-        Parameters
-        ----------
-        model : str
-            Model name.
-        """
-        return self.names.index(model)
 
 
 def clip_outputs(out: Path, clip: str, figure_format: str = "png") -> dict[str, Path]:
