@@ -39,6 +39,17 @@ class LocatedError(Exception):
         self.problem = message
         super().__init__(": ".join([p for p in (self.path, self.field) if p] + [message]))
 
+    def at(self, path: str | os.PathLike | None) -> LocatedError:
+        """The same error (its kind, field and location) said of ``path``: the file the
+        user gave, where the problem was found in one made from it.
+
+        Parameters
+        ----------
+        path : str or os.PathLike, optional
+            The file to name.
+        """
+        return type(self)(self.problem, path, field=self.field, location=self.location)
+
     def __reduce__(self):
         # rebuilt in the parent process when a worker raises it
         return _rebuild, (type(self), self.problem, self.path, self.field, self.location)

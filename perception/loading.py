@@ -48,7 +48,7 @@ def _record(tracks, observe, clip: str, source: str, **also):
         tracks, settled = settle_start(tracks, observe, clip=clip)
         rec = movement_record(tracks, observe, clip=clip)
     except InputError as exc:
-        raise type(exc)(exc.problem, source, field=exc.field) from None
+        raise exc.at(source) from None
     notes = (*also.pop("notes", ()), *rec.notes, *((settled,) if settled else ()))
     return dataclasses.replace(rec, source=source, notes=notes, **also)
 

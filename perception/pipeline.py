@@ -403,7 +403,7 @@ def recognize_tracks(tracks: Tracks, repertoire: Repertoire,
         if source is None:
             raise
         # name the file the user gave; keep the kind (TrackingError) and the field
-        raise type(exc)(exc.problem, source, field=exc.field) from None
+        raise exc.at(source) from None
     # brought to the reference scale first: a clip that cannot be judged is
     # refused before its scene is planned
     scored_obs, norm = _canonical(obs, repertoire, source, rules)
@@ -454,7 +454,7 @@ def _canonical(obs, repertoire: Repertoire, source, rules: VerdictRules):
     try:
         return canonical(obs, scene, durations, rules, repertoire.wrist_offset())
     except InputError as exc:
-        raise type(exc)(exc.problem, source or obs.clip, field=exc.field) from None
+        raise exc.at(source or obs.clip) from None
 
 
 @functools.lru_cache(maxsize=32, typed=True)

@@ -228,3 +228,18 @@ def test_a_video_is_tracked_to_the_metres_of_its_ground_truth(tmp_path):
 def test_load_movements_checks_its_settings():
     with pytest.raises(TypeError, match="load_movements"):
         load_movements(DATA / "optotrak-trials.tsv", "fast")
+
+
+def test_an_error_said_of_the_users_file_keeps_its_kind_field_and_location():
+    """LocatedError.at: the one way a refusal found in a file made from the user's (a
+    video's tracks, a recording's reach) is said of the user's file."""
+    import pickle
+
+    from perception.errors import TrackingError
+
+    exc = TrackingError("marker lost", "clip.tracks.h5", field="thumb", location=("a", "b"))
+    moved = exc.at("clip.mp4")
+    assert type(moved) is TrackingError and str(moved) == "clip.mp4: thumb: marker lost"
+    assert (moved.problem, moved.field, moved.location) == ("marker lost", "thumb", ("a", "b"))
+    assert str(pickle.loads(pickle.dumps(moved))) == str(moved)
+    assert str(exc) == "clip.tracks.h5: thumb: marker lost"  # the original is left as it was
