@@ -25,7 +25,6 @@ from perception.io.video import FrameSource, open_source, open_video, write_vide
 from perception.landmarks import LandmarkParams, Landmarks
 from perception.loading import load_movements
 from perception.measure import landmarks
-from perception.movement_record import MovementRecord
 from perception.observation import (
     MovementSpan,
     Observation,
@@ -49,6 +48,7 @@ from perception.recognition import (
 from perception.recognition.engine import StepScorer
 from perception.recognition.rules import VerdictRules, judge
 from perception.recordings import MocapImport, read_reaches, recognize_reach
+from perception.records import MovementRecord
 from perception.report import write_batch_report, write_clip_report
 from perception.synthetic.demos import demo_tracks
 from perception.synthetic.recipes import load_recipe, synthesize

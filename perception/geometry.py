@@ -109,7 +109,7 @@ class SimilarityTransform:
 
     def to_plane(self, px: np.ndarray) -> np.ndarray:
         """Pixels ``(..., 2)`` -> metres ``(..., 2)`` about the origin, x right and y up: the
-        scale and the flip, not the rotation (a :class:`~perception.movement_record.
+        scale and the flip, not the rotation (a :class:`~perception.records.
         MovementRecord`'s frame). NaN stays NaN."""
         rel = np.asarray(px, dtype=np.float64) - self.origin_px
         return np.stack([rel[..., 0] / self.px_per_m,

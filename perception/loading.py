@@ -3,7 +3,7 @@
 
 Each file kind of the registry (:mod:`perception.sources`) has its loader here
 (:data:`LOADERS`): a video, tracks file or pose file gives one
-:class:`~perception.movement_record.MovementRecord`, a motion-capture recording one
+:class:`~perception.records.MovementRecord`, a motion-capture recording one
 per reach, with the trials that give none and why. The module sits above the
 pipeline whose readers it calls, so the registry below it stays free of them.
 """
@@ -91,7 +91,7 @@ LOADERS: dict[str, Callable[..., Movements]] = {
 
 def load_movements(source: str | os.PathLike, settings=None, *,
                    tracks_out: str | os.PathLike | None = None) -> Movements:
-    """The movements of an input in metres (:class:`~perception.movement_record.
+    """The movements of an input in metres (:class:`~perception.records.
     MovementRecord`), as recognition sees them.
 
     A video is tracked (its tracks file written as ``recognize`` writes it, or a current

@@ -2,7 +2,7 @@
 
 The model frame (docs/coordinates.md): origin at the object centre, +y from
 the demonstrator's start toward the object, metres. Any input comes here as
-one :class:`~perception.movement_record.MovementRecord`: metres, x right and
+one :class:`~perception.records.MovementRecord`: metres, x right and
 y up, about the object's position in the first frames, at the scale its
 object's known diameter (or a given pixel scale) gives; a motion-capture
 reach's tracks are metres in its plane already (:attr:`Tracks.units`). The
@@ -35,7 +35,7 @@ from perception.filtering import alpha_beta
 from perception.geometry import DEFAULT_OBJECT_DIAMETER, SimilarityTransform
 from perception.io.pose import is_pose_file
 from perception.movement_bounds import end_row, onset_time
-from perception.movement_record import MARKERS, MovementRecord, make_record, reading_notes
+from perception.records import MARKERS, MovementRecord, make_record, reading_notes
 from perception.resume import Grown, Kept, Ordered, extended, rowwise
 from perception.validation import Int, Positive, Tuple, declared
 

@@ -18,10 +18,10 @@ from _demos import dlc_csv
 from perception.errors import InputError
 from perception.io.pose import PoseImport
 from perception.loading import load_movements
-from perception.movement_record import MARKERS, MovementRecord
 from perception.observation import ObserveParams, movement_record, observe
 from perception.pipeline import RecognitionSettings
 from perception.recordings import MocapImport, read_recording
+from perception.records import MARKERS, MovementRecord
 from perception.synthetic.independent import draw_independent, independent_paths, tracked_paths
 from perception.synthetic.scene import Camera
 
