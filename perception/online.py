@@ -58,7 +58,7 @@ class _Rows:
     @property
     def n(self) -> int:
         """Rows received."""
-        return len(self._a["time"].rows()) if self._a else 0
+        return self._a["time"].n if self._a else 0
 
     def append(self, *row) -> None:
         if not self._a:  # the first row sets the buffers (doubling as they fill)
