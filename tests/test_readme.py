@@ -23,3 +23,19 @@ def test_readme_python_blocks_run(tmp_path, monkeypatch):
     # the examples compute what they say
     assert namespace["rec"].winner.startswith("grasp-")
     assert namespace["peak_to_mean_ratio"](3) == 1.875
+
+
+def test_readme_names_the_default_repertoire_size_and_every_clip_figure():
+    from perception.recognition.planning import default_specs
+    from perception.report.clip import clip_outputs
+
+    text = README.read_text()
+    said = re.search(r"repertoire build -o rep\.h5 +# plan the models once \((\d+) by default\)",
+                     text)
+    assert said and int(said.group(1)) == len(default_specs())
+    # what recognize writes for one clip: every file a user finds there is named
+    figures = [p.name for k, p in clip_outputs(Path("out"), "<clip>").items()
+               if p.suffix == ".png"]
+    assert len(figures) >= 3
+    for name in figures:
+        assert f"`{name}`" in text, name
