@@ -156,6 +156,9 @@ def test_a_grip_lost_long_enough_to_hide_a_second_opening_is_not_called_normal(
     assert rec.verdict_detail == (None if verdict == "normal" else "digits-unseen")
     if verdict == "unfamiliar":
         assert rec.verdict_reason.startswith("insufficient data: the finger was lost 0.3")
+        # the rule it breaks is said once, with its thresholds' names
+        assert rec.verdict_reason.count("may hide a second opening") == 1, rec.verdict_reason
+        assert rec.verdict_reason.endswith(": max_gap, max_gap_share)"), rec.verdict_reason
 
 
 @pytest.mark.parametrize("condition, verdict", [

@@ -379,9 +379,8 @@ class Recognition:
             b = (start + gap - lm.onset_time) / lm.movement_time
             where = f" at {max(a, 0):.0%}-{min(b, 1):.0%} of the movement"
         lost = "the digits were" if name == "digits" else f"the {name} was"
-        lp = self.rules.landmarks
-        return (f"{lost} lost {gap:.2f} s{where} (a gap over {lp.max_gap:.2f} s and "
-                f"{lp.max_gap_share:.0%} of the movement may hide a second opening)")
+        # the reason (rules.reason) adds the rule it breaks, with its thresholds' names
+        return f"{lost} lost {gap:.2f} s{where}"
 
     @property
     def validation_warnings(self) -> list[ValidationWarning]:
