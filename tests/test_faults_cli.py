@@ -228,6 +228,36 @@ def test_recognize_into_an_existing_file_fails_before_tracking(monkeypatch, tmp_
     assert taken.read_text() == "not a folder"
 
 
+@pytest.mark.parametrize("command", ["recognize", "batch"])
+def test_a_read_only_output_folder_is_refused_before_any_work(command, monkeypatch, tmp_path,
+                                                              capsys):
+    import errno
+    import tempfile
+
+    import perception.pipeline as pipeline
+
+    clips = tmp_path / "clips"
+    clips.mkdir()
+    (clips / "a.mp4").write_bytes(b"a video")
+    out = tmp_path / "locked"
+    out.mkdir()
+
+    def never(*args, **kwargs):
+        raise AssertionError("worked before checking -o")
+
+    def read_only(*args, dir=None, **kwargs):  # as a read-only file system answers
+        raise OSError(errno.EROFS, "Read-only file system", dir)
+
+    monkeypatch.setattr(pipeline, "load_clip", never)
+    monkeypatch.setattr(batch_cli, "run_batch", never)
+    monkeypatch.setattr(batch_cli, "load_repertoire", never)
+    monkeypatch.setattr(tempfile, "TemporaryFile", read_only)
+    source = clips / "a.mp4" if command == "recognize" else clips
+    assert main([command, str(source), "-o", str(out)]) == 2
+    # the folder the user named, not a scratch file the command would have made there
+    one_line(capsys.readouterr().err, str(out), "--output", "Read-only file system")
+
+
 @pytest.fixture(scope="module")
 def tracks_file(tmp_path_factory):
     from _demos import demo_tracks

@@ -7,7 +7,7 @@ import sys
 from collections import Counter
 from pathlib import Path
 
-from hammer_mv.cli.checks import cap_jobs, output_folder
+from hammer_mv.cli.checks import cap_jobs, writable_folder
 from hammer_mv.cli.flags import field_flag, flag_text
 from hammer_mv.cli.options import add_recognition_options, load_repertoire, recognition_settings
 from hammer_mv.cli.recognize import add_figure_options
@@ -66,7 +66,7 @@ def run(args: argparse.Namespace) -> int:
 
     check_command(args.input, "batch")  # a camera or a stream: watch's
     args.input = Path(args.input)
-    output_folder(args.output)
+    writable_folder(args.output)  # a read-only one is said of itself, before any work
     _not_over_inputs(args.input, args.output)
     found = find_clips(args.input)
     items = found.items

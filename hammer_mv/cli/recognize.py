@@ -79,7 +79,7 @@ def run(args: argparse.Namespace) -> int:
     args : argparse.Namespace
         Parsed arguments.
     """
-    from hammer_mv.cli.checks import output_folder
+    from hammer_mv.cli.checks import writable_folder
     from hammer_mv.cli.flags import flag_text
     from hammer_mv.cli.options import load_repertoire, recognition_settings
     from perception.errors import InputError
@@ -100,7 +100,7 @@ def run(args: argparse.Namespace) -> int:
 
     kind = check_command(args.input, "recognize")  # a camera or a stream: watch's
     path = args.input = Path(args.input)
-    output_folder(args.output)  # before any tracking
+    writable_folder(args.output)  # before any tracking
     if not path.exists():
         raise InputError("input not found", path)
     if path.is_dir():
