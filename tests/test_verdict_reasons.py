@@ -185,6 +185,20 @@ def test_sixty_trials_give_one_warnings_line_per_kind():
     assert warnings_summary([("a", [])]) == []
 
 
+def test_a_value_just_outside_a_range_does_not_read_as_its_bound():
+    """Before: "movement time 0.40 s, outside the 0.4-2.1 s" (RTMocap's 0.398 s reach)."""
+    from perception.recognition.result import VALIDATED_MOVEMENT_TIME, _beyond
+
+    lo, hi = VALIDATED_MOVEMENT_TIME
+    lines = warnings_summary([("a", [{"kind": "movement_time", "value": lo - 0.002}]),
+                              ("b", [{"kind": "movement_time", "value": lo - 0.04}])])
+    assert lines == [f"2 of 2 trials: movement time {lo - 0.04:.2f}-{lo - 0.002:.3f} s, "
+                     f"outside the {lo}-{hi} s the verdict was validated on (a, b)"]
+    assert _beyond(hi + 0.001, (lo, hi)) == f"{hi + 0.001:.3f}"
+    assert _beyond(hi + 0.5, (lo, hi)) == f"{hi + 0.5:.2f}"  # two decimals where they do
+    assert _beyond(0.8, None) == "0.80"
+
+
 def test_the_validated_distances_hold_the_optotrak_grasps_it_was_validated_on():
     """Before: "reach distance 0.72 m is outside 0.1-0.7 m" on the grasps whose trials chose
     the rules (docs/mocap.md: the shared Optotrak table, 0.55-0.715 m as measured)."""

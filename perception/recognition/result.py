@@ -100,7 +100,8 @@ def warnings_summary(trials: Sequence[tuple[str, Sequence[dict]]], what: str = "
         span = ""
         if values.size:
             unit, digits = _WARNING_UNITS.get(kind, ("", 2))
-            lo, hi = (f"{x:.{digits}f}" for x in (values.min(), values.max()))
+            bounds = _WARNING_RANGES[kind][1] if kind in _WARNING_RANGES else None
+            lo, hi = (_beyond(x, bounds, digits) for x in (values.min(), values.max()))
             span = f"{lo}{unit}" if lo == hi else f"{lo}-{hi}{unit}"
         count = f"{len(hits)} of {total} {what}"
         if kind == "time_scale":
@@ -124,6 +125,19 @@ _WARNING_UNITS = {"movement_time": (" s", 2), "distance": (" m", 2), "time_scale
 _WARNING_RANGES = {"movement_time": ("movement time", VALIDATED_MOVEMENT_TIME, " s"),
                    "peak_speed": ("peak speed", VALIDATED_PEAK_SPEED, " m/s"),
                    "distance": ("reach distance", VALIDATED_DISTANCE, " m")}
+
+
+def _beyond(value: float, bounds: tuple[float, float] | None, digits: int = 2) -> str:
+    """``value`` with ``digits`` decimals, or up to two more where fewer would read as
+    inside ``bounds``: a 0.398 s movement is "0.398", not "0.40", beside a 0.4 s bound."""
+    text = f"{value:.{digits}f}"
+    for more in range(1, 3):
+        if bounds is None or not bounds[0] <= float(text) <= bounds[1]:
+            break
+        text = f"{value:.{digits + more}f}"
+    return text
+
+
 #: What a warning's likely cause may be, where one is known.
 _WARNING_HINTS = {"peak_speed": " (a motion-capture file's `units`?)"}
 
@@ -394,8 +408,9 @@ class Recognition:
             v = measured[kind]
             if math.isfinite(v) and not lo <= v <= hi:
                 out.append(ValidationWarning(
-                    kind, v, f"{label} {v:.2f}{unit} is outside the {lo}-{hi}{unit} the "
-                    f"verdict was validated on{_WARNING_HINTS.get(kind, '')}"))
+                    kind, v, f"{label} {_beyond(v, (lo, hi))}{unit} is outside the "
+                    f"{lo}-{hi}{unit} the verdict was validated on"
+                    f"{_WARNING_HINTS.get(kind, '')}"))
         if math.isfinite(lm.movement_time) and lm.movement_time > 0:
             n = self.normalisation
             if n is not None and abs(n.time_scale - 1) > 1e-9:
