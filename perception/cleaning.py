@@ -11,9 +11,13 @@ three as lost and bridges a gap only when it is short
 (:attr:`CleaningParams.max_bridge`); every repair is counted in a
 :class:`Repairs` so the report can say what was done.
 
+A marker seen again where it was held, within
+:attr:`CleaningParams.held_distance` (5 mm), did not move on meanwhile: its
+held samples were right, and it is not lost (a tracker's own output repeats
+a still marker exactly: a rendered rest, a blob's centroid on whole pixels).
 A file whose positions are rounded (a 1 mm export) repeats its samples
 exactly whenever the marker moves less than the rounding step: such a
-*quantised* live marker is not held. :func:`quantum` finds the step ``q``
+*quantised* live marker is not held either. :func:`quantum` finds the step ``q``
 from the data (every change of every coordinate is a whole multiple of it),
 and then a run of repeated samples counts as held only where the marker
 would have had to move more than the step during it: where it comes back
@@ -83,6 +87,14 @@ class CleaningParams:
         export): repeated samples count as held only where the marker would
         have had to move more than it. Default: found from the data
         (:func:`quantum`); 0 treats every run of ``held_samples`` as held.
+    held_distance : float
+        Repeated samples count as held only where the marker is seen again
+        (or, for a run to the end, came into it) further than this from where
+        it was held, m: nearer, it did not move on meanwhile, and the repeats
+        were its true place (within half the spike distance). Real systems'
+        holds end 6.7-170 mm away (Optotrak, 23 of them, median 69 mm); a
+        tracker's still marker starts to move within a pixel or two. 0: every
+        run is held.
     """
 
     spike_distance: NonNegative = 0.010
@@ -90,6 +102,7 @@ class CleaningParams:
     held_samples: Annotated[Int, Field(ge=2)] = 3
     max_bridge: NonNegative = 0.05
     quantum: NonNegative | None = None
+    held_distance: NonNegative = 0.005
 
 
 @dataclass(frozen=True)
@@ -151,7 +164,7 @@ def quantum(path: np.ndarray) -> float | None:
 
 
 def held(path: np.ndarray, run: int, step: float | None = None,
-         still: np.ndarray | None = None) -> np.ndarray:
+         still: np.ndarray | None = None, near: float = 0.0) -> np.ndarray:
     """(N,) samples that repeat the previous one seen exactly while the marker was lost.
 
     A run of ``run`` or more identical seen samples (all coordinates; samples
@@ -161,11 +174,11 @@ def held(path: np.ndarray, run: int, step: float | None = None,
     * it spans every seen sample (a marker that never moves);
     * ``still`` is true through it (every other marker repeats too: the
       whole scene is still);
-    * the positions are rounded to ``step`` and the marker would not have
-      had to move more than :data:`HELD_STEPS` steps during it: the nearest
-      of the next ``run`` seen samples lies within that of the held
-      position (or, for a run that lasts to the end, the sample before it
-      does).
+    * the marker would not have had to move more than ``near`` (or, where the
+      positions are rounded to ``step``, :data:`HELD_STEPS` steps if more)
+      during it: the nearest of the next ``run`` seen samples lies within
+      that of the held position (or, for a run that lasts to the end, the
+      sample before it does).
 
     Parameters
     ----------
@@ -177,6 +190,9 @@ def held(path: np.ndarray, run: int, step: float | None = None,
         The rounding step (:func:`quantum`); None: every run is held.
     still : (N,) bool array, optional
         Samples at which every other marker repeats its previous sample too.
+    near : float
+        Distance within which a marker seen again where it was held did not
+        move on (``CleaningParams.held_distance``), in the path's units.
     """
     path = np.asarray(path, dtype=float)
     seen = np.flatnonzero(np.isfinite(path).all(axis=1))
@@ -196,13 +212,14 @@ def held(path: np.ndarray, run: int, step: float | None = None,
             continue
         if still is not None and still[start:stop].all():
             continue
-        if step is not None:
+        tolerance = max(near, HELD_STEPS * step if step is not None else 0.0)
+        if tolerance > 0:
             v = path[first]
             if len(after):
                 moved = float(np.abs(path[after] - v).max(axis=1).min())
             else:
                 moved = float(np.abs(v - path[before[-1]]).max())
-            if moved <= HELD_STEPS * step:
+            if moved <= tolerance:
                 continue
         out[start:stop] = True
     return out
@@ -335,7 +352,7 @@ def clean_path(time: np.ndarray, path: np.ndarray, params: CleaningParams | None
     missing = ~np.isfinite(path).all(axis=1)
     path[missing] = np.nan
     step = quantum(path) if params.quantum is None else (params.quantum or None)
-    frozen = held(path, params.held_samples, step, still) & ~missing
+    frozen = held(path, params.held_samples, step, still, params.held_distance) & ~missing
     spiked = spikes(time, path, ~missing & ~frozen, params)
     lost = missing | frozen | spiked
     path[lost] = np.nan

@@ -193,9 +193,12 @@ def test_a_truly_held_marker_is_still_found_in_a_1mm_export():
     raw = path.copy()
     raw[k:k + 12] = raw[k]
     assert clean_path(t, raw)[1].held == 11
-    # the step can be given, and 0 turns the allowance off
-    assert clean_path(t, np.round(path * 1000) / 1000,
-                      CleaningParams(quantum=0.0))[1].held > 0
+    # the step can be given, and 0 turns the rounding's allowance off: the rests' repeats
+    # are then spared only as a marker seen again where it was held (held_distance), and
+    # held with both allowances off
+    rests = np.round(path * 1000) / 1000
+    assert clean_path(t, rests, CleaningParams(quantum=0.0))[1].held == 0
+    assert clean_path(t, rests, CleaningParams(quantum=0.0, held_distance=0.0))[1].held > 0
 
 
 def test_a_held_marker_with_samples_missing_among_its_repeats_is_still_held():
@@ -226,6 +229,45 @@ def test_a_quantised_marker_held_at_rest_and_released_at_rest_is_not_lost():
     k = int(np.searchsorted(t, 0.9))
     out, rep = clean_path(t[:k], rounded[:k])  # rest only
     assert rep.held == 0 and np.isfinite(out).all()
+
+
+def test_a_still_marker_a_tracker_repeats_exactly_is_not_held():
+    """A tracker's own output repeats a still marker to the last digit (a rendered rest, a
+    blob's centroid on half pixels) while another marker jitters: seen again where it was
+    held, it did not move on, and its repeats were its true place."""
+    t, path = _reach_path()
+    still = path.copy()
+    k = int(np.searchsorted(t, 0.5))
+    still[k:k + 20] = still[k]  # 0.2 s of exact repeats at rest, released at rest
+    m = int(np.searchsorted(t, 0.95))
+    still[m:m + 8] = still[m]  # repeats that end as the reach starts (within 5 mm)
+    out, rep = clean_path(t, still)
+    assert rep.held == 0 and np.isfinite(out).all()
+    # a marker frozen mid-reach is seen again far from where it was held: still lost
+    frozen = path.copy()
+    f = int(np.searchsorted(t, 1.4))
+    frozen[f:f + 12] = frozen[f]
+    assert clean_path(t, frozen)[1].held == 11
+    # with no allowance, every run of exact repeats is held, as before
+    assert clean_path(t, still, CleaningParams(held_distance=0.0))[1].held == 19 + 7
+
+
+def test_our_own_tracks_exported_as_a_pose_file_keep_their_rest(demo, tmp_path):
+    """hammer-mv's tracks written as a DeepLabCut file (``tracks export --format dlc``)
+    and read back: a digit the tracker repeated exactly at rest, while the object's blob
+    jittered, is not lost (it was: the README's quick start gave ``digits-unseen``)."""
+    tracks, diameter = demo
+    pos = tracks.position.copy()
+    j, o = tracks.markers.index("finger"), tracks.markers.index("object")
+    pos[:10, j] = pos[0, j]  # the finger's rest, repeated to the last digit
+    pos[-8:, j] = pos[-8, j]  # and at the end
+    pos[:, o] += np.random.default_rng(0).normal(0, 0.3, pos[:, o].shape)  # a jittering blob
+    written = write_dlc(tracks.replace(position=pos), tmp_path / "own.csv")
+    obs, _ = _observed(written, diameter)
+    record = json.loads(read_pose(written, PoseImport(
+        fps=30, object_diameter_px=diameter)).tracker["cleaning"])
+    assert record["repairs"]["finger"]["held"] == 0, record
+    assert not any("finger" in note for note in obs.notes), obs.notes
 
 
 # -- the real trials as DeepLabCut files ---------------------------------------------------
