@@ -265,9 +265,46 @@ def entry() -> int:
     tests and scripts call in their own processes.
     """
     gc.disable()
+    sys.stdout = _Console(sys.stdout)
     status = main(quiet_start=True)
     gc.freeze()
     return status
+
+
+class _Console:
+    """Standard output that goes quiet, not the command, when its reader closes early.
+
+    ``hammer-mv recognize REC | head -1``: the reader leaves after a line and the next
+    print raises ``BrokenPipeError``, which stopped the command half-way (two of four
+    reaches reported, no trials table). The command's work is its files; the console is
+    a view of it. So the first write that finds the pipe closed points the stream at
+    ``os.devnull`` (the interpreter's own flush at exit would fail too) and the command
+    goes on; the console's lines after it are dropped.
+    """
+
+    def __init__(self, stream):
+        self._stream = stream
+
+    def write(self, text: str) -> int:
+        try:
+            return self._stream.write(text)
+        except BrokenPipeError:
+            self._reader_gone()
+            return len(text)
+
+    def flush(self) -> None:
+        try:
+            self._stream.flush()
+        except BrokenPipeError:
+            self._reader_gone()
+
+    def _reader_gone(self) -> None:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, self._stream.fileno())
+        os.close(devnull)
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
 
 
 def main(argv: list[str] | None = None, *, quiet_start: bool = False) -> int:
