@@ -22,6 +22,7 @@ from perception.io.files import input_file, is_regular_file
 from perception.io.pose import pose_output
 from perception.pipeline import clip_name
 from perception.recordings import unknown_layout
+from perception.sources import files_taken
 
 if TYPE_CHECKING:
     from perception.pipeline import RecognitionSettings
@@ -244,7 +245,7 @@ def find_clips(source: str | os.PathLike) -> Discovery:
             skipped.append((path.name, why))
         elif kind == "unknown":
             skipped.append((path.name, "empty file (0 bytes)" if is_regular_file(path)
-                            and path.stat().st_size == 0 else "not a video, tracks or pose file"))
+                            and path.stat().st_size == 0 else f"not a {files_taken('batch')}"))
         elif not is_regular_file(path):
             skipped.append((path.name, "not a regular file (a FIFO, device, socket or a "
                                        "broken link)"))

@@ -228,7 +228,14 @@ def measure(source, *, params: LandmarkParams | None = None, mocap=None,
             raise InputError(why, source)
         from perception.pipeline import clip_name, load_clip
 
-        name = clip_name(source)[0]
+        name, kind_name = clip_name(source)
+        if kind_name == "unknown":  # this takes recordings too: say so, not load_clip's list
+            from perception.io.files import input_file
+            from perception.sources import files_taken
+
+            what = files_taken("landmarks")
+            input_file(source, what, empty=False)  # an empty file is of no kind: it says so
+            raise InputError(f"not a {what}", source)
         tracks = load_clip(source, pose=pose, tracks_out=tracks_out)
     else:
         tracks = source

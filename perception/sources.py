@@ -29,7 +29,7 @@ from perception.errors import InputError
 from perception.io.names import POSE_SUFFIXES, TRACKS_SUFFIX, VIDEO_SUFFIXES, live_kind
 
 __all__ = ["KINDS", "POSE_SUFFIXES", "TRACKS_SUFFIX", "VIDEO_SUFFIXES", "Kind", "check_command",
-           "clip_name", "input_kind"]
+           "clip_name", "files_taken", "input_kind"]
 
 
 
@@ -133,6 +133,25 @@ _TAKES = {"batch": "a folder of clips or a manifest.csv"}
 _INSTEAD = {"camera": "watch it with hammer-mv watch",
             "stream": "watch it with hammer-mv watch",
             "tracks": "recognize it with hammer-mv recognize"}
+
+
+#: The file kinds in the order their names are said (:func:`files_taken`).
+_SAID = ("video", "tracks", "pose", "mocap")
+
+
+def files_taken(command: str) -> str:
+    """The kinds of file ``command`` reads, in words: ``"video, tracks file, pose file or
+    motion-capture recording"`` (what its refusal of a file of no kind says).
+
+    Parameters
+    ----------
+    command : str
+        ``recognize``, ``landmarks``, ``batch`` or ``watch``.
+    """
+    named = {k.name: k.what.split(" ", 1)[1] for k in KINDS}
+    takes = [named[k.name] for name in _SAID for k in KINDS
+             if k.name == name and k.takes(command)]
+    return ", ".join(takes[:-1]) + f" or {takes[-1]}" if len(takes) > 1 else takes[0]
 
 
 def check_command(spec: str | os.PathLike, command: str) -> Kind | None:

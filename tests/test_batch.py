@@ -97,7 +97,8 @@ def test_batch_goes_on_past_bad_files(clips, repfile, tmp_path):
     assert s.loc["normal-01", "status"] == "ok"
     assert "notes" not in s.index  # not a clip: skipped, and listed as such
     skipped = json.loads((tmp_path / "out" / "batch.json").read_text())["skipped"]
-    assert skipped == [{"file": "notes.txt", "reason": "not a video, tracks or pose file"}]
+    assert skipped == [{"file": "notes.txt", "reason": "not a video, tracks file, pose file or "
+                                                      "motion-capture recording"}]
     assert s.loc["empty", "status"] == "failed" and "empty.mp4" in s.loc["empty", "error"]
     assert not list((tmp_path / "out").glob("empty.*")) and not list(
         (tmp_path / "out").glob(".*part*"))

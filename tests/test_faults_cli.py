@@ -407,3 +407,21 @@ def test_landmarks_of_an_empty_table_says_it_is_empty(tmp_path, capsys):
     assert main(["landmarks", str(tmp_path / "trial.tsv"), "-o", str(tmp_path / "l.csv")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "trial.tsv" in err[0] and "empty file (0 bytes)" in err[0]
+
+
+@pytest.mark.parametrize("command", ["recognize", "landmarks", "batch"])
+def test_a_file_of_no_kind_is_refused_naming_every_kind_the_command_reads(
+        tmp_path, capsys, command):
+    """landmarks and batch read motion-capture recordings too, and say so (they said "not
+    a video, tracks or pose file", as load_clip, which reads no recording, does)."""
+    from hammer_mv.cli import main
+
+    notes = tmp_path / "in" / "notes.txt"
+    notes.parent.mkdir()
+    notes.write_text("a few words\nof prose\n")
+    given = str(notes.parent if command == "batch" else notes)
+    out = str(tmp_path / ("l.csv" if command == "landmarks" else "out"))
+    assert main([command, given, "-o", out]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert "not a video, tracks file, pose file or motion-capture recording" in err[-1], err
+    assert "notes.txt" in err[-1]

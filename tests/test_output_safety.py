@@ -221,7 +221,8 @@ def test_a_batch_lists_a_table_of_no_known_layout_with_why(tmp_path):
     for name in ("odd.tsv", "odd2.csv"):
         assert skipped[name].startswith("not a") and "expected" in skipped[name]
         assert "pose file" in skipped[name]
-    assert skipped["notes.txt"] == "not a video, tracks or pose file"
+    assert skipped["notes.txt"] == ("not a video, tracks file, pose file or motion-capture "
+                                    "recording")
 
 
 def test_a_bug_reading_one_recording_does_not_end_the_batch(tmp_path, monkeypatch):

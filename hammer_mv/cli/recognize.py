@@ -96,7 +96,7 @@ def run(args: argparse.Namespace) -> int:
     )
     from perception.report.clip import write_clip_report
     from perception.report.tracking import write_tracking_report
-    from perception.sources import check_command
+    from perception.sources import check_command, files_taken
 
     kind = check_command(args.input, "recognize")  # a camera or a stream: watch's
     path = args.input = Path(args.input)
@@ -104,8 +104,8 @@ def run(args: argparse.Namespace) -> int:
     if not path.exists():
         raise InputError("input not found", path)
     if path.is_dir():
-        raise InputError("expected a video, tracks file, pose file or motion-capture "
-                         "recording, got a folder (use hammer-mv batch)", path)
+        raise InputError(f"expected a {files_taken('recognize')}, got a folder (use hammer-mv "
+                         "batch)", path)
     if kind is not None and kind.name == "mocap":
         return _run_mocap(args, path)
     from perception.recordings import unknown_layout
@@ -114,7 +114,7 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(why, path)
     clip, kind = clip_name(path)
     if kind == "unknown":
-        what = "video, tracks file, pose file or motion-capture recording"
+        what = files_taken("recognize")
         input_file(path, what, empty=False)  # an empty file is of no kind: it says so
         raise InputError(f"not a {what}", path)
     clip = _own_clip(args.output, clip, path)
