@@ -239,3 +239,26 @@ def test_a_library_log_line_names_fields_and_the_command_line_gives_their_flags(
     finally:
         root.removeHandler(theirs)
     assert _flag_words not in theirs.filters
+
+
+def test_a_batch_names_the_flag_of_the_field_a_clip_failed_on(tmp_path):
+    """A clip's error as a batch keeps it begins with the field it names ("time_column: no
+    column ..."): the failure line gives it as the flag the user typed."""
+    from types import SimpleNamespace
+
+    import pandas as pd
+
+    from hammer_mv.cli import build_parser
+    from hammer_mv.cli.batch import failure_reasons
+    from hammer_mv.cli.flags import flag_text
+
+    build_parser("batch")  # the command's flags, as its run has them
+    table = tmp_path / "trials.tsv"
+    summary = pd.DataFrame({"clip": ["trials"], "status": ["failed"],
+                            "error": [f"{table.absolute()}: time_column: no column 'globalTime'"]})
+    items = [SimpleNamespace(clip="trials", path=table)]
+    assert failure_reasons(summary, items) == "1: --time-column: no column 'globalTime'"
+    # a word that is no field, or a field named later, keeps its words
+    assert flag_text("trial 3: no reach found") == "trial 3: no reach found"
+    assert flag_text("no column 'x' (time_column)") == "no column 'x' (time_column)"
+    assert flag_text("check `px_per_m`") == "check --px-per-m"

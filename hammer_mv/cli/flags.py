@@ -161,6 +161,8 @@ def field_flag(field: str, flag: str) -> None:
 
 #: A field named in an error's text: its name in backquotes (```rate```).
 _NAMED = re.compile(r"`([a-z][a-z0-9_]*)`")
+#: The field an error's text begins with (``str(LocatedError)``: ``"field: problem"``).
+_LEADING = re.compile(r"([a-z][a-z0-9_]*): ")
 
 
 def as_flags(exc: BaseException) -> BaseException:
@@ -192,8 +194,14 @@ def as_flags(exc: BaseException) -> BaseException:
 
 def flag_text(text: str) -> str:
     """``text`` (a reason kept from a library error: a clip's, a trial's) with each field it
-    names in backquotes given as its flag, as :func:`as_flags` does for an error."""
-    return _NAMED.sub(lambda m: FIELD_FLAGS.get(m[1], m[0]), text)
+    names in backquotes given as its flag, as :func:`as_flags` does for an error, and the
+    field an error's text begins with (``"time_column: no column 'globalTime'"``, as a
+    batch keeps a clip's error) too."""
+    text = _NAMED.sub(lambda m: FIELD_FLAGS.get(m[1], m[0]), text)
+    field = _LEADING.match(text)
+    if field is not None and field[1] in FIELD_FLAGS:
+        text = FIELD_FLAGS[field[1]] + text[field.end(1):]
+    return text
 
 
 def add_video_options(p: argparse.ArgumentParser, *, fps: bool = True) -> None:
