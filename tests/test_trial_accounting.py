@@ -331,3 +331,33 @@ def test_recognize_and_landmarks_find_the_same_reaches_in_a_session(tmp_path):
     np.testing.assert_allclose(trials["onset_time"], rows["onset_time"], atol=1.5e3 / RATE)  # ms
     assert sorted(p.name for p in out.glob("*.recognition.json")) == sorted(
         f"{name}.recognition.json" for name in rows["trial"])
+
+
+def test_recognize_interrupted_accounts_for_every_reach_then_exits_130(tmp_path, monkeypatch,
+                                                                        capsys):
+    """Ctrl-C while a recording's reaches are scored: the reports written stay, the trials
+    table is written with a row for every reach (those left: not scored, interrupted), and
+    the command ends as interrupted (it wrote no table: the reaches left had no word)."""
+    import perception.report.clip as clip_report
+
+    table = Path(__file__).parent / "data" / "mocap" / "optotrak-trials.tsv"
+    write, calls = clip_report.write_clip_report, []
+
+    def interrupted_at_the_second(*args, **kw):
+        calls.append(1)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return write(*args, **kw)
+
+    monkeypatch.setattr(clip_report, "write_clip_report", interrupted_at_the_second)
+    out = tmp_path / "out"
+    status = cli.main(["recognize", str(table), "--rate", "85", "--markers", "thumb=thumb",
+                       "finger=index", "-o", str(out), "--no-figures"])
+    err = capsys.readouterr().err
+    assert status == 130 and "interrupted" in err
+    rows = pd.read_csv(out / "optotrak-trials.trials.csv")
+    assert list(rows["status"]) == ["ok", "not scored", "not scored", "not scored"]
+    assert rows["reason"].iloc[1:].str.startswith("interrupted").all()
+    assert len(list(out.glob("*.recognition.json"))) == 1
+    for trial in rows["trial"].iloc[1:]:
+        assert f"{trial}: not scored: interrupted" in err

@@ -15,6 +15,8 @@ import traceback
 from collections.abc import Callable
 from pathlib import Path
 
+#: Why a reach is not scored after Ctrl-C (its row in ``<recording>.trials.csv``).
+INTERRUPTED = "interrupted (Ctrl-C) before it was scored"
 #: Columns of ``<recording>.trials.csv``, the accounting of a recording's trials.
 TRIALS_COLUMNS = ("trial", "status", "reason", "verdict", "verdict_detail", "verdict_reason",
                   "winner", "winner_note", "onset_time", "end_time", "report", "source")
@@ -77,6 +79,7 @@ def score_recording(args: argparse.Namespace, path: Path, score: Callable, *,
     figures = {"figures": not args.no_figures,
                **{k: getattr(args, k) for k in ("figure_format", "dpi") if hasattr(args, k)}}
     rows, missed, kept, warned, k = [], [], [], [], -1
+    interrupted = False  # Ctrl-C in recognize: the reaches left are accounted for, then 130
     for entry in entries:
         if isinstance(entry, Unscored):
             rows.append({**_row(entry.name, entry.status, entry.reason, entry.onset_time,
@@ -85,12 +88,14 @@ def score_recording(args: argparse.Namespace, path: Path, score: Callable, *,
             continue
         k += 1  # the reach's number in the recording, in its fingerprint
         onset, end = float(entry.time[entry.onset]), float(entry.time[entry.end])
-        if (why := stopped()) is None:
+        if (why := stopped() or (INTERRUPTED if interrupted else None)) is None:
             try:
                 rec, extra, say = score(entry, settings, options, rep)
                 extra = {"fingerprint": clip_fingerprint(path, settings, f"{rep_id}#reach{k}"),
                          "condition": None, "input": str(path), **extra}
                 paths = write_clip_report(rec, out, extra=extra, **figures)
+            except KeyboardInterrupt:  # this reach's report is not written (atomic)
+                interrupted, why = True, INTERRUPTED
             except OSError:
                 raise  # the output folder's (full, read-only): the user's, for every reach
             except HammerMVError as exc:  # this reach's (a scene that cannot be planned, ...)
@@ -110,8 +115,8 @@ def score_recording(args: argparse.Namespace, path: Path, score: Callable, *,
         rows.append({**_row(entry.name, "failed" if why.startswith("failed") else "not scored",
                             why, onset, end, path), **entry_columns(entry)})
         missed.append((entry.name, why))
-    if stopped() is None:  # reports of trials not scored now (or no longer in the recording)
-        remove_stale_reports(out, path, kept)
+    if stopped() is None and not interrupted:  # reports of trials not scored now (or no
+        remove_stale_reports(out, path, kept)  # longer in the recording)
     # the trial's factors and numbers after its name, as summary.csv has them
     more = list(dict.fromkeys(c for r in rows for c in r if c not in TRIALS_COLUMNS))
     columns = [TRIALS_COLUMNS[0], *more, *TRIALS_COLUMNS[1:]]
@@ -125,6 +130,8 @@ def score_recording(args: argparse.Namespace, path: Path, score: Callable, *,
             print(f"{path.name}: warning: {flag_text(line)}", file=sys.stderr)
     for entry_name, why in missed:  # always: nothing is dropped without a word
         print(f"{entry_name}: not scored: {why}", file=sys.stderr)
+    if interrupted:  # the command's own end of an interruption (status 130)
+        raise KeyboardInterrupt
     return 1 if missed else 0
 
 
