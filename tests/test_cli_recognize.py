@@ -2,6 +2,7 @@
 
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -95,3 +96,26 @@ def test_recognize_of_a_file_that_is_not_video_never_loads_opencv(tmp_path, kind
     imported = [line.rsplit("|", 1)[-1].strip() for line in res.stderr.splitlines()
                 if line.startswith("import time:")]
     assert imported and "cv2" not in imported
+
+
+def test_flags_another_kind_of_input_reads_are_said_not_read(tmp_path, repfile):
+    """--rate and --markers are read from a motion-capture recording, --keypoints from a pose
+    file: given for a tracks file they were dropped without a word."""
+    path = _save(demo_tracks("normal", 0)[0], tmp_path / "n.tracks.h5")
+    proc = _recognize(path, tmp_path / "out", repfile, "--no-figures", "--rate", "85",
+                      "--markers", "thumb=x", "finger=y", "--keypoints", "thumb=a", "finger=b")
+    assert proc.returncode == 0, proc.stderr
+    warned = [line for line in proc.stderr.splitlines() if "not read" in line]
+    assert warned == ["hammer-mv recognize: warning: --markers, --rate (options of a "
+                      "motion-capture recording); --keypoints (options of a pose file) not "
+                      "read: the input is a tracks file"]
+    # a recording's own flags are read; a pose file's are not
+    table = Path(__file__).parent / "data" / "mocap" / "optotrak-trials.tsv"
+    proc = _recognize(table, tmp_path / "rec", repfile, "--no-figures", "--rate", "85",
+                      "--markers", "thumb=thumb", "finger=index", "--pcutoff", "0.5")
+    assert "--pcutoff (options of a pose file) not read: the input is a motion-capture " \
+           "recording" in proc.stderr
+    assert "--rate" not in proc.stderr
+    # nothing said where every flag given is read
+    proc = _recognize(path, tmp_path / "out2", repfile, "--no-figures")
+    assert "not read" not in proc.stderr

@@ -165,6 +165,36 @@ def add_mocap_options(p: argparse.ArgumentParser) -> None:
                                       "docs/mocap.md)"), FACTORS)
 
 
+#: The flags that only one kind of input reads, by kind (:func:`flags_not_read`).
+_ONLY = {"mocap": ("a motion-capture recording", (*MOCAP, *FACTORS)),
+         "pose": ("a pose file", tuple(s for s in POSE if s.field in ("keypoints", "pcutoff",
+                                                                       "individual")))}
+
+
+def flags_not_read(args: argparse.Namespace, kind: str) -> str | None:
+    """A warning naming the flags given that an input of ``kind`` does not read (another
+    kind's: ``--rate`` for a video), or None.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The command's.
+    kind : str
+        The input's kind (:func:`perception.pipeline.clip_name`'s: ``video``,
+        ``tracks``, ``pose``, ``mocap``).
+    """
+    said = []
+    for owner, (what, settings) in _ONLY.items():
+        given = [s.name for s in settings if owner != kind
+                 and getattr(args, s.field, s.value()) != s.value()]
+        if given:
+            said.append(f"{', '.join(given)} (options of {what})")
+    names = {"video": "a video", "tracks": "a tracks file", "pose": "a pose file",
+             "mocap": "a motion-capture recording"}
+    return (f"{'; '.join(said)} not read: the input is {names.get(kind, kind)}" if said
+            else None)
+
+
 def mocap_import(args: argparse.Namespace) -> MocapImport:
     """The :class:`~perception.recordings.MocapImport` the motion-capture options ask for.
 

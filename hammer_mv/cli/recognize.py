@@ -81,7 +81,7 @@ def run(args: argparse.Namespace) -> int:
     """
     from hammer_mv.cli.checks import writable_folder
     from hammer_mv.cli.flags import flag_text
-    from hammer_mv.cli.options import load_repertoire, recognition_settings
+    from hammer_mv.cli.options import flags_not_read, load_repertoire, recognition_settings
     from perception.errors import InputError
     from perception.io.files import input_file
     from perception.io.frame_sample import FrameSample
@@ -107,6 +107,8 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(f"expected a {files_taken('recognize')}, got a folder (use hammer-mv "
                          "batch)", path)
     if kind is not None and kind.name == "mocap":
+        if not args.quiet and (unread := flags_not_read(args, "mocap")) is not None:
+            print(f"hammer-mv recognize: warning: {unread}", file=sys.stderr)
         return _run_mocap(args, path)
     from perception.recordings import unknown_layout
 
@@ -118,6 +120,8 @@ def run(args: argparse.Namespace) -> int:
         input_file(path, what, empty=False)  # an empty file is of no kind: it says so
         raise InputError(f"not a {what}", path)
     clip = _own_clip(args.output, clip, path)
+    if not args.quiet and (unread := flags_not_read(args, kind)) is not None:
+        print(f"hammer-mv recognize: warning: {unread}", file=sys.stderr)
     settings = recognition_settings(args)
     rep, rep_id = load_repertoire(args)
     # a few frames for the contact sheet, kept while tracking
