@@ -354,3 +354,23 @@ def test_the_report_reads_its_profiles_and_confidence_figures_from_the_curves(tm
     # aperture profiles, typical clips, every clip's confidence, three condition profiles
     assert calls["curves"] >= 6 * n
     assert calls["whole"] <= 6 * n
+
+
+def test_summary_csv_written_a_chunk_at_a_time_is_the_whole_tables(tmp_path):
+    from perception.report.batch import _printable_table, write_summary_csv
+    from perception.report.tables import in_lab_units
+
+    # a failed clip, a trial without a reach and a name that is not UTF-8 (escaped in
+    # the file): the chunks' columns differ in what they hold, not in what they write
+    results = [*_with_unscored(_results(3)),
+               ClipResult("bad-\udcff-name", "normal", "failed", "no file", reason="no file")]
+    summary = summary_table(results)
+    _printable_table(in_lab_units(summary)).to_csv(tmp_path / "whole.csv", index=False,
+                                                   errors="backslashreplace")
+    whole = (tmp_path / "whole.csv").read_bytes()
+    assert b"bad-\\xff-name" in whole and b"movement_time" in whole
+    for chunk in (1, 2, 3, 100):
+        write_summary_csv(tmp_path / "chunks.csv", summary, chunk=chunk)
+        assert (tmp_path / "chunks.csv").read_bytes() == whole
+    write_summary_csv(tmp_path / "empty.csv", summary.iloc[:0])
+    assert (tmp_path / "empty.csv").read_bytes() == whole.split(b"\n")[0] + b"\n"

@@ -206,6 +206,34 @@ def _printable_table(table: pd.DataFrame) -> pd.DataFrame:
     return shown
 
 
+#: Rows of ``summary.csv`` made into text at once (:func:`write_summary_csv`).
+SUMMARY_CHUNK = 1000
+
+
+def write_summary_csv(path: Path, summary: pd.DataFrame, chunk: int = SUMMARY_CHUNK) -> Path:
+    """Write ``summary.csv`` atomically, ``chunk`` rows at a time: ``summary`` in lab
+    units (:func:`~perception.report.tables.in_lab_units`), its text valid UTF-8.
+
+    The same bytes as the whole table converted and written at once, without
+    its two whole copies (the units' and the escaping's: 1 kB a trial each).
+
+    Parameters
+    ----------
+    path : Path
+        The CSV file.
+    summary : pandas.DataFrame
+        :func:`perception.batch.summary_table`'s table (SI units).
+    chunk : int
+        Rows converted and written at a time.
+    """
+    with atomic.atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8",
+                                               errors="backslashreplace", newline="") as f:
+        for start in range(0, max(len(summary), 1), chunk):
+            _printable_table(in_lab_units(summary.iloc[start:start + chunk])).to_csv(
+                f, index=False, header=start == 0)
+    return Path(path)
+
+
 def _num(value, fmt: str) -> str:
     try:
         v = float(value)
@@ -539,7 +567,7 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
     out.mkdir(parents=True, exist_ok=True)
     summary = with_verdict_reasons(summary, recognitions)
     # the landmark columns in the landmark tables' units (ms, mm, mm/s, %), said beside it
-    write_csv(out / "summary.csv", _printable_table(in_lab_units(summary)))
+    write_summary_csv(out / "summary.csv", summary)
     write_units(out / "summary.csv", summary.columns)
     # landmarks.csv written a chunk of movements at a time; kept of it, what the
     # statistics and the strips figure read (the whole table was 2 kB a trial)
