@@ -60,3 +60,18 @@ def test_side_by_side_reports_a_failed_batch_instead_of_waiting(tmp_path):
     items[1] = dataclasses.replace(items[1], path=tmp_path / "gone.mp4")  # fails its batch
     with pytest.raises(RuntimeError, match="failed"):
         bench_recognition._side_by_side(items, tmp_path / "out", default_repertoire(), 2)
+
+
+def test_the_study_names_the_lines_that_hold_more_a_trial_largest_first():
+    import bench_study
+
+    small = {"/v/site-packages/pandas/frame.py:3": 1_000, f"{ROOT}/perception/batch.py:9": 500,
+             "/v/lib/python3.11/dataclasses.py:1501": 900}
+    large = {"/v/site-packages/pandas/frame.py:3": 301_000,  # 3 kB a trial more
+             f"{ROOT}/perception/batch.py:9": 100,  # shrank: not named
+             "/v/lib/python3.11/dataclasses.py:1501": 900,  # the same: not named
+             "/v/lib/python3.11/json/decoder.py:7": 50_000}  # new among the largest
+    rows = bench_study._grown_lines(small, large, 100)
+    assert [(what, size) for what, size, *_ in rows] == [
+        ("    held a trial, pandas/frame.py:3", "3000 B"),
+        ("    held a trial, json/decoder.py:7", "500 B")]
