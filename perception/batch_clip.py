@@ -100,7 +100,7 @@ def _current_report(item: BatchItem, out: Path, fingerprint: str,
     return data if data.get("fingerprint") == fingerprint else None
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class RunTiming:
     """Where and when one clip of a batch ran: what a profile of a batch reads
     (``tools/bench_recognition.py``: each worker's start-up, its idle time between
@@ -123,7 +123,7 @@ class RunTiming:
     cpu: float
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class ClipResult:
     """How one clip of a batch went.
 
