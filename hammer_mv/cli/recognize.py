@@ -69,6 +69,14 @@ def add_figure_options(p: argparse.ArgumentParser) -> None:
                    help=f"resolution of PNG figures, dots per inch (default: {DPI})")
 
 
+def _say_unread(args: argparse.Namespace, kind: str) -> None:
+    """Warn of the flags given that an input of ``kind`` does not read (another kind's)."""
+    from hammer_mv.cli.options import flags_not_read
+
+    if not args.quiet and (unread := flags_not_read(args, kind)) is not None:
+        print(f"hammer-mv recognize: warning: {unread}", file=sys.stderr)
+
+
 def run(args: argparse.Namespace) -> int:
     """Execute ``hammer-mv recognize`` with parsed ``args``; return the exit status.
 
@@ -81,7 +89,7 @@ def run(args: argparse.Namespace) -> int:
     """
     from hammer_mv.cli.checks import writable_folder
     from hammer_mv.cli.flags import flag_text
-    from hammer_mv.cli.options import flags_not_read, load_repertoire, recognition_settings
+    from hammer_mv.cli.options import load_repertoire, recognition_settings
     from perception.errors import InputError
     from perception.io.files import input_file
     from perception.io.frame_sample import FrameSample
@@ -107,9 +115,9 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(f"expected a {files_taken('recognize')}, got a folder (use hammer-mv "
                          "batch)", path)
     if kind is not None and kind.name == "mocap":
-        if not args.quiet and (unread := flags_not_read(args, "mocap")) is not None:
-            print(f"hammer-mv recognize: warning: {unread}", file=sys.stderr)
-        return _run_mocap(args, path)
+        status = _run_mocap(args, path)
+        _say_unread(args, "mocap")  # once the input is read: a refusal stays one line
+        return status
     from perception.recordings import unknown_layout
 
     if (why := unknown_layout(path)) is not None:
@@ -120,8 +128,6 @@ def run(args: argparse.Namespace) -> int:
         input_file(path, what, empty=False)  # an empty file is of no kind: it says so
         raise InputError(f"not a {what}", path)
     clip = _own_clip(args.output, clip, path)
-    if not args.quiet and (unread := flags_not_read(args, kind)) is not None:
-        print(f"hammer-mv recognize: warning: {unread}", file=sys.stderr)
     settings = recognition_settings(args)
     rep, rep_id = load_repertoire(args)
     # a few frames for the contact sheet, kept while tracking
@@ -130,6 +136,7 @@ def run(args: argparse.Namespace) -> int:
     tracks = load_clip(path, tracks_out=tracks_out, progress=not args.quiet and sys.stderr.isatty(),
                        setup=settings.tracking, pose=settings.pose, frames=frames,
                        **settings.video_options())
+    _say_unread(args, kind)  # once the input is read: a refusal stays one line
     rec = recognize_tracks(tracks, rep, settings, clip=clip, source=path)
     extra = {"fingerprint": clip_fingerprint(path, settings, rep_id), "condition": None,
              "input": str(path),
