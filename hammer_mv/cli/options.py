@@ -183,14 +183,16 @@ def flags_not_read(args: argparse.Namespace, kind: str) -> str | None:
         The input's kind (:func:`perception.pipeline.clip_name`'s: ``video``,
         ``tracks``, ``pose``, ``mocap``).
     """
+    from perception.sources import KINDS
+
     said = []
     for owner, (what, settings) in _ONLY.items():
-        given = [s.name for s in settings if owner != kind
-                 and getattr(args, s.field, s.value()) != s.value()]
+        if owner == kind:
+            continue
+        given = [s.name for s in settings if getattr(args, s.field, s.value()) != s.value()]
         if given:
             said.append(f"{', '.join(given)} (options of {what})")
-    names = {"video": "a video", "tracks": "a tracks file", "pose": "a pose file",
-             "mocap": "a motion-capture recording"}
+    names = {k.name: k.what for k in KINDS}
     return (f"{'; '.join(said)} not read: the input is {names.get(kind, kind)}" if said
             else None)
 
