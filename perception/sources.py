@@ -148,9 +148,9 @@ def files_taken(command: str) -> str:
     command : str
         ``recognize``, ``landmarks``, ``batch`` or ``watch``.
     """
-    named = {k.name: k.what.split(" ", 1)[1] for k in KINDS}
-    takes = [named[k.name] for name in _SAID for k in KINDS
-             if k.name == name and k.takes(command)]
+    kinds = {k.name: k for k in KINDS}
+    # without the article: "video, tracks file, ..." reads as one list after "a"
+    takes = [kinds[n].what.split(" ", 1)[1] for n in _SAID if kinds[n].takes(command)]
     return ", ".join(takes[:-1]) + f" or {takes[-1]}" if len(takes) > 1 else takes[0]
 
 

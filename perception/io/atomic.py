@@ -54,6 +54,7 @@ __all__ = [
     "save_figure",
     "write_bytes",
     "write_csv",
+    "write_csv_chunks",
     "write_json",
     "write_text",
 ]
@@ -373,6 +374,26 @@ def write_csv(path: str | os.PathLike, table) -> Path:
                 writer.writerows([_cell(v) for v in row] for row in zip(*table.values()))
         else:
             table.to_csv(tmp, index=False, errors="backslashreplace")
+    return Path(path)
+
+
+def write_csv_chunks(path: str | os.PathLike, tables: Iterable) -> Path:
+    """Write the tables ``tables`` gives, one after another, as one CSV at ``path``
+    atomically (no index; the first's header only): a long table written a piece at a
+    time, never whole in memory.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Output file.
+    tables : iterable of pandas.DataFrame
+        The pieces, in order, each with the same columns (at least one: an empty
+        table gives the header alone).
+    """
+    with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8", errors="backslashreplace",
+                                        newline="") as f:
+        for i, table in enumerate(tables):
+            table.to_csv(f, index=False, header=i == 0)
     return Path(path)
 
 

@@ -226,12 +226,9 @@ def write_summary_csv(path: Path, summary: pd.DataFrame, chunk: int = SUMMARY_CH
     chunk : int
         Rows converted and written at a time.
     """
-    with atomic.atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8",
-                                               errors="backslashreplace", newline="") as f:
-        for start in range(0, max(len(summary), 1), chunk):
-            _printable_table(in_lab_units(summary.iloc[start:start + chunk])).to_csv(
-                f, index=False, header=start == 0)
-    return Path(path)
+    return atomic.write_csv_chunks(
+        path, (_printable_table(in_lab_units(summary.iloc[start:start + chunk]))
+               for start in range(0, max(len(summary), 1), chunk)))
 
 
 def _num(value, fmt: str) -> str:

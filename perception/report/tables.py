@@ -458,7 +458,7 @@ def write_landmark_table(summary: pd.DataFrame, recognitions: Mapping[str, ClipS
     """
     import pandas as pd
 
-    from perception.io.atomic import atomic_path
+    from perception.io.atomic import write_csv_chunks
 
     factors = [f for f in factor_columns(summary) if f not in _NUMBERS]
     columns = [*_HEAD, *_renamed(factors), *_NUMBERS, *_LONG]
@@ -466,8 +466,8 @@ def write_landmark_table(summary: pd.DataFrame, recognitions: Mapping[str, ClipS
     kept: dict[str, list] = {c: array.array("d") if c == "value" else []
                              for c in keep if c in columns}
     movements = _movements(summary, recognitions, factors)
-    with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8", errors="backslashreplace",
-                                        newline="") as f:
+
+    def tables():  # a chunk of movements at a time; the first (its header) even if empty
         first = True
         while True:
             some = list(itertools.islice(movements, chunk))
@@ -479,10 +479,12 @@ def write_landmark_table(summary: pd.DataFrame, recognitions: Mapping[str, ClipS
                          else pd.DataFrame([], columns=columns)).astype(
                     {"trial_number": str, "reach_number": str})
                 del raw
-                (shown(table) if shown else table).to_csv(f, index=False, header=first)
+                yield shown(table) if shown else table
             first = False
             if len(some) < chunk:
-                break
+                return
+
+    write_csv_chunks(path, tables())
     return columns, kept
 
 
