@@ -30,3 +30,20 @@ def test_recognize_piped_to_head_writes_every_reach_and_the_trials_table(tmp_pat
     assert all(json.loads(r.read_text())["verdict"] for r in reports)
     rows = (out / "optotrak-trials.trials.csv").read_text().splitlines()
     assert len(rows) == 1 + 4
+
+
+def test_a_console_without_a_descriptor_goes_quiet_too():
+    """The console script's stdout replaced by one without a file descriptor (an embedding
+    program's): a closed reader still silences it, not a traceback."""
+    import io
+
+    from hammer_mv.cli import _Console
+
+    class Closed(io.StringIO):
+        def write(self, text):
+            raise BrokenPipeError
+
+    console = _Console(Closed())
+    assert console.write("a line\n") == len("a line\n")
+    assert console.write("another\n") == len("another\n")  # devnull now
+    console.flush()

@@ -299,8 +299,13 @@ class _Console:
             self._reader_gone()
 
     def _reader_gone(self) -> None:
+        try:
+            descriptor = self._stream.fileno()
+        except (AttributeError, OSError, ValueError):  # a stream without one: replace it
+            self._stream = open(os.devnull, "w")  # noqa: SIM115 - the process's, to its end
+            return
         devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, self._stream.fileno())
+        os.dup2(devnull, descriptor)
         os.close(devnull)
 
     def __getattr__(self, name):
