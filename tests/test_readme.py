@@ -39,3 +39,20 @@ def test_readme_names_the_default_repertoire_size_and_every_clip_figure():
     assert len(figures) >= 3
     for name in figures:
         assert f"`{name}`" in text, name
+
+
+def test_solver_defaults_in_the_docs_are_the_functions_own():
+    # README once said tol=1e-12 where the default is 0 (Todorov's absolute test
+    # alone): a modeller copying it would stop at another iteration than his code
+    import inspect
+
+    import minvar
+
+    defaults = {name: p.default for name, p in inspect.signature(minvar.solve).parameters.items()
+                if p.default is not inspect.Parameter.empty}
+    for doc in (README, README.parent / "docs" / "model.md"):
+        said = re.findall(r"`minvar\.solve\(problem, ([^`]*)\)`", doc.read_text())
+        assert said, doc.name
+        for args in said:
+            for name, value in (a.split("=") for a in args.split(", ")):
+                assert float(value) == defaults[name], (doc.name, name, value)
