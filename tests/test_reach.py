@@ -4,7 +4,15 @@ import numpy as np
 import pytest
 from scipy.stats import spearmanr
 
-from minvar import ReachTask, ViaPoint, reach_problem, simulate_reach, solve, state_moments
+from minvar import (
+    PointMassPlant,
+    ReachTask,
+    ViaPoint,
+    reach_problem,
+    simulate_reach,
+    solve,
+    state_moments,
+)
 from minvar.analysis import (
     closest_approach,
     count_speed_peaks,
@@ -57,6 +65,19 @@ def test_endpoint_sd_falls_as_duration_grows_exactly():
         sds.append(np.sqrt(np.trace(cov[-1][:2, :2])))
     assert np.all(np.diff(sds) < 0)
     assert sds[0] > 1.8 * sds[-1]
+
+
+@pytest.mark.parametrize("dt, sd_mm, end_mm", [(0.01, 7.3, 1.45), (0.0111, 8.2, 1.7),
+                                                (0.008, 5.8, 1.2), (0.005, 3.6, 0.7)])
+def test_variability_depends_on_the_step_as_documented(dt, sd_mm, end_mm):
+    # docs/model.md: the noises enter per step, unscaled by sqrt(dt), so the
+    # end-point SD follows the step while the mean path hardly moves
+    p = reach_problem(THESIS_REACH, PointMassPlant(dt=dt))
+    s = solve(p)
+    mean, cov = state_moments(p, s.K, s.L)
+    end_mm_measured = np.linalg.norm(mean[-1, :2] - THESIS_REACH.goal) * 1000
+    assert np.sqrt(np.trace(cov[-1][:2, :2])) * 1000 == pytest.approx(sd_mm, abs=0.05)
+    assert end_mm_measured == pytest.approx(end_mm, abs=0.05)
 
 
 @pytest.mark.slow
