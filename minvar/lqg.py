@@ -17,7 +17,7 @@ expected cost stops changing.
 
 This is a line-by-line port of Todorov's ``kalman_lqg.m``; it reproduces that
 code's ``K``, ``L``, expected trajectory and cost per iteration (see
-``tests/test_lqg.py`` and ``shared/reference``). The problem itself,
+``tests/test_lqg.py`` and ``tests/data/todorov_reach.json``). The problem itself,
 :class:`~minvar.problem.LQGProblem`, is in :mod:`minvar.problem`; the exact
 moments of any gains (``expected_cost``, ``state_moments``,
 ``estimation_error_covariance``) are in :mod:`minvar.moments` and imported
