@@ -500,6 +500,14 @@ def run_experiment(
         Root seed; setting ``i`` uses its child ``i``.
     base : GraspTask, optional
         Task the settings modify.
+
+    Raises
+    ------
+    ValueError
+        An unknown ``name``, ``trials`` out of range, a setting that is not a
+        valid task (naming the field), or fewer than 2 different ``values``
+        for an experiment that fits the MGA's regression (viapoint-distance,
+        object-size), refused before anything is simulated.
     """
     if name not in SWEEPS:
         raise ValueError(f"experiment: unknown name {name!r}; expected one of "
@@ -508,6 +516,9 @@ def run_experiment(
     spec = SWEEPS[name]
     base = GraspTask() if base is None else base
     given = [float(v) for v in (spec.values if values is None else values)]
+    if spec.stats is not None and len(set(given)) < 2:  # before minutes of simulation
+        raise ValueError(f"values: the MGA regression of the {name} experiment needs at least "
+                         f"2 different settings, got {given}")
     swept = [v + base.wrist_offset for v in given] if spec.moved else given
     sweep = run_sweep(spec.parameter, swept, trials=trials, seed=seed, base=base,
                       bootstrap=spec.draws)

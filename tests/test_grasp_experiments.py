@@ -176,6 +176,22 @@ def test_bad_experiment_inputs():
         run_sweep("colour", (1,), trials=5)
 
 
+
+@pytest.mark.parametrize("values", [(0.04,), (0.01, 0.01)])
+def test_an_mga_regression_over_one_setting_is_refused_before_simulating(values, monkeypatch):
+    # it was scipy's "Cannot calculate a linear regression" after every
+    # setting had been simulated (minutes at the thesis's 500 repetitions)
+    import minvar.grasp_experiments as ge
+
+    monkeypatch.setattr(ge, "run_sweep", lambda *a, **k: pytest.fail("simulated first"))
+    with pytest.raises(ValueError, match=r"values: .*at least 2 different settings"):
+        viapoint_distance_experiment(values, trials=5)
+    with pytest.raises(ValueError, match=r"values: .*at least 2 different settings"):
+        object_size_experiment(values[:1], trials=5)
+    monkeypatch.undo()
+    # a sweep without a regression runs one setting
+    assert len(viapoint_height_experiment((0.0,), trials=5).summary) == 1
+
 def test_figures_are_built_and_named_after_the_thesis():
     e = variability_size_experiment((0.02, 0.06), trials=10, seed=0)
     figures = e.plot()
