@@ -224,7 +224,7 @@ def speed_accuracy(
     durations : sequence of float
         Movement times, s (thesis: 0.5 to 1.2 s).
     trials : int
-        Repetitions per duration (thesis: 200).
+        Repetitions per duration (thesis: 200): an integer >= 2, an SD needs two.
     seed : int
         Each duration draws from its own child of this seed, so adding a
         duration does not change the others.
@@ -240,6 +240,9 @@ def speed_accuracy(
     durations = [float(d) for d in durations]
     if not durations:
         raise ValueError("speed_accuracy: durations must not be empty")
+    if isinstance(trials, bool) or not isinstance(trials, int | np.integer) or trials < 2:
+        raise ValueError(f"speed_accuracy: trials: expected an integer >= 2 (an SD needs two "
+                         f"repetitions), got {trials!r}")
     plant = PointMassPlant() if plant is None else plant
     seeds = np.random.SeedSequence(seed).spawn(len(durations))
     rows, summary = [], []

@@ -80,6 +80,13 @@ def test_variability_depends_on_the_step_as_documented(dt, sd_mm, end_mm):
     assert end_mm_measured == pytest.approx(end_mm, abs=0.05)
 
 
+
+@pytest.mark.parametrize("trials", [1, 0, 2.5])
+def test_speed_accuracy_needs_two_whole_repetitions(trials):
+    # one gave NaN SDs (and numpy's warnings), as the command line refuses it
+    with pytest.raises(ValueError, match="speed_accuracy: trials: .*>= 2"):
+        speed_accuracy(THESIS_REACH, durations=(0.5,), trials=trials)
+
 @pytest.mark.slow
 def test_speed_accuracy_sweep_monte_carlo():
     sweep = speed_accuracy(THESIS_REACH, trials=200, seed=0)
