@@ -360,7 +360,11 @@ static int lqg_forward(int T, int n, int m, int k, int nc, int nd, const double 
             for (size_t i = 0; i < nn; i++) SiXE[i] = T3[i] - EE0[i];
         }
         memcpy(SiX, SiXnew, sizeof(double) * nn);
-        memcpy(SiE, newE, sizeof(double) * nn);
+        /* akh SiE A' is symmetric only in exact arithmetic: with little sensory noise its
+         * rounding grows from step to step until the iteration diverges (as moments.py) */
+        for (int i = 0; i < n; i++)
+            for (int j = 0; j < n; j++)
+                SiE[i * n + j] = 0.5 * (newE[i * n + j] + newE[j * n + i]);
     }
     status = 0;
 done:

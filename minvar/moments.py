@@ -139,6 +139,9 @@ class Moments:
             newE += self.noise_fwd.dot(LML.ravel()).reshape(n, n)
         if self.has_C0 or self.has_E0:
             newE += self.EE0 + self.CC0
+        # akh Mee A' is symmetric only in exact arithmetic: with little sensory noise its
+        # rounding grows from step to step until the iteration diverges
+        newE = 0.5 * (newE + newE.T)
         abl = A - B.dot(L)
         if optimal:
             newX = KMK + abl.dot(Mhh).dot(abl.T)

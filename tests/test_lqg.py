@@ -132,6 +132,22 @@ def test_singular_filter_falls_back_to_pseudo_inverse(reference_problem, engine)
     assert expected_cost(p, s.K, s.L) == pytest.approx(s.cost, rel=1e-8)
 
 
+@pytest.mark.parametrize("sigma_s", [0.0, 0.001, 0.01])
+def test_a_reach_with_little_sensory_noise_converges(sigma_s, engine):
+    # the filter's error covariance is symmetric only in exact arithmetic: unsymmetrised,
+    # its rounding grew until the cost bounced to 1e11 (0.001 m), the SVD failed (none),
+    # or 21 iterations ended unconverged (0.01 m)
+    import minvar
+
+    task = minvar.ReachTask((0.2, 0.2), (0.4, 0.5), 0.5)
+    p = minvar.reach_problem(task, minvar.PointMassPlant(sigma_s=sigma_s))
+    s = solve(p, engine=engine)
+    assert s.converged and s.iterations <= 6
+    assert expected_cost(p, s.K, s.L) == pytest.approx(s.cost, rel=1e-8)
+    end = state_moments(p, s.K, s.L)[0][-1][:2]
+    assert np.linalg.norm(end - np.asarray(task.goal)) < 0.003
+
+
 def test_simulation_is_reproducible(reference_problem, engine):
     s = solve(reference_problem, engine=engine)
     a = simulate(reference_problem, s, 50, seed=5).states
