@@ -77,7 +77,9 @@ def simulate(
     execution : LQGProblem, optional
         Problem whose noise model (``C, C0, D, D0, E0, S1``) is used to execute
         the plan, when it differs from the planning model (e.g. the grasp
-        chapter's 1 % coefficient of variation). Defaults to ``problem``.
+        chapter's 1 % coefficient of variation; ``problem.with_noise(...)``). Its
+        plant, cost and start (``A, B, H, Q, R, X1``) must be the planned ones.
+        Defaults to ``problem``.
 
     Returns
     -------
@@ -87,20 +89,23 @@ def simulate(
     Raises
     ------
     ValueError
-        If ``trials`` is below 1 or its arrays would exceed the memory budget
-        (checked before any allocation), or the solution is for another problem.
+        If ``trials`` is not a whole number of at least 1 or its arrays would exceed
+        the memory budget (checked before any allocation), the solution is for another
+        problem, or ``execution`` differs from ``problem`` in more than its noise.
     """
+    if isinstance(trials, bool) or int(trials) != trials or trials < 1:
+        raise ValueError(f"simulate: trials must be a whole number >= 1, got {trials!r}")
     trials = int(trials)
-    if trials < 1:
-        raise ValueError(f"simulate: trials must be >= 1, got {trials}")
     p = problem
     e = p if execution is None else execution
     if e is not p:
-        for name in ("A", "B", "H", "Q"):
-            if getattr(e, name).shape != getattr(p, name).shape:
+        # only the noise is executed from it: a plant or cost of its own would be ignored
+        for name in ("A", "B", "H", "Q", "R", "X1"):
+            mine, planned = getattr(e, name), getattr(p, name)
+            if mine is not planned and not np.array_equal(mine, planned):
                 raise ValueError(
-                    f"simulate: execution.{name} has shape {getattr(e, name).shape}, "
-                    f"expected {getattr(p, name).shape} as in the planned problem"
+                    f"simulate: execution.{name} differs from the planned problem's; only "
+                    "the execution's noise model (C, C0, D, D0, E0, S1) is used"
                 )
     rng = as_generator(seed)
     T, n, m = p.horizon, p.n_states, p.n_controls

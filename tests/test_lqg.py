@@ -165,6 +165,26 @@ def test_execution_noise_can_differ_from_planning(reference_problem, engine):
     assert np.all(soft < 0.5 * loud)
 
 
+@pytest.mark.parametrize("field", ["A", "B", "H", "Q", "R", "X1"])
+def test_an_execution_with_another_plant_or_cost_is_refused(reference_problem, field):
+    # only the execution's noise is simulated: another plant was run as the planned one
+    s = solve(reference_problem, engine="numpy")
+    other = dataclasses.replace(reference_problem,
+                                **{field: 1.01 * getattr(reference_problem, field)})
+    with pytest.raises(ValueError, match=rf"execution\.{field} differs"):
+        simulate(reference_problem, s, 5, execution=other)
+    same = dataclasses.replace(reference_problem,
+                               **{field: getattr(reference_problem, field).copy()})
+    assert simulate(reference_problem, s, 5, execution=same).states.shape[0] == 5
+
+
+@pytest.mark.parametrize("trials", [0, 2.5, True])
+def test_simulate_refuses_a_number_of_trials_that_is_not_whole(reference_problem, trials):
+    s = solve(reference_problem, engine="numpy")
+    with pytest.raises(ValueError, match="trials must be a whole number"):
+        simulate(reference_problem, s, trials)
+
+
 @pytest.mark.parametrize(
     "field, value, message",
     [
