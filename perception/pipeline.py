@@ -265,6 +265,8 @@ def load_clip(source: str | os.PathLike | Tracks, *, tracks_out: str | os.PathLi
         from perception.io.pose import read_pose  # movement only for pose files
 
         return read_pose(path, pose)
+    if not path.exists():  # as the tracker says it, not the FileNotFoundError of its key
+        raise InputError("no such file", path)
     out = tracks_path_for(path) if tracks_out is None else Path(tracks_out)
     if not keep_truncated and fps is None:
         current = current_tracks(path, [out, tracks_path_for(path)], setup)
