@@ -132,7 +132,7 @@ def _tracks_movement(tracks, px_per_m: float) -> tuple[np.ndarray, np.ndarray, n
 
 def landmarks(source, *, params: LandmarkParams | None = None, mocap=None,
               px_per_m: float | None = None, object_diameter: float | None = None, pose=None,
-              tracks_out=None) -> pd.DataFrame:
+              tracks_out=None, object_diameter_px: float | None = None) -> pd.DataFrame:
     """The landmarks of every movement in ``source``, as a table (:func:`measure`'s).
 
     Parameters
@@ -151,9 +151,13 @@ def landmarks(source, *, params: LandmarkParams | None = None, mocap=None,
         How a pose file becomes tracks.
     tracks_out : str or os.PathLike, optional
         Where a video's tracks are written (default: beside the video).
+    object_diameter_px : float, optional
+        The object's apparent diameter, px, where the tracks do not give it
+        (with ``object_diameter``).
     """
     return measure(source, params=params, mocap=mocap, px_per_m=px_per_m,
-                   object_diameter=object_diameter, pose=pose, tracks_out=tracks_out).table
+                   object_diameter=object_diameter, pose=pose, tracks_out=tracks_out,
+                   object_diameter_px=object_diameter_px).table
 
 
 def measure(source, *, params: LandmarkParams | None = None, mocap=None,
