@@ -169,9 +169,22 @@ class OnlineRecognizer:
         """
         t = self._next_time(t)
         data = np.asarray(frame_or_points)
-        if data.ndim != 3 and data.shape != (len(self.markers), 2):
-            raise InputError(f"expected a frame (H, W, 3) or positions ({len(self.markers)}, 2),"
+        M = len(self.markers)
+        if data.ndim != 3 and data.shape != (M, 2):
+            raise InputError(f"expected a frame (H, W, 3) or positions ({M}, 2),"
                              f" got shape {data.shape}", field="frame_or_points")
+        # refused here, before the row counts: not OpenCV's error from the tracker's first
+        # look at the frames, nor numpy's from the rows' arrays
+        if data.ndim == 3 and (data.shape[2] != 3 or data.dtype != np.uint8):
+            raise InputError(f"expected a frame (H, W, 3) of uint8 BGR, got {data.shape} "
+                             f"{data.dtype}", field="frame_or_points")
+        if data.ndim != 3 and data.dtype.kind not in "biuf":
+            raise InputError(f"expected positions as numbers, got {data.dtype}",
+                             field="frame_or_points")
+        for name, values in (("likelihood", likelihood), ("status", status)):
+            if values is not None and np.shape(values) != (M,):
+                raise InputError(f"expected one value per marker, shape ({M},), got shape "
+                                 f"{np.shape(values)}", field=name)
         index = self._received if index is None else int(index)
         self._received += 1
         self._last_time = t

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 
+import numpy as np
 import pandas as pd
 import pytest
 
@@ -34,3 +35,23 @@ def test_landmarks_takes_the_object_size_in_pixels_its_error_asks_for():
     scaled = pc.landmarks(bare, px_per_m=800.0)
     assert given["status"].tolist() == ["complete"]
     pd.testing.assert_frame_equal(given, scaled)
+
+
+@pytest.mark.parametrize("given, field", [
+    (dict(frame_or_points=np.zeros((48, 64, 4), np.uint8)), "frame_or_points"),   # BGRA
+    (dict(frame_or_points=np.zeros((48, 64, 3), float)), "frame_or_points"),      # not uint8
+    (dict(frame_or_points=np.array([["a", "b"]] * 4)), "frame_or_points"),
+    (dict(likelihood=np.ones(3)), "likelihood"),
+    (dict(status=np.zeros((4, 1), np.int8)), "status"),
+])
+def test_a_bad_row_or_frame_given_online_is_refused_naming_the_argument(given, field):
+    rec = pc.OnlineRecognizer(pc.Repertoire.default())
+    args = {"frame_or_points": np.full((4, 2), 100.0), **given}
+    # the tracker looks ahead over its first frames: the error must come with the first
+    for k in range(6):
+        with pytest.raises(InputError) as caught:
+            rec.update(t=k / 30, **args)
+        assert caught.value.field == field
+    # and the rows refused did not count
+    state = rec.update(np.full((4, 2), 100.0), 0.0)
+    assert state.frame == 0
