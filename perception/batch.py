@@ -344,7 +344,8 @@ def run_batch(
     Returns
     -------
     pandas.DataFrame
-        The summary (see :func:`summary_table`), a row per clip: per reach of a
+        The summary (see :func:`summary_table`; with ``verdict_reason`` and
+        ``winner_note``, as ``summary.csv``), a row per clip: per reach of a
         recording and per trial or movement of it that gives none (its status
         and reason); ``attrs["trials"]`` the trials read (:func:`count_trials`);
         ``attrs["timing"]`` where the run's time went: ``read`` (finding the
@@ -439,7 +440,7 @@ def _finish(done: list[ClipResult], rows: ModelRows, items: list[BatchItem],
             settings: RecognitionSettings, skipped, *, t0: float, t1: float,
             jobs: int) -> pd.DataFrame:
     """The batch's report from its results (:func:`run_batch`'s last steps)."""
-    from perception.report.batch import write_batch_report
+    from perception.report.batch import with_verdict_reasons, write_batch_report
     from perception.report.conditions import reference_model
 
     out, figure_format, dpi = job.out, job.figure_format, job.dpi
@@ -462,6 +463,8 @@ def _finish(done: list[ClipResult], rows: ModelRows, items: list[BatchItem],
                   for r in done if not r.scored]
     warnings = ClipWarnings(tuple((r.clip, tuple(r.summary.warning_values)) for r in scored))
     kept = rows.summaries((r.summary for r in scored), reference)
+    # the caller's table is summary.csv's (the report would add these columns to its copy)
+    summary = with_verdict_reasons(summary, kept)
     # the results, read: the report reads each clip back from disk, the summary's rows
     # hold the rest (the caller keeps no reference to the list)
     del scored

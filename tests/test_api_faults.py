@@ -55,3 +55,16 @@ def test_a_bad_row_or_frame_given_online_is_refused_naming_the_argument(given, f
     # and the rows refused did not count
     state = rec.update(np.full((4, 2), 100.0), 0.0)
     assert state.frame == 0
+
+
+def test_the_summary_run_batch_returns_has_summary_csv_s_verdict_reasons(tmp_path):
+    (tmp_path / "in").mkdir()
+    for condition in ("normal", "delayed"):
+        pc.demo_tracks(condition, seed=0)[0].save(tmp_path / "in" / f"{condition}.tracks.h5")
+    summary = pc.run_batch(pc.discover(tmp_path / "in"), tmp_path / "out",
+                           pc.Repertoire.default(), quiet=True)
+    written = pd.read_csv(tmp_path / "out" / "summary.csv", keep_default_na=False)
+    assert summary["verdict_reason"].tolist() == written["verdict_reason"].tolist()
+    assert summary["winner_note"].fillna("").tolist() == written["winner_note"].tolist()
+    assert all(summary["verdict_reason"].str.len() > 0)
+    assert {"trials", "timing", "warnings"} <= set(summary.attrs)
