@@ -36,6 +36,7 @@ from perception.batch_clip import (
     _remove_outputs,
     process_clip,
 )
+from perception.boundary import expect
 from perception.discovery import (
     ERRORS_LOG,
     REPORT_SET,
@@ -368,7 +369,12 @@ def run_batch(
     if settings is not None and not isinstance(settings, RecognitionSettings):
         raise TypeError(f"expected RecognitionSettings, got {type(settings).__name__}")
     settings = RecognitionSettings() if settings is None else settings
+    if isinstance(items, (str, os.PathLike)):  # not an AttributeError from its characters
+        raise TypeError(f"run_batch(items=): expected BatchItems, got the path {str(items)!r}: "
+                        f"give discover({str(items)!r})")
     items = list(items)
+    for item in items:
+        expect(item, BatchItem, "run_batch(items=)", hint="discover")
     if not items:  # as the command line says it, not a KeyError from an empty summary
         raise InputError("no clips found: the batch was given none", field="items")
     if jobs < 1:

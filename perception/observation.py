@@ -407,7 +407,7 @@ def movement_record(tracks, params: ObserveParams | None = None, *,
     from perception.boundary import expect
     from perception.io.tracks import Tracks
 
-    expect(tracks, Tracks, "movement_record(tracks=)", hint="perception.load_tracks")
+    expect(tracks, Tracks, "movement_record(tracks=)", hint="Tracks.load or track_video")
     expect(params, ObserveParams, "movement_record(params=)", optional=True)
     return make_record(tracks, ObserveParams() if params is None else params, clip)
 
@@ -560,6 +560,11 @@ def movement_span(tracks, params: ObserveParams | None = None, *,
     InputError
         As :func:`observe`, for everything up to finding the movement.
     """
+    from perception.boundary import expect
+    from perception.io.tracks import Tracks
+
+    expect(tracks, Tracks, "movement_span(tracks=)", hint="Tracks.load or track_video")
+    expect(params, ObserveParams, "movement_span(params=)", optional=True)
     params = ObserveParams() if params is None else params
     return _prepare(tracks, params, _clip_name(tracks, clip)).span
 
@@ -620,7 +625,7 @@ def observe(tracks, params: ObserveParams | None = None, *, clip: str | None = N
     from perception.boundary import expect
     from perception.io.tracks import Tracks
 
-    expect(tracks, Tracks, "observe(tracks=)", hint="perception.load_tracks or track_video")
+    expect(tracks, Tracks, "observe(tracks=)", hint="Tracks.load or track_video")
     expect(params, ObserveParams, "observe(params=)", optional=True)
     params = ObserveParams() if params is None else params
     p = _prepare(tracks, params, _clip_name(tracks, clip))

@@ -9,6 +9,7 @@ from deep inside.
 from __future__ import annotations
 
 import dataclasses
+import re
 
 import numpy as np
 import pandas as pd
@@ -68,3 +69,21 @@ def test_the_summary_run_batch_returns_has_summary_csv_s_verdict_reasons(tmp_pat
     assert summary["winner_note"].fillna("").tolist() == written["winner_note"].tolist()
     assert all(summary["verdict_reason"].str.len() > 0)
     assert {"trials", "timing", "warnings"} <= set(summary.attrs)
+
+
+@pytest.mark.parametrize("call, said", [
+    (lambda out: pc.movement_span(None), "movement_span(tracks=): expected Tracks"),
+    (lambda out: pc.movement_span("clip.tracks.h5"), "movement_span(tracks=): expected Tracks"),
+    (lambda out: pc.movement_span(pc.demo_tracks("normal")[0], "fast"),
+     "movement_span(params=): expected ObserveParams"),
+    (lambda out: pc.observe(None), r"observe\(tracks=\): expected Tracks \(Tracks.load"),
+    (lambda out: pc.run_batch("clips/", out, pc.Repertoire.default()),
+     r"run_batch\(items=\): expected BatchItems, got the path 'clips/': give discover"),
+    (lambda out: pc.run_batch(["a.mp4"], out, pc.Repertoire.default()),
+     "run_batch(items=): expected BatchItem"),
+])
+def test_an_argument_of_the_wrong_type_is_a_type_error_saying_what_was_expected(
+        tmp_path, call, said):
+    with pytest.raises(TypeError, match=said if "\\" in said else re.escape(said)):
+        call(tmp_path / "out")
+    assert not (tmp_path / "out").exists()
