@@ -9,6 +9,7 @@ from deep inside.
 from __future__ import annotations
 
 import dataclasses
+import math
 import re
 
 import numpy as np
@@ -87,3 +88,16 @@ def test_an_argument_of_the_wrong_type_is_a_type_error_saying_what_was_expected(
     with pytest.raises(TypeError, match=said if "\\" in said else re.escape(said)):
         call(tmp_path / "out")
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("given, field", [
+    (dict(fps=0), "demo_tracks.fps"), (dict(fps=-30), "demo_tracks.fps"),
+    (dict(fps=math.nan), "demo_tracks.fps"), (dict(fps=5000), "demo_tracks.fps"),
+    (dict(fps="30"), "demo_tracks.fps"), (dict(noise_px=-1), "demo_tracks.noise_px"),
+    (dict(noise_px=math.inf), "demo_tracks.noise_px"),
+])
+def test_a_demonstration_at_an_impossible_rate_or_noise_is_refused(given, field):
+    with pytest.raises(InputError) as caught:
+        pc.demo_tracks("normal", **given)
+    assert caught.value.field == field
+    assert len(pc.demo_tracks("normal", fps=np.float64(25), noise_px=np.int64(0))[0].time) == 41

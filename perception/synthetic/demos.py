@@ -13,14 +13,18 @@ Two kinds, both with their ground truth:
 
 from __future__ import annotations
 
+import math
+import numbers
 import os
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from perception.errors import InputError
 from perception.geometry import DEFAULT_OBJECT_DIAMETER
 from perception.io.tracks import Tracks
+from perception.limits import MAX_FPS
 from perception.synthetic.independent import tracked_paths
 from perception.synthetic.render import RenderResult, render_clip
 from perception.synthetic.scene import Camera, RenderStyle, Scene
@@ -65,8 +69,20 @@ def demo_tracks(condition: str, seed: int = 0, *, fps: float = 30.0, angle_deg: 
     truth : dict
         ``world`` (marker -> (T, 2) m), ``onset_frame`` and the ``params``
         (:class:`~perception.synthetic.stimuli.StimulusParams`).
+
+    Raises
+    ------
+    InputError
+        A condition, distance or duration :class:`StimulusParams` refuses, a
+        frame rate outside 0-1000 frames/s, a negative or infinite noise.
     """
     p = StimulusParams(condition=condition, distance=distance, duration=duration)
+    # as a recipe's: a rate of 0 gave NaN times, a negative one no frames at all
+    if not (isinstance(fps, numbers.Real) and 0 < fps <= MAX_FPS):
+        raise InputError(f"expected a number > 0 and <= {MAX_FPS:g}, got {fps!r}",
+                         field="demo_tracks.fps")
+    if not (isinstance(noise_px, numbers.Real) and 0 <= noise_px < math.inf):
+        raise InputError(f"expected a number >= 0, got {noise_px!r}", field="demo_tracks.noise_px")
     t, paths = stimulus_paths(p, fps, seed=seed)
     cam = Camera(DEMO_CAMERA.px_per_m, DEMO_CAMERA.origin_px, angle_deg)
     world = {**paths, "object": np.zeros_like(paths["wrist"])}
