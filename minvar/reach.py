@@ -129,6 +129,8 @@ def simulate_reach(
     -------
     ReachResult
     """
+    if not isinstance(task, ReachTask):  # as simulate_grasp's
+        raise ValueError(f"simulate_reach: task: expected a ReachTask, got {type(task).__name__}")
     plant = PointMassPlant() if plant is None else plant
     problem = reach_problem(task, plant)
     if solution is None:

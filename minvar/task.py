@@ -161,6 +161,12 @@ def reach_problem(task: ReachTask, plant: PointMassPlant | None = None) -> LQGPr
     LQGProblem
         ``T = task.steps(plant.dt)`` steps; ``n = 8 + 2 P`` states.
     """
+    # as plan_grasp's: not an AttributeError from the first field read
+    if not isinstance(task, ReachTask):
+        raise ValueError(f"reach_problem: task: expected a ReachTask, got {type(task).__name__}")
+    if plant is not None and not isinstance(plant, PointMassPlant):
+        raise ValueError(f"reach_problem: plant: expected a PointMassPlant, got "
+                         f"{type(plant).__name__}")
     plant = PointMassPlant() if plant is None else plant
     T = task.steps(plant.dt)
     targets = task.targets

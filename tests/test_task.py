@@ -118,6 +118,12 @@ def test_grasp_form_reaches_every_chain():
         (lambda: ReachTask((0, 0), (0.1, 0), 1.0, form="printed"), "ReachTask.form"),
         (lambda: PointMassPlant().dynamics(1, form="exact"), "dynamics"),
         (lambda: __import__("minvar").GraspTask(form="Thesis"), "GraspTask.form"),
+        # a dict or None for the task, a string for the plant: not an AttributeError
+        (lambda: reach_problem({"start": (0, 0)}), "reach_problem: task: expected a ReachTask"),
+        (lambda: reach_problem(ReachTask((0, 0), (0.1, 0), 1.0), "fast"),
+         "reach_problem: plant: expected a PointMassPlant, got str"),
+        (lambda: __import__("minvar").simulate_reach(None, trials=2),
+         "simulate_reach: task: expected a ReachTask, got NoneType"),
     ],
 )
 def test_bad_input_is_a_value_error_naming_the_argument(make, message):
