@@ -11,6 +11,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import re
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -101,3 +102,14 @@ def test_a_demonstration_at_an_impossible_rate_or_noise_is_refused(given, field)
         pc.demo_tracks("normal", **given)
     assert caught.value.field == field
     assert len(pc.demo_tracks("normal", fps=np.float64(25), noise_px=np.int64(0))[0].time) == 41
+
+
+def test_the_mocap_import_errors_docs_mocap_md_quotes_are_the_ones_raised():
+    text = (Path(__file__).resolve().parents[1] / "docs" / "mocap.md").read_text()
+    quoted = " ".join(text.split())  # the quotes wrap across lines
+    for rate in ("85", 0):
+        with pytest.raises(InputError) as caught:
+            pc.MocapImport(rate=rate)
+        said = str(caught.value)
+        assert said.startswith("MocapImport.rate: ")
+        assert said.removeprefix("MocapImport.rate: ") in quoted, said
