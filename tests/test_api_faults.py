@@ -113,3 +113,17 @@ def test_the_mocap_import_errors_docs_mocap_md_quotes_are_the_ones_raised():
         said = str(caught.value)
         assert said.startswith("MocapImport.rate: ")
         assert said.removeprefix("MocapImport.rate: ") in quoted, said
+
+
+def test_the_online_states_docstring_names_every_verdict_a_state_takes():
+    from perception.recognition.provisional import OnlineState
+
+    doc = OnlineState.__doc__.split("verdict : ")[1].split("familiarity : ")[0]
+    tracks, _ = pc.demo_tracks("delayed", seed=0)
+    rec = pc.OnlineRecognizer(pc.Repertoire.default(), tracker_attrs=dict(tracks.tracker))
+    seen = {(s.verdict, s.verdict_detail) for s in
+            (rec.update(p, t) for p, t in zip(tracks.position, tracks.time))}
+    assert {"unfamiliar", "abnormal"} <= {v for v, _ in seen}
+    for verdict, detail in seen:
+        assert (f"``{verdict}``" if verdict else "None") in doc, verdict
+        assert detail is None or f"``{detail}``" in doc, detail

@@ -210,9 +210,13 @@ class OnlineState:
         The model the provisional verdict rests on (best by log-likelihood
         among the kind the grip shows so far).
     verdict : str or None
-        Provisional verdict: ``normal``, ``abnormal`` or ``reach`` (None before the onset).
+        Provisional verdict: ``recognize``'s of the rows so far, ``normal``,
+        ``abnormal``, ``reach`` or ``unfamiliar`` (``incomplete`` until the
+        hand has arrived); None while the rows are not judged (phases
+        ``start`` and ``rest``).
     verdict_detail : str or None
-        ``re-opening`` where a second opening has been seen.
+        As ``recognize``'s: an ``abnormal`` grasp's kind (``re-opening``,
+        ``delayed-opening``, ...), why an ``unfamiliar`` one (``incomplete``, ...).
     familiarity : float
         The leading model's familiarity so far.
     evidence : float
