@@ -127,3 +127,19 @@ def test_the_online_states_docstring_names_every_verdict_a_state_takes():
     for verdict, detail in seen:
         assert (f"``{verdict}``" if verdict else "None") in doc, verdict
         assert detail is None or f"``{detail}``" in doc, detail
+
+
+def test_every_figure_recognition_plot_draws_is_documented_and_a_new_figure():
+    from matplotlib.figure import Figure
+
+    rec = pc.recognize_clip(pc.demo_tracks("normal", seed=0)[0], pc.Repertoire.default())
+    with pytest.raises(ValueError) as caught:
+        rec.plot("nothing")
+    kinds = re.findall(r"'(\w+)'", str(caught.value).split("not")[0])
+    assert "confidence" in kinds and len(kinds) >= 3
+    page = (Path(__file__).resolve().parents[1] / "docs" / "recognition.md").read_text()
+    for kind in kinds:
+        assert f"``{kind}``" in pc.Recognition.plot.__doc__, kind
+        assert kind == "confidence" or f'`rec.plot("{kind}")`' in page, kind
+        first, second = rec.plot(kind), rec.plot(kind)
+        assert isinstance(first, Figure) and first is not second

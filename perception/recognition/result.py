@@ -541,7 +541,11 @@ class Recognition:
             (:func:`~perception.report.figures.confidence_figure`, the
             report's ``<clip>.confidence.png``); ``paths``: the demonstration
             against the reference grasp model's own movement
-            (:func:`~perception.report.figures.paths_figure`, ``<clip>.paths.png``).
+            (:func:`~perception.report.figures.paths_figure`, ``<clip>.paths.png``);
+            ``kinematics``: the trial at a glance, its speed and grip aperture
+            with their landmarks
+            (:func:`~perception.report.kinematics.kinematics_figure`,
+            ``<clip>.kinematics.png``).
         """
         from perception.report.figures import confidence_figure, paths_figure
         from perception.report.kinematics import kinematics_figure
