@@ -27,7 +27,9 @@ from __future__ import annotations
 import dataclasses
 import functools
 import hashlib
+import importlib
 import json
+import numbers
 import os
 import threading
 from dataclasses import dataclass, field
@@ -117,6 +119,23 @@ class RecognitionSettings:
     mocap: MocapImport | None = None
     decoder_threads: int = 0
     planning_threads: int | None = None
+
+    def __post_init__(self):
+        # each refused here, not as an AttributeError where a clip first reads it
+        from perception.boundary import expect
+
+        for name, kind in (("observe", ObserveParams), ("hammer", HammerParams),
+                           ("rules", VerdictRules)):
+            expect(getattr(self, name), kind, f"RecognitionSettings({name}=)")
+        for name, module, kind in (("tracking", "perception.tracking.setup", "TrackingSetup"),
+                                   ("pose", "perception.io.pose", "PoseImport"),
+                                   ("mocap", "perception.recordings", "MocapImport")):
+            if getattr(self, name) is not None:  # imported only where one is given
+                expect(getattr(self, name), getattr(importlib.import_module(module), kind),
+                       f"RecognitionSettings({name}=)", optional=True)
+        if self.fps is not None and not isinstance(self.fps, numbers.Real):
+            raise TypeError(f"RecognitionSettings(fps=): expected a number (frames/s) or None, "
+                            f"got {type(self.fps).__name__} {self.fps!r}"[:200])
 
     def video_options(self) -> dict:
         """How to read videos, as keyword arguments of :func:`load_clip`."""

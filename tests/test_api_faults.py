@@ -143,3 +143,19 @@ def test_every_figure_recognition_plot_draws_is_documented_and_a_new_figure():
         assert kind == "confidence" or f'`rec.plot("{kind}")`' in page, kind
         first, second = rec.plot(kind), rec.plot(kind)
         assert isinstance(first, Figure) and first is not second
+
+
+@pytest.mark.parametrize("given, said", [
+    (dict(observe="x"), "RecognitionSettings(observe=): expected ObserveParams, got str"),
+    (dict(rules={"late_opening": 0.6}), "RecognitionSettings(rules=): expected VerdictRules"),
+    (dict(hammer=None), "RecognitionSettings(hammer=): expected HammerParams, got NoneType"),
+    (dict(mocap={"rate": 85}), "RecognitionSettings(mocap=): expected MocapImport or None"),
+    (dict(pose="dlc"), "RecognitionSettings(pose=): expected PoseImport or None"),
+    (dict(tracking="setup.toml"), "RecognitionSettings(tracking=): expected TrackingSetup"),
+    (dict(fps="30"), "RecognitionSettings(fps=): expected a number (frames/s) or None, got str"),
+])
+def test_settings_of_the_wrong_type_are_refused_when_made(given, said):
+    # they were an AttributeError where a clip first read them (observe: in observe())
+    with pytest.raises(TypeError, match=re.escape(said)):
+        pc.RecognitionSettings(**given)
+    pc.RecognitionSettings(fps=np.float64(25), mocap=pc.MocapImport(rate=85))
