@@ -191,7 +191,8 @@ def measure(source, *, params: LandmarkParams | None = None, mocap=None,
     Measured
         Its table: one row per movement: ``trial``, ``status``, the landmarks
         of :data:`UNITS` (NaN where the recording does not show them),
-        ``source`` and ``reason``; a recording's trial or movement that gives
+        ``source``, ``reason`` and ``bound`` (the rule that bounded the
+        movement, ``5 % of peak speed``); a recording's trial or movement that gives
         no reach is a row with its ``status`` (``no reach``, ``starts in
         motion``, ...) and ``reason``, NaN landmarks. One trial's failure
         never stops the trials after it.
@@ -255,9 +256,10 @@ def measure(source, *, params: LandmarkParams | None = None, mocap=None,
         scale = dpx / object_diameter
     time, transport, aperture = _tracks_movement(tracks, scale)
     lm = movement_landmarks(time, transport, aperture, params)
-    row = landmarks_row(name, lm, source=str(getattr(tracks, "path", None) or name))
     bound = (f"{params.speed:g} m/s" if params.speed is not None
              else f"{params.threshold * 100:g} % of peak speed")
+    # the rule in the table too, as a recording's rows give theirs
+    row = landmarks_row(name, lm, source=str(getattr(tracks, "path", None) or name), bound=bound)
     return Measured(_table([row]), 1, [MovementLandmarks(name, name, lm, lm.status,
                                                          bound=bound)])
 

@@ -159,3 +159,10 @@ def test_settings_of_the_wrong_type_are_refused_when_made(given, said):
     with pytest.raises(TypeError, match=re.escape(said)):
         pc.RecognitionSettings(**given)
     pc.RecognitionSettings(fps=np.float64(25), mocap=pc.MocapImport(rate=85))
+
+
+def test_the_landmarks_of_tracks_say_the_rule_that_bounded_them_as_a_recordings_do():
+    tracks, _ = pc.demo_tracks("normal", seed=0)
+    assert pc.landmarks(tracks, px_per_m=800.0)["bound"].tolist() == ["5 % of peak speed"]
+    fixed = pc.landmarks(tracks, px_per_m=800.0, params=pc.LandmarkParams(speed=0.05))
+    assert fixed["bound"].tolist() == ["0.05 m/s"]
