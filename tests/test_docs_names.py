@@ -42,3 +42,11 @@ def test_every_python_name_a_page_gives_exists(page):
     names = sorted(set(NAME.findall(page.read_text())))
     assert [n for n in names if not _resolves(n)] == []
 
+
+def test_the_late_opening_share_beside_grip_departs_is_the_rules():
+    from perception.recognition.rules import VerdictRules
+
+    text = " ".join((ROOT / "docs" / "recognition.md").read_text().split())
+    said = re.search(r"grip_departs`\): it starts to open \(10 % of its opening\) after "
+                     r"(\d+) % of the movement", text)
+    assert said and int(said.group(1)) == round(VerdictRules().late_opening * 100)
