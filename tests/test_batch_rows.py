@@ -142,7 +142,8 @@ def test_the_report_reads_the_kept_clips_one_at_a_time(tmp_path):
             self.kept = kept
 
         def __getitem__(self, clip):
-            gc.collect()
+            if len(alive) > 4:  # what a full collection frees does not count (one is slow)
+                gc.collect()
             most.append(len(alive))
             one = pickle.loads(pickle.dumps(self.kept[clip]))
             alive.add(one)
