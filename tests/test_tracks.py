@@ -136,6 +136,8 @@ def test_shapes_are_validated():
     tr = _tracks()
     with pytest.raises(ValueError, match="Tracks.position: expected shape"):
         tr.replace(position=tr.position[:, :2])
+    with pytest.raises(ValueError, match="Tracks.markers: expected a sequence of marker names"):
+        tr.replace(markers="thumb")  # was split into five markers, one per letter
 
 
 def test_interpolation_fills_short_gaps_only():

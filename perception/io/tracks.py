@@ -147,6 +147,9 @@ class Tracks:
     path: Path | None = None
 
     def __post_init__(self) -> None:
+        if isinstance(self.markers, str):  # not one marker per letter
+            raise ValueError(f"Tracks.markers: expected a sequence of marker names, got the "
+                             f"string {self.markers!r}")
         markers = tuple(str(m) for m in self.markers)
         arrays = {name: np.asarray(getattr(self, name), dtype=dtype)
                   for name, dtype in _DTYPES.items()}
