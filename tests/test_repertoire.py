@@ -26,6 +26,15 @@ def test_default_repertoire_has_both_kinds_and_ten_models():
     assert np.allclose(r.finger.x0[8:10], 1.0)
 
 
+def test_a_repertoire_shows_its_models_in_a_notebook():
+    lazy = Repertoire.default()
+    assert repr(lazy) == ("<LazyRepertoire: 16 models (grasp-0.5s, grasp-0.6s, grasp-0.7s, "
+                          "grasp-0.8s, ... reach-1.2s)>")
+    assert lazy._models is None  # shown without planning a model
+    one = Repertoire(default_repertoire().models[:1])
+    assert repr(one) == "<Repertoire: 1 model (grasp-0.5s)>"
+
+
 def test_round_trip_is_exact(tmp_path):
     rep = Repertoire.build([ModelSpec("g", "grasp", {"duration": 0.9}),
                             ModelSpec("r", "reach", {"duration": 0.9})])

@@ -91,6 +91,13 @@ class Repertoire:
     def __len__(self) -> int:
         return len(self.models)
 
+    def __repr__(self) -> str:
+        # names only: asking for the models would plan a lazy repertoire's
+        names = self.names
+        shown = ", ".join(names[:4]) + (f", ... {names[-1]}" if len(names) > 4 else "")
+        count = f"{len(names)} model" + ("s" if len(names) != 1 else "")
+        return f"<{type(self).__name__}: {count} ({shown})>"
+
     @property
     def names(self) -> list[str]:
         """Model names in order."""
