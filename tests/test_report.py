@@ -159,6 +159,28 @@ def test_the_batch_page_and_its_figures(scored):
     assert 'href="#clip-0"' in page and 'id="clip-0"' in page
 
 
+def test_the_pages_other_columns_are_summary_csvs_values(scored, tmp_path):
+    # the folded table says it shows summary.csv's columns: it shows them in that file's
+    # units (ms, mm, %), not the in-memory table's SI ones (a movement time of 1.73 beside
+    # summary.csv's 1725)
+    import re
+
+    out, recs = scored
+    results = [ClipResult(n, c, "ok", summary=ClipSummary.from_recognition(r))
+               for n, (r, c) in recs.items()]
+    write_batch_report(summary_table(results), {r.clip: r.summary for r in results}, tmp_path)
+    page = (tmp_path / "report.html").read_text()
+    table = page.split("other columns of summary.csv", 1)[1].split("</table>", 1)[0]
+    rows = [re.findall(r"<t[hd][^>]*>(.*?)</t[hd]>", r) for r in table.split("<tr>")[1:]]
+    shown = pd.DataFrame(rows[1:], columns=[h.split(" (")[0] for h in rows[0]]).set_index("clip")
+    assert "movement_time (ms)" in rows[0] and "mga (mm)" in rows[0]  # each with its unit
+    written = pd.read_csv(tmp_path / "summary.csv").set_index("clip")
+    for column in ("movement_time", "peak_speed", "peak_speed_time", "mga", "mga_time"):
+        assert written[column].notna().all()
+        np.testing.assert_allclose(shown[column].astype(float), written.loc[shown.index, column],
+                                   rtol=6e-3, err_msg=column)  # shown to 3 digits
+
+
 def test_a_batch_draws_its_figures_without_pyplot(tmp_path):
     """``hammer-mv batch`` on tracks files, in a fresh process: the figures are drawn by
     matplotlib on Agg canvases, never through pyplot (its global figure registry)."""

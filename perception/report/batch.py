@@ -59,6 +59,7 @@ from perception.report.statistics import (
     participant_means,
 )
 from perception.report.tables import (
+    LANDMARK_UNITS,
     TABLES,
     in_lab_units,
     r_aliases,
@@ -329,17 +330,19 @@ _SHOWN = {"clip", "condition", "winner", "rule", "verdict", "verdict_detail", "f
 
 
 def _other_columns_table(summary: pd.DataFrame) -> Iterator[str]:
-    """summary.csv's other columns (the tracking quality, …), folded away."""
+    """summary.csv's other columns (the tracking quality, …), folded away: its values, in its
+    units (the landmarks' ms, mm, %, not the in-memory table's SI ones), each named."""
     cols = [c for c in summary.columns if c not in _SHOWN | r_aliases(summary.columns)
             and not c.startswith("conf_")]
     if not cols:
         return
     rows = ([_e(r["clip"])] + [_num(r[c], ".3g") if isinstance(r[c], int | float | np.number)
                                and not isinstance(r[c], bool) else _e(r[c]) for c in cols]
-            for r in records(summary[summary["status"] == "ok"]))
+            for r in records(in_lab_units(summary[summary["status"] == "ok"])))
+    headers = [f"{c} ({LANDMARK_UNITS[c]})" if c in LANDMARK_UNITS else c for c in cols]
     yield ("<details><summary>Tracking quality and other columns of summary.csv</summary>"
            '<div class="scroll">')
-    yield from _table_parts(["clip", *cols], rows, numeric=set(range(1, len(cols) + 1)))
+    yield from _table_parts(["clip", *headers], rows, numeric=set(range(1, len(cols) + 1)))
     yield "</div></details>"
 
 
