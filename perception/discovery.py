@@ -55,6 +55,9 @@ REPORT_SET = ("summary.csv", "summary.units.json", "statistics.csv", "condition_
               "report.html", "batch.json", "aperture_profiles.csv", "kinematic_profiles.csv",
               ERRORS_LOG, "landmarks.csv", "participant_means.csv", "landmark_statistics.csv",
               *(f"{stem}.{fmt}" for stem in BATCH_FIGURES for fmt in ("png", "svg", "pdf")))
+#: Why a folder inside a batch's input folder is skipped.
+SUBFOLDER = ("a folder: the files of the folder given are read, not those of its "
+             "subfolders (a manifest.csv can name them)")
 COMPANION_NAMES = ("manifest.csv", "README.md", "recipe.toml", "repertoire.h5", *REPORT_SET)
 #: A clip name becomes file names in the report folder: no separators, no
 #: leading dot, nothing that is not printable.
@@ -205,7 +208,8 @@ def find_clips(source: str | os.PathLike) -> Discovery:
         ``trial01``), read from its best pose file
         (:func:`~perception.io.pose.pose_output`). Files that are not clips
         (notes, setups, labelled videos, metadata, the other pose files of a
-        clip, FIFOs, devices or links to them) are skipped, never opened.
+        clip, FIFOs, devices or links to them) are skipped, never opened; so
+        are subfolders (their files are not read), but for a batch report's.
 
     Raises
     ------
@@ -235,7 +239,13 @@ def find_clips(source: str | os.PathLike) -> Discovery:
             continue
         if path.name.startswith(".") or path.name in COMPANION_NAMES:
             continue
-        if path.name.endswith(COMPANION_SUFFIXES) or path.is_dir():
+        if path.is_dir():
+            # a batch report (this input's own tracks/, or a report folder inside it) holds
+            # no clips; any other folder is named, never passed over without a word
+            if not (report_folder or (path / "batch.json").is_file()):
+                skipped.append((path.name, SUBFOLDER))
+            continue
+        if path.name.endswith(COMPANION_SUFFIXES):
             continue
         clip, kind = clip_name(path)
         output = pose_output(path.name)

@@ -26,6 +26,7 @@ from _faults import one_line
 
 from perception.batch import discover, find_clips, run_batch
 from perception.cluster import SCHEDULER_TIMEOUT_S
+from perception.discovery import SUBFOLDER
 from perception.provenance import code_digest
 from perception.recognition.repertoire import Repertoire
 from perception.synthetic.recipes import Recipe, StimulusParams, synthesize
@@ -66,6 +67,19 @@ def tracks_folder(tmp_path):
     for cond in ("normal", "delayed"):
         demo_tracks(cond, 0)[0].save(src / f"{cond}.tracks.h5")
     return src
+
+
+def test_a_subfolder_is_listed_as_skipped_not_passed_over(tracks_folder):
+    # a lab's P01/, P02/ folders of recordings: their files are not read, and that is
+    # said (it was silent: exit 0, the trials missing from the report without a word)
+    (tracks_folder / "P01").mkdir()
+    demo_tracks("normal", 1)[0].save(tracks_folder / "P01" / "normal.tracks.h5")
+    (tracks_folder / "report").mkdir()  # a batch report written inside the input
+    (tracks_folder / "report" / "batch.json").write_text("{}")
+    found = find_clips(tracks_folder)
+    assert [i.clip for i in found.items] == ["delayed", "normal"]
+    assert dict(found.skipped) == {"P01": SUBFOLDER}
+    assert "not those of its subfolders" in SUBFOLDER
 
 
 def test_fifos_devices_and_notes_in_a_folder_are_skipped_not_opened(tracks_folder, repfile,
