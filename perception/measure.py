@@ -104,11 +104,15 @@ class Measured:
     movements : list of MovementLandmarks
         The same movements for :func:`~perception.report.tables.tidy_landmarks`
         (clip, factors, flags), in order.
+    skipped : list of (str, str)
+        The files of the folders measured that are not clips, each as
+        ``(path, why)`` (:attr:`perception.discovery.Discovery.skipped`).
     """
 
     table: pd.DataFrame
     trials: int
     movements: list[MovementLandmarks] = field(default_factory=list)
+    skipped: list[tuple[str, str]] = field(default_factory=list)
 
     @property
     def measured(self) -> int:
@@ -338,11 +342,13 @@ def _measure_inputs(inputs: list[Path], params, mocap, progress, kwargs: dict,
     params = LandmarkParams() if params is None else params
     mocap = MocapImport() if mocap is None else mocap
     settings = _MocapSettings(mocap)
-    rows, movements, trials = [], [], 0
+    rows, movements, trials, skipped = [], [], 0, []
     for path in inputs:
         listed = path.is_dir() or _is_manifest(path)
         if listed:
-            items = find_clips(path).items
+            discovery = find_clips(path)
+            items = discovery.items
+            skipped += [(str(path / name), why) for name, why in discovery.skipped]
         else:
             name, kind = clip_name(path)
             items = [BatchItem(name, path, kind)]
@@ -366,7 +372,7 @@ def _measure_inputs(inputs: list[Path], params, mocap, progress, kwargs: dict,
             found_here.sort(key=lambda m: m.clip)
         movements += found_here
     # one table of every row: a frame per movement took 1 ms each (2 s for 2,000)
-    return Measured(_table(rows), trials, movements)
+    return Measured(_table(rows), trials, movements, skipped)
 
 
 @dataclass(frozen=True)

@@ -400,6 +400,25 @@ def test_a_batch_lists_an_empty_table_as_empty(tmp_path):
     assert "empty" not in dict(found.skipped)["notes.tsv"]
 
 
+def test_landmarks_of_a_folder_names_the_files_it_skipped(tmp_path, capsys):
+    """landmarks finds a folder's clips as batch does, and says what it skipped as batch
+    does (it said nothing: notes, an empty table, a subfolder of recordings all dropped)."""
+    from hammer_mv.cli import main
+
+    folder = tmp_path / "in"
+    (folder / "P01").mkdir(parents=True)
+    (folder / "notes.txt").write_text("a few words\n")
+    (folder / "trial.tsv").write_bytes(b"")
+    main(["landmarks", str(folder), "-o", str(tmp_path / "l.csv")])
+    said = [line for line in capsys.readouterr().err.splitlines() if "skipped" in line]
+    assert len(said) == 1 and said[0].startswith("hammer-mv landmarks: skipped 3 file(s)")
+    for name, why in (("notes.txt", "not a video"), ("trial.tsv", "empty file"),
+                      ("P01", "a folder")):
+        assert f"{folder / name} ({why}" in said[0]
+    main(["landmarks", str(folder), "-o", str(tmp_path / "l.csv"), "--quiet"])
+    assert "skipped" not in capsys.readouterr().err
+
+
 def test_landmarks_of_an_empty_table_says_it_is_empty(tmp_path, capsys):
     from hammer_mv.cli import main
 

@@ -71,11 +71,7 @@ def run(args: argparse.Namespace) -> int:
     found = find_clips(args.input)
     items = found.items
     if found.skipped and not args.quiet:
-        names = ", ".join(f"{name} ({why})" for name, why in found.skipped[:3])
-        more = (f" and {len(found.skipped) - 3} more (batch.json lists them)"
-                if len(found.skipped) > 3 else "")
-        print(f"hammer-mv batch: skipped {len(found.skipped)} file(s) that are not clips: "
-              f"{names}{more}", file=sys.stderr)
+        print(skipped_line("batch", found.skipped, "batch.json lists them"), file=sys.stderr)
     if not items:
         first = (f" ({len(found.skipped)} file(s) skipped; {found.skipped[0][0]}: "
                  f"{found.skipped[0][1]})" if found.skipped else "")
@@ -104,6 +100,15 @@ def run(args: argparse.Namespace) -> int:
         print(f"hammer-mv batch: {failed} clip(s) failed ({failure_reasons(summary, items)}); "
               f"see {args.output / 'summary.csv'}", file=sys.stderr)
     return 1 if failed or len(unscored) else 0
+
+
+def skipped_line(command: str, skipped: list[tuple[str, str]], rest: str) -> str:
+    """The one line that names the files of an input folder a command did not read, and
+    why: the first three, then how many more (``rest`` says where they are listed)."""
+    names = ", ".join(f"{name} ({why})" for name, why in skipped[:3])
+    more = f" and {len(skipped) - 3} more ({rest})" if len(skipped) > 3 else ""
+    return (f"hammer-mv {command}: skipped {len(skipped)} file(s) that are not clips: "
+            f"{names}{more}")
 
 
 def _warnings(summary) -> list[tuple[str, list[dict]]]:

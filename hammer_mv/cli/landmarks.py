@@ -147,6 +147,10 @@ def run(args: argparse.Namespace) -> int:
     finally:
         if bar is not None:
             bar.close()
+    if found.skipped and not args.quiet:  # as batch says them: none passed over silently
+        from hammer_mv.cli.batch import skipped_line
+
+        print(skipped_line("landmarks", found.skipped, "-v logs each"), file=sys.stderr)
     movements = found.movements
     if args.wide:
         table = wide_landmarks(movements)
