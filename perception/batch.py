@@ -336,7 +336,7 @@ def run_batch(
         No progress bar (there is none anyway when stderr is not a terminal).
     skipped : iterable of (str, str)
         Files of the input that are not clips, with why (:attr:`Discovery.skipped`),
-        listed in ``batch.json``.
+        listed in ``batch.json`` and ``report.html``.
     figure_format : str
         Format of every figure, the clips' and the batch's: ``png``, ``svg`` or ``pdf``.
     dpi : int
@@ -477,8 +477,9 @@ def _finish(done: list[ClipResult], rows: ModelRows, items: list[BatchItem],
     done.clear()
     _remove_report(out)  # the last run's set: a kill or a full disk below leaves no mix
     try:
+        skipped = list(skipped)  # the page and batch.json both list them
         write_batch_report(summary, kept, out, models=repertoire.models,
-                           figure_format=figure_format, dpi=dpi, jobs=jobs)
+                           figure_format=figure_format, dpi=dpi, jobs=jobs, skipped=skipped)
         if bugs:
             write_text(out / ERRORS_LOG, "\n".join(bugs))
         write_json(out / "batch.json", {

@@ -9,6 +9,7 @@ recording a failure ended the batch without its summary.
 
 from __future__ import annotations
 
+import html
 import json
 import os
 import shutil
@@ -99,6 +100,11 @@ def test_fifos_devices_and_notes_in_a_folder_are_skipped_not_opened(tracks_folde
     assert list(summary["clip"]) == ["delayed", "normal"] and (summary["status"] == "ok").all()
     skipped = json.loads((out / "batch.json").read_text())["skipped"]
     assert {s["file"] for s in skipped} == {"x.mp4", "z.mp4", "notes.txt", "setup.toml"}
+    # and on the page, each with why (the page said nothing of them)
+    page = (out / "report.html").read_text()
+    assert "4 file(s) of the input not read" in page and "Files not read (4)" in page
+    for s in skipped:
+        assert f"<td>{s['file']}</td><td>{html.escape(s['reason'])}</td>" in page
 
 
 def test_a_manifest_row_naming_a_device_fails_that_clip_at_once(tracks_folder, repfile,

@@ -531,7 +531,8 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
                        out: Path, *, profile_model: str | None = None,
                        title: str = "hammer-mv recognition report",
                        models: Sequence | None = None, figure_format: str = "png",
-                       dpi: int = DPI, jobs: int = 1) -> BatchReport:
+                       dpi: int = DPI, jobs: int = 1,
+                       skipped: Iterable[tuple[str, str]] = ()) -> BatchReport:
     """Write ``summary.csv``, the chapter 5 figures and statistics, the tidy tables
     (``landmarks.csv``, ``participant_means.csv``, ``landmark_statistics.csv``) and
     ``report.html``.
@@ -562,6 +563,9 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
     jobs : int
         Worker processes that may fit the statistics' measures side by side
         (:func:`~perception.report.statistics.landmark_statistics`).
+    skipped : iterable of (str, str)
+        The input folder's files that are not clips, with why
+        (:attr:`perception.discovery.Discovery.skipped`): listed on the page.
     """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -609,6 +613,10 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
         sections.append(f"<h2>Not scored ({len(failed)})</h2>" + _table(
             ["clip", "status", "reason"],
             [[_e(c), _e(st), _e(w)] for c, st, w in zip(failed["clip"], failed["status"], why)]))
+    skipped = list(skipped)
+    if skipped:  # every file of the input is on the page: a row, or a line saying why not
+        sections.append(f"<h2>Files not read ({len(skipped)})</h2>" + _table(
+            ["file", "reason"], [[_e(name), _e(why)] for name, why in skipped]))
     names = sorted(os.listdir(out))  # once, not once per clip
     clips = (_clip_section(rec, out, anchors[rec.clip], condition_of.get(rec.clip), names)
              for rec in recs)
@@ -616,7 +624,9 @@ def write_batch_report(summary: pd.DataFrame, recognitions: dict[str, ClipSummar
                                                       else []), *TABLES)]
     body = [
         f"<h1>{_e(title)}</h1>",
-        f"<p>{len(summary)} clips: {scored} scored, {len(failed)} not scored. Tables: "
+        f"<p>{len(summary)} clips: {scored} scored, {len(failed)} not scored"
+        + (f"; {len(skipped)} file(s) of the input not read (below)" if skipped else "")
+        + ". Tables: "
         + ", ".join(tables) + '. <span class="note">' + _HOW_TO_READ + "</span></p>",
         counts,
         "<h2>Summary</h2>", _main_table(summary, anchors, profile_model), _models_table(summary),
