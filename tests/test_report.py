@@ -181,6 +181,16 @@ def test_the_pages_other_columns_are_summary_csvs_values(scored, tmp_path):
                                    rtol=6e-3, err_msg=column)  # shown to 3 digits
 
 
+def test_the_pages_other_columns_show_whole_milliseconds_without_an_exponent():
+    from perception.report.batch import _other_columns_table
+
+    summary = pd.DataFrame({"clip": ["a"], "status": ["ok"], "movement_time": [1.4417],
+                            "peak_speed": [0.942], "mga_time": [0.3083]})
+    table = "".join(_other_columns_table(summary))
+    assert "<td class=n>1442</td><td class=n>942</td><td class=n>30.8</td>" in table
+    assert "e+" not in table  # 1.44e+03 ms
+
+
 def test_a_batch_draws_its_figures_without_pyplot(tmp_path):
     """``hammer-mv batch`` on tracks files, in a fresh process: the figures are drawn by
     matplotlib on Agg canvases, never through pyplot (its global figure registry)."""

@@ -336,7 +336,10 @@ def _other_columns_table(summary: pd.DataFrame) -> Iterator[str]:
             and not c.startswith("conf_")]
     if not cols:
         return
-    rows = ([_e(r["clip"])] + [_num(r[c], ".3g") if isinstance(r[c], int | float | np.number)
+    def number(v):  # 3 digits, whole ms and mm/s without an exponent (1442, not 1.44e+03)
+        return _num(v, ".0f" if abs(v) >= 1000 else ".3g")
+
+    rows = ([_e(r["clip"])] + [number(r[c]) if isinstance(r[c], int | float | np.number)
                                and not isinstance(r[c], bool) else _e(r[c]) for c in cols]
             for r in records(in_lab_units(summary[summary["status"] == "ok"])))
     headers = [f"{c} ({LANDMARK_UNITS[c]})" if c in LANDMARK_UNITS else c for c in cols]
