@@ -251,7 +251,10 @@ def measure(source, *, params: LandmarkParams | None = None, mocap=None,
         name = str(tracks.attrs.get("clip", "tracks"))
     scale = px_per_m
     if scale is None:
-        dpx = tracks.object_diameter_px() if object_diameter_px is None else object_diameter_px
+        # the flag is for tracks that do not give the size (a pose file's): a tracker's
+        # measurement stands, as batch and recognize scale a video by it
+        dpx = tracks.object_diameter_px()
+        dpx = object_diameter_px if dpx is None else dpx
         if dpx is None or object_diameter is None:
             where = tracks.path or (source if not isinstance(source, Tracks) else "tracks")
             raise InputError("the scale is unknown: give `px_per_m`, or the object's diameter "

@@ -344,6 +344,20 @@ def test_landmarks_takes_object_diameter_px_and_suggests_only_its_own_flags():
     assert found.landmarks.movement_time == pytest.approx(direct.landmarks.movement_time)
 
 
+def test_object_diameter_px_scales_only_tracks_that_do_not_measure_the_object():
+    # batch's landmarks.csv reads a tracked video at its tracker's measured object size,
+    # whatever --object-diameter-px says (a pose file's flag); landmarks took the flag over
+    # the measurement, so one command line gave a video other values in the two tables
+    from perception.measure import measure
+    from perception.synthetic.demos import demo_tracks
+
+    tracks, _ = demo_tracks("normal", 0)
+    assert tracks.object_diameter_px() == pytest.approx(80.0)  # as its tracker measured
+    own = measure(tracks, object_diameter=0.1).movements[0].landmarks
+    given = measure(tracks, object_diameter=0.1, object_diameter_px=60.0).movements[0].landmarks
+    assert given.mga == own.mga and given.peak_speed == own.peak_speed
+
+
 def test_landmarks_on_a_deeplabcut_file_takes_the_flag_it_suggests(tmp_path):
     from perception.io.exports import write_dlc
     from perception.synthetic.demos import demo_tracks
