@@ -1,6 +1,7 @@
 """The command line explains itself: help on every argument, defaults shown, common flags."""
 
 import argparse
+import re
 
 import pytest
 
@@ -66,3 +67,12 @@ def test_the_top_level_help_explains_the_pipeline():
     for name in ("synth", "track", "tracks", "recognize", "batch", "calibrate", "reach", "grasp",
                  "repertoire"):
         assert f"    {name}" in text
+
+
+def test_batch_help_names_every_kind_it_reads_and_that_subfolders_are_not():
+    # it named videos, tracks and pose files: a lab with motion-capture tables could not
+    # tell from --help that batch takes them, nor that P01/, P02/ are not read
+    batch = dict(PARSERS)[("hammer-mv", "batch")]
+    text = re.sub(r"-\s+", "-", " ".join(batch.format_help().split()))  # wrapped at hyphens
+    assert "motion-capture recordings, or a manifest.csv" in text
+    assert "not its subfolders" in text and "skipped and listed" in text

@@ -24,15 +24,18 @@ def register(sub) -> None:
     """
     p = sub.add_parser("batch", help="recognise a folder of clips (or a synth manifest)",
                        description="Track and recognise every clip of INPUT (a folder of "
-                       "videos / .tracks.h5 files, or a manifest.csv from hammer-mv synth) in "
-                       "parallel; write REPORT_DIR/report.html, summary.csv, statistics and "
-                       "per-clip reports. Rerunning skips clips whose report is current. "
+                       "videos, .tracks.h5 files, pose files and motion-capture recordings, "
+                       "not its subfolders; or a manifest.csv naming them, as hammer-mv synth "
+                       "writes one) in parallel; write REPORT_DIR/report.html, summary.csv, "
+                       "statistics and per-clip reports. Files that are not clips are skipped "
+                       "and listed. Rerunning skips clips whose report is current. "
                        "A motion-capture recording gives a row per reach and per trial not "
                        "scored, with its status and reason. Exits 1 if any clip failed or a "
                        "trial could not be scored (each is in the report, with why).")
     # kept as typed (a Path would make "udp://host" "udp:/host"): its kind is read first
     p.add_argument("input", metavar="INPUT",
-                   help="folder of videos, .tracks.h5 or pose files, or a manifest.csv")
+                   help="folder of videos, .tracks.h5, pose files or motion-capture "
+                   "recordings, or a manifest.csv")
     p.add_argument("-o", "--output", type=Path, required=True, metavar="REPORT_DIR",
                    help="report folder (report.html, summary.csv, per-clip reports)")
     p.add_argument("--jobs", type=int, default=1, metavar="N",
