@@ -10,10 +10,13 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 
-__all__ = ["OK", "Landmarks"]
+__all__ = ["OK", "TRANSPORT_LOST", "Landmarks"]
 
 #: A landmark's flag when nothing casts doubt on it (:meth:`Landmarks.flag`).
 OK = "ok"
+#: Every landmark's flag where the transport point is never seen long enough for a speed
+#: (:attr:`Landmarks.status` ``marker lost``).
+TRANSPORT_LOST = "not seen: the transport point is lost throughout"
 #: Landmarks derived from others: their flag is the first doubtful one of these.
 _DERIVED = {"opening": ("mga", "rest_aperture"),
             "peak_speed_seconds": ("peak_speed_time", "movement_time"),
@@ -120,9 +123,13 @@ class Landmarks:
     @property
     def status(self) -> str:
         """Whether the recording holds the whole movement: ``complete``, ``starts in
-        motion``, ``ends in motion`` or ``in motion throughout``."""
+        motion``, ``ends in motion`` or ``in motion throughout``; ``marker lost`` where
+        the transport point is lost throughout (:data:`TRANSPORT_LOST`), so that no
+        speed tells whether the hand moved at all."""
         if math.isnan(self.onset_time) and math.isnan(self.end_time):
-            return "in motion throughout"
+            # without a speed the onset and end are unknown, not outside the recording
+            lost = self.flags.get("onset_time") == TRANSPORT_LOST
+            return "marker lost" if lost else "in motion throughout"
         if math.isnan(self.onset_time):
             return "starts in motion"
         if math.isnan(self.end_time):

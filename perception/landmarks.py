@@ -35,7 +35,7 @@ from perception.landmark_flags import (
     why_not_open,
 )
 from perception.landmark_stream import filtfilt_run, median_step, speed_and_floor
-from perception.landmark_values import _NAMES, OK, Landmarks
+from perception.landmark_values import _NAMES, OK, TRANSPORT_LOST, Landmarks
 from perception.resume import Kept, grown_of, rowwise
 from perception.rowwise import finite_rows, row_norm, run_edges
 from perception.validation import Int, Share, declared
@@ -490,8 +490,7 @@ def _landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.ndarray,
     # (landmark_stream: the rows whose filtered positions changed, measured again)
     speed, floor = speed_and_floor(time, params._lowpass(time, path, step), FLOOR_PERCENTILE)
     if not np.isfinite(speed).any():
-        return Landmarks(flags=all_flags(_NAMES, "not seen: the transport point is lost "
-                                                 "throughout"))
+        return Landmarks(flags=all_flags(_NAMES, TRANSPORT_LOST))
     raised = []  # (side, share of peak) where a bound was raised above the asked one
     if bounds is None:
         peak = int(np.nanargmax(speed))

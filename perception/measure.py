@@ -120,6 +120,20 @@ class Measured:
         return int((self.table["reason"].fillna("") == "").sum()) if len(self.table) else 0
 
 
+def _transport_lost(tracks) -> str:
+    """Why the transport point of ``tracks`` is never seen, as a recording's ``marker lost``
+    reason says it (:func:`perception.reaches.trial_reaches`): the markers that carry it
+    and are never seen, named."""
+    seen = {m: bool(np.isfinite(tracks.marker(m)).all(axis=1).any())
+            for m in ("wrist", "thumb", "finger") if m in tracks.markers}
+    if seen.get("wrist"):  # the wrist carries it wherever it is seen (_tracks_movement)
+        return "marker lost: the wrist is never seen long enough to give a speed"
+    never = [m for m, ever in seen.items() if not ever]
+    if seen["thumb"] and seen["finger"]:  # never both at once (or too briefly): the midpoint
+        never.append("thumb and finger together")
+    return f"marker lost throughout: {', '.join(never)}"
+
+
 def _tracks_movement(tracks, px_per_m: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Time, transport (m) and aperture (m) of tracks in pixels."""
     def get(name):
@@ -266,7 +280,13 @@ def measure(source, *, params: LandmarkParams | None = None, mocap=None,
     bound = (f"{params.speed:g} m/s" if params.speed is not None
              else f"{params.threshold * 100:g} % of peak speed")
     # the rule in the table too, as a recording's rows give theirs
-    row = landmarks_row(name, lm, source=str(getattr(tracks, "path", None) or name), bound=bound)
+    origin = str(getattr(tracks, "path", None) or name)
+    if lm.status == "marker lost":  # a movement that gives none, as a recording's trial
+        reason = _transport_lost(tracks)
+        row = landmarks_row(name, lm, source=origin, reason=reason)
+        return Measured(_table([row]), 1, [MovementLandmarks(name, name, None, lm.status,
+                                                             reason)])
+    row = landmarks_row(name, lm, source=origin, bound=bound)
     return Measured(_table([row]), 1, [MovementLandmarks(name, name, lm, lm.status,
                                                          bound=bound)])
 

@@ -10,6 +10,7 @@ time, peak speed and maximum grip aperture are known in closed form.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import subprocess
@@ -411,3 +412,63 @@ def test_times_go_on_the_recordings_clock_or_say_whose_they_are():
     assert u.loc["onset_time", "value"] == pytest.approx(100.0)
     assert u.loc["onset_time", "clock"] == "observation"  # a report without its time origin
     assert k.loc["movement_time", "value"] == u.loc["movement_time", "value"] == 1200.0
+
+
+# -- a transport point never seen: `marker lost`, as a recording's trial says it -----------------
+def _lost(tracks, *markers):
+    """``tracks`` with ``markers`` lost in every row."""
+    position = tracks.position.copy()
+    position[:, [tracks.markers.index(m) for m in markers]] = np.nan
+    return dataclasses.replace(tracks, position=position)
+
+
+def test_tracks_whose_transport_point_is_lost_throughout_say_marker_lost_and_which():
+    from perception.measure import measure
+    from perception.synthetic.demos import demo_tracks
+
+    tracks, _ = demo_tracks("normal", 1)
+    for lost, why in ((("thumb", "finger", "wrist", "object"), "wrist, thumb, finger"),
+                      (("wrist", "thumb"), "wrist, thumb")):
+        found = measure(_lost(tracks, *lost), px_per_m=700)
+        row = found.table.iloc[0]
+        # not "in motion throughout" with no reason: nothing tells whether the hand moved
+        assert row["status"] == "marker lost", lost
+        assert row["reason"] == f"marker lost throughout: {why}"
+        assert found.measured == 0 and found.movements[0].landmarks is None
+        assert found.movements[0].status == "marker lost"
+    # the digits seen, never at once, and no wrist: the midpoint is what is lost
+    alternate = tracks.position.copy()
+    alternate[::2, 0] = alternate[1::2, 1] = np.nan
+    row = measure(_lost(dataclasses.replace(tracks, position=alternate), "wrist"),
+                  px_per_m=700).table.iloc[0]
+    assert row["reason"] == "marker lost throughout: wrist, thumb and finger together"
+    # the wrist seen in one row carries the transport, and gives no speed
+    once = _lost(tracks, "thumb", "finger", "wrist").position
+    once[10, 2] = tracks.position[10, 2]
+    row = measure(dataclasses.replace(tracks, position=once), px_per_m=700).table.iloc[0]
+    assert row["status"] == "marker lost" and "wrist is never seen long enough" in row["reason"]
+    # a thumb lost while the wrist is seen: the movement is measured whole, the aperture's
+    # landmarks flagged as not seen
+    thumbless = measure(_lost(tracks, "thumb"), px_per_m=700).movements[0]
+    assert thumbless.status == "complete" and thumbless.landmarks.peak_speed > 0
+    assert thumbless.landmarks.flag("mga").startswith("not seen")
+    # the value itself says so, wherever it is read
+    t = np.arange(50) / 30.0
+    lm = movement_landmarks(t, np.full((50, 2), np.nan), np.full(50, 0.02))
+    assert lm.status == "marker lost"
+
+
+def test_landmarks_and_recognize_of_a_tracks_file_whose_markers_are_lost(tmp_path):
+    from perception.synthetic.demos import demo_tracks
+
+    path = tmp_path / "gone.tracks.h5"
+    _lost(demo_tracks("normal", 1)[0], "thumb", "finger", "wrist").save(path)
+    out = tmp_path / "lm.csv"
+    res = hammer("landmarks", path, "--px-per-m", 700, "-o", out)
+    assert res.returncode == 1, res.stderr  # a trial not measured, as a recording's
+    assert "gone: not scored: marker lost throughout: wrist, thumb, finger" in res.stderr
+    table = _read(out)
+    assert set(table["status"]) == {"marker lost"} and set(table["flag"]) == {"not scored"}
+    res = hammer("recognize", path, "--px-per-m", 700, "-o", tmp_path / "rec", "--no-figures")
+    assert res.returncode == 2 and len(res.stderr.strip().splitlines()) == 1, res.stderr
+    assert "never seen" in res.stderr
