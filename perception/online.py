@@ -33,6 +33,7 @@ from perception.recognition.provisional import (
 from perception.recognition.repertoire import PlanCache, Repertoire
 from perception.recognition.result import Recognition
 from perception.recognition.rules import AT_END, judge
+from perception.records import check_markers
 from perception.resume import Grown
 
 __all__ = ["Decision", "OnlineRecognizer", "OnlineState", "SettleRule", "decision_summary"]
@@ -98,7 +99,8 @@ class OnlineRecognizer:
         Clip name (the report's).
     markers : sequence of str, optional
         Marker names of the rows given to :meth:`update` as positions (default:
-        the tracker's, ``thumb, finger, wrist, object``).
+        the tracker's, ``thumb, finger, wrist, object``); they must hold the
+        four, in any order, among others.
     tracker_attrs : dict, optional
         ``/tracker`` attributes of rows given as positions: the object's
         apparent size (``diameter_px``) sets the scale unless ``px_per_m`` does;
@@ -107,6 +109,12 @@ class OnlineRecognizer:
         When a verdict settles.
     plan_cache : PlanCache, optional
         Plans shared with other processes.
+
+    Raises
+    ------
+    InputError
+        ``markers`` without one the recognition needs, named as ``recognize``
+        names it (:func:`perception.records.check_markers`).
 
     Attributes
     ----------
@@ -139,6 +147,8 @@ class OnlineRecognizer:
             markers = (MARKER_NAMES if self.settings.tracking is None
                        else self.settings.tracking.markers.names)
         self.markers = tuple(markers)
+        # fixed from here on: a stream without one would wait at rest until finish() refused it
+        check_markers(self.markers, field="markers")
         self._rows = _Rows(len(self.markers))
         self._received = 0  # frames or rows given to update
         self._last_time: float | None = None

@@ -32,7 +32,7 @@ if TYPE_CHECKING:
 
     from perception.observation import ObserveParams
 
-__all__ = ["MARKERS", "MovementRecord", "make_record", "reading_notes"]
+__all__ = ["MARKERS", "MovementRecord", "check_markers", "make_record", "reading_notes"]
 
 #: The record's markers: the transport point, the digits and the object.
 MARKERS = ("wrist", "finger", "thumb", "object")
@@ -112,17 +112,40 @@ class MovementRecord:
         return pd.DataFrame(data)
 
 
+def check_markers(markers, path=None, *, field: str | None = None) -> None:
+    """Refuse marker names that lack one the recognition needs (:data:`MARKERS`).
+
+    Parameters
+    ----------
+    markers : sequence of str
+        The tracks' marker names.
+    path : str or os.PathLike, optional
+        What the error names (the clip).
+    field : str, optional
+        The field it names (default: the first marker missing).
+
+    Raises
+    ------
+    InputError
+        Naming every marker missing and those there are.
+    """
+    missing = [m for m in MARKERS if m not in markers]
+    if missing:
+        names = ", ".join(f"'{m}'" for m in missing)
+        said = f"marker {names} is" if len(missing) == 1 else f"markers {names} are"
+        raise InputError(f"{said} not in the tracks (have {', '.join(markers) or 'none'})",
+                         path, field=field or missing[0])
+
+
 def _positions(tracks, params: ObserveParams, name: str) -> dict[str, np.ndarray]:
     """(T, 2) positions of every needed marker in the input's units; refuses tracks that
     cannot be scored."""
     markers = list(tracks.markers)
+    check_markers(markers, name)
     pos = np.asarray(tracks.position, dtype=float)
     out = {}
     for m in MARKERS:
         what = "object" if m == "object" else f"marker '{m}'"
-        if m not in markers:
-            raise InputError(f"marker '{m}' is not in the tracks (have {', '.join(markers)})",
-                             name, field=m)
         out[m] = pos[:, markers.index(m)]
         if not np.isfinite(out[m]).all(axis=1).any():
             raise InputError(f"{what} is never seen in the clip", name, field=m)

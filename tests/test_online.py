@@ -261,3 +261,25 @@ def test_a_state_says_why_rows_are_not_judged_yet(rep):
     assert rest and all(s.waiting_for and s.verdict is None for s in rest)
     assert all(s.waiting_for is None and s.judged_on is not None
                for s in states if s.phase == "moving")
+
+
+def test_markers_without_one_recognition_needs_are_refused_at_once_as_recognize_says(rep):
+    """The markers are fixed at construction: not a stream at rest until ``finish``."""
+    tracks = _tracks("normal")
+    keep = [tracks.markers.index(m) for m in ("thumb", "finger", "wrist")]
+    short = dataclasses.replace(tracks, markers=tuple(tracks.markers[k] for k in keep),
+                                position=tracks.position[:, keep],
+                                likelihood=tracks.likelihood[:, keep],
+                                status=tracks.status[:, keep])
+    with pytest.raises(InputError) as offline:
+        recognize_tracks(short, rep)
+    with pytest.raises(InputError) as online:
+        OnlineRecognizer(rep, markers=short.markers)
+    assert online.value.field == "markers" and "markers: " in str(online.value)
+    assert online.value.problem == offline.value.problem
+    assert "marker 'object' is not in the tracks" in online.value.problem
+    with pytest.raises(InputError, match=r"markers 'finger', 'object' are not in the tracks"):
+        OnlineRecognizer(rep, markers=("thumb", "index", "wrist"))
+    # a marker lost in a row is NaN there, not a marker missing
+    rec = OnlineRecognizer(rep, markers=("object", "wrist", "finger", "thumb", "elbow"))
+    assert rec.update(np.full((5, 2), np.nan), 0.0).phase == "start"

@@ -58,3 +58,21 @@ def test_a_pose_file_has_no_frames_to_label(pose, tmp_path):
                diameter, "--repertoire", rep, "--labelled-video", tmp_path / "v.mp4")
     assert res.returncode == 2 and len(res.stderr.strip().splitlines()) == 1
     assert "--labelled-video" in res.stderr and not (tmp_path / "v.mp4").exists()
+
+
+def test_a_pose_file_lacking_a_keypoint_is_one_line_and_status_2(pose, tmp_path):
+    import dataclasses
+
+    _, rep, diameter = pose
+    tracks = demo_tracks("delayed", 2)[0]
+    keep = [tracks.markers.index(m) for m in ("thumb", "wrist", "object")]
+    dlc = tmp_path / "trialDLC_resnet50_labJan1shuffle1_1000.h5"
+    export_tracks(dataclasses.replace(tracks, markers=tuple(tracks.markers[k] for k in keep),
+                                      position=tracks.position[:, keep],
+                                      likelihood=tracks.likelihood[:, keep],
+                                      status=tracks.status[:, keep]), dlc, "dlc")
+    res = _cli("watch", dlc, "-o", tmp_path / "o", "--fps", "30", "--object-diameter-px",
+               diameter, "--repertoire", rep, "--as-fast-as-possible")
+    assert res.returncode == 2 and len(res.stderr.strip().splitlines()) == 1, res.stderr
+    assert "keypoint 'finger'" in res.stderr and "Traceback" not in res.stderr
+    assert not (tmp_path / "o" / "trial.recognition.json").exists()
