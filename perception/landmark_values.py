@@ -7,16 +7,21 @@ the measuring so that the value can be read (reports, tables) without it.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 
-__all__ = ["OK", "TRANSPORT_LOST", "Landmarks"]
+__all__ = ["OK", "TOO_FEW", "TRANSPORT_LOST", "Landmarks"]
 
 #: A landmark's flag when nothing casts doubt on it (:meth:`Landmarks.flag`).
 OK = "ok"
 #: Every landmark's flag where the transport point is never seen long enough for a speed
 #: (:attr:`Landmarks.status` ``marker lost``).
 TRANSPORT_LOST = "not seen: the transport point is lost throughout"
+#: Every landmark's flag where a movement has too few samples for a speed (its number in
+#: place of ``{}``; :attr:`Landmarks.status` ``too short``).
+TOO_FEW = "not seen: {} samples"
+_TOO_FEW = re.compile(re.escape(TOO_FEW).replace(r"\{\}", r"\d+"))
 #: Landmarks derived from others: their flag is the first doubtful one of these.
 _DERIVED = {"opening": ("mga", "rest_aperture"),
             "peak_speed_seconds": ("peak_speed_time", "movement_time"),
@@ -124,12 +129,15 @@ class Landmarks:
     def status(self) -> str:
         """Whether the recording holds the whole movement: ``complete``, ``starts in
         motion``, ``ends in motion`` or ``in motion throughout``; ``marker lost`` where
-        the transport point is lost throughout (:data:`TRANSPORT_LOST`), so that no
-        speed tells whether the hand moved at all."""
+        the transport point is lost throughout (:data:`TRANSPORT_LOST`) and ``too short``
+        where too few samples (:data:`TOO_FEW`) give no speed, so that none tells whether
+        the hand moved at all."""
         if math.isnan(self.onset_time) and math.isnan(self.end_time):
             # without a speed the onset and end are unknown, not outside the recording
-            lost = self.flags.get("onset_time") == TRANSPORT_LOST
-            return "marker lost" if lost else "in motion throughout"
+            why = self.flags.get("onset_time", "")
+            if why == TRANSPORT_LOST:
+                return "marker lost"
+            return "too short" if _TOO_FEW.fullmatch(why) else "in motion throughout"
         if math.isnan(self.onset_time):
             return "starts in motion"
         if math.isnan(self.end_time):

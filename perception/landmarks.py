@@ -35,7 +35,7 @@ from perception.landmark_flags import (
     why_not_open,
 )
 from perception.landmark_stream import filtfilt_run, median_step, speed_and_floor
-from perception.landmark_values import _NAMES, OK, TRANSPORT_LOST, Landmarks
+from perception.landmark_values import _NAMES, OK, TOO_FEW, TRANSPORT_LOST, Landmarks
 from perception.resume import Kept, grown_of, rowwise
 from perception.rowwise import finite_rows, row_norm, run_edges
 from perception.validation import Int, Share, declared
@@ -484,7 +484,7 @@ def _landmarks(time: np.ndarray, transport: np.ndarray, aperture: np.ndarray,
     stream)."""
     g_raw = np.asarray(aperture, dtype=float)
     if len(time) < 3:
-        return Landmarks(flags=all_flags(_NAMES, f"not seen: {len(time)} samples"))
+        return Landmarks(flags=all_flags(_NAMES, TOO_FEW.format(len(time))))
     path = np.asarray(transport, dtype=float)
     # the speed and its noise floor, resumed where a stream's last row measured them
     # (landmark_stream: the rows whose filtered positions changed, measured again)

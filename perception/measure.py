@@ -281,8 +281,9 @@ def measure(source, *, params: LandmarkParams | None = None, mocap=None,
              else f"{params.threshold * 100:g} % of peak speed")
     # the rule in the table too, as a recording's rows give theirs
     origin = str(getattr(tracks, "path", None) or name)
-    if lm.status == "marker lost":  # a movement that gives none, as a recording's trial
-        reason = _transport_lost(tracks)
+    if lm.status in ("marker lost", "too short"):  # none given, as by a recording's trial
+        reason = (_transport_lost(tracks) if lm.status == "marker lost"
+                  else f"too short: {tracks.n_frames} samples")
         row = landmarks_row(name, lm, source=origin, reason=reason)
         return Measured(_table([row]), 1, [MovementLandmarks(name, name, None, lm.status,
                                                              reason)])

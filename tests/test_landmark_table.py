@@ -472,3 +472,18 @@ def test_landmarks_and_recognize_of_a_tracks_file_whose_markers_are_lost(tmp_pat
     res = hammer("recognize", path, "--px-per-m", 700, "-o", tmp_path / "rec", "--no-figures")
     assert res.returncode == 2 and len(res.stderr.strip().splitlines()) == 1, res.stderr
     assert "never seen" in res.stderr
+
+
+def test_tracks_of_too_few_rows_for_a_speed_say_too_short_as_a_recording_does():
+    from perception.measure import measure
+    from perception.synthetic.demos import demo_tracks
+
+    tracks, _ = demo_tracks("normal", 1)
+    for n in (1, 2):
+        found = measure(tracks.rows(0, n), px_per_m=700)
+        row = found.table.iloc[0]
+        # "in motion throughout" with no reason before: two rows show no motion at all
+        assert (row["status"], row["reason"]) == ("too short", f"too short: {n} samples")
+        assert found.measured == 0 and found.movements[0].landmarks is None
+    # three rows give a speed: a movement that the rows cut, as before
+    assert measure(tracks.rows(0, 3), px_per_m=700).table.iloc[0]["status"] == "starts in motion"
