@@ -409,14 +409,19 @@ def test_landmarks_of_a_folder_names_the_files_it_skipped(tmp_path, capsys):
     (folder / "P01").mkdir(parents=True)
     (folder / "notes.txt").write_text("a few words\n")
     (folder / "trial.tsv").write_bytes(b"")
-    main(["landmarks", str(folder), "-o", str(tmp_path / "l.csv")])
-    said = [line for line in capsys.readouterr().err.splitlines() if "skipped" in line]
+    # nothing measured: refused as batch refuses it, no empty table
+    assert main(["landmarks", str(folder), "-o", str(tmp_path / "l.csv")]) == 2
+    assert not (tmp_path / "l.csv").exists()
+    err = capsys.readouterr().err.splitlines()
+    said = [line for line in err if "landmarks: skipped" in line]
     assert len(said) == 1 and said[0].startswith("hammer-mv landmarks: skipped 3 file(s)")
     for name, why in (("notes.txt", "not a video"), ("trial.tsv", "empty file"),
                       ("P01", "a folder")):
         assert f"{folder / name} ({why}" in said[0]
-    main(["landmarks", str(folder), "-o", str(tmp_path / "l.csv"), "--quiet"])
-    assert "skipped" not in capsys.readouterr().err
+    assert err[-1].startswith(f"hammer-mv landmarks: error: {folder}: no clips found (3 file")
+    assert main(["landmarks", str(folder), "-o", str(tmp_path / "l.csv"), "--quiet"]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and "no clips found" in err[0]  # the list left to the one error
 
 
 def test_landmarks_of_an_empty_table_says_it_is_empty(tmp_path, capsys):

@@ -152,6 +152,10 @@ def run(args: argparse.Namespace) -> int:
 
         print(skipped_line("landmarks", found.skipped, "-v logs each"), file=sys.stderr)
     movements = found.movements
+    if not movements and not found.trials:  # folders of nothing: as batch, no empty table
+        first = (f" ({len(found.skipped)} file(s) skipped; {found.skipped[0][0]}: "
+                 f"{found.skipped[0][1]})" if found.skipped else "")
+        raise InputError(f"no clips found{first}", inputs[0] if len(inputs) == 1 else None)
     if args.wide:
         table = wide_landmarks(movements)
         write_text(args.output, table.to_csv(index=False))
