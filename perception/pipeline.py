@@ -165,7 +165,8 @@ def clip_fingerprint(path: str | os.PathLike, settings: RecognitionSettings,
     The input file's content (its SHA-256, not its size and time: a
     different video of the same size is a different clip), the settings,
     the repertoire's identity and the code: a report carrying the same
-    fingerprint is current and need not be made again. The code is
+    fingerprint is current and need not be made again. Settings that only label
+    the clip's rows (``mocap.factors_from_name``) are left out. The code is
     :func:`~perception.provenance.code_digest`: any change to
     scoring, tracking, planning or the shipped calibration makes every
     report stale.
@@ -180,7 +181,11 @@ def clip_fingerprint(path: str | os.PathLike, settings: RecognitionSettings,
         Identity of the repertoire (e.g. its file name and content hash).
     """
     source = {"sha256": file_sha256(path)}
-    payload = json.dumps({"input": source, "settings": settings.fingerprint(),
+    decided = settings.fingerprint()
+    # a file name's factors label a clip's rows (taken fresh from its item on every run),
+    # they score nothing: renaming a group must not score a study again
+    decided.get("mocap", {}).pop("factors_from_name", None)
+    payload = json.dumps({"input": source, "settings": decided,
                           "repertoire": repertoire_id, "code": code_digest()},
                          sort_keys=True)
     return hashlib.sha256(payload.encode()).hexdigest()[:16]

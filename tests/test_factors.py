@@ -276,3 +276,9 @@ def test_batch_of_a_long_table_carries_its_factors_on_every_row(tmp_path):
     assert set(landmarks["trial_number"]) == {"38", "39", "40", "41"}
     means = pd.read_csv(out / "participant_means.csv")
     assert "participant" in means.columns and set(means["participant"]) == {"P01"}
+    # a factor renamed labels the rows afresh and scores nothing again
+    assert main(["batch", str(src), "-o", str(out), "--rate", "100", "--quiet",
+                 "--factors-from-name", r"(?P<subject>P\d+)_(?P<site>[a-z]+)"]) == 0
+    again = pd.read_csv(out / "summary.csv", dtype={"trial_number": str})
+    assert again["reused"].all() and again["subject"].tolist() == ["P01"] * 4
+    assert again["verdict"].tolist() == summary["verdict"].tolist()
