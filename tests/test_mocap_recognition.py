@@ -31,6 +31,17 @@ QUALISYS = DATA / "qualisys-recording.tsv"
 RATE = 1 / 0.01176471
 
 
+def hammer_here(capsys, *args):
+    """``hammer-mv *args`` run in this process: its exit status and standard error. For
+    tests of what a command writes; a subprocess adds its imports (about half of a
+    recording's ``recognize``) each time. Exit status and one-line errors: subprocesses."""
+    from hammer_mv.cli import main
+
+    capsys.readouterr()
+    status = main([str(a) for a in args])
+    return status, capsys.readouterr().err
+
+
 @pytest.fixture(scope="module")
 def optotrak_reaches():
     return read_reaches(OPTOTRAK, MocapImport(rate=RATE))
@@ -167,12 +178,11 @@ def test_a_shallow_reopening_is_told_from_a_real_grip_s_wobble(optotrak_reaches)
         assert "2 aperture peaks" in dip.verdict_reason
 
 
-def test_recognize_reads_a_lab_table_and_reports_every_trial(tmp_path):
+def test_recognize_reads_a_lab_table_and_reports_every_trial(tmp_path, capsys):
     out = tmp_path / "out"
-    res = subprocess.run([sys.executable, "-m", "hammer_mv", "recognize", str(OPTOTRAK),
-                          "--rate", str(RATE), "-o", str(out), "--no-figures"],
-                         capture_output=True, text=True, timeout=300)
-    assert res.returncode == 0, res.stderr
+    status, err = hammer_here(capsys, "recognize", OPTOTRAK, "--rate", RATE, "-o", out,
+                              "--no-figures")
+    assert status == 0, err
     reports = sorted(out.glob("*.recognition.json"))
     assert len(reports) == 4
     d = json.loads(reports[0].read_text())
@@ -233,12 +243,10 @@ def _reach_arrays(reach):
     return reach.time, reach.transport, reach.aperture
 
 
-def test_landmarks_command_writes_one_row_per_trial(tmp_path):
+def test_landmarks_command_writes_one_row_per_trial(tmp_path, capsys):
     out = tmp_path / "lm.csv"
-    res = subprocess.run([sys.executable, "-m", "hammer_mv", "landmarks", str(OPTOTRAK),
-                          "--rate", str(RATE), "-o", str(out), "--wide"], capture_output=True,
-                         text=True, timeout=120)
-    assert res.returncode == 0, res.stderr
+    status, err = hammer_here(capsys, "landmarks", OPTOTRAK, "--rate", RATE, "-o", out, "--wide")
+    assert status == 0, err
     import pandas as pd
 
     table = pd.read_csv(out)
@@ -273,24 +281,20 @@ def test_landmarks_of_pose_like_tracks_need_no_wrist_and_no_object():
         landmarks(bare)
 
 
-def test_batch_scores_every_reach_of_a_recording(tmp_path):
+def test_batch_scores_every_reach_of_a_recording(tmp_path, capsys):
     folder = tmp_path / "session"
     folder.mkdir()
     (folder / "trials.tsv").write_bytes(OPTOTRAK.read_bytes())
-    res = subprocess.run([sys.executable, "-m", "hammer_mv", "batch", str(folder), "-o",
-                          str(tmp_path / "report"), "--rate", str(RATE), "--quiet"],
-                         capture_output=True, text=True, timeout=300)
-    assert res.returncode == 0, res.stderr
+    batch = ("batch", folder, "-o", tmp_path / "report", "--rate", RATE, "--quiet")
+    status, err = hammer_here(capsys, *batch)
+    assert status == 0, err
     import pandas as pd
 
     summary = pd.read_csv(tmp_path / "report" / "summary.csv")
     assert sorted(summary["clip"]) == [f"trials-trial{k}" for k in range(4)]
     assert (summary["status"] == "ok").all()
     # a rerun reuses every reach's report
-    again = subprocess.run([sys.executable, "-m", "hammer_mv", "batch", str(folder), "-o",
-                            str(tmp_path / "report"), "--rate", str(RATE), "--quiet"],
-                           capture_output=True, text=True, timeout=300)
-    assert again.returncode == 0
+    assert hammer_here(capsys, *batch)[0] == 0
     assert pd.read_csv(tmp_path / "report" / "summary.csv")["reused"].all()
 
 
@@ -312,7 +316,7 @@ def test_a_reach_recorded_at_1000_hz_is_scored_like_the_same_at_85(optotrak_reac
                                                            abs=0.02)
 
 
-def test_landmarks_of_a_video_write_nothing_beside_it(tmp_path):
+def test_landmarks_of_a_video_write_nothing_beside_it(tmp_path, capsys):
     from perception.synthetic.demos import render_demo_clip
 
     clips = tmp_path / "clips"
@@ -320,10 +324,8 @@ def test_landmarks_of_a_video_write_nothing_beside_it(tmp_path):
     video = render_demo_clip(clips, "clip.mp4", n=60)[0].video
     before = sorted(p.name for p in clips.iterdir())
     out = tmp_path / "out" / "table.csv"
-    res = subprocess.run([sys.executable, "-m", "hammer_mv", "landmarks", str(video),
-                          "--object-diameter", "0.1", "-o", str(out)], capture_output=True,
-                         text=True, timeout=300)
-    assert res.returncode == 0, res.stderr
+    status, err = hammer_here(capsys, "landmarks", video, "--object-diameter", "0.1", "-o", out)
+    assert status == 0, err
     assert sorted(p.name for p in clips.iterdir()) == before     # the user's folder untouched
     assert (tmp_path / "out" / "tracks" / "clip.tracks.h5").is_file()
     import pandas as pd
