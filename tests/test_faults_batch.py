@@ -46,6 +46,15 @@ def _batch(src, out, *extra, env=None, timeout=HANG, cwd=None):
                           env=env, cwd=cwd)
 
 
+def _main(*args) -> int:
+    """``hammer-mv *args``' exit status, run in this process: for a test of what the
+    command decides and writes, where a subprocess would only add its imports (4 s of
+    CPU a batch). Hangs, crashes and exit messages stay in subprocesses (:func:`_batch`)."""
+    from hammer_mv.cli import main
+
+    return main([str(a) for a in args])
+
+
 @pytest.fixture(scope="module")
 def repfile(tmp_path_factory):
     return default_repertoire().save(tmp_path_factory.mktemp("rep") / "rep.h5")
@@ -126,7 +135,7 @@ def test_tracks_of_another_clip_beside_a_video_are_not_trusted(clips, repfile, t
     alone = tmp_path / "alone"
     alone.mkdir()
     shutil.copy(clips / "normal-01.mp4", alone)
-    assert _batch(alone, tmp_path / "ref", "--repertoire", str(repfile)).returncode == 0
+    assert _main("batch", alone, "-o", tmp_path / "ref", "--quiet", "--repertoire", repfile) == 0
     ref = json.loads((tmp_path / "ref" / "normal-01.recognition.json").read_text())
 
     src = tmp_path / "src"
@@ -134,12 +143,10 @@ def test_tracks_of_another_clip_beside_a_video_are_not_trusted(clips, repfile, t
     shutil.copy(clips / "normal-01.mp4", src)
     # the delayed grasp's tracks, under the normal clip's name
     shutil.copy(tmp_path / "ref" / "tracks" / "normal-01.tracks.h5", tmp_path / "keep.h5")
-    proc = subprocess.run([sys.executable, "-m", "hammer_mv", "track",
-                           str(clips / "delayed-01.mp4"), "-o", str(src / "normal-01.tracks.h5"),
-                           "--quiet"], capture_output=True, text=True)
-    assert proc.returncode == 0, proc.stderr
+    assert _main("track", clips / "delayed-01.mp4", "-o", src / "normal-01.tracks.h5",
+                 "--quiet") == 0
     out = tmp_path / "out"
-    assert _batch(src, out, "--repertoire", str(repfile)).returncode == 0
+    assert _main("batch", src, "-o", out, "--quiet", "--repertoire", repfile) == 0
     got = json.loads((out / "normal-01.recognition.json").read_text())
     for key in ("verdict", "winner", "familiarity", "margin"):
         assert got[key] == ref[key], key
@@ -148,7 +155,7 @@ def test_tracks_of_another_clip_beside_a_video_are_not_trusted(clips, repfile, t
     # its own current tracks beside it are reused, not tracked again
     shutil.copy(tmp_path / "keep.h5", src / "normal-01.tracks.h5")
     out2 = tmp_path / "out2"
-    assert _batch(src, out2, "--repertoire", str(repfile)).returncode == 0
+    assert _main("batch", src, "-o", out2, "--quiet", "--repertoire", repfile) == 0
     assert not (out2 / "tracks" / "normal-01.tracks.h5").exists()
     got = json.loads((out2 / "normal-01.recognition.json").read_text())
     assert got["verdict"] == ref["verdict"] and got["familiarity"] == ref["familiarity"]
