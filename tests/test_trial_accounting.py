@@ -56,6 +56,20 @@ def hammer(*args, timeout=300):
                           capture_output=True, text=True, timeout=timeout)
 
 
+def hammer_here(capsys, *args):
+    """``hammer(*args)`` run in this process, its exit status and console as a subprocess's
+    (``returncode``, ``stdout``, ``stderr``): for the tests of the lines and files a command
+    writes, where a subprocess adds the CLI's imports (about half of a recording's run)."""
+    from types import SimpleNamespace
+
+    from hammer_mv.cli import main
+
+    capsys.readouterr()
+    status = main([str(a) for a in args])
+    out, err = capsys.readouterr()
+    return SimpleNamespace(returncode=status, stdout=out, stderr=err)
+
+
 @pytest.fixture(scope="module")
 def table(tmp_path_factory):
     return write_table(tmp_path_factory.mktemp("rec") / "table.tsv")
@@ -159,9 +173,9 @@ def test_a_reach_that_cannot_be_planned_does_not_take_the_following_ones(table, 
     assert not (out / "table-trial0.recognition.json").exists()
 
 
-def test_landmarks_writes_the_still_trial_with_its_status_reason_and_nan(table, tmp_path):
+def test_landmarks_writes_the_still_trial_with_its_status_reason_and_nan(table, tmp_path, capsys):
     out = tmp_path / "lm.csv"
-    res = hammer("landmarks", table, "--rate", RATE, "-o", out, "--wide")
+    res = hammer_here(capsys, "landmarks", table, "--rate", RATE, "-o", out, "--wide")
     assert res.returncode == 1, res.stderr
     assert "3 trials, 2 reaches scored, 1 not scored" in res.stdout
     assert f"{STILL}: not scored: " in res.stderr
@@ -176,19 +190,19 @@ def test_landmarks_writes_the_still_trial_with_its_status_reason_and_nan(table, 
     # each scored row says which rule bounded it (the table dropped the column before)
     assert list(rows.loc[[0, 2], "bound"]) == ["5 % of peak speed"] * 2
     # the long table (the default): the still trial keeps its rows, flagged not scored
-    res = hammer("landmarks", table, "--rate", RATE, "-o", out)
+    res = hammer_here(capsys, "landmarks", table, "--rate", RATE, "-o", out)
     long = pd.read_csv(out, keep_default_na=False, na_values={"value": [""]})
     still = long[long["trial"] == STILL]
     assert len(still) and still["value"].isna().all()
     assert (still["flag"] == "not scored").all() and (still["reason"] != "").all()
 
 
-def test_batch_has_a_row_for_every_trial_and_exits_1(table, tmp_path):
+def test_batch_has_a_row_for_every_trial_and_exits_1(table, tmp_path, capsys):
     folder = tmp_path / "session"
     folder.mkdir()
     (folder / "table.tsv").write_bytes(table.read_bytes())
     report = tmp_path / "report"
-    res = hammer("batch", folder, "-o", report, "--rate", RATE, "--quiet", timeout=400)
+    res = hammer_here(capsys, "batch", folder, "-o", report, "--rate", RATE, "--quiet")
     assert res.returncode == 1, res.stderr
     assert f"{STILL}: not scored: " in res.stderr and "Traceback" not in res.stderr
     summary = pd.read_csv(report / "summary.csv", keep_default_na=False)
@@ -203,11 +217,11 @@ def test_batch_has_a_row_for_every_trial_and_exits_1(table, tmp_path):
     assert "Not scored (1)" in page and STILL in page
 
 
-def test_batch_prints_the_trial_summary(tmp_path):
+def test_batch_prints_the_trial_summary(tmp_path, capsys):
     folder = tmp_path / "session"
     folder.mkdir()
     write_table(folder / "table.tsv")
-    res = hammer("batch", folder, "-o", tmp_path / "report", "--rate", RATE, timeout=400)
+    res = hammer_here(capsys, "batch", folder, "-o", tmp_path / "report", "--rate", RATE)
     assert res.returncode == 1
     assert "3 trials, 2 reaches scored, 1 not scored" in res.stdout
 
@@ -247,14 +261,15 @@ def test_verdict_landmarks_threshold_sets_a_reachs_landmarks_as_a_videos(table):
     assert video.landmarks[0].movement_time < video_5.movement_time - 0.05
 
 
-def test_verdict_rules_file_changes_the_reports_landmarks(tmp_path):
+def test_verdict_rules_file_changes_the_reports_landmarks(tmp_path, capsys):
     table = write_table(tmp_path / "one.tsv", trials=(0,))
     rules = tmp_path / "rules.toml"
     rules.write_text("[verdict.landmarks]\nthreshold = 0.2\n")
     times = {}
     for name, extra in (("default", []), ("rules", ["--verdict-rules", rules])):
         out = tmp_path / name
-        res = hammer("recognize", table, "--rate", RATE, "-o", out, "--no-figures", *extra)
+        res = hammer_here(capsys, "recognize", table, "--rate", RATE, "-o", out, "--no-figures",
+                          *extra)
         assert res.returncode == 0, res.stderr
         d = json.loads((out / "one-trial0.recognition.json").read_text())
         times[name] = d["kinematics"]["observed"]["movement_time"]
