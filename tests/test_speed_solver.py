@@ -9,7 +9,7 @@ import sys
 import numpy as np
 import pytest
 
-from minvar import _kernel, reach_problem, solve
+from minvar import _kernel, expected_cost, reach_problem, solve
 from minvar.moments import Moments, estimation_error_covariance, mean_states
 from minvar.task import ReachTask, ViaPoint
 
@@ -121,8 +121,20 @@ def test_overflowing_dynamics_raise_naming_the_cause(reference_problem, engine):
         solve(p, engine=engine)
 
 
-def test_singular_sensor_noise_raises_naming_the_cause(reference_problem, engine):
+def test_singular_sensor_noise_solves_and_a_breakdown_names_it(reference_problem, engine,
+                                                             monkeypatch):
+    # no sensory noise: the pseudo-inverse's filter, on an error covariance kept symmetric
+    # (its rounding once grew until the SVD failed at iteration 6)
     p = dataclasses.replace(reference_problem, D0=np.zeros((6, 6)))
+    s = solve(p, engine=engine)
+    assert s.converged and np.isfinite(s.K).all() and np.isfinite(s.L).all()
+    assert expected_cost(p, s.K, s.L) == pytest.approx(s.cost, rel=1e-8)
+
+    def broken(M):
+        raise np.linalg.LinAlgError("SVD did not converge")
+
+    # should the pseudo-inverse still fail, the error says which noise is singular
+    monkeypatch.setattr(np.linalg, "pinv", broken)
     with pytest.raises(ValueError, match=r"observation noise D0 D0' is singular"):
         solve(p, engine=engine)
 
