@@ -87,9 +87,9 @@ def _recognized(item: BatchItem, out: Path, repertoire: Repertoire,
 
 
 def _current_report(item: BatchItem, out: Path, fingerprint: str,
-                    figure_format: str = "png") -> dict | None:
+                    figure_format: str = "png", dpi: int = DPI) -> dict | None:
     """The clip's finished report if it was made from this input and these settings
-    (its figures in ``figure_format``)."""
+    (its figures in ``figure_format``, PNG at ``dpi``)."""
     p = clip_outputs(out, item.clip, figure_format)
     if not all(path.exists() for path in p.values()):
         return None
@@ -97,7 +97,25 @@ def _current_report(item: BatchItem, out: Path, fingerprint: str,
         data = json.loads(p["json"].read_text())
     except (OSError, ValueError):
         return None
-    return data if data.get("fingerprint") == fingerprint else None
+    if data.get("fingerprint") != fingerprint:
+        return None
+    if figure_format == "png" and not all(_png_dpi(path) == dpi for key, path in p.items()
+                                          if key not in ("json", "csv")):
+        return None  # a rerun at another --dpi draws its figures again: none left mixed
+    return data
+
+
+def _png_dpi(path: Path) -> int | None:
+    """The resolution a PNG records (its pHYs chunk, read from the header alone), None if
+    it records none or cannot be read."""
+    from PIL import Image, UnidentifiedImageError
+
+    try:
+        with Image.open(path) as im:
+            found = im.info.get("dpi")
+    except (OSError, UnidentifiedImageError):
+        return None
+    return round(found[0]) if found else None
 
 
 @dataclass(frozen=True, slots=True)
@@ -614,7 +632,7 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
         input_file(item.path, "clip", empty=False)
         fp = clip_fingerprint(item.path, settings, repertoire_id + (
             f"#reach{item.reach}" if item.reach is not None else ""))
-        done = _current_report(item, out, fp, figure_format)
+        done = _current_report(item, out, fp, figure_format, dpi)
         if done is not None:
             return ClipResult(**base, status="reused", summary=ClipSummary.from_dict(done))
         rec, extra = _recognized(item, out, repertoire, settings, fp, progress, plan_cache,

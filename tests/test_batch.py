@@ -188,6 +188,15 @@ def test_changed_settings_or_input_are_rerun(clips, repfile, tmp_path):
     (src / "normal-01.mp4").touch()  # the same content: still current
     assert _main_batch(src, out, repfile, "--rule", "thesis") == 0
     assert pd.read_csv(out / "summary.csv")["reused"].all()
+    # figures at another resolution: the clip's drawn again, none left at the old one
+    from PIL import Image
+
+    for dpi, reused in ((60, False), (60, True)):
+        assert _main_batch(src, out, repfile, "--rule", "thesis", "--dpi", str(dpi)) == 0
+        assert pd.read_csv(out / "summary.csv")["reused"].all() == reused
+        for png in (out / f"normal-01.{key}.png" for key in ("confidence", "paths", "kinematics")):
+            with Image.open(png) as im:
+                assert round(im.info["dpi"][0]) == dpi, png.name
     # another video under the same name (the same size, even): made again
     shutil.copy(clips / "delayed-01.mp4", src / "normal-01.mp4")
     assert _main_batch(src, out, repfile, "--rule", "thesis") == 0
