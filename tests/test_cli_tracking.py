@@ -6,6 +6,7 @@ import h5py
 import numpy as np
 import pandas as pd
 import pytest
+from _cli import hammer_here
 from _clips import HARD, errors, render
 
 from perception.io.tracks import Tracks
@@ -20,17 +21,6 @@ def hammer(*args, cwd=None):
         cwd=cwd,
         timeout=120,
     )
-
-
-def hammer_here(capsys, *args):
-    """``hammer(*args)`` run in this process: exit status, standard output and error. For
-    tests of what commands write: a subprocess adds its imports (seconds) to each."""
-    from hammer_mv.cli import main
-
-    capsys.readouterr()
-    status = main([str(a) for a in args])
-    out, err = capsys.readouterr()
-    return status, out, err
 
 
 @pytest.fixture(scope="module")

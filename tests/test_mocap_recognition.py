@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _cli import hammer_here
 from _demos import default_repertoire
 from scipy.signal import butter, filtfilt
 
@@ -29,17 +30,6 @@ DATA = Path(__file__).parent / "data" / "mocap"
 OPTOTRAK = DATA / "optotrak-trials.tsv"
 QUALISYS = DATA / "qualisys-recording.tsv"
 RATE = 1 / 0.01176471
-
-
-def hammer_here(capsys, *args):
-    """``hammer-mv *args`` run in this process: its exit status and standard error. For
-    tests of what a command writes; a subprocess adds its imports (about half of a
-    recording's ``recognize``) each time. Exit status and one-line errors: subprocesses."""
-    from hammer_mv.cli import main
-
-    capsys.readouterr()
-    status = main([str(a) for a in args])
-    return status, capsys.readouterr().err
 
 
 @pytest.fixture(scope="module")
@@ -180,8 +170,8 @@ def test_a_shallow_reopening_is_told_from_a_real_grip_s_wobble(optotrak_reaches)
 
 def test_recognize_reads_a_lab_table_and_reports_every_trial(tmp_path, capsys):
     out = tmp_path / "out"
-    status, err = hammer_here(capsys, "recognize", OPTOTRAK, "--rate", RATE, "-o", out,
-                              "--no-figures")
+    status, _, err = hammer_here(capsys, "recognize", OPTOTRAK, "--rate", RATE, "-o", out,
+                                 "--no-figures")
     assert status == 0, err
     reports = sorted(out.glob("*.recognition.json"))
     assert len(reports) == 4
@@ -245,7 +235,7 @@ def _reach_arrays(reach):
 
 def test_landmarks_command_writes_one_row_per_trial(tmp_path, capsys):
     out = tmp_path / "lm.csv"
-    status, err = hammer_here(capsys, "landmarks", OPTOTRAK, "--rate", RATE, "-o", out, "--wide")
+    status, _, err = hammer_here(capsys, "landmarks", OPTOTRAK, "--rate", RATE, "-o", out, "--wide")
     assert status == 0, err
     import pandas as pd
 
@@ -286,7 +276,7 @@ def test_batch_scores_every_reach_of_a_recording(tmp_path, capsys):
     folder.mkdir()
     (folder / "trials.tsv").write_bytes(OPTOTRAK.read_bytes())
     batch = ("batch", folder, "-o", tmp_path / "report", "--rate", RATE, "--quiet")
-    status, err = hammer_here(capsys, *batch)
+    status, _, err = hammer_here(capsys, *batch)
     assert status == 0, err
     import pandas as pd
 
@@ -324,7 +314,7 @@ def test_landmarks_of_a_video_write_nothing_beside_it(tmp_path, capsys):
     video = render_demo_clip(clips, "clip.mp4", n=60)[0].video
     before = sorted(p.name for p in clips.iterdir())
     out = tmp_path / "out" / "table.csv"
-    status, err = hammer_here(capsys, "landmarks", video, "--object-diameter", "0.1", "-o", out)
+    status, _, err = hammer_here(capsys, "landmarks", video, "--object-diameter", "0.1", "-o", out)
     assert status == 0, err
     assert sorted(p.name for p in clips.iterdir()) == before     # the user's folder untouched
     assert (tmp_path / "out" / "tracks" / "clip.tracks.h5").is_file()

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+from _cli import hammer_here
 
 from perception.discovery import BatchItem, expand_recordings, find_clips
 from perception.pipeline import RecognitionSettings
@@ -30,19 +31,6 @@ RATE = 85.0
 def hammer(*args, timeout=300, cwd=None):
     return subprocess.run([sys.executable, "-m", "hammer_mv", *map(str, args)],
                           capture_output=True, text=True, timeout=timeout, cwd=cwd)
-
-
-def hammer_here(capsys, *args):
-    """``hammer(*args)`` run in this process: its exit status and standard error.
-
-    For the tests that look at what a command wrote, not at how a process exits: a
-    subprocess adds its imports (about half of a mocap ``recognize``'s CPU) each run.
-    """
-    from hammer_mv.cli import main
-
-    capsys.readouterr()
-    status = main([str(a) for a in args])
-    return status, capsys.readouterr().err
 
 
 def write_trials(path: Path, trials=(0,), names=None, sep="\t", trial_column=True) -> Path:
@@ -100,7 +88,7 @@ def test_a_batch_of_same_stem_recordings_reports_each(tmp_path, capsys):
     write_trials(folder / "a.tsv", trial_column=False)
     write_trials(folder / "a.csv", sep=",", trial_column=False)
     report = tmp_path / "report"
-    status, err = hammer_here(capsys, "batch", folder, "-o", report, "--rate", RATE, "--quiet")
+    status, _, err = hammer_here(capsys, "batch", folder, "-o", report, "--rate", RATE, "--quiet")
     assert status == 0, err
     assert "Traceback" not in err
     summary = pd.read_csv(report / "summary.csv")
@@ -126,8 +114,8 @@ def test_recognize_gives_a_second_recording_of_one_stem_its_own_reports(tmp_path
     a = write_trials(tmp_path / "P01.tsv", trial_column=False)
     b = write_trials(tmp_path / "P01.csv", trials=(1,), sep=",", trial_column=False)
     for path in (a, b):
-        status, err = hammer_here(capsys, "recognize", path, "--rate", RATE, "-o", out,
-                                  "--no-figures")
+        status, _, err = hammer_here(capsys, "recognize", path, "--rate", RATE, "-o", out,
+                                     "--no-figures")
         assert status == 0, err
     reports = {p.name: json.loads(p.read_text())["input"] for p in out.glob("*.recognition.json")}
     assert {name: Path(src).name for name, src in reports.items()} == {
@@ -144,13 +132,13 @@ def test_a_rerun_after_a_trial_left_the_table_removes_its_report(tmp_path, capsy
     folder.mkdir()
     table = write_trials(folder / "t.tsv", trials=(0, 1))
     report = tmp_path / "report"
-    status, err = hammer_here(capsys, "batch", folder, "-o", report, "--rate", RATE, "--quiet")
+    status, _, err = hammer_here(capsys, "batch", folder, "-o", report, "--rate", RATE, "--quiet")
     assert status == 0, err
     assert (report / "t-trial1.recognition.json").is_file()
     other = report / "other.recognition.json"   # another input's report: never touched
     other.write_text(json.dumps({"input": str(tmp_path / "elsewhere.tsv"), "mocap": {}}))
     write_trials(table, trials=(0,))
-    status, err = hammer_here(capsys, "batch", folder, "-o", report, "--rate", RATE, "--quiet")
+    status, _, err = hammer_here(capsys, "batch", folder, "-o", report, "--rate", RATE, "--quiet")
     assert status == 0, err
     assert not list(report.glob("t-trial1.*"))
     assert (report / "t-trial0.recognition.json").is_file() and other.is_file()

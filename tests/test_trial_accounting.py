@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from _cli import hammer_here
 from _demos import default_repertoire
 
 import hammer_mv.cli as cli
@@ -54,20 +55,6 @@ def write_table(path: Path, trials=(0, 9, 1)) -> Path:
 def hammer(*args, timeout=300):
     return subprocess.run([sys.executable, "-m", "hammer_mv", *map(str, args)],
                           capture_output=True, text=True, timeout=timeout)
-
-
-def hammer_here(capsys, *args):
-    """``hammer(*args)`` run in this process, its exit status and console as a subprocess's
-    (``returncode``, ``stdout``, ``stderr``): for the tests of the lines and files a command
-    writes, where a subprocess adds the CLI's imports (about half of a recording's run)."""
-    from types import SimpleNamespace
-
-    from hammer_mv.cli import main
-
-    capsys.readouterr()
-    status = main([str(a) for a in args])
-    out, err = capsys.readouterr()
-    return SimpleNamespace(returncode=status, stdout=out, stderr=err)
 
 
 @pytest.fixture(scope="module")
