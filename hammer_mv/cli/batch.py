@@ -58,7 +58,6 @@ def run(args: argparse.Namespace) -> int:
     args : argparse.Namespace
         Parsed arguments.
     """
-    from perception.errors import InputError
     from perception.recognition.result import warnings_summary
     from perception.recordings import trial_summary
 
@@ -76,9 +75,7 @@ def run(args: argparse.Namespace) -> int:
     if found.skipped and not args.quiet:
         print(skipped_line("batch", found.skipped, "batch.json lists them"), file=sys.stderr)
     if not items:
-        first = (f" ({len(found.skipped)} file(s) skipped; {found.skipped[0][0]}: "
-                 f"{found.skipped[0][1]})" if found.skipped else "")
-        raise InputError(f"no clips found{first}", args.input)
+        raise no_clips(found.skipped, args.input)
     rep, rep_id = load_repertoire(args)
     summary = run_batch(items, args.output, rep, recognition_settings(args), jobs=jobs,
                         scheduler=args.scheduler, repertoire_id=rep_id, quiet=args.quiet,
@@ -103,6 +100,15 @@ def run(args: argparse.Namespace) -> int:
         print(f"hammer-mv batch: {failed} clip(s) failed ({failure_reasons(summary, items)}); "
               f"see {args.output / 'summary.csv'}", file=sys.stderr)
     return 1 if failed or len(unscored) else 0
+
+
+def no_clips(skipped: list[tuple[str, str]], where) -> Exception:
+    """The error of an input that holds no clip: the first file skipped, and why."""
+    from perception.errors import InputError
+
+    first = f" ({len(skipped)} file(s) skipped; {skipped[0][0]}: {skipped[0][1]})" \
+        if skipped else ""
+    return InputError(f"no clips found{first}", where)
 
 
 def skipped_line(command: str, skipped: list[tuple[str, str]], rest: str) -> str:

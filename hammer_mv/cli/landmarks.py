@@ -147,15 +147,13 @@ def run(args: argparse.Namespace) -> int:
     finally:
         if bar is not None:
             bar.close()
-    if found.skipped and not args.quiet:  # as batch says them: none passed over silently
-        from hammer_mv.cli.batch import skipped_line
+    from hammer_mv.cli.batch import no_clips, skipped_line
 
+    if found.skipped and not args.quiet:  # as batch says them: none passed over silently
         print(skipped_line("landmarks", found.skipped, "-v logs each"), file=sys.stderr)
     movements = found.movements
     if not movements and not found.trials:  # folders of nothing: as batch, no empty table
-        first = (f" ({len(found.skipped)} file(s) skipped; {found.skipped[0][0]}: "
-                 f"{found.skipped[0][1]})" if found.skipped else "")
-        raise InputError(f"no clips found{first}", inputs[0] if len(inputs) == 1 else None)
+        raise no_clips(found.skipped, inputs[0] if len(inputs) == 1 else None)
     if args.wide:
         table = wide_landmarks(movements)
         write_text(args.output, table.to_csv(index=False))
