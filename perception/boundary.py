@@ -10,7 +10,7 @@ what came.
 
 from __future__ import annotations
 
-__all__ = ["expect"]
+__all__ = ["expect", "expect_frame"]
 
 
 def expect(value, kind: type | tuple[type, ...], name: str, *, optional: bool = False,
@@ -47,3 +47,25 @@ def expect(value, kind: type | tuple[type, ...], name: str, *, optional: bool = 
     shown = shown if len(shown) <= 40 else shown[:37] + "..."
     raise TypeError(f"{name}: expected {wanted}{f' ({hint})' if hint else ''}, got "
                     f"{type(value).__name__} {shown}")
+
+
+def expect_frame(frame, name: str, *, field: str | None = None):
+    """``frame`` if it is a video frame the tracker reads, an (H, W, 3) uint8 BGR array;
+    else an :class:`~perception.errors.InputError` naming ``field`` (refused before any
+    tracking: not OpenCV's error from its first look at it).
+
+    Parameters
+    ----------
+    frame : numpy.ndarray
+        The frame given.
+    name : str
+        Who was given it: ``"Tracker.update"``.
+    field : str, optional
+        The argument that gave it.
+    """
+    from perception.errors import InputError
+
+    if frame.ndim != 3 or frame.shape[2] != 3 or frame.dtype.name != "uint8":
+        raise InputError(f"{name}: expected an (H, W, 3) uint8 BGR frame, got {frame.shape} "
+                         f"{frame.dtype}", field=field)
+    return frame

@@ -21,6 +21,7 @@ import math
 
 import numpy as np
 
+from perception.boundary import expect_frame
 from perception.errors import InputError
 from perception.io.tracks import Status, Tracks
 from perception.pipeline import RecognitionSettings, recognize_tracks
@@ -185,9 +186,8 @@ class OnlineRecognizer:
                              f" got shape {data.shape}", field="frame_or_points")
         # refused here, before the row counts: not OpenCV's error from the tracker's first
         # look at the frames, nor numpy's from the rows' arrays
-        if data.ndim == 3 and (data.shape[2] != 3 or data.dtype != np.uint8):
-            raise InputError(f"expected a frame (H, W, 3) of uint8 BGR, got {data.shape} "
-                             f"{data.dtype}", field="frame_or_points")
+        if data.ndim == 3:
+            expect_frame(data, "OnlineRecognizer.update", field="frame_or_points")
         if data.ndim != 3 and data.dtype.kind not in "biuf":
             raise InputError(f"expected positions as numbers, got {data.dtype}",
                              field="frame_or_points")

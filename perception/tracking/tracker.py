@@ -64,6 +64,7 @@ from typing import Any
 
 import numpy as np
 
+from perception.boundary import expect_frame
 from perception.errors import InputError
 from perception.io.tracks import Status
 from perception.tracking.blur import (
@@ -318,11 +319,7 @@ class Tracker:
 
     # -- steps --------------------------------------------------------------
     def _check_frame(self, frame: np.ndarray) -> None:
-        if frame.ndim != 3 or frame.shape[2] != 3 or frame.dtype != np.uint8:
-            raise ValueError(
-                f"Tracker.update: expected an (H, W, 3) uint8 BGR frame, got {frame.shape} "
-                f"{frame.dtype}"
-            )
+        expect_frame(frame, "Tracker.update", field="frame")
         if self._frame_shape is None:
             self._frame_shape = frame.shape[:2]
             for t in self._tracks:
