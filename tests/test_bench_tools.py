@@ -63,7 +63,7 @@ def test_side_by_side_reports_a_failed_batch_instead_of_waiting(tmp_path):
 
 
 def test_the_study_names_the_lines_that_hold_more_a_trial_largest_first():
-    import bench_study
+    import study_memory
 
     small = {"/v/site-packages/pandas/frame.py:3": 1_000, f"{ROOT}/perception/batch.py:9": 500,
              "/v/lib/python3.11/dataclasses.py:1501": 900}
@@ -71,7 +71,17 @@ def test_the_study_names_the_lines_that_hold_more_a_trial_largest_first():
              f"{ROOT}/perception/batch.py:9": 100,  # shrank: not named
              "/v/lib/python3.11/dataclasses.py:1501": 900,  # the same: not named
              "/v/lib/python3.11/json/decoder.py:7": 50_000}  # new among the largest
-    rows = bench_study._grown_lines(small, large, 100)
+    rows = study_memory._grown_lines(small, large, 100)
     assert [(what, size) for what, size, *_ in rows] == [
         ("    held a trial, pandas/frame.py:3", "3000 B"),
         ("    held a trial, json/decoder.py:7", "500 B")]
+
+
+def test_make_bench_finds_every_section():
+    # tools/bench.py runs main() of each tools/bench_<name>.py: a helper module named so
+    # (the study part once was) broke `make bench` before any section ran
+    import bench
+
+    sections = bench._discover()
+    assert {"solver", "execution", "recognition"} <= set(sections)
+    assert all(callable(run) for run in sections.values())

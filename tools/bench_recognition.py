@@ -12,7 +12,7 @@ which no way of sharing the clips can beat. ``--clips`` and ``--counts``
 size the scaling run (``tools/device/run.sh`` measures 1 and 16 processes
 in one call).
 
-The ``study`` part (issue 45; ``--only study``; ``tools/bench_study.py``) writes
+The ``study`` part (issue 45; ``--only study``; ``tools/study_memory.py``) writes
 the shipped Optotrak trials as a lab's study, ``--participants`` x ``--study-trials`` (100 x 100 =
 10,000 trials by default), one file per participant with a ``participant``
 and a ``condition`` column, runs ``hammer-mv batch`` of it with its figures
@@ -357,7 +357,7 @@ def main(argv: list[str] | None = None) -> None:
     cores = (len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
              else os.cpu_count() or 1)
     if args.only == "study":
-        from bench_study import study_rows
+        from study_memory import study_rows
 
         jobs = args.jobs or cores
         table(f"perception: a lab's study through batch ({cores} cores)",

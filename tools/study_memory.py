@@ -1,6 +1,7 @@
 """The study part of ``tools/bench_recognition.py`` (``--only study``; issue 45): the
 shipped Optotrak trials written as a lab's study and run through ``hammer-mv batch``
 with its figures and report, its time and its memory (see that tool's docstring).
+Not named ``bench_*.py``: ``tools/bench.py`` runs ``main()`` of each such module.
 """
 
 from __future__ import annotations
