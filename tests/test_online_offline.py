@@ -20,12 +20,11 @@ import dataclasses
 import functools
 import itertools
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from _cli import hammer_here
 from _demos import default_repertoire, demo_tracks
 
 from perception.errors import InputError
@@ -139,11 +138,6 @@ def cli_setup(tmp_path_factory):
     return d, rep, clip
 
 
-def _hammer(*args):
-    return subprocess.run([sys.executable, "-m", "hammer_mv", *map(str, args)],
-                          capture_output=True, text=True)
-
-
 def _outputs(folder):
     """Every CSV and JSON written under ``folder``, by its path there."""
     return {str(p.relative_to(folder)): p for p in sorted(folder.rglob("*"))
@@ -153,14 +147,15 @@ def _outputs(folder):
 @pytest.mark.parametrize("name, row, extra", CLI_CASES,
                          ids=[f"{c}-{i}{'-px' if e else ''}"
                               for i, (c, r, e) in enumerate(CLI_CASES)])
-def test_watch_as_fast_as_possible_writes_what_recognize_writes(cli_setup, tmp_path, name,
-                                                                row, extra):
+def test_watch_as_fast_as_possible_writes_what_recognize_writes(cli_setup, tmp_path, capsys,
+                                                                name, row, extra):
     _, rep, clip = cli_setup
     video = clip(name)
     flags = [*_flags(row), *extra, "--no-figures", "--repertoire", rep]
-    offline = _hammer("recognize", video, "-o", tmp_path / "recognize", *flags)
+    offline = hammer_here(capsys, "recognize", video, "-o", tmp_path / "recognize", *flags)
     assert offline.returncode == 0, offline.stderr
-    online = _hammer("watch", video, "--as-fast-as-possible", "-o", tmp_path / "watch", *flags)
+    online = hammer_here(capsys, "watch", video, "--as-fast-as-possible", "-o",
+                         tmp_path / "watch", *flags)
     assert online.returncode == 0, online.stderr
     a, b = _outputs(tmp_path / "recognize"), _outputs(tmp_path / "watch")
     assert a.keys() == b.keys() == {f"{name}.recognition.json", f"{name}.confidence.csv"}
