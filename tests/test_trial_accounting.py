@@ -53,6 +53,8 @@ def write_table(path: Path, trials=(0, 9, 1)) -> Path:
 
 
 def hammer(*args, timeout=300):
+    """``hammer-mv *args`` as a subprocess: for what the process shows (exit status 2 in one
+    line); the lines and files of a command are tested in-process (:func:`hammer_here`)."""
     return subprocess.run([sys.executable, "-m", "hammer_mv", *map(str, args)],
                           capture_output=True, text=True, timeout=timeout)
 
@@ -98,9 +100,10 @@ def test_a_missing_marker_is_still_the_whole_files_mistake(table):
         read_recording(table, MocapImport(rate=RATE, markers=MarkerMap("thumb", "pinky")))
 
 
-def test_recognize_writes_a_row_for_the_still_trial_lists_it_and_exits_1(table, tmp_path):
+def test_recognize_writes_a_row_for_the_still_trial_lists_it_and_exits_1(table, tmp_path,
+                                                                          capsys):
     out = tmp_path / "out"
-    res = hammer("recognize", table, "--rate", RATE, "-o", out, "--no-figures")
+    res = hammer_here(capsys, "recognize", table, "--rate", RATE, "-o", out, "--no-figures")
     assert res.returncode == 1, res.stderr
     assert "3 trials, 2 reaches scored, 1 not scored" in res.stdout
     listed = [line for line in res.stderr.splitlines() if "not scored" in line]
@@ -120,16 +123,17 @@ def test_recognize_writes_a_row_for_the_still_trial_lists_it_and_exits_1(table, 
                                       "table-trial1.recognition.json"]
 
 
-def test_recognize_quiet_still_lists_what_was_not_scored(table, tmp_path):
-    res = hammer("recognize", table, "--rate", RATE, "-o", tmp_path / "out", "--no-figures",
-                 "--quiet")
+def test_recognize_quiet_still_lists_what_was_not_scored(table, tmp_path, capsys):
+    res = hammer_here(capsys, "recognize", table, "--rate", RATE, "-o", tmp_path / "out",
+                      "--no-figures", "--quiet")
     assert res.returncode == 1 and res.stdout == ""
     assert f"{STILL}: not scored: " in res.stderr
 
 
-def test_recognize_exits_0_when_every_trial_is_scored(tmp_path):
+def test_recognize_exits_0_when_every_trial_is_scored(tmp_path, capsys):
     table = write_table(tmp_path / "good.tsv", trials=(0, 1))
-    res = hammer("recognize", table, "--rate", RATE, "-o", tmp_path / "out", "--no-figures")
+    res = hammer_here(capsys, "recognize", table, "--rate", RATE, "-o", tmp_path / "out",
+                      "--no-figures")
     assert res.returncode == 0, res.stderr
     assert "2 trials, 2 reaches scored, 0 not scored" in res.stdout
     assert "not scored:" not in res.stderr
@@ -312,7 +316,7 @@ def test_a_bad_mocap_flag_is_one_line_naming_it(flags, named, table, tmp_path):
     assert len(res.stderr.strip().splitlines()) == 1 and named in res.stderr
 
 
-def test_recognize_and_landmarks_find_the_same_reaches_in_a_session(tmp_path):
+def test_recognize_and_landmarks_find_the_same_reaches_in_a_session(tmp_path, capsys):
     # four real trials one after another, no trial column: a session. landmarks found its
     # movements while recognize refused it whole ("the wrist never leaves its rest
     # position"); both now take the same reaches, named and timed alike
@@ -320,12 +324,13 @@ def test_recognize_and_landmarks_find_the_same_reaches_in_a_session(tmp_path):
     cols = [f"{m}{a}raw" for m in ("index", "thumb") for a in "XYZ"]
     session = tmp_path / "session.tsv"
     real[cols].to_csv(session, sep="\t", index=False, float_format="%.3f")
-    res = hammer("landmarks", session, "--rate", RATE, "-o", tmp_path / "lm.csv", "--wide")
+    res = hammer_here(capsys, "landmarks", session, "--rate", RATE, "-o", tmp_path / "lm.csv",
+                      "--wide")
     assert res.returncode == 0, res.stderr
     rows = pd.read_csv(tmp_path / "lm.csv")
     assert len(rows) >= 4 and (rows["status"] == "complete").all()
     out = tmp_path / "rec"
-    res = hammer("recognize", session, "--rate", RATE, "-o", out, "--no-figures")
+    res = hammer_here(capsys, "recognize", session, "--rate", RATE, "-o", out, "--no-figures")
     assert res.returncode == 0, res.stderr
     trials = pd.read_csv(out / "session.trials.csv")
     assert list(trials["trial"]) == list(rows["trial"])
