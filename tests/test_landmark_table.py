@@ -19,8 +19,10 @@ import sys
 import numpy as np
 import pandas as pd
 import pytest
+from _cli import hammer_here
 from scipy.optimize import brentq
 
+from hammer_mv.cli import main
 from perception.landmarks import LandmarkParams, movement_landmarks, speed_bound
 from perception.report.tables import (
     LANDMARK_COLUMNS,
@@ -100,6 +102,8 @@ def _known():
 
 
 def hammer(*args, timeout=300):
+    """``hammer-mv *args`` as a subprocess: for what the process shows (exit status 2 in one
+    line); the lines and files of a command are tested in-process (:func:`hammer_here`)."""
     return subprocess.run([sys.executable, "-m", "hammer_mv", *map(str, args)],
                           capture_output=True, text=True, timeout=timeout)
 
@@ -111,11 +115,11 @@ def _read(path) -> pd.DataFrame:
 
 
 # -- the long table, read by pandas, against known values --------------------------------------
-def test_the_long_table_holds_known_values_in_lab_units(tmp_path):
+def test_the_long_table_holds_known_values_in_lab_units(tmp_path, capsys):
     table = tmp_path / "reach.tsv"
     _table({("p1", "small", 1): _trial()}).to_csv(table, sep="\t", index=False)
     out = tmp_path / "lm.csv"
-    res = hammer("landmarks", table, "-o", out)
+    res = hammer_here(capsys, "landmarks", table, "-o", out)
     assert res.returncode == 0, res.stderr
     lm = _read(out)
     assert list(lm.columns) == ["clip", "trial", "condition", "participant", "trial_number",
@@ -166,7 +170,7 @@ def test_a_peak_speed_inside_a_gap_is_flagged_and_a_clean_one_is_not():
     assert lm.flag("mga") == "ok"  # the MGA, at 70 %, is seen
 
 
-def test_an_opening_time_not_seen_has_a_flag_and_why(tmp_path):
+def test_an_opening_time_not_seen_has_a_flag_and_why(tmp_path, capsys):
     # the thumb lost for 0.3 s from just after the onset: the grip opens unseen
     gap_trial = _trial(gap=(START + 0.1, START + 0.4))
     t, index, thumb = gap_trial
@@ -183,7 +187,7 @@ def test_an_opening_time_not_seen_has_a_flag_and_why(tmp_path):
     _table({("p1", "small", 1): _trial(), ("p1", "small", 2): gap_trial}, wrist=True).to_csv(
         table, sep="\t", index=False)
     out = tmp_path / "lm.csv"
-    res = hammer("landmarks", table, "-o", out)
+    res = hammer_here(capsys, "landmarks", table, "-o", out)
     assert res.returncode == 0, res.stderr
     assert "2 movement(s), 1 complete, 1 with a flagged landmark" in res.stdout
     lm = _read(out)
@@ -276,9 +280,10 @@ def _same(ours: pd.DataFrame, batch: pd.DataFrame) -> None:
     np.testing.assert_allclose(ours["value"], batch["value"], rtol=1e-9, atol=1e-9)
 
 
-def test_landmarks_on_a_folder_and_a_manifest_give_batchs_table(design, batch_table, tmp_path):
+def test_landmarks_on_a_folder_and_a_manifest_give_batchs_table(design, batch_table, tmp_path,
+                                                                 capsys):
     out = tmp_path / "folder.csv"
-    res = hammer("landmarks", design, "-o", out)
+    res = hammer_here(capsys, "landmarks", design, "-o", out)
     assert res.returncode == 1, res.stderr  # the still trial is not scored
     assert "5 trials, 4 reaches scored, 1 not scored" in res.stdout
     folder = _read(out)
@@ -287,15 +292,16 @@ def test_landmarks_on_a_folder_and_a_manifest_give_batchs_table(design, batch_ta
     assert set(folder["participant"]) == {"p1", "p2"}
     assert set(folder["condition"]) == {"small", "large"}
     assert (folder[folder["trial_number"] == "5"]["flag"] == "not scored").all()
-    res = hammer("landmarks", design / "manifest.csv", "-o", tmp_path / "manifest.csv")
+    res = hammer_here(capsys, "landmarks", design / "manifest.csv", "-o",
+                      tmp_path / "manifest.csv")
     assert res.returncode == 1, res.stderr
     pd.testing.assert_frame_equal(_read(tmp_path / "manifest.csv"), folder)
 
 
-def test_the_wide_table_has_the_same_values_and_a_units_sidecar(design, tmp_path):
+def test_the_wide_table_has_the_same_values_and_a_units_sidecar(design, tmp_path, capsys):
     long_out, wide_out = tmp_path / "long.csv", tmp_path / "wide.csv"
-    assert hammer("landmarks", design, "-o", long_out).returncode == 1
-    assert hammer("landmarks", design, "-o", wide_out, "--wide").returncode == 1
+    assert hammer_here(capsys, "landmarks", design, "-o", long_out).returncode == 1
+    assert hammer_here(capsys, "landmarks", design, "-o", wide_out, "--wide").returncode == 1
     long, wide = _read(long_out), pd.read_csv(wide_out, dtype={"trial_number": str})
     assert len(wide) == long["clip"].nunique()
     pivot = long.pivot(index="clip", columns="landmark", values="value")
@@ -359,7 +365,7 @@ def test_object_diameter_px_scales_only_tracks_that_do_not_measure_the_object():
     assert given.mga == own.mga and given.peak_speed == own.peak_speed
 
 
-def test_landmarks_on_a_deeplabcut_file_takes_the_flag_it_suggests(tmp_path):
+def test_landmarks_on_a_deeplabcut_file_takes_the_flag_it_suggests(tmp_path, capsys):
     from perception.io.exports import write_dlc
     from perception.synthetic.demos import demo_tracks
 
@@ -367,16 +373,18 @@ def test_landmarks_on_a_deeplabcut_file_takes_the_flag_it_suggests(tmp_path):
     pose = tmp_path / "t1DLC_resnet50_xShuffle1_1000.csv"
     write_dlc(tracks, pose, scorer="DLC_resnet50_xShuffle1_1000")
     out = tmp_path / "lm.csv"
-    res = hammer("landmarks", pose, "--fps", 25, "-o", out)
+    res = hammer_here(capsys, "landmarks", pose, "--fps", 25, "-o", out)
     assert res.returncode == 2 and "--object-diameter-px" in res.stderr, res.stderr
-    help_text = hammer("landmarks", "--help").stdout
+    with pytest.raises(SystemExit):  # argparse ends --help
+        main(["landmarks", "--help"])
+    help_text = capsys.readouterr().out
     for flag in {f for f in res.stderr.split() if f.startswith("--")}:
         assert flag.strip("(),.:") in help_text, flag  # every flag it names, it has
-    res = hammer("landmarks", pose, "--fps", 25, "-o", out, "--object-diameter-px", 80,
-                 "--object-diameter", 0.06)
+    res = hammer_here(capsys, "landmarks", pose, "--fps", 25, "-o", out, "--object-diameter-px",
+                      80, "--object-diameter", 0.06)
     assert res.returncode == 0, res.stderr
     by_px = _read(out).set_index("landmark")["value"]
-    res = hammer("landmarks", pose, "--fps", 25, "-o", out, "--px-per-m", 80 / 0.06)
+    res = hammer_here(capsys, "landmarks", pose, "--fps", 25, "-o", out, "--px-per-m", 80 / 0.06)
     assert res.returncode == 0, res.stderr
     pd.testing.assert_series_equal(_read(out).set_index("landmark")["value"], by_px)
     assert 500 < by_px["movement_time"] < 1500
@@ -458,13 +466,13 @@ def test_tracks_whose_transport_point_is_lost_throughout_say_marker_lost_and_whi
     assert lm.status == "marker lost"
 
 
-def test_landmarks_and_recognize_of_a_tracks_file_whose_markers_are_lost(tmp_path):
+def test_landmarks_and_recognize_of_a_tracks_file_whose_markers_are_lost(tmp_path, capsys):
     from perception.synthetic.demos import demo_tracks
 
     path = tmp_path / "gone.tracks.h5"
     _lost(demo_tracks("normal", 1)[0], "thumb", "finger", "wrist").save(path)
     out = tmp_path / "lm.csv"
-    res = hammer("landmarks", path, "--px-per-m", 700, "-o", out)
+    res = hammer_here(capsys, "landmarks", path, "--px-per-m", 700, "-o", out)
     assert res.returncode == 1, res.stderr  # a trial not measured, as a recording's
     assert "gone: not scored: marker lost throughout: wrist, thumb, finger" in res.stderr
     table = _read(out)
