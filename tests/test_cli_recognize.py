@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _cli import hammer_here
 from _demos import default_repertoire, demo_tracks
 
 
@@ -15,9 +16,15 @@ def repfile(tmp_path_factory):
 
 
 def _recognize(path, out, repfile, *extra):
+    """``hammer-mv recognize`` as a subprocess: for what the process shows (exit status 2 in
+    one line); the lines and files of a run are tested in-process (:func:`_recognize_here`)."""
     return subprocess.run([sys.executable, "-m", "hammer_mv", "recognize", str(path), "-o",
                            str(out), "--repertoire", str(repfile), *extra],
                           capture_output=True, text=True)
+
+
+def _recognize_here(capsys, path, out, repfile, *extra):
+    return hammer_here(capsys, "recognize", path, "-o", out, "--repertoire", repfile, *extra)
 
 
 def _save(tracks, path):
@@ -25,9 +32,9 @@ def _save(tracks, path):
     return path
 
 
-def test_tracks_file_is_recognised(tmp_path, repfile):
+def test_tracks_file_is_recognised(tmp_path, repfile, capsys):
     path = _save(demo_tracks("normal", 0)[0], tmp_path / "n.tracks.h5")
-    proc = _recognize(path, tmp_path / "out", repfile)
+    proc = _recognize_here(capsys, path, tmp_path / "out", repfile)
     assert proc.returncode == 0, proc.stderr
     assert "winner grasp-" in proc.stdout
     assert (tmp_path / "out" / "n.recognition.json").exists()
@@ -98,12 +105,13 @@ def test_recognize_of_a_file_that_is_not_video_never_loads_opencv(tmp_path, kind
     assert imported and "cv2" not in imported
 
 
-def test_flags_another_kind_of_input_reads_are_said_not_read(tmp_path, repfile):
+def test_flags_another_kind_of_input_reads_are_said_not_read(tmp_path, repfile, capsys):
     """--rate and --markers are read from a motion-capture recording, --keypoints from a pose
     file: given for a tracks file they were dropped without a word."""
     path = _save(demo_tracks("normal", 0)[0], tmp_path / "n.tracks.h5")
-    proc = _recognize(path, tmp_path / "out", repfile, "--no-figures", "--rate", "85",
-                      "--markers", "thumb=x", "finger=y", "--keypoints", "thumb=a", "finger=b")
+    proc = _recognize_here(capsys, path, tmp_path / "out", repfile, "--no-figures", "--rate",
+                           "85", "--markers", "thumb=x", "finger=y", "--keypoints", "thumb=a",
+                           "finger=b")
     assert proc.returncode == 0, proc.stderr
     warned = [line for line in proc.stderr.splitlines() if "not read" in line]
     assert warned == ["hammer-mv recognize: warning: --markers, --rate (options of a "
@@ -111,11 +119,11 @@ def test_flags_another_kind_of_input_reads_are_said_not_read(tmp_path, repfile):
                       "read: the input is a tracks file"]
     # a recording's own flags are read; a pose file's are not
     table = Path(__file__).parent / "data" / "mocap" / "optotrak-trials.tsv"
-    proc = _recognize(table, tmp_path / "rec", repfile, "--no-figures", "--rate", "85",
-                      "--markers", "thumb=thumb", "finger=index", "--pcutoff", "0.5")
+    proc = _recognize_here(capsys, table, tmp_path / "rec", repfile, "--no-figures", "--rate",
+                           "85", "--markers", "thumb=thumb", "finger=index", "--pcutoff", "0.5")
     assert "--pcutoff (options of a pose file) not read: the input is a motion-capture " \
            "recording" in proc.stderr
     assert "--rate" not in proc.stderr
     # nothing said where every flag given is read
-    proc = _recognize(path, tmp_path / "out2", repfile, "--no-figures")
+    proc = _recognize_here(capsys, path, tmp_path / "out2", repfile, "--no-figures")
     assert "not read" not in proc.stderr
