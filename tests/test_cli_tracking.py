@@ -14,6 +14,9 @@ from perception.synthetic.scene import Occlusion
 
 
 def hammer(*args, cwd=None):
+    """``hammer-mv *args`` as a subprocess: for what the process shows (exit status 2 in one
+    line, the console of a run whose stderr is not a terminal); the lines and files of a
+    command are tested in-process (:func:`hammer_here`)."""
     return subprocess.run(
         [sys.executable, "-m", "hammer_mv", *map(str, args)],
         capture_output=True,
@@ -62,13 +65,14 @@ def test_track_output_option_and_quiet(clips, tmp_path):
     assert Tracks.load(out).n_frames == 24
 
 
-def test_track_roi_and_colours_options(clips, tmp_path):
+def test_track_roi_and_colours_options(clips, tmp_path, capsys):
     video = _copy(clips["good"], tmp_path)
     truth = Tracks.load(clips["good"].truth)
     x, y = truth.position[0, 0]
     colours = tmp_path / "colours.toml"
     colours.write_text("[thumb]\nhue = [[170, 8]]\n")
-    proc = hammer(
+    proc = hammer_here(
+        capsys,
         "track",
         video,
         "--roi",
@@ -98,10 +102,10 @@ def test_truncated_avi_is_refused_in_one_line(clips, tmp_path):
     assert not (tmp_path / "cut.tracks.h5").exists()
 
 
-def test_tracks_info(clips, tmp_path):
+def test_tracks_info(clips, tmp_path, capsys):
     video = _copy(clips["good"], tmp_path)
-    hammer("track", video, "--quiet")
-    proc = hammer("tracks", "info", tmp_path / "good.tracks.h5")
+    hammer_here(capsys, "track", video, "--quiet")
+    proc = hammer_here(capsys, "tracks", "info", tmp_path / "good.tracks.h5")
     assert proc.returncode == 0, proc.stderr
     assert "24 frames" in proc.stdout
     for name in ("thumb", "finger", "wrist", "object"):
@@ -110,12 +114,13 @@ def test_tracks_info(clips, tmp_path):
 
 
 @pytest.mark.parametrize("fmt", ["dlc", "trackpy", "csv"])
-def test_tracks_export(clips, tmp_path, fmt):
+def test_tracks_export(clips, tmp_path, fmt, capsys):
     video = _copy(clips["good"], tmp_path)
-    hammer("track", video, "--quiet")
+    hammer_here(capsys, "track", video, "--quiet")
     tracks = Tracks.load(tmp_path / "good.tracks.h5")
     out = tmp_path / f"out.{fmt}.csv"
-    proc = hammer("tracks", "export", tmp_path / "good.tracks.h5", "--format", fmt, "-o", out)
+    proc = hammer_here(capsys, "tracks", "export", tmp_path / "good.tracks.h5", "--format", fmt,
+                       "-o", out)
     assert proc.returncode == 0, proc.stderr
     if fmt == "dlc":
         df = pd.read_csv(out, header=[0, 1, 2], index_col=0)
@@ -159,7 +164,7 @@ def test_trim_keeps_exactly_the_frames_recognition_scores(tmp_path, capsys):
     assert status == 0 and f"active: frames {trimmed[0]} .. {trimmed[-1]}" in info
 
 
-def test_trim_of_tracks_without_a_movement_is_refused_in_one_line(tmp_path):
+def test_trim_of_tracks_without_a_movement_is_refused_in_one_line(tmp_path, capsys):
     from perception.synthetic.demos import demo_tracks
 
     tracks, _ = demo_tracks("normal", 0)
@@ -171,7 +176,7 @@ def test_trim_of_tracks_without_a_movement_is_refused_in_one_line(tmp_path):
     assert proc.returncode == 2
     assert proc.stderr.count("\n") == 1 and "--trim: no movement found" in proc.stderr
     assert not out.exists()
-    info = hammer("tracks", "info", tmp_path / "still.tracks.h5")
+    info = hammer_here(capsys, "tracks", "info", tmp_path / "still.tracks.h5")
     assert "active: none (no movement found" in info.stdout
 
 
@@ -277,18 +282,19 @@ def _frame_count(path):
     return n
 
 
-def test_labelled_video_from_track_and_from_tracks_render(clips, tmp_path):
+def test_labelled_video_from_track_and_from_tracks_render(clips, tmp_path, capsys):
     import cv2
     import numpy as np
 
     video = _copy(clips["good"], tmp_path)
     labelled = tmp_path / "labelled.mp4"
-    proc = hammer("track", video, "--labelled-video", labelled, "--quiet")
+    proc = hammer_here(capsys, "track", video, "--labelled-video", labelled, "--quiet")
     assert proc.returncode == 0, proc.stderr
     assert _frame_count(labelled) == 24
     again = tmp_path / "again.mp4"
-    proc = hammer("tracks", "render", tmp_path / "good.tracks.h5", "-o", again)
-    assert proc.returncode == 0, proc.stderr and "24 frames labelled" in proc.stdout
+    proc = hammer_here(capsys, "tracks", "render", tmp_path / "good.tracks.h5", "-o", again)
+    assert proc.returncode == 0, proc.stderr
+    assert "24 frames labelled" in proc.stdout
     assert _frame_count(again) == 24
     # the drawing is there: the labelled frame differs from the video near the thumb
     from perception.io.tracks import Tracks
@@ -300,16 +306,16 @@ def test_labelled_video_from_track_and_from_tracks_render(clips, tmp_path):
         fa, fb = a.read()[1], b.read()[1]
     diff = np.abs(fa.astype(int) - fb.astype(int))[y - 15:y + 15, x - 15:x + 15].sum(axis=-1)
     assert (diff > 60).sum() > 20
-    proc = hammer("tracks", "render", tmp_path / "good.tracks.h5", tmp_path / "none.mp4",
-                  "-o", tmp_path / "x.mp4")
+    proc = hammer_here(capsys, "tracks", "render", tmp_path / "good.tracks.h5",
+                       tmp_path / "none.mp4", "-o", tmp_path / "x.mp4")
     assert proc.returncode == 2 and "none.mp4" in proc.stderr
     assert not (tmp_path / "x.mp4").exists()
 
 
-def test_tracks_info_prints_the_quality_table(clips, tmp_path):
+def test_tracks_info_prints_the_quality_table(clips, tmp_path, capsys):
     video = _copy(clips["good"], tmp_path)
-    assert hammer("track", video, "--quiet").returncode == 0
-    proc = hammer("tracks", "info", tmp_path / "good.tracks.h5")
+    assert hammer_here(capsys, "track", video, "--quiet").returncode == 0
+    proc = hammer_here(capsys, "tracks", "info", tmp_path / "good.tracks.h5")
     assert proc.returncode == 0, proc.stderr
     assert "quality:" in proc.stdout and "reacquisitions" in proc.stdout
     thumb = next(line for line in proc.stdout.splitlines()[::-1] if line.startswith("thumb"))
