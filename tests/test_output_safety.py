@@ -28,9 +28,11 @@ DATA = Path(__file__).parent / "data" / "mocap"
 RATE = 85.0
 
 
-def hammer(*args, timeout=300, cwd=None):
+def hammer(*args, timeout=300):
+    """``hammer-mv *args`` as a subprocess: for what the process shows (exit status 2 in one
+    line); the lines and files of a command are tested in-process (:func:`hammer_here`)."""
     return subprocess.run([sys.executable, "-m", "hammer_mv", *map(str, args)],
-                          capture_output=True, text=True, timeout=timeout, cwd=cwd)
+                          capture_output=True, text=True, timeout=timeout)
 
 
 def write_trials(path: Path, trials=(0,), names=None, sep="\t", trial_column=True) -> Path:
@@ -55,11 +57,13 @@ def test_landmarks_refuses_to_write_over_its_recording(tmp_path):
     assert table.read_bytes() == before
 
 
-def test_landmarks_refuses_an_input_named_through_another_path(tmp_path):
+def test_landmarks_refuses_an_input_named_through_another_path(tmp_path, monkeypatch,
+                                                                capsys):
     table = write_trials(tmp_path / "T.tsv")
     before = table.read_bytes()
-    res = hammer("landmarks", "T.tsv", "--rate", RATE, "-o", tmp_path / "." / "T.tsv",
-                 cwd=tmp_path, timeout=120)
+    monkeypatch.chdir(tmp_path)
+    res = hammer_here(capsys, "landmarks", "T.tsv", "--rate", RATE, "-o",
+                      tmp_path / "." / "T.tsv")
     assert res.returncode == 2 and table.read_bytes() == before
 
 
@@ -179,11 +183,11 @@ def test_stale_trials_of_several_recordings_go_in_one_pass(tmp_path, monkeypatch
     assert (out / "a-trial0.recognition.json").is_file()
 
 
-def test_a_batch_will_not_write_its_report_over_a_recording_in_its_folder(tmp_path):
+def test_a_batch_will_not_write_its_report_over_a_recording_in_its_folder(tmp_path, capsys):
     folder = tmp_path / "in"
     folder.mkdir()
     write_trials(folder / "landmarks.csv", sep=",")
-    res = hammer("batch", folder, "-o", folder, "--rate", RATE, timeout=120)
+    res = hammer_here(capsys, "batch", folder, "-o", folder, "--rate", RATE)
     assert res.returncode == 2 and "landmarks.csv" in res.stderr
     # elsewhere, the file a batch report would call its own is listed, not silently left
     found = find_clips(folder)
