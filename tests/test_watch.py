@@ -10,9 +10,11 @@ import time
 from pathlib import Path
 
 import pytest
+from _cli import hammer_here
 from _demos import default_repertoire
 from _reports import assert_json_close
 
+from hammer_mv.cli import main
 from perception.synthetic.demos import render_demo_clip
 
 
@@ -22,12 +24,14 @@ def clip(tmp_path_factory):
     d = tmp_path_factory.mktemp("watch")
     video = render_demo_clip(d, "clip.mp4", n=75)[0].video
     rep = default_repertoire().save(d / "rep.h5")
-    proc = _hammer("recognize", video, "-o", d / "offline", "--no-figures", "--repertoire", rep)
-    assert proc.returncode == 0, proc.stderr
+    assert main(["recognize", str(video), "-o", str(d / "offline"), "--no-figures",
+                 "--repertoire", str(rep)]) == 0
     return video, rep, json.loads((d / "offline" / "clip.recognition.json").read_text()), d
 
 
 def _hammer(*args, **kw):
+    """``hammer-mv *args`` as a subprocess: for what the process shows (exit status 2 in one
+    line); the lines and files of a command are tested in-process (:func:`hammer_here`)."""
     return subprocess.run([sys.executable, "-m", "hammer_mv", *map(str, args)],
                           capture_output=True, text=True, **kw)
 
@@ -37,10 +41,10 @@ def _close(a, b):
     return assert_json_close(a, b, rel=1e-9, abs_=1e-12)
 
 
-def test_watch_a_file_writes_what_recognize_writes(clip, tmp_path):
+def test_watch_a_file_writes_what_recognize_writes(clip, tmp_path, capsys):
     video, rep, offline, d = clip
-    proc = _hammer("watch", video, "-o", tmp_path, "--no-figures", "--repertoire", rep,
-                   "--live", "--as-fast-as-possible")
+    proc = hammer_here(capsys, "watch", video, "-o", tmp_path, "--no-figures", "--repertoire",
+                       rep, "--live", "--as-fast-as-possible")
     assert proc.returncode == 0, proc.stderr
     lines = proc.stdout.splitlines()
     assert sum(" s  " in line for line in lines) == 75  # one per frame
