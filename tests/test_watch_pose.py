@@ -8,6 +8,7 @@ import subprocess
 import sys
 
 import pytest
+from _cli import hammer_here
 from _demos import default_repertoire, demo_tracks
 
 from perception.io.exports import export_tracks
@@ -26,15 +27,18 @@ def pose(tmp_path_factory):
 
 
 def _cli(*args):
+    """``hammer-mv *args`` as a subprocess: for what the process shows (exit status 2 in one
+    line); the lines and files of a command are tested in-process (:func:`hammer_here`)."""
     return subprocess.run([sys.executable, "-m", "hammer_mv", *map(str, args)],
                           capture_output=True, text=True, timeout=300)
 
 
-def test_a_pose_file_watched_is_the_pose_file_recognised(pose, tmp_path):
+def test_a_pose_file_watched_is_the_pose_file_recognised(pose, tmp_path, capsys):
     dlc, rep, diameter = pose
     opts = ["--fps", "30", "--object-diameter-px", diameter, "--repertoire", rep, "--no-figures"]
-    a = _cli("recognize", dlc, "-o", tmp_path / "a", *opts)
-    b = _cli("watch", dlc, "-o", tmp_path / "b", "--as-fast-as-possible", "--live", *opts)
+    a = hammer_here(capsys, "recognize", dlc, "-o", tmp_path / "a", *opts)
+    b = hammer_here(capsys, "watch", dlc, "-o", tmp_path / "b", "--as-fast-as-possible", "--live",
+                    *opts)
     assert a.returncode == 0 and b.returncode == 0, a.stderr + b.stderr
     name = "trial.recognition.json"  # a DeepLabCut file is named after its video
     off = json.loads((tmp_path / "a" / name).read_text())
