@@ -7,6 +7,7 @@ import sys
 
 import pandas as pd
 import pytest
+from _cli import hammer_here
 from _demos import default_repertoire
 
 from hammer_mv.cli import main
@@ -37,12 +38,6 @@ def clips(tmp_path_factory):
 @pytest.fixture(scope="module")
 def repfile(tmp_path_factory):
     return default_repertoire().save(tmp_path_factory.mktemp("rep") / "rep.h5")
-
-
-def _batch(src, out, repfile, *extra):
-    return subprocess.run([sys.executable, "-m", "hammer_mv", "batch", str(src), "-o",
-                           str(out), "--repertoire", str(repfile), "--quiet", *extra],
-                          capture_output=True, text=True)
 
 
 def _main_batch(src, out, repfile, *extra):
@@ -91,14 +86,15 @@ def test_batch_jobs_1_and_2_agree_and_resume(clips, repfile, tmp_path):
     assert pd.read_csv(one / "summary.csv")["reused"].all()
 
 
-def test_batch_goes_on_past_bad_files(clips, repfile, tmp_path):
+def test_batch_goes_on_past_bad_files(clips, repfile, tmp_path, capsys):
     src = tmp_path / "src"
     src.mkdir()
     for name in ("normal-01.mp4", "manifest.csv"):
         shutil.copy(clips / name, src / name)
     (src / "notes.txt").write_text("not a video")
     (src / "empty.mp4").write_bytes(b"")
-    proc = _batch(src, tmp_path / "out", repfile)
+    proc = hammer_here(capsys, "batch", src, "-o", tmp_path / "out", "--repertoire", repfile,
+                       "--quiet")
     assert proc.returncode == 1 and "1 clip(s) failed" in proc.stderr
     s = pd.read_csv(tmp_path / "out" / "summary.csv").set_index("clip")
     assert s.loc["normal-01", "status"] == "ok"
