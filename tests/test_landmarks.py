@@ -8,12 +8,11 @@ model's own must match.
 
 import json
 import math
-import subprocess
-import sys
 
 import numpy as np
 import pandas as pd
 import pytest
+from _cli import hammer_here
 from _demos import default_repertoire, demo_tracks
 from scipy.special import beta as beta_fn
 
@@ -258,13 +257,11 @@ def test_summary_csv_has_the_landmark_columns(reports, tmp_path):
     assert row["aperture_peaks"] == "1" and row["verdict_detail"] == "delayed-opening"
 
 
-def test_recognize_prints_the_kind_of_an_abnormal_verdict(tmp_path):
+def test_recognize_prints_the_kind_of_an_abnormal_verdict(tmp_path, capsys):
     rep = default_repertoire().save(tmp_path / "rep.h5")
     demo_tracks("delayed", 0)[0].save(tmp_path / "d.tracks.h5")
-    proc = subprocess.run([sys.executable, "-m", "hammer_mv", "recognize",
-                           str(tmp_path / "d.tracks.h5"), "-o", str(tmp_path / "out"),
-                           "--repertoire", str(rep), "--no-figures"],
-                          capture_output=True, text=True)
+    proc = hammer_here(capsys, "recognize", tmp_path / "d.tracks.h5", "-o", tmp_path / "out",
+                       "--repertoire", rep, "--no-figures")
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.startswith("d: abnormal (delayed-opening), winner grasp-")
 
