@@ -6,6 +6,7 @@ import sys
 import cv2
 import numpy as np
 import pytest
+from _cli import hammer_here
 from _clips import errors, render
 
 from perception.errors import InputError
@@ -14,6 +15,8 @@ from perception.tracking.setup import TrackingSetup, calibrate, load_setup, writ
 
 
 def hammer(*args):
+    """``hammer-mv *args`` as a subprocess: for what the process shows (exit status 2 in one
+    line); the lines and files of a command are tested in-process (:func:`hammer_here`)."""
     return subprocess.run([sys.executable, "-m", "hammer_mv", *map(str, args)],
                           capture_output=True, text=True)
 
@@ -60,7 +63,7 @@ def test_setup_file_refuses_unknown_tables_and_keys_naming_the_nearest(tmp_path)
     assert TrackingSetup().to_dict()["sizes"]["object_diameter"] == 0.1
 
 
-def test_calibrate_then_track_with_setup_round_trip(tmp_path):
+def test_calibrate_then_track_with_setup_round_trip(tmp_path, capsys):
     """A session: calibrate on one clip, track another clip of the setup with --setup."""
     scene = Scene.reach_to_grasp(30, 30, onset=0.3, duration=0.6)
     one, _ = render(tmp_path, "one.mp4", n=30, width=480, height=360, scene=scene, hand=True,
@@ -68,11 +71,11 @@ def test_calibrate_then_track_with_setup_round_trip(tmp_path):
     two, _ = render(tmp_path, "two.mp4", n=30, width=480, height=360, scene=scene, hand=True,
                     noise_sd=3.0, seed=5, angle=-10.0)
     setup = tmp_path / "setup.toml"
-    proc = hammer("calibrate", one.video, "-o", setup)
+    proc = hammer_here(capsys, "calibrate", one.video, "-o", setup)
     assert proc.returncode == 0, proc.stderr
     assert "marker diameter" in proc.stdout and setup.exists()
     out = tmp_path / "two.tracks.h5"
-    proc = hammer("track", two.video, "-o", out, "--setup", setup)
+    proc = hammer_here(capsys, "track", two.video, "-o", out, "--setup", setup)
     assert proc.returncode == 0, proc.stderr
     from perception.io.tracks import Tracks
 
@@ -88,20 +91,20 @@ def test_calibrate_then_track_with_setup_round_trip(tmp_path):
     assert len(proc.stderr.strip().splitlines()) == 1 and not (tmp_path / "x.h5").exists()
 
 
-def test_calibrate_refuses_an_ambiguous_marker_and_a_roi_settles_it(tmp_path):
+def test_calibrate_refuses_an_ambiguous_marker_and_a_roi_settles_it(tmp_path, capsys):
     scene = Scene.reach_to_grasp(8, 30, onset=1.0)
     twin = scene.thumb[0] + (0.026, 0.0)
     clip, _ = render(tmp_path, n=8, width=320, height=240, angle=0.0, scene=scene,
                      distractors=(Distractor("thumb", tuple(twin)),))
     out = tmp_path / "setup.toml"
-    proc = hammer("calibrate", clip.video, "-o", out)
+    proc = hammer_here(capsys, "calibrate", clip.video, "-o", out)
     assert proc.returncode == 2 and "thumb" in proc.stderr and "--roi thumb" in proc.stderr
     assert not out.exists()
     from perception.io.tracks import Tracks
 
     truth = Tracks.load(clip.truth)
     x, y = truth.position[0, truth.index("thumb")]
-    proc = hammer("calibrate", clip.video, "-o", out, "--roi", "thumb", int(x) - 8, int(y) - 8,
-                  16, 16)
+    proc = hammer_here(capsys, "calibrate", clip.video, "-o", out, "--roi", "thumb", int(x) - 8,
+                       int(y) - 8, 16, 16)
     assert proc.returncode == 0, proc.stderr
     assert out.exists()
