@@ -7,10 +7,9 @@ import sys
 
 import pandas as pd
 import pytest
-from _cli import hammer_here
+from _cli import hammer_here, main_here
 from _demos import default_repertoire
 
-from hammer_mv.cli import main
 from perception.batch import discover, run_batch
 from perception.synthetic.recipes import Recipe, StimulusParams, synthesize
 
@@ -44,8 +43,7 @@ def _main_batch(src, out, repfile, *extra):
     """``hammer-mv batch``'s exit status, run in this process: what a subprocess would
     add is its imports (4 s of CPU a run), and the tests that use this look at the
     exit status and the files written, not at the console."""
-    return main(["batch", str(src), "-o", str(out), "--repertoire", str(repfile), "--quiet",
-                 *extra])
+    return main_here("batch", src, "-o", out, "--repertoire", repfile, "--quiet", *extra)
 
 
 def _same_reports(a, b, *, input_spelled_alike=True):
@@ -126,8 +124,8 @@ def test_dask_scheduler_gives_the_same_results(clips, tmp_path):
 
 def test_recognize_writes_the_contract(clips, repfile, tmp_path):
     out = tmp_path / "r"
-    assert main(["recognize", str(clips / "open-close-open-01.mp4"), "-o", str(out),
-                 "--repertoire", str(repfile), "--quiet"]) == 0
+    assert main_here("recognize", clips / "open-close-open-01.mp4", "-o", out, "--repertoire",
+                     repfile, "--quiet") == 0
     d = json.loads((out / "open-close-open-01.recognition.json").read_text())
     assert d["clip"] == "open-close-open-01" and d["rule"] == "likelihood"
     assert {"name", "kind", "final_confidence"} <= set(d["models"][0])
@@ -140,8 +138,8 @@ def test_recognize_writes_the_contract(clips, repfile, tmp_path):
     # a tracks file is accepted as input too
     tracks = out / "tracks" / "open-close-open-01.tracks.h5"
     assert tracks.exists()
-    assert main(["recognize", str(tracks), "-o", str(tmp_path / "r2"),
-                 "--repertoire", str(repfile), "--quiet"]) == 0
+    assert main_here("recognize", tracks, "-o", tmp_path / "r2", "--repertoire", repfile,
+                     "--quiet") == 0
 
 
 @pytest.mark.parametrize("make, message", [

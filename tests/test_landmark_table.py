@@ -19,10 +19,9 @@ import sys
 import numpy as np
 import pandas as pd
 import pytest
-from _cli import hammer_here
+from _cli import hammer_here, main_here
 from scipy.optimize import brentq
 
-from hammer_mv.cli import main
 from perception.landmarks import LandmarkParams, movement_landmarks, speed_bound
 from perception.report.tables import (
     LANDMARK_COLUMNS,
@@ -376,7 +375,7 @@ def test_landmarks_on_a_deeplabcut_file_takes_the_flag_it_suggests(tmp_path, cap
     res = hammer_here(capsys, "landmarks", pose, "--fps", 25, "-o", out)
     assert res.returncode == 2 and "--object-diameter-px" in res.stderr, res.stderr
     with pytest.raises(SystemExit):  # argparse ends --help
-        main(["landmarks", "--help"])
+        main_here("landmarks", "--help")
     help_text = capsys.readouterr().out
     for flag in {f for f in res.stderr.split() if f.startswith("--")}:
         assert flag.strip("(),.:") in help_text, flag  # every flag it names, it has

@@ -10,11 +10,10 @@ import time
 from pathlib import Path
 
 import pytest
-from _cli import hammer_here
+from _cli import hammer_here, main_here
 from _demos import default_repertoire
 from _reports import assert_json_close
 
-from hammer_mv.cli import main
 from perception.synthetic.demos import render_demo_clip
 
 
@@ -24,8 +23,8 @@ def clip(tmp_path_factory):
     d = tmp_path_factory.mktemp("watch")
     video = render_demo_clip(d, "clip.mp4", n=75)[0].video
     rep = default_repertoire().save(d / "rep.h5")
-    assert main(["recognize", str(video), "-o", str(d / "offline"), "--no-figures",
-                 "--repertoire", str(rep)]) == 0
+    assert main_here("recognize", video, "-o", d / "offline", "--no-figures", "--repertoire",
+                     rep) == 0
     return video, rep, json.loads((d / "offline" / "clip.recognition.json").read_text()), d
 
 
