@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import contextlib
-import os
 from typing import NamedTuple
 
 
@@ -15,31 +13,12 @@ class Ran(NamedTuple):
     stderr: str
 
 
-@contextlib.contextmanager
-def _environment_kept():
-    """``os.environ`` put back as it was once the command ends.
-
-    ``main()`` sets OpenCV's and FFmpeg's log levels for its process
-    (``os.environ.setdefault``); left set, they pass to every later subprocess
-    of the test process, and a test that a subprocess prints no FFmpeg chatter
-    would pass without ``main()``'s own settings.
-    """
-    saved = dict(os.environ)
-    try:
-        yield
-    finally:
-        if dict(os.environ) != saved:
-            os.environ.clear()
-            os.environ.update(saved)
-
-
 def main_here(*args) -> int:
     """``hammer-mv *args`` run in this process: its exit status, the console left to pytest
     (for a fixture, which ``capsys`` does not reach)."""
     from hammer_mv.cli import main
 
-    with _environment_kept():
-        return main([str(a) for a in args])
+    return main([str(a) for a in args])
 
 
 def hammer_here(capsys, *args) -> Ran:

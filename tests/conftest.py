@@ -24,6 +24,19 @@ def _signals_as_in_a_terminal():
             signal.signal(number, handler)
 
 
+@pytest.fixture(autouse=True)
+def _no_log_levels_from_an_earlier_main(monkeypatch):
+    """Each test starts without the log levels ``hammer_mv.cli.main()`` sets for its process.
+
+    ``main()`` sets OpenCV's and FFmpeg's log levels (``os.environ.setdefault``);
+    after a test that calls it in the pytest process they would pass to every later
+    subprocess of that worker, and a test that a subprocess prints no FFmpeg chatter
+    would pass without the subprocess's own ``main()`` setting them.
+    """
+    for name in ("OPENCV_FFMPEG_LOGLEVEL", "OPENCV_LOG_LEVEL"):
+        monkeypatch.delenv(name, raising=False)
+
+
 @pytest.fixture(scope="session")
 def todorov():
     """Inputs and outputs of Todorov's kalman_lqg.m for the thesis reach."""
