@@ -269,8 +269,14 @@ def measure(source, *, params: LandmarkParams | None = None, mocap=None,
         # measurement stands, as batch and recognize scale a video by it
         dpx = tracks.object_diameter_px()
         dpx = object_diameter_px if dpx is None else dpx
+        where = tracks.path or (source if not isinstance(source, Tracks) else "tracks")
+        if dpx is not None and object_diameter is None:
+            # the half given is named, so that the line asks for the other half
+            raise InputError(f"the scale is unknown: the object is {dpx:g} px across, but "
+                             "its real diameter is not given "
+                             "(landmarks assumes none): give `object_diameter` in m, or "
+                             "`px_per_m`", where, field="object_diameter")
         if dpx is None or object_diameter is None:
-            where = tracks.path or (source if not isinstance(source, Tracks) else "tracks")
             raise InputError("the scale is unknown: give `px_per_m`, or the object's diameter "
                              "(`object_diameter`) with its apparent size in the tracks (a "
                              "tracker's, or `object_diameter_px`)", where, field="px_per_m")

@@ -83,6 +83,7 @@ def unknown_layout(path) -> str | None:
 
     from perception.io.mocap import is_mocap_file
     from perception.io.pose import pose_output
+    from perception.io.pose_sleap_csv import is_sleap_csv
 
     p = Path(path)
     suffix = p.suffix.lower()
@@ -98,6 +99,8 @@ def unknown_layout(path) -> str | None:
     if suffix == ".csv" and (pose_output(p.name) is not None or {"bodyparts", "coords"} <= {
             line.split(",", 1)[0].strip().strip('"').lower() for line in lines[:4]}):
         return None  # DeepLabCut's header rows (Lightning Pose writes them too)
+    if suffix == ".csv" and is_sleap_csv(lines[0]):
+        return None  # SLEAP's analysis CSV
     # a .txt of prose (notes) is no table at all: the plain "not a clip" fits it
     if suffix == ".txt" and not any(_tabular(line) for line in lines):
         return None

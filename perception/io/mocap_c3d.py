@@ -29,8 +29,29 @@ __all__ = ["read_c3d"]
 _MOCAP_EXTRA = "reading C3D files needs ezc3d: pip install 'hammer-mv[mocap]'"
 #: C3D point groups that hold modelled outputs (Vicon Plug-in Gait), not markers.
 _C3D_MODELLED = ("ANGLES", "FORCES", "MOMENTS", "POWERS", "SCALARS", "REACTIONS")
-#: The processor type byte of the parameter section: big-endian for MIPS (86).
-_BIG_ENDIAN = 86
+#: The processor type byte of the parameter section: DEC (VAX) floats for 85, big-endian for
+#: MIPS (86); Intel (84) otherwise.
+_DEC, _BIG_ENDIAN = 85, 86
+
+
+#: POINT:UNITS words other than mm, cm and m, as writers put them in a parameter of 4
+#: characters (Peak Performance writes 'mete').
+_UNIT_WORDS = {word[:k]: unit for word, unit in (("meters", "m"), ("metres", "m"),
+                                                 ("millimeters", "mm"), ("millimetres", "mm"),
+                                                 ("centimeters", "cm"), ("centimetres", "cm"))
+               for k in (4, len(word))}
+
+
+def _ezc3d_says(exc: BaseException) -> str:
+    """What ezc3d's error says of a file, without its advice to ezc3d's own users (a flag
+    to set in its API, an issue to open with it)."""
+    text = str(exc).strip()
+    if "MIPS processor" in text:
+        return ("written for a MIPS (SGI) processor, which ezc3d, the C3D reader, does not "
+                "read: save it again as a PC (Intel) C3D")
+    text = text.replace(". If you want to ignore this error, set ignoreBadFormatting to true",
+                        "")
+    return f"ezc3d: {text}"
 
 
 def _c3d_values(group: Mapping, name: str) -> list:
@@ -67,9 +88,14 @@ def _stated_frames(path: Path) -> tuple[int, int] | None:
             processor = fh.read(1)
     except OSError:
         return None
-    order = ">" if processor and processor[0] == _BIG_ENDIAN else "<"
+    kind = processor[0] if processor else None
+    order = ">" if kind == _BIG_ENDIAN else "<"
     points, analogs, first, last = struct.unpack(order + "HHHH", head[2:10])
-    scale, data_start = struct.unpack(order + "fH", head[12:18])
+    (data_start,) = struct.unpack(order + "H", head[16:18])
+    raw = head[12:16]
+    if kind == _DEC:  # a VAX F float: its two 16-bit words swapped, and 4 times the value
+        raw = raw[2:] + raw[:2]  # (read as IEEE, its sign is a bit of the mantissa)
+    (scale,) = struct.unpack(order + "f", raw)
     stated = last - first + 1
     width = 4 if scale < 0 else 2  # bytes per value
     frame_bytes = (4 * points + analogs) * width
@@ -98,7 +124,7 @@ def read_c3d(path: Path, source: str, rate, units) -> list[MocapTrial]:
     try:
         c3d = ezc3d.c3d(os.fspath(path))
     except (OSError, RuntimeError, ValueError, IndexError) as exc:
-        raise InputError(f"not a readable C3D file ({exc})", path) from None
+        raise InputError(f"not a readable C3D file ({_ezc3d_says(exc)})", path) from None
     point = c3d["parameters"]["POINT"]
     points = np.asarray(c3d["data"]["points"], dtype=float)[:3]  # (3, n_points, n_frames)
     residuals = np.asarray(c3d["data"]["meta_points"]["residuals"], dtype=float)
@@ -150,5 +176,10 @@ def read_c3d(path: Path, source: str, rate, units) -> list[MocapTrial]:
     first = int(c3d["header"]["points"].get("first_frame", 0))
     time = (first + np.arange(points.shape[2])) / rate
     stated = [str(u).strip() for u in _c3d_values(point, "UNITS") if str(u).strip()]
-    own_units = (stated[0], "POINT:UNITS") if stated else None
+    own_units = None
+    if stated:
+        word = _UNIT_WORDS.get(stated[0].lower(), stated[0])
+        if word != stated[0] and units is None:
+            notes.append(f"POINT:UNITS {stated[0]!r} read as {word}")
+        own_units = (word, "POINT:UNITS")
     return assemble(path, source, [("", time, markers, {})], rate, units, own_units, notes)

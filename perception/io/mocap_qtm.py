@@ -102,6 +102,13 @@ def read_qtm(path: Path, source: str, text: TableText, rate, units, trial_column
         if fields[0] == "MARKER_NAMES":
             named = fields[1:]
         skip += 1
+    included = " ".join(header.get("DATA_INCLUDED", ["3D"]))
+    if included.upper() != "3D":  # QTM's 6DOF, skeleton and analysis exports name no markers
+        what = header.get("DATA_TYPES") or header.get("BODY_NAMES") or []
+        held = f" ({', '.join(what[:4])}{', ...' if len(what) > 4 else ''})" if what else ""
+        raise InputError(f"a QTM export of {included!r} data{held}, not markers' positions: "
+                         "export the 3D data (DATA_INCLUDED 3D, the markers' X, Y, Z)", path,
+                         field="DATA_INCLUDED")
     names = header.get("MARKER_NAMES")
     if not names:
         raise InputError("expected the markers' names, each once", path, field="MARKER_NAMES")
@@ -109,10 +116,6 @@ def read_qtm(path: Path, source: str, text: TableText, rate, units, trial_column
     if twice:  # which column is which cannot be told
         raise InputError(f"expected the markers' names, each once: {', '.join(map(repr, twice))} "
                          "named more than once", path, field="MARKER_NAMES")
-    included = " ".join(header.get("DATA_INCLUDED", ["3D"]))
-    if included.upper() != "3D":
-        raise InputError(f"expected 3D marker data, got {included!r}", path,
-                         field="DATA_INCLUDED")
     notes = list(text.notes) + _name_notes(names, named, header)
     own_rate = None
     if header.get("FREQUENCY"):

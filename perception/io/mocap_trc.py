@@ -12,7 +12,9 @@ The layout, as OpenSim's ``TRCFileAdapter`` reads it::
     1  0.000  160.0  40.0  200.0  ...                 <- an empty cell or NaN: a lost sample
 
 The cells are tab-separated (some writers pad them with spaces, or part the
-first line by spaces; a few write white space throughout). What writers do
+first line by spaces; a few write white space throughout; a file opened in a
+spreadsheet and saved as CSV has every line parted by commas, or by
+semicolons, each padded with empty cells to the widest line). What writers do
 differently, each read here: the names not above their X column (OpenSim's
 own example files put an extra tab before the first), trailing tabs, a file
 ending before the rows' last markers (lost: NaN), ``NaN``/``nan`` or empty
@@ -32,7 +34,7 @@ import numpy as np
 
 from perception.errors import InputError
 from perception.io.mocap_tables import no_clock, table_trials
-from perception.io.mocap_text import TableText, decimal_mark, delimiter
+from perception.io.mocap_text import TableText, decimal_mark, delimiter, split
 from perception.io.mocap_trial import RATE_TOLERANCE, MocapTrial, check_rate, strip_subject
 from perception.limits import MAX_FRAMES
 
@@ -48,6 +50,9 @@ _UNIT_WORDS = {"mm": "mm", "millimeters": "mm", "millimetres": "mm", "cm": "cm",
 #: files write ``NaN``, ``nan``, ``Nan``, ``NAN``).
 _NANS = sorted({sign + "".join(c.upper() if k >> i & 1 else c for i, c in enumerate("nan"))
                 for k in range(8) for sign in ("", "-", "+")})
+#: A TRC file's first word (line 1), and a spreadsheet's separator after it.
+_FIRST_WORD = re.compile(r"\s*pathfiletype(?:\s|[,;]|$)", re.IGNORECASE)
+_SAVED = re.compile(r"\s*pathfiletype\s*([,;])", re.IGNORECASE)
 #: The header's keys as OpenSim writes them (line 2).
 _KEYS = "DataRate CameraRate NumFrames NumMarkers Units OrigDataRate OrigDataStartFrame " \
         "OrigNumFrames"
@@ -61,8 +66,24 @@ def is_trc(first_line: str) -> bool:
     first_line : str
         The line.
     """
-    words = first_line.split()
-    return bool(words) and words[0].lower() == "pathfiletype"
+    return _FIRST_WORD.match(first_line) is not None
+
+
+def _saved_as_csv(lines: list[str], top: int) -> tuple[list[str], str | None]:
+    """The lines of a TRC file a spreadsheet saved as CSV (``PathFileType,4,(X/Y/Z),...``,
+    parted by commas or semicolons) with its header lines parted by tabs as a TRC writer parts
+    them, and that separator; other files' lines as they are, and None. The rows are left as
+    they are (read as any table's)."""
+    found = _SAVED.match(lines[top])
+    if found is None or "\t" in lines[top]:
+        return lines, None
+    sep = found.group(1)
+    last = top + 4  # past the names; past the X1 Y1 Z1 row under them, where there is one
+    coords = [c for c in split(lines[last], sep) if c] if last < len(lines) else []
+    if coords and all(_AXIS.fullmatch(c) for c in coords):
+        last += 1
+    header = ["\t".join(split(line, sep)) for line in lines[top + 1: last]]
+    return lines[: top + 1] + header + lines[last:], sep
 
 
 def _cells(line: str, sep: str) -> list[str]:
@@ -91,11 +112,16 @@ def read_trc(path: Path, source: str, text: TableText, rate, units, trial_column
                          "expected 'PathFileType 4 (X/Y/Z) ...'", path, field="PathFileType")
     lines = text.all_lines()
     top = text.skip  # the PathFileType line; the lines below are numbered from it for messages
+    lines, saved = _saved_as_csv(lines, top)
+    notes = []
+    if saved is not None:
+        notes.append(f"a TRC file saved as CSV (cells parted by {saved!r}): read as the tabbed "
+                     "layout")
     if len(lines) < top + 4:
         raise InputError(f"the file ends before its marker names (line {top + 4})", path,
                          field="Frame#")
-    meta, notes = _meta(lines[top + 1], lines[top + 2], top, path)
-    notes = list(text.notes) + notes
+    meta, more = _meta(lines[top + 1], lines[top + 2], top, path)
+    notes = list(text.notes) + notes + more
     time_label, names = _names(lines[top + 3], top, path)
     start = top + 4
     coords = lines[start].split() if start < len(lines) else []
@@ -196,7 +222,7 @@ def _rows(path: Path, data: list[str], markers: int, time_label: str, top: int):
     """
     import pandas as pd
 
-    body = [line for line in data if line.strip()]
+    body = [line for line in data if line.strip(" \t,;")]  # a row of empty cells is blank
     if not body:
         raise InputError("no data rows below the header", path, field="Frame#")
     sep = delimiter(body[0])

@@ -140,7 +140,9 @@ def check_unit(value, path: Path, where: str) -> str:
     """
     unit = str(value).strip().lower()
     if unit not in UNITS:
-        raise InputError(f"unknown length unit {value!r} (expected mm, cm or m)", path,
+        # a file's own word: the flag says what it means
+        fix = "" if where == "units" else ": give the file's unit with `units`"
+        raise InputError(f"unknown length unit {value!r} (expected mm, cm or m){fix}", path,
                          field=where)
     return unit
 

@@ -63,6 +63,7 @@ from perception.io.pose_arrays import (
     unique_fill,
 )
 from perception.io.pose_mapping import keypoint_mapping, object_at_grip
+from perception.io.pose_sleap_csv import is_sleap_csv, sleap_csv_dataset
 from perception.io.tracks import Status, Tracks, position_bounds
 from perception.limits import MAX_FPS, MAX_FRAMES, MAX_KEYPOINTS, MAX_POSE_POINTS
 from perception.track_cleaning import TrackCleaning, clean_tracks
@@ -102,6 +103,7 @@ _OUTPUTS = tuple((re.compile(pattern, re.IGNORECASE), what) for pattern, what in
     (_DLC + r"\.pickle", "DeepLabCut's metadata or raw detections, not poses"),
     (_DLC + r"(?:labeled|_full)" + _VIDEO, "DeepLabCut's labelled video, not a trial"),
     (r"(?:.*\.\d{3}_)?(?P<video>.+?)(?:" + _VIDEO + r")?(?:\.predictions)?\.analysis\.h5", 1),
+    (r"(?:.*\.\d{3}_)?(?P<video>.+?)(?:" + _VIDEO + r")?(?:\.predictions)?\.analysis\.csv", 0),
     (r"(?P<video>.+?)(?:" + _VIDEO + r")?\.predictions\.slp", 0),
 ))
 
@@ -310,6 +312,9 @@ _LABELLED = ("DeepLabCut's labelled frames (CollectedData: a row per labelled im
 def _source(path: Path) -> str:
     """Which tool wrote a pose file: ``dlc``, ``sleap``, ``lp``, ``nwb`` or ``movement``."""
     suffix = path.suffix.lower()
+    output = pose_output(path.name)
+    if output is not None and isinstance(output[1], str):  # DeepLabCut's, but not poses
+        raise InputError(output[1], path)
     by_suffix = {".nc": "movement", ".slp": "sleap", ".nwb": "nwb"}
     if suffix in by_suffix:
         return by_suffix[suffix]
@@ -318,6 +323,8 @@ def _source(path: Path) -> str:
             first = fh.readline().strip().lower()
         if first.startswith("scorer,,"):  # the index is folder, video and image: 3 columns
             raise InputError(_LABELLED, path)
+        if is_sleap_csv(first):
+            return "sleap"
         # DeepLabCut's first header row names the scorer; Lightning Pose writes the same table
         return "dlc" if first.startswith("scorer") else "lp"
     import h5py
@@ -494,6 +501,8 @@ def _load_dataset(path: Path, source: str, fps: float | None):
                 _check_sizes_table(df, path)
                 ds = PoseTable(dlc_inputs(df, fps))
                 return ds, _own_frames(df.index, len(df))
+            if suffix == ".csv" and source == "sleap":  # movement reads SLEAP's HDF5 only
+                return sleap_csv_dataset(path, fps), None
             return load_dataset(path, source_software=_SOURCES[source], fps=fps), None
     except InputError:
         raise
