@@ -26,7 +26,8 @@ from perception.landmarks import LandmarkParams
 from perception.validation import NonNegative, Positive, Tuple, declared
 
 __all__ = ["MIN_SAMPLES", "OBJECT_WORDS",
-           "MarkerMap", "Movement", "Reach", "ReachParams", "Unscored", "ever_seen"]
+           "MarkerMap", "Movement", "Reach", "ReachParams", "Unscored", "digit_number",
+           "ever_seen"]
 
 #: Fewest samples a trial needs to be searched for reaches (the low-pass filter's own
 #: need is 3 x its order + 1 per seen stretch), and a reach to be scored.
@@ -59,6 +60,33 @@ _SIDE = re.compile(r"^(left|right|l|r)[\s_.:-]|[\s_.:-](left|right|l|r)$|"
                    r"^(l|r)(?=thumb|index|finger|wrist|wr[ab]|hand)", re.IGNORECASE)
 #: Words of the digits a hand is told by.
 _DIGITS = ("thumb", "index", "finger")
+#: A digit by its anatomical number, a word of the name: ``right_d1_tip``, ``L.D2``,
+#: ``digit1`` (digit 1 the thumb, digit 2 the index, as hand labs number them).
+_NUMBERED = re.compile(r"(?:^|[\s_.:-])(?:d|digit)([12])(?=$|[\s_.:-])", re.IGNORECASE)
+
+
+def digit_number(name: str) -> int | None:
+    """The digit a marker's name numbers (``right_d1_tip``: 1, the thumb), where it names
+    no digit in words; else None.
+
+    Parameters
+    ----------
+    name : str
+        A marker's name.
+    """
+    numbered = _NUMBERED.search(name)
+    if numbered is None or any(w in name.lower() for w in _DIGITS):
+        return None
+    return int(numbered.group(1))
+
+
+def _says(name: str, *words: str) -> bool:
+    """Whether a marker's name says one of the digit ``words`` (``thumb``, ``index``,
+    ``finger``), in words or by the digit's number (``d1`` the thumb, ``d2`` the index)."""
+    low = name.lower()
+    numbered = _NUMBERED.search(name)
+    number = {"1": ("thumb",), "2": ("index", "finger")}[numbered.group(1)] if numbered else ()
+    return any(w in low or w in number for w in words)
 
 
 def _joint(name: str) -> int:
@@ -76,7 +104,7 @@ def _side(name: str) -> str | None:
 def _one_hand(names: list[str], paths) -> str | None:
     """The side whose hand the digits are taken from where the names say two (None if
     they do not): the one whose thumb and finger markers move farthest, else the right."""
-    sides = {_side(n) for n in names if any(w in n.lower() for w in _DIGITS)} - {None}
+    sides = {_side(n) for n in names if _says(n, *_DIGITS)} - {None}
     if len(sides) < 2:
         return None
     if paths is None:
@@ -84,7 +112,7 @@ def _one_hand(names: list[str], paths) -> str | None:
 
     def travel(side):  # the largest range of a seen digit marker's coordinates (NaN: lost)
         ranges = [float(np.max(np.nanmax(p, axis=0) - np.nanmin(p, axis=0)))
-                  for n in names if _side(n) == side and any(w in n.lower() for w in _DIGITS)
+                  for n in names if _side(n) == side and _says(n, *_DIGITS)
                   and ever_seen(p := np.asarray(paths[n], dtype=float))]
         return max(ranges, default=0.0)
 
@@ -176,7 +204,7 @@ class MarkerMap:
             names = [n for n in names if _side(n) in (None, hand)]
 
         def pick(*words):
-            hits = [n for n in names if any(w in low[n] for w in words)]
+            hits = [n for n in names if _says(n, *words)]
             # a marker seen before one never seen, then a tip before another point, then
             # one not numbered (index beside index2), then the most distal of numbered
             # points (OpenPose's thumb_1 ... thumb_4: 4 the tip)

@@ -81,6 +81,7 @@ from perception.reach_data import (
     Reach,
     ReachParams,
     Unscored,
+    digit_number,
     ever_seen,
 )
 from perception.reach_plane import PlaneFit, ReachTracks, fit_plane, reach_tracks
@@ -158,6 +159,10 @@ def trial_reaches(trial, markers: MarkerMap | None = None,
         notes += [f"marker {m!r} is never seen: not taken as the {role}"
                   for m, role in MarkerMap.guess(list(trial.markers)).roles()
                   if m not in used and not ever_seen(trial.markers[m])]
+        # a digit told by its number, not its name, is said (d1 the thumb, d2 the index)
+        notes += [f"marker {m!r} taken as the {role} (digit {digit_number(m)})"
+                  for m, role in markers.roles() if role in ("thumb", "finger")
+                  and digit_number(m) is not None]
     markers = markers.matched(trial.markers)
     markers.check(trial.markers, trial.source)
     source = str(trial.source)

@@ -12,9 +12,18 @@ docs/mocap-formats.md, "Where the layouts came from"), with numbers of its own:
   ``FP1.C3D``, whose POINT:UNITS is ``'mete'`` (metres cut to 4 characters);
   SGI (MIPS) files and files ezc3d finds not standard, refused in ezc3d's words
   meant for its own users;
+- Rofunc's OptiTrack Motive take (``Take 2023-03-29 06.23.40 PM.csv``): rigid
+  bodies, their Rigid Body Markers, and the same markers again as Markers
+  (measured), under the same names;
 - a Qualisys QTM export of analysis data (``DATA_INCLUDED Angle``), as beside
   the 3D exports of reiv27/biomechanics;
 - DeepLabCut's example ``..._skeleton.csv`` (``analyzeskeleton``: bone lengths);
+- pyomeca's ``markers_without_header.csv``: a Vicon Nexus Trajectories block
+  without its header lines (frame, sub frame, then X, Y, Z per marker), and
+  lab tables of numbers that start with a frame counter and a time;
+- Anipose tables of a hand whose digits are numbered, as hand labs name them
+  (``left_wrist_x, ..., left_d1_knuckle_x, ..., right_d2_tip``: digit 1 the
+  thumb, digit 2 the index; a reach-to-grasp project's MATLAB scripts);
 - SLEAP's analysis CSV (its test file
   ``minimal_instance.000_centered_pair_low_quality.analysis.csv``: ``track,
   frame_idx, instance.score, NODE.x, NODE.y, NODE.score``), which movement does
@@ -34,6 +43,8 @@ from _cli import hammer_here
 
 from perception.errors import InputError
 from perception.io.mocap import read_mocap, table_layout
+from perception.io.mocap_tables import leading_columns
+from perception.io.mocap_text import table_text
 
 KEYS = "DataRate,CameraRate,NumFrames,NumMarkers,Units,OrigDataRate,OrigDataStartFrame," \
        "OrigNumFrames"
@@ -79,6 +90,86 @@ def test_a_trc_file_saved_as_csv_is_told_by_its_first_line(tmp_path):
     assert table_layout(path) == "trc"
     (trial,) = read_mocap(path)
     np.testing.assert_allclose(trial.markers["wrist"][0], [0.2, 0.2005, 0.3])
+
+
+def _counted(path, lead, n=6):
+    """Numbers only: ``lead`` (frame; frame, sub frame; frame, time) then two markers'
+    X, Y, Z in mm."""
+    rows = []
+    for i in range(n):
+        first = {"frame": [i + 1], "sub": [i + 1, 0], "time": [i + 1, f"{i / 100:.3f}"]}[lead]
+        rows.append(",".join(map(str, first + [10.5 + i, 20, 30, 110, 120 + i, 130])) + ",")
+    path.write_text("\n".join(rows) + "\n")
+    return path
+
+
+@pytest.mark.parametrize("lead, kinds", [("frame", ("frame",)), ("sub", ("frame", "sub frame")),
+                                         ("time", ("frame", "time"))])
+def test_a_table_of_numbers_led_by_a_frame_counter_is_read(tmp_path, lead, kinds):
+    path = _counted(tmp_path / "markers_without_header.csv", lead)
+    assert table_layout(path) == "headerless"
+    assert leading_columns(table_text(path), len(kinds)) == kinds
+    with pytest.raises(InputError, match=rf"{len(kinds) + 6} columns \(a frame counter") as err:
+        read_mocap(path, rate=100)
+    assert err.value.field == "columns" and "X, Y, Z for each of 2 markers" in str(err.value)
+    (trial,) = read_mocap(path, columns="a,b", rate=None if lead == "time" else 100)
+    np.testing.assert_allclose(trial.markers["b"][2], [0.11, 0.122, 0.13])
+    np.testing.assert_allclose(trial.time, np.arange(6) / 100, atol=1e-12)
+    assert any(f"read as the {' and '.join(kinds)}" in note for note in trial.notes)
+
+
+def test_a_table_of_numbers_whose_first_column_does_not_count_is_refused(tmp_path):
+    path = tmp_path / "odd.csv"
+    path.write_text("\n".join(f"{v},10,20,30" for v in (3.5, 1.25, 7.0)) + "\n")
+    assert table_layout(path) is None
+
+
+def test_a_motive_rigid_body_marker_and_the_marker_it_solves_are_told_apart(tmp_path):
+    types = ["Rigid Body"] * 7 + ["Rigid Body Marker"] * 3 + ["Marker"] * 3
+    names = ["Box"] * 7 + ["Box:Marker1"] * 6
+    parts = ["Rotation"] * 4 + ["Position"] * 9
+    axes = list("XYZW") + list("XYZ") * 3
+    lines = ["Format Version,1.23,Take Name,Take 2023-03-29 06.23.40 PM,Capture Frame Rate,"
+             "120.000000,Export Frame Rate,120.000000,Rotation Type,Quaternion,Length Units,"
+             "Millimeters,Coordinate Space,Global", "",
+             ",Type," + ",".join(types), ",Name," + ",".join(names),
+             ",ID," + ",".join(["7264DAA5"] * 10 + ['"C5B98015"'] * 3),
+             ",," + ",".join(parts), "Frame,Time (Seconds)," + ",".join(axes)]
+    lines += [f"{i},{i / 120:.6f},0,0,0,1,100,200,300,110,210,310,111,211,311" for i in range(4)]
+    path = tmp_path / "Take 2023-03-29 06.23.40 PM.csv"
+    path.write_text("\n".join(lines) + "\n")
+    (trial,) = read_mocap(path)
+    assert trial.marker_names() == ("Box", "Marker1 (rigid body)", "Marker1")
+    np.testing.assert_allclose(trial.markers["Marker1"][0], [0.111, 0.211, 0.311])
+    np.testing.assert_allclose(trial.markers["Marker1 (rigid body)"][0], [0.11, 0.21, 0.31])
+    assert any("the Marker keeps the name" in note for note in trial.notes)
+
+
+def test_digits_named_by_their_number_are_guessed_on_the_hand_that_moves(tmp_path):
+    from perception.reach_data import MarkerMap
+
+    parts = [f"{side}_{p}" for side in ("left", "right")
+             for p in ("wrist", "d1_knuckle", "d1_tip", "d2_tip", "d5_tip")]
+    header = [f"{p}_{a}" for p in parts for a in ("x", "y", "z", "error", "ncams", "score")]
+    rows = []
+    for i in range(100):  # the right hand reaches 300 mm in 0.6 s between rests; the left stays
+        u = min(max((i - 20) / 60, 0), 1)
+        x = 300 * (10 * u**3 - 15 * u**4 + 6 * u**5)
+        opening = 40 * np.sin(np.pi * u)  # the digits open and close on the way
+        rows.append([v for p in parts for v in (
+            (x if p.startswith("right") else 0) + 5 * parts.index(p),
+            100 + (opening if p.endswith("d2_tip") else 0), 50, 0.5, 3, 0.9)])
+    path = tmp_path / "reach01.csv"
+    path.write_text("\n".join([",".join(header + ["fnum"])]
+                              + [",".join(map(str, r + [i])) for i, r in enumerate(rows)]) + "\n")
+    (trial,) = read_mocap(path, rate=100, units="mm")
+    guess = MarkerMap.guess(trial.markers)
+    assert (guess.thumb, guess.finger, guess.wrist) == ("right_d1_tip", "right_d2_tip",
+                                                        ("right_wrist",))
+    from perception.reaches import trial_reaches
+
+    (reach,), _ = trial_reaches(trial)  # the right hand's 300 mm
+    assert "marker 'right_d1_tip' taken as the thumb (digit 1)" in reach.notes
 
 
 ezc3d = pytest.importorskip("ezc3d", reason="the 'mocap' extra")

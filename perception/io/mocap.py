@@ -29,6 +29,7 @@ from perception.io.mocap_dlc3d import is_dlc3d, read_dlc3d
 from perception.io.mocap_qtm import is_qtm, read_qtm
 from perception.io.mocap_stream import stream_xyz_table
 from perception.io.mocap_tables import (
+    leading_columns,
     marker_columns,
     read_headerless,
     read_xyz_table,
@@ -94,7 +95,8 @@ def _sniff(text: TableText) -> str | None:
         return "xyz-table"
     while cells and not cells[-1]:
         cells.pop()
-    if cells and all(is_number(c) for c in cells) and len(cells) % 3 == 0:
+    if cells and all(is_number(c) for c in cells) and (
+            len(cells) % 3 == 0 or leading_columns(text, len(cells) % 3)):
         return "headerless"
     return None
 

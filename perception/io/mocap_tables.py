@@ -38,7 +38,8 @@ from perception.io.mocap_trial import (
     unique_name,
 )
 
-__all__ = ["marker_columns", "no_clock", "read_headerless", "read_xyz_table", "table_trials"]
+__all__ = ["leading_columns", "marker_columns", "no_clock", "read_headerless", "read_xyz_table",
+           "table_trials"]
 
 TIME = re.compile(r"(?:t|time|times|timestamp)(?:[\s_]*[(\[]?(s|sec|secs|seconds|ms|msec)[)\]]?)?",
                   re.IGNORECASE)
@@ -543,6 +544,51 @@ def headerless_width(text: TableText) -> tuple[int, int]:
     return full, len(fields)
 
 
+#: Data lines looked at to tell a headerless table's leading columns.
+_LEADING_SAMPLE = 50
+
+
+def leading_columns(text: TableText, count: int) -> tuple[str, ...] | None:
+    """The ``count`` (1 or 2) columns before the markers' X, Y, Z of a headerless table, as
+    lab exports write them (a Vicon Nexus block without its header, pyomeca's
+    ``markers_without_header.csv``): ``("frame",)``, ``("frame", "sub frame")`` or
+    ``("frame", "time")``, told from its first lines; None when they are not those.
+
+    The frame column holds whole numbers in steps of 1; a sub frame column one value
+    throughout; a time column increasing values.
+
+    Parameters
+    ----------
+    text : TableText
+        The table.
+    count : int
+        Columns before the markers' (the first line's fields modulo 3).
+    """
+    if count not in (1, 2):
+        return None
+    sep = delimiter(text.first)
+    rows = [split(line, sep)[:count] for line in text.lines[text.skip:text.skip + _LEADING_SAMPLE]
+            if line.strip()]
+    try:
+        values = np.array([[float(c) for c in row] for row in rows if len(row) == count])
+    except ValueError:
+        return None
+    if len(values) < 2 or len(values) < len(rows) or not (np.diff(values[:, 0]) == 1).all() \
+            or (values[:, 0] != np.round(values[:, 0])).any():
+        return None
+    if count == 1:
+        return ("frame",)
+    second = values[:, 1]
+    if (second == second[0]).all():
+        return ("frame", "sub frame")
+    return ("frame", "time") if (np.diff(second) > 0).all() else None
+
+
+def _leading_words(kinds: tuple[str, ...]) -> str:
+    return {("frame",): "a frame counter", ("frame", "sub frame"): "a frame counter, sub frames",
+            ("frame", "time"): "a frame counter, a time column"}[kinds]
+
+
 def read_headerless(path: Path, source: str, text: TableText, rate, units, trial_column,
                     time_column, columns) -> list[MocapTrial]:
     """A table of numbers with no header: X, Y, Z per marker, named by ``columns``.
@@ -559,16 +605,19 @@ def read_headerless(path: Path, source: str, text: TableText, rate, units, trial
         As :func:`perception.io.mocap.read_mocap` takes them.
     """
     full, width = headerless_width(text)
+    kinds = leading_columns(text, width % 3) or ()
     if columns is None:
         per = ("X, Y, Z for each of " f"{width // 3} markers" if width % 3 == 0
-               else "not a multiple of 3 (X, Y, Z per marker)")
+               else f"{_leading_words(kinds)} and X, Y, Z for each of {width // 3} markers"
+               if kinds else "not a multiple of 3 (X, Y, Z per marker)")
         raise InputError(f"a table without a header row, {width} columns ({per}): name its "
                          "markers in column order with `columns` NAME,NAME,...", path,
                          field="columns")
     names = marker_list(columns, path)
     if 3 * len(names) == full:
         width = full
-    if 3 * len(names) != width:
+    lead = len(kinds) if kinds and 3 * len(names) + len(kinds) == width else 0
+    if 3 * len(names) + lead != width:
         raise InputError(f"`columns` names {len(names)} markers, {3 * len(names)} columns "
                          f"(X, Y, Z each); the table has {width} columns", path,
                          field="columns")
@@ -578,7 +627,8 @@ def read_headerless(path: Path, source: str, text: TableText, rate, units, trial
     if time_column is not None and not no_clock(time_column):
         raise InputError(f"a table without a header row has no column {time_column!r}: its "
                          "samples are timed by `rate`", path, field="time_column")
-    if rate is None:
+    time_col = "time" if lead and "time" in kinds and not no_clock(time_column) else None
+    if rate is None and time_col is None:
         raise InputError("a table without a header row has no time column: give the sampling "
                          "rate (samples/s) with `rate`", path, field="rate")
     sep = delimiter(text.first)
@@ -589,11 +639,15 @@ def read_headerless(path: Path, source: str, text: TableText, rate, units, trial
                          field="columns")
     for k in range(df.shape[1], width):  # a last marker lost throughout: empty cells
         df[k] = np.nan
-    df.columns = [f"{n} {a}" for n in names for a in "XYZ"]
+    df.columns = [*kinds[:lead], *(f"{n} {a}" for n in names for a in "XYZ")]
     groups = {n: tuple(f"{n} {a}" for a in "XYZ") for n in names}
     notes = list(text.notes) + [f"no header row: columns read as X, Y, Z of "
                                 f"{', '.join(names)} (`columns`)"]
+    if lead:
+        said = " and ".join(kinds[:lead])
+        notes.append(f"the first {lead} column{'s' if lead > 1 else ''} read as the {said}"
+                     f"{', the clock' if time_col else ''}, not markers")
     if decimal == ",":
         notes.append("decimal commas read")
-    return table_trials(path, source, df, groups, None, None, rate, units, None, notes,
+    return table_trials(path, source, df, groups, time_col, None, rate, units, None, notes,
                         extra=False)

@@ -14,8 +14,10 @@ pathviewr's ``read_motive_csv`` (rOpenSci) parses it::
     Frame,Time (Seconds),X,Y,Z,X,...
     0,0.000000,102.5,208.3,-3.7,...     <- an empty cell is a lost sample
 
-A marker's (and a rigid-body marker's) position is read under its name; a
-rigid body's position (its pivot) as a marker named after the body; the
+A marker's (and a rigid-body marker's) position is read under its name (a
+rigid-body marker also exported as a measured marker of that name is
+``NAME (rigid body)``); a rigid body's position (its pivot) as a marker named
+after the body; the
 rotations, marker qualities and mean marker errors are not read. The rate is
 the export's (``Export Frame Rate``), the unit ``Length Units``, and the time
 column (``Time (Seconds)``) is the clock.
@@ -51,6 +53,25 @@ def _read_type(kind: str) -> bool:
     """Whether columns of this Motive type hold a marker position that is read."""
     kind = kind.strip().lower()
     return kind == "rigid body" or kind.endswith("marker")
+
+
+def _names(entries: dict[tuple, dict], notes: list[str]) -> list[str]:
+    """Each entry's name; a rigid body's marker written under a marker's name too is named
+    apart (Motive exports a rigid body's markers where its solve puts them, and the same
+    markers as measured: ``Rigid Body Marker`` and ``Marker`` columns of one name)."""
+    measured = {name for kind, name, _ in entries if kind.strip().lower() == "marker"}
+    names, both = [], []
+    for kind, name, _ in entries:
+        if kind.strip().lower() == "rigid body marker" and name in measured:
+            both.append(name)
+            name = f"{name} (rigid body)"
+        names.append(name)
+    if both:
+        more = f" (and {len(both) - 1} more)" if len(both) > 1 else ""
+        notes.append(f"{both[0]!r}{more} written as a Marker (as measured) and as a Rigid Body "
+                     f"Marker (where the rigid body's solve puts it): the Marker keeps the "
+                     f"name, the other is read as {both[0] + ' (rigid body)'!r}")
+    return names
 
 
 def read_motive(path: Path, source: str, text: TableText, rate, units, trial_column,
@@ -101,7 +122,7 @@ def read_motive(path: Path, source: str, text: TableText, rate, units, trial_col
     notes = list(text.notes)
     if skipped:
         notes.append(f"{', '.join(sorted(skipped))} columns not read")
-    used, more = strip_subject([key[1] for key in entries])
+    used, more = strip_subject(_names(entries, notes))
     notes += more
     df = load(path, text.raw, sep, axis_at + 1, None)
     df.columns = [f"c{j}" for j in range(df.shape[1])]
