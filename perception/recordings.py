@@ -361,6 +361,9 @@ def iter_recording(path, options: MocapImport | None = None
     # a unit or a rate no human hand fits is every trial's: said before any reach is sought
     read = iter(trials)
     first = list(itertools.islice(read, SCALE_TRIALS))
+    if first:  # no hand's markers: said before the hand's pace (a gait trial's walk is long)
+        mapped = options.markers or MarkerMap.guess(first[0].markers)
+        mapped.matched(first[0].markers).check(first[0].markers, path)
     check_scale(first, path, options)
     for trial in itertools.chain(first, read):
         count += 1

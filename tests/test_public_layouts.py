@@ -9,7 +9,9 @@ docs/mocap-formats.md, "Where the layouts came from"), with numbers of its own:
   empty cells to the widest, a row of empty cells under the X1 Y1 Z1 row);
 - the C3D samples of c3d.org (as BTKData keeps them): ``Eb015vi.c3d``, a DEC
   (VAX) file whose header floats are DEC floats, and Peak Performance's
-  ``FP1.C3D``, whose POINT:UNITS is ``'mete'`` (metres cut to 4 characters);
+  ``FP1.C3D``, whose POINT:UNITS is ``'mete'`` (metres cut to 4 characters) and
+  whose markers (PT00 ... PT07, a gait trial) move for 8 s on end: no hand's
+  markers, said as such, not as a wrong rate;
   SGI (MIPS) files and files ezc3d finds not standard, refused in ezc3d's words
   meant for its own users;
 - Rofunc's OptiTrack Motive take (``Take 2023-03-29 06.23.40 PM.csv``): rigid
@@ -170,6 +172,21 @@ def test_digits_named_by_their_number_are_guessed_on_the_hand_that_moves(tmp_pat
 
     (reach,), _ = trial_reaches(trial)  # the right hand's 300 mm
     assert "marker 'right_d1_tip' taken as the thumb (digit 1)" in reach.notes
+
+
+def test_a_recording_of_no_hand_says_so_before_judging_its_pace(tmp_path, capsys):
+    """Peak Performance's FP1.C3D: 8 markers walking for 8 s without a pause."""
+    t = np.arange(480) / 60
+    header = ["time"] + [f"PT0{k}_{a}" for k in range(8) for a in "XYZ"]
+    rows = [[f"{s:.4f}"] + [f"{v:.4f}" for k in range(8)
+                            for v in (1.2 * s + 0.1 * k, 0.4 + 0.05 * np.sin(6 * s), 0.8)]
+            for s in t]
+    path = tmp_path / "FP1.csv"
+    path.write_text("\n".join([",".join(header)] + [",".join(r) for r in rows]) + "\n")
+    ran = hammer_here(capsys, "landmarks", path, "--units", "m", "-o", tmp_path / "lm.csv")
+    assert ran.returncode == 2
+    assert "--markers: no marker 'thumb' for the thumb (the recording has PT00" in ran.stderr
+    assert "--rate" not in ran.stderr
 
 
 ezc3d = pytest.importorskip("ezc3d", reason="the 'mocap' extra")
