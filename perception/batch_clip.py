@@ -23,9 +23,8 @@ from typing import TYPE_CHECKING, BinaryIO, NamedTuple
 
 import numpy as np
 
-from perception.discovery import BatchItem
+from perception.discovery import BatchItem, batch_file
 from perception.errors import HammerMVError
-from perception.io.files import input_file
 from perception.io.frame_sample import FrameSample
 from perception.io.names import output_folder, output_stem
 from perception.pipeline import (
@@ -628,8 +627,7 @@ def process_clip(item: BatchItem, out: Path, repertoire: Repertoire,
         status, reason = item.unscored
         return ClipResult(**base, status=status, reason=reason)
     try:
-        # before hashing: a FIFO or device would never end
-        input_file(item.path, "clip", empty=False)
+        batch_file(item.path)  # before hashing: a FIFO or device would never end
         fp = clip_fingerprint(item.path, settings, repertoire_id + (
             f"#reach{item.reach}" if item.reach is not None else ""))
         done = _current_report(item, out, fp, figure_format, dpi)

@@ -29,8 +29,8 @@ if TYPE_CHECKING:
     from perception.reaches import Reach
 
 __all__ = ["COMPANION_NAMES", "ERRORS_LOG", "REPORT_SET", "BatchItem", "Discovery",
-           "check_clip_name", "discover", "expand_recordings", "find_clips", "recording_items",
-           "safe_clip_name", "stream_recordings"]
+           "batch_file", "check_clip_name", "discover", "expand_recordings", "find_clips",
+           "recording_items", "safe_clip_name", "stream_recordings"]
 
 log = logging.getLogger(__name__)
 
@@ -156,6 +156,21 @@ def _from_manifest(source: Path) -> list[BatchItem]:
                         if c not in ("clip", "video", "condition"))
         items.append(BatchItem(clip, path, clip_name(path)[1], cond, factors=factors))
     return sorted(items, key=lambda i: i.clip)
+
+
+def batch_file(path: Path) -> None:
+    """Refuse a clip's file that a batch cannot read, in one line: missing, not a regular
+    file, empty, or of no kind a batch reads (a manifest can name one; a folder's are
+    skipped before), listing every kind it reads, recordings too.
+
+    Parameters
+    ----------
+    path : Path
+        The file a batch item names.
+    """
+    input_file(path, "clip", empty=False)
+    if clip_name(path)[1] == "unknown":
+        raise InputError(f"not a {files_taken('batch')}", path)
 
 
 @dataclass(frozen=True)

@@ -171,8 +171,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"{line} -> {args.output}", file=sys.stdout)
         print(trial_summary(found.trials, len(movements) - len(missed), len(missed)),
               file=sys.stdout)
-    for m in missed:  # always: none dropped
-        print(f"{m.trial}: not scored: {flag_text(m.reason)}", file=sys.stderr)
+    for m in missed:  # always: none dropped; by the clip, as the table and a batch name it
+        print(f"{m.clip}: not scored: {flag_text(m.reason)}", file=sys.stderr)
     return 1 if missed else 0
 
 
