@@ -63,3 +63,33 @@ def test_a_manifest_row_of_no_kind_says_every_kind_batch_reads(tmp_path, capsys)
     assert why.endswith("notes.txt: not a video, tracks file, pose file or motion-capture "
                         "recording"), why
     assert summary.loc["pilot", "status"] != "failed"  # the batch went on past the bad row
+
+
+def test_a_c3d_description_over_127_characters_is_refused_before_ezc3d(tmp_path):
+    """c3d.org's BKINtechnologies.c3d (a description of 163 characters) and
+    bad_parameter_section.c3d (a length byte of 211 where an offset is wrong): ezc3d reads
+    the byte as signed and asked for about 4 GB (12.4 GB held by the batch that read one;
+    a batch and a landmarks run at once were killed for memory). Refused first, naming
+    the parameter; a file of short descriptions is read as before."""
+    import pytest
+
+    ezc3d = pytest.importorskip("ezc3d", reason="the 'mocap' extra")
+    from perception.errors import InputError
+    from perception.io.mocap import read_mocap
+
+    path = tmp_path / "kinarm.c3d"
+    c3d = ezc3d.c3d()
+    c3d["parameters"]["POINT"]["RATE"]["value"] = [100]
+    c3d["parameters"]["POINT"]["LABELS"]["value"] = ("thumb", "index")
+    c3d["data"]["points"] = np.ones((4, 2, 10))
+    c3d.write(str(path))
+    data = bytearray(path.read_bytes())
+    start = (data[0] - 1) * 512
+    at = data.index(b"POINT", start)  # the POINT group: its offset (2 bytes), its description
+    assert data[at + 7] < 128  # as ezc3d writes it
+    assert len(read_mocap(path)) == 1
+    data[at + 7] = 164  # as BKIN's EXPERIMENT:SESSION, 0xA4: -92 to ezc3d
+    path.write_bytes(bytes(data))
+    with pytest.raises(InputError, match="the description of POINT is 164 characters long") as e:
+        read_mocap(path)
+    assert "not a readable C3D file" in str(e.value) and "kinarm.c3d" in str(e.value)

@@ -105,6 +105,47 @@ def _stated_frames(path: Path) -> tuple[int, int] | None:
     return stated, held
 
 
+def _negative_length(path: Path) -> tuple[str, int] | None:
+    """The first group or parameter, walked as ezc3d walks them, whose description length
+    byte is 128 or more, with that length: ezc3d reads the byte as signed and asks for
+    4 GB less the length (12 GB held for c3d.org's BKINtechnologies.c3d), or None."""
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(2)
+            if len(head) < 2 or not head[0]:
+                return None
+            fh.seek((head[0] - 1) * 512)
+            section = fh.read(255 * 512)  # the most blocks its header can count
+    except OSError:
+        return None
+    if len(section) < 4 or section[3] == _BIG_ENDIAN:  # refused by ezc3d before
+        return None
+    groups: dict[int, str] = {}
+    pos = 4
+    while pos + 4 <= len(section):
+        chars, gid = struct.unpack_from("<bb", section, pos)
+        if not chars:  # the end of the section
+            return None
+        at = pos + 2 + abs(chars)  # the offset to the next entry, from here
+        name = section[pos + 2:at].decode("latin-1")
+        (step,) = struct.unpack_from("<H", section, at) if at + 2 <= len(section) else (0,)
+        end = at + 2
+        if gid < 0:
+            groups[-gid] = name
+        elif end + 2 <= len(section):
+            size, dims = struct.unpack_from("<bb", section, end)
+            shape = section[end + 2:end + 2 + max(dims, 0)]
+            end += 2 + max(dims, 0) + abs(size) * int(np.prod(list(shape), dtype=np.int64))
+        if end >= len(section):
+            return None
+        if section[end] > 127:
+            return (name if gid < 0 else f"{groups.get(gid, gid)}:{name}"), section[end]
+        if not step:
+            return None
+        pos = at + step
+    return None
+
+
 def read_c3d(path: Path, source: str, rate, units) -> list[MocapTrial]:
     """A C3D file's marker points.
 
@@ -121,6 +162,11 @@ def read_c3d(path: Path, source: str, rate, units) -> list[MocapTrial]:
         import ezc3d
     except ImportError:
         raise InputError(_MOCAP_EXTRA, path) from None
+    if (long := _negative_length(path)) is not None:
+        raise InputError(f"not a readable C3D file (the description of {long[0]} is "
+                         f"{long[1]} characters long by its length byte: ezc3d, the C3D "
+                         "reader, reads a length over 127 as negative and would ask for "
+                         "gigabytes of memory)", path)
     try:
         c3d = ezc3d.c3d(os.fspath(path))
     except (OSError, RuntimeError, ValueError, IndexError) as exc:
