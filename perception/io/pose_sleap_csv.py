@@ -74,18 +74,18 @@ def sleap_csv_dataset(path: Path, fps: float | None):
             or (frame != np.round(frame)).any():
         raise InputError("frame_idx: expected the frames' numbers, whole numbers from 0", path)
     track = df["track"].fillna("").astype(str).str.strip().replace("", UNTRACKED).to_numpy()
-    twice = pd.Series(list(zip(track, frame))).duplicated()
+    twice = pd.DataFrame({"track": track, "frame": frame}).duplicated().to_numpy()
     if twice.any():
-        row = int(np.flatnonzero(twice.to_numpy())[0])
+        row = int(np.argmax(twice))
         what = ("instances without a track: which is which from frame to frame is not known; "
                 "track them in SLEAP" if track[row] == UNTRACKED else
                 f"instances of track {track[row]!r}")
         raise InputError(f"frame {int(frame[row])} holds two {what}", path)
-    names = list(dict.fromkeys(track))
+    who, names = pd.factorize(track)  # the tracks in the order they first appear
+    names = list(names)
     frame = frame.astype(int)
     position = np.full((frame.max() + 1, 2, len(nodes), len(names)), np.nan)
     confidence = np.full((frame.max() + 1, len(nodes), len(names)), np.nan)
-    who = np.array([names.index(t) for t in track])
     for k, node in enumerate(nodes):
         position[frame, 0, k, who] = pd.to_numeric(df[f"{node}.x"], errors="coerce")
         position[frame, 1, k, who] = pd.to_numeric(df[f"{node}.y"], errors="coerce")
