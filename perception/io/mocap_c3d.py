@@ -12,6 +12,7 @@ import os
 import struct
 from collections.abc import Mapping
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -70,32 +71,47 @@ def _labels(point: Mapping) -> list[str]:
     return [str(x).strip() for x in labels]
 
 
-def _stated_frames(path: Path) -> tuple[int, int] | None:
-    """``(frames the header states, frames whose bytes the file holds)``, or None if unknown.
+class _Bytes(NamedTuple):
+    """What the checks before ezc3d read of a C3D file: its header (the first 512 bytes),
+    its size, and its parameter section (at most the 255 blocks its header can count)."""
 
-    The header (C3D's first 512 bytes) gives the parameter block, the point
-    and analog counts per frame, the first and last frame, the scale (negative:
-    floats) and the block where the data start.
-    """
+    head: bytes
+    size: int
+    section: bytes
+
+
+def _file_bytes(path: Path) -> _Bytes | None:
+    """The header, size and parameter section of a C3D file, read once; None if it cannot
+    be read or its header is too short."""
     try:
         with open(path, "rb") as fh:
             head = fh.read(512)
-            fh.seek(0, os.SEEK_END)
-            size = fh.tell()
             if len(head) < 24:
                 return None
-            fh.seek(max(head[0] - 1, 0) * 512 + 3)
-            processor = fh.read(1)
+            fh.seek(max(head[0] - 1, 0) * 512)
+            section = fh.read(255 * 512)
+            size = fh.seek(0, os.SEEK_END)
     except OSError:
         return None
-    kind = processor[0] if processor else None
+    return _Bytes(head, size, section)
+
+
+def _stated_frames(raw: _Bytes) -> tuple[int, int] | None:
+    """``(frames the header states, frames whose bytes the file holds)``, or None if unknown.
+
+    The header gives the parameter block, the point and analog counts per
+    frame, the first and last frame, the scale (negative: floats) and the
+    block where the data start.
+    """
+    head, size = raw.head, raw.size
+    kind = raw.section[3] if len(raw.section) > 3 else None
     order = ">" if kind == _BIG_ENDIAN else "<"
     points, analogs, first, last = struct.unpack(order + "HHHH", head[2:10])
     (data_start,) = struct.unpack(order + "H", head[16:18])
-    raw = head[12:16]
+    word = head[12:16]
     if kind == _DEC:  # a VAX F float: its two 16-bit words swapped, and 4 times the value
-        raw = raw[2:] + raw[:2]  # (read as IEEE, its sign is a bit of the mantissa)
-    (scale,) = struct.unpack(order + "f", raw)
+        word = word[2:] + word[:2]  # (read as IEEE, its sign is a bit of the mantissa)
+    (scale,) = struct.unpack(order + "f", word)
     stated = last - first + 1
     width = 4 if scale < 0 else 2  # bytes per value
     frame_bytes = (4 * points + analogs) * width
@@ -105,19 +121,13 @@ def _stated_frames(path: Path) -> tuple[int, int] | None:
     return stated, held
 
 
-def _negative_length(path: Path) -> tuple[str, int] | None:
+def _negative_length(raw: _Bytes) -> tuple[str, int] | None:
     """The first group or parameter, walked as ezc3d walks them, whose description length
     byte is 128 or more, with that length: ezc3d reads the byte as signed and asks for
     4 GB less the length (12 GB held for c3d.org's BKINtechnologies.c3d), or None."""
-    try:
-        with open(path, "rb") as fh:
-            head = fh.read(2)
-            if len(head) < 2 or not head[0]:
-                return None
-            fh.seek((head[0] - 1) * 512)
-            section = fh.read(255 * 512)  # the most blocks its header can count
-    except OSError:
+    if not raw.head[0]:
         return None
+    section = raw.section
     if len(section) < 4 or section[3] == _BIG_ENDIAN:  # refused by ezc3d before
         return None
     groups: dict[int, str] = {}
@@ -162,7 +172,8 @@ def read_c3d(path: Path, source: str, rate, units) -> list[MocapTrial]:
         import ezc3d
     except ImportError:
         raise InputError(_MOCAP_EXTRA, path) from None
-    if (long := _negative_length(path)) is not None:
+    raw = _file_bytes(path)
+    if raw is not None and (long := _negative_length(raw)) is not None:
         raise InputError(f"not a readable C3D file (the description of {long[0]} is "
                          f"{long[1]} characters long by its length byte: ezc3d, the C3D "
                          "reader, reads a length over 127 as negative and would ask for "
@@ -179,7 +190,7 @@ def read_c3d(path: Path, source: str, rate, units) -> list[MocapTrial]:
         raise InputError("no marker points: POINT:USED is 0 (the file holds other data only: "
                          "analog channels, forces or rotations)",
                          path, field="POINT:USED")
-    counts = _stated_frames(path)
+    counts = None if raw is None else _stated_frames(raw)
     if counts is not None and min(counts[1], points.shape[2]) < counts[0]:
         held = min(counts[1], points.shape[2])
         if held == 0:
